@@ -1,0 +1,36 @@
+# Everything a fresh machine needs: `make run` (the main job) and `make test`.
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+REPLAY := $(VENV)/bin/replay
+STAMP  := $(VENV)/.installed
+OUT    ?= out
+
+# the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md
+SCENARIOS ?= $(wildcard scenarios/stick_*.yaml)
+
+.PHONY: install run test bench golden-check clean
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[test]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+run: $(STAMP)
+	@for s in $(SCENARIOS); do $(REPLAY) run $$s -o $(OUT)/logs/$$(basename $$s .yaml).mcap || exit $$?; done
+	$(REPLAY) figures $(OUT)/logs/*.mcap -o $(OUT)/figures
+	$(REPLAY) claims $(OUT)/logs/*.mcap --markdown $(OUT)/claims.md
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+bench: $(STAMP)
+	$(PY) -m bench
+
+golden-check: $(STAMP)
+	$(REPLAY) golden check
+
+clean:
+	rm -rf $(OUT)

@@ -1,0 +1,276 @@
+"""The ``replay`` command line. Bad input gets one clear line and exit code 2, never a traceback."""
+
+from __future__ import annotations
+
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import click
+
+from replay import registry
+from replay.log import LogError, LogReader
+from replay.papers import PAPERS
+from replay.scenario import ScenarioError, load_scenario
+
+DEFAULT_LOG_DIR = Path("out/logs")
+DEFAULT_FIGURE_DIR = Path("out/figures")
+SCENARIO_DIR = Path("scenarios")
+
+
+def _fail(message: str, code: int = 2) -> None:
+    click.echo(f"error: {message}", err=True)
+    sys.exit(code)
+
+
+class _Progress:
+    """A one-line progress display on a terminal; silent elsewhere or with --quiet."""
+
+    def __init__(self, label: str, enabled: bool) -> None:
+        self.label = label
+        self.enabled = enabled and sys.stderr.isatty()
+
+    def __call__(self, t: float, duration: float) -> None:
+        if self.enabled:
+            frac = min(1.0, t / duration) if duration > 0 else 1.0
+            bar = "#" * int(frac * 30)
+            sys.stderr.write(f"\r{self.label} [{bar:<30}] t = {t:6.3f} / {duration:.3f} s")
+            sys.stderr.flush()
+
+    def done(self) -> None:
+        if self.enabled:
+            sys.stderr.write("\r\x1b[2K")
+            sys.stderr.flush()
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="paper-replay")
+def main() -> None:
+    """paper-replay: re-run landmark high-speed robotics experiments from YAML scenarios."""
+
+
+def _load(path: str, sets=(), seed=None):
+    try:
+        return load_scenario(path, sets=list(sets), seed=seed)
+    except ScenarioError as exc:
+        _fail(str(exc))
+
+
+@main.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("-o", "--out", type=click.Path(dir_okay=False), help="log path "
+              "(default out/logs/NAME.mcap)")
+@click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE",
+              help="override a scenario field (repeatable)")
+@click.option("--seed", type=int, help="override the scenario's seed")
+@click.option("-q", "--quiet", is_flag=True, help="no progress, only errors")
+def run(scenario, out, sets, seed, quiet):
+    """Run SCENARIO and write its MCAP log."""
+    from replay.runner import RunInterrupted, Runner
+    sc = _load(scenario, sets, seed)
+    out = Path(out) if out else DEFAULT_LOG_DIR / f"{sc.name}.mcap"
+    progress = _Progress(sc.name, not quiet)
+    try:
+        result = Runner(sc, progress=progress).run(out)
+    except RunInterrupted as exc:
+        progress.done()
+        click.echo(f"interrupted at t = {exc.result.t_end:.4f} s; partial log kept: "
+                   f"{exc.result.path}", err=True)
+        sys.exit(130)
+    except LogError as exc:
+        progress.done()
+        _fail(str(exc))
+    progress.done()
+    if result.stopped_by == "error":
+        _fail(f"{result.error} at t = {result.t_end:.4f} s; log kept: {result.path}", code=1)
+    if not quiet:
+        events = ", ".join(f"{k} x{n}" for k, n in sorted(result.events.items())) or "none"
+        click.echo(f"{sc.name}: {result.t_end:.3f} s simulated in {result.wall_time:.2f} s "
+                   f"(stopped by {result.stopped_by}); events: {events}")
+        click.echo(f"log: {result.path}")
+
+
+@main.command()
+@click.argument("scenarios", nargs=-1, type=click.Path(dir_okay=False))
+@click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
+def validate(scenarios, sets):
+    """Check scenario files without running them (all of scenarios/ by default)."""
+    paths = scenarios or sorted(str(p) for p in SCENARIO_DIR.glob("*.yaml"))
+    bad = 0
+    for p in paths:
+        try:
+            load_scenario(p, sets=list(sets))
+            click.echo(f"ok: {p}")
+        except ScenarioError as exc:
+            click.echo(f"error: {exc}", err=True)
+            bad += 1
+    if bad:
+        sys.exit(2)
+
+
+@main.command("list")
+@click.option("--plugins", is_flag=True, help="list the installed plug-ins instead")
+def list_(plugins):
+    """The scenarios (name, paper, description), or the plug-ins."""
+    if plugins:
+        for kind in registry.GROUPS:
+            click.echo(f"{kind}s: {', '.join(registry.names(kind)) or '-'}")
+        return
+    for p in sorted(SCENARIO_DIR.glob("*.yaml")):
+        try:
+            sc = load_scenario(p)
+        except ScenarioError as exc:
+            click.echo(f"{p.stem:<28} (invalid: {exc})")
+            continue
+        click.echo(f"{p.stem:<28} {sc.paper:<16} {sc.description}")
+
+
+def _reader(path: str) -> LogReader:
+    try:
+        return LogReader(path)
+    except LogError as exc:
+        _fail(str(exc))
+
+
+@main.command()
+@click.argument("log", type=click.Path(dir_okay=False))
+def info(log):
+    """Summarise a LOG: scenario, topics, counts, duration and events."""
+    r = _reader(log)
+    try:
+        sc = r.scenario()
+        click.echo(f"scenario: {sc['name']} (paper {sc['paper']}, seed {sc['seed']}, "
+                   f"code {sc['version']})")
+    except LogError:
+        click.echo("scenario: (no /scenario message)")
+    t0, t1 = r.time_range()
+    click.echo(f"duration: {t1 - t0:.4f} s simulated{'  [TRUNCATED log]' if r.truncated else ''}")
+    click.echo("topics:")
+    for topic, n in r.topic_counts().items():
+        click.echo(f"  {topic:<28} {n:>8}")
+    events = r.events()
+    click.echo(f"events: {len(events)}")
+    for e in events:
+        data = e.get("data", {})
+        brief = ", ".join(f"{k}={_short(v)}" for k, v in list(data.items())[:6])
+        click.echo(f"  t = {e['t']:8.4f} s  {e['kind']:<12} {brief}")
+
+
+def _short(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if isinstance(v, list):
+        return "[" + ", ".join(_short(x) for x in v[:3]) + (", …" if len(v) > 3 else "") + "]"
+    if isinstance(v, dict):
+        return "{…}"
+    return str(v)
+
+
+def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
+    paths = logs or sorted(str(p) for p in DEFAULT_LOG_DIR.glob("*.mcap"))
+    if not paths:
+        _fail(f"no logs given and none in {DEFAULT_LOG_DIR}/ (run `replay run SCENARIO` first)")
+    by_paper: dict[str, dict[str, LogReader]] = defaultdict(dict)
+    for p in paths:
+        r = _reader(p)
+        try:
+            sc = r.scenario()
+        except LogError as exc:
+            _fail(str(exc))
+        by_paper[sc["paper"]][sc["name"]] = r
+    return by_paper
+
+
+@main.command()
+@click.argument("logs", nargs=-1, type=click.Path(dir_okay=False))
+@click.option("-o", "--out", type=click.Path(file_okay=False), default=str(DEFAULT_FIGURE_DIR),
+              show_default=True)
+def figures(logs, out):
+    """Regenerate the papers' figures (PNG and SVG) from LOGS (default: out/logs/*.mcap)."""
+    for paper, readers in _logs_by_paper(logs).items():
+        try:
+            make = registry.load("figures", paper)
+        except registry.UnknownPlugin:
+            click.echo(f"{paper}: no figures defined yet ({', '.join(readers)})", err=True)
+            continue
+        for path in make(readers, Path(out)):
+            click.echo(f"figure: {path}")
+
+
+@main.command()
+@click.argument("logs", nargs=-1, type=click.Path(dir_okay=False))
+@click.option("--markdown", type=click.Path(dir_okay=False), help="also write the table here")
+def claims(logs, markdown):
+    """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
+    from analysis.claims import format_table
+    sections = []
+    for paper, readers in _logs_by_paper(logs).items():
+        try:
+            evaluate = registry.load("claims", paper)
+        except registry.UnknownPlugin:
+            click.echo(f"{paper}: no claims defined yet", err=True)
+            continue
+        rows = evaluate(readers)
+        title = PAPERS[paper].title if paper in PAPERS else paper
+        sections.append(format_table(title, rows))
+    text = "\n\n".join(sections)
+    click.echo(text)
+    if markdown:
+        Path(markdown).parent.mkdir(parents=True, exist_ok=True)
+        Path(markdown).write_text(text + "\n")
+
+
+@main.group()
+def golden():
+    """Golden-log regression: `check` compares fresh runs, `update` rewrites them."""
+
+
+def _goldens(names):
+    from replay.golden import load_manifest
+    try:
+        table = load_manifest()
+    except FileNotFoundError:
+        _fail("no data/golden/manifest.yaml here (run from the project root)")
+    unknown = [n for n in names if n not in table]
+    if unknown:
+        _fail(f"unknown golden log {unknown[0]!r} (known: {', '.join(table)})")
+    return [table[n] for n in (names or table)]
+
+
+@golden.command("check")
+@click.argument("names", nargs=-1)
+def golden_check(names):
+    """Re-run each golden scenario and compare it with its stored log."""
+    from replay.golden import check
+    failed = 0
+    for g in _goldens(names):
+        if not g.log.is_file():
+            click.echo(f"FAIL {g.name}: no golden log {g.log} (run `replay golden update "
+                       f"{g.name}`)")
+            failed += 1
+            continue
+        diffs = check(g)
+        if diffs:
+            failed += 1
+            click.echo(f"FAIL {g.name}: first difference: {diffs[0]}")
+            for d in diffs[1:]:
+                click.echo(f"     also {d}")
+        else:
+            click.echo(f"ok   {g.name}")
+    if failed:
+        sys.exit(1)
+
+
+@golden.command("update")
+@click.argument("names", nargs=-1, required=True)
+def golden_update(names):
+    """Rewrite golden logs; commit them with the reason in the message."""
+    from replay.golden import update
+    for g in _goldens(names):
+        path = update(g)
+        click.echo(f"updated {path} ({path.stat().st_size / 1024:.0f} KiB)")
+    click.echo("commit the golden logs with the reason for the change in the commit message")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,93 @@
+"""The stick-capture hand as data: two planar 2-joint fingers on an XY slider base (no simulator).
+
+Higashimori et al. 2007, Sec. IV-A: sliders 400 mm x 400 mm at up to 1.0 m/s per axis; two fingers
+of two joints each, up to 14.0 rad/s per joint; no orientation degree of freedom. Link lengths and
+the spacing of the finger roots are not given in the paper: scenarios state the values they assume.
+
+Frames: world (= paper's Sigma_R) on the table, z up. The palm is parallel to the world x axis;
+finger k's root is at ``base + root_offset[k]``; its tip centre is at
+``root + l1 (cos q1, sin q1) + l2 (cos(q1 + q2), sin(q1 + q2))``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class StickSpec:
+    """What the method may know of the object (paper Assumptions 7 and 10): not the friction."""
+    mass: float            # kg
+    inertia: float         # kg*m^2 about the centre of mass
+    length: float          # m
+    width: float           # m (the analysis takes it as ~0, Assumption 5)
+    restitution: float     # Newton's e, eq. 2
+
+
+@dataclass(frozen=True)
+class HandSpec:
+    root_offsets: tuple[tuple[float, float], tuple[float, float]]  # m, from the base
+    link_lengths: tuple[float, float]                               # l1, l2 (m), both fingers
+    joint_limits: tuple[tuple[float, float], tuple[float, float]]   # (q1 lo, hi), (q2 lo, hi) rad
+    joint_speed: float        # rad/s, each joint
+    base_limits: tuple[tuple[float, float], tuple[float, float]]    # (x lo, hi), (y lo, hi) m
+    base_speed: float         # m/s, each slider axis
+    tip_radius: float         # m, fingertip disc radius
+
+
+@dataclass(frozen=True)
+class AirTableSpec:
+    hand: HandSpec
+    stick: StickSpec
+
+
+@dataclass(frozen=True)
+class HandCommand:
+    """Position targets; the plant moves toward them no faster than the spec's speed limits."""
+    base: tuple[float, float]                               # m
+    joints: tuple[tuple[float, float], tuple[float, float]]  # rad, (q1, q2) per finger
+
+
+def finger_tip(hand: HandSpec, base, k: int, q) -> np.ndarray:
+    """Tip centre of finger ``k`` (world, m) for base position and joints ``q = (q1, q2)``."""
+    l1, l2 = hand.link_lengths
+    rx, ry = hand.root_offsets[k]
+    return np.array([base[0] + rx + l1 * math.cos(q[0]) + l2 * math.cos(q[0] + q[1]),
+                     base[1] + ry + l1 * math.sin(q[0]) + l2 * math.sin(q[0] + q[1])])
+
+
+def finger_ik(hand: HandSpec, base, k: int, tip, q_near=None):
+    """Joints putting finger ``k``'s tip at ``tip`` (world), or None when out of reach or limits.
+
+    Of the two elbow solutions within the joint limits, the one nearest ``q_near`` is returned.
+    """
+    l1, l2 = hand.link_lengths
+    rx, ry = hand.root_offsets[k]
+    dx, dy = tip[0] - base[0] - rx, tip[1] - base[1] - ry
+    c2 = (dx * dx + dy * dy - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
+    if c2 < -1.0 - 1e-12 or c2 > 1.0 + 1e-12:
+        return None
+    c2 = min(1.0, max(-1.0, c2))
+    best = None
+    for sign in (1.0, -1.0):
+        q2 = sign * math.acos(c2)
+        q1 = math.atan2(dy, dx) - math.atan2(l2 * math.sin(q2), l1 + l2 * math.cos(q2))
+        q1 = (q1 + math.pi) % (2.0 * math.pi) - math.pi
+        q = (q1, q2)
+        if not all(lo - 1e-9 <= v <= hi + 1e-9 for v, (lo, hi) in zip(q, hand.joint_limits)):
+            continue
+        cost = 0.0 if q_near is None else abs(q1 - q_near[0]) + abs(q2 - q_near[1])
+        if best is None or cost < best[0]:
+            best = (cost, q)
+    return None if best is None else best[1]
+
+
+def travel_time(hand: HandSpec, base_from, base_to, joints_from, joints_to) -> float:
+    """Least time (s) to move base and joints between two configurations at the speed limits
+    (every axis moves independently at its own limit)."""
+    t_base = max(abs(b - a) for a, b in zip(base_from, base_to)) / hand.base_speed
+    t_joint = max(abs(b - a) for qa, qb in zip(joints_from, joints_to) for a, b in zip(qa, qb))
+    return max(t_base, t_joint / hand.joint_speed)

@@ -1,0 +1,110 @@
+"""The small typed interfaces where plants, sensors and controllers meet (in the runner only).
+
+- A **Plant** knows physics and nothing of any paper's method. It takes actuator commands,
+  steps its simulator by a fixed ``dt``, reports ground truth for the log, a :class:`Scene` for
+  cameras, physics events (collisions, rest) and a ``spec()``: the nominal robot and object
+  description a controller may know (kinematics, limits, the object's mass), never simulator state.
+- A **Sensor** turns a Scene into a measurement (a payload dataclass); the runner logs it at the
+  capture time and delivers it to the controller ``latency`` seconds later.
+- A **Controller** knows its paper's method and nothing of any simulator: it sees only
+  measurements (and the spec), returns commands, and says what it intends (``intent()``, merged
+  into the plant's collision events) and what it decided (``pop_events()``, e.g. ``infeasible``).
+
+Each plug-in declares ``Params``, a dataclass of :func:`replay.params.param` fields, validated from
+the scenario's ``params:`` mapping. Plug-ins are found by name through entry points
+(``paper_replay.plants``, ``paper_replay.sensors``, ``paper_replay.controllers``).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from replay.scene import Scene
+
+
+@dataclass
+class Occurrence:
+    """Something that happened, before it becomes an ``/events`` message: ``kind`` and ``data``."""
+    kind: str
+    data: dict
+
+
+class Plant(ABC):
+    Params: ClassVar[type]
+    description: ClassVar[str] = ""
+
+    def __init__(self, params: Any, *, dt: float, rng: np.random.Generator) -> None:
+        self.params = params
+        self.dt = dt
+        self.rng = rng
+
+    @abstractmethod
+    def apply(self, command: Any) -> None:
+        """Set the actuator command, held until the next call."""
+
+    @abstractmethod
+    def step(self) -> None:
+        """Advance the simulation by ``dt``."""
+
+    @abstractmethod
+    def truth(self, t: float) -> dict[str, Any]:
+        """Ground truth to log now: topic -> payload dataclass."""
+
+    @abstractmethod
+    def scene(self) -> Scene:
+        """The visible primitives now, for cameras."""
+
+    @abstractmethod
+    def spec(self) -> Any:
+        """The nominal description a controller may know (no simulator objects)."""
+
+    def pop_events(self) -> list[Occurrence]:
+        """Physics events since the last call."""
+        return []
+
+    def close(self) -> None:
+        pass
+
+
+class Sensor(ABC):
+    Params: ClassVar[type]
+    topic: ClassVar[str]
+    description: ClassVar[str] = ""
+
+    def __init__(self, params: Any, *, rng: np.random.Generator, spec: Any = None) -> None:
+        self.params = params
+        self.rng = rng
+        self.spec = spec
+
+    @abstractmethod
+    def measure(self, t: float, scene: Scene) -> Any | None:
+        """A measurement payload (with ``t`` = capture time), or None when nothing was seen."""
+
+
+class Controller(ABC):
+    Params: ClassVar[type]
+    description: ClassVar[str] = ""
+
+    def __init__(self, params: Any, *, spec: Any) -> None:
+        self.params = params
+        self.spec = spec
+
+    @abstractmethod
+    def update(self, t: float, measurements: list[tuple[str, Any]]) -> Any | None:
+        """Measurements delivered since the last call (topic, payload) -> a command or None."""
+
+    def intent(self) -> dict:
+        """What the method plans for the next contact (merged into collision events)."""
+        return {}
+
+    def pop_events(self) -> list[Occurrence]:
+        """Decisions worth an ``/events`` message since the last call (e.g. ``infeasible``)."""
+        return []
+
+    def telemetry(self, t: float) -> dict[str, Any]:
+        """Extra topics to log this control step: topic -> payload."""
+        return {}

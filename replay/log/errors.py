@@ -1,0 +1,33 @@
+"""The log package's own error types."""
+
+
+class LogError(Exception):
+    """A log could not be written or read."""
+
+
+class NotALogError(LogError):
+    """The file is not an MCAP file."""
+
+
+class NonFiniteValueError(LogError):
+    """A payload held NaN or infinity (NaN is not JSON): a physics error, not a message."""
+
+    def __init__(self, topic: str, payload: dict):
+        self.topic = topic
+        self.payload = payload
+        bad = sorted(_non_finite_paths(payload))
+        self.fields = bad
+        super().__init__(f"non-finite value on {topic}: {', '.join(bad) or '?'}")
+
+
+def _non_finite_paths(value, path=""):
+    import math
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            yield path or "(value)"
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            yield from _non_finite_paths(v, f"{path}.{k}" if path else str(k))
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            yield from _non_finite_paths(v, f"{path}[{i}]")

@@ -1,0 +1,140 @@
+"""Message payloads of the log contract (docs/DESIGN.md): one dataclass per topic.
+
+Every message carries ``t``, simulated seconds. Fields are SI (m, kg, s, rad). A payload's JSON
+schema is derived from its fields, so the MCAP file is self-describing for the ``mcap`` CLI and
+Foxglove. Topic names and field names are a contract: add topics and fields, rename none.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+from dataclasses import dataclass, field
+from typing import Any
+
+
+@dataclass
+class ScenarioInfo:
+    t: float
+    name: str
+    paper: str
+    yaml: str        # the resolved scenario, every default filled in
+    seed: int
+    version: str
+
+
+@dataclass
+class Event:
+    t: float
+    kind: str        # collision, catch, grasp, release, infeasible, rest, ...
+    data: dict = field(default_factory=dict)
+
+
+@dataclass
+class StickState:
+    t: float
+    x: float
+    y: float
+    theta: float
+    vx: float
+    vy: float
+    omega: float
+
+
+@dataclass
+class FingersState:
+    t: float
+    tips: list       # [[x, y], [x, y]] fingertip centres (m)
+
+
+@dataclass
+class VisionStick:
+    t: float         # capture time of the image
+    x: float
+    y: float
+    theta: float
+
+
+@dataclass
+class JointState:
+    t: float
+    name: list
+    position: list
+    velocity: list
+    effort: list
+
+
+@dataclass
+class JointCommand:
+    t: float
+    position: list   # q_d (rad)
+    torque: list     # (N*m)
+
+
+@dataclass
+class ObjectState:
+    t: float
+    position: list
+    orientation: list   # [qx, qy, qz, qw]
+    velocity: list
+    angular_velocity: list
+
+
+@dataclass
+class EffectorState:
+    t: float
+    position: list
+    desired_position: list
+
+
+@dataclass
+class VisionObject:
+    t: float
+    position: list      # measured [x, y, z] (m)
+    features: dict = field(default_factory=dict)
+
+
+@dataclass
+class OptimizationCost:
+    t: float
+    iteration: int
+    torque_cost: float
+    velocity_cost: float
+
+
+# topic -> payload type, for the contract topics
+TOPICS: dict[str, type] = {
+    "/scenario": ScenarioInfo,
+    "/events": Event,
+    "/stick/state": StickState,
+    "/fingers/state": FingersState,
+    "/vision/stick": VisionStick,
+    "/arm/joint_state": JointState,
+    "/hand/joint_state": JointState,
+    "/arm/joint_command": JointCommand,
+    "/object/state": ObjectState,
+    "/effector/state": EffectorState,
+    "/vision/object": VisionObject,
+    "/optimization/cost": OptimizationCost,
+}
+
+_JSON_TYPES = {float: "number", int: "integer", str: "string", bool: "boolean",
+               list: "array", dict: "object"}
+
+
+def json_schema(cls: type) -> dict[str, Any]:
+    """A JSON schema (draft 2020-12 subset) of a payload dataclass."""
+    hints = typing.get_type_hints(cls)
+    props = {}
+    for f in dataclasses.fields(cls):
+        tp = typing.get_origin(hints[f.name]) or hints[f.name]
+        props[f.name] = {"type": _JSON_TYPES.get(tp, "object")}
+    return {"title": cls.__name__, "type": "object", "properties": props,
+            "required": [f.name for f in dataclasses.fields(cls)]}
+
+
+def to_dict(payload: Any) -> dict[str, Any]:
+    """A payload dataclass (or a plain dict) as a JSON-ready dict."""
+    if isinstance(payload, dict):
+        return payload
+    return {f.name: getattr(payload, f.name) for f in dataclasses.fields(payload)}

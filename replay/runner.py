@@ -1,0 +1,199 @@
+"""The fixed-step, multi-rate runner: the only place where a plant, its sensors and a controller meet.
+
+Time is an integer count of physics steps k (t = k / physics_rate), so rates never drift. Each
+step: cameras due at k capture the plant's scene (logged at the capture time, delivered to the
+controller ``latency`` later), the controller due at k reads what was delivered and commands the
+plant, the plant's state is logged, the plant steps, and the physics events of that step are
+logged at its end, collisions with the controller's intent attached. The run stops at
+``timing.duration`` or ``stop.after`` seconds after one of ``stop.on_events``.
+"""
+
+from __future__ import annotations
+
+import platform
+import subprocess
+import time
+from collections import deque
+from dataclasses import dataclass, field
+from importlib import metadata as importlib_metadata
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from replay import __version__, registry
+from replay.log import LogWriter, NonFiniteValueError
+from replay.messages import Event, ScenarioInfo
+from replay.scenario import Scenario, resolved_yaml
+
+
+class RunInterrupted(Exception):
+    """Ctrl-C during a run; the log was closed and kept."""
+
+    def __init__(self, result: "RunResult"):
+        self.result = result
+        super().__init__(f"interrupted at t = {result.t_end:.4f} s")
+
+
+@dataclass
+class RunResult:
+    path: Path
+    steps: int = 0
+    t_end: float = 0.0
+    stopped_by: str = "duration"          # duration | event kind | error | interrupted
+    events: dict = field(default_factory=dict)
+    messages: int = 0
+    wall_time: float = 0.0
+    error: str = ""
+
+
+def _git_commit() -> str:
+    try:
+        out = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], capture_output=True,
+                             text=True, timeout=5, cwd=Path(__file__).resolve().parent)
+        return out.stdout.strip() if out.returncode == 0 else ""
+    except (OSError, subprocess.SubprocessError):
+        return ""
+
+
+def provenance(sc: Scenario) -> dict[str, str]:
+    info = {"scenario": sc.name, "paper": sc.paper, "seed": str(sc.seed),
+            "paper-replay": __version__, "python": platform.python_version(),
+            "git_commit": _git_commit() or "unknown"}
+    for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
+        try:
+            info[pkg] = importlib_metadata.version(pkg)
+        except importlib_metadata.PackageNotFoundError:
+            pass
+    return info
+
+
+def _divider(physics_rate: int, rate: float) -> int:
+    return max(1, int(round(physics_rate / rate)))
+
+
+class Runner:
+    def __init__(self, scenario: Scenario, *,
+                 progress: Callable[[float, float], None] | None = None,
+                 observers: tuple = ()) -> None:
+        self.sc = scenario
+        self.progress = progress
+        self.observers = observers   # callables(topic, payload, t) — e.g. a live viewer
+        rate = scenario.timing.physics_rate
+        self.dt = 1.0 / rate
+        seeds = np.random.SeedSequence(scenario.seed).spawn(2 + len(scenario.sensors))
+        plant_cls = registry.load("plant", scenario.plant.type)
+        self.plant = plant_cls(scenario.plant.params, dt=self.dt,
+                               rng=np.random.default_rng(seeds[0]))
+        spec = self.plant.spec()
+        self.sensors = []
+        for i, (name, s) in enumerate(scenario.sensors.items()):
+            cls = registry.load("sensor", s.type)
+            sensor = cls(s.params, rng=np.random.default_rng(seeds[2 + i]), spec=spec)
+            self.sensors.append((name, sensor, _divider(rate, s.rate),
+                                 int(round(s.latency * rate))))
+        ctrl_cls = registry.load("controller", scenario.controller.type)
+        self.controller = ctrl_cls(scenario.controller.params, spec=spec)
+        self.ctrl_div = _divider(rate, scenario.controller.rate)
+        self.log_div = (_divider(rate, scenario.timing.state_log_rate)
+                        if scenario.timing.state_log_rate else 1)
+
+    def t_ns(self, k: int) -> int:
+        return k * 1_000_000_000 // self.sc.timing.physics_rate
+
+    def run(self, out: str | Path) -> RunResult:
+        sc = self.sc
+        rate = sc.timing.physics_rate
+        n_steps = int(round(sc.timing.duration * rate))
+        result = RunResult(path=Path(out))
+        wall0 = time.perf_counter()
+        log = LogWriter(out)
+        log.metadata("provenance", provenance(sc))
+        text = resolved_yaml(sc)
+        log.metadata("scenario", {"yaml": text})
+        version = f"{__version__}+{_git_commit() or 'unknown'}"
+        self._write(log, "/scenario", ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version),
+                    0)
+        pending: deque = deque()          # (deliver at step, topic, payload), in step order
+        stop_at: int | None = None
+        collisions = 0
+        k = 0
+        try:
+            while k < n_steps and (stop_at is None or k < stop_at):
+                t = k / rate
+                t_ns = self.t_ns(k)
+                scene = None
+                for name, sensor, div, latency in self.sensors:
+                    if k % div == 0:
+                        scene = scene if scene is not None else self.plant.scene()
+                        m = sensor.measure(t, scene)
+                        if m is not None:
+                            self._write(log, sensor.topic, m, t_ns)
+                            pending.append((k + latency, sensor.topic, m))
+                if k % self.ctrl_div == 0:
+                    delivered = []
+                    while pending and pending[0][0] <= k:
+                        _, topic, m = pending.popleft()
+                        delivered.append((topic, m))
+                    command = self.controller.update(t, delivered)
+                    if command is not None:
+                        self.plant.apply(command)
+                    for occ in self.controller.pop_events():
+                        stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
+                    for topic, payload in self.controller.telemetry(t).items():
+                        self._write(log, topic, payload, t_ns)
+                if k % self.log_div == 0:
+                    for topic, payload in self.plant.truth(t).items():
+                        self._write(log, topic, payload, t_ns)
+                self.plant.step()
+                k += 1
+                t1, t1_ns = k / rate, self.t_ns(k)
+                for occ in self.plant.pop_events():
+                    if occ.kind == "collision":
+                        collisions += 1
+                        occ.data = {"index": collisions, **occ.data,
+                                    "planned": self.controller.intent()}
+                    stop_at = self._event(log, occ, t1, t1_ns, result, stop_at, k)
+                if self.progress and k % max(1, rate // 20) == 0:
+                    self.progress(t1, sc.timing.duration)
+            # the final state, so the log ends where the run ended
+            t_end = k / rate
+            for topic, payload in self.plant.truth(t_end).items():
+                self._write(log, topic, payload, self.t_ns(k))
+        except NonFiniteValueError as exc:
+            result.stopped_by = "error"
+            result.error = str(exc)
+            self._write(log, "/events", Event(k / rate, "error", {
+                "reason": "non-finite value", "topic": exc.topic, "fields": exc.fields}),
+                self.t_ns(k))
+        except KeyboardInterrupt:
+            result.stopped_by = "interrupted"
+            self._write(log, "/events", Event(k / rate, "interrupted", {}), self.t_ns(k))
+            self._finish(log, result, k, wall0)
+            raise RunInterrupted(result) from None
+        finally:
+            self.plant.close()
+        self._finish(log, result, k, wall0)
+        return result
+
+    def _finish(self, log: LogWriter, result: RunResult, k: int, wall0: float) -> None:
+        result.steps = k
+        result.t_end = k / self.sc.timing.physics_rate
+        result.messages = log.count
+        log.close()
+        result.wall_time = time.perf_counter() - wall0
+
+    def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:
+        log.write(topic, payload, t_ns)
+        for observe in self.observers:
+            observe(topic, payload, t_ns)
+
+    def _event(self, log, occ, t, t_ns, result, stop_at, k):
+        self._write(log, "/events", Event(t, occ.kind, occ.data), t_ns)
+        result.events[occ.kind] = result.events.get(occ.kind, 0) + 1
+        if occ.kind == "nan":
+            raise NonFiniteValueError("/events", occ.data)
+        if stop_at is None and occ.kind in self.sc.stop.on_events:
+            result.stopped_by = occ.kind
+            stop_at = k + int(round(self.sc.stop.after * self.sc.timing.physics_rate))
+        return stop_at

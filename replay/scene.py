@@ -1,0 +1,63 @@
+"""What a camera can see: simulator-free geometric primitives with world poses (SI units).
+
+A plant describes its visible bodies with these; a camera renders them. Orientation is a unit
+quaternion [qx, qy, qz, qw] (scalar last, as in the log contract and PyBullet).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Box:
+    name: str
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+    size: tuple[float, float, float]          # full extents along the body x, y, z axes (m)
+    albedo: float = 0.5                        # 0 black .. 1 white, as a camera sees it
+
+
+@dataclass(frozen=True)
+class Sphere:
+    name: str
+    position: tuple[float, float, float]
+    radius: float
+    albedo: float = 0.5
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    name: str
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+    radius: float
+    length: float
+    albedo: float = 0.5
+
+
+Primitive = Box | Sphere | Cylinder
+
+
+@dataclass
+class Scene:
+    """The visible primitives at one instant, by name."""
+    primitives: list = field(default_factory=list)
+
+    def get(self, name: str):
+        for p in self.primitives:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+
+def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
+    """Rotation about +z by ``yaw`` rad as [qx, qy, qz, qw]."""
+    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
+
+
+def quaternion_yaw(q) -> float:
+    """Yaw (rad) of a rotation that is about +z only."""
+    qx, qy, qz, qw = q
+    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))

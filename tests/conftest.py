@@ -1,0 +1,43 @@
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _toy_plugins():
+    import toy_plugins
+    toy_plugins.install()
+
+
+@pytest.fixture
+def project_root(monkeypatch):
+    """Run from the project root, where scenarios/ and data/ are."""
+    monkeypatch.chdir(ROOT)
+    return ROOT
+
+
+TOY = """\
+name: toy
+paper: none
+description: a point mass pushed to a target
+seed: 3
+timing: {physics_rate: 1000, duration: 1.0}
+plant:
+  type: toy
+  params: {mass: 2.0}
+sensors:
+  cam: {type: toy_sensor, rate: 100, latency: 0.02}
+controller: {type: toy_pd, rate: 500, params: {target: 1.0}}
+"""
+
+
+@pytest.fixture
+def toy_yaml(tmp_path):
+    p = tmp_path / "toy.yaml"
+    p.write_text(TOY)
+    return p

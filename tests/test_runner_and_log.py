@@ -1,0 +1,132 @@
+"""The runner's timing (multi-rate, latency), events and stop conditions, and the MCAP log contract."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from replay.log import LogReader, LogWriter, NotALogError
+from replay.messages import Event
+from replay.runner import Runner
+from replay.scenario import load_scenario
+
+
+def _run(toy_yaml, tmp_path, sets=(), name="run.mcap"):
+    sc = load_scenario(toy_yaml, sets=list(sets))
+    runner = Runner(sc)
+    result = runner.run(tmp_path / name)
+    return runner, result, LogReader(result.path)
+
+
+def test_rates_and_latency(toy_yaml, tmp_path):
+    runner, result, log = _run(toy_yaml, tmp_path)
+    counts = log.topic_counts()
+    assert counts["/toy/measured"] == 100          # 100 Hz for 1 s
+    assert counts["/toy/state"] == 1000 + 1        # every physics step, plus the final state
+    assert counts["/scenario"] == 1
+    # every measurement reached the controller 20 ms (latency) after capture, at a 500 Hz tick
+    seen = runner.controller.seen
+    assert seen and all(abs((now - cap) - 0.02) < 1e-9 for now, cap in seen)
+    # log time is simulated time
+    for m in log.messages("/toy/measured"):
+        assert m.t_ns == round(m.data["t"] * 1e9)
+
+
+def test_controller_drives_plant(toy_yaml, tmp_path):
+    _, _, log = _run(toy_yaml, tmp_path, sets=["timing.duration=3.0"])
+    last = log.series("/toy/state")[-1]
+    assert abs(last["x"] - 1.0) < 0.05
+
+
+def test_events_and_stop_condition(toy_yaml, tmp_path):
+    _, result, log = _run(toy_yaml, tmp_path, sets=[
+        "plant.params.wall=0.5", "stop.on_events=[collision]", "stop.after=0.1",
+        "timing.duration=5"])
+    events = log.events()
+    assert [e["kind"] for e in events] == ["collision"]
+    e = events[0]
+    assert e["data"]["index"] == 1 and e["data"]["planned"] == {"target": 1.0}
+    assert result.stopped_by == "collision"
+    assert abs(result.t_end - (e["t"] + 0.1)) < 1.5e-3
+
+
+def test_same_seed_same_bytes_other_seed_differs(toy_yaml, tmp_path):
+    sets = ["sensors.cam.params.noise=0.01"]
+    _, a, _ = _run(toy_yaml, tmp_path, sets, "a.mcap")
+    _, b, _ = _run(toy_yaml, tmp_path, sets, "b.mcap")
+    assert a.path.read_bytes() == b.path.read_bytes()
+    sc = load_scenario(toy_yaml, sets=sets, seed=4)
+    c = Runner(sc).run(tmp_path / "c.mcap")
+    assert c.path.read_bytes() != a.path.read_bytes()
+
+
+def test_nan_becomes_an_error_event(toy_yaml, tmp_path):
+    _, result, log = _run(toy_yaml, tmp_path, sets=["plant.params.blow_up_at=0.3"])
+    assert result.stopped_by == "error"
+    err = log.events()[-1]
+    assert err["kind"] == "error" and err["data"]["topic"] in ("/toy/state", "/toy/measured")
+    assert "x" in err["data"]["fields"]
+    assert abs(err["t"] - 0.3) < 2e-3
+
+
+def test_provenance_in_metadata_and_scenario_topic(toy_yaml, tmp_path):
+    _, _, log = _run(toy_yaml, tmp_path)
+    meta = log.metadata()
+    assert meta["provenance"]["seed"] == "3" and "numpy" in meta["provenance"]
+    sc = log.scenario()
+    assert sc["name"] == "toy" and "kp: 100.0" in sc["yaml"] and sc["seed"] == 3
+
+
+def test_truncated_log_is_readable_to_its_last_chunk(tmp_path):
+    w = LogWriter(tmp_path / "x.mcap", chunk_size=2000)
+    for k in range(5000):
+        w.write("/events", Event(k * 1e-3, "tick", {"k": k}), k * 1_000_000)
+    w.close()
+    data = (tmp_path / "x.mcap").read_bytes()
+    (tmp_path / "cut.mcap").write_bytes(data[: len(data) // 2])
+    r = LogReader(tmp_path / "cut.mcap")
+    assert r.truncated
+    ks = [m.data["data"]["k"] for m in r.messages()]
+    assert 1000 < len(ks) < 5000 and ks == list(range(len(ks)))
+
+
+def test_not_a_log(tmp_path):
+    p = tmp_path / "x.mcap"
+    p.write_text("hello")
+    with pytest.raises(NotALogError):
+        LogReader(p)
+
+
+KILLED_RUN = r"""
+import sys, time
+sys.path.insert(0, {tests!r})
+import toy_plugins; toy_plugins.install()
+from replay.scenario import load_scenario
+from replay.runner import Runner
+sc = load_scenario({yaml!r}, sets=["timing.duration=600", "timing.physics_rate=1000"])
+class Slow:
+    def __call__(self, t, d):
+        if t > 10.0:
+            print("ready", flush=True); time.sleep(60)
+Runner(sc, progress=Slow()).run({out!r})
+"""
+
+
+def test_killed_run_leaves_a_readable_part_file(toy_yaml, tmp_path):
+    out = tmp_path / "killed.mcap"
+    code = KILLED_RUN.format(tests=os.path.dirname(__file__), yaml=str(toy_yaml), out=str(out))
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=30)
+    assert not out.exists()
+    part = tmp_path / "killed.mcap.part"
+    r = LogReader(part)
+    assert r.truncated
+    states = r.series("/toy/state")
+    assert len(states) > 100 and json.dumps(states[-1])
