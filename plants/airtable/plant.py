@@ -1,0 +1,279 @@
+"""The air table of Higashimori et al. 2007 (Sec. IV-A) in Pymunk: a free stick and two fingertips.
+
+- The stick is a dynamic body with the paper's m and I set explicitly (not from shape density).
+  It collides as a segment (``collision_width`` = 0, Assumption 5) or as a box. No gravity in
+  the plane, no damping, no table friction (the table blows air).
+- The fingertips are kinematic discs, position-commanded through the rate-limited servo of the
+  slider base and the finger joints: each step the tip's velocity is set so that Pymunk's
+  position integration lands it on the forward kinematics, so the contact solver sees the real
+  fingertip velocity. Finger links do not collide (Assumption 9).
+- Stick/fingertip contacts use Newton's restitution e and Coulomb friction mu (Chipmunk combines
+  the two shapes' values by product; the fingertip's are 1, so the pair gets exactly e and mu).
+
+Chipmunk2D facts this relies on (read in Munk2D's cpSpaceStep.c/cpArbiter.c, the engine of
+Pymunk 7, and checked by tests/test_airtable_plant.py):
+positions are integrated at the start of a step, contacts are then detected at the new
+positions and velocities solved; restitution is a per-contact "bounce" target computed from the
+velocity before the solve; on later steps of a persisting contact the bounce target asks for an
+approaching velocity, which the non-negative normal impulse cannot produce, so the collision
+impulse is applied once (the previous step's impulse is re-applied as a warm start and the
+solver's first iteration takes it back out, leaving ~1e-17 m/s). Penetration is removed by a separate bias velocity that moves positions
+only.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pymunk
+
+from replay.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec
+from replay.interfaces import Occurrence, Plant
+from replay.messages import FingersState, StickState
+from replay.scene import Box, Cylinder, Scene, yaw_quaternion
+
+from plants.airtable.hand import HandServo
+from plants.airtable.params import Params
+
+STICK_TYPE = 1
+TIP_TYPE = 2
+_TIP_GROUP = 1          # fingertips never collide with each other
+
+
+def _vec(v) -> list[float]:
+    return [float(v[0]), float(v[1])]
+
+
+class AirTablePlant(Plant):
+    """Stick on an air table and a two-fingered hand on an XY slider (Pymunk)."""
+
+    Params = Params
+    description = ("Pymunk air table: a free stick (no table friction) and two position-"
+                   "commanded fingertip discs on an XY slider hand (Higashimori et al. 2007)")
+
+    def __init__(self, params: Params | None = None, *, dt: float,
+                 rng: np.random.Generator | None = None) -> None:
+        params = params if params is not None else Params()
+        super().__init__(params, dt=dt, rng=rng if rng is not None else np.random.default_rng(0))
+        if not dt > 0:
+            raise ValueError(f"dt must be > 0, got {dt}")
+        p = params
+        self._hand_spec = self._make_hand_spec(p)
+        self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
+
+        space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        space.damping = 1.0                      # no velocity damping
+        space.iterations = int(p.solver.iterations)
+        space.collision_slop = float(p.solver.collision_slop)
+        space.collision_bias = float(p.solver.collision_bias)
+        space.sleep_time_threshold = math.inf    # bodies never sleep
+        self.space = space
+
+        # The stick: m and I set on the body; its shape has no mass or density.
+        st = p.stick
+        body = pymunk.Body(st.mass, st.inertia, body_type=pymunk.Body.DYNAMIC)
+        body.position = (p.initial.x, p.initial.y)
+        body.angle = p.initial.theta
+        body.velocity = (p.initial.vx, p.initial.vy)
+        body.angular_velocity = p.initial.omega
+        half = st.length / 2.0
+        if st.collision_width > 0.0:
+            shape = pymunk.Poly.create_box(body, (st.length, st.collision_width), radius=0.0)
+        else:
+            shape = pymunk.Segment(body, (-half, 0.0), (half, 0.0), 0.0)
+        shape.elasticity = st.restitution
+        shape.friction = st.friction
+        shape.collision_type = STICK_TYPE
+        space.add(body, shape)
+        self.stick_body, self.stick_shape = body, shape
+        if body.mass != st.mass or body.moment != st.inertia:   # pragma: no cover - guard
+            raise RuntimeError("Pymunk changed the stick's mass or inertia")
+
+        # The fingertips: kinematic discs (infinite mass, Assumption 8).
+        self.tip_bodies: list[pymunk.Body] = []
+        self.tip_shapes: list[pymunk.Circle] = []
+        for k, tip in enumerate(self.hand.tips()):
+            tb = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+            tb.position = (float(tip[0]), float(tip[1]))
+            ts = pymunk.Circle(tb, p.hand.tip_radius)
+            ts.elasticity = 1.0     # pair restitution = e * 1
+            ts.friction = 1.0       # pair friction = mu * 1
+            ts.collision_type = TIP_TYPE
+            ts.filter = pymunk.ShapeFilter(group=_TIP_GROUP)
+            space.add(tb, ts)
+            self.tip_bodies.append(tb)
+            self.tip_shapes.append(ts)
+
+        space.on_collision(TIP_TYPE, STICK_TYPE, begin=self._on_begin)
+
+        self._steps = 0
+        self._events: list[Occurrence] = []
+        self._pending: list[dict] = []
+        self._before: tuple = ([0.0, 0.0], 0.0)
+        self._last_command: tuple | None = None
+        self._rest_since: float | None = None
+        self._rest_reported = False
+        self._nan_reported = False
+
+    # -- construction helpers -------------------------------------------------------------
+
+    @staticmethod
+    def _make_hand_spec(p: Params) -> HandSpec:
+        h = p.hand
+        return HandSpec(
+            root_offsets=(tuple(map(float, h.root_offset0)), tuple(map(float, h.root_offset1))),
+            link_lengths=(float(h.link_lengths[0]), float(h.link_lengths[1])),
+            joint_limits=(tuple(map(float, h.q1_limits)), tuple(map(float, h.q2_limits))),
+            joint_speed=float(h.joint_speed),
+            base_limits=(tuple(map(float, h.base_x_limits)), tuple(map(float, h.base_y_limits))),
+            base_speed=float(h.base_speed),
+            tip_radius=float(h.tip_radius),
+        )
+
+    # -- Plant interface ------------------------------------------------------------------
+
+    @property
+    def time(self) -> float:
+        """Simulated time of this plant (steps * dt)."""
+        return self._steps * self.dt
+
+    def apply(self, command: HandCommand) -> None:
+        key = (tuple(map(float, command.base)),
+               tuple(tuple(map(float, q)) for q in command.joints))
+        if key == self._last_command:
+            return                      # the same target again: nothing new to clamp or report
+        self._last_command = key
+        clamped = self.hand.set_targets(command.base, command.joints)
+        if clamped is not None:
+            self._events.append(Occurrence("limit", clamped))
+
+    def step(self) -> None:
+        dt = self.dt
+        # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
+        self.hand.advance(dt)
+        for tb, tip in zip(self.tip_bodies, self.hand.tips()):
+            tb.velocity = ((float(tip[0]) - tb.position.x) / dt,
+                           (float(tip[1]) - tb.position.y) / dt)
+        b = self.stick_body
+        self._before = (_vec(b.velocity), float(b.angular_velocity))
+        self._pending = []
+        self.space.step(dt)
+        self._steps += 1
+        v_after, w_after = _vec(b.velocity), float(b.angular_velocity)
+        for c in self._pending:
+            c["v_after"], c["omega_after"] = v_after, w_after
+            self._events.append(Occurrence("collision", c))
+        self._pending = []
+        self._check_state()
+
+    def _on_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
+        """A fingertip started touching the stick (called after position integration, before
+        the velocity solve: the stick's pose is that of the contact, its velocity the one before)."""
+        sa, sb = arbiter.shapes
+        cps = arbiter.contact_point_set
+        normal = np.array(cps.normal, dtype=float)      # from shape a to shape b
+        if sa is self.stick_shape:
+            tip_shape = sb
+            normal = -normal
+            pts = [np.array(pt.point_a, dtype=float) for pt in cps.points]
+        else:
+            tip_shape = sa
+            pts = [np.array(pt.point_b, dtype=float) for pt in cps.points]
+        if not pts:
+            return
+        finger = self.tip_shapes.index(tip_shape)
+        contact = np.mean(pts, axis=0)
+        b = self.stick_body
+        theta = float(b.angle)
+        c, s = math.cos(theta), math.sin(theta)
+        d = contact - np.array(b.position, dtype=float)
+        r_x, r_y = c * d[0] + s * d[1], -s * d[0] + c * d[1]     # R_B(theta)^T d
+        v_before, w_before = self._before
+        self._pending.append({
+            "finger": finger,
+            "r_x": float(r_x), "r_y": float(r_y), "theta": theta,
+            "v_before": v_before, "omega_before": w_before,
+            "contact": _vec(contact), "normal": _vec(normal),
+            "penetration": float(-min(pt.distance for pt in cps.points)),
+            "tip_velocity": _vec(self.tip_bodies[finger].velocity),
+        })
+
+    def _check_state(self) -> None:
+        b = self.stick_body
+        values = {"x": b.position.x, "y": b.position.y, "theta": b.angle,
+                  "vx": b.velocity.x, "vy": b.velocity.y, "omega": b.angular_velocity}
+        for k, tb in enumerate(self.tip_bodies):
+            values[f"tip{k}_x"], values[f"tip{k}_y"] = tb.position.x, tb.position.y
+        bad = sorted(k for k, v in values.items() if not math.isfinite(v))
+        if bad:
+            if not self._nan_reported:
+                self._nan_reported = True
+                self._events.append(Occurrence("nan", {"fields": bad, "step": self._steps}))
+            return
+        t = self.time
+        slow = (math.hypot(b.velocity.x, b.velocity.y) < self.params.rest_speed
+                and abs(b.angular_velocity) < self.params.rest_omega)
+        if not slow:
+            self._rest_since = None
+            self._rest_reported = False        # moving again: a later rest is a new event
+            return
+        if self._rest_since is None:
+            self._rest_since = t
+        if not self._rest_reported and t - self._rest_since >= self.params.rest_time - 1e-12:
+            self._rest_reported = True
+            self._events.append(Occurrence("rest", {
+                "since": self._rest_since, "x": b.position.x, "y": b.position.y,
+                "theta": b.angle, "speed": math.hypot(b.velocity.x, b.velocity.y),
+                "omega": b.angular_velocity}))
+
+    def pop_events(self) -> list[Occurrence]:
+        out, self._events = self._events, []
+        return out
+
+    def truth(self, t: float) -> dict[str, Any]:
+        b = self.stick_body
+        return {
+            "/stick/state": StickState(t=t, x=b.position.x, y=b.position.y, theta=b.angle,
+                                       vx=b.velocity.x, vy=b.velocity.y,
+                                       omega=b.angular_velocity),
+            "/fingers/state": FingersState(t=t, tips=[_vec(tb.position)
+                                                      for tb in self.tip_bodies]),
+            "/hand/state": {"t": t, "base": self.hand.base.tolist(),
+                            "joints": self.hand.joints.tolist(),
+                            "base_target": self.hand.base_target.tolist(),
+                            "joint_targets": self.hand.joint_targets.tolist()},
+        }
+
+    def scene(self) -> Scene:
+        st = self.params.stick
+        b = self.stick_body
+        x, y, th = b.position.x, b.position.y, b.angle
+        q = yaw_quaternion(th)
+        marker_h = 0.0005
+        prims: list = [
+            Box("stick", (x, y, st.thickness / 2.0), q,
+                (st.length, st.visual_width, st.thickness), albedo=0.3),
+            Box("marker", (x, y, st.thickness + marker_h / 2.0), q,
+                (st.marker_length, st.marker_width, marker_h), albedo=1.0),
+        ]
+        h = self.params.hand
+        for k, tb in enumerate(self.tip_bodies):
+            prims.append(Cylinder(f"tip{k}", (tb.position.x, tb.position.y, h.tip_height / 2.0),
+                                  (0.0, 0.0, 0.0, 1.0), h.tip_radius, h.tip_height,
+                                  albedo=0.1))
+        return Scene(prims)
+
+    def spec(self) -> AirTableSpec:
+        st = self.params.stick
+        # Nominal values only: the method must not need mu (Assumption 10 and the paper's point).
+        # The width is the one the fingertips collide with (it sets where contact happens).
+        return AirTableSpec(hand=self._hand_spec,
+                            stick=StickSpec(mass=st.mass, inertia=st.inertia, length=st.length,
+                                            width=st.collision_width,
+                                            restitution=st.restitution))
+
+    def close(self) -> None:
+        self._pending = []
