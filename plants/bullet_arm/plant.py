@@ -1,0 +1,554 @@
+"""A torque-controlled arm with a position-controlled hand and one free object, in PyBullet.
+
+Physics only: the plant takes joint torques (arm) and joint targets (hand), steps PyBullet by a
+fixed ``dt`` in DIRECT mode and reports ground truth, a camera scene, its nominal spec and
+physics events (``contact``, ``catch``, ``release``, ``drop``, ``miss``, ``torque_limit``,
+``velocity_limit``, ``joint_limit``, ``nan``). It knows nothing of any paper's method.
+
+PyBullet facts used (shared/robots/README.md, measured on this machine):
+- URDFs are loaded with ``URDF_USE_INERTIA_FROM_FILE`` (else inertia comes from collision shapes);
+- the default joint motors are switched off (``VELOCITY_CONTROL``, force 0) for torque control,
+  and ``TORQUE_CONTROL`` torques are set again before every step (PyBullet clears them);
+- the tool frame is a zero-mass link; PyBullet's default link damping (0.04) is set to 0 so the
+  arm follows M qdd + H qd + g = tau exactly.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as p
+from pybullet_utils import bullet_client
+
+from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
+from plants.models.arm import build_arm
+from replay.interfaces import Occurrence, Plant
+from replay.messages import EffectorState, JointState, ObjectState
+from replay.params import param
+from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
+from replay.robot.hand import HANDS, hand_body, hand_mass
+from replay.robot.serial_chain import rpy_to_matrix, matrix_to_quaternion
+from replay.robot.wam import (DEFAULT_VELOCITY_LIMIT, TORQUE_LIMIT_SETS, default_tool_d,
+                              load_wam_table, wam_chain, wam_joint_limits)
+from replay.scene import Box, Scene, Sphere
+
+_CATCH_CLOSING_SPEED = (math.pi / 2.0) / 0.020   # Namiki & Ishikawa IV-A: 90 deg in 20 ms
+
+
+@dataclass
+class Params:
+    arm: str = param("wam4", choices=("wam4", "wam7"),
+                     doc="Barrett WAM with 4 axes (J1-J4 + tool plate) or 7 axes (with wrist)")
+    tool_d: float = param(-1.0, unit="m",
+                          doc="tool frame offset along the last DH z axis; negative = the table's "
+                              "(wam4: 0.35 m, the manual; libbarrett wam4.conf uses 0.36 m; "
+                              "wam7: 0, the J7 flange)")
+    base_position: list = param([0.0, 0.0, 0.0], unit="m", length=3,
+                                doc="world position of the base plate (J1 axis foot)")
+    base_rpy: list = param([0.0, 0.0, 0.0], unit="rad", length=3,
+                           doc="base plate orientation, URDF roll-pitch-yaw")
+    initial_q: list = param([], unit="rad",
+                            doc="initial arm joint angles, one per axis; [] = all zero. "
+                                "Catching (Namiki & Ishikawa IV-A): [0, pi/4, 0, 0]")
+    initial_qd: list = param([], unit="rad/s", doc="initial arm joint velocities; [] = zero")
+    locked_joints: list = param([], doc="arm joints held rigidly at their initial angle "
+                                        "(built as fixed joints), e.g. ['J3'] for catching")
+    torque_limit_set: str = param(
+        "public_urdf", choices=tuple(TORQUE_LIMIT_SETS),
+        doc="named torque limits (wam.yaml notes: sources disagree): 'libbarrett' control-signal "
+            "limits (25, 20, 15, 15, 5, 5, 5) N*m, or 'public_urdf' effort limits "
+            "(60, 60, 45, 30, 10, 10, 10) N*m. Default public_urdf: libbarrett's numbers clamp "
+            "the output of its PID joint controllers (a software setting), while a model's "
+            "effort limit stands for what the actuators give; the paper's arm was driven harder "
+            "than a stock WAM (5 m/s, 30 m/s^2). A scenario states which it uses")
+    torque_limits: list = param([], unit="N*m", ge=0.0,
+                                doc="explicit |tau| limits per axis; [] = torque_limit_set")
+    velocity_limits: list = param([], unit="rad/s", gt=0.0,
+                                  doc="|qd| limits per axis; [] = 3.0 rad/s each (assumed, no "
+                                      "table source)")
+    enforce_velocity_limits: bool = param(
+        False, doc="if true, a joint at its speed limit gets no torque further in its direction "
+                   "of motion; if false, exceeding it is only reported (velocity_limit event)")
+    hand: str = param("catch3", choices=("catch3", "grasp4", "none"),
+                      doc="hand table: catch3 (3 fingers, 3 axes), grasp4 (4 fingers, 14 joints, "
+                          "provisional sizes), none")
+    hand_closing_speed: float = param(_CATCH_CLOSING_SPEED, unit="rad/s", gt=0.0,
+                                      doc="hand joints' speed limit; 90 deg in 20 ms = 78.54")
+    hand_max_torque: float = param(2.0, unit="N*m", gt=0.0,
+                                   doc="each hand joint's actuator torque limit (assumed)")
+    hand_initial: list = param([], unit="rad", doc="initial hand joint angles; [] = open")
+    object: str = param("ball", choices=("ball", "box", "none"), doc="the free object")
+    object_radius: float = param(0.0175, unit="m", gt=0.0,
+                                 doc="ball radius; 35 mm diameter assumed (the paper gives none)")
+    object_size: list = param([0.05, 0.05, 0.05], unit="m", length=3, gt=0.0,
+                              doc="box full extents")
+    object_mass: float = param(0.025, unit="kg", gt=0.0,
+                               doc="assumed: a solid-rubber ball of 35 mm (~1.1 g/cm^3)")
+    object_position: list = param([1.5, 0.0, 1.0], unit="m", length=3,
+                                  doc="initial centre of the object (world)")
+    object_rpy: list = param([0.0, 0.0, 0.0], unit="rad", length=3,
+                             doc="initial orientation (roll-pitch-yaw)")
+    object_velocity: list = param([0.0, 0.0, 0.0], unit="m/s", length=3,
+                                  doc="initial linear velocity")
+    object_angular_velocity: list = param([0.0, 0.0, 0.0], unit="rad/s", length=3,
+                                          doc="initial angular velocity")
+    object_gravity: bool = param(True, doc="gravity acts on the object (false: it floats)")
+    object_albedo: float = param(0.9, unit="1", ge=0.0, le=1.0, doc="brightness seen by cameras")
+    object_lateral_friction: float = param(0.8, unit="1", ge=0.0,
+                                           doc="Coulomb coefficient (rubber, assumed)")
+    object_rolling_friction: float = param(0.0, unit="m", ge=0.0,
+                                           doc="PyBullet rolling friction")
+    object_spinning_friction: float = param(0.0, unit="m", ge=0.0,
+                                            doc="PyBullet spinning friction")
+    object_restitution: float = param(0.6, unit="1", ge=0.0, le=1.0,
+                                      doc="PyBullet restitution (multiplied with the robot's)")
+    hand_lateral_friction: float = param(1.0, unit="1", ge=0.0,
+                                         doc="Coulomb coefficient of palm/fingers (rubber pads)")
+    hand_restitution: float = param(0.3, unit="1", ge=0.0, le=1.0,
+                                    doc="PyBullet restitution of the robot's links")
+    contact_stiffness: float = param(0.0, unit="N/m", ge=0.0,
+                                     doc="object contact stiffness; 0 = PyBullet's rigid contact")
+    contact_damping: float = param(0.0, unit="N*s/m", ge=0.0,
+                                   doc="object contact damping (used with contact_stiffness)")
+    solver_iterations: int = param(50, ge=1, doc="PyBullet constraint solver iterations")
+    gravity: float = param(9.81, unit="m/s^2", ge=0.0, doc="|g| along world -z")
+    catch_hold_time: float = param(0.05, unit="s", gt=0.0,
+                                   doc="catch: held this long (touching >= catch_min_parts of "
+                                       "palm/fingers, moving with the hand)")
+    catch_min_parts: int = param(2, ge=1, doc="distinct hand parts (palm, fingers) touching")
+    catch_relative_speed: float = param(0.1, unit="m/s", gt=0.0,
+                                        doc="max object speed relative to the palm when held")
+    miss_height: float = param(0.0, unit="m",
+                               doc="object centre below this world z: drop (after a catch) or "
+                                   "miss")
+
+
+class BulletArmPlant(Plant):
+    Params = Params
+    description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"
+
+    def __init__(self, params: Params, *, dt: float, rng: np.random.Generator) -> None:
+        super().__init__(params, dt=dt, rng=rng)
+        P = params
+        self.dof = 4 if P.arm == "wam4" else 7
+        self._table = load_wam_table()
+        dof = self.dof
+        self.tool_d = default_tool_d(dof, self._table) if P.tool_d < 0 else float(P.tool_d)
+        self.hand_table = HANDS.get(P.hand) if P.hand != "none" else None
+        q0 = np.zeros(dof) if not P.initial_q else np.asarray(P.initial_q, float)
+        qd0 = np.zeros(dof) if not P.initial_qd else np.asarray(P.initial_qd, float)
+        if q0.shape != (dof,) or qd0.shape != (dof,):
+            raise ValueError(f"initial_q/initial_qd need {dof} values for {P.arm}")
+        self.torque_limits = (np.asarray(P.torque_limits, float) if P.torque_limits
+                              else np.asarray(TORQUE_LIMIT_SETS[P.torque_limit_set][:dof]))
+        self.velocity_limits = (np.asarray(P.velocity_limits, float) if P.velocity_limits
+                                else np.full(dof, DEFAULT_VELOCITY_LIMIT))
+        if self.torque_limits.shape != (dof,) or self.velocity_limits.shape != (dof,):
+            raise ValueError(f"torque_limits/velocity_limits need {dof} values for {P.arm}")
+        names = tuple(r["joint"] for r in self._table["dh"][:dof])
+        for n in P.locked_joints:
+            if n not in names:
+                raise ValueError(f"locked_joints: unknown joint {n!r} (joints: {names})")
+        self.locked = {n: float(q0[names.index(n)]) for n in P.locked_joints}
+        qd0[[names.index(n) for n in self.locked]] = 0.0
+        self.model = build_arm(dof, tool_d=self.tool_d, hand=self.hand_table, locked=self.locked,
+                               torque_limits=self.torque_limits,
+                               velocity_limits=self.velocity_limits, table=self._table)
+        self.urdf_path = self.model.write()
+        self.joint_names = names
+        self.lower, self.upper = wam_joint_limits(dof, self._table)
+
+        # ---- the world
+        self.bc = bullet_client.BulletClient(connection_mode=p.DIRECT)
+        bc = self.bc
+        bc.setTimeStep(dt)
+        bc.setGravity(0.0, 0.0, -P.gravity)
+        bc.setPhysicsEngineParameter(numSolverIterations=int(P.solver_iterations),
+                                     deterministicOverlappingPairs=1)
+        orn = matrix_to_quaternion(rpy_to_matrix(P.base_rpy))
+        self.robot = bc.loadURDF(str(self.urdf_path), basePosition=list(P.base_position),
+                                 baseOrientation=list(orn), useFixedBase=True,
+                                 flags=p.URDF_USE_INERTIA_FROM_FILE)
+        self._jidx = {}
+        self._link_name = {-1: "wam_base"}
+        for j in range(bc.getNumJoints(self.robot)):
+            info = bc.getJointInfo(self.robot, j)
+            self._jidx[info[1].decode()] = j
+            self._link_name[j] = info[12].decode()
+        self._link_index = {v: k for k, v in self._link_name.items()}
+        self.active = tuple(i for i, n in enumerate(names) if n not in self.locked)
+        self._arm_j = [self._jidx[names[i]] for i in self.active]
+        self.hand_names = self.model.hand_joints
+        self._hand_j = [self._jidx[n] for n in self.hand_names]
+        # pybullet dof order (movable joints in index order) -> for calculate* helpers
+        self._dofs = [j for j in range(bc.getNumJoints(self.robot))
+                      if bc.getJointInfo(self.robot, j)[2] == p.JOINT_REVOLUTE]
+        self._tool_link = self._link_index["wam_tool"]
+        self._palm_link = self._link_index.get("palm")
+        for j in range(-1, bc.getNumJoints(self.robot)):
+            bc.changeDynamics(self.robot, j, linearDamping=0.0, angularDamping=0.0,
+                              lateralFriction=P.hand_lateral_friction,
+                              restitution=P.hand_restitution)
+        for k, j in enumerate(self._arm_j):
+            bc.resetJointState(self.robot, j, q0[self.active[k]], qd0[self.active[k]])
+        bc.setJointMotorControlArray(self.robot, self._arm_j, p.VELOCITY_CONTROL,
+                                     forces=[0.0] * len(self._arm_j))
+        ht = self.hand_table
+        h0 = (np.asarray(P.hand_initial, float) if P.hand_initial
+              else (ht.open_posture if ht else np.zeros(0)))
+        if h0.shape != (len(self._hand_j),):
+            raise ValueError(f"hand_initial needs {len(self._hand_j)} values")
+        for j, v in zip(self._hand_j, h0):
+            bc.resetJointState(self.robot, j, float(v), 0.0)
+        self._hand_target = h0.copy()
+        if ht is not None:
+            self._hand_lo = np.array([j.lower for j in ht.joints])
+            self._hand_hi = np.array([j.upper for j in ht.joints])
+
+        # ---- the free object
+        self.obj = None
+        if P.object != "none":
+            if P.object == "ball":
+                shape = bc.createCollisionShape(p.GEOM_SPHERE, radius=P.object_radius)
+            else:
+                shape = bc.createCollisionShape(p.GEOM_BOX,
+                                                halfExtents=[s / 2 for s in P.object_size])
+            oorn = matrix_to_quaternion(rpy_to_matrix(P.object_rpy))
+            self.obj = bc.createMultiBody(baseMass=P.object_mass,
+                                          baseCollisionShapeIndex=shape,
+                                          basePosition=list(P.object_position),
+                                          baseOrientation=list(oorn))
+            kw = dict(linearDamping=0.0, angularDamping=0.0,
+                      lateralFriction=P.object_lateral_friction,
+                      rollingFriction=P.object_rolling_friction,
+                      spinningFriction=P.object_spinning_friction,
+                      restitution=P.object_restitution)
+            if P.contact_stiffness > 0.0:
+                kw.update(contactStiffness=P.contact_stiffness, contactDamping=P.contact_damping)
+            bc.changeDynamics(self.obj, -1, **kw)
+            bc.resetBaseVelocity(self.obj, list(P.object_velocity),
+                                 list(P.object_angular_velocity))
+
+        # ---- command and bookkeeping
+        self._tau_cmd = np.zeros(dof)
+        self._tau_applied = np.zeros(dof)
+        self._clamped = np.zeros(dof, dtype=bool)
+        self._events: list[Occurrence] = []
+        self._t = 0.0
+        self._steps = 0
+        self.clamp_count = 0
+        self._in_contact = False
+        self._hold = 0.0
+        self._unhold = 0.0
+        self.caught = False
+        self._ever_caught = False
+        self._fallen = False
+        self.diverged = False
+        self._vel_over = np.zeros(dof, dtype=bool)
+        self._at_limit = np.zeros(dof, dtype=bool)
+        self._torque_episode = np.zeros(dof, dtype=bool)
+        self._obj_vel_before = (np.asarray(P.object_velocity, float) if self.obj is not None
+                                else np.zeros(3))
+        self._contacts: list = []
+        self._spec = self._make_spec(q0)
+
+    # ------------------------------------------------------------------ spec
+    def _make_spec(self, q0: np.ndarray) -> ArmSpec:
+        P = self.params
+        ht = self.hand_table
+        payload = hand_body(ht, self._hand_target) if ht is not None else None
+        model = wam_chain(self.dof, tool_d=self.tool_d, base_position=P.base_position,
+                          base_rpy=P.base_rpy, gravity=P.gravity, payload=payload,
+                          table=self._table)
+        hand = None
+        if ht is not None:
+            hand = HandSpec(name=ht.name, joint_names=ht.joint_names, lower=self._hand_lo,
+                            upper=self._hand_hi, open_posture=ht.open_posture,
+                            closed_posture=ht.closed_posture,
+                            closing_speed=float(P.hand_closing_speed),
+                            max_torque=float(P.hand_max_torque), mass=hand_mass(ht), table=ht)
+        obj = None
+        if self.obj is not None:
+            obj = ObjectSpec(kind=P.object, mass=float(P.object_mass),
+                             radius=float(P.object_radius) if P.object == "ball" else 0.0,
+                             size=tuple(P.object_size) if P.object == "box" else (0.0, 0.0, 0.0))
+        return ArmSpec(
+            name=P.arm, joint_names=self.joint_names, lower=self.lower, upper=self.upper,
+            torque_limits=self.torque_limits.copy(), velocity_limits=self.velocity_limits.copy(),
+            locked_joints=tuple(self.locked), initial_q=q0.copy(), model=model,
+            tool=model.tool.copy(), hand=hand, object=obj, gravity=float(P.gravity), dt=self.dt,
+            notes={"torque_limits": P.torque_limit_set if not P.torque_limits else "scenario",
+                   "velocity_limits": "scenario" if P.velocity_limits else
+                   f"assumed {DEFAULT_VELOCITY_LIMIT} rad/s (no table source)",
+                   "hand": ht.note if ht else "",
+                   "urdf": str(self.urdf_path)})
+
+    def spec(self) -> ArmSpec:
+        return self._spec
+
+    # ------------------------------------------------------------------ state
+    def arm_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """(q, qd) of every arm joint (locked ones at their lock value, zero speed)."""
+        q = np.zeros(self.dof)
+        qd = np.zeros(self.dof)
+        for n, v in self.locked.items():
+            q[self.joint_names.index(n)] = v
+        for k, st in enumerate(self.bc.getJointStates(self.robot, self._arm_j)):
+            q[self.active[k]], qd[self.active[k]] = st[0], st[1]
+        return q, qd
+
+    def hand_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if not self._hand_j:
+            return np.zeros(0), np.zeros(0), np.zeros(0)
+        st = self.bc.getJointStates(self.robot, self._hand_j)
+        return (np.array([s[0] for s in st]), np.array([s[1] for s in st]),
+                np.array([s[3] for s in st]))
+
+    def object_state(self):
+        pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
+        v, w = self.bc.getBaseVelocity(self.obj)
+        return np.array(pos), np.array(orn), np.array(v), np.array(w)
+
+    def effector_state(self):
+        """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity."""
+        ls = self.bc.getLinkState(self.robot, self._tool_link, computeLinkVelocity=1,
+                                  computeForwardKinematics=1)
+        return np.array(ls[4]), np.array(ls[5]), np.array(ls[6]), np.array(ls[7])
+
+    # ------------------------------------------------------------------ command
+    def apply(self, command: ArmCommand) -> None:
+        tau = np.asarray(command.torque, dtype=float).reshape(-1)
+        if tau.shape != (self.dof,):
+            raise ValueError(f"ArmCommand.torque needs {self.dof} values, got {tau.shape[0]}")
+        self._tau_cmd = tau
+        if command.hand is not None and self._hand_j:
+            h = np.asarray(command.hand, dtype=float).reshape(-1)
+            if h.shape != (len(self._hand_j),):
+                raise ValueError(f"ArmCommand.hand needs {len(self._hand_j)} values")
+            self._hand_target = np.clip(h, self._hand_lo, self._hand_hi)
+
+    def _limit_torque(self, qd: np.ndarray) -> None:
+        finite = np.isfinite(self._tau_cmd)
+        tau = np.where(finite, self._tau_cmd, 0.0)     # a non-finite command gives no torque
+        lim = self.torque_limits
+        applied = np.clip(tau, -lim, lim)
+        clamped = (applied != tau) | ~finite
+        if self.params.enforce_velocity_limits:
+            over = (np.abs(qd) >= self.velocity_limits) & (np.sign(applied) == np.sign(qd))
+            over &= applied != 0.0
+            applied = np.where(over, 0.0, applied)
+            clamped |= over
+        for n in self.locked:
+            i = self.joint_names.index(n)
+            applied[i] = 0.0
+            clamped[i] = False
+        for i in np.flatnonzero(clamped & ~self._torque_episode):
+            self._events.append(Occurrence("torque_limit", {
+                "joint": self.joint_names[i],
+                "commanded": float(tau[i]) if finite[i] else None,
+                "applied": float(applied[i]), "limit": float(lim[i])}))
+        self._torque_episode = clamped
+        self.clamp_count += int(clamped.sum())
+        self._tau_applied, self._clamped = applied, clamped
+
+    def step(self) -> None:
+        bc = self.bc
+        q, qd = self.arm_state()
+        self._limit_torque(qd)
+        bc.setJointMotorControlArray(self.robot, self._arm_j, p.TORQUE_CONTROL,
+                                     forces=[float(self._tau_applied[i]) for i in self.active])
+        if self._hand_j:
+            hq, _, _ = self.hand_state()
+            speed = self.params.hand_closing_speed
+            # rate-limited position servo: reach the target at most at the closing speed, the
+            # last step landing on it (PyBullet's velocity motor is implicit, so this is stable)
+            v = np.clip((self._hand_target - hq) / self.dt, -speed, speed)
+            bc.setJointMotorControlArray(self.robot, self._hand_j, p.VELOCITY_CONTROL,
+                                         targetVelocities=v.tolist(),
+                                         forces=[self.params.hand_max_torque] * len(v))
+        if self.obj is not None:
+            pos, _, v, _ = self.object_state()
+            self._obj_vel_before = v
+            if not self.params.object_gravity:
+                bc.applyExternalForce(self.obj, -1, [0.0, 0.0, self.params.object_mass
+                                                     * self.params.gravity],
+                                      pos.tolist(), p.WORLD_FRAME)
+        bc.stepSimulation()
+        self._steps += 1
+        self._t = self._steps * self.dt
+        self._check_events()
+
+    # ------------------------------------------------------------------ events
+    def _robot_contacts(self):
+        """Contact points object-robot that touch (normal force > 0 or no gap)."""
+        pts = self.bc.getContactPoints(bodyA=self.obj, bodyB=self.robot)
+        return [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
+
+    def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
+        if link < 0:
+            return np.zeros(3)
+        ls = self.bc.getLinkState(self.robot, link, computeLinkVelocity=1,
+                                  computeForwardKinematics=1)
+        return np.array(ls[6]) + np.cross(np.array(ls[7]), point - np.array(ls[0]))
+
+    def _check_events(self) -> None:
+        P = self.params
+        q, qd = self.arm_state()
+        finite = bool(np.all(np.isfinite(q)) and np.all(np.isfinite(qd)))
+        if self.obj is not None:
+            pos, orn, v, w = self.object_state()
+            finite = finite and bool(np.all(np.isfinite(pos)) and np.all(np.isfinite(v)))
+        if not finite:
+            if not self.diverged:
+                self.diverged = True
+                self._events.append(Occurrence("nan", {"step": self._steps}))
+            return
+        over = np.abs(qd) > self.velocity_limits
+        for i in np.flatnonzero(over & ~self._vel_over):
+            self._events.append(Occurrence("velocity_limit", {
+                "joint": self.joint_names[i], "velocity": float(qd[i]),
+                "limit": float(self.velocity_limits[i])}))
+        self._vel_over = over
+        at = (q <= self.lower + 1e-3) | (q >= self.upper - 1e-3)
+        for i in np.flatnonzero(at & ~self._at_limit):
+            if self.joint_names[i] in self.locked:
+                continue
+            self._events.append(Occurrence("joint_limit", {
+                "joint": self.joint_names[i], "position": float(q[i]),
+                "lower": float(self.lower[i]), "upper": float(self.upper[i])}))
+        self._at_limit = at
+        if self.obj is None:
+            return
+        contacts = self._robot_contacts()
+        self._contacts = contacts
+        links = sorted({self._link_name[c[4]] for c in contacts})
+        parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
+        if contacts and not self._in_contact:
+            c = max(contacts, key=lambda c: c[9])
+            point = np.array(c[6])
+            n = np.array(c[7])                         # from the robot towards the object
+            v_rel = self._obj_vel_before - self._link_point_velocity(c[4], point)
+            self._events.append(Occurrence("contact", {
+                "links": links, "parts": parts, "position": point.tolist(),
+                "speed": float(np.linalg.norm(v_rel)),
+                "normal_speed": float(-v_rel @ n),
+                "object_velocity_before": self._obj_vel_before.tolist(),
+                "object_velocity_after": v.tolist()}))
+        self._in_contact = bool(contacts)
+        # caught: touching enough hand parts and moving with the palm
+        hand_parts = [x for x in parts if x != "arm"]
+        held = False
+        if self._palm_link is not None and len(hand_parts) >= P.catch_min_parts:
+            rel = v - self._link_point_velocity(self._palm_link, pos)
+            held = float(np.linalg.norm(rel)) < P.catch_relative_speed
+        if held:
+            self._hold += self.dt
+            self._unhold = 0.0
+        else:
+            self._hold = 0.0
+            self._unhold += self.dt
+        eps = 1e-9
+        if held and not self.caught and self._hold >= P.catch_hold_time - eps:
+            self.caught = self._ever_caught = True
+            self._events.append(Occurrence("catch", {
+                "parts": hand_parts, "links": links, "position": pos.tolist(),
+                "hold_time": float(self._hold)}))
+        if self.caught and not held and self._unhold >= P.catch_hold_time - eps:
+            self.caught = False
+            self._events.append(Occurrence("release", {"position": pos.tolist()}))
+        if not self._fallen and pos[2] < P.miss_height:
+            self._fallen = True
+            kind = "drop" if self._ever_caught else "miss"
+            self._events.append(Occurrence(kind, {"position": pos.tolist(),
+                                                  "velocity": v.tolist()}))
+
+    def pop_events(self) -> list[Occurrence]:
+        ev, self._events = self._events, []
+        return ev
+
+    # ------------------------------------------------------------------ log and scene
+    def truth(self, t: float) -> dict:
+        q, qd = self.arm_state()
+        out = {
+            "/arm/joint_state": JointState(t, list(self.joint_names), q.tolist(), qd.tolist(),
+                                           self._tau_applied.tolist()),
+            "/arm/applied_torque": AppliedTorque(t, list(self.joint_names),
+                                                 [float(x) if math.isfinite(x) else None
+                                                  for x in self._tau_cmd.tolist()],
+                                                 self._tau_applied.tolist(),
+                                                 [bool(c) for c in self._clamped]),
+        }
+        if self._hand_j:
+            hq, hqd, heff = self.hand_state()
+            out["/hand/joint_state"] = JointState(t, list(self.hand_names), hq.tolist(),
+                                                  hqd.tolist(), heff.tolist())
+        pe, oe, ve, we = self.effector_state()
+        out["/effector/state"] = EffectorState(t, pe.tolist(), [])
+        out["/effector/motion"] = EffectorMotion(t, pe.tolist(), oe.tolist(), ve.tolist(),
+                                                 we.tolist(), float(np.linalg.norm(ve)))
+        if self.obj is not None:
+            pos, orn, v, w = self.object_state()
+            out["/object/state"] = ObjectState(t, pos.tolist(), orn.tolist(), v.tolist(),
+                                               w.tolist())
+            links = sorted({self._link_name[c[4]] for c in self._contacts})
+            out["/object/contacts"] = ObjectContacts(
+                t, sorted({self.model.part_of_link.get(l, "arm") for l in links}), links,
+                float(sum(c[9] for c in self._contacts)))
+        return out
+
+    def scene(self) -> Scene:
+        prims = []
+        if self.obj is not None:
+            pos, orn, _, _ = self.object_state()
+            if self.params.object == "ball":
+                prims.append(Sphere("ball", tuple(pos.tolist()), float(self.params.object_radius),
+                                    float(self.params.object_albedo)))
+            else:
+                prims.append(Box("box", tuple(pos.tolist()), tuple(orn.tolist()),
+                                 tuple(float(s) for s in self.params.object_size),
+                                 float(self.params.object_albedo)))
+        return Scene(prims)
+
+    # ------------------------------------------------------------------ cross-checks (tests)
+    def _full_dofs(self, q_arm, qd_arm=None, qdd_arm=None):
+        hq, _, _ = self.hand_state()
+        pos, vel, acc = [], [], []
+        arm_of = {self._jidx[self.joint_names[i]]: i for i in self.active}
+        hand_of = {j: k for k, j in enumerate(self._hand_j)}
+        for j in self._dofs:
+            if j in arm_of:
+                i = arm_of[j]
+                pos.append(float(q_arm[i]))
+                vel.append(0.0 if qd_arm is None else float(qd_arm[i]))
+                acc.append(0.0 if qdd_arm is None else float(qdd_arm[i]))
+            else:
+                pos.append(float(hq[hand_of[j]]))
+                vel.append(0.0)
+                acc.append(0.0)
+        return pos, vel, acc, [self._dofs.index(self._jidx[self.joint_names[i]])
+                               for i in self.active]
+
+    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
+        """PyBullet's inverse dynamics for the arm (hand joints frozen at their current angles);
+        locked joints' entries are NaN. For cross-checks in tests."""
+        pos, vel, acc, cols = self._full_dofs(q, qd, qdd)
+        tau = np.array(self.bc.calculateInverseDynamics(self.robot, pos, vel, acc))
+        out = np.full(self.dof, np.nan)
+        out[list(self.active)] = tau[cols]
+        return out
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """PyBullet's mass matrix of the active arm joints (hand frozen), len(active) square."""
+        pos, _, _, cols = self._full_dofs(q)
+        M = np.array(self.bc.calculateMassMatrix(self.robot, pos))
+        return M[np.ix_(cols, cols)]
+
+    def close(self) -> None:
+        if getattr(self, "bc", None) is not None:
+            try:
+                self.bc.disconnect()
+            except Exception:
+                pass
+            self.bc = None

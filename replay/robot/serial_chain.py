@@ -1,0 +1,467 @@
+"""A serial chain of revolute joints in standard (Spong) Denavit–Hartenberg form. Pure NumPy.
+
+Conventions (Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control*, Sec. 3.2):
+
+- Row i of the DH table is (alpha_i, a_i, d_i, theta_offset_i); joint i rotates about z_{i-1}, and
+  ``T^{i-1}_i = Rz(q_i + theta_offset_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``.
+- Frame 0 sits at ``base`` (a 4x4 world transform); frame i is fixed in link i.
+- Link i's mass properties are given in frame i: ``com`` is the centre of mass, ``inertia`` the
+  tensor about the centre of mass with axes aligned with frame i (libbarrett's convention).
+- The tool frame is ``tool`` (a constant 4x4) after the last DH frame; it has no mass.
+- Dynamics ``M(q) qdd + H(q, qd) qd + g(q) = tau`` (Namiki & Ishikawa eq. 15) computed by the
+  recursive Newton–Euler algorithm in world coordinates (Spong Sec. 7.5 / Craig Sec. 6.5):
+  ``g(q)`` is the torque that holds the arm still against gravity.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+
+def rot_x(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rot_y(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rot_z(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def transform(rotation: np.ndarray | None = None, translation=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """A 4x4 homogeneous transform."""
+    T = np.eye(4)
+    if rotation is not None:
+        T[:3, :3] = rotation
+    T[:3, 3] = translation
+    return T
+
+
+def dh_transform(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
+    """Standard DH: Rz(theta) Tz(d) Tx(a) Rx(alpha)."""
+    ct, st = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    return np.array([[ct, -st * ca, st * sa, a * ct],
+                     [st, ct * ca, -ct * sa, a * st],
+                     [0.0, sa, ca, d],
+                     [0.0, 0.0, 0.0, 1.0]])
+
+
+def quaternion_to_matrix(q) -> np.ndarray:
+    """[qx, qy, qz, qw] -> 3x3 rotation matrix."""
+    x, y, z, w = np.asarray(q, dtype=float) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def matrix_to_quaternion(R: np.ndarray) -> np.ndarray:
+    """3x3 rotation matrix -> [qx, qy, qz, qw] with qw >= 0."""
+    m = np.asarray(R, dtype=float)
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = 2.0 * np.sqrt(tr + 1.0)
+        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = [0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = [(m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
+    else:
+        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s, (m[1, 0] - m[0, 1]) / s]
+    q = np.array(q)
+    q /= np.linalg.norm(q)
+    return -q if q[3] < 0 else q
+
+
+def rpy_to_matrix(rpy) -> np.ndarray:
+    """URDF roll-pitch-yaw (fixed axes x, y, z): R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    r, p, y = rpy
+    return rot_z(y) @ rot_y(p) @ rot_x(r)
+
+
+def matrix_to_rpy(R: np.ndarray) -> tuple[float, float, float]:
+    """Inverse of :func:`rpy_to_matrix` (pitch in [-pi/2, pi/2])."""
+    R = np.asarray(R, dtype=float)
+    sp = -R[2, 0]
+    if abs(sp) < 1.0 - 1e-12:
+        pitch = float(np.arcsin(np.clip(sp, -1.0, 1.0)))
+        roll = float(np.arctan2(R[2, 1], R[2, 2]))
+        yaw = float(np.arctan2(R[1, 0], R[0, 0]))
+    else:  # gimbal lock: put everything in yaw
+        pitch = float(np.copysign(np.pi / 2, sp))
+        roll = 0.0
+        yaw = float(np.arctan2(-R[0, 1], R[1, 1]))
+    return roll, pitch, yaw
+
+
+@dataclass(frozen=True, eq=False)
+class RigidBody:
+    """Mass properties: ``com`` (m) in the body frame, ``inertia`` (kg*m^2) about the centre of
+    mass with axes aligned with the body frame."""
+    mass: float
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+    def __post_init__(self):
+        object.__setattr__(self, "com", np.asarray(self.com, dtype=float).reshape(3))
+        object.__setattr__(self, "inertia", np.asarray(self.inertia, dtype=float).reshape(3, 3))
+
+    def transformed(self, T: np.ndarray) -> RigidBody:
+        """The same body described in a frame F where ``T`` is this body frame's pose in F."""
+        R = T[:3, :3]
+        return RigidBody(self.mass, R @ self.com + T[:3, 3], R @ self.inertia @ R.T)
+
+    def combined(self, other: RigidBody) -> RigidBody:
+        """Two bodies in the same frame as one (parallel-axis theorem, Steiner)."""
+        m = self.mass + other.mass
+        if m <= 0.0:
+            return RigidBody(0.0)
+        c = (self.mass * self.com + other.mass * other.com) / m
+        inertia = np.zeros((3, 3))
+        for b in (self, other):
+            r = b.com - c
+            inertia += b.inertia + b.mass * (float(r @ r) * np.eye(3) - np.outer(r, r))
+        return RigidBody(m, c, inertia)
+
+
+@dataclass(frozen=True)
+class DHRow:
+    alpha: float
+    a: float
+    d: float
+    theta_offset: float = 0.0
+
+
+class SerialChain:
+    """Kinematics and rigid-body dynamics of a revolute serial chain (see the module docstring).
+
+    All joint-space arrays have length ``n`` (every joint of the chain). A locked joint is simply
+    held at a value by the caller; the matching rows/columns can be dropped with ``active``.
+    """
+
+    def __init__(self, dh: Sequence[DHRow], links: Sequence[RigidBody], *,
+                 base: np.ndarray | None = None, tool: np.ndarray | None = None,
+                 gravity: Sequence[float] = (0.0, 0.0, -9.81),
+                 joint_names: Sequence[str] | None = None) -> None:
+        if len(dh) != len(links):
+            raise ValueError(f"{len(dh)} DH rows but {len(links)} links")
+        self.dh = tuple(dh)
+        self.links = tuple(links)
+        self.n = len(self.dh)
+        self.base = np.eye(4) if base is None else np.asarray(base, dtype=float)
+        self.tool = np.eye(4) if tool is None else np.asarray(tool, dtype=float)
+        self.gravity = np.asarray(gravity, dtype=float)
+        self.joint_names = tuple(joint_names) if joint_names else tuple(
+            f"J{i + 1}" for i in range(self.n))
+        self._masses = np.array([b.mass for b in self.links])
+        self._coms = np.array([b.com for b in self.links])
+        self._inertias = np.array([b.inertia for b in self.links])
+
+    # ------------------------------------------------------------------ variants
+    def with_payload(self, body: RigidBody) -> SerialChain:
+        """The chain with ``body`` (given in the tool frame) rigidly added to the last link."""
+        last = self.links[-1].combined(body.transformed(self.tool))
+        return SerialChain(self.dh, self.links[:-1] + (last,), base=self.base, tool=self.tool,
+                           gravity=self.gravity, joint_names=self.joint_names)
+
+    def with_gravity(self, gravity: Sequence[float]) -> SerialChain:
+        return SerialChain(self.dh, self.links, base=self.base, tool=self.tool, gravity=gravity,
+                           joint_names=self.joint_names)
+
+    # ------------------------------------------------------------------ kinematics
+    def _q(self, q) -> np.ndarray:
+        q = np.asarray(q, dtype=float).reshape(-1)
+        if q.shape[0] != self.n:
+            raise ValueError(f"expected {self.n} joint values, got {q.shape[0]}")
+        return q
+
+    def frames(self, q) -> list[np.ndarray]:
+        """World transforms of frames 0..n (n+1 matrices; frame 0 is the base)."""
+        q = self._q(q)
+        T = [self.base]
+        for row, qi in zip(self.dh, q):
+            T.append(T[-1] @ dh_transform(row.alpha, row.a, row.d, qi + row.theta_offset))
+        return T
+
+    def fk(self, q) -> np.ndarray:
+        """World transform of the tool frame."""
+        return self.frames(q)[-1] @ self.tool
+
+    def tool_position(self, q) -> np.ndarray:
+        return self.fk(q)[:3, 3]
+
+    def jacobian(self, q, point_in_tool=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Geometric Jacobian (6 x n: linear velocity of the point, then angular velocity)."""
+        Ts = self.frames(q)
+        p = (Ts[-1] @ self.tool @ np.array([*point_in_tool, 1.0]))[:3]
+        J = np.zeros((6, self.n))
+        for i in range(self.n):
+            z, o = Ts[i][:3, 2], Ts[i][:3, 3]
+            J[:3, i] = np.cross(z, p - o)
+            J[3:, i] = z
+        return J
+
+    def position_jacobian(self, q, point_in_tool=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """d(point)/dq, 3 x n."""
+        return self.jacobian(q, point_in_tool)[:3]
+
+    def tool_motion(self, q, qd, qdd=None, point_in_tool=(0.0, 0.0, 0.0)):
+        """World position, velocity (J qd) and acceleration (J qdd + Jdot qd) of a tool point."""
+        q, qd = self._q(q), self._q(qd)
+        qdd = np.zeros(self.n) if qdd is None else self._q(qdd)
+        Ts = self.frames(q)
+        w = np.zeros(3)
+        dw = np.zeros(3)
+        v = np.zeros(3)   # of the origin o_{i-1}
+        a = np.zeros(3)
+        for i in range(self.n):
+            z, o0, o1 = Ts[i][:3, 2], Ts[i][:3, 3], Ts[i + 1][:3, 3]
+            dw = dw + z * qdd[i] + np.cross(w, z * qd[i])
+            w = w + z * qd[i]
+            r = o1 - o0
+            v = v + np.cross(w, r)
+            a = a + np.cross(dw, r) + np.cross(w, np.cross(w, r))
+        p = (Ts[-1] @ self.tool @ np.array([*point_in_tool, 1.0]))[:3]
+        r = p - Ts[-1][:3, 3]
+        return p, v + np.cross(w, r), a + np.cross(dw, r) + np.cross(w, np.cross(w, r))
+
+    # ------------------------------------------------------------------ dynamics
+    def rnea(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> np.ndarray:
+        """Inverse dynamics tau = M qdd + H qd + g: recursive Newton–Euler in world coordinates.
+
+        Forward pass: angular velocity/acceleration of link i and linear acceleration of o_{i-1}
+        (on joint i's axis, fixed in links i-1 and i); gravity enters as a base acceleration -g.
+        Backward pass: force and moment (about o_{i-1}) that link i-1 exerts on link i.
+        Written with 3-tuples of floats: for n <= 7 this is ~10x faster than small NumPy arrays.
+        """
+        q, qd, qdd = self._q(q), self._q(qd), self._q(qdd)
+        g = self.gravity if gravity is None else np.asarray(gravity, dtype=float)
+        Ts = self.frames(q)
+        n = self.n
+        qd_l, qdd_l = qd.tolist(), qdd.tolist()
+        zs = [tuple(T[:3, 2].tolist()) for T in Ts]
+        os_ = [tuple(T[:3, 3].tolist()) for T in Ts]
+        cs = [tuple((Ts[i + 1][:3, :3] @ self.links[i].com + Ts[i + 1][:3, 3]).tolist())
+              for i in range(n)]
+        Is = [(Ts[i + 1][:3, :3] @ self.links[i].inertia @ Ts[i + 1][:3, :3].T).tolist()
+              for i in range(n)]
+        w = (0.0, 0.0, 0.0)
+        dw = (0.0, 0.0, 0.0)
+        a_o = tuple((-g).tolist())
+        a_cs, ws, dws = [], [], []
+        for i in range(n):
+            z, o0, o1 = zs[i], os_[i], os_[i + 1]
+            zq = _scale(z, qd_l[i])
+            dw = _add3(dw, _scale(z, qdd_l[i]), _cross(w, zq))
+            w = _add(w, zq)
+            rc = _sub(cs[i], o0)
+            a_cs.append(_add3(a_o, _cross(dw, rc), _cross(w, _cross(w, rc))))
+            ws.append(w)
+            dws.append(dw)
+            r = _sub(o1, o0)
+            a_o = _add3(a_o, _cross(dw, r), _cross(w, _cross(w, r)))
+        tau = np.zeros(n)
+        f_next = (0.0, 0.0, 0.0)
+        n_next = (0.0, 0.0, 0.0)       # moment about o_i exerted on link i+1
+        for i in reversed(range(n)):
+            m = self.links[i].mass
+            o0, o1 = os_[i], os_[i + 1]
+            ma = _scale(a_cs[i], m)
+            f = _add(ma, f_next)
+            Iw = _matvec(Is[i], ws[i])
+            nm = _add3(_add(_matvec(Is[i], dws[i]), _cross(ws[i], Iw)),
+                       _cross(_sub(cs[i], o0), ma),
+                       _add(n_next, _cross(_sub(o1, o0), f_next)))
+            z = zs[i]
+            tau[i] = z[0] * nm[0] + z[1] * nm[1] + z[2] * nm[2]
+            f_next, n_next = f, nm
+        return tau
+
+    def _link_jacobians(self, q):
+        """Per link i: COM Jacobian Jv (n, n, 3), angular Jw (n, n, 3), world inertia (n, 3, 3)."""
+        Ts = self.frames(q)
+        n = self.n
+        z = np.array([T[:3, 2] for T in Ts[:-1]])                     # joint axes z_0..z_{n-1}
+        o = np.array([T[:3, 3] for T in Ts[:-1]])
+        R = np.array([T[:3, :3] for T in Ts[1:]])
+        c = np.einsum("ijk,ik->ij", R, self._coms) + np.array([T[:3, 3] for T in Ts[1:]])
+        mask = np.tril(np.ones((n, n)))[:, :, None]                   # joint j moves link i>=j
+        Jv = np.cross(np.broadcast_to(z, (n, n, 3)), c[:, None, :] - o[None, :, :]) * mask
+        Jw = np.broadcast_to(z, (n, n, 3)) * mask
+        Iw = np.einsum("iab,ibc,idc->iad", R, self._inertias, R)
+        return Jv, Jw, Iw
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """M(q) = sum_i m_i Jv_i^T Jv_i + Jw_i^T I_i Jw_i (Spong eq. 7.50); an algorithm
+        independent of :meth:`rnea`, so the two check each other."""
+        Jv, Jw, Iw = self._link_jacobians(self._q(q))
+        M = (np.einsum("i,ijk,ilk->jl", self._masses, Jv, Jv)
+             + np.einsum("ijk,ikm,ilm->jl", Jw, Iw, Jw))
+        return 0.5 * (M + M.T)
+
+    def coriolis(self, q, qd) -> np.ndarray:
+        """H(q, qd) qd: Coriolis and centrifugal torques."""
+        return self.rnea(q, qd, np.zeros(self.n), gravity=np.zeros(3))
+
+    def gravity_torque(self, q) -> np.ndarray:
+        """g(q) = dV/dq = -sum_i m_i Jv_i^T g: the joint torques that hold the chain still."""
+        Jv, _, _ = self._link_jacobians(self._q(q))
+        return -np.einsum("i,ijk,k->j", self._masses, Jv, self.gravity)
+
+    def forward_dynamics(self, q, qd, tau) -> np.ndarray:
+        """qdd = M^-1 (tau - H qd - g)."""
+        return np.linalg.solve(self.mass_matrix(q), np.asarray(tau, float) - self.rnea(
+            q, qd, np.zeros(self.n)))
+
+    # ------------------------------------------------------------------ batched (leading axis)
+    def frames_batch(self, Q) -> np.ndarray:
+        """World transforms of frames 0..n for many configurations: Q (N, n) -> (N, n+1, 4, 4)."""
+        Q = np.asarray(Q, dtype=float).reshape(-1, self.n)
+        N = Q.shape[0]
+        out = np.empty((N, self.n + 1, 4, 4))
+        out[:, 0] = self.base
+        for i, row in enumerate(self.dh):
+            th = Q[:, i] + row.theta_offset
+            ct, st = np.cos(th), np.sin(th)
+            ca, sa = math.cos(row.alpha), math.sin(row.alpha)
+            A = np.zeros((N, 4, 4))
+            A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = ct, -st * ca, st * sa, row.a * ct
+            A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = st, ct * ca, -ct * sa, row.a * st
+            A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, row.d
+            A[:, 3, 3] = 1.0
+            out[:, i + 1] = out[:, i] @ A
+        return out
+
+    def tool_position_batch(self, Q) -> np.ndarray:
+        """(N, n) -> (N, 3)."""
+        return (self.frames_batch(Q)[:, -1] @ self.tool)[:, :3, 3]
+
+    def _link_jacobians_batch(self, Q):
+        Ts = self.frames_batch(Q)
+        n = self.n
+        z = Ts[:, :-1, :3, 2]                                   # (N, n, 3) axes z_0..z_{n-1}
+        o = Ts[:, :-1, :3, 3]
+        R = Ts[:, 1:, :3, :3]                                   # (N, n, 3, 3)
+        c = np.einsum("lijk,ik->lij", R, self._coms) + Ts[:, 1:, :3, 3]
+        mask = np.tril(np.ones((n, n)))[None, :, :, None]
+        zb = np.broadcast_to(z[:, None, :, :], (z.shape[0], n, n, 3))
+        Jv = np.cross(zb, c[:, :, None, :] - o[:, None, :, :]) * mask   # (N, link, joint, 3)
+        Jw = zb * mask
+        Iw = np.einsum("liab,ibc,lidc->liad", R, self._inertias, R)
+        return Jv, Jw, Iw
+
+    def mass_matrix_batch(self, Q) -> np.ndarray:
+        """M for many configurations: (N, n) -> (N, n, n)."""
+        Jv, Jw, Iw = self._link_jacobians_batch(Q)
+        Jv_t = np.swapaxes(Jv, 2, 3)                            # (N, link, 3, joint)
+        Jw_t = np.swapaxes(Jw, 2, 3)
+        M = (np.einsum("i,nikj,nikl->njl", self._masses, Jv_t, Jv_t, optimize=True)
+             + (np.swapaxes(Jw_t, 2, 3) @ (Iw @ Jw_t)).sum(axis=1))
+        return 0.5 * (M + np.swapaxes(M, 1, 2))
+
+    def gravity_torque_batch(self, Q) -> np.ndarray:
+        """g for many configurations: (N, n) -> (N, n)."""
+        Jv, _, _ = self._link_jacobians_batch(Q)
+        return -np.einsum("i,nijk,k->nj", self._masses, Jv, self.gravity)
+
+    def rnea_batch(self, Q, QD, QDD, gravity: Sequence[float] | None = None) -> np.ndarray:
+        """tau = M qdd + H qd + g for many states: each (N, n) -> (N, n). Same recursion as
+        :meth:`rnea`, vectorised over the leading axis."""
+        Q = np.asarray(Q, dtype=float).reshape(-1, self.n)
+        QD = np.asarray(QD, dtype=float).reshape(Q.shape)
+        QDD = np.asarray(QDD, dtype=float).reshape(Q.shape)
+        g = self.gravity if gravity is None else np.asarray(gravity, dtype=float)
+        Ts = self.frames_batch(Q)
+        N, n = Q.shape
+        w = np.zeros((N, 3))
+        dw = np.zeros((N, 3))
+        a_o = np.broadcast_to(-g, (N, 3)).copy()
+        keep = []
+        for i in range(n):
+            z, o0, o1 = Ts[:, i, :3, 2], Ts[:, i, :3, 3], Ts[:, i + 1, :3, 3]
+            R1 = Ts[:, i + 1, :3, :3]
+            zq = z * QD[:, i:i + 1]
+            dw = dw + z * QDD[:, i:i + 1] + np.cross(w, zq)
+            w = w + zq
+            c = R1 @ self.links[i].com + o1
+            rc = c - o0
+            a_c = a_o + np.cross(dw, rc) + np.cross(w, np.cross(w, rc))
+            Iw = R1 @ self.links[i].inertia @ np.swapaxes(R1, 1, 2)
+            keep.append((z, o0, o1, c, a_c, w, dw, Iw))
+            r = o1 - o0
+            a_o = a_o + np.cross(dw, r) + np.cross(w, np.cross(w, r))
+        tau = np.zeros((N, n))
+        f_next = np.zeros((N, 3))
+        n_next = np.zeros((N, 3))
+        for i in reversed(range(n)):
+            z, o0, o1, c, a_c, w_i, dw_i, Iw = keep[i]
+            ma = self.links[i].mass * a_c
+            f = ma + f_next
+            nm = (np.einsum("nab,nb->na", Iw, dw_i)
+                  + np.cross(w_i, np.einsum("nab,nb->na", Iw, w_i))
+                  + np.cross(c - o0, ma) + n_next + np.cross(o1 - o0, f_next))
+            tau[:, i] = np.einsum("na,na->n", z, nm)
+            f_next, n_next = f, nm
+        return tau
+
+    def coriolis_batch(self, Q, QD) -> np.ndarray:
+        """H(q, qd) qd for many states: (N, n) -> (N, n)."""
+        Q = np.asarray(Q, dtype=float).reshape(-1, self.n)
+        return self.rnea_batch(Q, QD, np.zeros_like(Q), gravity=np.zeros(3))
+
+    def link_bodies_world(self, q) -> list[RigidBody]:
+        """Each link's mass properties in world coordinates (for checks and drawing)."""
+        Ts = self.frames(q)
+        return [b.transformed(Ts[i + 1]) for i, b in enumerate(self.links)]
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def _add3(a, b, c):
+    return (a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2])
+
+
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _scale(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def _matvec(m, v):
+    return (m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
+            m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
+            m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2])
+
+
+def active_block(x: np.ndarray, active: Sequence[int]) -> np.ndarray:
+    """Rows (and columns, for a square matrix) of the active joints."""
+    idx = np.asarray(active, dtype=int)
+    x = np.asarray(x)
+    if x.ndim == 2 and x.shape[0] == x.shape[1]:
+        return x[np.ix_(idx, idx)]
+    return x[idx]
+
+
+__all__ = ["DHRow", "RigidBody", "SerialChain", "active_block", "dh_transform", "transform",
+           "rot_x", "rot_y", "rot_z", "quaternion_to_matrix", "matrix_to_quaternion",
+           "rpy_to_matrix", "matrix_to_rpy"]
