@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 
 @dataclass(frozen=True)
 class Box:
@@ -61,3 +63,17 @@ def quaternion_yaw(q) -> float:
     """Yaw (rad) of a rotation that is about +z only."""
     qx, qy, qz, qw = q
     return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+
+
+def quaternion_matrix(q) -> np.ndarray:
+    """Rotation matrix of a quaternion [qx, qy, qz, qw] (normalised here)."""
+    x, y, z, w = (float(v) for v in q)
+    n = x * x + y * y + z * z + w * w
+    if n == 0.0:
+        raise ValueError("zero quaternion")
+    s = 2.0 / n
+    return np.array([
+        [1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
+        [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
+        [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)],
+    ])

@@ -47,27 +47,13 @@ import numpy as np
 from replay.interfaces import Sensor
 from replay.messages import VisionStick
 from replay.params import param
-from replay.scene import Box, Cylinder, Scene, Sphere
+from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix
 from replay.vision.pinhole import PinholeCamera
 
 _RIM = 48             # vertices of a polygon standing in for a circle
 
 
 # --- geometry of primitives ----------------------------------------------------------------
-
-def quaternion_matrix(q) -> np.ndarray:
-    """Rotation matrix of a unit quaternion [qx, qy, qz, qw]."""
-    x, y, z, w = (float(v) for v in q)
-    n = x * x + y * y + z * z + w * w
-    if n == 0.0:
-        raise ValueError("zero quaternion")
-    s = 2.0 / n
-    return np.array([
-        [1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
-        [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
-        [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)],
-    ])
-
 
 def box_corners(box: Box) -> np.ndarray:
     """The 8 corners (8, 3) of a box in world coordinates; the last 4 are the body +z face."""
