@@ -1,0 +1,89 @@
+"""What the catching method needs of a robot model, in the active coordinates p = (q1, q2, q4).
+
+Wraps either ``replay.robot.SerialChain`` (``ArmModel.from_chain``) or four plain callables on the
+full joint vector (``ArmModel(fk, mass_matrix, bias, gravity)``): fk(q) -> the catch point
+l(q) (3,), mass_matrix(q) -> M (n, n), bias(q, qd) -> H(q, qd) qd + g(q) (n,), gravity(q) -> g (n,)
+(eq. 15). Locked joints are held at ``q_fixed`` with zero speed and acceleration.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+import numpy as np
+
+
+class ArmModel:
+    def __init__(self, fk: Callable, mass_matrix: Callable, bias: Callable, gravity: Callable, *,
+                 n: int = 4, active: Sequence[int] = (0, 1, 3), q_fixed=None,
+                 inverse_dynamics: Callable | None = None) -> None:
+        self._fk, self._M, self._bias, self._g = fk, mass_matrix, bias, gravity
+        self._id = inverse_dynamics
+        self.n = n
+        self.active = np.asarray(active, dtype=int)
+        self.q_fixed = np.zeros(n) if q_fixed is None else np.asarray(q_fixed, float).copy()
+
+    @classmethod
+    def from_chain(cls, chain, *, active=(0, 1, 3), q_fixed=None, point_in_tool=(0.0, 0.0, 0.0)):
+        """A ``replay.robot.SerialChain``; l(q) is the point ``point_in_tool`` of its tool frame."""
+        pt = np.array([*point_in_tool, 1.0])
+
+        def fk(q):
+            return (chain.frames(q)[-1] @ chain.tool @ pt)[:3]
+
+        return cls(fk, chain.mass_matrix,
+                   lambda q, qd: chain.rnea(q, qd, np.zeros(chain.n)),
+                   chain.gravity_torque, n=chain.n, active=active, q_fixed=q_fixed,
+                   inverse_dynamics=chain.rnea)
+
+    # ---- coordinates
+    def full(self, p) -> np.ndarray:
+        q = self.q_fixed.copy()
+        q[self.active] = p
+        return q
+
+    def full_rate(self, pd) -> np.ndarray:
+        q = np.zeros(self.n)
+        q[self.active] = pd
+        return q
+
+    # ---- kinematics (full q)
+    def fk(self, q) -> np.ndarray:
+        return np.asarray(self._fk(np.asarray(q, float)), float)
+
+    def point(self, p) -> np.ndarray:
+        """l(q) (eq. 3) at active coordinates p."""
+        return self.fk(self.full(p))
+
+    # ---- dynamics: eq. 15, full joint vector in and out
+    def inverse_dynamics_full(self, q, qd, qdd) -> np.ndarray:
+        if self._id is not None:
+            return np.asarray(self._id(q, qd, qdd), float)
+        return self._M(q) @ qdd + self._bias(q, qd)
+
+    def tau(self, p, pd, pdd) -> np.ndarray:
+        """Active joint torques of eq. 15 / 17 (the locked joint's holding torque dropped)."""
+        return self.inverse_dynamics_full(self.full(p), self.full_rate(pd),
+                                          self.full_rate(pdd))[self.active]
+
+    def tau_full(self, p, pd, pdd) -> np.ndarray:
+        return self.inverse_dynamics_full(self.full(p), self.full_rate(pd), self.full_rate(pdd))
+
+    def mass(self, p) -> np.ndarray:
+        M = np.asarray(self._M(self.full(p)), float)
+        return M[np.ix_(self.active, self.active)]
+
+    def gravity_full(self, q) -> np.ndarray:
+        return np.asarray(self._g(np.asarray(q, float)), float)
+
+    def tau_and_partials(self, p, pd, pdd, h: float = 1e-6):
+        """tau, d tau/dp, d tau/dpd (forward differences) and M (active blocks)."""
+        tau = self.tau(p, pd, pdd)
+        Tq = np.empty((len(p), len(p)))
+        Tqd = np.empty_like(Tq)
+        for k in range(len(p)):
+            e = np.zeros(len(p))
+            e[k] = h
+            Tq[:, k] = (self.tau(p + e, pd, pdd) - tau) / h
+            Tqd[:, k] = (self.tau(p, pd + e, pdd) - tau) / h
+        return tau, Tq, Tqd, self.mass(p)
