@@ -106,5 +106,5 @@ class Controller(ABC):
         return []
 
     def telemetry(self, t: float) -> dict[str, Any]:
-        """Extra topics to log this control step: topic -> payload."""
+        """Extra topics to log this control step: topic -> payload (or a list of payloads)."""
         return {}

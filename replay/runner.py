@@ -141,7 +141,8 @@ class Runner:
                     for occ in self.controller.pop_events():
                         stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
                     for topic, payload in self.controller.telemetry(t).items():
-                        self._write(log, topic, payload, t_ns)
+                        for item in (payload if isinstance(payload, list) else [payload]):
+                            self._write(log, topic, item, t_ns)
                 if k % self.log_div == 0:
                     for topic, payload in self.plant.truth(t).items():
                         self._write(log, topic, payload, t_ns)

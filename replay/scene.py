@@ -44,8 +44,10 @@ Primitive = Box | Sphere | Cylinder
 
 @dataclass
 class Scene:
-    """The visible primitives at one instant, by name."""
+    """What sensors can measure at one instant: the visible primitives, by name, and the
+    robot's own readings (e.g. joint encoders: reading name -> payload)."""
     primitives: list = field(default_factory=list)
+    readings: dict = field(default_factory=dict)
 
     def get(self, name: str):
         for p in self.primitives:

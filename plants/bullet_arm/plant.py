@@ -509,7 +509,9 @@ class BulletArmPlant(Plant):
                 prims.append(Box("box", tuple(pos.tolist()), tuple(orn.tolist()),
                                  tuple(float(s) for s in self.params.object_size),
                                  float(self.params.object_albedo)))
-        return Scene(prims)
+        q, qd = self.arm_state()
+        encoders = {"name": list(self.joint_names), "position": q.tolist(), "velocity": qd.tolist()}
+        return Scene(prims, readings={"arm": encoders})
 
     # ------------------------------------------------------------------ cross-checks (tests)
     def _full_dofs(self, q_arm, qd_arm=None, qdd_arm=None):

@@ -3,7 +3,7 @@
 At each control step (1 kHz) the controller
 
 1. takes the newest stereo position r_o ("/vision/object", one frame old) and the joint state
-   ("/arm/joint_state", from an encoder sensor; without it the torque is the feed-forward only);
+   ("/arm/encoders", from the joint_encoders sensor; without it the torque is the feed-forward only);
 2. estimates r_o' (and r_o'' = g) with a ballistic least-squares fit (:mod:`.estimator`) and,
    optionally, carries r_o forward over the measurement's age (latency compensation);
 3. maps q_d = f(r_o) (eq. 7), qd_d = F r_o' (eq. 23), qdd_d = F r_o'' + Fdot r_o' (eq. 16);
@@ -239,7 +239,7 @@ class CatchingController(Controller):
         for topic, m in measurements:
             if topic == "/vision/object":
                 self.est.add(m.t, m.position)
-            elif topic == "/arm/joint_state":
+            elif topic in ("/arm/encoders", "/arm/joint_state"):
                 self._joint_state(m)
         P = self.params
         act = list(self.active)
