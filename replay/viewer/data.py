@@ -1,0 +1,250 @@
+"""Log -> compact NumPy arrays: one :class:`Track` per topic, found by time with ``searchsorted``.
+
+A log is read once, message by message (the MCAP reader decompresses one chunk at a time), and
+each message's numbers go straight into preallocated float64 columns: the decoded JSON is
+dropped at once, so the file is never held in memory twice. Non-numeric fields (joint names)
+are kept once, from a topic's first message. The same accumulator grows during a live run
+(``replay run --view``), where the runner hands it each message as it is written.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from replay.log import LogError, LogReader
+from replay.messages import to_dict
+from replay.viewer.errors import ViewerError
+
+# topics kept as Python objects rather than columns (few messages, free-form data)
+OBJECT_TOPICS = ("/scenario", "/events")
+
+
+@dataclass
+class Track:
+    """One topic's messages as columns: ``t`` (s, ascending) and ``fields[name]`` (n, ...)."""
+    topic: str
+    t: np.ndarray
+    fields: dict[str, np.ndarray]
+    labels: dict[str, Any] = field(default_factory=dict)   # non-numeric fields, first message
+    ragged: tuple[str, ...] = ()                            # fields whose shape changed (NaN rows)
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def index(self, t: float) -> int:
+        """The last message at or before ``t`` (-1 before the first one)."""
+        return int(np.searchsorted(self.t, t + 1e-12, side="right")) - 1
+
+    def at(self, name: str, t: float):
+        """Field ``name`` of the last message at or before ``t``, or None."""
+        i = self.index(t)
+        col = self.fields.get(name)
+        if i < 0 or col is None:
+            return None
+        return col[i]
+
+    def has(self, name: str) -> bool:
+        return name in self.fields and len(self.t) > 0
+
+
+def _shape_of(value) -> tuple | None:
+    """Column shape of a JSON value: () number, (n,) list of numbers, (n, m) list of lists;
+    None for anything else (strings, objects, empty or mixed lists)."""
+    if isinstance(value, (bool, int, float)):
+        return ()
+    if isinstance(value, list) and value:
+        if all(isinstance(v, (bool, int, float)) for v in value):
+            return (len(value),)
+        if all(isinstance(v, list) and v for v in value):
+            n = len(value[0])
+            if all(len(v) == n and all(isinstance(x, (bool, int, float)) for x in v)
+                   for v in value):
+                return (len(value), n)
+    return None
+
+
+class _TrackBuilder:
+    def __init__(self, topic: str, capacity: int) -> None:
+        self.topic = topic
+        self.cap = max(8, capacity)
+        self.n = 0
+        self.t = np.empty(self.cap)
+        self.cols: dict[str, np.ndarray] | None = None
+        self.labels: dict[str, Any] = {}
+        self.ragged: set[str] = set()
+
+    def _layout(self, data: dict) -> None:
+        self.cols = {}
+        for name, value in data.items():
+            if name == "t":
+                continue
+            shape = _shape_of(value)
+            if shape is None:
+                self.labels[name] = value
+            else:
+                self.cols[name] = np.full((self.cap, *shape), np.nan)
+
+    def _grow(self) -> None:
+        self.cap *= 2
+        t = np.empty(self.cap)
+        t[:self.n] = self.t[:self.n]
+        self.t = t
+        for name, col in self.cols.items():
+            new = np.full((self.cap, *col.shape[1:]), np.nan)
+            new[:self.n] = col[:self.n]
+            self.cols[name] = new
+
+    def add(self, t_ns: int, data: dict) -> None:
+        if self.cols is None:
+            self._layout(data)
+        if self.n == self.cap:
+            self._grow()
+        n = self.n
+        self.t[n] = t_ns * 1e-9
+        for name, col in self.cols.items():
+            value = data.get(name)
+            shape = col.shape[1:]
+            try:
+                if shape and (not isinstance(value, list) or len(value) != shape[0] or
+                              (len(shape) > 1 and np.shape(value) != shape)):
+                    raise ValueError(name)      # no broadcasting of a shorter list
+                col[n] = value
+            except (TypeError, ValueError):     # missing, or its shape changed
+                col[n] = np.nan
+                self.ragged.add(name)
+        self.n = n + 1
+
+    def track(self) -> Track:
+        n = self.n
+        return Track(self.topic, self.t[:n], {k: v[:n] for k, v in (self.cols or {}).items()},
+                     dict(self.labels), tuple(sorted(self.ragged)))
+
+
+@dataclass
+class RunData:
+    """One run as the viewer sees it: its scenario, its tracks, its events."""
+    label: str                               # scenario name, or the file name
+    path: Path | None
+    scenario: dict                           # the /scenario message ({} if absent)
+    config: dict                             # the resolved scenario YAML, parsed ({} if absent)
+    tracks: dict[str, Track]
+    events: list[dict]
+    truncated: bool = False
+    notes: list[str] = field(default_factory=list)   # what the viewer could not show, and why
+
+    def track(self, topic: str) -> Track | None:
+        tr = self.tracks.get(topic)
+        return tr if tr is not None and len(tr) else None
+
+    @property
+    def plant_type(self) -> str:
+        return str((self.config.get("plant") or {}).get("type", ""))
+
+    @property
+    def plant_params(self) -> dict:
+        return dict((self.config.get("plant") or {}).get("params") or {})
+
+    @property
+    def sensors(self) -> dict:
+        return dict(self.config.get("sensors") or {})
+
+    def time_range(self) -> tuple[float, float]:
+        ts = [tr.t for tr in self.tracks.values() if len(tr)]
+        ts += [np.array([e["t"] for e in self.events], dtype=float)] if self.events else []
+        if not ts:
+            return 0.0, 0.0
+        return float(min(a[0] for a in ts if len(a))), float(max(a[-1] for a in ts if len(a)))
+
+
+class RunAccumulator:
+    """Messages in, :class:`RunData` out; safe to snapshot from another thread while it grows."""
+
+    def __init__(self, path: Path | None = None, counts: dict[str, int] | None = None) -> None:
+        self.path = path
+        self.counts = counts or {}
+        self.scenario: dict = {}
+        self.events: list[dict] = []
+        self.builders: dict[str, _TrackBuilder] = {}
+        self.t_last = 0.0
+        self._lock = threading.Lock()
+
+    def add(self, topic: str, t_ns: int, data: dict) -> None:
+        with self._lock:
+            self.t_last = max(self.t_last, t_ns * 1e-9)
+            if topic == "/scenario":
+                self.scenario = data
+            elif topic == "/events":
+                self.events.append({"t": t_ns * 1e-9, **data} if "t" not in data else data)
+            else:
+                b = self.builders.get(topic)
+                if b is None:
+                    b = self.builders[topic] = _TrackBuilder(topic, self.counts.get(topic, 256))
+                b.add(t_ns, data)
+
+    def observe(self, topic: str, payload, t_ns: int) -> None:
+        """A runner observer: ``Runner(..., observers=(acc.observe,))``."""
+        self.add(topic, t_ns, to_dict(payload))
+
+    def snapshot(self, truncated: bool = False) -> RunData:
+        with self._lock:
+            tracks = {topic: b.track() for topic, b in self.builders.items()}
+            events = list(self.events)
+            scenario = dict(self.scenario)
+        config, notes = {}, []
+        if scenario.get("yaml"):
+            try:
+                config = yaml.safe_load(scenario["yaml"]) or {}
+            except yaml.YAMLError as exc:
+                notes.append(f"scenario YAML unreadable ({exc.__class__.__name__}); "
+                             "default geometry used")
+            if not isinstance(config, dict):
+                config = {}
+        label = scenario.get("name") or (self.path.stem if self.path else "live run")
+        for tr in tracks.values():
+            for name in tr.ragged:
+                notes.append(f"{tr.topic}.{name} changes shape or is missing in some messages; "
+                             "those messages are left out")
+        return RunData(label=str(label), path=self.path, scenario=scenario, config=config,
+                       tracks=tracks, events=events, truncated=truncated, notes=notes)
+
+
+def load_run(path: str | Path) -> RunData:
+    """Read a run's log into arrays. Raises :class:`ViewerError` (one line) if it cannot."""
+    path = Path(path)
+    try:
+        reader = LogReader(path)
+        counts = {} if reader.truncated else reader.topic_counts()
+        acc = RunAccumulator(path, counts)
+        for m in reader.messages():
+            acc.add(m.topic, m.t_ns, m.data)
+    except ViewerError:
+        raise
+    except LogError as exc:
+        raise ViewerError(str(exc)) from None
+    except (ValueError, OSError) as exc:      # a corrupt message (bad JSON) or a read error
+        raise ViewerError(f"{path}: unreadable log ({exc})") from None
+    run = acc.snapshot(truncated=reader.truncated)
+    if not run.tracks and not run.events:
+        why = " (truncated before its first chunk)" if reader.truncated else ""
+        raise ViewerError(f"{path}: the log holds no messages{why}")
+    if reader.truncated:
+        _, t1 = run.time_range()
+        run.notes.insert(0, f"truncated log: read up to t = {t1:.4f} s")
+    if not run.scenario:
+        run.notes.append("no /scenario message: default geometry used")
+    return run
+
+
+def resample(t: np.ndarray, y: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """``y(t)`` on ``grid`` by linear interpolation (held constant outside ``t``)."""
+    y = np.asarray(y, dtype=float)
+    good = np.isfinite(y)
+    if not good.any():
+        return np.zeros_like(grid)
+    return np.interp(grid, t[good], y[good])
