@@ -149,32 +149,56 @@ def _fill(img: np.ndarray, poly: np.ndarray, grey: float) -> None:
     roi += alpha * (np.float32(grey) - roi)
 
 
-def render_scene(camera: PinholeCamera, scene: Scene, *, background: float = 0.1) -> np.ndarray:
-    """A noiseless float32 grey image (0..255) of the scene; ``background`` is an albedo.
-
-    Every primitive is drawn as its silhouette (the convex hull of its projected outline) with
-    grey level ``255 * albedo``, far ones first (painter's order by the distance of each
-    primitive's centre from the camera: a marker lying on a stick, centred above the stick's
-    centre, is nearer to any camera above the table; nearest depth fails for oblique views of
-    such stacks). Primitives reaching behind the camera are not drawn.
-    """
-    k = camera.intrinsics
-    img = np.full((k.height, k.width), 255.0 * background, np.float32)
+def _projected_items(camera: PinholeCamera, scene: Scene) -> list:
+    """(distance, albedo, convex hull in pixels) of each drawable primitive, far ones first
+    (painter's order by the distance of each primitive's centre from the camera: a marker lying
+    on a stick, centred above the stick's centre, is nearer to any camera above the table;
+    nearest depth fails for oblique views of such stacks). Primitives reaching behind the camera
+    are not drawn."""
     items = []
     for prim in scene.primitives:
         pts = _outline_points(camera, prim)
-        if len(pts) == 0:
+        if len(pts) == 0 or np.any(camera.to_camera(pts)[:, 2] <= 1e-6):
             continue
-        if np.any(camera.to_camera(pts)[:, 2] <= 1e-6):
-            continue
-        distance = float(np.linalg.norm(np.asarray(prim.position, dtype=float) - camera.position))
-        items.append((distance, prim, pts))
-    items.sort(key=lambda it: -it[0])
-    for _, prim, pts in items:
         uv = camera.project(pts).astype(np.float32)
         hull = cv2.convexHull(uv).reshape(-1, 2).astype(np.float64)
         if len(hull) >= 3:
-            _fill(img, hull, 255.0 * float(prim.albedo))
+            distance = float(np.linalg.norm(np.asarray(prim.position, dtype=float)
+                                            - camera.position))
+            items.append((distance, float(prim.albedo), hull, prim.name))
+    items.sort(key=lambda it: -it[0])
+    return items
+
+
+def hull_window(camera: PinholeCamera, hull: np.ndarray, margin: int = 8):
+    """The pixel box (x0, y0, x1, y1) around a silhouette plus ``margin``, clipped to the image
+    (None if it is off the image)."""
+    k = camera.intrinsics
+    x0 = max(int(math.floor(hull[:, 0].min())) - margin, 0)
+    y0 = max(int(math.floor(hull[:, 1].min())) - margin, 0)
+    x1 = min(int(math.ceil(hull[:, 0].max())) + margin + 1, k.width)
+    y1 = min(int(math.ceil(hull[:, 1].max())) + margin + 1, k.height)
+    return None if x1 <= x0 or y1 <= y0 else (x0, y0, x1, y1)
+
+
+def render_scene(camera: PinholeCamera, scene: Scene, *, background: float = 0.1,
+                 window=None, items=None) -> np.ndarray:
+    """A noiseless float32 grey image (0..255) of the scene; ``background`` is an albedo.
+
+    Every primitive is drawn as its silhouette (the convex hull of its projected outline) with
+    grey level ``255 * albedo``, far ones first. With ``window = (x0, y0, x1, y1)`` only that
+    part of the image is rendered (pixel (x0, y0) of the image is pixel (0, 0) of the result);
+    ``items`` are ``_projected_items`` already computed.
+    """
+    k = camera.intrinsics
+    x0, y0, x1, y1 = window if window is not None else (0, 0, k.width, k.height)
+    img = np.full((y1 - y0, x1 - x0), 255.0 * background, np.float32)
+    offset = np.array([x0, y0], dtype=float)
+    for _, albedo, hull, _ in (items if items is not None else _projected_items(camera, scene)):
+        lo, hi = hull.min(axis=0), hull.max(axis=0)
+        if hi[0] < x0 - 1 or hi[1] < y0 - 1 or lo[0] > x1 or lo[1] > y1:
+            continue                                     # wholly outside the window
+        _fill(img, hull - offset, 255.0 * albedo)
     return img
 
 
@@ -248,7 +272,7 @@ class StickCamera(Sensor):
     def __init__(self, params: StickCameraParams, *, rng: np.random.Generator, spec=None) -> None:
         super().__init__(params, rng=rng, spec=spec)
         self.camera = self.make_camera(params)
-        self.last_image: np.ndarray | None = None
+        self._last = None
 
     # --- helpers usable without a sensor instance -------------------------------------------
     @staticmethod
@@ -260,20 +284,25 @@ class StickCamera(Sensor):
 
     @staticmethod
     def render(scene: Scene, params: StickCameraParams | None = None,
-               rng: np.random.Generator | None = None) -> np.ndarray:
-        """The 8-bit image the camera would see (noise only if ``rng`` is given)."""
+               rng: np.random.Generator | None = None, window=None) -> np.ndarray:
+        """The 8-bit image the camera would see (noise only if ``rng`` is given), or only its
+        ``window`` (x0, y0, x1, y1)."""
         p = params if params is not None else StickCameraParams()
-        img = render_scene(StickCamera.make_camera(p), scene, background=p.background)
+        img = render_scene(StickCamera.make_camera(p), scene, background=p.background,
+                           window=window)
         if rng is not None and p.noise_sigma > 0.0:
             img = img + np.float32(p.noise_sigma) * rng.standard_normal(img.shape, dtype=np.float32)
         return np.clip(np.rint(img), 0, 255).astype(np.uint8)
 
     @staticmethod
-    def marker_moments(image: np.ndarray, params: StickCameraParams) -> dict | None:
+    def marker_moments(image: np.ndarray, params: StickCameraParams,
+                       origin: tuple[int, int] = (0, 0)) -> dict | None:
         """Segment the marker in an 8-bit image; its weighted ``cv2.moments`` (in full-image
         pixel coordinates: ``u``, ``v`` centroid, ``angle`` of the long axis in the image,
-        ``pixels`` above threshold), or None when there is no whole blob of enough pixels."""
+        ``pixels`` above threshold), or None when there is no whole blob of enough pixels.
+        ``image`` may be a window of the full image whose first pixel is ``origin``."""
         h, w = image.shape
+        ox, oy = origin
         mask = (image > params.threshold).astype(np.uint8)
         bright = cv2.findNonZero(mask)
         if bright is None:
@@ -288,7 +317,8 @@ class StickCamera(Sensor):
         bx, by = bx + cx, by + cy
         if area < params.min_pixels:
             return None
-        if bx == 0 or by == 0 or bx + bw == w or by + bh == h:
+        if (bx + ox == 0 or by + oy == 0 or bx + ox + bw == params.width
+                or by + oy + bh == params.height):
             return None                                        # cut by the image border
         x0, y0 = max(bx - 3, 0), max(by - 3, 0)
         x1, y1 = min(bx + bw + 3, w), min(by + bh + 3, h)
@@ -305,20 +335,43 @@ class StickCamera(Sensor):
         m = cv2.moments(weight.astype(np.float32))
         if m["m00"] <= 0.0:
             return None
-        return {"u": x0 + m["m10"] / m["m00"], "v": y0 + m["m01"] / m["m00"],
+        return {"u": ox + x0 + m["m10"] / m["m00"], "v": oy + y0 + m["m01"] / m["m00"],
                 "angle": 0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"]),
                 "pixels": area, "background": background, "moments": m}
 
     # --- the sensor ---------------------------------------------------------------------------
+    @property
+    def last_image(self) -> np.ndarray | None:
+        """The whole last frame (background outside the rendered window, without its noise)."""
+        if self._last is None:
+            return None
+        crop, (x0, y0, x1, y1) = self._last
+        p = self.params
+        full = np.full((p.height, p.width), round(255.0 * p.background), np.uint8)
+        full[y0:y1, x0:x1] = crop
+        return full
+
     def measure(self, t: float, scene: Scene) -> VisionStick | None:
         p = self.params
-        img = self.render(scene, p, self.rng)
-        self.last_image = img
+        # Only a window around the marker is rendered (and given noise): the moments use
+        # nothing else, and the dark table elsewhere never passes the threshold.
+        items = _projected_items(self.camera, scene)
+        hull = next((h for _, _, h, name in items if name == p.marker), None)
+        window = None if hull is None else hull_window(self.camera, hull)
+        if window is None:                       # no marker in view: the whole (rare) frame
+            window = (0, 0, p.width, p.height)
+        img = render_scene(self.camera, scene, background=p.background, window=window,
+                           items=items)
+        if p.noise_sigma > 0.0:
+            img = img + np.float32(p.noise_sigma) * self.rng.standard_normal(img.shape,
+                                                                            dtype=np.float32)
+        img = np.clip(np.rint(img), 0, 255).astype(np.uint8)
+        self._last = (img, window)
         try:
             marker = scene.get(p.marker)
         except KeyError:
             return None
-        found = self.marker_moments(img, p)
+        found = self.marker_moments(img, p, origin=window[:2])
         if found is None:
             return None
         # The marker's silhouette seen from above is its top face swept down to its bottom face;
