@@ -27,7 +27,7 @@ test: $(STAMP)
 	$(PY) -m pytest -q
 
 bench: $(STAMP)
-	$(PY) -m bench
+	$(PY) -m replay.bench
 
 golden-check: $(STAMP)
 	$(REPLAY) golden check

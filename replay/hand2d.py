@@ -36,6 +36,8 @@ class HandSpec:
     base_limits: tuple[tuple[float, float], tuple[float, float]]    # (x lo, hi), (y lo, hi) m
     base_speed: float         # m/s, each slider axis
     tip_radius: float         # m, fingertip disc radius
+    start_base: tuple[float, float] = (0.0, 0.0)    # m, where the hand is homed at t = 0
+    start_joints: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
 
 
 @dataclass(frozen=True)

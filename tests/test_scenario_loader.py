@@ -101,3 +101,15 @@ def test_set_overrides_and_is_validated(toy_yaml):
 def test_yaml_is_not_evaluated(tmp_path, toy_yaml):
     msg = _error(tmp_path, toy_yaml.read_text().replace("seed: 3", "seed: !!python/object:os.system 'true'"))
     assert "not valid YAML" in msg or "could not determine" in msg or "constructor" in msg
+
+
+def test_extends_with_another_plugin_type_replaces_its_params(tmp_path, toy_yaml):
+    from replay import registry
+    import toy_plugins
+    registry.register("controller", "toy_pd2", toy_plugins.ToyController)
+    child = tmp_path / "child.yaml"
+    child.write_text("extends: toy.yaml\ncontroller: {type: toy_pd2, params: {kp: 5}}\n")
+    sc = load_scenario(child)
+    assert sc.controller.type == "toy_pd2"
+    assert sc.controller.params.kp == 5.0
+    assert sc.controller.rate == 1000.0       # the base's rate: 500 belonged to the other type

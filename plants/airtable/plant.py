@@ -131,6 +131,8 @@ class AirTablePlant(Plant):
             base_limits=(tuple(map(float, h.base_x_limits)), tuple(map(float, h.base_y_limits))),
             base_speed=float(h.base_speed),
             tip_radius=float(h.tip_radius),
+            start_base=(float(h.base[0]), float(h.base[1])),
+            start_joints=(tuple(map(float, h.joints0)), tuple(map(float, h.joints1))),
         )
 
     # -- Plant interface ------------------------------------------------------------------

@@ -1,7 +1,8 @@
 """Loading scenarios strictly: YAML (safe) -> typed dataclasses, errors with file, line and field.
 
 - ``extends: other.yaml`` (relative to the file) starts from that file; mappings merge key by
-  key, anything else is replaced.
+  key, anything else is replaced, and a plug-in section whose ``type:`` changes is replaced
+  whole.
 - ``--set key.path=value`` overrides one field (the value is read as YAML).
 - Every plug-in's ``params`` are checked against its ``Params`` dataclass.
 - Unknown keys, wrong types, missing fields and out-of-range values raise :class:`ScenarioError`
@@ -102,8 +103,13 @@ def _get(mapping: yaml.MappingNode, key: str):
 
 
 def _merge(base: yaml.Node, over: yaml.Node) -> yaml.Node:
-    """``over`` on top of ``base``: mappings merge key by key, anything else is replaced."""
+    """``over`` on top of ``base``: mappings merge key by key, anything else is replaced. A
+    plug-in section whose ``type:`` changes is replaced whole (its params belong to another
+    plug-in)."""
     if not (isinstance(base, yaml.MappingNode) and isinstance(over, yaml.MappingNode)):
+        return over
+    base_type, over_type = _get(base, "type"), _get(over, "type")
+    if base_type and over_type and base_type[1].value != over_type[1].value:
         return over
     merged = list(base.value)
     for k, v in over.value:
@@ -204,6 +210,8 @@ def _check_range(value: float, meta, node, path) -> None:
 def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
     """Turn a YAML node into a value of type ``tp`` (dataclass, scalar, list, dict)."""
     meta = meta or {}
+    if tp is list or tp is tuple:
+        tp = list[Any] if tp is list else tuple[Any, ...]
     origin = typing.get_origin(tp)
     if tp is Any:
         return node  # validated later (plug-in params)
@@ -231,7 +239,8 @@ def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
             item_types = args
         else:
             item_types = [args[0]] * len(node.value)
-        items = [build(v, t, f"{path}[{i}]", {**meta, "length": None})
+        items = [_scalar(v, f"{path}[{i}]") if t is Any else
+                 build(v, t, f"{path}[{i}]", {**meta, "length": None})
                  for i, (v, t) in enumerate(zip(node.value, item_types))]
         return tuple(items) if origin is tuple else items
     if origin is dict:

@@ -1,0 +1,102 @@
+"""Higashimori et al. 2007, Fig. 7: translational and rotational velocity of the stick vs time
+during the capture, collision instants marked — drawn from a run's log."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from analysis.series import arrays, events  # noqa: E402
+from replay.log import LogReader  # noqa: E402
+
+
+def fig7(log: LogReader, title: str = ""):
+    s = arrays(log, "/stick/state", ["vx", "vy", "omega"])
+    speed = np.hypot(s["vx"], s["vy"])
+    fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
+    ax_v.plot(s["t"], speed, color="tab:blue", lw=1.4, label="simulated (Pymunk)")
+    ax_w.plot(s["t"], s["omega"], color="tab:red", lw=1.4, label="simulated (Pymunk)")
+    last_label = -1.0
+    for e in events(log, "collision"):
+        for ax in (ax_v, ax_w):
+            ax.axvline(e["t"], color="0.4", lw=0.8, ls="--")
+        if e["t"] - last_label > 0.04:   # label collisions that are far enough apart to read
+            ax_v.annotate(f"#{e['data'].get('index', '')}", (e["t"], 1.0), xytext=(2, -10),
+                          xycoords=("data", "axes fraction"), textcoords="offset points",
+                          fontsize=7, color="0.3")
+            last_label = e["t"]
+    for e in events(log, "capture"):
+        for ax in (ax_v, ax_w):
+            ax.axvline(e["t"], color="tab:green", lw=1.0)
+    ax_v.set_ylabel("translational speed |v| [m/s]")
+    ax_w.set_ylabel("angular velocity ω [rad/s]")
+    ax_w.set_xlabel("time [s]")
+    ax_w.axhline(0.0, color="0.7", lw=0.6)
+    for ax in (ax_v, ax_w):
+        ax.grid(alpha=0.3)
+    ax_v.set_title(title or "Translational and rotational velocities (cf. Fig. 7)", fontsize=10)
+    ax_v.legend(fontsize=8, loc="upper right")
+    fig.text(0.01, 0.005, "dashed: fingertip-stick collisions #index (from /events); green: capture",
+             fontsize=7, color="0.35")
+    fig.tight_layout()
+    return fig
+
+
+def friction_overlay(logs: dict[str, LogReader]):
+    """The same strategy run under different friction: the curves should coincide (Sec. II-C)."""
+    fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
+    for name, log in sorted(logs.items()):
+        mu = _mu(log)
+        s = arrays(log, "/stick/state", ["vx", "vy", "omega"])
+        label = f"{name} (μ = {mu:g})" if mu is not None else name
+        ax_v.plot(s["t"], np.hypot(s["vx"], s["vy"]), lw=1.2, label=label)
+        ax_w.plot(s["t"], s["omega"], lw=1.2, label=label)
+    ax_v.set_ylabel("|v| [m/s]")
+    ax_w.set_ylabel("ω [rad/s]")
+    ax_w.set_xlabel("time [s]")
+    ax_v.set_title("Friction independence: the same plan under different μ", fontsize=10)
+    ax_v.legend(fontsize=7)
+    for ax in (ax_v, ax_w):
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def _mu(log: LogReader):
+    import yaml
+    try:
+        sc = yaml.safe_load(log.scenario()["yaml"])
+        return float(sc["plant"]["params"]["stick"]["friction"])
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+def _save(fig, out: Path, stem: str) -> list[Path]:
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [out / f"{stem}.png", out / f"{stem}.svg"]
+    fig.savefig(paths[0], dpi=150)
+    fig.savefig(paths[1], metadata={"Date": None})  # no timestamp: same log, same file
+    plt.close(fig)
+    return paths
+
+
+def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
+    """Fig. 7 for every stick run, and the friction overlay for runs of the same strategy."""
+    paths: list[Path] = []
+    for name, log in sorted(logs.items()):
+        paths += _save(fig7(log, f"{name}: velocities vs time (cf. Fig. 7)"), out, f"{name}_fig7")
+    by_strategy: dict[str, dict[str, LogReader]] = {}
+    for name, log in logs.items():
+        import yaml
+        sc = yaml.safe_load(log.scenario()["yaml"])
+        if float(sc["plant"]["params"]["stick"].get("collision_width", 0.0)) == 0.0:
+            by_strategy.setdefault(sc["controller"]["type"], {})[name] = log
+    for strategy, group in sorted(by_strategy.items()):
+        if len({_mu(log) for log in group.values()}) > 1:
+            paths += _save(friction_overlay(group), out, f"{strategy}_friction")
+    return paths

@@ -1,0 +1,326 @@
+"""Friction independent collision of a stick with a fixed fingertip (Higashimori et al. 2007, Sec. II).
+
+Pure NumPy. Velocities u = [vx, vy, omega] of the stick's centre of mass in the reference frame
+Sigma_R; theta is the stick's orientation (its x_B axis along the length); the contact point
+^B r = [r_x, r_y] is in the stick frame Sigma_B. ``side`` = +1 for a fingertip touching from
+y_B >= 0 (^B r_y = +W/2), -1 from y_B <= 0 (^B r_y = -W/2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def rotation(theta: float) -> np.ndarray:
+    """R_B(theta): the posture of Sigma_B in Sigma_R."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def tangent_normal(theta: float, side: int) -> tuple[np.ndarray, np.ndarray]:
+    """s_i and n_i in Sigma_R (eqs. 3, 4): n_i points from the fingertip into the stick."""
+    s_b = np.array([1.0, 0.0]) if side > 0 else np.array([-1.0, 0.0])
+    n_b = np.array([0.0, -1.0]) if side > 0 else np.array([0.0, 1.0])
+    R = rotation(theta)
+    return R @ s_b, R @ n_b
+
+
+def mass_matrix(m: float, inertia: float) -> np.ndarray:
+    """M of eq. 5."""
+    return np.diag([m, m, inertia])
+
+
+def contact_jacobian(theta: float, r_b) -> np.ndarray:
+    """H_i of eq. 5: v_C = H_i u (eqs. 6, 7), with [a x] = [-a_y, a_x]."""
+    a = rotation(theta) @ np.asarray(r_b, dtype=float)
+    return np.array([[1.0, 0.0, -a[1]], [0.0, 1.0, a[0]]])
+
+
+def collision_map(m: float, inertia: float, e: float, theta: float, r_b, side: int) -> np.ndarray:
+    """J_i of eq. 22: u_i = J_i u_{i-1}, valid under the friction independent condition (eq. 12).
+
+    J_i = E_3 - (1 + e) M^-1 H_i^T K_i^-1 n_i n_i^T H_i, with K_i = H_i M^-1 H_i^T (eq. 9).
+    """
+    M_inv = np.linalg.inv(mass_matrix(m, inertia))
+    H = contact_jacobian(theta, r_b)
+    K = H @ M_inv @ H.T
+    _, n = tangent_normal(theta, side)
+    return np.eye(3) - (1.0 + e) * M_inv @ H.T @ np.linalg.solve(K, np.outer(n, n) @ H)
+
+
+def alpha(a) -> float:
+    """alpha(a) of eq. 23: the orientation that makes the stick perpendicular to the vector a."""
+    ax, ay = float(a[0]), float(a[1])
+    if ay != 0.0:
+        return math.atan(-ax / ay)
+    return math.pi / 2.0
+
+
+def friction_independent(theta: float, v, side: int = 1, tol: float = 1e-9) -> bool:
+    """Eq. 12: s_i^T v_{B,i-1} = 0 (within ``tol`` of |v|)."""
+    s, _ = tangent_normal(theta, side)
+    v = np.asarray(v, dtype=float)
+    return abs(float(s @ v)) <= tol * max(1.0, float(np.linalg.norm(v)))
+
+
+# --------------------------------------------------------------------------------------------
+# Sec. II-D: the fingertip position for a desired velocity after a friction independent collision
+#
+# The quadratics of eqs. 25 and 28 are derived for W ~ 0 (Assumption 5): the contact is taken on
+# the stick's axis, ^B r = [r_x, 0], in H_i, J_i and C_i below. The paper writes b_1 and b_2 for
+# the side ^B r_y = +W/2; for ^B r_y = -W/2 its r_x is measured along s_i = -x_B. We write them in
+# ^B r_x for both sides, which multiplies b_1 and b_2 by ``side`` (the roots then satisfy eqs. 24
+# and 27 through J_i exactly on either side).
+# --------------------------------------------------------------------------------------------
+
+
+def _sign(side: int) -> float:
+    return 1.0 if side > 0 else -1.0
+
+
+def _roots(a: float, b: float, c: float) -> tuple[float, ...]:
+    """Real roots of a r^2 + b r + c = 0, ascending (one root when a ~ 0, none when complex)."""
+    scale = max(abs(a), abs(b), abs(c), 1e-300)
+    if abs(a) <= 1e-12 * scale:
+        return () if abs(b) <= 1e-12 * scale else (-c / b,)
+    disc = b * b - 4.0 * a * c
+    if disc < 0.0:
+        return ()
+    q = -0.5 * (b + math.copysign(math.sqrt(disc), b))   # numerically stable pair
+    if q == 0.0:
+        return (0.0,)
+    return tuple(sorted((q / a, c / q)))
+
+
+def f_omega(m: float, inertia: float, e: float, theta: float, side: int, u_prev,
+            omega_d: float) -> tuple[float, ...]:
+    """F_omega,i(omega_d) of eq. 25: both r_x (ascending) giving omega_i = omega_d (eq. 24)."""
+    u = np.asarray(u_prev, dtype=float)
+    _, n = tangent_normal(theta, side)
+    a1 = m * (omega_d + e * u[2])
+    b1 = -(1.0 + e) * m * _sign(side) * float(n @ u[:2])
+    c1 = inertia * (omega_d - u[2])
+    return _roots(a1, b1, c1)
+
+
+def f_v(m: float, inertia: float, e: float, theta: float, side: int, u_prev,
+        speed_d: float) -> tuple[float, ...]:
+    """F_V,i(V_d) of eq. 28: both r_x (ascending) giving V_i = V_d (eq. 27).
+
+    V_i is the speed along -v_{i-1}/|v_{i-1}| (V_d = 0 stops the translation); valid for a
+    friction independent collision, theta = alpha(v_{i-1}), and v_{i-1} != 0.
+    """
+    u = np.asarray(u_prev, dtype=float)
+    speed = float(np.linalg.norm(u[:2]))
+    if speed == 0.0:
+        return ()
+    _, n = tangent_normal(theta, side)
+    a2 = m * (speed_d + speed)
+    b2 = (1.0 + e) * inertia * u[2] * _sign(side) * float(n @ u[:2]) / speed
+    c2 = inertia * (speed_d - e * speed)
+    return _roots(a2, b2, c2)
+
+
+def axis_map(m: float, inertia: float, e: float, theta: float, r_x: float, side: int) -> np.ndarray:
+    """J_i (eq. 22) for a contact on the stick's axis, ^B r = [r_x, 0] (W ~ 0, Assumption 5)."""
+    return collision_map(m, inertia, e, theta, (r_x, 0.0), side)
+
+
+def contact_condition(m: float, inertia: float, e: float, theta: float, r_x: float, side: int,
+                      u_prev) -> float:
+    """C_i of eq. 26: n_i^T H_i J_i u_{i-1}, the normal velocity of the contact point after the
+    collision; > 0 when it leaves the fingertip (then it approached before: C_i = -e n^T H u)."""
+    u = np.asarray(u_prev, dtype=float)
+    _, n = tangent_normal(theta, side)
+    H = contact_jacobian(theta, (r_x, 0.0))
+    return float(n @ H @ axis_map(m, inertia, e, theta, r_x, side) @ u)
+
+
+def approach_speed(theta: float, r_x: float, side: int, u_prev) -> float:
+    """-n_i^T H_i u_{i-1}: how fast the contact point moves into the fingertip before (m/s)."""
+    u = np.asarray(u_prev, dtype=float)
+    _, n = tangent_normal(theta, side)
+    return -float(n @ contact_jacobian(theta, (r_x, 0.0)) @ u)
+
+
+@dataclass(frozen=True)
+class ContactSolution:
+    """One planned friction independent collision: where, from which side, and what it does."""
+    theta: float              # theta_B,i (rad), in (-pi/2, pi/2] as alpha() returns it
+    side: int                 # +1: ^B r_y = +W/2, -1: ^B r_y = -W/2
+    r_x: float                # ^B r_x,i (m)
+    u_before: tuple           # u_{i-1} = (vx, vy, omega)
+    u_after: tuple            # u_i = J_i u_{i-1} (eq. 22)
+    roots: tuple              # both roots of eq. 25 / 28 (m)
+    condition: float          # C_i (eq. 26) of the chosen root (m/s)
+    length: float | None = None
+
+    @property
+    def within(self) -> bool:
+        """|r_x| <= L/2 (always True when no length was given)."""
+        return self.length is None or abs(self.r_x) <= 0.5 * self.length + 1e-12
+
+    def r_b(self, width: float = 0.0) -> np.ndarray:
+        """^B r_i = [r_x, side W/2]."""
+        return np.array([self.r_x, 0.5 * width * self.side])
+
+
+def _valid(m, inertia, e, theta, r_x, side, u) -> bool:
+    """Eq. 26 (C_i > 0); for e = 0 C_i vanishes, so test the approach before instead."""
+    if e > 0.0:
+        tol = 1e-12 * max(1.0, float(np.linalg.norm(u)))
+        return contact_condition(m, inertia, e, theta, r_x, side, u) > tol
+    return approach_speed(theta, r_x, side, u) > 1e-12
+
+
+def contact_options(m: float, inertia: float, e: float, theta: float, u_prev, *,
+                    omega: float | None = None, speed: float | None = None,
+                    length: float | None = None, sides=(1, -1)) -> list[ContactSolution]:
+    """Every (side, root) giving omega_i = ``omega`` (eq. 25) or V_i = ``speed`` (eq. 28) that
+    passes C_i > 0 (eq. 26), each with u_i = J_i u_{i-1}.
+
+    Both roots of one side can pass eq. 26 (e.g. F_V,1(0) for the Fig. 7 numbers: r_x = -25.8 mm
+    gives omega_1 = -10 rad/s, r_x = +10.5 mm gives +18 rad/s): the strategy's own rule (eq. 31,
+    35 or 37) then chooses. Roots beyond the stick (|r_x| > L/2) are kept, ``within`` False.
+    """
+    if (omega is None) == (speed is None):
+        raise ValueError("give exactly one of omega, speed")
+    u = np.asarray(u_prev, dtype=float)
+    out = []
+    for side in sides:
+        if omega is not None:
+            roots = f_omega(m, inertia, e, theta, side, u, omega)
+        else:
+            roots = f_v(m, inertia, e, theta, side, u, speed)
+        out += [contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
+                for r in roots if _valid(m, inertia, e, theta, r, side, u)]
+    return out
+
+
+def solve_contact(m: float, inertia: float, e: float, theta: float, side: int, u_prev, *,
+                  omega: float | None = None, speed: float | None = None,
+                  length: float | None = None) -> ContactSolution | None:
+    """The r_x on ``side`` giving omega_i = ``omega`` (eq. 25) or V_i = ``speed`` (eq. 28) with
+    C_i > 0 (eq. 26), and the predicted u_i = J_i u_{i-1}; None when no root passes.
+
+    When both roots pass, the one with the smaller |r_x| (see :func:`contact_options` for both).
+    A root beyond the stick (|r_x| > L/2 for the given ``length``) is still returned with
+    ``within`` False: the caller reports it.
+    """
+    opts = contact_options(m, inertia, e, theta, u_prev, omega=omega, speed=speed,
+                           length=length, sides=(side,))
+    return min(opts, key=lambda s: abs(s.r_x)) if opts else None
+
+
+def contact_at(m: float, inertia: float, e: float, theta: float, side: int, u_prev, r_x: float,
+               *, length: float | None = None, roots: tuple = ()) -> ContactSolution:
+    """The collision at a given r_x (e.g. a clamped one), predicted with J_i (eq. 22)."""
+    u = np.asarray(u_prev, dtype=float)
+    u_after = axis_map(m, inertia, e, theta, r_x, side) @ u
+    return ContactSolution(theta=theta, side=1 if side > 0 else -1, r_x=float(r_x),
+                           u_before=tuple(float(x) for x in u),
+                           u_after=tuple(float(x) for x in u_after),
+                           roots=tuple(float(r) for r in roots),
+                           condition=contact_condition(m, inertia, e, theta, r_x, side, u),
+                           length=length)
+
+
+# --------------------------------------------------------------------------------------------
+# Sec. III: the contact conditions of the 2-step and 3-step strategies (side selection)
+# --------------------------------------------------------------------------------------------
+
+
+def two_step_first(m: float, inertia: float, e: float, u0, length: float | None = None
+                   ) -> ContactSolution | None:
+    """Eq. 30: theta_1 = alpha(v_0), r_x = F_omega,1(0) with C_1 > 0, and the side giving p = -1
+    in eq. 31 (v_1 against v_0). Preference: within the stick, then p = -1, then small |r_x|."""
+    u = np.asarray(u0, dtype=float)
+    theta = alpha(u[:2])
+    sols = contact_options(m, inertia, e, theta, u, omega=0.0, length=length)
+    if not sols:
+        return None
+    return min(sols, key=lambda s: (not s.within, float(np.dot(s.u_after[:2], u[:2])) >= 0.0,
+                                    abs(s.r_x)))
+
+
+def three_step_first(m: float, inertia: float, e: float, u0, length: float | None = None
+                     ) -> ContactSolution | None:
+    """Eq. 34: theta_1 = alpha(v_0), r_x = F_V,1(0) with C_1 > 0; the side satisfying eq. 35
+    (omega_1 against omega_0) is preferred after being within the stick."""
+    u = np.asarray(u0, dtype=float)
+    theta = alpha(u[:2])
+    sols = contact_options(m, inertia, e, theta, u, speed=0.0, length=length)
+    if not sols:
+        return None
+    return min(sols, key=lambda s: (not s.within, s.u_after[2] * u[2] >= 0.0, abs(s.r_x)))
+
+
+def three_step_second(m: float, inertia: float, e: float, u1, lambda_2,
+                      length: float | None = None) -> ContactSolution | None:
+    """Eq. 36: theta_2 = alpha(lambda_2), r_x = F_omega,2(0) with C_2 > 0, and the side for which
+    v_2 / |v_2| = lambda_2 (eq. 37). None when no side sends the stick along lambda_2."""
+    u = np.asarray(u1, dtype=float)
+    lam = np.asarray(lambda_2, dtype=float)
+    theta = alpha(lam)
+    sols = [s for s in contact_options(m, inertia, e, theta, u, omega=0.0, length=length)
+            if float(np.dot(s.u_after[:2], lam)) > 0.0]
+    if not sols:
+        return None
+    return min(sols, key=lambda s: (not s.within, abs(s.r_x)))
+
+
+def closing_contact(m: float, inertia: float, e: float, u_prev, length: float | None = None
+                    ) -> ContactSolution | None:
+    """Eqs. 32 / 38: ^B r_x = 0 on the side the stick moves into (n_i = -n_{i-1} alternately),
+    so v_i = -e v_{i-1} (eq. 33) and no rotation. None when the stick does not translate."""
+    u = np.asarray(u_prev, dtype=float)
+    if float(np.linalg.norm(u[:2])) == 0.0:
+        return None
+    theta = alpha(u[:2])
+    for side in (1, -1):
+        if approach_speed(theta, 0.0, side, u) > 0.0:
+            return contact_at(m, inertia, e, theta, side, u, 0.0, length=length, roots=(0.0,))
+    return None
+
+
+# --------------------------------------------------------------------------------------------
+# Derived numbers (Sec. IV-B, Fig. 7)
+# --------------------------------------------------------------------------------------------
+
+
+def spin_before_pure_rotation(m: float, inertia: float, e: float, speed: float,
+                              omega_1: float) -> list[tuple[float, float]]:
+    """The initial spins omega_0 for which the 3-step first collision (v_1 = 0 at
+    theta_1 = alpha(v_0), eq. 34) of a stick moving at ``speed`` leaves ``omega_1``.
+
+    Returns [(omega_0, d), ...], d = |^B r_x,1| (m), smaller d first; [] when none exists.
+    With v_1 = 0, eq. 22 gives omega_1 = omega_0 - sgn(omega_1) m d |v_0| / I, and Newton's law
+    (eq. 10) at the contact gives  e |v_0| m d^2 - (1 + e) I |omega_1| d + e |v_0| I = 0.
+    """
+    out = []
+    for d in _roots(e * speed * m, -(1.0 + e) * inertia * abs(omega_1), e * speed * inertia):
+        if d > 0.0:
+            out.append((omega_1 - math.copysign(1.0, omega_1) * m * d * speed / inertia, d))
+    return sorted(out, key=lambda p: p[1])
+
+
+def pure_rotation_min_spin(m: float, inertia: float, e: float, speed: float) -> float:
+    """The least |omega_1| a 3-step first collision (v_1 = 0, eq. 34) can leave on a stick moving
+    at ``speed``: 2 e |v_0| sqrt(m / I) / (1 + e), where the quadratic of
+    :func:`spin_before_pure_rotation` has a double root."""
+    return 2.0 * e * speed * math.sqrt(m / inertia) / (1.0 + e)
+
+
+def pure_rotation_stop_distance(m: float, inertia: float, e: float) -> float:
+    """|F_omega,2(0)| for a purely rotating stick (v_1 = 0): eq. 25 with b_1 = 0 gives
+    r_x^2 = I / (m e), whatever omega_1 (the 3-step second collision, eq. 36)."""
+    return math.sqrt(inertia / (m * e))
+
+
+def pure_rotation_residual_spin(m: float, inertia: float, e: float, d: float) -> float:
+    """omega_2 / omega_1 after a purely rotating stick hits a fingertip at |r_x| = d (eq. 22):
+    (I - e m d^2) / (I + m d^2); zero at d = pure_rotation_stop_distance()."""
+    return (inertia - e * m * d * d) / (inertia + m * d * d)

@@ -1,0 +1,160 @@
+"""Velocity estimation and trajectory prediction of the stick from high-speed vision.
+
+Higashimori et al. 2007, Sec. IV-A: "PC estimates the velocity and predicts the trajectory of
+object" from 300 fps measurements of position and orientation. Between collisions the stick moves
+with constant velocities (Assumption 6), so x, y and theta are fitted as straight lines in time by
+least squares over a sliding window of the latest samples.
+
+Orientation: a camera sees a stick's axis only modulo pi (theta in (-pi/2, pi/2]). Each sample is
+unwrapped to the branch theta + k pi nearest the current prediction (or the previous sample), so
+the estimator's theta is continuous; it aliases only beyond pi/2 of rotation between samples
+(471 rad/s at 300 fps).
+
+Collisions: once the fit is ready (``min_samples`` since the last restart: a shorter fit
+extrapolates too noisily), a sample farther than ``pos_tol`` (m) or ``theta_tol`` (rad) from the
+prediction of the current fit breaks the constant-velocity model. With
+``confirm`` = 2 (default) the break is accepted when the next sample deviates too (an isolated
+outlier is dropped); the fit then restarts from the deviating samples, and
+:meth:`StickEstimator.add` returns True.
+
+Defaults (SI): window 30 samples (0.1 s at 300 fps), ready after 6 samples (20 ms), pos_tol
+0.002 m, theta_tol 0.03 rad, confirm 2. Pure NumPy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class StickEstimate:
+    """The constant-velocity fit, evaluated at ``t_ref`` (the latest sample's time)."""
+    t_ref: float      # s
+    x: float          # m
+    y: float          # m
+    theta: float      # rad, continuous (unwrapped)
+    vx: float         # m/s
+    vy: float         # m/s
+    omega: float      # rad/s
+    n: int            # samples in the fit
+    rms_xy: float     # m, residual rms of the position fit
+    rms_theta: float  # rad, residual rms of the orientation fit
+
+    @property
+    def u(self) -> np.ndarray:
+        """[vx, vy, omega], the paper's u_B."""
+        return np.array([self.vx, self.vy, self.omega])
+
+    @property
+    def speed(self) -> float:
+        return math.hypot(self.vx, self.vy)
+
+    def at(self, t: float) -> tuple[float, float, float]:
+        """Pose (x, y, theta) at time ``t`` under constant velocities."""
+        dt = t - self.t_ref
+        return (self.x + self.vx * dt, self.y + self.vy * dt, self.theta + self.omega * dt)
+
+
+def unwrap_to(theta_mod_pi: float, near: float) -> float:
+    """The branch theta + k pi closest to ``near``."""
+    return theta_mod_pi + math.pi * round((near - theta_mod_pi) / math.pi)
+
+
+class StickEstimator:
+    """Sliding-window least-squares fit of x, y, theta linear in t, with collision detection."""
+
+    def __init__(self, *, window: int = 30, min_samples: int = 6, pos_tol: float = 0.002,
+                 theta_tol: float = 0.03, confirm: int = 2) -> None:
+        if window < 2 or min_samples < 2 or min_samples > window or confirm < 1:
+            raise ValueError("need 2 <= min_samples <= window and confirm >= 1")
+        self.window = window
+        self.min_samples = min_samples
+        self.pos_tol = pos_tol
+        self.theta_tol = theta_tol
+        self.confirm = confirm
+        self._samples: list[tuple[float, float, float, float]] = []   # (t, x, y, theta unwrapped)
+        self._pending: list[tuple[float, float, float, float]] = []
+        self._fit: StickEstimate | None = None
+        self.breaks: list[float] = []            # time of the first sample after each break
+        self.before_break: StickEstimate | None = None   # the fit the last break ended
+
+    # -- input ------------------------------------------------------------------------------
+    def add(self, t: float, x: float, y: float, theta: float) -> bool:
+        """Add a measurement (theta modulo pi). True when it confirms a collision (model break)."""
+        near = self._predict_theta(t)
+        sample = (float(t), float(x), float(y), unwrap_to(float(theta), near))
+        if not self.ready() or not self._deviates(sample):
+            self._pending.clear()           # isolated outliers are dropped
+            self._append(sample)
+            return False
+        self._pending.append(sample)
+        if len(self._pending) < self.confirm:
+            return False
+        self.before_break = self._fit
+        self.breaks.append(self._pending[0][0])
+        self._samples = list(self._pending)
+        self._pending.clear()
+        self._refit()
+        return True
+
+    def reset(self) -> None:
+        """Forget everything (e.g. the stick was lost)."""
+        self._samples.clear()
+        self._pending.clear()
+        self._fit = None
+
+    # -- output -----------------------------------------------------------------------------
+    def ready(self) -> bool:
+        """At least ``min_samples`` samples since the last restart."""
+        return self._fit is not None and self._fit.n >= self.min_samples
+
+    def estimate(self) -> StickEstimate | None:
+        """The current fit (None before the first sample)."""
+        return self._fit
+
+    def predict(self, t: float) -> tuple[float, float, float]:
+        """(x, y, theta) at ``t``, theta continuous."""
+        if self._fit is None:
+            raise RuntimeError("no samples yet")
+        return self._fit.at(t)
+
+    # -- internals --------------------------------------------------------------------------
+    def _predict_theta(self, t: float) -> float:
+        if self._fit is not None and self._fit.n >= 2:
+            return self._fit.at(t)[2]
+        if self._samples:
+            return self._samples[-1][3]
+        return 0.0
+
+    def _deviates(self, sample) -> bool:
+        t, x, y, th = sample
+        px, py, pth = self._fit.at(t)
+        return math.hypot(x - px, y - py) > self.pos_tol or abs(th - pth) > self.theta_tol
+
+    def _append(self, sample) -> None:
+        self._samples.append(sample)
+        if len(self._samples) > self.window:
+            del self._samples[: len(self._samples) - self.window]
+        self._refit()
+
+    def _refit(self) -> None:
+        data = np.array(self._samples)
+        t = data[:, 0]
+        t_ref = float(t[-1])
+        n = len(t)
+        if n == 1:
+            _, x, y, th = self._samples[0]
+            self._fit = StickEstimate(t_ref, x, y, th, 0.0, 0.0, 0.0, 1, 0.0, 0.0)
+            return
+        tau = t - t_ref
+        A = np.column_stack([np.ones(n), tau])
+        coef, *_ = np.linalg.lstsq(A, data[:, 1:], rcond=None)    # rows: value at t_ref, rate
+        res = data[:, 1:] - A @ coef
+        rms_xy = float(math.sqrt(np.mean(res[:, 0] ** 2 + res[:, 1] ** 2)))
+        rms_th = float(math.sqrt(np.mean(res[:, 2] ** 2)))
+        self._fit = StickEstimate(t_ref, float(coef[0, 0]), float(coef[0, 1]), float(coef[0, 2]),
+                                  float(coef[1, 0]), float(coef[1, 1]), float(coef[1, 2]),
+                                  n, rms_xy, rms_th)
