@@ -15,7 +15,7 @@ from pybullet_utils import bullet_client
 from plants.bullet_arm import BulletArmPlant, Params
 from plants.models import build_arm
 from replay.interfaces import Plant
-from replay.messages import EffectorState, JointState, ObjectState, to_dict
+from replay.messages import JointState, ObjectState, to_dict
 from replay.robot.arm_types import ArmCommand, ArmSpec
 from replay.robot.capability import max_tool_speed, tool_acceleration_from_rest
 from replay.robot.hand import CATCH3, GRASP4, hand_body
@@ -308,8 +308,8 @@ def test_truth_scene_spec_payloads():
     assert tr["/hand/joint_state"].name == list(CATCH3.joint_names)
     obj = tr["/object/state"]
     assert isinstance(obj, ObjectState) and obj.orientation == [0.0, 0.0, 0.0, 1.0]
-    eff = tr["/effector/state"]
-    assert isinstance(eff, EffectorState) and eff.desired_position == []
+    assert "/effector/state" not in tr          # the controller's topic (actual and desired)
+    eff = tr["/effector/motion"]
     np.testing.assert_allclose(eff.position, plant.spec().model.tool_position(START), atol=1e-4)
     import json
     for payload in tr.values():

@@ -25,7 +25,7 @@ from pybullet_utils import bullet_client
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.models.arm import build_arm
 from replay.interfaces import Occurrence, Plant
-from replay.messages import EffectorState, JointState, ObjectState
+from replay.messages import JointState, ObjectState
 from replay.params import param
 from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
 from replay.robot.hand import HANDS, hand_body, hand_mass
@@ -484,8 +484,8 @@ class BulletArmPlant(Plant):
             hq, hqd, heff = self.hand_state()
             out["/hand/joint_state"] = JointState(t, list(self.hand_names), hq.tolist(),
                                                   hqd.tolist(), heff.tolist())
+        # the tool frame's motion; /effector/state (actual and desired point) is the controller's
         pe, oe, ve, we = self.effector_state()
-        out["/effector/state"] = EffectorState(t, pe.tolist(), [])
         out["/effector/motion"] = EffectorMotion(t, pe.tolist(), oe.tolist(), ve.tolist(),
                                                  we.tolist(), float(np.linalg.norm(ve)))
         if self.obj is not None:

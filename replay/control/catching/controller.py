@@ -199,6 +199,7 @@ class CatchingController(Controller):
         self._q_o = None
         self._warned_state = False
         self._t = 0.0
+        self._costs_logged = False       # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
     def _optimised_alpha(self) -> np.ndarray:
@@ -328,6 +329,9 @@ class CatchingController(Controller):
                "/effector/state": EffectorState(
                    t, position=self.model.fk(self.q).tolist() if self.q is not None else [],
                    desired_position=self.model.fk(self.q_d).tolist())}
+        if not self._costs_logged:       # the offline optimisation's history, once (t = 0)
+            self._costs_logged = True
+            out["/optimization/cost"] = self.optimization_costs()
         if self._r is not None:
             out["/catching/state"] = CatchingState(
                 t, self._r.tolist(), self._v.tolist(), self._q_o.tolist(), self.qd_d.tolist(),

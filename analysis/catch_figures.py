@@ -1,0 +1,215 @@
+"""Namiki & Ishikawa 2003, Figs. 6-9, drawn from runs' logs.
+
+- Fig. 6: the two costs of eq. 25 per optimisation iteration (``/optimization/cost``); the
+  unoptimised run's single record is iteration 0, the initial parameters.
+- Fig. 7: the catching trajectory: the ball (``/object/state``), the desired end effector
+  l(q_d) and the actual l(q) (the controller's ``/effector/state``: the catch point, where the
+  ball's centre sits on the palm), per axis against time and seen from the side (x-z).
+- Fig. 8: joint angles q1, q2, q4 (``/arm/joint_state``) with q_d (``/arm/joint_command``).
+- Fig. 9: command torques (``/arm/joint_command``) with the torque limits.
+
+Figs. 7-9 overlay the optimised run (solid) and the unoptimised one (dashed) when both logs are
+given; every other catching run gets its own Fig. 7.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from analysis.catch_claims import (ACTIVE, JOINTS, CatchRun, _opt_limits, _pair,  # noqa: E402
+                                   first_contact, load_run)
+from analysis.figure_files import save  # noqa: E402
+from replay.log import LogReader  # noqa: E402
+
+STYLE = {"optimised": dict(ls="-", lw=1.5), "initial": dict(ls="--", lw=1.3)}
+C_BALL, C_DES, C_ACT = "tab:orange", "tab:blue", "tab:green"
+
+
+def _label(run: CatchRun) -> str:
+    return f"{run.name} ({'optimised' if run.mapping == 'optimised' else 'initial parameters'})"
+
+
+def _span(run: CatchRun, after: float = 0.08) -> tuple[float, float]:
+    start = (run.t0 if run.t0 is not None else run.t_ctrl[0]) - 0.02
+    end = (run.t_c if run.t_c is not None else run.t_ctrl[-1]) + after
+    return start, min(end, run.t_ctrl[-1])
+
+
+def _marks(ax, run: CatchRun, style: dict, text: bool = False) -> None:
+    """t0 (mapping starts), t_c (catch surface), first contact and catch/miss, within the axes'
+    time span (labels staggered so that close instants stay readable)."""
+    marks = [(run.t0, "t₀"), (run.t_c, "t_c")]
+    c = first_contact(run)
+    if c is not None:
+        marks.append((c["t"], "contact"))
+    for e in run.events:
+        if e["kind"] in ("catch", "miss", "drop"):
+            marks.append((e["t"], e["kind"]))
+    lo, hi = ax.get_xlim()
+    row = 0
+    for t, name in sorted((m for m in marks if m[0] is not None), key=lambda m: m[0]):
+        if not lo <= t <= hi:
+            continue
+        ax.axvline(t, color="0.55", lw=0.7, ls=style.get("ls", "-"))
+        if text:
+            ax.annotate(name, (t, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(2, -9 - 8 * (row % 3)), textcoords="offset points", fontsize=7,
+                        color="0.35")
+            row += 1
+
+
+def fig6(opt: CatchRun | None, ini: CatchRun | None):
+    fig, (ax_t, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.0, 5.0))
+    for run, color, label in ((opt, "tab:blue", "optimisation (eq. 25)"),
+                              (ini, "tab:red", "initial parameters (unoptimised run)")):
+        if run is None or not run.costs:
+            continue
+        it = [c["iteration"] for c in run.costs]
+        marker = "o" if len(it) > 1 else "s"
+        ax_t.plot(it, [c["torque_cost"] for c in run.costs], marker=marker, color=color,
+                  label=label, ms=5 if len(it) > 1 else 8, fillstyle="none" if len(it) == 1
+                  else "full")
+        ax_w.plot(it, [c["velocity_cost"] for c in run.costs], marker=marker, color=color,
+                  label=label, ms=5 if len(it) > 1 else 8, fillstyle="none" if len(it) == 1
+                  else "full")
+    ax_t.set_ylabel("Σ τᵀ K_τ τ (dynamics)")
+    ax_w.set_ylabel("Σ ωᵀ K_ω ω (kinematics)")
+    ax_w.set_xlabel("optimisation iteration")
+    ref = opt or ini
+    if ref is not None:
+        tau, w = _opt_limits(ref)
+        fig.text(0.01, 0.005, "K_τ = diag(1/τ_max²), τ_max = (" + ", ".join(f"{x:g}" for x in tau)
+                 + ") N·m;  K_ω = diag(1/ω_max²), ω_max = (" + ", ".join(f"{x:g}" for x in w)
+                 + ") rad/s;  joints 1, 2, 4", fontsize=7, color="0.35")
+    for ax in (ax_t, ax_w):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    ax_t.set_title("Optimisation of the cost functions (cf. Fig. 6)", fontsize=10)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    return fig
+
+
+def _ball_series(run: CatchRun, t0: float, t1: float):
+    w = run.window(run.t_obj, t0, t1)
+    return run.t_obj[w], run.ball[w]
+
+
+def fig7(runs: list[CatchRun], title: str):
+    fig = plt.figure(figsize=(10.0, 7.0))
+    gs = fig.add_gridspec(2, 3, height_ratios=(1.0, 1.25))
+    axes = [fig.add_subplot(gs[0, i]) for i in range(3)]
+    side = fig.add_subplot(gs[1, :])
+    span = (min(_span(r)[0] for r in runs), max(_span(r)[1] for r in runs))
+    for ax in axes:
+        ax.set_xlim(*span)
+    for run in runs:
+        st = STYLE["optimised" if run.mapping == "optimised" else "initial"]
+        t0, t1 = _span(run)
+        wc = run.window(run.t_ctrl, t0, t1)
+        tb, ball = _ball_series(run, t0, t1)
+        for i, ax in enumerate(axes):
+            ax.plot(tb, ball[:, i], color=C_BALL, **st)
+            ax.plot(run.t_ctrl[wc], run.effector_desired[wc, i], color=C_DES, **st)
+            ax.plot(run.t_ctrl[wc], run.effector[wc, i], color=C_ACT, **st)
+            _marks(ax, run, st, text=(run is runs[0] and i == 0))
+        side.plot(ball[:, 0], ball[:, 2], color=C_BALL, **st)
+        side.plot(run.effector_desired[wc, 0], run.effector_desired[wc, 2], color=C_DES, **st)
+        side.plot(run.effector[wc, 0], run.effector[wc, 2], color=C_ACT, **st)
+        if run.t_c is not None:
+            k = run.ctrl_index(run.t_c)
+            side.plot(*run.effector_desired[k, [0, 2]], "o", color=C_DES, ms=6, fillstyle="none")
+        c = first_contact(run)
+        if c is not None:
+            side.plot(*run.ball_at(c["t"])[0][[0, 2]], "x", color=C_BALL, ms=7)
+    for ax, name in zip(axes, "xyz"):
+        ax.set_ylabel(f"{name} [m]")
+        ax.set_xlabel("time [s]")
+        ax.grid(alpha=0.3)
+    side.set_xlabel("x [m]")
+    side.set_ylabel("z [m]")
+    side.set_aspect("equal", adjustable="datalim")
+    side.grid(alpha=0.3)
+    side.set_title("side view (x-z): ○ l(q_d) at t_c, × ball at the first contact", fontsize=9)
+    handles = [plt.Line2D([], [], color=C_BALL, label="ball r_o (truth)"),
+               plt.Line2D([], [], color=C_DES, label="desired l(q_d)"),
+               plt.Line2D([], [], color=C_ACT, label="actual l(q)")]
+    handles += [plt.Line2D([], [], color="0.3", label=_label(r),
+                           **STYLE["optimised" if r.mapping == "optimised" else "initial"])
+                for r in runs]
+    side.legend(handles=handles, fontsize=7, loc="upper left")
+    fig.suptitle(title, fontsize=10)
+    fig.text(0.01, 0.005, "l(q): the catch point (ball centre on the palm); vertical lines: t₀ "
+             "(first vision frame used), t_c (r_o on the catch surface, q4 = q_α), contact, "
+             "catch/miss", fontsize=7, color="0.35")
+    fig.tight_layout(rect=(0, 0.02, 1, 0.97))
+    return fig
+
+
+def _joint_figure(runs: list[CatchRun], title: str, what: str):
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.6, 6.4))
+    axes[0].set_xlim(min(_span(r, 0.1)[0] for r in runs), max(_span(r, 0.1)[1] for r in runs))
+    for run in runs:
+        st = STYLE["optimised" if run.mapping == "optimised" else "initial"]
+        t0, t1 = _span(run, after=0.1)
+        wa = run.window(run.t_arm, t0, t1)
+        wc = run.window(run.t_ctrl, t0, t1)
+        for ax, j, name in zip(axes, ACTIVE, JOINTS):
+            if what == "angles":
+                ax.plot(run.t_arm[wa], run.q[wa, j], color="tab:blue" if run.mapping ==
+                        "optimised" else "tab:red", label=f"q, {_label(run)}", **st)
+                ax.plot(run.t_ctrl[wc], run.q_desired[wc, j], color="0.35", lw=0.8,
+                        ls=st["ls"], label=f"q_d, {run.name}")
+                ax.set_ylabel(f"q{name[1]} [rad]")
+            else:
+                ax.plot(run.t_ctrl[wc], run.torque[wc, j], color="tab:blue" if run.mapping ==
+                        "optimised" else "tab:red", label=_label(run), **st)
+                ax.set_ylabel(f"τ{name[1]} [N·m]")
+            _marks(ax, run, st, text=(run is runs[0] and j == 0))
+    if what == "torques":
+        tau, _ = _opt_limits(runs[0])
+        for ax, lim in zip(axes, tau):
+            for s in (-1, 1):
+                ax.axhline(s * lim, color="0.6", lw=0.8, ls=":")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=7, loc="best")
+    axes[-1].set_xlabel("time [s]")
+    axes[0].set_title(title, fontsize=10)
+    note = ("axis 3 locked at 0; thin grey: q_d = g∘l_c⁻¹(r_o)" if what == "angles" else
+            "command torque τ = τ_ff(q_d) + PD, clipped at the limits (dotted)")
+    fig.text(0.01, 0.005, note + "; vertical lines: t₀, t_c, contact, catch/miss",
+             fontsize=7, color="0.35")
+    fig.tight_layout(rect=(0, 0.025, 1, 1))
+    return fig
+
+
+def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
+    """Figs. 6-9 for the optimised / unoptimised pair, and Fig. 7 for every other run."""
+    out = Path(out)
+    runs = {name: load_run(log, name) for name, log in sorted(logs.items())}
+    if not runs:
+        return []
+    opt, ini = _pair(runs)
+    pair = [r for r in (opt, ini) if r is not None]
+    paths: list[Path] = []
+    if pair:
+        what = " vs ".join(r.name for r in pair)
+        paths += save(fig6(opt, ini), out, "catch_fig6")
+        paths += save(fig7(pair, f"Catching trajectory: {what} (cf. Fig. 7)"), out,
+                       "catch_fig7")
+        paths += save(_joint_figure(pair, f"Joint angles: {what} (cf. Fig. 8)", "angles"), out,
+                       "catch_fig8")
+        paths += save(_joint_figure(pair, f"Command torques: {what} (cf. Fig. 9)", "torques"),
+                       out, "catch_fig9")
+    for name, run in runs.items():
+        if run in pair:
+            continue
+        paths += save(fig7([run], f"Catching trajectory: {_label(run)} (cf. Fig. 7)"), out,
+                       f"{name}_fig7")
+    return paths
