@@ -11,6 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from analysis.figure_files import save  # noqa: E402
 from analysis.series import arrays, events  # noqa: E402
 from replay.log import LogReader  # noqa: E402
 
@@ -76,20 +77,11 @@ def _mu(log: LogReader):
         return None
 
 
-def _save(fig, out: Path, stem: str) -> list[Path]:
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / f"{stem}.png", out / f"{stem}.svg"]
-    fig.savefig(paths[0], dpi=150)
-    fig.savefig(paths[1], metadata={"Date": None})  # no timestamp: same log, same file
-    plt.close(fig)
-    return paths
-
-
 def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     """Fig. 7 for every stick run, and the friction overlay for runs of the same strategy."""
     paths: list[Path] = []
     for name, log in sorted(logs.items()):
-        paths += _save(fig7(log, f"{name}: velocities vs time (cf. Fig. 7)"), out, f"{name}_fig7")
+        paths += save(fig7(log, f"{name}: velocities vs time (cf. Fig. 7)"), out, f"{name}_fig7")
     by_strategy: dict[str, dict[str, LogReader]] = {}
     for name, log in logs.items():
         import yaml
@@ -98,5 +90,5 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
             by_strategy.setdefault(sc["controller"]["type"], {})[name] = log
     for strategy, group in sorted(by_strategy.items()):
         if len({_mu(log) for log in group.values()}) > 1:
-            paths += _save(friction_overlay(group), out, f"{strategy}_friction")
+            paths += save(friction_overlay(group), out, f"{strategy}_friction")
     return paths
