@@ -133,8 +133,15 @@ def json_schema(cls: type) -> dict[str, Any]:
             "required": [f.name for f in dataclasses.fields(cls)]}
 
 
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+
+
 def to_dict(payload: Any) -> dict[str, Any]:
     """A payload dataclass (or a plain dict) as a JSON-ready dict."""
     if isinstance(payload, dict):
         return payload
-    return {f.name: getattr(payload, f.name) for f in dataclasses.fields(payload)}
+    cls = type(payload)
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = tuple(f.name for f in dataclasses.fields(payload))
+    return {name: getattr(payload, name) for name in names}

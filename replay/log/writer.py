@@ -19,6 +19,8 @@ from replay.log.errors import LogError, NonFiniteValueError
 from replay.messages import TOPICS, json_schema, to_dict
 
 PART_SUFFIX = ".part"
+_ENCODER = json.JSONEncoder(allow_nan=False, separators=(",", ":"))   # built once: dumps() with
+                                                                       # options builds one a call
 
 
 def seconds_to_ns(t: float) -> int:
@@ -80,7 +82,7 @@ class LogWriter:
         """Write one message; ``t_ns`` (simulated time) is both log and publish time."""
         body = to_dict(payload)
         try:
-            data = json.dumps(body, allow_nan=False, separators=(",", ":")).encode()
+            data = _ENCODER.encode(body).encode()
         except ValueError:
             raise NonFiniteValueError(topic, body) from None
         channel = self._channel(topic, payload)
