@@ -141,7 +141,8 @@ def test_cameras_from_sensor_params(stick_log, arm_log):
     assert np.allclose(R[:, 2], [0.0, 0.0, -1.0], atol=1e-9)
     cams, _ = cameras(load_run(arm_log).sensors)
     assert len(cams) == 2                                          # a stereo pair in a list
-    cams, missing = cameras({"cam": {"type": "stick_camera", "params": {"noise": 0.1}}})
+    cams, missing = cameras({"cam": {"type": "stick_camera", "params": {"noise": 0.1}},
+                             "enc": {"type": "joint_encoders"}})
     assert cams == [] and missing == ["cam"]
 
 

@@ -147,93 +147,50 @@ class CameraPose:
     aspect: float                              # width / height
 
 
-_POS_KEYS = ("position", "eye", "camera_position", "pos", "origin")
-_TARGET_KEYS = ("target", "look_at", "lookat", "center")
-_FOVX_KEYS = ("fov_x", "fov", "hfov", "fov_horizontal")
-
-
-def _vec3(v):
-    if isinstance(v, (list, tuple)) and len(v) == 3 and all(isinstance(x, (int, float))
-                                                           for x in v):
-        return np.asarray(v, dtype=float)
-    return None
-
-
-def _look_at_matrix(eye, target, up) -> np.ndarray | None:
-    z = target - eye
-    if np.linalg.norm(z) == 0:
-        return None
-    z = z / np.linalg.norm(z)
-    x = np.cross(-np.asarray(up, float), z)
-    if np.linalg.norm(x) < 1e-9:                      # looking straight along "up"
-        x = np.cross([0.0, -1.0, 0.0], z) if abs(z[1]) < 0.9 else np.cross([-1.0, 0, 0], z)
-    x = x / np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
-
-
 def _matrix_to_wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
     import viser.transforms as vtf
     w, x, y, z = vtf.SO3.from_matrix(R).wxyz
     return (float(w), float(x), float(y), float(z))
 
 
-def _camera_from_dict(name: str, d: dict) -> CameraPose | None:
-    eye = next((_vec3(d[k]) for k in _POS_KEYS if _vec3(d.get(k)) is not None), None)
-    if eye is None:
-        return None
-    R = None
-    target = next((_vec3(d[k]) for k in _TARGET_KEYS if _vec3(d.get(k)) is not None), None)
-    if target is not None:
-        up = _vec3(d.get("up"))
-        R = _look_at_matrix(eye, target, up if up is not None else np.array([0.0, 0.0, 1.0]))
-    elif isinstance(d.get("rotation"), list) and np.shape(d["rotation"]) == (3, 3):
-        R = np.asarray(d["rotation"], dtype=float)
-    if R is None:
-        return None
-    w, h = d.get("width"), d.get("height")
-    res = d.get("resolution") or d.get("image_size")
-    if (w is None or h is None) and isinstance(res, list) and len(res) == 2:
-        w, h = res
-    w, h = float(w or 128), float(h or 128)
-    fov_x = next((float(d[k]) for k in _FOVX_KEYS if isinstance(d.get(k), (int, float))), None)
-    if fov_x is None and isinstance(d.get("fov_deg"), (int, float)):
-        fov_x = math.radians(float(d["fov_deg"]))
-    fx = d.get("fx") or d.get("focal_px")
-    if isinstance(fx, (int, float)) and fx > 0:
-        fov_y = 2.0 * math.atan((h / 2.0) / float(d.get("fy") or fx))
-    elif fov_x is not None and 0 < fov_x < math.pi:
-        fov_y = 2.0 * math.atan(math.tan(fov_x / 2.0) * h / w)
-    else:
-        fov_y = math.radians(40.0)
-    return CameraPose(name, tuple(float(v) for v in eye), _matrix_to_wxyz(R), fov_y, w / h)
-
-
-def _walk_cameras(name: str, obj, out: list) -> None:
-    if isinstance(obj, dict):
-        cam = _camera_from_dict(name, obj)
-        if cam is not None:
-            out.append(cam)
-            return
-        for k, v in obj.items():
-            if isinstance(v, (dict, list)):
-                _walk_cameras(f"{name}/{k}", v, out)
-    elif isinstance(obj, list):
-        for i, v in enumerate(obj):
-            _walk_cameras(f"{name}/{i}", v, out)
+def _pose(name: str, cam) -> CameraPose:
+    """A pinhole camera (replay.vision.pinhole) as the viewer draws it."""
+    k = cam.intrinsics
+    fov_y = 2.0 * math.atan((k.height / 2.0) / k.fy)
+    return CameraPose(name, tuple(float(v) for v in cam.position), _matrix_to_wxyz(cam.rotation),
+                      fov_y, k.width / k.height)
 
 
 def cameras(sensors: dict) -> tuple[list[CameraPose], list[str]]:
-    """Camera poses found in ``sensors.*.params`` (a position plus a target or rotation, any
-    nesting, e.g. a stereo pair's list), and the names of camera-like sensors without one."""
+    """The camera poses of a scenario's ``sensors`` (the resolved YAML as a dict), from each camera
+    sensor's own model (its ``make_camera`` / ``make_cameras`` of its Params), and the names of
+    camera sensors whose pose could not be had (unknown type, invalid params)."""
+    import yaml
+
+    from replay import registry
+    from replay.scenario.loader import ScenarioError, build_dataclass
+
     found: list[CameraPose] = []
     missing: list[str] = []
     for name, spec in (sensors or {}).items():
         if not isinstance(spec, dict):
             continue
-        params = spec.get("params") or {}
-        before = len(found)
-        _walk_cameras(str(name), params, found)
-        kind = str(spec.get("type", ""))
-        if len(found) == before and any(w in kind for w in ("camera", "vision", "stereo")):
+        try:
+            cls = registry.load("sensor", str(spec.get("type", "")))
+        except registry.UnknownPlugin:
             missing.append(str(name))
+            continue
+        make = getattr(cls, "make_cameras", None) or getattr(cls, "make_camera", None)
+        if make is None:                       # not a camera (e.g. joint encoders)
+            continue
+        try:
+            node = yaml.compose(yaml.safe_dump(spec.get("params") or {}))
+            params = build_dataclass(node, cls.Params, f"sensors.{name}.params")
+        except ScenarioError:
+            missing.append(str(name))
+            continue
+        made = make(params)
+        made = list(made) if isinstance(made, (list, tuple)) else [made]
+        found += [_pose(str(name) if len(made) == 1 else f"{name}/{i}", cam)
+                  for i, cam in enumerate(made)]
     return found, missing

@@ -113,11 +113,9 @@ def write_arm_log(path, *, duration: float = 0.8, rate: int = 1000, name: str = 
               "velocity_limits": [], "hand": hand if table else "none", "hand_initial": [],
               "object": obj, "object_radius": 0.0175, "object_size": [0.05, 0.04, 0.03],
               "object_position": [1.5, 0.0, 1.0]}
-    sensors = {"stereo": {"type": "stereo_camera", "rate": 1000.0, "latency": 0.001, "params": {
-        "cameras": [{"position": [0.4, -1.2, 1.3], "target": [0.6, 0.0, 0.9], "fov_x": 0.7,
-                     "width": 128, "height": 128},
-                    {"position": [0.8, -1.2, 1.3], "target": [0.6, 0.0, 0.9], "fov_x": 0.7,
-                     "width": 128, "height": 128}]}}}
+    sensors = {"stereo": {"type": "stereo_ball", "rate": 1000.0, "latency": 0.001, "params": {
+        "cam0_position": [0.4, -1.2, 1.3], "cam0_target": [0.6, 0.0, 0.9],
+        "cam1_position": [0.8, -1.2, 1.3], "cam1_target": [0.6, 0.0, 0.9], "fov": 0.7}}}
     paper = "namiki2003" if obj == "ball" else "namiki1999"
     text = _scenario(name, paper, duration, rate, {"type": "bullet_arm", "params": params},
                      sensors)
