@@ -130,3 +130,42 @@ def test_killed_run_leaves_a_readable_part_file(toy_yaml, tmp_path):
     assert r.truncated
     states = r.series("/toy/state")
     assert len(states) > 100 and json.dumps(states[-1])
+
+
+INTERRUPTED_RUN = r"""
+import sys, time
+sys.path.insert(0, {tests!r})
+import toy_plugins; toy_plugins.install()
+from replay.cli import main
+import replay.runner as runner
+orig = runner.Runner.run
+def run(self, out):
+    def tick(t, d):
+        if t > 1.0:
+            print("ready", flush=True); time.sleep(60)
+    self.progress = tick
+    return orig(self, out)
+runner.Runner.run = run
+sys.argv = ["replay", "run", {yaml!r}, "-o", {out!r}, "--set", "timing.duration=600"]
+main()
+"""
+
+
+def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
+    out = tmp_path / "interrupted.mcap"
+    code = INTERRUPTED_RUN.format(tests=os.path.dirname(__file__), yaml=str(toy_yaml),
+                                  out=str(out))
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130
+    assert "interrupted at t = " in err and "partial log kept" in err and "Traceback" not in err
+    r = LogReader(out)                      # finished properly: summary, final name
+    assert not r.truncated
+    assert r.events()[-1]["kind"] == "interrupted"
+    assert 0.9 < r.time_range()[1] < 1.2
