@@ -79,3 +79,13 @@ def quaternion_matrix(q) -> np.ndarray:
         [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
         [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)],
     ])
+
+
+def wrap_half_pi(angle: float) -> float:
+    """An axis angle (known modulo pi, as a symmetric marker shows it) in (-pi/2, pi/2]."""
+    a = math.fmod(angle, math.pi)
+    if a <= -math.pi / 2.0:
+        a += math.pi
+    elif a > math.pi / 2.0:
+        a -= math.pi
+    return a

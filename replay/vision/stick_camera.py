@@ -47,7 +47,7 @@ import numpy as np
 from replay.interfaces import Sensor
 from replay.messages import VisionStick
 from replay.params import param
-from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix
+from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix, wrap_half_pi
 from replay.vision.pinhole import PinholeCamera
 
 _RIM = 48             # vertices of a polygon standing in for a circle
@@ -387,13 +387,3 @@ class StickCamera(Sensor):
         theta = wrap_half_pi(math.atan2(pts[1, 1] - pts[0, 1], pts[1, 0] - pts[0, 0]))
         return VisionStick(t=t, x=float(pts[0, 0]) + float(p.position_offset[0]),
                            y=float(pts[0, 1]) + float(p.position_offset[1]), theta=theta)
-
-
-def wrap_half_pi(angle: float) -> float:
-    """An axis angle (known modulo pi) in (-pi/2, pi/2]."""
-    a = math.fmod(angle, math.pi)
-    if a <= -math.pi / 2.0:
-        a += math.pi
-    elif a > math.pi / 2.0:
-        a -= math.pi
-    return a

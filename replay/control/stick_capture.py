@@ -1,0 +1,488 @@
+"""The controller machinery the 2-step and 3-step capturing strategies (Higashimori et al. 2007,
+Sec. III) share: phases, planned collisions, events and the capture check.
+
+:class:`StickCaptureController` runs the cycle below; the strategies
+(``stick_strategy``) give the contact of each collision. The hand plans are made by
+``stick_plan`` (collisions) and ``stick_close`` (the closing), with the hand model of
+``stick_hand_model`` and the predicted sweep of ``stick_sweep``.
+
+Pure NumPy. The controller sees only ``/vision/stick`` measurements (x, y, theta mod pi; already
+delayed by the camera latency) and the :class:`~replay.hand2d.AirTableSpec` (hand kinematics and
+the stick's m, I, L, W, e; never the friction mu). It has no hand feedback: it tracks its own
+commands with a model that moves every axis toward its target at the spec's speed limit, starting
+from where the spec says the hand was homed (``HandSpec.start_base`` / ``start_joints``).
+
+Cycle of one planned collision i:
+
+1. Observe until the :class:`~replay.control.stick_estimator.StickEstimator` is ready.
+2. Solve the contact (r_x, side) from the estimated u_{i-1} (stick_collision: eqs. 25, 28, 26 and
+   the side rules 31, 35, 37), at the target orientation theta* (alpha(v_{i-1}), eq. 23, or
+   alpha(lambda_2) for the 3-step second collision).
+3. Walk the future times at which the predicted orientation equals theta* modulo pi, earliest
+   first, up to ``horizon``; at each, put the fingertip centre at contact - tip_radius n, find a
+   base position and finger joints (``hand2d.finger_ik``) reachable in time (``hand2d.travel_time``
+   plus ``arrive_margin``) for which the stick's predicted sweep does not hit the waiting tip
+   before the contact, and an idle-finger posture clear of the sweep before and
+   ``post_horizon`` after the contact (the J-predicted motion). A tip inside the sweep of a
+   spinning stick waits outside it (``stage_margin``) and moves in just after the stick's last
+   pass; a fingertip inside the stick's reach is first pulled out of it. Every route is checked
+   against the predicted sweep along the hand's own motion (each axis at its speed limit, as
+   the plant moves). The first crossing that works is the plan; it is refined with every new
+   estimate until ``freeze`` before the contact.
+4. A model break of the estimator within ``detect_window`` of the planned time is the planned
+   collision; the plan for the next step is then made from fresh estimates. A break much earlier,
+   or none by ``detect_window`` after the plan, is reported (``missed``) and the step re-planned.
+
+Closing (eqs. 32, 33, 38): once the stick translates, the finger that made the last collision is
+behind it; the other waits on the line through the centre of mass along v, ahead of the stick, at
+the point the stick reaches first that the hand can get to in time (going around an end of the
+stick when it starts behind it); the rear fingertip waits behind the stick while the slider
+moves (finger joints cannot hold a tip still against a moving slider), then follows the stick
+along that line (``follow_gap`` behind) to the final gap W + 2 tip_radius + grip_clearance.
+Whatever spin is left is ignored by the closing plan (the fingers then squeeze a turning stick:
+not friction independent).
+A ``capture`` event is emitted once the estimated speed stays below ``capture_speed`` and spin
+below ``capture_spin`` for ``capture_hold`` with both modelled fingertips at the stick's two faces.
+
+Infeasibility and fallbacks (each reported once per step as an ``infeasible`` event; the
+``r_x_beyond_stick`` one with the plan's final numbers, when it freezes or the collision happens):
+
+- ``r_x_beyond_stick``: the solved |r_x| exceeds L/2 (e.g. the 3-step second collision with the
+  paper's m, I, e needs sqrt(I / (m e)) = 86.5 mm > 50 mm). Fallback: clamp |r_x| to
+  L/2 - ``tip_margin`` on the same side and predict the outcome with J_i (eq. 22); for a purely
+  rotating stick this leaves omega_2 / omega_1 = (I - e m r^2) / (I + m r^2), the least spin any
+  contact on the stick can leave. The next step proceeds from the measured result; when the
+  strategy's last contact was clamped and J predicts |omega| >= ``min_spin``, up to ``max_extra``
+  spin-stop collisions (the 2-step first collision, eq. 30, on the current u) are added before
+  the closing.
+- ``unreachable``: an orientation crossing passed without a plan that reaches it in time (data:
+  t_contact, and the best t_needed vs t_available of the last attempt; t_needed null when no hand
+  configuration reaches the spot or keeps clear of the stick at all); for the closing, after
+  ``close_retry`` of failed attempts. Fallback: keep the hand where it is and try again every
+  ``retry_interval`` (later crossings enter the horizon; one beyond it is simply waited for).
+- ``no_solution`` / ``no_crossing``: no root of eq. 25 / 28 passes eq. 26, or the stick does not
+  spin while not perpendicular to its motion (theta never reaches alpha(v)). Fallback: go to the
+  closing step with the stick as it moves (not friction independent).
+
+A step whose job is to stop the spin is skipped when |omega| < ``min_spin`` already (``skip``).
+
+Events (``pop_events``): ``plan`` (a contact is committed; data = the intent), ``infeasible``,
+``missed`` (the model broke well before the planned time, or not by ``detect_window`` after it),
+``skip``, ``capture``. ``intent()``: index, finger, t, theta, r_x, r_y, side, v_after,
+omega_after, contact and tip (world, m), clamped, r_x_solved. theta is the estimator's continuous
+orientation (it starts from the camera's first reading in (-pi/2, pi/2]); r_x, r_y and side are
+in that body frame (the solution's frame theta* = alpha(.) may differ from it by pi).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from replay.hand2d import AirTableSpec, HandCommand, HandSpec
+from replay.interfaces import Controller, Occurrence
+from replay.params import param
+from replay.control import stick_collision as sc
+from replay.control.stick_close import ClosePlan, ClosePlanner
+from replay.control.stick_estimator import StickEstimate, StickEstimator
+from replay.control.stick_hand_model import Config, HandModel
+from replay.control.stick_plan import ContactPlan, ContactPlanner, Shortfall
+
+TOPIC_VISION = "/vision/stick"
+TOPIC_ESTIMATE = "/control/stick_estimate"
+
+
+# ------------------------------------------------------------------------------------------
+# Parameters
+# ------------------------------------------------------------------------------------------
+
+
+@dataclass
+class StickCaptureParams:
+    window: int = param(30, unit="1", ge=2, le=1000,
+                        doc="samples in the sliding least-squares window (0.1 s at 300 fps)")
+    min_samples: int = param(6, unit="1", ge=2, le=1000,
+                             doc="samples since the last collision before the estimate is used")
+    pos_tol: float = param(0.002, unit="m", gt=0.0, le=0.1,
+                           doc="position deviation from the prediction that breaks the model")
+    theta_tol: float = param(0.03, unit="rad", gt=0.0, le=1.0,
+                             doc="orientation deviation from the prediction that breaks the model")
+    confirm: int = param(2, unit="1", ge=1, le=5,
+                         doc="consecutive deviating samples that confirm a collision")
+    horizon: float = param(1.0, unit="s", gt=0.0, le=10.0,
+                           doc="how far ahead a contact is searched")
+    arrive_margin: float = param(0.01, unit="s", ge=0.0, le=0.5,
+                                 doc="the fingertip must be at the spot this long before contact")
+    freeze: float = param(0.01, unit="s", ge=0.0, le=0.5,
+                          doc="the target is no longer refined this long before the contact")
+    detect_window: float = param(0.04, unit="s", gt=0.0, le=1.0,
+                                 doc="a model break this close to the planned time is the plan's")
+    min_spin: float = param(0.2, unit="rad/s", ge=0.0, le=100.0,
+                            doc="below this |omega| a spin-stopping step is skipped")
+    max_extra: int = param(2, unit="1", ge=0, le=10,
+                           doc="spin-stop collisions (eq. 30) added when a clamped contact left "
+                               "|omega| >= min_spin, before closing")
+    tip_margin: float = param(0.005, unit="m", ge=0.0, le=0.05,
+                              doc="fallback: |r_x| is clamped to L/2 - tip_margin")
+    sweep_margin: float = param(0.003, unit="m", ge=0.0, le=0.05,
+                                doc="clearance between an idle fingertip and the predicted sweep")
+    stage_margin: float = param(0.01, unit="m", ge=0.0, le=0.2,
+                                doc="a staged tip waits this far outside a spinning stick's reach")
+    post_horizon: float = param(0.1, unit="s", ge=0.0, le=2.0,
+                                doc="after a contact the idle finger stays clear this long")
+    grip_clearance: float = param(0.002, unit="m", ge=0.0, le=0.05,
+                                  doc="final fingertip gap = W + 2 tip_radius + grip_clearance")
+    follow_gap: float = param(0.01, unit="m", ge=0.0, le=0.1,
+                              doc="the rear fingertip follows this far behind the stick")
+    retry_interval: float = param(0.02, unit="s", ge=0.0, le=1.0,
+                                  doc="after a failed plan, wait this long before trying again")
+    close_retry: float = param(0.3, unit="s", gt=0.0, le=5.0,
+                               doc="the closing is re-planned when no capture this long after "
+                                   "the planned meeting")
+    capture_speed: float = param(0.02, unit="m/s", gt=0.0, le=1.0,
+                                 doc="capture: estimated speed below this")
+    capture_spin: float = param(0.5, unit="rad/s", gt=0.0, le=50.0,
+                                doc="capture: estimated |omega| below this")
+    capture_hold: float = param(0.05, unit="s", ge=0.0, le=5.0,
+                                doc="capture: conditions held this long")
+
+
+def _finite_or_none(v) -> float | None:
+    """Event data must be JSON without NaN/inf (the log contract): non-finite -> None."""
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+# ------------------------------------------------------------------------------------------
+# The controller
+# ------------------------------------------------------------------------------------------
+
+
+class StickCaptureController(Controller):
+    """Shared machinery; subclasses give the contact of each step (``_options``)."""
+
+    Params: ClassVar[type] = StickCaptureParams
+    n_steps: ClassVar[int] = 1
+
+    def __init__(self, params, *, spec: AirTableSpec) -> None:
+        super().__init__(params, spec=spec)
+        p = params
+        self.hand: HandSpec = spec.hand
+        self.stick = spec.stick
+        self.est = StickEstimator(window=p.window, min_samples=p.min_samples, pos_tol=p.pos_tol,
+                                  theta_tol=p.theta_tol, confirm=p.confirm)
+        self.model = HandModel(self.hand, self._home())
+        self.planner = ContactPlanner(p, self.hand, self.stick, self.model)
+        self.closing = ClosePlanner(self.planner)
+        self.phase = "observe"
+        self.step = 1                       # index of the next collision
+        self.plan: ContactPlan | None = None
+        self.close: ClosePlan | None = None
+        self.last_finger: int | None = None
+        self.captured = False
+        self._capture_since: float | None = None
+        self._events: list[Occurrence] = []
+        self._reported: set = set()
+        self._next_try = -math.inf          # no new plan attempt before this time
+        self.extra = 0                      # spin-stop collisions added so far
+        self._lost: tuple | None = None     # (time of a contact chance not yet planned, numbers)
+
+    # -- Controller interface -----------------------------------------------------------------
+    def update(self, t: float, measurements) -> HandCommand:
+        self.model.advance(t)
+        broke = fresh = False
+        for topic, m in measurements:
+            if topic != TOPIC_VISION or m is None:
+                continue
+            broke |= self.est.add(m.t, m.x, m.y, m.theta)
+            fresh = True
+        if broke:
+            self._on_break(t)
+        if fresh and self.est.ready():
+            self._on_estimate(t)
+        self._command(t)
+        self._check_capture(t)
+        return self.model.target.command()
+
+    def intent(self) -> dict:
+        if self.plan is not None:
+            return self.plan.intent(self.stick.width)
+        if self.close is not None:
+            return self.close.intent(self.stick.width)
+        return {}
+
+    def pop_events(self) -> list[Occurrence]:
+        out, self._events = self._events, []
+        return out
+
+    def telemetry(self, t: float) -> dict:
+        e = self.est.estimate()
+        msg = {"t": float(t), "phase": self.phase, "step": self.step,
+               "ready": bool(self.est.ready())}
+        if e is not None:
+            x, y, th = e.at(t)
+            msg.update({"t_ref": e.t_ref, "x": x, "y": y, "theta": th, "vx": e.vx, "vy": e.vy,
+                        "omega": e.omega, "n": e.n, "rms_xy": e.rms_xy,
+                        "rms_theta": e.rms_theta})
+        return {TOPIC_ESTIMATE: msg}
+
+    # -- strategy hooks -------------------------------------------------------------------------
+    def _options(self, est: StickEstimate, step: int) -> list[sc.ContactSolution]:
+        """Contacts for collision ``step``, in order of preference (empty: none)."""
+        raise NotImplementedError
+
+    def _spin_stop(self, step: int) -> bool:
+        """True when collision ``step`` is meant to remove the spin (omega_i = 0)."""
+        raise NotImplementedError
+
+    def _contacts(self, est: StickEstimate, step: int) -> list[sc.ContactSolution]:
+        """The strategy's contacts, or an added spin-stop collision (eq. 30) after them."""
+        if step <= self.n_steps:
+            return self._options(est, step)
+        st = self.stick
+        sol = sc.two_step_first(st.mass, st.inertia, st.restitution, est.u, st.length)
+        return [] if sol is None else [sol]
+
+    def _stops_spin(self, step: int) -> bool:
+        return step > self.n_steps or self._spin_stop(step)
+
+    def _finger_order(self, sol: sc.ContactSolution, step: int) -> tuple[tuple[int, ...], bool]:
+        """Fingers to try and whether the order is strict (else: the quickest)."""
+        return (0, 1), False
+
+    # -- events ---------------------------------------------------------------------------------
+    def _report(self, kind: str, key, **data) -> None:
+        if key in self._reported:
+            return
+        self._reported.add(key)
+        clean = {k: (_finite_or_none(v) if isinstance(v, (float, np.floating)) else v)
+                 for k, v in data.items()}
+        self._events.append(Occurrence(kind=kind, data=clean))
+
+    def _on_break(self, t: float) -> None:
+        t_break = self.est.breaks[-1]
+        if self.phase != "approach" or self.plan is None:
+            return
+        plan = self.plan
+        self._report_clamp(plan)
+        self._next_try = -math.inf
+        self._lost = None
+        if abs(t_break - plan.t) <= self.params.detect_window:
+            self.last_finger = plan.finger
+            self.plan = None
+            self.step += 1
+            self.phase = "observe"
+            if self.step > self.n_steps:
+                spinning = abs(plan.sol.u_after[2]) >= self.params.min_spin
+                if spinning and self.extra < self.params.max_extra:
+                    self.extra += 1          # one more spin-stop collision (eq. 30)
+                else:
+                    self.phase = "close"
+        else:
+            self._events.append(Occurrence("missed", {
+                "index": plan.index, "reason": "early_contact", "t_planned": float(plan.t),
+                "t_break": float(t_break)}))
+            self.plan = None
+            self.phase = "observe"
+
+    def _on_estimate(self, t: float) -> None:
+        est = self.est.estimate()
+        p = self.params
+        if self.phase in ("observe", "approach"):
+            if self.plan is not None and est.t_ref > self.plan.t + p.detect_window:
+                self._events.append(Occurrence("missed", {
+                    "index": self.plan.index, "reason": "no_collision",
+                    "t_planned": float(self.plan.t), "t_now": float(t)}))
+                self.plan = None
+                self.phase = "observe"
+            if self.plan is None:
+                if t >= self._next_try:
+                    self._plan_step(t, est)
+                    if self.plan is None and self.phase != "close":
+                        self._next_try = t + p.retry_interval
+            elif t < self.plan.t - p.freeze and len(self.plan.route) <= 1:
+                self._refine(t, est)
+        elif self.phase == "close":
+            if self.close is not None and t > self.close.t_meet + p.close_retry \
+                    and self._capture_since is None:
+                self.close = None
+            if self.close is None:
+                if t >= self._next_try:
+                    self._plan_close(t, est)
+                    if self.close is None:
+                        self._next_try = t + p.retry_interval
+            elif t < self.close.t_meet - p.freeze:
+                self.closing.refine(t, est, self.close, len(self.est.breaks))
+
+    # -- planning a collision -------------------------------------------------------------------
+    def _plan_step(self, t: float, est: StickEstimate) -> None:
+        p = self.params
+        step = self.step
+        if self._stops_spin(step) and abs(est.omega) < p.min_spin:
+            self._events.append(Occurrence("skip", {"index": step, "omega": float(est.omega),
+                                                    "reason": "no_spin"}))
+            self.step = self.n_steps + 1
+            self.phase = "close"
+            return
+        options = self._contacts(est, step)
+        if not options:
+            self._report("infeasible", (step, "no_solution"), step=step, reason="no_solution",
+                         vx=est.vx, vy=est.vy, omega=est.omega)
+            self._to_close()
+            return
+        usable = [c for c in map(self._clamp, options) if c is not None]
+        shortfall = Shortfall()
+        crossings_any = False
+        first = math.inf
+        for sol, raw in usable:
+            crossings = self.planner.crossings(t, est, sol.theta)
+            crossings_any |= bool(crossings)
+            first = min([first, *crossings])
+            fingers, strict = self._finger_order(sol, step)
+            for t_c in crossings:
+                plan = self.planner.reach(self.step, t, est, sol, raw, t_c, fingers, strict,
+                                          shortfall)
+                if plan is not None:
+                    self.plan = plan
+                    self._lost = None
+                    self.phase = "approach"
+                    self._events.append(Occurrence("plan", plan.intent(self.stick.width)))
+                    return
+        if not crossings_any:
+            if abs(est.omega) < 1e-6:
+                self._report("infeasible", (step, "no_crossing"), step=step,
+                             reason="no_crossing", omega=est.omega, theta=est.theta)
+                self._to_close()
+            return                      # else the next crossing is beyond the horizon: wait
+        self._lost_chance(t, first, shortfall)
+
+    def _lost_chance(self, t: float, deadline: float, shortfall: Shortfall) -> None:
+        """Report ``unreachable`` once a contact opportunity has passed unplanned (an attempt
+        that fails now may still succeed later, from nearer): the numbers of the last attempt
+        made for it. ``deadline`` = the opportunity's time."""
+        lost = self._lost
+        if lost is not None and t > lost[0]:            # that chance passed unplanned
+            self._report("infeasible", (self.step, "unreachable"), step=self.step,
+                         reason="unreachable", t_contact=lost[0], t_needed=lost[1].t_needed,
+                         t_available=lost[1].t_available)
+            lost = None
+        if lost is None or deadline <= lost[0] + 0.05:   # the same (drifting) chance, or earlier
+            self._lost = (deadline, shortfall)
+
+    def _clamp(self, sol: sc.ContactSolution):
+        """(sol, None) when within the stick, else the fallback (clamped sol, raw r_x), or None
+        when the clamped contact would not be approaching."""
+        if sol.within:
+            return sol, None
+        r = math.copysign(0.5 * self.stick.length - self.params.tip_margin, sol.r_x)
+        if sc.approach_speed(sol.theta, r, sol.side, sol.u_before) <= 0.0:
+            return None
+        st = self.stick
+        return sc.contact_at(st.mass, st.inertia, st.restitution, sol.theta, sol.side,
+                             sol.u_before, r, length=st.length, roots=sol.roots), sol.r_x
+
+    def _report_clamp(self, plan: ContactPlan) -> None:
+        """The ``infeasible`` event of a clamped contact, with the plan's final numbers."""
+        if plan.clamped:
+            self._report("infeasible", (plan.index, "r_x_beyond_stick"), step=plan.index,
+                         reason="r_x_beyond_stick", theta=plan.sol.theta, r_x=plan.raw_r_x,
+                         limit=0.5 * self.stick.length, fallback_r_x=plan.sol.r_x,
+                         omega_after=plan.sol.u_after[2],
+                         v_after=[float(v) for v in plan.sol.u_after[:2]])
+
+    def _to_close(self) -> None:
+        self.step = self.n_steps + 1
+        self.phase = "close"
+
+    def _refine(self, t: float, est: StickEstimate) -> None:
+        """Re-solve the committed crossing and finger with the new estimate; keep the old plan
+        when the refined one does not work."""
+        old = self.plan
+        options = self._contacts(est, old.index)
+        n_old = sc.tangent_normal(old.sol.theta, old.sol.side)[1]
+        for sol in options:
+            if float(np.dot(sc.tangent_normal(sol.theta, sol.side)[1], n_old)) <= 0.0:
+                continue                # the other face (alpha may jump by pi: compare n)
+            clamped = self._clamp(sol)
+            if clamped is None:
+                return
+            sol, raw = clamped
+            crossings = self.planner.crossings(t, est, sol.theta, keep_past=True)
+            if not crossings:
+                return
+            t_c = min(crossings, key=lambda tc: abs(tc - old.t))
+            if abs(est.omega) > 1e-6 and abs(t_c - old.t) > 0.5 * math.pi / abs(est.omega):
+                return                                  # not the same crossing any more
+            plan = self.planner.reach(self.step, t, est, sol, raw, t_c, (old.finger,), True,
+                                      Shortfall(), bases=[old.config.base])
+            if plan is None:       # the spot moved out of reach from the old base
+                plan = self.planner.reach(self.step, t, est, sol, raw, t_c, (old.finger,),
+                                          True, Shortfall())
+            if plan is not None:
+                self.plan = plan
+            return
+
+    # -- closing (eqs. 32, 33, 38) --------------------------------------------------------------
+    def _plan_close(self, t: float, est: StickEstimate) -> None:
+        shortfall = Shortfall()
+        close = self.closing.plan(t, est, self.last_finger, self.step, len(self.est.breaks),
+                                  shortfall)
+        if close is not None:
+            self.close = close
+            self._lost = None
+            self._events.append(Occurrence("plan", close.intent(self.stick.width)))
+            return
+        # the closing has no discrete chances: report once it failed for close_retry
+        p = self.params
+        self._lost_chance(t, t + p.close_retry if self._lost is None else self._lost[0],
+                          shortfall)
+
+    # -- commands and capture -------------------------------------------------------------------
+    def _command(self, t: float) -> None:
+        if self.phase == "approach" and self.plan is not None:
+            self.model.target = self.plan.target(t)
+            if t >= self.plan.t - self.params.freeze:
+                self._report_clamp(self.plan)
+        elif self.phase in ("close", "captured") and self.close is not None:
+            if self.phase == "close":
+                self.model.target = self.closing.command(t, self.close, self.est)
+
+    def _check_capture(self, t: float) -> None:
+        if self.phase != "close" or self.close is None or not self.est.ready():
+            return
+        p, st, hand = self.params, self.stick, self.hand
+        est = self.est.estimate()
+        x, y, th = est.at(t)
+        ok = est.speed < p.capture_speed and abs(est.omega) < p.capture_spin
+        if ok:
+            cs, sn = math.cos(th), math.sin(th)
+            sides = []
+            for k in (0, 1):
+                d = self.model.config.tip(hand, k) - np.array([x, y])
+                xb, yb = d[0] * cs + d[1] * sn, -d[0] * sn + d[1] * cs
+                at = abs(xb) <= 0.5 * st.length and \
+                    abs(yb) <= 0.5 * st.width + hand.tip_radius + p.grip_clearance + 0.003
+                sides.append(yb if at else 0.0)
+            ok = sides[0] * sides[1] < 0.0
+        if not ok:
+            self._capture_since = None
+            return
+        if self._capture_since is None:
+            self._capture_since = t
+        if t - self._capture_since >= p.capture_hold and not self.captured:
+            self.captured = True
+            self.phase = "captured"
+            self._events.append(Occurrence("capture", {
+                "t_since": float(self._capture_since), "speed": float(est.speed),
+                "omega": float(est.omega), "x": float(x), "y": float(y), "theta": float(th),
+                "tips": [[float(v) for v in self.model.config.tip(hand, k)] for k in (0, 1)]}))
+
+    # -- set-up -----------------------------------------------------------------------------------
+    def _home(self) -> Config:
+        """Where the hand was homed at t = 0 (the spec says; the method has no hand feedback
+        after that and tracks its own commands)."""
+        hand = self.hand
+        return Config(tuple(hand.start_base), tuple(tuple(q) for q in hand.start_joints))

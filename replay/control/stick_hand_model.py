@@ -1,0 +1,164 @@
+"""The hand as the stick-capture controllers model it: configurations, the open-loop motion
+model, and the candidate bases and postures the planners try.
+
+Higashimori et al. 2007, Sec. IV-A: two fingers with two joints each on x-y sliders, no degree of
+freedom for the hand's orientation. The paper neglects the links and the arm (Assumption 9) and
+gives no equations for them; the kinematics are ``replay.hand2d``'s (``finger_tip``,
+``finger_ik``, ``travel_time``) with the limits of the :class:`~replay.hand2d.HandSpec`.
+
+The controllers have no hand feedback. They track their own commands with the plant's motion
+model: every axis moves toward its target at its speed limit, from where the spec says the hand
+was homed. :class:`HandModel` follows it in time; :func:`route_configs` and :func:`route_tips`
+sample it along a planned route of waypoints [(t_start, Config)] (:func:`route_target`).
+
+Pure NumPy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from replay import hand2d
+from replay.hand2d import HandCommand, HandSpec
+
+
+# ------------------------------------------------------------------------------------------
+# Hand configurations and the open-loop hand model
+# ------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Config:
+    base: tuple           # (x, y) m
+    joints: tuple         # ((q1, q2), (q1, q2)) rad
+
+    def with_finger(self, k: int, q) -> "Config":
+        j = [tuple(self.joints[0]), tuple(self.joints[1])]
+        j[k] = (float(q[0]), float(q[1]))
+        return Config(self.base, tuple(j))
+
+    def tip(self, hand: HandSpec, k: int) -> np.ndarray:
+        return hand2d.finger_tip(hand, self.base, k, self.joints[k])
+
+    def command(self) -> HandCommand:
+        return HandCommand(base=(float(self.base[0]), float(self.base[1])),
+                           joints=tuple((float(q[0]), float(q[1])) for q in self.joints))
+
+
+def travel(hand: HandSpec, a: Config, b: Config) -> float:
+    return hand2d.travel_time(hand, a.base, b.base, a.joints, b.joints)
+
+
+class HandModel:
+    """Where the hand is, assuming each axis moves to its target at its speed limit."""
+
+    def __init__(self, hand: HandSpec, start: Config) -> None:
+        self.hand = hand
+        self.config = start
+        self.target = start
+        self._t: float | None = None
+
+    def advance(self, t: float) -> None:
+        if self._t is not None and t > self._t:
+            dt = t - self._t
+            step_b = self.hand.base_speed * dt
+            step_q = self.hand.joint_speed * dt
+            base = tuple(a + min(step_b, max(-step_b, b - a))
+                         for a, b in zip(self.config.base, self.target.base))
+            joints = tuple(tuple(a + min(step_q, max(-step_q, b - a)) for a, b in zip(qa, qb))
+                           for qa, qb in zip(self.config.joints, self.target.joints))
+            self.config = Config(base, joints)
+        self._t = t
+
+
+# ------------------------------------------------------------------------------------------
+# Routes: waypoints [(t_start, Config)] and the hand's motion along them
+# ------------------------------------------------------------------------------------------
+
+
+def route_target(route: list, t: float, default: Config) -> Config:
+    """The waypoint of [(t_start, Config)] to command at time ``t``."""
+    out = route[0][1] if route else default
+    for t_start, cfg in route:
+        if t >= t_start:
+            out = cfg
+    return out
+
+
+def route_configs(hand: HandSpec, starts, frm, to, times):
+    """Base (T, 2) and joints (T, 2, 2) along waypoint segments, each axis moving toward its
+    target at its speed limit (the plant's motion model)."""
+    times = np.asarray(times, dtype=float)
+    base = np.empty((len(times), 2))
+    joints = np.empty((len(times), 2, 2))
+    for i, (s0, a, b) in enumerate(zip(starts, frm, to)):
+        t_end = starts[i + 1] if i + 1 < len(starts) else math.inf
+        sel = (times >= s0) | (i == 0)
+        sel &= times < t_end
+        if not sel.any():
+            continue
+        tau = np.maximum(times[sel] - s0, 0.0)[:, None]
+        a_b, b_b = np.array(a.base), np.array(b.base)
+        base[sel] = a_b + np.clip(b_b - a_b, -hand.base_speed * tau, hand.base_speed * tau)
+        a_q, b_q = np.array(a.joints).reshape(4), np.array(b.joints).reshape(4)
+        q = a_q + np.clip(b_q - a_q, -hand.joint_speed * tau, hand.joint_speed * tau)
+        joints[sel] = q.reshape(-1, 2, 2)
+    return base, joints
+
+
+def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
+    """Fingertip centres (T, 2 fingers, 2) for bases (T, 2) and joints (T, 2, 2)."""
+    l1, l2 = hand.link_lengths
+    roots = np.array(hand.root_offsets)[None, :, :] + np.asarray(base)[:, None, :]
+    q1, q12 = joints[..., 0], joints[..., 0] + joints[..., 1]
+    return roots + np.stack([l1 * np.cos(q1) + l2 * np.cos(q12),
+                             l1 * np.sin(q1) + l2 * np.sin(q12)], axis=-1)
+
+
+# ------------------------------------------------------------------------------------------
+# Candidates for the planners' inverse-kinematics search
+# ------------------------------------------------------------------------------------------
+
+
+def posture_grid(hand: HandSpec) -> list[tuple]:
+    """5 x 5 finger postures (q1, q2) spanning the joint limits (for an idle finger)."""
+    (a0, a1), (b0, b1) = hand.joint_limits
+    return [(float(q1), float(q2)) for q1 in np.linspace(a0, a1, 5)
+            for q2 in np.linspace(b0, b1, 5)]
+
+
+def base_candidates(hand: HandSpec, k: int, tip, here: tuple) -> list[tuple]:
+    """The current base ``here`` (when the tip is comfortably within reach from it, so later
+    refinements stay reachable), then bases putting finger k's root below the tip at a few
+    comfortable reaches and angles (clamped to the slider range)."""
+    (xlo, xhi), (ylo, yhi) = hand.base_limits
+    root = np.array(hand.root_offsets[k])
+    reach = sum(hand.link_lengths)
+    out = []
+    if np.linalg.norm(np.asarray(tip) - root - np.array(here)) <= 0.85 * reach:
+        out.append(here)
+    for rho in (0.7 * reach, 0.5 * reach, 0.85 * reach):
+        for deg in (90.0, 65.0, 115.0, 40.0, 140.0):
+            a = math.radians(deg)
+            b = np.asarray(tip) - root - rho * np.array([math.cos(a), math.sin(a)])
+            out.append((float(np.clip(b[0], xlo, xhi)), float(np.clip(b[1], ylo, yhi))))
+    return out
+
+
+def close_bases(hand: HandSpec, F, Rr, front: int, rear: int, here: tuple) -> list[tuple]:
+    """The current base ``here``, then bases putting the two finger roots' midpoint below the
+    midpoint of the fingertip spots F (front) and Rr (rear) at a few reaches and sideways
+    offsets (clamped to the slider range)."""
+    (xlo, xhi), (ylo, yhi) = hand.base_limits
+    mid = 0.5 * (np.asarray(F) + np.asarray(Rr))
+    roots = 0.5 * (np.array(hand.root_offsets[front]) + np.array(hand.root_offsets[rear]))
+    reach = sum(hand.link_lengths)
+    out = [here]
+    for frac in (0.7, 0.55, 0.85, 0.4):
+        for dx in (0.0, -0.03, 0.03):
+            b = mid - roots - np.array([dx, frac * reach])
+            out.append((float(np.clip(b[0], xlo, xhi)), float(np.clip(b[1], ylo, yhi))))
+    return out

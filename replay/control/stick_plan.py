@@ -1,0 +1,291 @@
+"""Planning the hand's approach to one collision of a stick-capture strategy.
+
+Higashimori et al. 2007, Sec. III: collision i happens at the orientation theta* = alpha(v_{i-1})
+(eq. 23; alpha(lambda_2) for the 3-step second collision, eq. 36) at the fingertip position
+(r_x, r_y) the strategy solved (``stick_collision``: eqs. 25, 28 with 26, and the side rules 31,
+35, 37). Here that contact becomes a hand plan:
+
+- :meth:`ContactPlanner.crossings`: the future times the predicted orientation equals theta*
+  modulo pi (Assumption 6: constant velocities between collisions), earliest first, up to
+  ``horizon``.
+- :meth:`ContactPlanner.reach`: at a crossing, the contact point R(theta*) r and the fingertip
+  centre contact - tip_radius n; a base and finger joints (``hand2d.finger_ik``) reachable in
+  time (``hand2d.travel_time`` plus ``arrive_margin``), and an idle-finger posture clear of the
+  stick's predicted sweep before and ``post_horizon`` after the contact (the motion J_i predicts,
+  eq. 22).
+- :meth:`ContactPlanner.find_route`: waypoints that bring the hand there with no fingertip hit
+  on the way: straight, or via a staging point ``stage_margin`` outside a spinning stick's
+  reach, moving in just after its last pass; each after first pulling a tip out of the stick's
+  reach. :meth:`ContactPlanner.route_clear` checks a route against the sweep along the hand's
+  own motion (each axis at its speed limit, as the plant moves).
+
+The result is a :class:`ContactPlan` (the approach phase's plan; its ``intent`` is the ``plan``
+event's data). :class:`Shortfall` keeps the best time needed vs available of failed attempts
+(the ``unreachable`` report).
+
+Pure NumPy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from replay import hand2d
+from replay.hand2d import HandSpec
+from replay.scene import wrap_half_pi
+from replay.control import stick_collision as sc
+from replay.control.stick_estimator import StickEstimate
+from replay.control.stick_hand_model import (Config, HandModel, base_candidates, posture_grid,
+                                             route_configs, route_target, route_tips, travel)
+from replay.control.stick_sweep import Motion, covered, covered_along, sample_times
+
+CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
+GO_DELAY = 0.003       # s, a staged tip moves in this long after the stick's last pass
+
+
+# ------------------------------------------------------------------------------------------
+# The plan and the shortfall of failed attempts
+# ------------------------------------------------------------------------------------------
+
+
+@dataclass
+class ContactPlan:
+    index: int               # collision number i
+    finger: int
+    t: float                 # planned contact time (s)
+    theta: float             # continuous orientation at the contact (estimator's frame)
+    sol: sc.ContactSolution  # in the frame theta* = sol.theta (mod pi)
+    raw_r_x: float | None    # the solved r_x when it was beyond the stick (sol is clamped)
+    contact: np.ndarray      # world contact point (m)
+    tip: np.ndarray          # world fingertip centre (m)
+    config: Config           # the hand at the contact
+    route: list = field(default_factory=list)   # [(t_start, Config)], the last one = config
+
+    @property
+    def clamped(self) -> bool:
+        return self.raw_r_x is not None
+
+    def target(self, t: float) -> Config:
+        """The waypoint to command at time ``t``."""
+        return route_target(self.route, t, self.config)
+
+    def frame_flip(self) -> int:
+        """+1 if the estimator's frame at the contact equals theta*'s, -1 if it differs by pi."""
+        k = round((self.theta - self.sol.theta) / math.pi)
+        return 1 if k % 2 == 0 else -1
+
+    def intent(self, width: float) -> dict:
+        f = self.frame_flip()
+        return {"index": self.index, "finger": self.finger, "t": float(self.t),
+                "theta": float(self.theta), "r_x": f * self.sol.r_x,
+                "r_y": f * self.sol.side * width / 2.0, "side": f * self.sol.side,
+                "v_after": [float(self.sol.u_after[0]), float(self.sol.u_after[1])],
+                "omega_after": float(self.sol.u_after[2]),
+                "contact": [float(x) for x in self.contact], "tip": [float(x) for x in self.tip],
+                "clamped": self.clamped, "r_x_solved": f * (self.raw_r_x if self.clamped
+                                                             else self.sol.r_x)}
+
+
+@dataclass
+class Shortfall:
+    """The attempt that came closest: time needed vs time available (s)."""
+    t_needed: float = math.inf
+    t_available: float = 0.0
+
+    def note(self, needed: float, available: float) -> None:
+        if needed - available < self.t_needed - self.t_available:
+            self.t_needed, self.t_available = needed, available
+
+
+# ------------------------------------------------------------------------------------------
+# The planner
+# ------------------------------------------------------------------------------------------
+
+
+class ContactPlanner:
+    """Crossings, hand configurations and routes for one planned collision, for a hand whose
+    motion ``model`` tracks the controller's commands."""
+
+    def __init__(self, params, hand: HandSpec, stick, model: HandModel) -> None:
+        self.params = params
+        self.hand = hand
+        self.stick = stick
+        self.model = model
+        self._passive_grid = posture_grid(hand)
+
+    def crossings(self, t: float, est: StickEstimate, theta_star: float,
+                  keep_past: bool = False) -> list[float]:
+        """Future times (<= t + horizon) at which theta(t) = theta* (mod pi)."""
+        p = self.params
+        t_min = t if keep_past else t + p.arrive_margin
+        t_max = t + p.horizon
+        if abs(est.omega) < 1e-6:
+            if abs(wrap_half_pi(est.theta - theta_star)) < 0.02:
+                return [float(x) for x in np.arange(t_min, t_max, 0.01)]   # aligned: any time
+            return []
+        w = est.omega
+        delta = ((theta_star - est.theta) * math.copysign(1.0, w)) % math.pi
+        period = math.pi / abs(w)
+        out = []
+        tau = delta / abs(w)
+        while est.t_ref + tau <= t_max:
+            if est.t_ref + tau >= t_min:
+                out.append(est.t_ref + tau)
+            tau += period
+        return out
+
+    def reach(self, index: int, t: float, est: StickEstimate, sol: sc.ContactSolution,
+              raw: float | None, t_c: float, fingers, strict: bool, shortfall: Shortfall,
+              bases=None) -> ContactPlan | None:
+        """The quickest hand configuration that has finger k's tip at the contact spot for
+        t_c with every check passed (the plan of collision ``index``), or None."""
+        p, st, hand = self.params, self.stick, self.hand
+        pre = Motion(est)
+        c_c, th_c = pre.pose(t_c)
+        R = sc.rotation(sol.theta)
+        contact = c_c + R @ sol.r_b(st.width)
+        _, n = sc.tangent_normal(sol.theta, sol.side)
+        tip = contact - hand.tip_radius * n
+        motion = Motion(est, t_c, sol.u_after)
+        now = self.model.config
+        times_all = sample_times(t, t_c + p.post_horizon)
+        best: tuple | None = None
+        for k in fingers:
+            j = 1 - k
+            for base in (bases if bases is not None else base_candidates(
+                    hand, k, tip, tuple(self.model.target.base))):
+                q = hand2d.finger_ik(hand, base, k, tip, q_near=now.joints[k])
+                if q is None:
+                    continue
+                cfg = Config(tuple(base), now.joints).with_finger(k, q)
+                passive = self._passive(cfg, j, motion, times_all, tip)
+                if passive is None:
+                    continue
+                cfg = cfg.with_finger(j, passive)
+                need = travel(hand, now, cfg)
+                t_arr = t + need
+                if t_arr > t_c - p.arrive_margin:
+                    shortfall.note(need + p.arrive_margin, t_c - t)
+                    continue
+                found = self.find_route(t, now, cfg, k, motion, t_c, tip, c_c)
+                if found is None:
+                    continue
+                route, cost = found
+                if best is None or cost < best[0]:
+                    best = (cost, ContactPlan(index, k, t_c, th_c, sol, raw, contact,
+                                              tip, cfg, route))
+            if best is not None and strict:
+                break
+        return None if best is None else best[1]
+
+    def find_route(self, t: float, now: Config, cfg: Config, k: int, motion: Motion,
+                   t_c: float, tip, c_c) -> tuple[list, float] | None:
+        """Waypoints [(t_start, Config)] that bring the hand from ``now`` to ``cfg`` (finger k's
+        tip at the spot) before t_c with no fingertip hit by the predicted sweep on the way,
+        and the arrival time. Tried in order: straight there; via a staging point outside a
+        spinning stick's reach, moving in after its last pass over the spot; each of these after
+        first pulling any fingertip out of the stick's reach."""
+        p, st, hand = self.params, self.stick, self.hand
+        half_l, half_w = 0.5 * st.length, 0.5 * st.width
+        times = sample_times(t, t_c - CONTACT_GUARD)
+        hit = covered(motion, times, [tip], half_l, half_w, hand.tip_radius - 5e-4)[:, 0]
+        heads: list[list] = [[]]
+        exit_cfg = self._exit_config(t, now, motion)
+        if exit_cfg is not None:
+            heads.append([(t, exit_cfg)])
+        tails: list[list] = [[]]
+        if hit.any():
+            t_go = float(times[hit][-1]) + GO_DELAY
+            u = np.asarray(tip) - c_c
+            if np.linalg.norm(u) > 1e-9:
+                stage = c_c + u / np.linalg.norm(u) * (half_l + hand.tip_radius + p.stage_margin)
+                q_s = hand2d.finger_ik(hand, cfg.base, k, stage, q_near=cfg.joints[k])
+                if q_s is not None:
+                    tails.append([(None, cfg.with_finger(k, q_s)), (t_go, cfg)])
+        for head in heads:
+            for tail in tails:
+                route = list(head)
+                t_free = t if not head else t + travel(hand, now, head[-1][1])
+                for t_start, c in (tail or [(None, cfg)]):
+                    route.append((t_free if t_start is None else t_start, c))
+                if not route or route[0][0] > t:
+                    route.insert(0, (t, now))
+                arrival = self.route_clear(t, now, route, k, motion, t_c)
+                if arrival is not None:
+                    return route, arrival
+        return None
+
+    def route_clear(self, t: float, now: Config, route: list, k: int, motion: Motion,
+                    t_c: float, check_idle: bool = True) -> float | None:
+        """The arrival time of ``route`` if every segment finishes before the next starts, the
+        last before t_c - arrive_margin, and no fingertip is hit by the predicted sweep: on the
+        way (both tips) and, once arrived, finger k's tip until just before t_c and the idle
+        tip (``sweep_margin`` clear) until t_c + post_horizon. Else None."""
+        p, st, hand = self.params, self.stick, self.hand
+        starts, frm, to = [], [], []
+        prev = now
+        for i, (t_start, cfg) in enumerate(route):
+            if i + 1 < len(route):
+                if t_start + travel(hand, prev, cfg) > route[i + 1][0] + 1e-9:
+                    return None
+            starts.append(t_start)
+            frm.append(prev)
+            to.append(cfg)
+            prev = cfg
+        arrival = starts[-1] + travel(hand, frm[-1], to[-1])
+        if arrival > t_c - p.arrive_margin:
+            return None
+        times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
+        base, joints = route_configs(hand, starts, frm, to, times)
+        tips = route_tips(hand, base, joints)                             # (T, 2, 2)
+        half_l, half_w = 0.5 * st.length, 0.5 * st.width
+        moving = times < arrival
+        act = times <= t_c - CONTACT_GUARD
+        if covered_along(motion, times[act], tips[act, k], half_l, half_w,
+                         hand.tip_radius - 5e-4).any():
+            return None
+        if check_idle:
+            grow = np.where(moving, hand.tip_radius - 5e-4, hand.tip_radius + p.sweep_margin)
+            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow).any():
+                return None
+        return arrival
+
+    def _exit_config(self, t: float, now: Config, motion: Motion) -> Config | None:
+        """``now`` with every fingertip within the stick's reach moved radially out of it
+        (base kept), or None when no tip is inside or a tip cannot get out."""
+        p, st, hand = self.params, self.stick, self.hand
+        c, _ = motion.pose(t)
+        r_in = 0.5 * st.length + hand.tip_radius + p.sweep_margin
+        r_out = 0.5 * st.length + hand.tip_radius + p.stage_margin
+        cfg, moved = now, False
+        for k in (0, 1):
+            d = now.tip(hand, k) - c
+            dist = float(np.linalg.norm(d))
+            if dist >= r_in or dist < 1e-9:
+                continue
+            q = hand2d.finger_ik(hand, now.base, k, c + d / dist * r_out, q_near=now.joints[k])
+            if q is None:
+                return None
+            cfg, moved = cfg.with_finger(k, q), True
+        return cfg if moved else None
+
+    def _passive(self, cfg: Config, j: int, motion: Motion, times, active_tip):
+        """The idle finger's joints nearest its current ones whose tip stays clear of the
+        predicted sweep (and of the active tip); None when no posture is clear."""
+        hand, st, p = self.hand, self.stick, self.params
+        cands = [tuple(cfg.joints[j])] + self._passive_grid
+        tips = np.array([hand2d.finger_tip(hand, cfg.base, j, q) for q in cands])
+        hit = covered(motion, times, tips, 0.5 * st.length, 0.5 * st.width,
+                      hand.tip_radius + p.sweep_margin).any(axis=0)
+        far = np.linalg.norm(tips - active_tip[None, :], axis=1) > 2.0 * hand.tip_radius \
+            + p.sweep_margin
+        ok = np.flatnonzero(~hit & far)
+        if ok.size == 0:
+            return None
+        cur = np.array(cfg.joints[j])
+        dist = [float(np.max(np.abs(np.array(cands[i]) - cur))) for i in ok]
+        return cands[int(ok[int(np.argmin(dist))])]
+
