@@ -23,6 +23,7 @@ import pybullet as p
 from pybullet_utils import bullet_client
 
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
+from plants.bullet_arm.quiet import quiet_c_output
 from plants.models.arm import build_arm
 from replay.interfaces import Occurrence, Plant
 from replay.messages import JointState, ObjectState
@@ -161,7 +162,8 @@ class BulletArmPlant(Plant):
         self.lower, self.upper = wam_joint_limits(dof, self._table)
 
         # ---- the world
-        self.bc = bullet_client.BulletClient(connection_mode=p.DIRECT)
+        with quiet_c_output():                           # connect prints "argv[0]="
+            self.bc = bullet_client.BulletClient(connection_mode=p.DIRECT)
         bc = self.bc
         bc.setTimeStep(dt)
         bc.setGravity(0.0, 0.0, -P.gravity)
