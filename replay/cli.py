@@ -136,6 +136,27 @@ def _replay_live(live, log: Path) -> None:
 
 
 @main.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("-o", "--out", type=click.Path(dir_okay=False),
+              help="where to write (default: the controller's alpha_file)")
+def optimise(scenario, out):
+    """Run a controller's offline optimisation from scratch and store its result where the
+    scenario reads it (the catching mapping's alpha, eq. 25)."""
+    from replay.runner import Runner
+    sc = _load(scenario)
+    stored = getattr(sc.controller.params, "alpha_file", None)
+    if stored is None:
+        _fail(f"controller {sc.controller.type!r} has no offline optimisation to store")
+    path = Path(out or stored)
+    if not str(path):
+        _fail("the scenario sets no controller.params.alpha_file: give -o FILE")
+    runner = Runner(_load(scenario, ["controller.params.alpha_file=''"]))
+    runner.controller.write_alpha_file(path)
+    runner.plant.close()
+    click.echo(f"wrote {path}")
+
+
+@main.command()
 @click.argument("scenarios", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
 def validate(scenarios, sets):

@@ -3,15 +3,13 @@ in PyBullet with stereo vision and encoders, their logs (contract topics, the ou
 figures and the claims table made from those logs, and the golden log.
 
 Regenerate the precomputed mapping parameters after a change of the arm model or of the
-controller's configuration:  .venv/bin/python tests/test_catch_experiment.py --write-alpha
+controller's configuration:  replay optimise scenarios/catch_optimised.yaml
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -24,28 +22,6 @@ G = np.array([0.0, 0.0, -9.81])
 
 CONTRACT = ["/scenario", "/events", "/arm/joint_state", "/hand/joint_state", "/arm/joint_command",
             "/object/state", "/effector/state", "/vision/object", "/optimization/cost"]
-
-
-def write_alpha_file() -> Path:
-    """Optimise eq. 25 for catch_optimised.yaml's configuration and store alpha (and the cost
-    history) where the scenario's ``alpha_file`` points."""
-    import os
-
-    from replay import registry
-    from replay.control.catching import CatchingController
-    from replay.scenario import load_scenario
-    os.chdir(ROOT)
-    sc = load_scenario(SCENARIOS / "catch_optimised.yaml")
-    plant = registry.load("plant", sc.plant.type)(sc.plant.params, dt=1e-3,
-                                                   rng=np.random.default_rng(0))
-    try:
-        params = dataclasses.replace(sc.controller.params, alpha_file="")
-        CatchingController(params, spec=plant.spec()).write_alpha_file(ROOT / params.alpha_file
-                                                                       if params.alpha_file
-                                                                       else ALPHA)
-    finally:
-        plant.close()
-    return ALPHA
 
 
 # ------------------------------------------------------------------------------ runs
@@ -119,7 +95,7 @@ def test_release_state_is_the_documented_derivation(runs, name, speed):
 def test_alpha_file_is_current_and_its_history_is_logged(runs):
     r = runs["catch_optimised"]
     log, ctl = r["log"], r["runner"].controller
-    assert "warning" not in _kinds(log), "stale alpha file: run this file with --write-alpha"
+    assert "warning" not in _kinds(log), "stale alpha file: run `replay optimise scenarios/catch_optimised.yaml`"
     data = json.loads(ALPHA.read_text())
     assert data["meta"]["key"] == ctl.config.key(ctl.model)
     assert ALPHA.stat().st_size < 50_000
@@ -271,13 +247,6 @@ def test_golden_catch_log_matches(monkeypatch):
     assert g.log.is_file() and g.log.stat().st_size < 1_000_000
     diffs = check(g)
     assert not diffs, "\n".join(str(d) for d in diffs)
-
-
-if __name__ == "__main__":
-    if "--write-alpha" in sys.argv:
-        print(f"wrote {write_alpha_file()}")
-    else:
-        print(__doc__)
 
 
 def test_what_if_fast_joints_catches_with_the_optimised_mapping(tmp_path):

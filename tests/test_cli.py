@@ -59,3 +59,12 @@ def test_list_plugins():
     r = invoke("list", "--plugins")
     assert r.exit_code == 0
     assert "toy" in r.output and "airtable" in r.output
+
+
+def test_optimise_rewrites_the_catching_alpha_identically(project_root, tmp_path):
+    out = tmp_path / "alpha.json"
+    r = invoke("optimise", "scenarios/catch_optimised.yaml", "-o", out)
+    assert r.exit_code == 0, r.output
+    assert out.read_bytes() == (project_root / "data/catching/alpha_optimised.json").read_bytes()
+    r = invoke("optimise", "scenarios/stick_3step.yaml")
+    assert r.exit_code == 2 and "no offline optimisation" in r.output
