@@ -56,10 +56,10 @@ def _git_commit() -> str:
         return ""
 
 
-def provenance(sc: Scenario) -> dict[str, str]:
+def provenance(sc: Scenario, commit: str) -> dict[str, str]:
     info = {"scenario": sc.name, "paper": sc.paper, "seed": str(sc.seed),
             "paper-replay": __version__, "python": platform.python_version(),
-            "git_commit": _git_commit() or "unknown"}
+            "git_commit": commit}
     for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
         try:
             info[pkg] = importlib_metadata.version(pkg)
@@ -108,10 +108,11 @@ class Runner:
         result = RunResult(path=Path(out))
         wall0 = time.perf_counter()
         log = LogWriter(out)
-        log.metadata("provenance", provenance(sc))
+        commit = _git_commit() or "unknown"
+        log.metadata("provenance", provenance(sc, commit))
         text = resolved_yaml(sc)
         log.metadata("scenario", {"yaml": text})
-        version = f"{__version__}+{_git_commit() or 'unknown'}"
+        version = f"{__version__}+{commit}"
         self._write(log, "/scenario", ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version),
                     0)
         pending: deque = deque()          # (deliver at step, topic, payload), in step order

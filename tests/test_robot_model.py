@@ -10,8 +10,9 @@ import pytest
 
 from replay.robot.hand import CATCH3, GRASP4, HANDS, hand_body, hand_mass
 from replay.robot.serial_chain import (RigidBody, matrix_to_quaternion, matrix_to_rpy,
-                                       quaternion_to_matrix, rpy_to_matrix)
+                                       rpy_to_matrix)
 from replay.robot.wam import load_wam_table, wam_chain, wam_joint_limits
+from replay.scene import quaternion_matrix
 
 START = np.array([0.0, math.pi / 4, 0.0, 0.0])        # Namiki & Ishikawa IV-A initial pose
 CATCH = np.array([0.0, math.pi / 4, 0.0, math.pi / 2])  # q4 = q_alpha = pi/2
@@ -205,7 +206,7 @@ def test_rotation_helpers_round_trip():
         rpy = rng.uniform([-3, -1.5, -3], [3, 1.5, 3])
         R = rpy_to_matrix(rpy)
         np.testing.assert_allclose(rpy_to_matrix(matrix_to_rpy(R)), R, atol=1e-12)
-        np.testing.assert_allclose(quaternion_to_matrix(matrix_to_quaternion(R)), R, atol=1e-12)
+        np.testing.assert_allclose(quaternion_matrix(matrix_to_quaternion(R)), R, atol=1e-12)
 
 
 @pytest.mark.parametrize("dof", [4, 7])

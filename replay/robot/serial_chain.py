@@ -56,16 +56,9 @@ def dh_transform(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
                      [0.0, 0.0, 0.0, 1.0]])
 
 
-def quaternion_to_matrix(q) -> np.ndarray:
-    """[qx, qy, qz, qw] -> 3x3 rotation matrix."""
-    x, y, z, w = np.asarray(q, dtype=float) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-
 def matrix_to_quaternion(R: np.ndarray) -> np.ndarray:
-    """3x3 rotation matrix -> [qx, qy, qz, qw] with qw >= 0."""
+    """3x3 rotation matrix -> [qx, qy, qz, qw] with qw >= 0 (inverse of
+    :func:`replay.scene.quaternion_matrix`)."""
     m = np.asarray(R, dtype=float)
     tr = m[0, 0] + m[1, 1] + m[2, 2]
     if tr > 0:
@@ -463,5 +456,5 @@ def active_block(x: np.ndarray, active: Sequence[int]) -> np.ndarray:
 
 
 __all__ = ["DHRow", "RigidBody", "SerialChain", "active_block", "dh_transform", "transform",
-           "rot_x", "rot_y", "rot_z", "quaternion_to_matrix", "matrix_to_quaternion",
+           "rot_x", "rot_y", "rot_z", "matrix_to_quaternion",
            "rpy_to_matrix", "matrix_to_rpy"]

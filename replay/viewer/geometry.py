@@ -14,6 +14,8 @@ from typing import Callable
 
 import numpy as np
 
+from replay.hand2d import finger_chain
+from replay.robot.serial_chain import matrix_to_quaternion, rpy_to_matrix
 from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
 from replay.viewer.errors import ViewerError
 
@@ -61,15 +63,8 @@ class StickGeometry:
     def finger_points(self, base, joints) -> np.ndarray:
         """(2 fingers, 3 points: root, elbow, tip, 2) from the slider base and (q1, q2) per
         finger, by ``replay.hand2d``'s kinematics."""
-        l1, l2 = self.link_lengths
-        out = np.zeros((2, 3, 2))
-        for k in range(2):
-            q1, q2 = joints[k]
-            root = np.asarray(base, float) + np.asarray(self.root_offsets[k])
-            elbow = root + l1 * np.array([math.cos(q1), math.sin(q1)])
-            tip = elbow + l2 * np.array([math.cos(q1 + q2), math.sin(q1 + q2)])
-            out[k] = (root, elbow, tip)
-        return out
+        return np.array([finger_chain(base, self.root_offsets[k], self.link_lengths, joints[k])
+                         for k in range(2)])
 
 
 # --------------------------------------------------------------------------- arms
@@ -129,12 +124,8 @@ def arm_urdf(p: dict, urdf_for: Callable[[dict], Path] | None = None) -> Path:
 
 
 def rpy_to_wxyz(rpy) -> tuple[float, float, float, float]:
-    """URDF roll-pitch-yaw (fixed axes x, y, z) as a [w, x, y, z] quaternion."""
-    r, p, y = (float(v) / 2.0 for v in rpy)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), \
-        math.cos(y), math.sin(y)
-    return (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
+    """URDF roll-pitch-yaw (fixed axes x, y, z) as a [w, x, y, z] quaternion (viser's order)."""
+    return _matrix_to_wxyz(rpy_to_matrix(rpy))
 
 
 # --------------------------------------------------------------------------- cameras
@@ -148,8 +139,7 @@ class CameraPose:
 
 
 def _matrix_to_wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
-    import viser.transforms as vtf
-    w, x, y, z = vtf.SO3.from_matrix(R).wxyz
+    x, y, z, w = matrix_to_quaternion(R)
     return (float(w), float(x), float(y), float(z))
 
 
