@@ -28,6 +28,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m replay.bench
+	$(PY) -m replay.viewer.bench
 
 golden-check: $(STAMP)
 	$(REPLAY) golden check
