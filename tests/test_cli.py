@@ -61,10 +61,26 @@ def test_list_plugins():
     assert "toy" in r.output and "airtable" in r.output
 
 
-def test_optimise_rewrites_the_catching_alpha_identically(project_root, tmp_path):
+def test_optimise_regenerates_the_catching_alpha(project_root, tmp_path):
+    """The optimiser is deterministic on one machine, but BLAS reduction order moves its low bits
+    between machines (4e-8 seen): the stored result must match within a stated tolerance, and the
+    configuration key exactly."""
+    import json
+
+    import numpy as np
+
     out = tmp_path / "alpha.json"
     r = invoke("optimise", "scenarios/catch_optimised.yaml", "-o", out)
     assert r.exit_code == 0, r.output
-    assert out.read_bytes() == (project_root / "data/catching/alpha_optimised.json").read_bytes()
+    new = json.loads(out.read_text())
+    old = json.loads((project_root / "data/catching/alpha_optimised.json").read_text())
+    assert new["meta"] == old["meta"]
+    for key in ("alpha", "alpha0"):
+        np.testing.assert_allclose(new[key], old[key], rtol=1e-5, atol=1e-6)
+    assert len(new["history"]) == len(old["history"])
+    for a, b in zip(new["history"], old["history"]):
+        assert a["iteration"] == b["iteration"]
+        np.testing.assert_allclose([a["torque_cost"], a["velocity_cost"]],
+                                   [b["torque_cost"], b["velocity_cost"]], rtol=1e-6)
     r = invoke("optimise", "scenarios/stick_3step.yaml")
     assert r.exit_code == 2 and "no offline optimisation" in r.output
