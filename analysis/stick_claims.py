@@ -15,7 +15,7 @@ import yaml
 
 from analysis.claims import Claim, within
 from analysis.series import arrays, events
-from replay.control.stick_collision import (pure_rotation_min_spin, pure_rotation_residual_spin,
+from replay.control.stick.collision import (pure_rotation_min_spin, pure_rotation_residual_spin,
                                             pure_rotation_stop_distance)
 from replay.log import LogReader
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from plants.airtable import AirTablePlant, Params
-from replay.hand2d import AirTableSpec, HandCommand, finger_ik, finger_tip, travel_time
+from replay.robot.hand2d import AirTableSpec, HandCommand, finger_ik, finger_tip, travel_time
 from replay.interfaces import Plant
 from replay.messages import FingersState, StickState, to_dict
 from replay.scene import Box, Cylinder, quaternion_yaw

@@ -24,8 +24,8 @@ import pytest
 from pybullet_utils import bullet_client
 
 from replay.scene import Scene, Sphere
-from replay.vision.silhouette import sphere_ellipse
-from replay.vision.stereo import StereoBallCamera, StereoBallCameraParams
+from replay.sensors.silhouette import sphere_ellipse
+from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 
 PARAMS = StereoBallCameraParams(threshold=0.5 * 255 * (0.1 + 0.9))   # half-coverage level
 CORNER_OFFSET = np.array([0.5, -0.5])                                # TinyRenderer - ours, px

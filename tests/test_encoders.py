@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from replay.encoders import EncoderParams, JointEncoders
+from replay.sensors.encoders import EncoderParams, JointEncoders
 from replay.scene import Scene
 
 

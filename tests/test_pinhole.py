@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from replay.vision.pinhole import Intrinsics, PinholeCamera, look_at_rotation
+from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
 
 
 def random_camera(rng, width=128, height=96):

@@ -16,10 +16,10 @@ from replay.interfaces import Sensor
 from replay.messages import VisionObject, to_dict
 from replay.scenario.loader import ScenarioError, build_dataclass
 from replay.scene import Box, Scene, Sphere
-from replay.vision.pinhole import PinholeCamera
-from replay.vision.silhouette import (correct_sphere_centroid, render, sphere_centroid_bias,
+from replay.sensors.pinhole import PinholeCamera
+from replay.sensors.silhouette import (correct_sphere_centroid, render, sphere_centroid_bias,
                                       sphere_ellipse)
-from replay.vision.stereo import StereoBallCamera, StereoBallCameraParams
+from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 
 from conftest import ROOT
 
@@ -79,7 +79,7 @@ def test_is_a_sensor_with_declared_params_and_entry_point():
     assert (p.width, p.height, p.noise_sigma, p.tracked) == (128, 128, 0.0, "ball")
     assert np.linalg.norm(np.subtract(p.cam0_position, p.cam1_position)) == pytest.approx(0.8)
     eps = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"]
-    assert eps["paper_replay.sensors"]["stereo_ball"] == "replay.vision.stereo:StereoBallCamera"
+    assert eps["paper_replay.sensors"]["stereo_ball"] == "replay.sensors.stereo:StereoBallCamera"
 
 
 def test_params_load_strictly_from_yaml():

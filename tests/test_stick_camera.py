@@ -9,8 +9,8 @@ import pytest
 from replay.interfaces import Sensor
 from replay.messages import VisionStick
 from replay.scene import Box, Cylinder, Scene, Sphere, yaw_quaternion
-from replay.vision.pinhole import PinholeCamera
-from replay.vision.stick_camera import (StickCamera, StickCameraParams, polygon_coverage,
+from replay.sensors.pinhole import PinholeCamera
+from replay.sensors.stick_camera import (StickCamera, StickCameraParams, polygon_coverage,
                                         render_scene, wrap_half_pi)
 
 STICK = (0.100, 0.010, 0.005)          # L x W (paper) x an assumed thickness (m)

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from replay.control.stick_estimator import StickEstimator, unwrap_to
+from replay.control.stick.estimator import StickEstimator, unwrap_to
 
 FPS = 300.0
 

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from replay import hand2d
-from replay.control import stick_collision as sc
-from replay.control.stick_strategy import (HandModel, ThreeStepController, ThreeStepParams,
+from replay.robot import hand2d
+from replay.control.stick import collision as sc
+from replay.control.stick.strategy import (HandModel, ThreeStepController, ThreeStepParams,
                                            TwoStepController, TwoStepParams, Config)
-from replay.hand2d import AirTableSpec, HandSpec, StickSpec
+from replay.robot.hand2d import AirTableSpec, HandSpec, StickSpec
 from replay.interfaces import Controller
 from replay.messages import VisionStick
 

@@ -122,7 +122,7 @@ def test_geometry_from_the_resolved_scenario(tmp_path):
     g = StickGeometry.from_params(run.plant_params)
     assert g.length == 0.2 and g.visual_width == 0.01 and g.tip_radius == 0.005
     assert StickGeometry.from_params({}) == StickGeometry()       # the plant's defaults
-    # the fingers' kinematics match the logged fingertips (replay.hand2d's convention)
+    # the fingers' kinematics match the logged fingertips (replay.robot.hand2d's convention)
     hs, fi = run.track("/hand/state"), run.track("/fingers/state")
     pts = g.finger_points(hs.fields["base"][100], hs.fields["joints"][100])
     assert np.allclose(pts[:, 2], fi.fields["tips"][100], atol=1e-12)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from replay.hand2d import HandSpec, finger_tip
+from replay.robot.hand2d import HandSpec, finger_tip
 
 
 def _toward(current: np.ndarray, target: np.ndarray, max_delta: float) -> np.ndarray:

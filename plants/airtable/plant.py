@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from replay.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec
+from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec
 from replay.interfaces import Occurrence, Plant
 from replay.messages import FingersState, StickState
 from replay.scene import Box, Cylinder, Scene, yaw_quaternion

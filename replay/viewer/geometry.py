@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-from replay.hand2d import finger_chain
+from replay.robot.hand2d import finger_chain
 from replay.robot.serial_chain import matrix_to_quaternion, rpy_to_matrix
 from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
 from replay.viewer.errors import ViewerError
@@ -62,7 +62,7 @@ class StickGeometry:
 
     def finger_points(self, base, joints) -> np.ndarray:
         """(2 fingers, 3 points: root, elbow, tip, 2) from the slider base and (q1, q2) per
-        finger, by ``replay.hand2d``'s kinematics."""
+        finger, by ``replay.robot.hand2d``'s kinematics."""
         return np.array([finger_chain(base, self.root_offsets[k], self.link_lengths, joints[k])
                          for k in range(2)])
 
@@ -144,7 +144,7 @@ def _matrix_to_wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
 
 
 def _pose(name: str, cam) -> CameraPose:
-    """A pinhole camera (replay.vision.pinhole) as the viewer draws it."""
+    """A pinhole camera (replay.sensors.pinhole) as the viewer draws it."""
     k = cam.intrinsics
     fov_y = 2.0 * math.atan((k.height / 2.0) / k.fy)
     return CameraPose(name, tuple(float(v) for v in cam.position), _matrix_to_wxyz(cam.rotation),

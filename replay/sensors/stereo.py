@@ -6,7 +6,7 @@ systems (CPV: 128 x 128 photodetectors, segmentation, target extraction and imag
 This sensor does the same with images:
 
 1. each camera's 8-bit 128 x 128 image is rendered from the scene's silhouettes
-   (:mod:`replay.vision.silhouette`: the sphere's exact perspective ellipse, boxes as projected
+   (:mod:`replay.sensors.silhouette`: the sphere's exact perspective ellipse, boxes as projected
    hulls, anti-aliased on an 8x finer grid) plus Gaussian pixel noise from the sensor's ``rng``;
 2. segmentation by a grey-level threshold; the target is the largest 8-connected blob (the
    arm is not in the plant's scene, so the ball is usually the only bright thing); a blob cut
@@ -19,7 +19,7 @@ This sensor does the same with images:
 
 The centroid of a sphere's silhouette is not the projection of its centre: the ellipse's
 centre lies radially outward from the principal point by ``r^2 / (Z^2 - r^2)`` of the projected
-centre's distance (:func:`~replay.vision.silhouette.sphere_centroid_bias`). With the defaults it
+centre's distance (:func:`~replay.sensors.silhouette.sphere_centroid_bias`). With the defaults it
 is at most ~0.045 px (ball at x = 2.2 m, 0.55 m from a camera and ~40 px off-axis) and ~0.004 px
 near the catch point; removing it changes the worst triangulation error over typical throws from
 1.45 to 1.25 mm and the median from 0.18 to 0.13 mm. It is removed anyway
@@ -64,8 +64,8 @@ from replay.interfaces import Sensor
 from replay.messages import VisionObject
 from replay.params import param
 from replay.scene import Scene, Sphere
-from replay.vision.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.vision.silhouette import correct_sphere_centroid, render
+from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
+from replay.sensors.silhouette import correct_sphere_centroid, render
 
 _DILATE = np.ones((5, 5), np.uint8)   # the grey-moment region: the blob grown by 2 px
 _MARGIN = 4                           # px around the blob: region (2) + background ring (2)

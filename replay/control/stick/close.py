@@ -3,7 +3,7 @@
 Higashimori et al. 2007, Sec. III-B Step 2 and III-C Step 3 (eqs. 32, 33, 38): once the stick
 translates perpendicular to its axis, the fingertips close along the line through the centre of
 mass along v; a contact there (r_x = 0, normal through the centre of mass) leaves no spin, so
-the translation can be removed by simply closing the gap (``stick_collision.closing_contact``
+the translation can be removed by simply closing the gap (``collision.closing_contact``
 gives the contact's predicted outcome).
 
 The finger that made the last collision is behind the stick; the other waits on that line,
@@ -18,7 +18,7 @@ has touched nothing (:meth:`ClosePlanner.refine`).
 
 The result is a :class:`ClosePlan` (the closing phase's plan; its ``intent`` is the ``plan``
 event's data). Routes are checked with the contact planner's
-:meth:`~replay.control.stick_plan.ContactPlanner.route_clear`.
+:meth:`~replay.control.stick.plan.ContactPlanner.route_clear`.
 
 Pure NumPy.
 """
@@ -31,12 +31,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from replay import hand2d
-from replay.control import stick_collision as sc
-from replay.control.stick_estimator import StickEstimate, StickEstimator
-from replay.control.stick_hand_model import Config, close_bases, route_target, travel
-from replay.control.stick_plan import CONTACT_GUARD, ContactPlanner, Shortfall
-from replay.control.stick_sweep import Motion
+from replay.robot import hand2d
+from replay.control.stick import collision as sc
+from replay.control.stick.estimator import StickEstimate, StickEstimator
+from replay.control.stick.hand_model import Config, close_bases, route_target, travel
+from replay.control.stick.plan import CONTACT_GUARD, ContactPlanner, Shortfall
+from replay.control.stick.sweep import Motion
 
 
 @dataclass

@@ -2,7 +2,7 @@
 
 Higashimori et al. 2007, Sec. III: collision i happens at the orientation theta* = alpha(v_{i-1})
 (eq. 23; alpha(lambda_2) for the 3-step second collision, eq. 36) at the fingertip position
-(r_x, r_y) the strategy solved (``stick_collision``: eqs. 25, 28 with 26, and the side rules 31,
+(r_x, r_y) the strategy solved (``collision``: eqs. 25, 28 with 26, and the side rules 31,
 35, 37). Here that contact becomes a hand plan:
 
 - :meth:`ContactPlanner.crossings`: the future times the predicted orientation equals theta*
@@ -33,14 +33,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from replay import hand2d
-from replay.hand2d import HandSpec
+from replay.robot import hand2d
+from replay.robot.hand2d import HandSpec
 from replay.scene import wrap_half_pi
-from replay.control import stick_collision as sc
-from replay.control.stick_estimator import StickEstimate
-from replay.control.stick_hand_model import (Config, HandModel, base_candidates, posture_grid,
+from replay.control.stick import collision as sc
+from replay.control.stick.estimator import StickEstimate
+from replay.control.stick.hand_model import (Config, HandModel, base_candidates, posture_grid,
                                              route_configs, route_target, route_tips, travel)
-from replay.control.stick_sweep import Motion, covered, covered_along, sample_times
+from replay.control.stick.sweep import Motion, covered, covered_along, sample_times
 
 CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
 GO_DELAY = 0.003       # s, a staged tip moves in this long after the stick's last pass

@@ -2,7 +2,7 @@
 
 The paper's high-speed vision sits 1 m above the air table and measures the stick's position and
 orientation at 300 fps from a white rectangular marker on the stick. This sensor does the same
-with images: it renders the scene through a :class:`~replay.vision.pinhole.PinholeCamera` looking
+with images: it renders the scene through a :class:`~replay.sensors.pinhole.PinholeCamera` looking
 straight down at the table, adds pixel noise, segments the marker by a grey-level threshold and
 takes image moments (``cv2.moments``):
 
@@ -48,7 +48,7 @@ from replay.interfaces import Sensor
 from replay.messages import VisionStick
 from replay.params import param
 from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix, wrap_half_pi
-from replay.vision.pinhole import PinholeCamera
+from replay.sensors.pinhole import PinholeCamera
 
 _RIM = 48             # vertices of a polygon standing in for a circle
 

@@ -2,20 +2,20 @@
 Sec. III) share: phases, planned collisions, events and the capture check.
 
 :class:`StickCaptureController` runs the cycle below; the strategies
-(``stick_strategy``) give the contact of each collision. The hand plans are made by
-``stick_plan`` (collisions) and ``stick_close`` (the closing), with the hand model of
-``stick_hand_model`` and the predicted sweep of ``stick_sweep``.
+(``strategy``) give the contact of each collision. The hand plans are made by
+``plan`` (collisions) and ``close`` (the closing), with the hand model of
+``hand_model`` and the predicted sweep of ``sweep``.
 
 Pure NumPy. The controller sees only ``/vision/stick`` measurements (x, y, theta mod pi; already
-delayed by the camera latency) and the :class:`~replay.hand2d.AirTableSpec` (hand kinematics and
+delayed by the camera latency) and the :class:`~replay.robot.hand2d.AirTableSpec` (hand kinematics and
 the stick's m, I, L, W, e; never the friction mu). It has no hand feedback: it tracks its own
 commands with a model that moves every axis toward its target at the spec's speed limit, starting
 from where the spec says the hand was homed (``HandSpec.start_base`` / ``start_joints``).
 
 Cycle of one planned collision i:
 
-1. Observe until the :class:`~replay.control.stick_estimator.StickEstimator` is ready.
-2. Solve the contact (r_x, side) from the estimated u_{i-1} (stick_collision: eqs. 25, 28, 26 and
+1. Observe until the :class:`~replay.control.stick.estimator.StickEstimator` is ready.
+2. Solve the contact (r_x, side) from the estimated u_{i-1} (collision: eqs. 25, 28, 26 and
    the side rules 31, 35, 37), at the target orientation theta* (alpha(v_{i-1}), eq. 23, or
    alpha(lambda_2) for the 3-step second collision).
 3. Walk the future times at which the predicted orientation equals theta* modulo pi, earliest
@@ -82,14 +82,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from replay.hand2d import AirTableSpec, HandCommand, HandSpec
+from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec
 from replay.interfaces import Controller, Occurrence
 from replay.params import param
-from replay.control import stick_collision as sc
-from replay.control.stick_close import ClosePlan, ClosePlanner
-from replay.control.stick_estimator import StickEstimate, StickEstimator
-from replay.control.stick_hand_model import Config, HandModel
-from replay.control.stick_plan import ContactPlan, ContactPlanner, Shortfall
+from replay.control.stick import collision as sc
+from replay.control.stick.close import ClosePlan, ClosePlanner
+from replay.control.stick.estimator import StickEstimate, StickEstimator
+from replay.control.stick.hand_model import Config, HandModel
+from replay.control.stick.plan import ContactPlan, ContactPlanner, Shortfall
 
 TOPIC_VISION = "/vision/stick"
 TOPIC_ESTIMATE = "/control/stick_estimate"

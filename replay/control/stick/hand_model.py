@@ -3,8 +3,8 @@ model, and the candidate bases and postures the planners try.
 
 Higashimori et al. 2007, Sec. IV-A: two fingers with two joints each on x-y sliders, no degree of
 freedom for the hand's orientation. The paper neglects the links and the arm (Assumption 9) and
-gives no equations for them; the kinematics are ``replay.hand2d``'s (``finger_tip``,
-``finger_ik``, ``travel_time``) with the limits of the :class:`~replay.hand2d.HandSpec`.
+gives no equations for them; the kinematics are ``replay.robot.hand2d``'s (``finger_tip``,
+``finger_ik``, ``travel_time``) with the limits of the :class:`~replay.robot.hand2d.HandSpec`.
 
 The controllers have no hand feedback. They track their own commands with the plant's motion
 model: every axis moves toward its target at its speed limit, from where the spec says the hand
@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay import hand2d
-from replay.hand2d import HandCommand, HandSpec
+from replay.robot import hand2d
+from replay.robot.hand2d import HandCommand, HandSpec
 
 
 # ------------------------------------------------------------------------------------------

@@ -6,9 +6,9 @@
   theta_1 = alpha(v_0) (eqs. 34, 35), the second stops the spin at theta_2 = alpha(lambda_2) and
   sends the stick along lambda_2 (eqs. 36, 37); then the closing (eq. 38).
 
-Each gives the contacts of its collisions (``stick_collision``) to the shared machinery of
-:class:`~replay.control.stick_capture.StickCaptureController` (phases, hand plans, fallbacks,
-events and the capture check: see ``stick_capture``). Pure NumPy.
+Each gives the contacts of its collisions (``collision``) to the shared machinery of
+:class:`~replay.control.stick.capture.StickCaptureController` (phases, hand plans, fallbacks,
+events and the capture check: see ``capture``). Pure NumPy.
 """
 
 from __future__ import annotations
@@ -19,10 +19,10 @@ from typing import ClassVar
 import numpy as np
 
 from replay.params import param
-from replay.control import stick_collision as sc
-from replay.control.stick_capture import StickCaptureController, StickCaptureParams
-from replay.control.stick_estimator import StickEstimate
-from replay.control.stick_hand_model import Config, HandModel
+from replay.control.stick import collision as sc
+from replay.control.stick.capture import StickCaptureController, StickCaptureParams
+from replay.control.stick.estimator import StickEstimate
+from replay.control.stick.hand_model import Config, HandModel
 
 # Config and HandModel are re-exported: callers (the tests) model the hand with them
 __all__ = ["TwoStepParams", "ThreeStepParams", "TwoStepController", "ThreeStepController",

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.stick_estimator import StickEstimate
+from replay.control.stick.estimator import StickEstimate
 
 SAMPLE_DT = 0.001      # s, time step of the predicted-sweep checks
 

@@ -25,7 +25,7 @@ polygon outward by ~0.65 fine pixel (measured 0.64-0.68 for 4-40 px radii), so t
 semi-axes are reduced by that much first, and its ``N``-gon is scaled to the ellipse's area.
 Boxes and cylinders are not shrunk (their outlines come out ~0.65 / supersample px too large).
 Primitives reaching behind the camera's plane are not drawn. Image conventions are
-:mod:`replay.vision.pinhole`'s: integer pixel coordinates are pixel centres.
+:mod:`replay.sensors.pinhole`'s: integer pixel coordinates are pixel centres.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ import cv2
 import numpy as np
 
 from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix
-from replay.vision.pinhole import PinholeCamera
+from replay.sensors.pinhole import PinholeCamera
 
 SHIFT = 8               # fractional bits of vertices given to cv2.fillConvexPoly
 AA_GROWTH = 0.65        # fine px by which cv2's LINE_AA fill grows a convex polygon
