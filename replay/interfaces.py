@@ -66,6 +66,12 @@ class Plant(ABC):
         """Physics events since the last call."""
         return []
 
+    def outcome(self, t: float) -> dict | None:
+        """The physical verdict at the end of a run: ``{"success": bool, "reason": str, **metrics}``
+        (e.g. captured and the final speed; caught and the relative speed at first contact), or
+        None when this plant has no notion of success."""
+        return None
+
     def close(self) -> None:
         pass
 
@@ -104,6 +110,12 @@ class Controller(ABC):
     def pop_events(self) -> list[Occurrence]:
         """Decisions worth an ``/events`` message since the last call (e.g. ``infeasible``)."""
         return []
+
+    def outcome(self, t: float) -> dict:
+        """The method's side of the verdict at the end of a run: metrics to add and, when the
+        method knows it failed (no feasible plan, target out of reach), ``success: False`` with
+        its ``reason``."""
+        return {}
 
     def telemetry(self, t: float) -> dict[str, Any]:
         """Extra topics to log this control step: topic -> payload (or a list of payloads)."""

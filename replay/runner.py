@@ -10,10 +10,10 @@ logged at its end, collisions with the controller's intent attached. The run sto
 
 from __future__ import annotations
 
+import heapq
 import platform
 import subprocess
 import time
-from collections import deque
 from dataclasses import dataclass, field
 from importlib import metadata as importlib_metadata
 from pathlib import Path
@@ -45,6 +45,7 @@ class RunResult:
     messages: int = 0
     wall_time: float = 0.0
     error: str = ""
+    outcome: dict = field(default_factory=dict)   # the final ``outcome`` event's data
 
 
 def _git_commit() -> str:
@@ -115,7 +116,10 @@ class Runner:
         version = f"{__version__}+{commit}"
         self._write(log, "/scenario", ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version),
                     0)
-        pending: deque = deque()          # (deliver at step, topic, payload), in step order
+        # (deliver at step, sequence, topic, payload): a heap, so readings reach the controller in
+        # time order whatever the sensors' order and latencies
+        pending: list = []
+        seq = 0
         stop_at: int | None = None
         collisions = 0
         k = 0
@@ -130,11 +134,12 @@ class Runner:
                         m = sensor.measure(t, scene)
                         if m is not None:
                             self._write(log, sensor.topic, m, t_ns)
-                            pending.append((k + latency, sensor.topic, m))
+                            heapq.heappush(pending, (k + latency, seq, sensor.topic, m))
+                            seq += 1
                 if k % self.ctrl_div == 0:
                     delivered = []
                     while pending and pending[0][0] <= k:
-                        _, topic, m = pending.popleft()
+                        _, _, topic, m = heapq.heappop(pending)
                         delivered.append((topic, m))
                     command = self.controller.update(t, delivered)
                     if command is not None:
@@ -162,21 +167,44 @@ class Runner:
             t_end = k / rate
             for topic, payload in self.plant.truth(t_end).items():
                 self._write(log, topic, payload, self.t_ns(k))
+            self._outcome(log, result, k, self._verdict(k / rate))
         except NonFiniteValueError as exc:
             result.stopped_by = "error"
             result.error = str(exc)
             self._write(log, "/events", Event(k / rate, "error", {
                 "reason": "non-finite value", "topic": exc.topic, "fields": exc.fields}),
                 self.t_ns(k))
+            self._outcome(log, result, k, {"success": False,
+                                           "reason": f"error: non-finite value on {exc.topic}"})
         except KeyboardInterrupt:
             result.stopped_by = "interrupted"
             self._write(log, "/events", Event(k / rate, "interrupted", {}), self.t_ns(k))
+            self._outcome(log, result, k, {"success": False, "reason": "interrupted"})
             self._finish(log, result, k, wall0)
             raise RunInterrupted(result) from None
         finally:
             self.plant.close()
         self._finish(log, result, k, wall0)
         return result
+
+    def _verdict(self, t: float) -> dict:
+        """The plant's physical verdict, with the method's metrics and its own failure reason."""
+        verdict = {"success": True, "reason": "completed"}
+        verdict.update(self.plant.outcome(t) or {})
+        method = dict(self.controller.outcome(t) or {})
+        failed = method.pop("success", True) is False
+        reason = method.pop("reason", None)
+        verdict.update(method)
+        if failed and verdict["success"]:
+            verdict["success"] = False
+            verdict["reason"] = reason or "the method reported a failure"
+        return verdict
+
+    def _outcome(self, log: LogWriter, result: RunResult, k: int, verdict: dict) -> None:
+        """Every run ends with one ``outcome`` event: the one place a user or a sweep reads it."""
+        result.outcome = verdict
+        self._write(log, "/events", Event(k / self.sc.timing.physics_rate, "outcome", verdict),
+                    self.t_ns(k))
 
     def _finish(self, log: LogWriter, result: RunResult, k: int, wall0: float) -> None:
         result.steps = k

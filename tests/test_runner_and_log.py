@@ -35,6 +35,29 @@ def test_rates_and_latency(toy_yaml, tmp_path):
         assert m.t_ns == round(m.data["t"] * 1e9)
 
 
+def test_readings_reach_the_controller_in_time_order(toy_yaml, tmp_path):
+    """A zero-latency reading is delivered at its capture step even when a slower sensor's
+    reading, captured at the same step, was queued ahead of it."""
+    sc = load_scenario(toy_yaml, sets=["sensors.fast={type: toy_sensor, rate: 100, latency: 0.0}",
+                                       "controller.rate=1000"])
+    assert list(sc.sensors) == ["cam", "fast"]          # the 20 ms sensor comes first
+    runner = Runner(sc)
+    runner.run(tmp_path / "order.mcap")
+    delays = sorted({round(now - cap, 9) for now, cap in runner.controller.seen})
+    assert delays == [0.0, 0.02]
+
+
+def test_every_run_ends_with_an_outcome(toy_yaml, tmp_path):
+    _, result, log = _run(toy_yaml, tmp_path)
+    events = log.events()
+    assert events[-1]["kind"] == "outcome"
+    assert events[-1]["data"] == {"success": True, "reason": "completed"} == result.outcome
+    _, result, log = _run(toy_yaml, tmp_path, sets=["plant.params.blow_up_at=0.2"], name="nan.mcap")
+    last = log.events()[-1]
+    assert last["kind"] == "outcome" and last["data"]["success"] is False
+    assert "non-finite" in last["data"]["reason"]
+
+
 def test_controller_drives_plant(toy_yaml, tmp_path):
     _, _, log = _run(toy_yaml, tmp_path, sets=["timing.duration=3.0"])
     last = log.series("/toy/state")[-1]
@@ -46,7 +69,7 @@ def test_events_and_stop_condition(toy_yaml, tmp_path):
         "plant.params.wall=0.5", "stop.on_events=[collision]", "stop.after=0.1",
         "timing.duration=5"])
     events = log.events()
-    assert [e["kind"] for e in events] == ["collision"]
+    assert [e["kind"] for e in events] == ["collision", "outcome"]
     e = events[0]
     assert e["data"]["index"] == 1 and e["data"]["planned"] == {"target": 1.0}
     assert result.stopped_by == "collision"
@@ -66,7 +89,8 @@ def test_same_seed_same_bytes_other_seed_differs(toy_yaml, tmp_path):
 def test_nan_becomes_an_error_event(toy_yaml, tmp_path):
     _, result, log = _run(toy_yaml, tmp_path, sets=["plant.params.blow_up_at=0.3"])
     assert result.stopped_by == "error"
-    err = log.events()[-1]
+    err, outcome = log.events()[-2:]
+    assert outcome["kind"] == "outcome" and outcome["data"]["success"] is False
     assert err["kind"] == "error" and err["data"]["topic"] in ("/toy/state", "/toy/measured")
     assert "x" in err["data"]["fields"]
     assert abs(err["t"] - 0.3) < 2e-3
@@ -167,5 +191,6 @@ def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
     assert "interrupted at t = " in err and "partial log kept" in err and "Traceback" not in err
     r = LogReader(out)                      # finished properly: summary, final name
     assert not r.truncated
-    assert r.events()[-1]["kind"] == "interrupted"
+    assert [e["kind"] for e in r.events()[-2:]] == ["interrupted", "outcome"]
+    assert r.events()[-1]["data"] == {"success": False, "reason": "interrupted"}
     assert 0.9 < r.time_range()[1] < 1.2
