@@ -414,5 +414,9 @@ def golden_update(names):
     click.echo("commit the golden logs with the reason for the change in the commit message")
 
 
+from replay.sweep.commands import register  # noqa: E402  (replay sweep, ablate, report)
+
+register(main)
+
 if __name__ == "__main__":
     main()

@@ -1,0 +1,221 @@
+"""A predict-then-intercept baseline for the catching arm (not in Namiki & Ishikawa: the classic
+approach their direct mapping is set against, built here for the ablation).
+
+Each control step it
+
+1. filters the stereo positions with a Kalman filter (:mod:`.kalman`: state (r, v), known gravity);
+2. predicts the ballistic arc from the estimate and its first crossing of the catch surface
+   |r - O| = |c| (the same surface as the direct mapping's eq. 4: where q4 = q_alpha and the ball
+   meets the palm): the catch point p_c and time t_c;
+3. inverse kinematics of p_c on that surface (closed form, ``CatchGeometry.inverse``; q3 held);
+4. a quintic joint trajectory from the current desired state to (q_c, 0, 0), ending ``margin``
+   before t_c (at least ``min_duration`` long), **re-planned** whenever the predicted catch point
+   moves by more than ``replan_distance`` or t_c by more than ``replan_time`` (the estimates
+   improve, or the ball was disturbed), until ``freeze_time`` before t_c;
+5. tracks it with the same PD + inverse-dynamics law and torque saturation as the direct
+   controller, and closes the hand so that its closing ends at t_c.
+
+So the arm goes to where the ball will be and waits there, open-palmed toward the shoulder's
+outward normal, instead of moving with the ball as the direct mapping does.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from replay.control.catching.mapping import CatchGeometry
+from replay.control.catching.model import ArmModel
+from replay.control.predictive.kalman import BallKalman, first_crossing
+from replay.control.predictive.trajectory import Quintic
+from replay.interfaces import Controller, Occurrence
+from replay.messages import EffectorState, JointCommand
+from replay.params import param
+from replay.robot.arm_types import ArmCommand, ArmSpec
+
+TOPIC_VISION_OBJECT = "/vision/object"
+TOPIC_ENCODERS = "/arm/encoders"
+
+
+@dataclass
+class Params:
+    q_alpha: float = param(math.pi / 2, unit="rad",
+                           doc="joint angle of the selected joint at the catch (the catch "
+                               "surface), as the direct mapping's")
+    selected_joint: str = param("J4", doc="the joint at q_alpha on the catch surface")
+    held_joints: list = param(["J3"], doc="joints held at their initial angle")
+    catch_q: list = param([0.0, math.pi / 4], unit="rad", length=2,
+                          doc="(q1, q2) the inverse kinematics prefers (branch choice)")
+    catch_offset: float = param(-1.0, unit="m",
+                                doc="catch point this far along the tool z axis; negative = "
+                                    "palm thickness + ball radius from the spec")
+    meas_sigma: float = param(0.002, unit="m", gt=0.0,
+                              doc="Kalman measurement noise (the stereo's ~1-2 mm, "
+                                  "sensors/stereo.py)")
+    accel_sigma: float = param(2.0, unit="m/s^2", gt=0.0,
+                               doc="Kalman process noise: unmodelled acceleration (drag, kicks)")
+    min_measurements: int = param(3, ge=1, doc="frames before the first plan")
+    margin: float = param(0.02, unit="s", ge=0.0,
+                          doc="reach the catch posture this long before the predicted arrival")
+    min_duration: float = param(0.03, unit="s", gt=0.0,
+                                doc="a re-planned trajectory lasts at least this long")
+    replan_distance: float = param(0.005, unit="m", ge=0.0,
+                                   doc="re-plan when the predicted catch point moves this far")
+    replan_time: float = param(0.003, unit="s", ge=0.0,
+                               doc="re-plan when the predicted catch time moves this much")
+    freeze_time: float = param(0.01, unit="s", ge=0.0,
+                               doc="no re-planning this close to the predicted catch")
+    kp: list = param([900.0, 1500.0, 300.0, 150.0], unit="N*m/rad", ge=0.0,
+                     doc="PD stiffness per arm joint (as the direct controller's)")
+    kd: list = param([30.0, 45.0, 10.0, 4.0], unit="N*m*s/rad", ge=0.0,
+                     doc="PD damping per arm joint (as the direct controller's)")
+    close_lead: float = param(0.0, unit="s", doc="start closing this much earlier than "
+                                                 "(t_c - closing time)")
+
+
+class PredictiveController(Controller):
+    Params = Params
+    spec_type = ArmSpec
+    command_type = ArmCommand
+    reads = (TOPIC_VISION_OBJECT, TOPIC_ENCODERS)
+    description = ("predict-then-intercept baseline: Kalman filter, ballistic catch point, IK, "
+                   "re-planned quintic joint trajectory, PD + dynamics")
+
+    def __init__(self, params: Params, *, spec) -> None:
+        super().__init__(params, spec=spec)
+        P = params
+        names = tuple(spec.joint_names)
+        self.names = names
+        self.n = len(names)
+        held = [names.index(j) for j in P.held_joints]
+        self.active = tuple(i for i in range(self.n) if i not in held)
+        if len(self.active) != 3 or names.index(P.selected_joint) != self.active[-1]:
+            raise ValueError(f"the predictive baseline needs 3 active joints ending with "
+                             f"{P.selected_joint}; got {[names[i] for i in self.active]}")
+        self.q_init = np.asarray(spec.initial_q, float).copy()
+        self.tau_limit = np.asarray(spec.torque_limits, float)
+        self.gravity = np.array([0.0, 0.0, -float(spec.gravity)])
+        off = P.catch_offset
+        if off < 0:
+            off = 0.0
+            if spec.hand is not None:
+                off += float(spec.hand.table.palm_thickness)
+            if spec.object is not None:
+                off += float(spec.object.radius)
+        self.model = ArmModel.from_chain(spec.model, active=self.active, q_fixed=self.q_init,
+                                         point_in_tool=(0.0, 0.0, off))
+        self.geo = CatchGeometry.from_fk(self.model.fk, P.q_alpha, p_ref=tuple(P.catch_q))
+        self.kp = np.asarray(P.kp, float)
+        self.kd = np.asarray(P.kd, float)
+        if self.kp.shape != (self.n,) or self.kd.shape != (self.n,):
+            raise ValueError(f"kp and kd need {self.n} values")
+        self.kf = BallKalman(self.gravity, meas_sigma=P.meas_sigma, accel_sigma=P.accel_sigma)
+        self.hand = spec.hand
+        if self.hand is not None:
+            self.hand_open = np.asarray(self.hand.open_posture, float)
+            self.hand_closed = np.asarray(self.hand.closed_posture, float)
+            self.close_time = float(np.max(np.abs(self.hand_closed - self.hand_open))
+                                    / self.hand.closing_speed)
+        else:
+            self.close_time = 0.0
+        self.q = self.qd = None
+        self.q_d = self.q_init.copy()
+        self.qd_d = np.zeros(self.n)
+        self.qdd_d = np.zeros(self.n)
+        self.tau = np.zeros(self.n)
+        self.plan: Quintic | None = None
+        self.t_catch: float | None = None
+        self.p_catch: np.ndarray | None = None
+        self.replans = 0
+        self.closing = False
+        self._events: list[Occurrence] = []
+
+    # ------------------------------------------------------------------ control
+    def update(self, t: float, measurements: list) -> ArmCommand:
+        P = self.params
+        for topic, m in measurements:
+            if topic == TOPIC_VISION_OBJECT:
+                self.kf.add(m.t, m.position)
+            elif topic in (TOPIC_ENCODERS, "/arm/joint_state"):
+                self._joint_state(m)
+        if self.kf.n >= P.min_measurements:
+            self._maybe_replan(t)
+        if self.plan is not None:
+            self.q_d, self.qd_d, self.qdd_d = self.plan(t)
+        if self.hand is not None and not self.closing and self.t_catch is not None \
+                and t >= self.t_catch - self.close_time - P.close_lead - 1e-9:
+            self.closing = True
+            self._events.append(Occurrence("hand_close", {
+                "predicted_catch_time": self.t_catch, "closing_time": self.close_time}))
+        self.tau = self._torque()
+        hand = None
+        if self.hand is not None:
+            hand = (self.hand_closed if self.closing else self.hand_open).tolist()
+        return ArmCommand(torque=self.tau.tolist(), hand=hand)
+
+    def _maybe_replan(self, t: float) -> None:
+        P = self.params
+        if self.t_catch is not None and t >= self.t_catch - P.freeze_time:
+            return
+        r, v = self.kf.state(t)
+        s = first_crossing(r, v, self.gravity, self.geo.origin, self.geo.catch_radius)
+        if s is None:
+            return
+        t_c = t + s
+        p_c = r + v * s + 0.5 * self.gravity * s * s
+        if (self.plan is not None and np.linalg.norm(p_c - self.p_catch) <= P.replan_distance
+                and abs(t_c - self.t_catch) <= P.replan_time):
+            return
+        inv = self.geo.inverse(p_c)
+        q_goal = self.model.full(inv.p[0])
+        t_end = max(t_c - P.margin, t + P.min_duration)
+        self.plan = Quintic(t, t_end, self.q_d, self.qd_d, self.qdd_d, q_goal)
+        self.t_catch, self.p_catch = t_c, p_c
+        self.replans += 1
+        self._events.append(Occurrence("plan", {
+            "catch_time": t_c, "catch_point": p_c.tolist(), "q_goal": q_goal.tolist(),
+            "arrive": t_end, "in_domain": bool(inv.in_domain[0]), "index": self.replans,
+            "position_sigma": self.kf.position_sigma(),
+            "velocity_sigma": self.kf.velocity_sigma()}))
+
+    def _joint_state(self, m) -> None:
+        pos, vel = np.asarray(m.position, float), np.asarray(m.velocity, float)
+        names = list(getattr(m, "name", []) or [])
+        if names and set(self.names) <= set(names):
+            idx = [names.index(n) for n in self.names]
+            pos, vel = pos[idx], vel[idx]
+        if pos.shape == (self.n,):
+            self.q, self.qd = pos, (vel if vel.shape == (self.n,) else np.zeros(self.n))
+
+    def _torque(self) -> np.ndarray:
+        ff = self.model.inverse_dynamics_full(self.q_d, self.qd_d, self.qdd_d)
+        tau = ff if self.q is None else ff + self.kp * (self.q_d - self.q) + \
+            self.kd * (self.qd_d - self.qd)
+        return np.clip(tau, -self.tau_limit, self.tau_limit)
+
+    # ------------------------------------------------------------------ reporting
+    def intent(self) -> dict:
+        out = {"method": "predictive", "hand_closing": self.closing, "replans": self.replans}
+        if self.t_catch is not None:
+            out.update(catch_time=self.t_catch, catch_point=self.p_catch.tolist())
+        return out
+
+    def pop_events(self) -> list[Occurrence]:
+        ev, self._events = self._events, []
+        return ev
+
+    def outcome(self, t: float) -> dict:
+        out = {"replans": self.replans}
+        if self.t_catch is not None:
+            out.update(predicted_catch_time=self.t_catch,
+                       predicted_catch_point=self.p_catch.tolist())
+        return out
+
+    def telemetry(self, t: float) -> dict:
+        return {"/arm/joint_command": JointCommand(t, position=self.q_d.tolist(),
+                                                   torque=self.tau.tolist()),
+                "/effector/state": EffectorState(
+                    t, position=self.model.fk(self.q).tolist() if self.q is not None else [],
+                    desired_position=self.model.fk(self.q_d).tolist())}

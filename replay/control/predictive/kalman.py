@@ -1,0 +1,85 @@
+"""A Kalman filter on the stereo positions: state (r, v), known gravity, white-noise acceleration.
+
+The textbook constant-acceleration-input model (not from either paper): between measurements
+r' = v, v' = g + w with w white of spectral density ``accel_sigma^2`` per axis, so over dt
+
+    x <- F x + B g,   F = [[I, dt I], [0, I]],   B g = [g dt^2 / 2, g dt],
+    P <- F P F^T + Q, Q = q [[dt^3/3 I, dt^2/2 I], [dt^2/2 I, dt I]],  q = accel_sigma^2,
+
+and a stereo position z = r + n, n ~ N(0, meas_sigma^2 I), updates it. The filter is kept at the
+time of its newest measurement; :meth:`state` carries it forward ballistically.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class BallKalman:
+    def __init__(self, gravity=(0.0, 0.0, -9.81), *, meas_sigma: float = 0.002,
+                 accel_sigma: float = 2.0, v_sigma0: float = 10.0) -> None:
+        self.g = np.asarray(gravity, float)
+        self.R = np.eye(3) * meas_sigma ** 2
+        self.q = accel_sigma ** 2
+        self.v_sigma0 = v_sigma0
+        self.x: np.ndarray | None = None        # (6,) r, v
+        self.P: np.ndarray | None = None
+        self.t: float | None = None
+        self.n = 0
+
+    def _predict(self, dt: float) -> None:
+        if dt <= 0.0:
+            return
+        F = np.eye(6)
+        F[:3, 3:] = np.eye(3) * dt
+        self.x = F @ self.x + np.concatenate([0.5 * self.g * dt * dt, self.g * dt])
+        I3 = np.eye(3)
+        Q = self.q * np.block([[dt ** 3 / 3 * I3, dt ** 2 / 2 * I3], [dt ** 2 / 2 * I3, dt * I3]])
+        self.P = F @ self.P @ F.T + Q
+
+    def add(self, t: float, z) -> None:
+        z = np.asarray(z, float)
+        if self.x is None:
+            self.x = np.concatenate([z, np.zeros(3)])
+            self.P = np.diag([self.R[0, 0]] * 3 + [self.v_sigma0 ** 2] * 3)
+            self.t = float(t)
+            self.n = 1
+            return
+        if t <= self.t:
+            return                                  # repeated or out-of-order frame
+        self._predict(t - self.t)
+        self.t = float(t)
+        H = np.hstack([np.eye(3), np.zeros((3, 3))])
+        S = H @ self.P @ H.T + self.R
+        K = np.linalg.solve(S, H @ self.P).T
+        self.x = self.x + K @ (z - H @ self.x)
+        self.P = (np.eye(6) - K @ H) @ self.P
+        self.n += 1
+
+    def state(self, t: float):
+        """(r, v) at time t, carried ballistically from the newest estimate (None before any)."""
+        if self.x is None:
+            return None
+        dt = t - self.t
+        r, v = self.x[:3], self.x[3:]
+        return r + v * dt + 0.5 * self.g * dt * dt, v + self.g * dt
+
+    def position_sigma(self) -> float:
+        return float(np.sqrt(np.trace(self.P[:3, :3]) / 3.0)) if self.P is not None else np.inf
+
+    def velocity_sigma(self) -> float:
+        return float(np.sqrt(np.trace(self.P[3:, 3:]) / 3.0)) if self.P is not None else np.inf
+
+
+def first_crossing(r, v, g, origin, radius: float) -> float | None:
+    """Smallest s >= 0 with |r + v s + g s^2 / 2 - origin| = radius (None if the arc never gets
+    there): the quartic |d + v s + g s^2/2|^2 = R^2, d = r - origin."""
+    d = np.asarray(r, float) - np.asarray(origin, float)
+    v, g = np.asarray(v, float), np.asarray(g, float)
+    if d @ d <= radius * radius:
+        return 0.0
+    coeffs = [0.25 * (g @ g), v @ g, v @ v + d @ g, 2.0 * (d @ v), d @ d - radius * radius]
+    roots = np.roots(coeffs)
+    real = roots[np.abs(roots.imag) < 1e-9].real
+    real = real[real >= 0.0]
+    return float(real.min()) if real.size else None

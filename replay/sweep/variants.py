@@ -1,0 +1,105 @@
+"""Variants: one resolved scenario each, keyed by the hash of (resolved scenario, seed, code version).
+
+The key is what makes a sweep resumable: a variant whose key is already in the table is done (a
+rerun skips it, an interrupted sweep picks up the rest); change the scenario, the seed or the code
+and the key changes. A variant whose scenario does not load (a value out of range, an unknown plug-in
+parameter) is still a variant: it becomes a row with that reason, keyed by what was asked.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from replay import __version__
+from replay.scenario import ScenarioError, load_scenario, resolved_yaml
+from replay.sweep.spec import SweepSpec, sets_for
+
+
+@dataclass
+class Variant:
+    index: int
+    key: str                    # 16 hex digits
+    params: dict[str, str]      # axis -> the table's cell
+    scenario_path: str
+    sets: list[str]
+    seed: int
+    resolved: str = ""          # the resolved YAML ("" when it failed to load)
+    error: str = ""             # why it failed to load
+    name: str = ""              # the scenario's name
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def code_version() -> str:
+    """Package version, git commit and a digest of uncommitted changes (so an edit re-runs)."""
+    here = Path(__file__).resolve().parent
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], capture_output=True,
+                                text=True, timeout=10, cwd=here)
+        diff = subprocess.run(["git", "diff", "HEAD", "--", ".", ":(exclude)*.csv"],
+                              capture_output=True, timeout=30, cwd=here.parent.parent)
+    except (OSError, subprocess.SubprocessError):
+        return __version__
+    version = f"{__version__}+{commit.stdout.strip() or 'unknown'}"
+    if diff.returncode == 0 and diff.stdout:
+        version += "." + hashlib.sha256(diff.stdout).hexdigest()[:8]
+    return version
+
+
+def variant_key(resolved: str, seed: int, version: str) -> str:
+    h = hashlib.sha256()
+    for part in (resolved, str(seed), version):
+        h.update(part.encode())
+        h.update(b"\0")
+    return h.hexdigest()[:16]
+
+
+def expand(scenario: str | Path, spec: SweepSpec, seed: int, *, sets: list[str] = (),
+           version: str | None = None) -> list[Variant]:
+    """The sweep's variants, each loaded and validated (or carrying why it cannot be)."""
+    version = code_version() if version is None else version
+    out = []
+    for i, point in enumerate(spec.points(seed)):
+        path, point_sets = sets_for(point)
+        path = str(path or scenario)
+        all_sets = list(sets) + point_sets
+        cells = {k: spec.label(k, v) for k, v in point.items()}
+        v = Variant(index=i, key="", params=cells, scenario_path=path, sets=all_sets, seed=seed)
+        try:
+            sc = load_scenario(path, sets=all_sets, seed=seed)
+            v.resolved = resolved_yaml(sc)
+            v.name = sc.name
+            v.key = variant_key(v.resolved, seed, version)
+        except ScenarioError as exc:
+            v.error = f"invalid: {exc}"
+            v.key = variant_key(f"{path}\n" + "\n".join(all_sets), seed, version)
+        out.append(v)
+    return out
+
+
+def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] = ()) -> None:
+    """A varied key that names no field of the scenario is a bad --grid/--random, not a variant
+    failure: raise SweepSpecError before anything runs."""
+    from replay.scenario.loader import to_plain
+    from replay.sweep.spec import SCENARIO_AXIS, SweepSpecError
+    try:
+        base = to_plain(load_scenario(scenario, sets=list(sets)))
+    except ScenarioError as exc:
+        raise SweepSpecError(str(exc)) from None
+    keys = [a.name for a in spec.random]
+    for a in spec.grid:
+        if a.name == SCENARIO_AXIS:
+            continue
+        keys += list(a.values[0]) if isinstance(a.values[0], dict) else [a.name]
+    for key in keys:
+        node: Any = base
+        for depth, part in enumerate(key.split(".")):
+            if not isinstance(node, dict) or part not in node:
+                where = ".".join(key.split(".")[:depth]) or "(top level)"
+                choices = ", ".join(node) if isinstance(node, dict) else "(not a mapping)"
+                raise SweepSpecError(f"{key}: no field {part!r} in {where} of {scenario} "
+                                     f"(fields: {choices})")
+            node = node[part]

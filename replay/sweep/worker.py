@@ -1,0 +1,90 @@
+"""One variant, run anywhere (a pool process, a Ray worker): resolved scenario in, table row out.
+
+The task carries the resolved YAML, not a file path, so a worker on another machine runs exactly
+what was expanded here (it needs the same code and data files, e.g. the catching alpha). Nothing
+raises out of :func:`run_variant`: an exception in a plug-in, a NaN, a scenario the plant rejects
+are a row with ``success: False`` and the reason.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+
+def run_variant(task: dict[str, Any]) -> dict[str, Any]:
+    """task: key, index, resolved, error, log (path or ""), cwd, metrics ("module:function" of
+    a LogReader -> extra columns, or "") -> a row (without the params)."""
+    wall0 = time.perf_counter()
+    cpu0 = time.process_time()
+    row: dict[str, Any] = {"key": task["key"], "index": task["index"]}
+    if task.get("error"):
+        row.update(success=False, reason=task["error"], wall_time=0.0, cpu_time=0.0, log="")
+        return row
+    log = task.get("log") or ""
+    tmp = None
+    if not log:
+        fd, tmp = tempfile.mkstemp(suffix=".mcap", prefix="sweep-")
+        os.close(fd)
+    cwd = task.get("cwd")
+    if cwd and Path(cwd).is_dir() and os.getcwd() != cwd:
+        os.chdir(cwd)                     # relative data paths (alpha files) as in the scenario
+    try:
+        from replay.runner import Runner
+        from replay.scenario.loader import scenario_from_text
+        sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>")
+        if log:
+            Path(log).parent.mkdir(parents=True, exist_ok=True)
+        result = Runner(sc).run(log or tmp)
+        outcome = dict(result.outcome)
+        row["success"] = bool(outcome.pop("success", False))
+        row["reason"] = str(outcome.pop("reason", ""))
+        if result.stopped_by == "error" and not row["reason"]:
+            row["reason"] = f"error: {result.error}"
+        row["t_end"] = result.t_end
+        row["stopped_by"] = result.stopped_by
+        row.update({f"m.{k}": _cell(v) for k, v in outcome.items()})
+        row.update({f"e.{k}": n for k, n in sorted(result.events.items())})
+        if task.get("metrics"):
+            row.update({f"x.{k}": _cell(v) for k, v in
+                        _extract(task["metrics"], log or tmp).items()})
+    except Exception as exc:                        # noqa: BLE001 - a failed variant is a row
+        row["success"] = False
+        last = traceback.extract_tb(exc.__traceback__)[-1]
+        row["reason"] = (f"error: {type(exc).__name__}: {exc} "
+                         f"({Path(last.filename).name}:{last.lineno})").replace("\n", " ")
+    finally:
+        if tmp:
+            Path(tmp).unlink(missing_ok=True)
+    row["wall_time"] = round(time.perf_counter() - wall0, 4)
+    row["cpu_time"] = round(time.process_time() - cpu0, 4)
+    row["log"] = log if log and Path(log).is_file() else ""
+    return row
+
+
+def load_function(ref: str):
+    """``package.module:function`` -> the function."""
+    import importlib
+    module, _, name = ref.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def _extract(ref: str, log: str) -> dict:
+    """Extra table columns read from the variant's log by the sweep's ``metrics`` function."""
+    from replay.log import LogReader
+    return dict(load_function(ref)(LogReader(log)) or {})
+
+
+def _cell(v: Any) -> Any:
+    """A metric as a CSV cell: numbers and strings as they are, the rest as JSON."""
+    import json
+    if isinstance(v, bool) or v is None or isinstance(v, (int, str)):
+        return v
+    if isinstance(v, float):
+        return v if math.isfinite(v) else str(v)
+    return json.dumps(v, separators=(",", ":"))
