@@ -68,6 +68,9 @@ class Params:
                                   doc="initial linear velocity")
     object_angular_velocity: list = param([0.0, 0.0, 0.0], unit="rad/s", length=3,
                                           doc="initial angular velocity")
+    object_impulses: list = param([], doc="external impulses on the object, [[t, Jx, Jy, Jz], "
+                                          "...] (s, N*s, world): a disturbance such as a "
+                                          "mid-flight kick (plants/bullet_arm/impulse.py)")
     object_gravity: bool = param(True, doc="gravity acts on the object (false: it floats)")
     object_albedo: float = param(0.9, unit="1", ge=0.0, le=1.0, doc="brightness seen by cameras")
     object_lateral_friction: float = param(0.8, unit="1", ge=0.0,

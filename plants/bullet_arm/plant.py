@@ -21,6 +21,7 @@ import numpy as np
 import pybullet as p
 from pybullet_utils import bullet_client
 
+from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
@@ -164,6 +165,7 @@ class BulletArmPlant(Plant):
         self._obj_vel_before = (np.asarray(P.object_velocity, float) if self.obj is not None
                                 else np.zeros(3))
         self._contacts: list = []
+        self._impulses = ImpulseSchedule(P.object_impulses, dt)
         self._spec = self._make_spec(q0)
 
     # ------------------------------------------------------------------ spec
@@ -282,6 +284,12 @@ class BulletArmPlant(Plant):
                                          forces=[self.params.hand_max_torque] * len(v))
         if self.obj is not None:
             pos, _, v, _ = self.object_state()
+            J = self._impulses.pop(self._steps) if self._impulses else None
+            if J is not None:                            # a scenario-set kick (impulse.py)
+                v = v + J / self.params.object_mass
+                bc.resetBaseVelocity(self.obj, v.tolist(), self.object_state()[3].tolist())
+                self._events.append(Occurrence("impulse", {"impulse": J.tolist(),
+                                                           "velocity_after": v.tolist()}))
             self._obj_vel_before = v
             if not self.params.object_gravity:
                 bc.applyExternalForce(self.obj, -1, [0.0, 0.0, self.params.object_mass

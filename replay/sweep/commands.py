@@ -68,7 +68,8 @@ def sweep(scenario, grids, randoms, n, sets, seed, out, workers, executor, addre
         sys.exit(130)
 
 
-def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs, progress):
+def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs, progress,
+         metrics=""):
     from replay.sweep.engine import run_sweep
     from replay.sweep.variants import check_keys, expand
     if executor != "ray" and address:
@@ -77,14 +78,61 @@ def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs,
         check_keys(scenario, spec, list(sets))
     except SweepSpecError as exc:
         _fail(str(exc))
-    variants = expand(scenario, spec, seed, sets=list(sets))
+    try:
+        variants = expand(scenario, spec, seed, sets=list(sets))
+    except SweepSpecError as exc:
+        _fail(str(exc))
     try:
         return run_sweep(variants, out, workers=workers, executor=executor, address=address,
-                         keep_logs=keep_logs, progress=progress)
+                         keep_logs=keep_logs, progress=progress, metrics=metrics)
     except ExecutorError as exc:
         _fail(str(exc))
+
+
+@click.command()
+@click.argument("names", nargs=-1)
+@click.option("--list", "list_", is_flag=True, help="list the ablations (sweeps/*.yaml)")
+@click.option("--workers", type=click.IntRange(min=1), help="parallel variants")
+@click.option("--executor", type=click.Choice(EXECUTORS), default="local", show_default=True)
+@click.option("--address", help="Ray cluster to join (with --executor ray)")
+@click.option("--store", is_flag=True, help="also keep each table as data/ablations/NAME.csv "
+                                            "(what the report plots without a fresh run)")
+@click.option("--plot-only", is_flag=True, help="no runs: redraw from the freshest table")
+@click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
+@click.option("-q", "--quiet", is_flag=True, help="no progress bar")
+def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, quiet):
+    """Run the named ablations (sweeps/NAME.yaml; all with no NAME) and draw each plot from its
+    table into out/ablations/NAME/."""
+    from replay.sweep import ablations
+    if list_:
+        for name in ablations.names():
+            sf = ablations.load(name)
+            click.echo(f"{name:<28} {sf.paper:<16} {sf.description}")
+        return
+    try:
+        files = [ablations.load(n) for n in (names or ablations.names())]
+    except SweepSpecError as exc:
+        _fail(str(exc))
+    for sf in files:
+        out = ablations.OUT_DIR / sf.name
+        if plot_only:
+            table, _ = ablations.table_path(sf.name)
+            if table is None:
+                _fail(f"{sf.name}: no table yet (run `replay ablate {sf.name}`)")
+        else:
+            summary = _run(str(sf.scenario), sf.spec, sf.seed, sf.sets, out, workers, executor,
+                           address, not no_logs, not quiet, metrics=sf.metrics)
+            click.echo(f"{sf.name}: {summary.line()}")
+            if summary.interrupted:
+                sys.exit(130)
+            table = summary.table
+            if store:
+                click.echo(f"stored: {ablations.store(sf.name, table)}")
+        for path in ablations.plot(sf, table, out):
+            click.echo(f"plot: {path}")
 
 
 def register(group: click.Group) -> None:
     """Add this package's commands to the ``replay`` group."""
     group.add_command(sweep)
+    group.add_command(ablate)

@@ -4,7 +4,7 @@ A grid axis is a scenario field (any ``--set`` key path) with a list of values; 
 as YAML (``1e-3``, ``[1, 2]``, ``true``). An axis may also *link* several fields, one mapping per
 value (sweep files only, e.g. a throw speed that sets the release point and velocity together), and
 the axis ``scenario`` varies the scenario file itself (e.g. the direct mapping against the
-predictive baseline). Random axes draw ``n`` values uniformly from ``[lo, hi]`` with a generator
+predictive baseline) and the axis ``seed`` the run's seed. Random axes draw ``n`` values uniformly from ``[lo, hi]`` with a generator
 seeded by the sweep's seed, so the same command gives the same variants. Variants are the cartesian
 product of the grid axes, times the ``n`` random draws.
 
@@ -206,6 +206,7 @@ class SweepFile:
     plot: str                   # "module:function" drawing the table
     caption: str                # what the plot shows, one sentence (the report's text)
     paper: str
+    metrics: str = ""           # "module:function" LogReader -> extra columns, or ""
 
 
 def load_sweep_file(path: str | Path) -> SweepFile:
@@ -221,7 +222,7 @@ def load_sweep_file(path: str | Path) -> SweepFile:
     if not isinstance(data, dict):
         raise SweepSpecError(f"{path}: a sweep file is a mapping")
     known = {"name", "description", "paper", "scenario", "seed", "set", "grid", "random", "n",
-             "plot", "caption"}
+             "plot", "caption", "metrics"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise SweepSpecError(f"{path}: unknown field {unknown[0]!r} (expected one of: "
@@ -248,7 +249,8 @@ def load_sweep_file(path: str | Path) -> SweepFile:
         spec=spec, seed=int(data.get("seed", 0)),
         sets=[f"{k}={_yaml_text(v)}" for k, v in sets.items()],
         description=str(data.get("description", "")), plot=str(data["plot"]),
-        caption=str(data.get("caption", "")).strip(), paper=str(data.get("paper", "")))
+        caption=str(data.get("caption", "")).strip(), paper=str(data.get("paper", "")),
+        metrics=str(data.get("metrics", "")))
 
 
 def _file_axis(path: Path, name: str, values: Any) -> Axis:
@@ -277,15 +279,22 @@ def _yaml_text(v: Any) -> str:
         .strip()
 
 
-def sets_for(point: dict[str, Any]) -> tuple[str | None, list[str]]:
-    """A variant's point -> (scenario file or None, ``--set`` assignments)."""
-    scenario = None
+SEED_AXIS = "seed"
+
+
+def sets_for(point: dict[str, Any]) -> tuple[str | None, int | None, list[str]]:
+    """A variant's point -> (scenario file or None, seed or None, ``--set`` assignments)."""
+    scenario = seed = None
     sets = []
     for name, value in point.items():
         if name == SCENARIO_AXIS:
             scenario = value
+        elif name == SEED_AXIS:
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise SweepSpecError(f"seed: expected whole numbers >= 0, got {value!r}")
+            seed = value
         elif isinstance(value, dict):
             sets += [f"{k}={_yaml_text(v)}" for k, v in value.items()]
         else:
             sets.append(f"{name}={_yaml_text(value)}")
-    return scenario, sets
+    return scenario, seed, sets

@@ -63,19 +63,20 @@ def expand(scenario: str | Path, spec: SweepSpec, seed: int, *, sets: list[str] 
     version = code_version() if version is None else version
     out = []
     for i, point in enumerate(spec.points(seed)):
-        path, point_sets = sets_for(point)
+        path, point_seed, point_sets = sets_for(point)
         path = str(path or scenario)
         all_sets = list(sets) + point_sets
+        vseed = seed if point_seed is None else point_seed
         cells = {k: spec.label(k, v) for k, v in point.items()}
-        v = Variant(index=i, key="", params=cells, scenario_path=path, sets=all_sets, seed=seed)
+        v = Variant(index=i, key="", params=cells, scenario_path=path, sets=all_sets, seed=vseed)
         try:
-            sc = load_scenario(path, sets=all_sets, seed=seed)
+            sc = load_scenario(path, sets=all_sets, seed=vseed)
             v.resolved = resolved_yaml(sc)
             v.name = sc.name
-            v.key = variant_key(v.resolved, seed, version)
+            v.key = variant_key(v.resolved, vseed, version)
         except ScenarioError as exc:
             v.error = f"invalid: {exc}"
-            v.key = variant_key(f"{path}\n" + "\n".join(all_sets), seed, version)
+            v.key = variant_key(f"{path}\n" + "\n".join(all_sets), vseed, version)
         out.append(v)
     return out
 
@@ -84,14 +85,14 @@ def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] = ()) -> N
     """A varied key that names no field of the scenario is a bad --grid/--random, not a variant
     failure: raise SweepSpecError before anything runs."""
     from replay.scenario.loader import to_plain
-    from replay.sweep.spec import SCENARIO_AXIS, SweepSpecError
+    from replay.sweep.spec import SCENARIO_AXIS, SEED_AXIS, SweepSpecError
     try:
         base = to_plain(load_scenario(scenario, sets=list(sets)))
     except ScenarioError as exc:
         raise SweepSpecError(str(exc)) from None
     keys = [a.name for a in spec.random]
     for a in spec.grid:
-        if a.name == SCENARIO_AXIS:
+        if a.name in (SCENARIO_AXIS, SEED_AXIS):
             continue
         keys += list(a.values[0]) if isinstance(a.values[0], dict) else [a.name]
     for key in keys:

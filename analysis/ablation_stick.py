@@ -1,0 +1,76 @@
+"""The stick-capture ablations (sweeps/stick_*.yaml): a metrics function the sweep runs on each
+log, and the plots drawn from the tables."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from analysis.ablation_table import captured, rate_by  # noqa: E402
+from analysis.figure_files import save  # noqa: E402
+from replay.sweep.table import as_float  # noqa: E402
+
+
+def first_collision(log) -> dict:
+    """The stick's velocity after the first collision, measured and as the method planned it."""
+    for e in log.events():
+        if e["kind"] == "collision" and e["data"].get("index") == 1:
+            d = e["data"]
+            planned = d.get("planned") or {}
+            out = {"speed_after": math.hypot(*d["v_after"]), "omega_after": d["omega_after"],
+                   "t": e["t"]}
+            if planned.get("v_after") is not None:
+                out["planned_speed_after"] = math.hypot(*planned["v_after"])
+                out["planned_omega_after"] = planned["omega_after"]
+            return out
+    return {}
+
+
+def plot_friction(rows: list[dict], out: Path, stem: str) -> list[Path]:
+    fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
+    widths = sorted({as_float(r["plant.params.stick.collision_width"]) for r in rows})
+    for w in widths:
+        sub = sorted((r for r in rows if as_float(r["plant.params.stick.collision_width"]) == w),
+                     key=lambda r: as_float(r["plant.params.stick.friction"]))
+        mu = [as_float(r["plant.params.stick.friction"]) for r in sub]
+        ax_v.plot(mu, [as_float(r.get("x.speed_after")) for r in sub], "o-",
+                  label=f"W = {w * 1e3:g} mm")
+        ax_w.plot(mu, [as_float(r.get("x.omega_after")) for r in sub], "o-",
+                  label=f"W = {w * 1e3:g} mm")
+    plan_v = [as_float(r.get("x.planned_speed_after")) for r in rows]
+    plan_w = [as_float(r.get("x.planned_omega_after")) for r in rows]
+    if rows and not np.all(np.isnan(plan_v)):
+        ax_v.axhline(float(np.nanmean(plan_v)), color="k", lw=0.8, ls="--", label="planned")
+        ax_w.axhline(float(np.nanmean(plan_w)), color="k", lw=0.8, ls="--", label="planned")
+    ax_v.set_ylabel("|v| after collision 1 [m/s]")
+    ax_w.set_ylabel("ω after collision 1 [rad/s]")
+    ax_w.set_xlabel("friction coefficient μ")
+    for ax in (ax_v, ax_w):
+        ax.grid(True, alpha=0.3)
+    ax_v.legend(fontsize=8)
+    ax_v.set_title("3-step strategy: first collision vs μ and width W", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out, stem)
+
+
+def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    for noise, (xs, ys) in sorted(rate_by(rows, "camera", "sensors.camera.params.noise_sigma",
+                                          captured).items(), key=lambda kv: float(kv[0])):
+        ax.plot(xs, ys, "o-", label=f"pixel noise σ = {float(noise):g} grey levels")
+    ax.axvline(300, color="0.5", lw=0.8, ls=":", label="paper: 300 fps")
+    ax.set_xscale("log")
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_xlabel("camera frame rate [Hz] (latency one frame)")
+    ax.set_ylabel("capture rate")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("3-step strategy: capture rate vs vision rate and noise", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out, stem)

@@ -1,0 +1,43 @@
+"""Reading a sweep's table for the ablation plots (analysis/ablation_*.py): rates per group."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+
+import numpy as np
+
+from replay.sweep.table import as_bool, as_float
+
+
+def count(row: dict, kind: str) -> int:
+    """How many events of ``kind`` the variant's run had (the table's ``e.KIND`` column)."""
+    v = as_float(row.get(f"e.{kind}"))
+    return 0 if np.isnan(v) else int(v)
+
+
+def caught(row: dict) -> bool:
+    """The ball was caught and kept: a ``catch`` event, no ``drop``, and the outcome a success."""
+    return as_bool(row.get("success")) and count(row, "catch") > 0 and count(row, "drop") == 0
+
+
+def captured(row: dict) -> bool:
+    """The stick was captured (a ``capture`` event) and the outcome a success."""
+    return as_bool(row.get("success")) and count(row, "capture") > 0
+
+
+def rate_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[list, list]]:
+    """{line value: (sorted x values, success rate at each)} over the rows."""
+    groups: dict = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        groups[r.get(line, "") if line else ""][as_float(r[x])].append(bool(ok(r)))
+    out = {}
+    for name, by_x in groups.items():
+        xs = sorted(by_x)
+        out[name] = (xs, [float(np.mean(by_x[v])) for v in xs])
+    return out
+
+
+def failures(rows: list[dict]) -> list[str]:
+    """Reasons of the variants that did not run to an outcome (errors, invalid parameters)."""
+    return [f"{r.get('index')}: {r.get('reason')}" for r in rows
+            if str(r.get("reason", "")).startswith(("error", "invalid"))]
