@@ -74,3 +74,34 @@ def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
     ax.set_title("3-step strategy: capture rate vs vision rate and noise", fontsize=10)
     fig.tight_layout()
     return save(fig, out, stem)
+
+
+def summary_friction(rows: list[dict]) -> str:
+    from analysis.ablation_table import failures
+    parts = []
+    for w in sorted({as_float(r["plant.params.stick.collision_width"]) for r in rows}):
+        sub = [r for r in rows if as_float(r["plant.params.stick.collision_width"]) == w]
+        v = np.array([as_float(r.get("x.speed_after")) for r in sub])
+        om = np.array([as_float(r.get("x.omega_after")) for r in sub])
+        if np.all(np.isnan(v)):
+            parts.append(f"W = {w * 1e3:g} mm: no first collision")
+            continue
+        parts.append(f"W = {w * 1e3:g} mm: |v| {np.nanmin(v):.3f}-{np.nanmax(v):.3f} m/s, "
+                     f"ω {np.nanmin(om):.2f} to {np.nanmax(om):.2f} rad/s")
+    plan = [as_float(r.get("x.planned_omega_after")) for r in rows]
+    text = "Over μ = 0-1 after collision 1: " + "; ".join(parts)
+    if rows and not np.all(np.isnan(plan)):
+        text += f" (planned ω {np.nanmean(plan):.2f} rad/s, |v| ~0)"
+    bad = failures(rows)
+    return text + (f"; {len(bad)} variants failed to run" if bad else "") + "."
+
+
+def summary_vision(rows: list[dict]) -> str:
+    from analysis.ablation_table import overall, pct
+    curves = rate_by(rows, "camera", "sensors.camera.params.noise_sigma", captured)
+    parts = []
+    for noise in sorted(curves, key=float):
+        xs, ys = curves[noise]
+        parts.append(f"σ = {float(noise):g}: " + ", ".join(f"{pct(y)} at {x:g} fps"
+                                                            for x, y in zip(xs[::-1], ys[::-1])))
+    return f"Capture rate ({overall(rows, captured)}): " + "; ".join(parts) + "."

@@ -41,3 +41,26 @@ def failures(rows: list[dict]) -> list[str]:
     """Reasons of the variants that did not run to an outcome (errors, invalid parameters)."""
     return [f"{r.get('index')}: {r.get('reason')}" for r in rows
             if str(r.get("reason", "")).startswith(("error", "invalid"))]
+
+
+def pct(x: float) -> str:
+    return "n/a" if x is None or np.isnan(x) else f"{100 * x:.0f}%"
+
+
+def rate_at(curves: dict, line: str, x: float) -> float:
+    """The success rate of one line at one x (nan if that point was not run)."""
+    xs, ys = curves.get(line, ([], []))
+    for xv, yv in zip(xs, ys):
+        if abs(xv - x) <= 1e-6 * max(1.0, abs(x)):
+            return yv
+    return float("nan")
+
+
+def overall(rows: list[dict], ok) -> str:
+    n = len(rows)
+    k = sum(bool(ok(r)) for r in rows)
+    bad = failures(rows)
+    text = f"{k} of {n} variants succeeded"
+    if bad:
+        text += f"; {len(bad)} failed to run (first: {bad[0]})"
+    return text

@@ -132,7 +132,24 @@ def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, 
             click.echo(f"plot: {path}")
 
 
+@click.command()
+@click.option("-o", "--out", type=click.Path(file_okay=False), default="out/report",
+              show_default=True)
+@click.option("--logs", type=click.Path(file_okay=False), default="out/logs", show_default=True,
+              help="the runs whose figures and claims go in")
+def report(out, logs):
+    """Write the reproduction report (index.html and index.md): per paper the regenerated
+    figures, the claims table and the ablation plots; versions, seeds and commands."""
+    from replay.report import build_report
+    if not Path(logs).is_dir():
+        click.echo(f"note: no {logs}/: the report has no figures or claims (run `make run`)",
+                   err=True)
+    path = build_report(out, logs)
+    click.echo(f"report: {path} (and {path.with_suffix('.md')})")
+
+
 def register(group: click.Group) -> None:
     """Add this package's commands to the ``replay`` group."""
     group.add_command(sweep)
     group.add_command(ablate)
+    group.add_command(report)

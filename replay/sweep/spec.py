@@ -207,6 +207,7 @@ class SweepFile:
     caption: str                # what the plot shows, one sentence (the report's text)
     paper: str
     metrics: str = ""           # "module:function" LogReader -> extra columns, or ""
+    summary: str = ""           # "module:function" rows -> one sentence of what the plot shows
 
 
 def load_sweep_file(path: str | Path) -> SweepFile:
@@ -222,7 +223,7 @@ def load_sweep_file(path: str | Path) -> SweepFile:
     if not isinstance(data, dict):
         raise SweepSpecError(f"{path}: a sweep file is a mapping")
     known = {"name", "description", "paper", "scenario", "seed", "set", "grid", "random", "n",
-             "plot", "caption", "metrics"}
+             "plot", "caption", "metrics", "summary"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise SweepSpecError(f"{path}: unknown field {unknown[0]!r} (expected one of: "
@@ -250,7 +251,7 @@ def load_sweep_file(path: str | Path) -> SweepFile:
         sets=[f"{k}={_yaml_text(v)}" for k, v in sets.items()],
         description=str(data.get("description", "")), plot=str(data["plot"]),
         caption=str(data.get("caption", "")).strip(), paper=str(data.get("paper", "")),
-        metrics=str(data.get("metrics", "")))
+        metrics=str(data.get("metrics", "")), summary=str(data.get("summary", "")))
 
 
 def _file_axis(path: Path, name: str, values: Any) -> Axis:

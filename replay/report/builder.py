@@ -1,0 +1,288 @@
+"""One reproduction report: ``out/report/index.html`` and ``index.md``, made from logs and tables.
+
+Per paper: the regenerated figures (from the runs' logs, with the paper's captions), the claims
+table, the ablation plots (each redrawn from its sweep table: this machine's run under
+out/ablations/, else the stored one under data/ablations/) with one sentence of what each shows,
+computed from the same table. Then the versions, seeds and commands that made it. Everything the
+page links to is copied under the report directory, so the folder is self-contained.
+"""
+
+from __future__ import annotations
+
+import html
+import platform
+import re
+import shutil
+from collections import defaultdict
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+
+from replay import registry
+from replay.log import LogError, LogReader
+from replay.papers import PAPERS
+from replay.report.captions import CAPTIONS
+
+PACKAGES = ("numpy", "scipy", "pymunk", "pybullet", "opencv-python-headless", "mcap",
+            "matplotlib", "click", "pyyaml", "viser", "ray", "tqdm")
+
+
+@dataclass
+class Figure:
+    png: str                    # path relative to the report
+    svg: str
+    caption: str
+
+
+@dataclass
+class Ablation:
+    name: str
+    png: str
+    svg: str
+    caption: str
+    shows: str
+    table: str
+    sweep: str
+    source: str                 # "run here" | "stored"
+    command: str
+
+
+@dataclass
+class PaperSection:
+    key: str
+    title: str
+    authors: str
+    runs: list = field(default_factory=list)        # (scenario name, seed, log path)
+    figures: list = field(default_factory=list)
+    claims: list = field(default_factory=list)
+    claims_md: str = ""
+    ablations: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+
+
+def _readers(logs: list[Path]) -> dict[str, dict[str, LogReader]]:
+    by_paper: dict = defaultdict(dict)
+    for p in logs:
+        try:
+            r = LogReader(p)
+            sc = r.scenario()
+        except LogError:
+            continue
+        by_paper[sc["paper"]][sc["name"]] = r
+    return by_paper
+
+
+def _caption(paper: str, stem: str, name: str) -> str:
+    m = re.search(r"fig(\d+)", stem)
+    num = int(m.group(1)) if m else None
+    quoted = CAPTIONS.get(paper, {}).get(num)
+    base = f"Fig. {num}" if num else stem
+    run = f" Regenerated from the run {name!r}." if name else ""
+    return f"{base} (paper: “{quoted}”).{run}" if quoted else f"{base}.{run}"
+
+
+def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/logs") -> Path:
+    from replay.sweep import ablations
+    from replay.sweep.variants import code_version
+    out = Path(out)
+    if out.exists():
+        shutil.rmtree(out)
+    (out / "figures").mkdir(parents=True)
+    logs = sorted(Path(logs_dir).glob("*.mcap"))
+    by_paper = _readers(logs)
+    sections = []
+    for key, paper in PAPERS.items():
+        sec = PaperSection(key, paper.title, paper.authors)
+        readers = by_paper.get(key, {})
+        for name, r in sorted(readers.items()):
+            sc = r.scenario()
+            sec.runs.append((name, sc["seed"], str(r.path) if hasattr(r, "path") else name))
+        if readers:
+            try:
+                make = registry.load("figures", key)
+                paths = make(readers, out / "figures")
+            except registry.UnknownPlugin:
+                paths = []
+            for png in (p for p in paths if p.suffix == ".png"):
+                svg = png.with_suffix(".svg")
+                run = next((n for n in readers if png.stem.startswith(n)), "")
+                sec.figures.append(Figure(png.relative_to(out).as_posix(),
+                                          svg.relative_to(out).as_posix() if svg.is_file()
+                                          else "", _caption(key, png.stem, run)))
+            try:
+                evaluate = registry.load("claims", key)
+                sec.claims = evaluate(readers)
+                from analysis.claims import format_table
+                sec.claims_md = format_table(paper.title, sec.claims)
+            except registry.UnknownPlugin:
+                sec.notes.append("No claims table defined yet.")
+        for name in ablations.names():
+            sf = ablations.load(name)
+            if sf.paper != key:
+                continue
+            sec.ablations.append(_ablation(sf, out, ablations))
+        if key == "namiki1999" and not readers:
+            sec.notes.append("TODO: the grasping paper's scenarios, figures and claims land later; "
+                             "its ablations (grasp rate and tracking error against the loop "
+                             "period 1-33 ms and the object's speed) are to be added as "
+                             "sweeps/grasp_*.yaml once it exists.")
+        sections.append(sec)
+    info = _provenance(code_version())
+    commands = _commands(sections, logs)
+    (out / "index.md").write_text(_markdown(sections, info, commands), encoding="utf-8")
+    (out / "index.html").write_text(_html(sections, info, commands), encoding="utf-8")
+    return out / "index.html"
+
+
+def _ablation(sf, out: Path, ablations) -> Ablation:
+    from replay.sweep.table import read_table
+    from replay.sweep.worker import load_function
+    (out / "ablations").mkdir(exist_ok=True)
+    (out / "tables").mkdir(exist_ok=True)
+    (out / "sweeps").mkdir(exist_ok=True)
+    shutil.copy(sf.path, out / "sweeps" / sf.path.name)
+    table, source = ablations.table_path(sf.name)
+    command = f"replay ablate {sf.name}"
+    if table is None:
+        return Ablation(sf.name, "", "", sf.caption, f"Not run yet: `{command}`.", "",
+                        f"sweeps/{sf.path.name}", "not run", command)
+    shutil.copy(table, out / "tables" / f"{sf.name}.csv")
+    paths = ablations.plot(sf, table, out / "ablations")
+    png = next(p for p in paths if p.suffix == ".png")
+    svg = png.with_suffix(".svg")
+    rows = read_table(table)
+    shows = load_function(sf.summary)(rows) if sf.summary else ""
+    return Ablation(sf.name, png.relative_to(out).as_posix(),
+                    svg.relative_to(out).as_posix() if svg.is_file() else "", sf.caption, shows,
+                    f"tables/{sf.name}.csv", f"sweeps/{sf.path.name}", source, command)
+
+
+def _provenance(version: str) -> dict[str, str]:
+    info = {"paper-replay": version, "python": platform.python_version(),
+            "platform": platform.platform()}
+    for pkg in PACKAGES:
+        try:
+            info[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            info[pkg] = "(not installed)"
+    return info
+
+
+def _commands(sections, logs) -> list[str]:
+    cmds = []
+    for sec in sections:
+        for name, seed, _ in sec.runs:
+            cmds.append(f"replay run scenarios/{name}.yaml --seed {seed} -o out/logs/{name}.mcap")
+    if logs:
+        cmds += ["replay figures out/logs/*.mcap -o out/figures",
+                 "replay claims out/logs/*.mcap --markdown out/claims.md"]
+    for sec in sections:
+        for a in sec.ablations:
+            cmds.append(f"{a.command} --store   # table: {a.source}")
+    cmds.append("replay report")
+    return cmds
+
+
+# -- Markdown --------------------------------------------------------------------------------
+
+def _markdown(sections, info, commands) -> str:
+    lines = ["# paper-replay: reproduction report", "",
+             "Every figure below is regenerated from a run's MCAP log; every ablation plot from "
+             "its sweep table.", ""]
+    for sec in sections:
+        lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
+        if sec.runs:
+            lines += ["Runs: " + ", ".join(f"`{n}` (seed {s})" for n, s, _ in sec.runs), ""]
+        for note in sec.notes:
+            lines += [f"> {note}", ""]
+        if sec.figures:
+            lines += ["### Figures", ""]
+            for f in sec.figures:
+                lines += [f"![{f.caption}]({f.png})", "", f"*{f.caption}*", ""]
+        if sec.claims_md:
+            lines += ["### Claims", "", sec.claims_md.split("\n", 2)[2], ""]
+        if sec.ablations:
+            lines += ["### Ablations", ""]
+            for a in sec.ablations:
+                lines += [f"#### {a.name}", ""]
+                if a.png:
+                    lines += [f"![{a.caption}]({a.png})", ""]
+                lines += [f"*{a.caption}* {a.shows}", "",
+                          f"Table: [{a.table}]({a.table}) ({a.source}); sweep: "
+                          f"[{a.sweep}]({a.sweep}); `{a.command}`", ""]
+    lines += ["## Versions", "", "| package | version |", "|---|---|"]
+    lines += [f"| {k} | {v} |" for k, v in info.items()]
+    lines += ["", "## Commands", "", "```sh", *commands, "```", ""]
+    return "\n".join(lines)
+
+
+# -- HTML ------------------------------------------------------------------------------------
+
+_STYLE = """
+body { font-family: system-ui, sans-serif; max-width: 60rem; margin: 2rem auto; padding: 0 1rem;
+       color: #222; line-height: 1.45; }
+figure { margin: 1.2rem 0; } figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: 0.9rem; color: #444; }
+table { border-collapse: collapse; font-size: 0.85rem; margin: 0.8rem 0; }
+td, th { border: 1px solid #ccc; padding: 0.25rem 0.5rem; vertical-align: top; }
+.reproduced { color: #176317; } .differs { color: #a33; } .inconsistent { color: #a60; }
+pre { background: #f5f5f5; padding: 0.6rem; overflow-x: auto; font-size: 0.8rem; }
+.note { background: #fff8e0; padding: 0.5rem 0.8rem; border-left: 4px solid #e0b000; }
+"""
+
+
+def _e(text) -> str:
+    return html.escape(str(text))
+
+
+def _html(sections, info, commands) -> str:
+    h = ["<!doctype html>", "<html lang='en'><head><meta charset='utf-8'>",
+         "<title>paper-replay: reproduction report</title>", f"<style>{_STYLE}</style>",
+         "</head><body>", "<h1>paper-replay: reproduction report</h1>",
+         "<p>Every figure below is regenerated from a run's MCAP log; every ablation plot from "
+         "its sweep table. <a href='index.md'>Markdown version</a>.</p>", "<nav><ul>"]
+    h += [f"<li><a href='#{s.key}'>{_e(s.title)}</a></li>" for s in sections]
+    h += ["<li><a href='#versions'>Versions</a></li>", "<li><a href='#commands'>Commands</a></li>",
+          "</ul></nav>"]
+    for sec in sections:
+        h += [f"<section id='{sec.key}'>", f"<h2>{_e(sec.title)}</h2>",
+              f"<p><em>{_e(sec.authors)}</em> (<code>{sec.key}</code>)</p>"]
+        if sec.runs:
+            h.append("<p>Runs: " + ", ".join(f"<code>{_e(n)}</code> (seed {s})"
+                                             for n, s, _ in sec.runs) + "</p>")
+        h += [f"<p class='note'>{_e(n)}</p>" for n in sec.notes]
+        if sec.figures:
+            h.append("<h3>Figures</h3>")
+            for f in sec.figures:
+                svg = f" <a href='{f.svg}'>SVG</a>" if f.svg else ""
+                h.append(f"<figure><img src='{f.png}' alt='{_e(f.caption)}'>"
+                         f"<figcaption>{_e(f.caption)}{svg}</figcaption></figure>")
+        if sec.claims:
+            h += ["<h3>Claims</h3>", "<table><tr><th>quantity</th><th>paper states</th>"
+                  "<th>this run</th><th>status</th><th>note</th></tr>"]
+            for c in sec.claims:
+                h.append(f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.stated)}</td>"
+                         f"<td>{_e(c.measured)}</td><td class='{_e(c.status)}'><b>"
+                         f"{_e(c.status)}</b></td><td>{_e(c.note)}</td></tr>")
+            n_ok = sum(c.status == "reproduced" for c in sec.claims)
+            h += ["</table>", f"<p>{n_ok} of {len(sec.claims)} reproduced.</p>"]
+        if sec.ablations:
+            h.append("<h3>Ablations</h3>")
+            for a in sec.ablations:
+                h.append(f"<h4 id='ablation-{a.name}'>{_e(a.name)}</h4>")
+                if a.png:
+                    svg = f" <a href='{a.svg}'>SVG</a>" if a.svg else ""
+                    h.append(f"<figure><img src='{a.png}' alt='{_e(a.caption)}'><figcaption>"
+                             f"{_e(a.caption)} <strong>{_e(a.shows)}</strong>{svg}</figcaption>"
+                             "</figure>")
+                else:
+                    h.append(f"<p>{_e(a.caption)} {_e(a.shows)}</p>")
+                table = (f"<a href='{a.table}'>table</a> ({_e(a.source)}), " if a.table else "")
+                h.append(f"<p>{table}<a href='{a.sweep}'>sweep file</a>; "
+                         f"<code>{_e(a.command)}</code></p>")
+        h.append("</section>")
+    h += ["<h2 id='versions'>Versions</h2>", "<table><tr><th>package</th><th>version</th></tr>"]
+    h += [f"<tr><td>{_e(k)}</td><td>{_e(v)}</td></tr>" for k, v in info.items()]
+    h += ["</table>", "<h2 id='commands'>Commands</h2>",
+          "<pre>" + _e("\n".join(commands)) + "</pre>", "</body></html>"]
+    return "\n".join(h) + "\n"

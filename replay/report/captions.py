@@ -1,0 +1,16 @@
+"""The papers' own figure captions (quoted from the texts in shared/papers/), by paper and number."""
+
+CAPTIONS = {
+    "higashimori2007": {
+        6: "A series of photos during the 3-step capturing strategy.",
+        7: "Translational and rotational velocities with respect to time during the 3-step "
+           "capturing strategy.",
+    },
+    "namiki2003": {
+        6: "Optimization of cost functions",
+        7: "Catching trajectory (with optimization).",
+        8: "Time response of joint angles.",
+        9: "Time response of joint command torques.",
+    },
+    "namiki1999": {},
+}
