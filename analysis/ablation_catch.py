@@ -11,8 +11,33 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from analysis.ablation_table import caught, overall, pct, rate_at, rate_by  # noqa: E402
+from analysis.ablation_table import (caught, mean_by, overall, pct, rate_at,  # noqa: E402
+                                     rate_by)
 from analysis.figure_files import save  # noqa: E402
+
+
+def catch_metrics(log) -> dict:
+    """How near each run came to a catch, also when it missed: the closest approach of the ball's
+    centre to the hand's catch point l(q) (``/effector/state``, the controller's model of where
+    the ball should sit on the palm), and the ball's speed relative to the hand at its first
+    contact with the palm or fingers."""
+    from analysis.series import arrays, events
+    ball = arrays(log, "/object/state", ["position"])
+    hand = arrays(log, "/effector/state", ["position"]) if log.topic_counts().get(
+        "/effector/state") else {"t": np.zeros(0)}
+    out: dict = {}
+    if len(ball["t"]) and len(hand["t"]) and hand["position"].ndim == 2:
+        # the ball's state at the hand's stamps (both are logged at the control rate)
+        idx = np.clip(np.searchsorted(ball["t"], hand["t"]), 0, len(ball["t"]) - 1)
+        d = np.linalg.norm(ball["position"][idx] - hand["position"], axis=1)
+        k = int(np.argmin(d))
+        out.update(min_distance=float(d[k]), t_min_distance=float(hand["t"][k]))
+    for e in events(log, "contact"):
+        if set(e["data"].get("parts", [])) - {"arm"}:
+            out.update(contact_speed=e["data"]["speed"], contact_t=e["t"],
+                       contact_parts="+".join(e["data"]["parts"]))
+            break
+    return out
 
 
 def _rate_axes(ax, xlabel: str, log_x: bool = False) -> None:
@@ -24,12 +49,24 @@ def _rate_axes(ax, xlabel: str, log_x: bool = False) -> None:
     ax.grid(True, alpha=0.3)
 
 
+def _near_axes(ax, xlabel: str, log_x: bool = True) -> None:
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("ball speed rel. to hand\nat first hand contact [m/s]", fontsize=8)
+    if log_x:
+        ax.set_xscale("log")
+    ax.grid(True, alpha=0.3)
+
+
 def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for lat, (xs, ys) in sorted(rate_by(rows, "sensors.stereo.rate", "sensors.stereo.latency",
-                                        caught).items(), key=lambda kv: float(kv[0])):
+    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
+    x, line = "sensors.stereo.rate", "sensors.stereo.latency"
+    speeds = mean_by(rows, x, line, "x.contact_speed")
+    for lat, (xs, ys) in sorted(rate_by(rows, x, line, caught).items(),
+                                key=lambda kv: float(kv[0])):
         ax.plot(xs, ys, "o-", label=f"latency {float(lat) * 1e3:g} ms")
-    _rate_axes(ax, "stereo frame rate [Hz]", log_x=True)
+        ax2.plot(*speeds[lat], "o-")
+    _rate_axes(ax, "", log_x=True)
+    _near_axes(ax2, "stereo frame rate [Hz]")
     ax.legend(fontsize=8)
     ax.set_title("Direct mapping: catch rate vs camera rate and latency", fontsize=10)
     fig.tight_layout()
@@ -61,15 +98,18 @@ def plot_arm_limits(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 
 def plot_direct_vs_predictive(rows: list[dict], out: Path, stem: str) -> list[Path]:
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.0))
     styles = {"catch_optimised": ("tab:blue", "direct mapping"),
               "catch_predictive": ("tab:orange", "predict-then-intercept")}
     for (method, kick), sub in sorted(_split(rows, "scenario", "kick").items()):
         (xs, ys), = rate_by(sub, "camera", None, caught).values()
         color, label = styles.get(method, ("0.4", method))
-        ax.plot(xs, ys, "o-" if kick == "none" else "s--", color=color,
+        style = "o-" if kick == "none" else "s--"
+        ax.plot(xs, ys, style, color=color,
                 label=f"{label}, {'no kick' if kick == 'none' else 'mid-flight kick'}")
-    _rate_axes(ax, "stereo frame rate [Hz] (latency one frame)", log_x=True)
+        ax2.plot(*mean_by(sub, "camera", None, "x.contact_speed")[""], style, color=color)
+    _rate_axes(ax, "", log_x=True)
+    _near_axes(ax2, "stereo frame rate [Hz] (latency one frame)")
     ax.legend(fontsize=8)
     ax.set_title("Direct mapping vs predictor: catch rate vs camera rate", fontsize=10)
     fig.tight_layout()
@@ -129,6 +169,13 @@ def summary_direct_vs_predictive(rows: list[dict]) -> str:
     text = (f"At {hi:g} Hz the direct mapping caught {pct(d[0])} (kick: {pct(d[2])}) and the "
             f"predictor {pct(p[0])} (kick: {pct(p[2])}); at {lo:g} Hz direct {pct(d[1])} "
             f"(kick: {pct(d[3])}), predictor {pct(p[1])} (kick: {pct(p[3])}). ")
+    speeds = {k: mean_by(v, "camera", None, "x.contact_speed")[""] for k, v in split.items()}
+    sd = rate_at({"": speeds.get(("catch_optimised", "none"), ([], []))}, "", hi)
+    sp = rate_at({"": speeds.get(("catch_predictive", "none"), ([], []))}, "", hi)
+    if not (np.isnan(sd) or np.isnan(sp)):
+        text += (f"At first hand contact the ball moved at {sd:.1f} m/s relative to the hand "
+                 f"with the direct mapping and {sp:.1f} m/s with the predictor ({hi:g} Hz, no "
+                 "kick). ")
     fast_gap = np.nanmean([d[0] - p[0], d[2] - p[2]])
     slow_gap = np.nanmean([d[1] - p[1], d[3] - p[3]])
     if np.isnan(fast_gap) or (max(np.nanmax(d), np.nanmax(p)) == 0):

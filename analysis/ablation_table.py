@@ -37,6 +37,20 @@ def rate_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[l
     return out
 
 
+def mean_by(rows: list[dict], x: str, line: str | None, column: str
+            ) -> dict[str, tuple[list, list]]:
+    """{line value: (sorted x values, mean of a numeric column at each, nan-skipping)}."""
+    groups: dict = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        groups[r.get(line, "") if line else ""][as_float(r[x])].append(as_float(r.get(column)))
+    out = {}
+    for name, by_x in groups.items():
+        xs = sorted(by_x)
+        out[name] = (xs, [float(np.nanmean(by_x[v])) if not np.all(np.isnan(by_x[v]))
+                          else float("nan") for v in xs])
+    return out
+
+
 def failures(rows: list[dict]) -> list[str]:
     """Reasons of the variants that did not run to an outcome (errors, invalid parameters)."""
     return [f"{r.get('index')}: {r.get('reason')}" for r in rows

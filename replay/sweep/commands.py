@@ -71,7 +71,7 @@ def sweep(scenario, grids, randoms, n, sets, seed, out, workers, executor, addre
 def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs, progress,
          metrics=""):
     from replay.sweep.engine import run_sweep
-    from replay.sweep.variants import check_keys, expand
+    from replay.sweep.variants import check_keys, code_version, expand
     if executor != "ray" and address:
         _fail("--address is for --executor ray")
     try:
@@ -79,7 +79,9 @@ def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs,
     except SweepSpecError as exc:
         _fail(str(exc))
     try:
-        variants = expand(scenario, spec, seed, sets=list(sets))
+        # the metrics function makes columns: a different one is a different row
+        version = code_version() + (f"|{metrics}" if metrics else "")
+        variants = expand(scenario, spec, seed, sets=list(sets), version=version)
     except SweepSpecError as exc:
         _fail(str(exc))
     try:
