@@ -1,4 +1,5 @@
-# Everything a fresh machine needs: `make run` (the main job) and `make test`.
+# Everything a fresh machine needs: `make run` (the main job, ending with out/report/index.html)
+# and `make test`.
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 REPLAY := $(VENV)/bin/replay
@@ -8,7 +9,7 @@ OUT    ?= out
 # the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md
 SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml)
 
-.PHONY: install run test bench golden-check clean
+.PHONY: install run test bench ablations golden-check clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -22,6 +23,12 @@ run: $(STAMP)
 	@for s in $(SCENARIOS); do $(REPLAY) run $$s -o $(OUT)/logs/$$(basename $$s .yaml).mcap || exit $$?; done
 	$(REPLAY) figures $(OUT)/logs/*.mcap -o $(OUT)/figures
 	$(REPLAY) claims $(OUT)/logs/*.mcap --markdown $(OUT)/claims.md
+	$(REPLAY) report -o $(OUT)/report --logs $(OUT)/logs
+
+# the ablations (sweeps/*.yaml) from scratch, their tables kept under data/ablations/ for the
+# report (~150 variants: tens of minutes on 2 cores); `make run` only redraws them
+ablations: $(STAMP)
+	$(REPLAY) ablate --store --no-logs
 
 test: $(STAMP)
 	$(PY) -m pytest -q
@@ -29,6 +36,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) -m replay.bench
 	$(PY) -m replay.viewer.bench
+	$(PY) -m replay.sweep.bench
 
 golden-check: $(STAMP)
 	$(REPLAY) golden check

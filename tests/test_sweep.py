@@ -129,6 +129,12 @@ def test_failing_variants_are_rows_and_the_sweep_goes_on(toy_yaml, tmp_path):
         assert bad["success"] == "False" and bad["reason"].startswith("invalid:")
         assert "plant.params.mass" in bad["reason"]
     assert summary.ok == 1 and summary.failed == 3
+    # a rerun skips them all; --retry-failed runs again those whose reason is an error (the NaN)
+    # or invalid parameters, not the success
+    assert run_sweep(variants, tmp_path, workers=2, keep_logs=False, progress=False).ran == 0
+    retry = run_sweep(variants, tmp_path, workers=2, keep_logs=False, progress=False,
+                      retry_failed=True)
+    assert (retry.ran, retry.skipped) == (3, 1)
 
 
 def test_an_exception_in_a_plugin_is_a_row(toy_yaml, tmp_path, monkeypatch):
@@ -143,6 +149,14 @@ def test_an_exception_in_a_plugin_is_a_row(toy_yaml, tmp_path, monkeypatch):
     rows = read_table(tmp_path / "table.csv")
     assert summary.ran == 2 and len(rows) == 2
     assert all(r["success"] == "False" and "controller exploded" in r["reason"] for r in rows)
+
+
+def test_cli_sweep_prints_one_summary_line(toy_yaml, tmp_path):
+    r = CliRunner().invoke(main, ["sweep", str(toy_yaml), "--grid", "plant.params.mass=1,2",
+                                  "-o", str(tmp_path), "--workers", "2", "--no-logs", "-q"])
+    assert r.exit_code == 0, r.output
+    assert r.output.startswith("sweep: 2 variants: 2 ran, 0 skipped")
+    assert "variants/s" in r.output and len(read_table(tmp_path / "table.csv")) == 2
 
 
 def test_the_key_follows_scenario_seed_and_code(project_root):

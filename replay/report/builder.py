@@ -143,7 +143,7 @@ def _ablation(sf, out: Path, ablations) -> Ablation:
     shutil.copy(sf.path, out / "sweeps" / sf.path.name)
     table, source = ablations.table_path(sf.name)
     command = f"replay ablate {sf.name}"
-    if table is None:
+    if table is None or not read_table(table):
         return Ablation(sf.name, "", "", sf.caption, f"Not run yet: `{command}`.", "",
                         f"sweeps/{sf.path.name}", "not run", command)
     shutil.copy(table, out / "tables" / f"{sf.name}.csv")
@@ -207,9 +207,9 @@ def _markdown(sections, info, commands) -> str:
                 lines += [f"#### {a.name}", ""]
                 if a.png:
                     lines += [f"![{a.caption}]({a.png})", ""]
+                table = f"Table: [{a.table}]({a.table}) ({a.source}); " if a.table else ""
                 lines += [f"*{a.caption}* {a.shows}", "",
-                          f"Table: [{a.table}]({a.table}) ({a.source}); sweep: "
-                          f"[{a.sweep}]({a.sweep}); `{a.command}`", ""]
+                          f"{table}sweep: [{a.sweep}]({a.sweep}); `{a.command}`", ""]
     lines += ["## Versions", "", "| package | version |", "|---|---|"]
     lines += [f"| {k} | {v} |" for k, v in info.items()]
     lines += ["", "## Commands", "", "```sh", *commands, "```", ""]

@@ -37,7 +37,7 @@ def load(name: str) -> SweepFile:
 def table_path(name: str, out_dir: Path = OUT_DIR) -> tuple[Path | None, str]:
     """The freshest table of an ablation: this machine's run, else the stored one."""
     fresh = out_dir / name / "table.csv"
-    if fresh.is_file():
+    if fresh.is_file() and read_table(fresh):
         return fresh, "run here"
     stored = STORED_DIR / f"{name}.csv"
     if stored.is_file():

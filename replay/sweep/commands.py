@@ -41,9 +41,11 @@ def _fail(message: str, code: int = 2) -> None:
 @click.option("--address", help="Ray cluster to join (auto or HOST:PORT); default: a private "
                                 "local Ray")
 @click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
+@click.option("--retry-failed", is_flag=True, help="re-run the variants whose row says they "
+                                                   "failed to run (error:/invalid:)")
 @click.option("-q", "--quiet", is_flag=True, help="no progress bar")
 def sweep(scenario, grids, randoms, n, sets, seed, out, workers, executor, address, no_logs,
-          quiet):
+          retry_failed, quiet):
     """Run SCENARIO over a grid and/or random draws of its fields: one table row per variant
     (outcome, metrics, wall time, log). Reruns skip the variants already in the table."""
     from replay.scenario import ScenarioError, load_scenario
@@ -62,14 +64,14 @@ def sweep(scenario, grids, randoms, n, sets, seed, out, workers, executor, addre
         _fail(str(exc))
     out = Path(out) if out else DEFAULT_SWEEP_OUT / base.name
     summary = _run(scenario, spec, seed, sets, out, workers, executor, address, not no_logs,
-                   not quiet)
+                   not quiet, retry_failed=retry_failed)
     click.echo(summary.line())
     if summary.interrupted:
         sys.exit(130)
 
 
 def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs, progress,
-         metrics=""):
+         metrics="", retry_failed=False):
     from replay.sweep.engine import run_sweep
     from replay.sweep.variants import check_keys, code_version, expand
     if executor != "ray" and address:
@@ -86,7 +88,8 @@ def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs,
         _fail(str(exc))
     try:
         return run_sweep(variants, out, workers=workers, executor=executor, address=address,
-                         keep_logs=keep_logs, progress=progress, metrics=metrics)
+                         keep_logs=keep_logs, progress=progress, metrics=metrics,
+                         retry_failed=retry_failed)
     except ExecutorError as exc:
         _fail(str(exc))
 
@@ -101,8 +104,10 @@ def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs,
                                             "(what the report plots without a fresh run)")
 @click.option("--plot-only", is_flag=True, help="no runs: redraw from the freshest table")
 @click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
+@click.option("--retry-failed", is_flag=True, help="re-run variants that failed to run")
 @click.option("-q", "--quiet", is_flag=True, help="no progress bar")
-def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, quiet):
+def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, retry_failed,
+           quiet):
     """Run the named ablations (sweeps/NAME.yaml; all with no NAME) and draw each plot from its
     table into out/ablations/NAME/."""
     from replay.sweep import ablations
@@ -123,7 +128,8 @@ def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, 
                 _fail(f"{sf.name}: no table yet (run `replay ablate {sf.name}`)")
         else:
             summary = _run(str(sf.scenario), sf.spec, sf.seed, sf.sets, out, workers, executor,
-                           address, not no_logs, not quiet, metrics=sf.metrics)
+                           address, not no_logs, not quiet, metrics=sf.metrics,
+                           retry_failed=retry_failed)
             click.echo(f"{sf.name}: {summary.line()}")
             if summary.interrupted:
                 sys.exit(130)

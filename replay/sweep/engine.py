@@ -2,7 +2,8 @@
 
 ``run_sweep`` writes ``DIR/table.csv`` (and ``DIR/logs/KEY.mcap`` per variant unless
 ``keep_logs=False``), rewriting the table after every finished variant, so a killed or interrupted
-sweep resumes where it stopped and a rerun of a finished one runs nothing.
+sweep resumes where it stopped and a rerun of a finished one runs nothing (``retry_failed``: except
+the variants that failed to run at all, e.g. after installing a missing plug-in).
 """
 
 from __future__ import annotations
@@ -56,14 +57,16 @@ def _progress(total: int, enabled: bool):
 
 def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | None = None,
               executor: str = "local", address: str | None = None, keep_logs: bool = True,
-              progress: bool = True, metrics: str = "") -> SweepSummary:
+              progress: bool = True, metrics: str = "", retry_failed: bool = False
+              ) -> SweepSummary:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     table = out_dir / TABLE
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
     old = read_table(table)
-    rows = {r["key"]: r for r in old if r.get("key") in by_key}
+    rows = {r["key"]: r for r in old if r.get("key") in by_key
+            and not (retry_failed and is_error(r))}
     for key, r in rows.items():        # the index follows this sweep's order
         r["index"] = by_key[key].index
     stale = len(old) - len(rows)
@@ -99,6 +102,12 @@ def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | No
                         failed=len(done) - ok, wall_time=time.perf_counter() - t0, table=table,
                         rows=sorted(done, key=lambda r: int(r["index"])),
                         interrupted=interrupted, stale=stale)
+
+
+def is_error(row: dict) -> bool:
+    """A row that failed to run (an exception, a dead worker, a scenario that did not load), as
+    opposed to a run that ended without success."""
+    return str(row.get("reason", "")).startswith(("error", "invalid"))
 
 
 def _with_params(rows, by_key):
