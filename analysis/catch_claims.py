@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import yaml
@@ -26,8 +25,9 @@ import yaml
 from analysis.claims import Claim
 from analysis.series import events
 from replay.log import LogReader
+from replay.resources import data_path
 
-STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "namiki2003.yaml"
+STATED = data_path("claims", "namiki2003.yaml")
 ACTIVE = (0, 1, 3)                      # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
 JOINTS = ("J1", "J2", "J4")
 

@@ -11,13 +11,13 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+from replay.resources import data_path, sweep_dir
 from replay.sweep.spec import SweepFile, SweepSpecError, load_sweep_file
 from replay.sweep.table import read_table
 from replay.sweep.worker import load_function
 
-ROOT = Path(__file__).resolve().parents[2]
-SWEEP_DIR = ROOT / "sweeps"
-STORED_DIR = ROOT / "data" / "ablations"
+SWEEP_DIR = sweep_dir()
+STORED_DIR = data_path("ablations")
 OUT_DIR = Path("out/ablations")
 
 
