@@ -1,5 +1,5 @@
-"""Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/ folders ship in
-the wheel as package data under replay._shipped (found by replay.resources)."""
+"""Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
+folders ship in the wheel as package data under replay._shipped (found by replay.resources)."""
 
 from setuptools import find_namespace_packages, setup
 

@@ -11,9 +11,7 @@ import click
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.spec import SweepSpecError
 
-SWEEP_DIR = Path("sweeps")
 DEFAULT_SWEEP_OUT = Path("out/sweeps")
-DEFAULT_ABLATION_OUT = Path("out/ablations")
 
 
 def _fail(message: str, code: int = 2) -> None:
@@ -46,10 +44,12 @@ def _fail(message: str, code: int = 2) -> None:
 @click.option("-q", "--quiet", is_flag=True, help="no progress bar")
 def sweep(scenario, grids, randoms, n, sets, seed, out, workers, executor, address, no_logs,
           retry_failed, quiet):
-    """Run SCENARIO over a grid and/or random draws of its fields: one table row per variant
+    """Run SCENARIO (a file, or a shipped scenario's name) over a grid and/or random draws of its fields: one table row per variant
     (outcome, metrics, wall time, log). Reruns skip the variants already in the table."""
+    from replay.resources import find_scenario
     from replay.scenario import ScenarioError, load_scenario
     from replay.sweep.spec import from_options
+    scenario = find_scenario(scenario)
     try:
         spec = from_options(grids, randoms, n)
     except SweepSpecError as exc:
