@@ -74,11 +74,15 @@ def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 
 def plot_throw_speed(rows: list[dict], out: Path, stem: str) -> list[Path]:
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     (xs, ys), = rate_by(rows, "throw_speed", None, caught).values()
     ax.plot(xs, ys, "o-", color="tab:blue")
-    ax.axvspan(8.0, 10.0, color="tab:green", alpha=0.1, label="optimised for 8-10 m/s")
-    _rate_axes(ax, "throw speed [m/s]")
+    ax2.plot(*mean_by(rows, "throw_speed", None, "x.contact_speed")[""], "o-", color="tab:blue")
+    for a in (ax, ax2):
+        a.axvspan(8.0, 10.0, color="tab:green", alpha=0.1,
+                  label="optimised for 8-10 m/s" if a is ax else None)
+    _rate_axes(ax, "")
+    _near_axes(ax2, "throw speed [m/s]", log_x=False)
     ax.legend(fontsize=8)
     ax.set_title("Direct mapping: catch vs throw speed (1 kHz vision)", fontsize=10)
     fig.tight_layout()
@@ -86,11 +90,15 @@ def plot_throw_speed(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 
 def plot_arm_limits(rows: list[dict], out: Path, stem: str) -> list[Path]:
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for scale, (xs, ys) in sorted(rate_by(rows, "joint_speed_limit", "torque_scale",
-                                          caught).items(), key=lambda kv: float(kv[0])):
+    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
+    x, line = "joint_speed_limit", "torque_scale"
+    speeds = mean_by(rows, x, line, "x.contact_speed")
+    for scale, (xs, ys) in sorted(rate_by(rows, x, line, caught).items(),
+                                  key=lambda kv: float(kv[0])):
         ax.plot(xs, ys, "o-", label=f"torque limits x{scale}")
-    _rate_axes(ax, "enforced joint speed limit [rad/s]", log_x=True)
+        ax2.plot(*speeds[scale], "o-")
+    _rate_axes(ax, "", log_x=True)
+    _near_axes(ax2, "enforced joint speed limit [rad/s]")
     ax.legend(fontsize=8)
     ax.set_title("What the arm needs: catch vs joint speed and torque limits", fontsize=10)
     fig.tight_layout()
@@ -138,8 +146,13 @@ def summary_vision(rows: list[dict]) -> str:
 def summary_throw_speed(rows: list[dict]) -> str:
     (xs, ys), = rate_by(rows, "throw_speed", None, caught).values()
     yes = [f"{x:g}" for x, y in zip(xs, ys) if y > 0]
+    sx, sv = mean_by(rows, "throw_speed", None, "x.contact_speed")[""]
+    near = ""
+    if sv and not np.all(np.isnan(sv)):
+        near = (f"; the ball met the hand at {sv[0]:.1f} m/s relative to it at {sx[0]:g} m/s "
+                f"and {sv[-1]:.1f} m/s at {sx[-1]:g} m/s")
     return (f"Caught at {', '.join(yes) or 'no'} m/s of {', '.join(f'{x:g}' for x in xs)} m/s "
-            f"({overall(rows, caught)}).")
+            f"({overall(rows, caught)}){near}.")
 
 
 def summary_arm_limits(rows: list[dict]) -> str:
