@@ -17,6 +17,7 @@ from pathlib import Path
 from replay.sweep.executors import default_workers, run_local, run_ray
 from replay.sweep.table import as_bool, read_table, write_table
 from replay.sweep.variants import Variant
+from replay.sweep.worker import INTERRUPTED
 
 TABLE = "table.csv"
 
@@ -85,6 +86,9 @@ def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | No
         stream = (run_local(tasks, workers) if executor == "local"
                   else run_ray(tasks, workers, address))
         for row in stream:
+            if row.get("reason") == INTERRUPTED:     # Ctrl-C reached the worker: not done
+                interrupted = True
+                continue
             rows[row["key"]] = row
             ran += 1
             failed_now += not as_bool(row.get("success"))

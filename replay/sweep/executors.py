@@ -52,8 +52,12 @@ def run_local(tasks: list[dict], workers: int) -> Iterator[dict]:
                     yield f.result()
                 except Exception as exc:   # noqa: BLE001 - a dead worker (a crash in C code)
                     yield crashed(of[f], exc)
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    except BaseException:              # Ctrl-C, or the consumer stopped: do not wait for them
+        for proc in list(getattr(pool, "_processes", {}).values()):
+            proc.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
 
 
 def ray_available() -> bool:
@@ -65,7 +69,7 @@ def ray_available() -> bool:
 
 
 last_ray_init = float("nan")   # s the last ray.init took (bench, tests)
-INIT_ATTEMPTS = 2      # Ray gives its raylet 30 s to register; on a loaded machine, try again
+INIT_ATTEMPTS = 3      # Ray gives its raylet 30 s to register; on a loaded machine, try again
 
 
 def _init_ray(ray, workers: int, address: str | None) -> float:
@@ -73,6 +77,8 @@ def _init_ray(ray, workers: int, address: str | None) -> float:
     kw = dict(log_to_driver=False, logging_level="ERROR")
     if not address:
         kw.update(num_cpus=workers, include_dashboard=False, _node_ip_address="127.0.0.1")
+    # the raylet waits for its agents' port files; on a loaded machine they start slowly
+    os.environ.setdefault("RAY_agent_register_timeout_ms", "120000")
     t0 = time.perf_counter()
     for attempt in range(INIT_ATTEMPTS):
         try:

@@ -31,7 +31,7 @@ def write_table(path: str | Path, rows: Iterable[dict[str, Any]], params: list[s
     path = Path(path)
     rows = sorted(rows, key=lambda r: int(r["index"]))
     metrics = sorted({k for r in rows for k in r if str(k)[:2] in ("m.", "x.", "e.")})
-    columns = FIRST + list(params) + LAST + metrics + TAIL
+    columns = FIRST + [p for p in params if p not in LAST] + LAST + metrics + TAIL
     extra = sorted({k for r in rows for k in r} - set(columns))
     tmp = path.with_name(path.name + ".tmp")
     path.parent.mkdir(parents=True, exist_ok=True)

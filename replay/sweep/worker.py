@@ -17,6 +17,9 @@ from pathlib import Path
 from typing import Any
 
 
+INTERRUPTED = "interrupted"
+
+
 def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     """task: key, index, resolved, error, log (path or ""), cwd, metrics ("module:function" of
     a LogReader -> extra columns, or "") -> a row (without the params)."""
@@ -34,8 +37,8 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     cwd = task.get("cwd")
     if cwd and Path(cwd).is_dir() and os.getcwd() != cwd:
         os.chdir(cwd)                     # relative data paths (alpha files) as in the scenario
+    from replay.runner import RunInterrupted, Runner
     try:
-        from replay.runner import Runner
         from replay.scenario.loader import scenario_from_text
         sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>")
         if log:
@@ -53,6 +56,8 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         if task.get("metrics"):
             row.update({f"x.{k}": _cell(v) for k, v in
                         _extract(task["metrics"], log or tmp).items()})
+    except (RunInterrupted, KeyboardInterrupt):
+        row.update(success=False, reason=INTERRUPTED)   # not a result: the engine drops it
     except Exception as exc:                        # noqa: BLE001 - a failed variant is a row
         row["success"] = False
         last = traceback.extract_tb(exc.__traceback__)[-1]
