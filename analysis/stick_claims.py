@@ -15,9 +15,9 @@ import yaml
 
 from analysis.claims import Claim, within
 from analysis.series import arrays, events
-from replay.control.stick.collision import (pure_rotation_min_spin, pure_rotation_residual_spin,
-                                            pure_rotation_stop_distance)
 from replay.log import LogReader
+from replay.robot.stick_impact import (pure_rotation_min_spin, pure_rotation_residual_spin,
+                                       pure_rotation_stop_distance)
 
 STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "higashimori2007.yaml"
 

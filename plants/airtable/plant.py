@@ -32,7 +32,8 @@ import pymunk
 from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec
 from replay.interfaces import Occurrence, Plant
 from replay.messages import FingersState, StickState
-from replay.scene import Box, Cylinder, Scene, yaw_quaternion
+from replay.scene import Box, Cylinder, Scene
+from replay.spatial import yaw_quaternion
 
 from plants.airtable.hand import HandServo
 from plants.airtable.params import Params

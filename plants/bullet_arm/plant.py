@@ -29,7 +29,7 @@ from replay.interfaces import Occurrence, Plant
 from replay.messages import JointState, ObjectState
 from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
 from replay.robot.hand import HANDS, hand_body, hand_mass
-from replay.robot.serial_chain import rpy_to_matrix, matrix_to_quaternion
+from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 from replay.robot.wam import (DEFAULT_VELOCITY_LIMIT, TORQUE_LIMIT_SETS, default_tool_d,
                               load_wam_table, wam_chain, wam_joint_limits)
 from replay.scene import Box, Scene, Sphere

@@ -21,7 +21,7 @@ import numpy as np
 
 from plants.models.urdf import Geometry, Joint, Link, robot_xml, segment_cylinder, write_cached
 from replay.robot.hand import HandTable, joint_axis, link_body, palm_body, root_transform
-from replay.robot.serial_chain import rot_x, rot_z, transform
+from replay.spatial import rot_x, rot_z, transform
 from replay.robot.wam import (DEFAULT_VELOCITY_LIMIT, default_tool_d, load_wam_table, wam_dh,
                               wam_joint_limits, wam_joint_names, wam_links, wam_torque_limits)
 

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from replay.robot.serial_chain import DHRow, RigidBody, SerialChain, transform, rpy_to_matrix
+from replay.robot.serial_chain import DHRow, RigidBody, SerialChain
+from replay.spatial import rpy_to_matrix, transform
 
 WAM_YAML = Path(__file__).resolve().parents[2] / "data" / "robots" / "wam.yaml"
 
