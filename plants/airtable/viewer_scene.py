@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from plants.airtable.params import Params
+from plants.airtable.settings import hand_spec
 from replay.robot.hand2d import finger_chain
 from replay.spatial import yaw_wxyz
 from replay.viewer.data import RunData
@@ -34,14 +35,12 @@ class StickGeometry:
 
     @classmethod
     def of(cls, p: Params) -> StickGeometry:
-        st, h = p.stick, p.hand
+        st, hand = p.stick, hand_spec(p)
         return cls(length=float(st.length), visual_width=float(st.visual_width),
                    thickness=float(st.thickness), marker_length=float(st.marker_length),
-                   marker_width=float(st.marker_width), tip_radius=float(h.tip_radius),
-                   tip_height=float(h.tip_height),
-                   link_lengths=(float(h.link_lengths[0]), float(h.link_lengths[1])),
-                   root_offsets=((float(h.root_offset0[0]), float(h.root_offset0[1])),
-                                 (float(h.root_offset1[0]), float(h.root_offset1[1]))))
+                   marker_width=float(st.marker_width), tip_radius=hand.tip_radius,
+                   tip_height=float(p.hand.tip_height), link_lengths=hand.link_lengths,
+                   root_offsets=hand.root_offsets)
 
     def finger_points(self, base, joints) -> np.ndarray:
         """(2 fingers, 3 points: root, elbow, tip, 2) from the slider base and (q1, q2) per

@@ -56,8 +56,8 @@ def _dh_const(row) -> np.ndarray:
 
 def build_arm(dof: int = 4, *, tool_d: float | None = None, hand: HandTable | None = None,
               locked: Mapping[str, float] | None = None,
-              torque_limits: Sequence[float] | None = None,
-              velocity_limits: Sequence[float] | None = None,
+              torque_limits: Sequence[float] | np.ndarray | None = None,
+              velocity_limits: Sequence[float] | np.ndarray | None = None,
               table: dict | None = None) -> ArmModel:
     """Build the URDF text of a ``dof``-axis WAM (+ ``hand``), see the module docstring."""
     t = table or load_wam_table()

@@ -28,8 +28,8 @@ def _pose(name: str, cam) -> CameraPose:
     """A pinhole camera (replay.sensors.pinhole) as the viewer draws it."""
     k = cam.intrinsics
     fov_y = 2.0 * math.atan((k.height / 2.0) / k.fy)
-    return CameraPose(name, tuple(float(v) for v in cam.position), matrix_to_wxyz(cam.rotation),
-                      fov_y, k.width / k.height)
+    x, y, z = (float(v) for v in cam.position)
+    return CameraPose(name, (x, y, z), matrix_to_wxyz(cam.rotation), fov_y, k.width / k.height)
 
 
 def cameras(sensors: dict) -> tuple[list[CameraPose], list[str]]:

@@ -13,7 +13,7 @@ builder shares; it imports no plug-in (docs/viewer.md says how to add one).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 import viser
@@ -63,7 +63,7 @@ class RunScene:
         self.notes: list[str] = []
         self.handles: list = []
         self.dynamic: dict = {}         # nodes re-added as they change (lines), by role
-        self._path = None
+        self._path: Any = None
         self._path_len = -1
         self._path_thickness = 2.0
 
@@ -181,9 +181,9 @@ def scene_class(run: RunData) -> type[RunScene]:
     for key, cls in scenes.items():
         if key.startswith(f"{run.plant_type}.") and cls.suits(run) and cls.drawable(run):
             return cls
-    cls = scenes.get(run.plant_type)
-    if cls is not None and cls.drawable(run):
-        return cls
+    own = scenes.get(run.plant_type)
+    if own is not None and own.drawable(run):
+        return own
     for cls in scenes.values():
         if cls.drawable(run):
             return cls
