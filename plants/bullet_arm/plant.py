@@ -405,40 +405,6 @@ class BulletArmPlant(Plant):
         encoders = {"name": list(self.joint_names), "position": q.tolist(), "velocity": qd.tolist()}
         return Scene(prims, readings={"arm": encoders})
 
-    # ------------------------------------------------------------------ cross-checks (tests)
-    def _full_dofs(self, q_arm, qd_arm=None, qdd_arm=None):
-        hq, _, _ = self.hand_state()
-        pos, vel, acc = [], [], []
-        arm_of = {self._jidx[self.joint_names[i]]: i for i in self.active}
-        hand_of = {j: k for k, j in enumerate(self._hand_j)}
-        for j in self._dofs:
-            if j in arm_of:
-                i = arm_of[j]
-                pos.append(float(q_arm[i]))
-                vel.append(0.0 if qd_arm is None else float(qd_arm[i]))
-                acc.append(0.0 if qdd_arm is None else float(qdd_arm[i]))
-            else:
-                pos.append(float(hq[hand_of[j]]))
-                vel.append(0.0)
-                acc.append(0.0)
-        return pos, vel, acc, [self._dofs.index(self._jidx[self.joint_names[i]])
-                               for i in self.active]
-
-    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
-        """PyBullet's inverse dynamics for the arm (hand joints frozen at their current angles);
-        locked joints' entries are NaN. For cross-checks in tests."""
-        pos, vel, acc, cols = self._full_dofs(q, qd, qdd)
-        tau = np.array(self.bc.calculateInverseDynamics(self.robot, pos, vel, acc))
-        out = np.full(self.dof, np.nan)
-        out[list(self.active)] = tau[cols]
-        return out
-
-    def mass_matrix(self, q) -> np.ndarray:
-        """PyBullet's mass matrix of the active arm joints (hand frozen), len(active) square."""
-        pos, _, _, cols = self._full_dofs(q)
-        M = np.array(self.bc.calculateMassMatrix(self.robot, pos))
-        return M[np.ix_(cols, cols)]
-
     def close(self) -> None:
         if getattr(self, "bc", None) is not None:
             try:

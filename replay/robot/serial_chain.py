@@ -102,10 +102,6 @@ class SerialChain:
         return SerialChain(self.dh, self.links[:-1] + (last,), base=self.base, tool=self.tool,
                            gravity=self.gravity, joint_names=self.joint_names)
 
-    def with_gravity(self, gravity: Sequence[float]) -> SerialChain:
-        return SerialChain(self.dh, self.links, base=self.base, tool=self.tool, gravity=gravity,
-                           joint_names=self.joint_names)
-
     # ------------------------------------------------------------------ kinematics
     def _q(self, q) -> np.ndarray:
         q = np.asarray(q, dtype=float).reshape(-1)
