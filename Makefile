@@ -9,7 +9,7 @@ OUT    ?= out
 # the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md
 SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml)
 
-.PHONY: install run test bench ablations golden-check clean
+.PHONY: install run lint test bench ablations golden-check clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -26,9 +26,14 @@ run: $(STAMP)
 	$(REPLAY) report -o $(OUT)/report --logs $(OUT)/logs
 
 # the ablations (sweeps/*.yaml) from scratch, their tables kept under data/ablations/ for the
-# report (~150 variants: tens of minutes on 2 cores); `make run` only redraws them
+# report (~70 variants: tens of minutes on 2 shared cores); `make run` only redraws them
 ablations: $(STAMP)
 	$(REPLAY) ablate --store --no-logs
+
+# ruff (lint only: `ruff format` is not applied to the tree yet) and mypy, configured in pyproject.toml
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/mypy
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -14,10 +14,10 @@ import yaml
 
 from analysis.claims import Claim, within
 from analysis.series import arrays, events
-from replay.control.stick.collision import (pure_rotation_min_spin, pure_rotation_residual_spin,
-                                            pure_rotation_stop_distance)
 from replay.log import LogReader
 from replay.resources import data_path
+from replay.robot.stick_impact import (pure_rotation_min_spin, pure_rotation_residual_spin,
+                                       pure_rotation_stop_distance)
 
 STATED = data_path("claims", "higashimori2007.yaml")
 

@@ -19,7 +19,8 @@ import numpy as np
 import yaml
 
 from replay.resources import data_path
-from replay.robot.serial_chain import DHRow, RigidBody, SerialChain, transform, rpy_to_matrix
+from replay.robot.serial_chain import DHRow, RigidBody, SerialChain
+from replay.spatial import rpy_to_matrix, transform
 
 WAM_YAML = data_path("robots", "wam.yaml")
 
