@@ -22,9 +22,10 @@ def catch_metrics(log) -> dict:
     the ball should sit on the palm), and the ball's speed relative to the hand at its first
     contact with the palm or fingers."""
     from analysis.series import arrays, events
-    ball = arrays(log, "/object/state", ["position"])
-    hand = arrays(log, "/effector/state", ["position"]) if log.topic_counts().get(
-        "/effector/state") else {"t": np.zeros(0)}
+    from replay.messages import TOPIC_EFFECTOR_STATE, TOPIC_OBJECT_STATE
+    ball = arrays(log, TOPIC_OBJECT_STATE, ["position"])
+    hand = arrays(log, TOPIC_EFFECTOR_STATE, ["position"]) if log.topic_counts().get(
+        TOPIC_EFFECTOR_STATE) else {"t": np.zeros(0)}
     out: dict = {}
     if len(ball["t"]) and len(hand["t"]) and hand["position"].ndim == 2:
         # the ball's state at the hand's stamps (both are logged at the control rate)

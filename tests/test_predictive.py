@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from replay.control.predictive import BallKalman, PredictiveController, Quintic, first_crossing
-from replay.messages import JointState, VisionObject
+from replay.messages import TOPIC_ARM_ENCODERS, TOPIC_VISION_OBJECT, JointState, VisionObject
 
 ROOT = Path(__file__).resolve().parents[1]
 G = np.array([0.0, 0.0, -9.81])
@@ -84,8 +84,8 @@ def test_plans_converge_on_the_true_catch_point_over_throws(spec):
         for k in range(int(s_true * 1000) - 15):
             t = t0 + k * 1e-3
             z = _arc(THROW_START, v0, t - t0) + rng.normal(0.0, 0.002, 3)
-            ctrl.update(t + 1e-3, [("/vision/object", VisionObject(t, z.tolist())),
-                                   ("/arm/encoders", JointState(t, list(arm.joint_names),
+            ctrl.update(t + 1e-3, [(TOPIC_VISION_OBJECT, VisionObject(t, z.tolist())),
+                                   (TOPIC_ARM_ENCODERS, JointState(t, list(arm.joint_names),
                                                                 q.tolist(), [0.0] * 4, []))])
         p_true = _arc(THROW_START, v0, s_true)
         p_plan = ctrl.p_catch

@@ -11,7 +11,7 @@ from click.testing import CliRunner
 from replay.cli import main
 from replay.sweep.engine import run_sweep
 from replay.sweep.executors import ray_available
-from replay.sweep.spec import SweepSpecError, from_options, parse_grid, parse_random
+from replay.sweep.spec import SweepSpecError, from_options, parse_grid
 from replay.sweep.table import read_table
 from replay.sweep.variants import expand
 

@@ -74,7 +74,7 @@ def _readers(logs: list[Path]) -> dict[str, dict[str, LogReader]]:
 
 def _caption(paper: str, stem: str, name: str) -> str:
     m = re.search(r"fig(\d+)", stem)
-    num = int(m.group(1)) if m else None
+    num = int(m.group(1)) if m else 0
     quoted = CAPTIONS.get(paper, {}).get(num)
     base = f"Fig. {num}" if num else stem
     run = f" Regenerated from the run {name!r}." if name else ""

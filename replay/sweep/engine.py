@@ -66,8 +66,8 @@ def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | No
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
     old = read_table(table)
-    rows = {r["key"]: r for r in old if r.get("key") in by_key
-            and not (retry_failed and is_error(r))}
+    rows: dict[str, dict] = {r["key"]: dict(r) for r in old if r.get("key") in by_key
+                             and not (retry_failed and is_error(r))}
     for key, r in rows.items():        # the index follows this sweep's order
         r["index"] = by_key[key].index
     stale = len(old) - len(rows)

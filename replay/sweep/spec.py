@@ -72,7 +72,7 @@ class SweepSpec:
         rng = np.random.default_rng(np.random.SeedSequence([seed, 0x5EE9]))
         draws = []
         for _ in range(self.n):
-            d = {}
+            d: dict[str, Any] = {}
             for r in self.random:
                 if r.integer:
                     d[r.name] = int(rng.integers(int(r.lo), int(r.hi) + 1))

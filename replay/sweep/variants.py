@@ -57,7 +57,7 @@ def variant_key(resolved: str, seed: int, version: str) -> str:
     return h.hexdigest()[:16]
 
 
-def expand(scenario: str | Path, spec: SweepSpec, seed: int, *, sets: list[str] = (),
+def expand(scenario: str | Path, spec: SweepSpec, seed: int, *, sets: list[str] | tuple = (),
            version: str | None = None) -> list[Variant]:
     """The sweep's variants, each loaded and validated (or carrying why it cannot be)."""
     version = code_version() if version is None else version
@@ -81,7 +81,7 @@ def expand(scenario: str | Path, spec: SweepSpec, seed: int, *, sets: list[str] 
     return out
 
 
-def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] = ()) -> None:
+def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] | tuple = ()) -> None:
     """A varied key that names no field of the scenario is a bad --grid/--random, not a variant
     failure: raise SweepSpecError before anything runs."""
     from replay.scenario.loader import to_plain

@@ -29,8 +29,8 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     if task.get("error"):
         row.update(success=False, reason=task["error"], wall_time=0.0, cpu_time=0.0, log="")
         return row
-    log = task.get("log") or ""
-    tmp = None
+    log: str = task.get("log") or ""
+    tmp = ""
     if not log:
         fd, tmp = tempfile.mkstemp(suffix=".mcap", prefix="sweep-")
         os.close(fd)

@@ -31,16 +31,15 @@ from replay.control.catching.model import ArmModel
 from replay.control.predictive.kalman import BallKalman, first_crossing
 from replay.control.predictive.trajectory import Quintic
 from replay.interfaces import Controller, Occurrence
-from replay.messages import EffectorState, JointCommand
+from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE,
+                             TOPIC_EFFECTOR_STATE, TOPIC_VISION_OBJECT, EffectorState,
+                             JointCommand)
 from replay.params import param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
-TOPIC_VISION_OBJECT = "/vision/object"
-TOPIC_ENCODERS = "/arm/encoders"
-
 
 @dataclass
-class Params:
+class PredictiveParams:
     q_alpha: float = param(math.pi / 2, unit="rad",
                            doc="joint angle of the selected joint at the catch (the catch "
                                "surface), as the direct mapping's")
@@ -75,15 +74,18 @@ class Params:
                                                  "(t_c - closing time)")
 
 
+Params = PredictiveParams
+
+
 class PredictiveController(Controller):
-    Params = Params
+    Params = PredictiveParams
     spec_type = ArmSpec
     command_type = ArmCommand
-    reads = (TOPIC_VISION_OBJECT, TOPIC_ENCODERS)
+    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)
     description = ("predict-then-intercept baseline: Kalman filter, ballistic catch point, IK, "
                    "re-planned quintic joint trajectory, PD + dynamics")
 
-    def __init__(self, params: Params, *, spec) -> None:
+    def __init__(self, params: PredictiveParams, *, spec) -> None:
         super().__init__(params, spec=spec)
         P = params
         names = tuple(spec.joint_names)
@@ -107,8 +109,8 @@ class PredictiveController(Controller):
         self.model = ArmModel.from_chain(spec.model, active=self.active, q_fixed=self.q_init,
                                          point_in_tool=(0.0, 0.0, off))
         self.geo = CatchGeometry.from_fk(self.model.fk, P.q_alpha, p_ref=tuple(P.catch_q))
-        self.kp = np.asarray(P.kp, float)
-        self.kd = np.asarray(P.kd, float)
+        self.kp = np.asarray(P.kp, dtype=float)
+        self.kd = np.asarray(P.kd, dtype=float)
         if self.kp.shape != (self.n,) or self.kd.shape != (self.n,):
             raise ValueError(f"kp and kd need {self.n} values")
         self.kf = BallKalman(self.gravity, meas_sigma=P.meas_sigma, accel_sigma=P.accel_sigma)
@@ -120,14 +122,15 @@ class PredictiveController(Controller):
                                     / self.hand.closing_speed)
         else:
             self.close_time = 0.0
-        self.q = self.qd = None
+        self.q: np.ndarray | None = None
+        self.qd: np.ndarray | None = None
         self.q_d = self.q_init.copy()
         self.qd_d = np.zeros(self.n)
         self.qdd_d = np.zeros(self.n)
         self.tau = np.zeros(self.n)
         self.plan: Quintic | None = None
+        self.p_catch: np.ndarray = np.zeros(3)
         self.t_catch: float | None = None
-        self.p_catch: np.ndarray | None = None
         self.replans = 0
         self.closing = False
         self._events: list[Occurrence] = []
@@ -138,7 +141,7 @@ class PredictiveController(Controller):
         for topic, m in measurements:
             if topic == TOPIC_VISION_OBJECT:
                 self.kf.add(m.t, m.position)
-            elif topic in (TOPIC_ENCODERS, "/arm/joint_state"):
+            elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
                 self._joint_state(m)
         if self.kf.n >= P.min_measurements:
             self._maybe_replan(t)
@@ -165,7 +168,8 @@ class PredictiveController(Controller):
             return
         t_c = t + s
         p_c = r + v * s + 0.5 * self.gravity * s * s
-        if (self.plan is not None and np.linalg.norm(p_c - self.p_catch) <= P.replan_distance
+        if (self.plan is not None and self.t_catch is not None
+                and np.linalg.norm(p_c - self.p_catch) <= P.replan_distance
                 and abs(t_c - self.t_catch) <= P.replan_time):
             return
         inv = self.geo.inverse(p_c)
@@ -191,13 +195,14 @@ class PredictiveController(Controller):
 
     def _torque(self) -> np.ndarray:
         ff = self.model.inverse_dynamics_full(self.q_d, self.qd_d, self.qdd_d)
-        tau = ff if self.q is None else ff + self.kp * (self.q_d - self.q) + \
-            self.kd * (self.qd_d - self.qd)
+        if self.q is None or self.qd is None:
+            return np.clip(ff, -self.tau_limit, self.tau_limit)
+        tau = ff + self.kp * (self.q_d - self.q) + self.kd * (self.qd_d - self.qd)
         return np.clip(tau, -self.tau_limit, self.tau_limit)
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:
-        out = {"method": "predictive", "hand_closing": self.closing, "replans": self.replans}
+        out: dict = {"method": "predictive", "hand_closing": self.closing, "replans": self.replans}
         if self.t_catch is not None:
             out.update(catch_time=self.t_catch, catch_point=self.p_catch.tolist())
         return out
@@ -207,15 +212,15 @@ class PredictiveController(Controller):
         return ev
 
     def outcome(self, t: float) -> dict:
-        out = {"replans": self.replans}
+        out: dict = {"replans": self.replans}
         if self.t_catch is not None:
             out.update(predicted_catch_time=self.t_catch,
                        predicted_catch_point=self.p_catch.tolist())
         return out
 
     def telemetry(self, t: float) -> dict:
-        return {"/arm/joint_command": JointCommand(t, position=self.q_d.tolist(),
+        return {TOPIC_ARM_JOINT_COMMAND: JointCommand(t, position=self.q_d.tolist(),
                                                    torque=self.tau.tolist()),
-                "/effector/state": EffectorState(
+                TOPIC_EFFECTOR_STATE: EffectorState(
                     t, position=self.model.fk(self.q).tolist() if self.q is not None else [],
                     desired_position=self.model.fk(self.q_d).tolist())}

@@ -22,9 +22,9 @@ class BallKalman:
         self.R = np.eye(3) * meas_sigma ** 2
         self.q = accel_sigma ** 2
         self.v_sigma0 = v_sigma0
-        self.x: np.ndarray | None = None        # (6,) r, v
-        self.P: np.ndarray | None = None
-        self.t: float | None = None
+        self.x = np.zeros(6)                    # r, v (valid once n > 0)
+        self.P = np.eye(6)
+        self.t = 0.0
         self.n = 0
 
     def _predict(self, dt: float) -> None:
@@ -39,7 +39,7 @@ class BallKalman:
 
     def add(self, t: float, z) -> None:
         z = np.asarray(z, float)
-        if self.x is None:
+        if self.n == 0:
             self.x = np.concatenate([z, np.zeros(3)])
             self.P = np.diag([self.R[0, 0]] * 3 + [self.v_sigma0 ** 2] * 3)
             self.t = float(t)
@@ -58,17 +58,17 @@ class BallKalman:
 
     def state(self, t: float):
         """(r, v) at time t, carried ballistically from the newest estimate (None before any)."""
-        if self.x is None:
+        if self.n == 0:
             return None
         dt = t - self.t
         r, v = self.x[:3], self.x[3:]
         return r + v * dt + 0.5 * self.g * dt * dt, v + self.g * dt
 
     def position_sigma(self) -> float:
-        return float(np.sqrt(np.trace(self.P[:3, :3]) / 3.0)) if self.P is not None else np.inf
+        return float(np.sqrt(np.trace(self.P[:3, :3]) / 3.0)) if self.n else float("inf")
 
     def velocity_sigma(self) -> float:
-        return float(np.sqrt(np.trace(self.P[3:, 3:]) / 3.0)) if self.P is not None else np.inf
+        return float(np.sqrt(np.trace(self.P[3:, 3:]) / 3.0)) if self.n else float("inf")
 
 
 def first_crossing(r, v, g, origin, radius: float) -> float | None:
