@@ -166,3 +166,20 @@ def test_the_key_follows_scenario_seed_and_code(project_root):
     assert set(a).isdisjoint(v.key for v in expand(STICK, spec, 1, sets=SHORT, version="v1"))
     assert set(a).isdisjoint(v.key for v in expand(STICK, spec, 0, sets=SHORT, version="v2"))
     assert set(a).isdisjoint(v.key for v in expand(STICK, spec, 0, version="v1"))
+
+
+def test_seed_and_scenario_axes(toy_yaml, tmp_path):
+    other = tmp_path / "toy_heavy.yaml"
+    other.write_text(toy_yaml.read_text().replace("name: toy", "name: toy_heavy")
+                     .replace("mass: 2.0", "mass: 5.0"))
+    spec = from_options([f"scenario={toy_yaml},{other}", "seed=1,2"], [], None)
+    variants = expand(toy_yaml, spec, 0, version="test")
+    assert [(v.name, v.seed) for v in variants] == [("toy", 1), ("toy", 2), ("toy_heavy", 1),
+                                                    ("toy_heavy", 2)]
+    run_sweep(variants, tmp_path / "out", workers=2, keep_logs=False, progress=False)
+    with (tmp_path / "out" / "table.csv").open() as f:
+        header = f.readline().strip().split(",")
+    assert header.count("seed") == 1 and "scenario" in header
+    rows = read_table(tmp_path / "out" / "table.csv")
+    assert [(r["scenario"], r["seed"]) for r in rows] == [
+        (str(toy_yaml), "1"), (str(toy_yaml), "2"), (str(other), "1"), (str(other), "2")]
