@@ -141,7 +141,7 @@ def summary_vision(rows: list[dict]) -> str:
         xs, ys = curves[lat]
         parts.append(f"latency {float(lat) * 1e3:g} ms: {pct(ys[-1])} at {xs[-1]:g} Hz, "
                      f"{pct(ys[0])} at {xs[0]:.0f} Hz")
-    return f"Direct mapping ({overall(rows, caught)}): " + "; ".join(parts) + "."
+    return f"Direct mapping ({overall(rows, caught, 'caught')}): " + "; ".join(parts) + "."
 
 
 def summary_throw_speed(rows: list[dict]) -> str:
@@ -153,7 +153,7 @@ def summary_throw_speed(rows: list[dict]) -> str:
         near = (f"; the ball met the hand at {sv[0]:.1f} m/s relative to it at {sx[0]:g} m/s "
                 f"and {sv[-1]:.1f} m/s at {sx[-1]:g} m/s")
     return (f"Caught at {', '.join(yes) or 'no'} m/s of {', '.join(f'{x:g}' for x in xs)} m/s "
-            f"({overall(rows, caught)}){near}.")
+            f"({overall(rows, caught, 'caught')}){near}.")
 
 
 def summary_arm_limits(rows: list[dict]) -> str:
@@ -164,7 +164,7 @@ def summary_arm_limits(rows: list[dict]) -> str:
         first = next((x for x, y in zip(xs, ys) if y > 0), None)
         parts.append(f"torque x{scale}: " + (f"catches from {first:g} rad/s" if first is not None
                                              else "no catch up to " f"{xs[-1]:g} rad/s"))
-    return f"With the speed limit enforced ({overall(rows, caught)}): " + "; ".join(parts) + "."
+    return f"With the speed limit enforced ({overall(rows, caught, 'caught')}): " + "; ".join(parts) + "."
 
 
 def summary_direct_vs_predictive(rows: list[dict]) -> str:

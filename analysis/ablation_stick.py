@@ -104,4 +104,4 @@ def summary_vision(rows: list[dict]) -> str:
         xs, ys = curves[noise]
         parts.append(f"σ = {float(noise):g}: " + ", ".join(f"{pct(y)} at {x:g} fps"
                                                             for x, y in zip(xs[::-1], ys[::-1])))
-    return f"Capture rate ({overall(rows, captured)}): " + "; ".join(parts) + "."
+    return f"Capture rate ({overall(rows, captured, 'captured')}): " + "; ".join(parts) + "."

@@ -70,11 +70,11 @@ def rate_at(curves: dict, line: str, x: float) -> float:
     return float("nan")
 
 
-def overall(rows: list[dict], ok) -> str:
+def overall(rows: list[dict], ok, verb: str = "succeeded") -> str:
     n = len(rows)
     k = sum(bool(ok(r)) for r in rows)
     bad = failures(rows)
-    text = f"{k} of {n} variants succeeded"
+    text = f"{k} of {n} variants {verb}"
     if bad:
         text += f"; {len(bad)} failed to run (first: {bad[0]})"
     return text

@@ -44,7 +44,8 @@ class SweepSummary:
                 f"before); {self.ok} succeeded, {self.failed} failed; {self.wall_time:.1f} s "
                 f"({self.rate:.2f} variants/s); table: {self.table}")
         if self.stale:
-            text += f" ({self.stale} rows of another code or scenario version replaced)"
+            text += (f" ({self.stale} rows of another code or scenario version moved to "
+                     "table.stale.csv)")
         return ("interrupted: " if self.interrupted else "") + text
 
 
@@ -71,6 +72,8 @@ def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | No
     for key, r in rows.items():        # the index follows this sweep's order
         r["index"] = by_key[key].index
     stale = len(old) - len(rows)
+    if stale:                          # rows of another code or scenario version: kept aside
+        table.replace(out_dir / "table.stale.csv")
     todo = [v for v in variants if v.key not in rows]
     workers = workers or default_workers()
     tasks = [{"key": v.key, "index": v.index, "resolved": v.resolved, "error": v.error,
