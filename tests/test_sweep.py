@@ -183,3 +183,15 @@ def test_seed_and_scenario_axes(toy_yaml, tmp_path):
     rows = read_table(tmp_path / "out" / "table.csv")
     assert [(r["scenario"], r["seed"]) for r in rows] == [
         (str(toy_yaml), "1"), (str(toy_yaml), "2"), (str(other), "1"), (str(other), "2")]
+
+
+def test_rows_of_another_code_version_are_set_aside(toy_yaml, tmp_path):
+    spec = from_options(["plant.params.mass=1,2"], [], None)
+    run_sweep(expand(toy_yaml, spec, 0, version="v1"), tmp_path, workers=2, keep_logs=False,
+              progress=False)
+    keys_v1 = {r["key"] for r in read_table(tmp_path / "table.csv")}
+    s = run_sweep(expand(toy_yaml, spec, 0, version="v2"), tmp_path, workers=2, keep_logs=False,
+                  progress=False)
+    assert (s.ran, s.stale) == (2, 2)
+    assert {r["key"] for r in read_table(tmp_path / "table.stale.csv")} == keys_v1
+    assert not keys_v1 & {r["key"] for r in read_table(tmp_path / "table.csv")}
