@@ -161,9 +161,9 @@ def summary_arm_limits(rows: list[dict]) -> str:
     parts = []
     for scale in sorted(curves, key=float):
         xs, ys = curves[scale]
-        first = next((x for x, y in zip(xs, ys) if y > 0), None)
-        parts.append(f"torque x{scale}: " + (f"catches from {first:g} rad/s" if first is not None
-                                             else "no catch up to " f"{xs[-1]:g} rad/s"))
+        yes = [f"{x:g}" for x, y in zip(xs, ys) if y > 0]
+        parts.append(f"torque x{scale}: " + (f"caught at {', '.join(yes)} rad/s" if yes
+                                             else f"no catch from {xs[0]:g} to {xs[-1]:g} rad/s"))
     return f"With the speed limit enforced ({overall(rows, caught, 'caught')}): " + "; ".join(parts) + "."
 
 
