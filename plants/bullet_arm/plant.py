@@ -21,6 +21,7 @@ import numpy as np
 import pybullet as p
 from pybullet_utils import bullet_client
 
+from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
@@ -165,6 +166,10 @@ class BulletArmPlant(Plant):
                                 else np.zeros(3))
         self._contacts: list = []
         self._spec = self._make_spec(q0)
+        ht = self.hand_table          # the catch verdict (outcome.py): a free object and a hand
+        self._watch = (CatchWatch(kind=P.object, palm_radius=ht.palm_size[0],
+                                  palm_thickness=ht.palm_thickness)
+                       if self.obj is not None and ht is not None else None)
 
     # ------------------------------------------------------------------ spec
     def _make_spec(self, q0: np.ndarray) -> ArmSpec:
@@ -375,10 +380,20 @@ class BulletArmPlant(Plant):
             kind = "drop" if self._ever_caught else "miss"
             self._events.append(Occurrence(kind, {"position": pos.tolist(),
                                                   "velocity": v.tolist()}))
+        if self._watch is not None:
+            pe, oe, ve, we = self.effector_state()
+            self._watch.observe(self._t, pos, v, pe, oe, ve, we, hand_parts + (
+                ["arm"] if "arm" in parts else []), self.caught)
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
         return ev
+
+    def outcome(self, t: float) -> dict | None:
+        """Caught or not, and why, with the first touch's metrics (plants/bullet_arm/outcome.py)."""
+        if self._watch is None:
+            return None
+        return self._watch.verdict(caught=self.caught, ever_caught=self._ever_caught)
 
     # ------------------------------------------------------------------ log and scene
     def truth(self, t: float) -> dict:
