@@ -202,8 +202,12 @@ def test_hand_closes_before_the_predicted_arrival(runs):
     e = run.first_event("hand_close")
     assert e["t"] == pytest.approx(e["data"]["predicted_catch_time"] - 0.020, abs=1.5e-3)
     h = hand_closing(run)
-    assert h["time"] == pytest.approx(0.020, abs=1.5e-3)      # 90 deg in 20 ms (+1 ms ramp)
-    assert h["peak_speed"] <= (math.pi / 2) / 0.020 * 1.001
+    speed = (math.pi / 2) / 0.020                              # 90 deg in 20 ms
+    assert speed * 0.99 <= h["peak_speed"] <= speed * 1.001
+    if "time" in h:                                            # nothing in the way
+        assert h["time"] == pytest.approx(0.020, abs=1.5e-3)   # (+1 ms ramp)
+    else:                                                      # the caught ball stops them
+        assert 10.0 < h["stopped_at"] < 90.0
 
 
 # ------------------------------------------------------------------------------ analysis
@@ -261,6 +265,14 @@ def test_claims_from_the_logs(runs):
     assert by["catch_optimised: terminal constraint eq. 4 (r_e = l(q_d) − r_o)"].status == \
         "reproduced"
     assert by["catch_optimised: initial constraint eq. 9 at t0"].status == "reproduced"
+    # what eq. 25 leaves out, from the outcome events; eq. 22 as the runs met it
+    app = by["approach of the ball at first touch (angle off the palm axis, offset from it)"]
+    for name, r in runs.items():
+        o = r["result"].outcome
+        assert f"{name}: {o['approach_angle']:.0f}°, {1000 * o['contact_offset']:.0f} mm" \
+            in app.measured
+    assert by["torque limits (eq. 22) during the throw, t0 → t_c"].status == "differs"
+    assert by["joint speed limits (eq. 24) at the catch, given eq. 4"].status == "reproduced"
 
 
 def test_claims_command_prints_the_table(runs):

