@@ -440,11 +440,7 @@ def _torque_limit_rows(opt: CatchRun | None, ini: CatchRun | None) -> list[Claim
     """Eq. 22 in the runs: how often the commanded torque sat at the arm's limits, t0 -> t_c."""
     if opt is None or opt.t0 is None or opt.t_c is None:
         return []
-    lim = np.asarray(opt.scenario["plant"]["params"].get("torque_limits") or [], float)
-    if lim.size == 0:
-        from replay.robot.wam import TORQUE_LIMIT_SETS
-        lim = np.asarray(TORQUE_LIMIT_SETS[opt.plant_params.get("torque_limit_set",
-                                                                "public_urdf")][:4], float)
+    lim = np.asarray(opt.settings.torque_limits, float)
 
     def sat(run):
         w = run.window(run.t_ctrl, run.t0, run.t_c)

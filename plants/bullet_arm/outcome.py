@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.scene import quaternion_matrix
+from replay.spatial import quaternion_matrix
 
 
 @dataclass
