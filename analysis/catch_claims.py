@@ -536,7 +536,10 @@ def _pair_rows(opt: CatchRun | None, ini: CatchRun | None, st: dict) -> list[Cla
     rows.append(Claim("command torque RMS, t0 → t_c (Fig. 9)", "smaller when optimised",
                       f"optimised {ra:.1f} N·m {_fmt3(a['tau_rms'])} vs initial {rb:.1f} N·m "
                       f"{_fmt3(b['tau_rms'])} (J1, J2, J4)",
-                      "reproduced" if ra < rb else "differs"))
+                      "reproduced" if ra < rb else "differs",
+                      "eq. 25 weighs the unclamped eq.-17 torque over the throw set, dominated by "
+                      "its peaks near t_c (above the limits for every α); the run's commands are "
+                      "clamped at the limits (eq. 22 row)"))
     pa, pb = a["tau_peak"], b["tau_peak"]
     rows.append(Claim("command torque peak |τ|, t0 → t_c (Fig. 9)", "smaller when optimised",
                       f"optimised {_fmt3(pa)} vs initial {_fmt3(pb)} N·m (J1, J2, J4)",

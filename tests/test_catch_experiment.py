@@ -112,6 +112,27 @@ def test_alpha_file_is_current_and_its_history_is_logged(runs):
     assert init[0]["torque_cost"] == pytest.approx(costs[0]["torque_cost"], rel=1e-9)
 
 
+def test_alpha_files_resolve_from_the_scenario_file(tmp_path, monkeypatch):
+    """alpha_file is relative to the scenario file, whatever the working directory; the log's
+    resolved scenario keeps it as written (no machine-dependent path)."""
+    from replay.control.catching.controller import alpha_path
+    from replay.scenario import load_scenario, resolved_yaml
+    monkeypatch.chdir(tmp_path)
+    for name, file in (("catch_optimised", "alpha_optimised.json"),
+                       ("catch_8ms", "alpha_optimised.json"),
+                       ("catch_optimised_approach", "alpha_optimised_approach.json"),
+                       ("catch_eq24_infeasible", "alpha_eq24_infeasible.json")):
+        sc = load_scenario(SCENARIOS / f"{name}.yaml")
+        path = alpha_path(sc.controller.params)
+        assert path.resolve() == (ROOT / "data" / "catching" / file).resolve() and path.is_file()
+        assert str(ROOT) not in resolved_yaml(sc)
+    assert alpha_path(load_scenario(SCENARIOS / "catch_initial.yaml").controller.params) is None
+    from replay.runner import Runner                           # the what-if's file is current
+    runner = Runner(load_scenario(SCENARIOS / "catch_eq24_infeasible.yaml"))
+    assert runner.controller.result is None, "run `replay optimise` on catch_eq24_infeasible"
+    runner.plant.close()
+
+
 # ------------------------------------------------------------------------------ the logs
 @pytest.mark.parametrize("name", ["catch_optimised", "catch_initial"])
 def test_log_has_the_contract_topics(runs, name):
