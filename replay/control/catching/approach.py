@@ -71,15 +71,15 @@ def approach_term(mapping: DirectMapping, model: ArmModel, feats: Features, catc
     idx = np.asarray(catch_idx, int)
     nm, m = mapping.poly.n_mono, mapping.poly.m
     g = np.asarray(gravity, float)
-    normal, h0, G = [], [], []
+    normals, accs, grads = [], [], []
     for k in idx:
         p, pd, pdd = feats.p[k], feats.pd[k], feats.pdd[k]
         acc, J = model.point_acceleration(p, pd, pdd)     # b = 0, q_d' = q_o' at t_c
-        normal.append(model.tool_axis(p))
-        h0.append(acc - g)                                 # r_o'' = g
+        normals.append(model.tool_axis(p))
+        accs.append(acc - g)                               # r_o'' = g
         # d(J m2 A)/dA[j, c] = J[:, c] m2_j  ->  alpha index j * m + c (row-major A)
-        G.append(np.einsum("ic,j->ijc", J, feats.m2[k]).reshape(3, nm * m))
-    normal, h0, G = np.array(normal), np.array(h0), np.array(G)
+        grads.append(np.einsum("ic,j->ijc", J, feats.m2[k]).reshape(3, nm * m))
+    normal, h0, G = np.array(normals), np.array(accs), np.array(grads)
     P = np.eye(3)[None] - np.einsum("ki,kj->kij", normal, normal)
     a0 = float(np.median(np.linalg.norm(h0 + G @ np.asarray(alpha0, float), axis=1)))
     return ApproachTerm(normal, P, h0, G, a0, float(weight))
