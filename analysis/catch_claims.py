@@ -28,6 +28,9 @@ from analysis.series import events
 from plants.bullet_arm.params import Params as ArmParams
 from plants.bullet_arm.settings import ArmSettings, resolve
 from replay.log import LogReader
+from replay.messages import (TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE, TOPIC_CATCHING_STATE,
+                             TOPIC_EFFECTOR_MOTION, TOPIC_EFFECTOR_STATE, TOPIC_HAND_JOINT_STATE,
+                             TOPIC_OBJECT_STATE, TOPIC_OPTIMIZATION_COST, TOPIC_VISION_OBJECT)
 from replay.scenario import params_from_data
 
 STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "namiki2003.yaml"
@@ -116,17 +119,17 @@ def arm_settings(sc: dict) -> ArmSettings:
 
 def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     sc = _scenario(log)
-    eff = [m for m in log.series("/effector/state") if m["desired_position"] and m["position"]]
-    cmd = log.series("/arm/joint_command")
+    eff = [m for m in log.series(TOPIC_EFFECTOR_STATE) if m["desired_position"] and m["position"]]
+    cmd = log.series(TOPIC_ARM_JOINT_COMMAND)
     cmd_t = {round(m["t"], 9): m for m in cmd}
     eff = [m for m in eff if round(m["t"], 9) in cmd_t]
     cmd = [cmd_t[round(m["t"], 9)] for m in eff]
-    js = log.series("/arm/joint_state")
-    ob = log.series("/object/state")
-    mo = log.series("/effector/motion")
-    hj = log.series("/hand/joint_state")
-    vi = log.series("/vision/object")
-    cs = log.series("/catching/state")
+    js = log.series(TOPIC_ARM_JOINT_STATE)
+    ob = log.series(TOPIC_OBJECT_STATE)
+    mo = log.series(TOPIC_EFFECTOR_MOTION)
+    hj = log.series(TOPIC_HAND_JOINT_STATE)
+    vi = log.series(TOPIC_VISION_OBJECT)
+    cs = log.series(TOPIC_CATCHING_STATE)
     ev = events(log)
     run = CatchRun(
         name=name or sc["name"], scenario=sc,
@@ -141,7 +144,7 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
         t_tool=_vec(mo, "t"), tool_velocity=_vec(mo, "velocity").reshape(-1, 3),
         t_hand=_vec(hj, "t"), hand_q=_vec(hj, "position"), hand_qd=_vec(hj, "velocity"),
         t_vision=_vec(vi, "t"), vision=_vec(vi, "position").reshape(-1, 3),
-        costs=sorted(log.series("/optimization/cost"), key=lambda c: c["iteration"]),
+        costs=sorted(log.series(TOPIC_OPTIMIZATION_COST), key=lambda c: c["iteration"]),
         cs_t=_vec(cs, "t"), cs_qd_desired=_vec(cs, "velocity_desired"),
         cs_r_o=_vec(cs, "r_o").reshape(-1, 3),
         settings=arm_settings(sc), events=ev)

@@ -16,6 +16,7 @@ import yaml
 from analysis.claims import Claim, within
 from analysis.series import arrays, events
 from replay.log import LogReader
+from replay.messages import TOPIC_STICK_STATE
 from replay.robot.stick_impact import (pure_rotation_min_spin, pure_rotation_residual_spin,
                                        pure_rotation_stop_distance)
 
@@ -39,7 +40,7 @@ def _speed(v) -> float:
 
 def _t_stopped(log: LogReader, speed: float = 0.02) -> float | None:
     """First time after which the stick's speed stays below ``speed`` m/s."""
-    s = arrays(log, "/stick/state", ["vx", "vy"])
+    s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy"])
     moving = np.hypot(s["vx"], s["vy"]) >= speed
     if not len(moving) or moving[-1]:
         return None
