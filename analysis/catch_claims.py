@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import yaml
@@ -31,9 +30,10 @@ from replay.log import LogReader
 from replay.messages import (TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE, TOPIC_CATCHING_STATE,
                              TOPIC_EFFECTOR_MOTION, TOPIC_EFFECTOR_STATE, TOPIC_HAND_JOINT_STATE,
                              TOPIC_OBJECT_STATE, TOPIC_OPTIMIZATION_COST, TOPIC_VISION_OBJECT)
+from replay.resources import data_path
 from replay.scenario import params_from_data
 
-STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "namiki2003.yaml"
+STATED = data_path("claims", "namiki2003.yaml")
 ACTIVE = (0, 1, 3)                      # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
 JOINTS = ("J1", "J2", "J4")
 
