@@ -25,19 +25,22 @@ from replay.viewer.errors import ViewerError
 from replay.viewer.scenes import PlotSeries, PlotSpec, RunScene
 
 
-def plant_models_urdf(p: dict) -> Path:
+def plant_models_urdf(p: dict, params_cls: type = Params) -> Path:
     """The arm plant's URDF for these ``plant.params`` (as logged), built by the plant's own
-    resolver, so it is the very file (same cached path) the plant loads."""
-    return Path(resolve(params_from_data(Params, p, "plant.params")).arm_model().write())
+    resolver, so it is the very file (same cached path) the plant loads. ``params_cls``: the
+    plant's ``Params`` (this one's, or a subclass for a plant built on it)."""
+    return Path(resolve(params_from_data(params_cls, p, "plant.params")).arm_model().write())
 
 
-# Where an arm run's URDF comes from: ``plant.params`` -> path. Tests and other plants may
-# point this elsewhere (``Viewer(urdf_for=...)`` takes precedence).
-URDF_FOR: Callable[[dict], Path] = plant_models_urdf
+# Where an arm run's URDF comes from: ``plant.params`` -> path; None = the plant's own
+# (plant_models_urdf). Tests and other plants may point this elsewhere (``Viewer(urdf_for=...)``
+# takes precedence).
+URDF_FOR: Callable[[dict], Path] | None = None
 
 
-def arm_urdf(p: dict, urdf_for: Callable[[dict], Path] | None = None) -> Path:
-    fn = urdf_for or URDF_FOR
+def arm_urdf(p: dict, urdf_for: Callable[[dict], Path] | None = None,
+             params_cls: type = Params) -> Path:
+    fn = urdf_for or URDF_FOR or (lambda d: plant_models_urdf(d, params_cls))
     try:
         path = Path(fn(p))
     except Exception as exc:  # noqa: BLE001 - any failure is one line in the view
@@ -53,6 +56,8 @@ class ArmScene(RunScene):
     plant's URDF, the free object (ball / hexahedron) and its path, cameras."""
     kind = "arm"
     view_direction = (0.3, -1.05, 0.4)
+    Params: type = Params       # the plant's params; a scene for a plant built on this one
+                                # (e.g. with Params(Params) subclassed) sets its own
     needs = (TOPIC_ARM_JOINT_STATE, TOPIC_OBJECT_STATE)
     optional = (TOPIC_ARM_JOINT_STATE, TOPIC_HAND_JOINT_STATE, TOPIC_OBJECT_STATE, TOPIC_VISION_OBJECT)
 
@@ -69,7 +74,7 @@ class ArmScene(RunScene):
 
     def build(self) -> None:
         from viser.extras import ViserUrdf
-        p = self.params = self.plant_params(Params)
+        p = self.params = self.plant_params(self.Params)
         self.check_topics()
         self._path_thickness = 3.0
         sc, r = self.scene, self.root
@@ -87,7 +92,7 @@ class ArmScene(RunScene):
             position=tuple(float(v) for v in p.base_position), wxyz=rpy_to_wxyz(p.base_rpy)))
         if self.run.track(TOPIC_ARM_JOINT_STATE) is not None or self.run.plant_type:
             try:
-                path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"))
+                path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
                 override = None if not self.ghost else (*(c / 255 for c in self.color), 0.45)
                 self.urdf = ViserUrdf(self.server, path, root_node_name=f"{r}/arm",
                                       mesh_color_override=override)
