@@ -24,11 +24,13 @@ import yaml
 
 from analysis.claims import Claim
 from analysis.series import events
-from plants.bullet_arm.params import Params as ArmParams
 from plants.bullet_arm.settings import ArmSettings, resolve
 from replay.log import LogReader
+from replay.messages import (TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE, TOPIC_CATCHING_STATE,
+                             TOPIC_EFFECTOR_MOTION, TOPIC_EFFECTOR_STATE, TOPIC_HAND_JOINT_STATE,
+                             TOPIC_OBJECT_STATE, TOPIC_OPTIMIZATION_COST, TOPIC_VISION_OBJECT)
 from replay.resources import data_path
-from replay.scenario import params_from_data
+from replay.scenario import scenario_from_text
 
 STATED = data_path("claims", "namiki2003.yaml")
 ACTIVE = (0, 1, 3)                      # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
@@ -108,30 +110,25 @@ class CatchRun:
         return self.scenario["controller"]["params"]
 
 
-def arm_settings(sc: dict) -> ArmSettings:
-    """The arm plant's settings for a log's resolved scenario (its typed params, rebuilt by the
-    scenario loader, then the plant's own resolver)."""
-    return resolve(params_from_data(ArmParams, sc["plant"].get("params"), "plant.params"))
-
-
 def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     sc = _scenario(log)
-    eff = [m for m in log.series("/effector/state") if m["desired_position"] and m["position"]]
-    cmd = log.series("/arm/joint_command")
+    typed = scenario_from_text(log.scenario()["yaml"], name=f"{log.path.name}:/scenario")
+    eff = [m for m in log.series(TOPIC_EFFECTOR_STATE) if m["desired_position"] and m["position"]]
+    cmd = log.series(TOPIC_ARM_JOINT_COMMAND)
     cmd_t = {round(m["t"], 9): m for m in cmd}
     eff = [m for m in eff if round(m["t"], 9) in cmd_t]
     cmd = [cmd_t[round(m["t"], 9)] for m in eff]
-    js = log.series("/arm/joint_state")
-    ob = log.series("/object/state")
-    mo = log.series("/effector/motion")
-    hj = log.series("/hand/joint_state")
-    vi = log.series("/vision/object")
-    cs = log.series("/catching/state")
+    js = log.series(TOPIC_ARM_JOINT_STATE)
+    ob = log.series(TOPIC_OBJECT_STATE)
+    mo = log.series(TOPIC_EFFECTOR_MOTION)
+    hj = log.series(TOPIC_HAND_JOINT_STATE)
+    vi = log.series(TOPIC_VISION_OBJECT)
+    cs = log.series(TOPIC_CATCHING_STATE)
     ev = events(log)
     run = CatchRun(
         name=name or sc["name"], scenario=sc,
-        mapping=sc["controller"]["params"].get("mapping", "optimised"),
-        dt=1.0 / float(sc["controller"].get("rate", 1000.0)),
+        mapping=str(typed.controller.params.mapping),      # the typed scenario: no default here
+        dt=1.0 / float(typed.controller.rate),
         t_ctrl=_vec(eff, "t"), effector=_vec(eff, "position").reshape(-1, 3),
         effector_desired=_vec(eff, "desired_position").reshape(-1, 3),
         q_desired=_vec(cmd, "position"), torque=_vec(cmd, "torque"),
@@ -141,10 +138,10 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
         t_tool=_vec(mo, "t"), tool_velocity=_vec(mo, "velocity").reshape(-1, 3),
         t_hand=_vec(hj, "t"), hand_q=_vec(hj, "position"), hand_qd=_vec(hj, "velocity"),
         t_vision=_vec(vi, "t"), vision=_vec(vi, "position").reshape(-1, 3),
-        costs=sorted(log.series("/optimization/cost"), key=lambda c: c["iteration"]),
+        costs=sorted(log.series(TOPIC_OPTIMIZATION_COST), key=lambda c: c["iteration"]),
         cs_t=_vec(cs, "t"), cs_qd_desired=_vec(cs, "velocity_desired"),
         cs_r_o=_vec(cs, "r_o").reshape(-1, 3),
-        settings=arm_settings(sc), events=ev)
+        settings=resolve(typed.plant.params), events=ev)
     run.t0 = float(cs[0]["t"]) if cs else None
     hold = run.first_event("mapping_hold")
     if hold is not None:
