@@ -109,7 +109,7 @@ def plot_arm_limits(rows: list[dict], out: Path, stem: str) -> list[Path]:
 def plot_direct_vs_predictive(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.0))
     styles = {"catch_optimised": ("tab:blue", "direct mapping"),
-              "catch_predictive": ("tab:orange", "predict-then-intercept")}
+              "predictive_catch": ("tab:orange", "predict-then-intercept")}
     for (method, kick), sub in sorted(_split(rows, "scenario", "kick").items()):
         (xs, ys), = rate_by(sub, "camera", None, caught).values()
         color, label = styles.get(method, ("0.4", method))
@@ -179,13 +179,13 @@ def summary_direct_vs_predictive(rows: list[dict]) -> str:
 
     hi, lo = xs[-1], xs[0]
     d = [at("catch_optimised", k, x) for k in ("none", "kick") for x in (hi, lo)]
-    p = [at("catch_predictive", k, x) for k in ("none", "kick") for x in (hi, lo)]
+    p = [at("predictive_catch", k, x) for k in ("none", "kick") for x in (hi, lo)]
     text = (f"At {hi:g} Hz the direct mapping caught {pct(d[0])} (kick: {pct(d[2])}) and the "
             f"predictor {pct(p[0])} (kick: {pct(p[2])}); at {lo:g} Hz direct {pct(d[1])} "
             f"(kick: {pct(d[3])}), predictor {pct(p[1])} (kick: {pct(p[3])}). ")
     speeds = {k: mean_by(v, "camera", None, "x.contact_speed")[""] for k, v in split.items()}
     sd = rate_at({"": speeds.get(("catch_optimised", "none"), ([], []))}, "", hi)
-    sp = rate_at({"": speeds.get(("catch_predictive", "none"), ([], []))}, "", hi)
+    sp = rate_at({"": speeds.get(("predictive_catch", "none"), ([], []))}, "", hi)
     if not (np.isnan(sd) or np.isnan(sp)):
         text += (f"At first hand contact the ball moved at {sd:.1f} m/s relative to the hand "
                  f"with the direct mapping and {sp:.1f} m/s with the predictor ({hi:g} Hz, no "

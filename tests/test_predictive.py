@@ -58,7 +58,7 @@ def test_quintic_meets_its_boundary_conditions():
 def spec():
     from replay.runner import Runner
     from replay.scenario import load_scenario
-    sc = load_scenario(ROOT / "scenarios" / "catch_predictive.yaml")
+    sc = load_scenario(ROOT / "scenarios" / "predictive_catch.yaml")
     runner = Runner(sc)
     spec, params = runner.plant.spec(), sc.controller.params
     runner.plant.close()
