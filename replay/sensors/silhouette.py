@@ -32,7 +32,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix
+from replay.scene import Box, Cylinder, Scene, Sphere
+from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
 from replay.sensors.raster import composite
 
