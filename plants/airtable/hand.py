@@ -37,7 +37,7 @@ class HandServo:
         self.base_target = self.base.copy()
         self.joint_targets = self.joints.copy()
         self._settled = True          # at the targets: advance() has nothing to do
-        self._tips = None             # tips() of the current base and joints, once computed
+        self._tips: np.ndarray | None = None   # tips() of the current base and joints, once computed
 
     def clamp_base(self, base: np.ndarray) -> tuple[np.ndarray, bool]:
         c = np.clip(base, self._base_lo, self._base_hi)
@@ -74,7 +74,8 @@ class HandServo:
 
     def tips(self) -> np.ndarray:
         """Fingertip centres (2 x 2, world, m) for the current base and joints (a copy)."""
-        if self._tips is None:
-            self._tips = np.array([finger_tip(self.spec, self.base, k, self.joints[k])
-                                   for k in (0, 1)])
-        return self._tips.copy()
+        tips = self._tips
+        if tips is None:
+            tips = self._tips = np.array([finger_tip(self.spec, self.base, k, self.joints[k])
+                                          for k in (0, 1)])
+        return tips.copy()

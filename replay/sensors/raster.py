@@ -23,20 +23,19 @@ def _cut(a: np.ndarray, b: np.ndarray, limit: int):
     """Cut segments running from coordinate ``a`` to ``b`` at every integer in [0, limit] they
     cross: (segment index, s0, s1) of the pieces, s the parameter along the segment (0 at a,
     1 at b), in order along each segment (no sort: crossings are generated in the direction
-    the segment runs)."""
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    first = np.clip(np.ceil(lo), 0, limit)
-    last = np.clip(np.floor(hi), 0, limit)
+    the segment runs). Written for few NumPy calls: the arrays are short."""
     d = b - a
-    n = np.where(d != 0.0, np.maximum(last - first + 1, 0), 0).astype(np.int64) + 2
-    seg = np.repeat(np.arange(len(a)), n)
-    j = np.arange(seg.size) - np.repeat(np.cumsum(n) - n, n)       # 0 .. n - 1 on each segment
-    up = d[seg] > 0.0
-    k = np.where(up, first[seg] + (j - 1), last[seg] - (j - 1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.clip((k - a[seg]) / d[seg], 0.0, 1.0)
-    s = np.where(j == 0, 0.0, np.where(j == n[seg] - 1, 1.0, s))
-    inner = np.flatnonzero(j < n[seg] - 1)                          # piece from s[i] to s[i + 1]
+    first = np.minimum(np.maximum(np.ceil(np.minimum(a, b)), 0.0), limit)
+    last = np.minimum(np.maximum(np.floor(np.maximum(a, b)), 0.0), limit)
+    n = (np.maximum(last - first + 1.0, 0.0) * (d != 0.0)).astype(np.int64) + 2
+    seg = np.arange(len(a)).repeat(n)
+    j = np.arange(seg.size) - (n.cumsum() - n).repeat(n)          # 0 .. n - 1 on each segment
+    ds, ns = d[seg], n[seg]
+    k = np.where(ds > 0.0, first[seg] + (j - 1), last[seg] - (j - 1))
+    s = np.minimum(np.maximum((k - a[seg]) / np.where(ds != 0.0, ds, 1.0), 0.0), 1.0)
+    s[j == 0] = 0.0
+    s[j == ns - 1] = 1.0
+    inner = np.flatnonzero(j < ns - 1)                              # piece from s[i] to s[i + 1]
     return seg[inner], s[inner], s[inner + 1]
 
 
@@ -50,36 +49,54 @@ def coverage(polygons, x0: int, y0: int, w: int, h: int) -> np.ndarray:
     if not polys:
         return np.zeros((n, h, w))
     # window coordinates: pixel (c, r) spans [c, c + 1] x [r, r + 1]
-    origin = (x0 - 0.5, y0 - 0.5)
-    P = np.concatenate([q for _, q in polys]) - origin
-    Q = np.concatenate([np.roll(q, -1, axis=0) for _, q in polys]) - origin
-    sizes = [len(q) for _, q in polys]
-    cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]      # twice each polygon's signed area
-    area_sign = np.where(np.add.reduceat(cross, np.cumsum(sizes) - sizes) >= 0.0, -1.0, 1.0)
-    owner = np.repeat([i for i, _ in polys], sizes)
-    sign = np.repeat(area_sign, sizes)
+    origin = np.array([x0 - 0.5, y0 - 0.5])
+    if len(polys) == 1:
+        owner_id, P = polys[0]
+        P = P - origin
+        Q = np.concatenate((P[1:], P[:1]))
+        cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]  # twice the polygon's signed area
+        sign = -1.0 if cross.sum() >= 0.0 else 1.0     # either orientation covers positively
+        owner = None
+    else:
+        P = np.concatenate([q for _, q in polys]) - origin
+        Q = np.concatenate([np.concatenate((q[1:], q[:1])) for _, q in polys]) - origin
+        sizes = np.array([len(q) for _, q in polys], dtype=np.int64)
+        cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]
+        signs = np.where(np.add.reduceat(cross, sizes.cumsum() - sizes) >= 0.0, -1.0, 1.0)
+        owner = np.array([i for i, _ in polys]).repeat(sizes)
+        sign = signs.repeat(sizes)
     # edges cut into pieces within one pixel row, then within one pixel
     e, s0, s1 = _cut(P[:, 1], Q[:, 1], h)
-    d = Q[e] - P[e]
-    ya = P[e, 1] + s0 * d[:, 1]
-    yb = P[e, 1] + s1 * d[:, 1]
-    xa = P[e, 0] + s0 * d[:, 0]
-    xb = P[e, 0] + s1 * d[:, 0]
+    Pe, de = P[e], Q[e] - P[e]
+    ya = Pe[:, 1] + s0 * de[:, 1]
+    yb = Pe[:, 1] + s1 * de[:, 1]
+    xa = Pe[:, 0] + s0 * de[:, 0]
+    xb = Pe[:, 0] + s1 * de[:, 0]
     row = np.floor(0.5 * (ya + yb))
-    keep = (ya != yb) & (row >= 0) & (row < h)
+    keep = np.flatnonzero((ya != yb) & (row >= 0) & (row < h))
     e, row, xa, xb, ya, yb = e[keep], row[keep], xa[keep], xb[keep], ya[keep], yb[keep]
     r, u0, u1 = _cut(xa, xb, w)
     xm = xa[r] + 0.5 * (u0 + u1) * (xb[r] - xa[r])
-    dy = (u1 - u0) * (yb[r] - ya[r]) * sign[e[r]]
+    dy = (u1 - u0) * (yb[r] - ya[r])
+    dy = dy * (sign if owner is None else sign[e[r]])
     col = np.floor(xm)
-    keep = col < w                                     # right of the window: no effect in it
+    keep = np.flatnonzero(col < w)                     # right of the window: no effect in it
     r, xm, dy, col = r[keep], xm[keep], dy[keep], col[keep]
-    f = np.where(col < 0, 0.0, xm - col)               # left of the window: at its left edge
-    cell = ((owner[e[r]] * h + row[r]) * stride + np.maximum(col, 0.0)).astype(np.int64)
+    left = col < 0                                     # left of the window: at its left edge
+    f = xm - col
+    f[left] = 0.0
+    col[left] = 0.0
+    base = row[r] if owner is None else owner[e[r]] * h + row[r]
+    cell = (base * stride + col).astype(np.int64)
     size = n * h * stride
-    acc = (np.bincount(cell, weights=dy * (1.0 - f), minlength=size)
-           + np.bincount(cell + 1, weights=dy * f, minlength=size + 1)[:size])
-    return np.cumsum(acc.reshape(n, h, stride), axis=2)[:, :, :w]
+    acc = np.bincount(cell, weights=dy * (1.0 - f), minlength=size + 1)
+    acc[1:] += np.bincount(cell + 1, weights=dy * f, minlength=size + 1)[1:]
+    if owner is None and n > 1:                        # one drawable polygon among several
+        out = np.zeros((n, h, w))
+        out[owner_id] = acc[:size // n].reshape(h, stride).cumsum(axis=1)[:, :w]
+        return out
+    return acc[:size].reshape(n, h, stride).cumsum(axis=2)[:, :, :w]
+
 
 def composite(img: np.ndarray, polygons, greys, origin=(0, 0)) -> None:
     """Alpha-composite polygons (pixels of the full image) of grey levels ``greys`` onto a float
@@ -88,6 +105,7 @@ def composite(img: np.ndarray, polygons, greys, origin=(0, 0)) -> None:
     if not len(polygons):
         return
     h, w = img.shape
-    alpha = np.clip(coverage(polygons, origin[0], origin[1], w, h), 0.0, 1.0).astype(np.float32)
+    cov = coverage(polygons, origin[0], origin[1], w, h)
+    alpha = np.minimum(np.maximum(cov, 0.0), 1.0).astype(np.float32)
     for a, grey in zip(alpha, greys):
         img += a * (np.float32(grey) - img)

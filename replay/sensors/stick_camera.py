@@ -57,12 +57,15 @@ _RIM = 48             # vertices of a polygon standing in for a circle
 
 # --- geometry of primitives ----------------------------------------------------------------
 
+_BOX_SIGNS = np.array([[sx, sy, sz] for sz in (-1.0, 1.0)
+                       for sx, sy in ((1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0))])
+
+
 def box_corners(box: Box) -> np.ndarray:
     """The 8 corners (8, 3) of a box in world coordinates; the last 4 are the body +z face."""
-    hx, hy, hz = (0.5 * float(s) for s in box.size)
-    body = np.array([[sx * hx, sy * hy, sz * hz]
-                     for sz in (-1, 1) for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
-    return body @ quaternion_matrix(box.orientation).T + np.asarray(box.position, dtype=float)
+    half = np.array([0.5 * float(s) for s in box.size])
+    return (_BOX_SIGNS * half) @ quaternion_matrix(box.orientation).T + np.asarray(
+        box.position, dtype=float)
 
 
 def _circle(n: int) -> np.ndarray:
