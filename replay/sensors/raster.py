@@ -55,8 +55,8 @@ def coverage(polygons, x0: int, y0: int, w: int, h: int) -> np.ndarray:
         P = P - origin
         Q = np.concatenate((P[1:], P[:1]))
         cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]  # twice the polygon's signed area
-        sign = -1.0 if cross.sum() >= 0.0 else 1.0     # either orientation covers positively
-        owner = None
+        sign: float | np.ndarray = -1.0 if cross.sum() >= 0.0 else 1.0   # either orientation
+        owner = None                                   # covers positively
     else:
         P = np.concatenate([q for _, q in polys]) - origin
         Q = np.concatenate([np.concatenate((q[1:], q[:1])) for _, q in polys]) - origin
@@ -78,7 +78,7 @@ def coverage(polygons, x0: int, y0: int, w: int, h: int) -> np.ndarray:
     r, u0, u1 = _cut(xa, xb, w)
     xm = xa[r] + 0.5 * (u0 + u1) * (xb[r] - xa[r])
     dy = (u1 - u0) * (yb[r] - ya[r])
-    dy = dy * (sign if owner is None else sign[e[r]])
+    dy = dy * (sign if isinstance(sign, float) else sign[e[r]])
     col = np.floor(xm)
     keep = np.flatnonzero(col < w)                     # right of the window: no effect in it
     r, xm, dy, col = r[keep], xm[keep], dy[keep], col[keep]
