@@ -44,6 +44,32 @@ def bare_stepper(runner: Runner):
     return "plant.step (no bare engine found)", plant, plant.step
 
 
+def engine_in_run(sc, out: Path) -> tuple[float, float, int]:
+    """(CPU s of the whole run, CPU s inside the engine's own step, steps) of one run with the
+    engine's step call timed: the engine's share of a real run, where contacts and motors make
+    it work harder than bare stepping of the initial scene."""
+    runner = Runner(sc)
+    plant, spent = runner.plant, [0.0, 0]
+    clock = time.process_time
+
+    def timed(step):
+        def wrapper(*args, **kw):
+            c0 = clock()
+            out = step(*args, **kw)
+            spent[0] += clock() - c0
+            spent[1] += 1
+            return out
+        return wrapper
+    space, bc = getattr(plant, "space", None), getattr(plant, "bc", None)
+    if space is not None and hasattr(space, "step"):
+        space.step = timed(space.step)
+    elif bc is not None:
+        bc.stepSimulation = timed(bc.stepSimulation)
+    c0 = clock()
+    runner.run(out)
+    return clock() - c0, spent[0], spent[1]
+
+
 def _stats(values: list[float]) -> tuple[float, float, float]:
     return statistics.median(values), min(values), max(values)
 
@@ -81,6 +107,7 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
             total = sum(result.timings.values())
             for c in COMPONENTS:
                 shares[c].append(result.timings[c] / total)
+        run_cpu, engine_cpu, engine_steps = engine_in_run(sc, Path(tmp) / "engine.mcap")
     engine, plant, step = bare_stepper(Runner(sc))
     bare = []
     for _ in range(max(runs, 3)):
@@ -92,6 +119,7 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
     out = {"scenario": sc.name, "sim_time": result.t_end, "steps": result.steps,
            "messages": result.messages, "runs": runs, "cpu": _stats(cpu), "wall": _stats(wall),
            "engine": engine, "bare": _stats(bare),
+           "engine_in_run": (engine_cpu / run_cpu, engine_cpu / max(engine_steps, 1)),
            "shares": {c: statistics.median(v) for c, v in shares.items()}}
     for key in ("cpu", "wall"):                  # (median, min, max) of simulated s per second
         med, lo, hi = out[key]
@@ -128,7 +156,9 @@ def report(r: dict) -> str:
         f"{_range(r['rtf_wall'], '.1f')}x (shared machine: wall is noisy)",
         f"  bare engine ({r['engine']}, same scene and steps): {_range(r['bare'], '.4f')} s CPU "
         f"= {1e6 * r['bare'][0] / max(r['steps'], 1):.1f} us a step; "
-        f"full run / bare = {r['ratio']:.0f}x",
+        f"full run / bare = {r['ratio']:.0f}x; inside a run the engine takes "
+        f"{1e6 * r['engine_in_run'][1]:.1f} us a step, {100 * r['engine_in_run'][0]:.1f} % of the "
+        "run's CPU (contacts, motors)",
         "  where the time goes (runner's timers, share of the loop): "
         + ", ".join(f"{c} {100 * r['shares'][c]:.0f} %" for c in COMPONENTS)
         + "  [" + ", ".join(f"{c} {1e3 * r['shares'][c] * r['cpu'][0] / sim:.0f}"
