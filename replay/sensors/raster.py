@@ -19,11 +19,12 @@ from __future__ import annotations
 import numpy as np
 
 
-def _cut(a: np.ndarray, b: np.ndarray, limit: int):
+def _cut(a: np.ndarray, b: np.ndarray, limit):
     """Cut segments running from coordinate ``a`` to ``b`` at every integer in [0, limit] they
-    cross: (segment index, s0, s1) of the pieces, s the parameter along the segment (0 at a,
-    1 at b), in order along each segment (no sort: crossings are generated in the direction
-    the segment runs). Written for few NumPy calls: the arrays are short."""
+    cross (``limit`` one number or one per segment): (segment index, s0, s1) of the pieces, s
+    the parameter along the segment (0 at a, 1 at b), in order along each segment (no sort:
+    crossings are generated in the direction the segment runs). Written for few NumPy calls:
+    the arrays are short."""
     d = b - a
     first = np.minimum(np.maximum(np.ceil(np.minimum(a, b)), 0.0), limit)
     last = np.minimum(np.maximum(np.floor(np.maximum(a, b)), 0.0), limit)
@@ -39,63 +40,72 @@ def _cut(a: np.ndarray, b: np.ndarray, limit: int):
     return seg[inner], s[inner], s[inner + 1]
 
 
-def coverage(polygons, x0: int, y0: int, w: int, h: int) -> np.ndarray:
+def coverage_blocks(polygons, blocks) -> list[np.ndarray]:
     """Exact covered area (0..1) of each polygon ((N, 2) vertices in pixels, either orientation)
-    in each pixel of the ``h x w`` block whose first pixel is ``(x0, y0)``: shape (n, h, w).
-    All polygons' edges are cut and accumulated together (a few NumPy calls per block)."""
-    n = len(polygons)
-    stride = w + 1
-    polys = [(i, np.asarray(q, dtype=float)) for i, q in enumerate(polygons) if len(q) >= 3]
-    if not polys:
-        return np.zeros((n, h, w))
-    # window coordinates: pixel (c, r) spans [c, c + 1] x [r, r + 1]
-    origin = np.array([x0 - 0.5, y0 - 0.5])
-    if len(polys) == 1:
-        owner_id, P = polys[0]
-        P = P - origin
-        Q = np.concatenate((P[1:], P[:1]))
-        cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]  # twice the polygon's signed area
-        sign: float | np.ndarray = -1.0 if cross.sum() >= 0.0 else 1.0   # either orientation
-        owner = None                                   # covers positively
-    else:
-        P = np.concatenate([q for _, q in polys]) - origin
-        Q = np.concatenate([np.concatenate((q[1:], q[:1])) for _, q in polys]) - origin
-        sizes = np.array([len(q) for _, q in polys], dtype=np.int64)
-        cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]
-        signs = np.where(np.add.reduceat(cross, sizes.cumsum() - sizes) >= 0.0, -1.0, 1.0)
-        owner = np.array([i for i, _ in polys]).repeat(sizes)
-        sign = signs.repeat(sizes)
+    in each pixel of its own block ``(x0, y0, w, h)`` (the ``h x w`` pixels whose first is
+    ``(x0, y0)``): a list of (h, w) arrays. All polygons' edges are cut and accumulated together,
+    so the cost (a few dozen NumPy calls on short arrays) is shared by every polygon and block,
+    e.g. the same ball seen by two cameras."""
+    out = [np.zeros((int(b[3]), int(b[2]))) for b in blocks]
+    todo = [i for i, q in enumerate(polygons) if len(q) >= 3 and blocks[i][2] > 0
+            and blocks[i][3] > 0]
+    if not todo:
+        return out
+    # window coordinates: pixel (c, r) of a block spans [c, c + 1] x [r, r + 1]
+    Ps, Qs, sizes = [], [], []
+    for i in todo:
+        x0, y0 = blocks[i][0], blocks[i][1]
+        P = np.asarray(polygons[i], dtype=float) - (x0 - 0.5, y0 - 0.5)
+        Ps.append(P)
+        Qs.append(np.concatenate((P[1:], P[:1])))
+        sizes.append(len(P))
+    P, Q = np.concatenate(Ps), np.concatenate(Qs)
+    size = np.array(sizes, dtype=np.int64)
+    ws = np.array([blocks[i][2] for i in todo], dtype=np.int64)
+    hs = np.array([blocks[i][3] for i in todo], dtype=np.int64)
+    strides = ws + 1
+    offsets = np.concatenate(([0], (hs * strides).cumsum()))
+    cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]      # twice each polygon's signed area
+    signs = np.where(np.add.reduceat(cross, size.cumsum() - size) >= 0.0, -1.0, 1.0)
+    owner = np.arange(len(todo)).repeat(size)          # edge -> polygon (in ``todo``)
     # edges cut into pieces within one pixel row, then within one pixel
-    e, s0, s1 = _cut(P[:, 1], Q[:, 1], h)
+    e, s0, s1 = _cut(P[:, 1], Q[:, 1], hs[owner])
     Pe, de = P[e], Q[e] - P[e]
     ya = Pe[:, 1] + s0 * de[:, 1]
     yb = Pe[:, 1] + s1 * de[:, 1]
     xa = Pe[:, 0] + s0 * de[:, 0]
     xb = Pe[:, 0] + s1 * de[:, 0]
     row = np.floor(0.5 * (ya + yb))
-    keep = np.flatnonzero((ya != yb) & (row >= 0) & (row < h))
-    e, row, xa, xb, ya, yb = e[keep], row[keep], xa[keep], xb[keep], ya[keep], yb[keep]
-    r, u0, u1 = _cut(xa, xb, w)
+    oe = owner[e]
+    keep = np.flatnonzero((ya != yb) & (row >= 0) & (row < hs[oe]))
+    oe, row, xa, xb, ya, yb = oe[keep], row[keep], xa[keep], xb[keep], ya[keep], yb[keep]
+    r, u0, u1 = _cut(xa, xb, ws[oe])
+    o = oe[r]
     xm = xa[r] + 0.5 * (u0 + u1) * (xb[r] - xa[r])
-    dy = (u1 - u0) * (yb[r] - ya[r])
-    dy = dy * (sign if isinstance(sign, float) else sign[e[r]])
+    dy = (u1 - u0) * (yb[r] - ya[r]) * signs[o]
     col = np.floor(xm)
-    keep = np.flatnonzero(col < w)                     # right of the window: no effect in it
-    r, xm, dy, col = r[keep], xm[keep], dy[keep], col[keep]
-    left = col < 0                                     # left of the window: at its left edge
+    keep = np.flatnonzero(col < ws[o])                 # right of the block: no effect in it
+    o, r, xm, dy, col = o[keep], r[keep], xm[keep], dy[keep], col[keep]
+    left = col < 0                                     # left of the block: at its left edge
     f = xm - col
     f[left] = 0.0
     col[left] = 0.0
-    base = row[r] if owner is None else owner[e[r]] * h + row[r]
-    cell = (base * stride + col).astype(np.int64)
-    size = n * h * stride
-    acc = np.bincount(cell, weights=dy * (1.0 - f), minlength=size + 1)
-    acc[1:] += np.bincount(cell + 1, weights=dy * f, minlength=size + 1)[1:]
-    if owner is None and n > 1:                        # one drawable polygon among several
-        out = np.zeros((n, h, w))
-        out[owner_id] = acc[:size // n].reshape(h, stride).cumsum(axis=1)[:, :w]
-        return out
-    return acc[:size].reshape(n, h, stride).cumsum(axis=2)[:, :, :w]
+    cell = (offsets[o] + row[r] * strides[o] + col).astype(np.int64)
+    total = int(offsets[-1])
+    acc = np.bincount(cell, weights=dy * (1.0 - f), minlength=total + 1)
+    acc[1:] += np.bincount(cell + 1, weights=dy * f, minlength=total + 1)[1:]
+    for k, i in enumerate(todo):
+        h, w, st = int(hs[k]), int(ws[k]), int(strides[k])
+        out[i] = acc[offsets[k]:offsets[k] + h * st].reshape(h, st).cumsum(axis=1)[:, :w]
+    return out
+
+
+def coverage(polygons, x0: int, y0: int, w: int, h: int) -> np.ndarray:
+    """Exact covered area (0..1) of each polygon in each pixel of the ``h x w`` block whose first
+    pixel is ``(x0, y0)``: shape (n, h, w) (:func:`coverage_blocks` with one block)."""
+    if not len(polygons):
+        return np.zeros((0, h, w))
+    return np.stack(coverage_blocks(polygons, [(x0, y0, w, h)] * len(polygons)))
 
 
 def composite(img: np.ndarray, polygons, greys, origin=(0, 0)) -> None:
@@ -105,7 +115,11 @@ def composite(img: np.ndarray, polygons, greys, origin=(0, 0)) -> None:
     if not len(polygons):
         return
     h, w = img.shape
-    cov = coverage(polygons, origin[0], origin[1], w, h)
+    for cov, grey in zip(coverage(polygons, origin[0], origin[1], w, h), greys):
+        paint(img, cov, grey)
+
+
+def paint(img: np.ndarray, cov: np.ndarray, grey: float) -> None:
+    """``img += alpha (grey - img)`` in place, alpha the coverage clipped to [0, 1] (float32)."""
     alpha = np.minimum(np.maximum(cov, 0.0), 1.0).astype(np.float32)
-    for a, grey in zip(alpha, greys):
-        img += a * (np.float32(grey) - img)
+    img += alpha * (np.float32(grey) - img)

@@ -65,7 +65,7 @@ from replay.messages import VisionObject
 from replay.params import param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.sensors.silhouette import correct_sphere_centroid, render
+from replay.sensors.silhouette import correct_sphere_centroid, render_views
 
 _DILATE = np.ones((5, 5), np.uint8)   # the grey-moment region: the blob grown by 2 px
 _MARGIN = 4                           # px around the blob: region (2) + background ring (2)
@@ -159,8 +159,7 @@ class StereoBallCamera(Sensor):
         p = params if params is not None else StereoBallCameraParams()
         cams = cameras if cameras is not None else StereoBallCamera.make_cameras(p)
         out = []
-        for cam in cams:
-            img = render(cam, scene, background=p.background)
+        for img in render_views(cams, scene, background=p.background):
             if rng is not None and p.noise_sigma > 0.0:
                 img += np.float32(p.noise_sigma) * rng.standard_normal(img.shape, dtype=np.float32)
             out.append(np.clip(np.rint(img), 0, 255).astype(np.uint8))
