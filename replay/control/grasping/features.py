@@ -6,8 +6,9 @@ give the centre xi and rotation phi; its extents and fill the object's size and 
   towards +v (defined modulo pi; meaningless for an isotropic blob: see ``elongation``);
 - ``elongation = sqrt(lambda_1 / lambda_2)`` of the second-moment matrix;
 - ``fill`` = pixels / area of the smallest bounding box over orientations (5 deg steps, pixel
-  squares counted whole): a rectangle fills its box (~1), a disc pi/4 of it (~0.79). The
-  shape is a rectangle above ``rectangle_fill`` (a method parameter), else a circle.
+  squares counted whole): a rectangle fills its box (~1), a disc pi/4 of it (~0.79); at
+  16 x 16 a rolled rectangle's jagged outline fills only ~0.75, so the shape decision
+  (``recognition.shape_of``) uses the elongation as well.
 """
 
 from __future__ import annotations

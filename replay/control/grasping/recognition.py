@@ -7,7 +7,7 @@ meets the constraint plane given beforehand at the object's 3-D position; a seco
 the principal axis gives the roll about the plane's normal, so ``x_o = (x, y, z, roll, pitch,
 yaw)`` with pitch and yaw those of the plane (0 here: the plane's normal is the reference). The
 pixel extents at that depth give the size; the fill of the smallest bounding box the shape
-(rectangle vs circle), decided by a vote over the first ``shape_frames`` whole views (not cut by
+(rectangle vs circle: :func:`shape_of`), decided by a vote over the first ``shape_frames`` whole views (not cut by
 the image border) and then kept. The image Jacobian of the head (d xi / d(pan, tilt), for eq. 1)
 is that of the same model at the estimated point. Nothing here predicts motion.
 """
@@ -37,13 +37,27 @@ class RecognitionParams:
                        doc="the chip's calibrated horizontal field of view (= the sensor's)")
     width: int = param(16, unit="px", ge=2, doc="chip width (= the sensor's)")
     height: int = param(16, unit="px", ge=2, doc="chip height (= the sensor's)")
-    rectangle_fill: float = param(0.86, unit="1", gt=0.0, lt=1.0,
+    rectangle_fill: float = param(0.9, unit="1", gt=0.0, lt=1.0,
                                   doc="fill of the smallest bounding box above which the shape "
-                                      "is a rectangle (rectangle ~1, disc pi/4 = 0.79)")
+                                      "is a rectangle (an axis-aligned rectangle ~1, a disc "
+                                      "pi/4 = 0.79; a rolled one's jagged 16 x 16 edges ~0.75)")
+    rectangle_elongation: float = param(1.3, unit="1", ge=1.0,
+                                        doc="elongation above which the shape is a rectangle "
+                                            "(a disc's is 1; measured 1.01-1.11 on the chip)")
     min_area: int = param(6, unit="px", ge=1, doc="smallest target used to judge the shape")
     shape_frames: int = param(20, ge=1, doc="whole views voted on before the shape is decided")
     axis_elongation: float = param(1.25, unit="1", ge=1.0,
                                    doc="elongation above which the target's axis (roll) is used")
+
+
+def shape_of(b, params: RecognitionParams) -> str:
+    """Rectangle or circle from one target's features (Fig. 5(b)): a rectangle is elongated or
+    fills its bounding box; a circle neither. (A square face is told from a disc only by the
+    fill, i.e. when its edges line up with the pixels: at 16 x 16 a rolled square's jagged
+    outline fills ~0.75 of its box, like a disc.)"""
+    if b.elongation >= params.rectangle_elongation or b.fill >= params.rectangle_fill:
+        return "rectangle"
+    return "circle"
 
 
 def plane_basis(normal) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -183,7 +197,7 @@ class RecognitionTask(Controller):
                            b.elongation, J.tolist(), list(angles))
 
     def _vote(self, b) -> None:
-        kind = "rectangle" if b.fill >= self.params.rectangle_fill else "circle"
+        kind = shape_of(b, self.params)
         self._votes[kind] += 1
         if self.shape == "unknown" and sum(self._votes.values()) >= self.params.shape_frames:
             self.shape = max(self._votes, key=lambda k: (self._votes[k], k))
