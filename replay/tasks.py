@@ -65,7 +65,7 @@ class TaskSet(Controller):
         self._fields: dict[type, tuple[str, ...]] = {}
 
     def _route(self, topic: str, payload: Any) -> None:
-        stamp = getattr(payload, "t", None)
+        stamp = payload.get("t") if isinstance(payload, dict) else getattr(payload, "t", None)
         for task in self._readers.get(topic, ()):
             self._inbox[task.name].append((topic, payload))
             if stamp is not None:

@@ -64,6 +64,7 @@ class ArmParams:
 
 
 class ArmControlTask(Controller):
+    """Eqs. 2-3: arm tracking (S) and reaching (I - S) with wrist force feedback."""
     Params = ArmParams
     spec_type = GraspSpec
     command_type = ServoCommand

@@ -61,6 +61,7 @@ class HandParams:
 
 
 class HandControlTask(Controller):
+    """Eq. 4: hand compliance control with joint-torque feedback, preshaped by the shape."""
     Params = HandParams
     spec_type = GraspSpec
     command_type = ServoCommand

@@ -32,6 +32,7 @@ class HeadParams:
 
 
 class HeadTrackingTask(Controller):
+    """Eq. 1: active-vision tracking with the head model's image Jacobian."""
     Params = HeadParams
     spec_type = GraspSpec
     command_type = ServoCommand

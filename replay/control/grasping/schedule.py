@@ -43,6 +43,7 @@ def min_jerk(s: float) -> float:
 
 
 class ScheduleTask(Controller):
+    """The grasp/release schedule and the reaching target x_d^a, given beforehand."""
     Params = ScheduleParams
     spec_type = GraspSpec
     command_type = ServoCommand
