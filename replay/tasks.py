@@ -30,7 +30,7 @@ class TaskLoops:
     names: list
     ticked: list         # bool per task: ran this step
     latency: list        # s per task (None before its inputs first arrived)
-    inputs: dict         # task -> {topic: s since that topic's newest message was captured}
+    oldest: list         # per task: the input topic that latency is of
 
 
 @dataclass
@@ -56,6 +56,7 @@ class TaskSet(Controller):
         self._inbox: dict[str, list] = {t.name: [] for t in tasks}
         self._newest: dict[str, dict[str, float]] = {t.name: {} for t in tasks}
         self._latency: dict[str, float | None] = {t.name: None for t in tasks}
+        self._oldest: dict[str, str | None] = {t.name: None for t in tasks}
         self._ticked = [False] * len(tasks)
         self._telemetry: dict[str, list] = {}
         self._readers: dict[str, list[Task]] = {}
@@ -96,7 +97,10 @@ class TaskSet(Controller):
             inbox, self._inbox[task.name] = self._inbox[task.name], []
             command = task.controller.update(t, inbox)
             newest = self._newest[task.name]
-            self._latency[task.name] = (t - min(newest.values())) if newest else None
+            if newest:
+                topic = min(newest, key=lambda k: (newest[k], k))
+                self._latency[task.name] = t - newest[topic]
+                self._oldest[task.name] = topic
             if command is not None:
                 self._check(task, command)
                 commands.append(command)
@@ -113,8 +117,7 @@ class TaskSet(Controller):
         out[TOPIC_TASK_LOOPS] = TaskLoops(
             t, [x.name for x in self.tasks], list(self._ticked),
             [self._latency[x.name] for x in self.tasks],
-            {x.name: {topic: t - s for topic, s in sorted(self._newest[x.name].items())}
-             for x in self.tasks})
+            [self._oldest[x.name] for x in self.tasks])
         return out
 
     def pop_events(self) -> list[Occurrence]:

@@ -195,3 +195,15 @@ def test_head_loop_centres_the_target(spec):
         servo.step()
         err = np.asarray(obj.xi) - 7.5
     assert np.linalg.norm(err) < 0.5
+
+
+def test_image_jacobian_is_the_head_models(spec):
+    from replay.control.grasping.recognition import Camera
+    cam = Camera(spec.head, FOV, 16, 16)
+    X = np.array([0.75, 0.03, 0.52])
+    a = np.array(look_angles(spec.head, X)) + [0.02, -0.03]
+    J = cam.jacobian(a, X)
+    h = 1e-6
+    num = np.column_stack([(cam.project(a + e, X) - cam.project(a - e, X)) / (2 * h)
+                           for e in (np.array([h, 0.0]), np.array([0.0, h]))])
+    np.testing.assert_allclose(J, num, rtol=1e-5, atol=1e-4)

@@ -67,10 +67,15 @@ class VisionChipSensor(Sensor):
         self.intrinsics = Intrinsics.from_fov(p.width, p.height, p.fov)
         self.level = 255.0 * (p.background + p.threshold * (p.object_albedo - p.background))
         self.last_image: np.ndarray | None = None
+        self._camera = PinholeCamera(self.intrinsics)
 
     def camera(self, scene: Scene) -> PinholeCamera:
+        """The chip's camera at this frame's pose (one object, its pose replaced each frame: the
+        head model's rotation is orthonormal by construction, so it is not re-validated)."""
         r = scene.readings[self.params.reading]
-        return PinholeCamera(self.intrinsics, r["camera_rotation"], r["camera_position"])
+        self._camera.rotation = np.asarray(r["camera_rotation"], float)
+        self._camera.position = np.asarray(r["camera_position"], float)
+        return self._camera
 
     def image(self, scene: Scene) -> np.ndarray:
         """The binary (h, w) bool image of this frame."""

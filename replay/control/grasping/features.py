@@ -38,8 +38,9 @@ class Blob:
     touches_border: bool
 
 
-def blob(target: np.ndarray) -> Blob | None:
-    """The features of a binary target image, or None if it is empty."""
+def blob(target: np.ndarray, fill: bool = True) -> Blob | None:
+    """The features of a binary target image, or None if it is empty (``fill=False``: skip the
+    bounding-box search, ``fill`` is then NaN)."""
     vs, us = np.nonzero(target)
     n = len(us)
     if n == 0:
@@ -55,11 +56,15 @@ def blob(target: np.ndarray) -> Blob | None:
     ext = abs(c) + abs(s)
     length = float(along.max() - along.min() + ext)
     width = float(across.max() - across.min() + ext)
-    pa = np.stack([du, dv], axis=1) @ _DIRS                          # (n, angles)
-    pn = np.stack([du, dv], axis=1) @ _NORMALS
-    boxes = ((pa.max(0) - pa.min(0) + _PIXEL_EXTENT) * (pn.max(0) - pn.min(0) + _PIXEL_EXTENT))
+    fill_ratio = math.nan
+    if fill:
+        pts = np.stack([du, dv], axis=1)
+        pa, pn = pts @ _DIRS, pts @ _NORMALS                         # (n, angles)
+        boxes = ((pa.max(0) - pa.min(0) + _PIXEL_EXTENT) * (pn.max(0) - pn.min(0)
+                                                            + _PIXEL_EXTENT))
+        fill_ratio = float(n / boxes.min())
     h, w = target.shape
     border = bool(us.min() == 0 or vs.min() == 0 or us.max() == w - 1 or vs.max() == h - 1)
     return Blob(area=n, u=float(u0), v=float(v0), phi=phi,
                 elongation=math.sqrt(lam1 / max(lam2, 1e-12)), length=length, width=width,
-                fill=float(n / boxes.min()), touches_border=border)
+                fill=fill_ratio, touches_border=border)

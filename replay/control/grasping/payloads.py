@@ -19,7 +19,7 @@ class GraspObject:
     x_o: list            # [x, y, z, roll, pitch, yaw]
     size: list           # m, [length, width] in the plane
     shape: str           # rectangle | circle | unknown
-    fill: float
+    fill: float | None   # None once the shape is decided (not computed any more)
     elongation: float
     jacobian: list       # 2x2 image Jacobian d xi / d (pan, tilt) (px/rad) at capture
     head: list           # rad, (pan, tilt) at capture

@@ -89,14 +89,21 @@ class Camera:
         pc = R.T @ (np.asarray(point, float) - o)
         return self.c + self.f * pc[:2] / pc[2]
 
-    def jacobian(self, angles, point, h: float = 1e-5) -> np.ndarray:
-        """d pixel / d (pan, tilt) at ``angles`` for a fixed world point (central differences)."""
-        a = np.asarray(angles, float)
+    def jacobian(self, angles, point) -> np.ndarray:
+        """d pixel / d (pan, tilt) at ``angles`` for a fixed world point. The camera turns about
+        the head's centre h: about world z (pan) and the panned y axis (tilt, positive down), so
+        the point in the camera frame moves by -R^T (k x (X - h)) per radian about axis k."""
+        R, o = camera_pose(self.head, *angles)
+        X = np.asarray(point, float)
+        pc = R.T @ (X - o)
+        r = X - np.asarray(self.head.position, float)
+        a = self.head.yaw + angles[0]
         J = np.zeros((2, 2))
-        for i in range(2):
-            e = np.zeros(2)
-            e[i] = h
-            J[:, i] = (self.project(a + e, point) - self.project(a - e, point)) / (2.0 * h)
+        for i, k in enumerate(((0.0, 0.0, 1.0), (-math.sin(a), math.cos(a), 0.0))):
+            kxr = np.array([k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2],
+                            k[0] * r[1] - k[1] * r[0]])
+            d = -(R.T @ kxr)
+            J[:, i] = self.f * (d[:2] * pc[2] - pc[:2] * d[2]) / (pc[2] * pc[2])
         return J
 
 
@@ -164,7 +171,7 @@ class RecognitionTask(Controller):
         window = int(chip.count) if reacquired else int(target.sum())
         self._target = target
         self.frames += 1
-        b = blob(target)
+        b = blob(target, fill=self.shape == "unknown")
         if b is None:
             self.lost_frames += 1
             if self._had_target:
@@ -193,7 +200,8 @@ class RecognitionTask(Controller):
         x_o = [float(X[0]), float(X[1]), float(X[2]), roll if roll is not None else 0.0,
                0.0, 0.0]
         return GraspObject(chip.t, True, [b.u, b.v], b.phi, b.area, window, X.tolist(), roll,
-                           x_o, [b.length * scale, b.width * scale], self.shape, b.fill,
+                           x_o, [b.length * scale, b.width * scale], self.shape,
+                           b.fill if b.fill == b.fill else None,
                            b.elongation, J.tolist(), list(angles))
 
     def _vote(self, b) -> None:
