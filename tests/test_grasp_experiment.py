@@ -107,7 +107,7 @@ def test_grasp_rate_over_other_human_paths_and_speeds(tmp_path, project_root):
     ok = []
     for seed, speed in cases:
         result, _ = run(tmp_path, "grasp_hexahedron",
-                        ["timing.duration=1.6", f"plant.params.human_speed={speed}"], seed=seed)
+                        ["timing.duration=1.8", f"plant.params.human_speed={speed}"], seed=seed)
         ok.append(result.outcome["success"])
         print(f"seed {seed}, human {speed} m/s: {result.outcome['reason']}")
     rate = sum(ok) / len(ok)
