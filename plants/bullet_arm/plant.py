@@ -38,6 +38,8 @@ from replay.scene import Box, Scene, Sphere
 
 class BulletArmPlant(Plant):
     Params = Params
+    spec_type = ArmSpec
+    command_types = (ArmCommand,)
     description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"
 
     def __init__(self, params: Params, *, dt: float, rng: np.random.Generator) -> None:

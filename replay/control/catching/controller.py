@@ -38,7 +38,7 @@ from replay.control.catching.problem import ProblemConfig, build_problem
 from replay.interfaces import Controller, Occurrence
 from replay.messages import EffectorState, JointCommand, OptimizationCost
 from replay.params import param
-from replay.robot.arm_types import ArmCommand
+from replay.robot.arm_types import ArmCommand, ArmSpec
 
 
 @dataclass
@@ -111,6 +111,9 @@ class CatchingState:
 
 class CatchingController(Controller):
     Params = Params
+    spec_type = ArmSpec
+    command_type = ArmCommand
+    reads = ("/vision/object", "/arm/encoders")      # the stereo ball, the joint encoders
     description = ("Namiki & Ishikawa: direct mapping q_d = g o l_c^-1(r_o) from stereo "
                    "positions to joint targets, PD + dynamics feed-forward, hand timed by TTC")
 
