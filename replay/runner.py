@@ -210,7 +210,9 @@ class Runner:
         result.steps = k
         result.t_end = k / self.sc.timing.physics_rate
         result.messages = log.count
-        log.close()
+        # a failed or interrupted run never replaces a finished log at ``out``: NAME.failed.mcap
+        result.path = log.close({"error": "failed", "interrupted": "interrupted"}.get(
+            result.stopped_by, ""))
         result.wall_time = time.perf_counter() - wall0
 
     def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:

@@ -176,7 +176,9 @@ main()
 
 
 def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
-    out = tmp_path / "interrupted.mcap"
+    """The interrupted run is closed properly under its own name; an old log at -o stays."""
+    out = tmp_path / "run.mcap"
+    old = Runner(load_scenario(toy_yaml, sets=["timing.duration=0.1"])).run(out).path.read_bytes()
     code = INTERRUPTED_RUN.format(tests=os.path.dirname(__file__), yaml=str(toy_yaml),
                                   out=str(out))
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
@@ -189,7 +191,10 @@ def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
         proc.kill()
     assert proc.returncode == 130
     assert "interrupted at t = " in err and "partial log kept" in err and "Traceback" not in err
-    r = LogReader(out)                      # finished properly: summary, final name
+    assert out.read_bytes() == old
+    kept = tmp_path / "run.interrupted.mcap"
+    assert str(kept) in err
+    r = LogReader(kept)                     # finished properly: summary, its own name
     assert not r.truncated
     assert [e["kind"] for e in r.events()[-2:]] == ["interrupted", "outcome"]
     assert r.events()[-1]["data"] == {"success": False, "reason": "interrupted"}
