@@ -378,6 +378,7 @@ class Campaign:
         self.counts = collections.Counter()
         self.problems: list[str] = []
         self.calls = 0
+        self.progress = ""
 
     def call(self, argv, cwd: Path, timeout=None):
         env = dict(os.environ, PYTHONUNBUFFERED="1", COLUMNS="200")
@@ -392,7 +393,11 @@ class Campaign:
 
     def flag(self, kind: str, case: Case, detail: str = "") -> None:
         self.counts[kind] += 1
-        self.problems.append(f"{kind:<13} {case.family:<9} {case.note} {detail}".rstrip())
+        line = f"{kind:<13} {case.family:<9} {case.note} {detail}".rstrip()
+        self.problems.append(line)
+        if self.progress:
+            with open(self.progress, "a") as f:
+                f.write(line + "\n")
 
     def setup_dir(self, case: Case, idx: int) -> Path:
         d = self.work / f"c{idx:04d}"
@@ -498,9 +503,9 @@ class Campaign:
     # -- Ctrl-C, kill and failed runs ----------------------------------------------------------
 
     def interrupt_cases(self) -> None:
-        delays = [0.02, 0.1, 0.2, 0.3, 0.6, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0, 8.0]
+        delays = [0.05, 0.15, 0.3, 1.0, 2.5, 4.0, 6.0]
         for i, delay in enumerate(delays):
-            for sig in (signal.SIGINT, signal.SIGKILL) if delay >= 1.0 else (signal.SIGINT,):
+            for sig in (signal.SIGINT, signal.SIGKILL) if delay in (2.5, 6.0) else (signal.SIGINT,):
                 case = Case("signal", [], note=f"{signal.Signals(sig).name} at {delay} s")
                 d = self.work / f"sig{i}_{sig}"
                 d.mkdir()
@@ -618,10 +623,15 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=90.0)
     ap.add_argument("--report", default="")
+    ap.add_argument("--sample", type=int, default=0,
+                    help="run a seeded sample of this many value cases (0: all)")
     args = ap.parse_args()
     root = Path(args.root).resolve()
     work = Path(tempfile.mkdtemp(prefix="campaign_"))
     c = Campaign(shlex.split(args.replay), root, work, args.timeout)
+    if args.report:
+        c.progress = args.report + ".progress"
+        Path(c.progress).write_text("")
     t0 = time.time()
     rc, out, err = c.call(["run", STICK, "-o", str(work / "good.mcap"), "-q", "--set",
                            "timing.duration=0.6"], root)
@@ -635,7 +645,10 @@ def main() -> None:
     cases = []
     for name, make in families.items():
         if only is None or name in only:
-            cases += make()
+            made = make()
+            if name == "value" and args.sample and args.sample < len(made):
+                made = random.Random(1).sample(made, args.sample)
+            cases += made
     with ThreadPoolExecutor(max_workers=args.jobs) as ex:
         list(ex.map(lambda ic: c.run_case(*ic), enumerate(cases)))
     if only is None or "signal" in only:
