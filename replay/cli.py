@@ -78,7 +78,7 @@ def _load(path: str, sets=(), seed=None):
 
 @main.command()
 @click.argument("scenario", type=click.Path(dir_okay=False))
-@click.option("-o", "--out", type=click.Path(dir_okay=False), help="log path "
+@click.option("-o", "--out", type=click.Path(), help="log path "
               "(default out/logs/NAME.mcap)")
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE",
               help="override a scenario field (repeatable)")
