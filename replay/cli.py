@@ -243,8 +243,10 @@ def optimise(scenario, out):
     if path.resolve() in set(sc.inputs) or path.suffix in (".yaml", ".yml", ".mcap"):
         _fail(f"will not write the optimisation over {path} (a scenario or a log): give -o "
               "FILE.json")
-    if path.is_dir():
-        _fail(f"cannot write {path}: it is a folder")
+    try:
+        check_output(path, kind="optimisation result", magic=b"{")
+    except LogError as exc:
+        _fail(str(exc))
     runner = _runner(scenario, _load(scenario, ["controller.params.alpha_file=''"]), Runner)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import tempfile
 import threading
 from pathlib import Path
 from typing import Any
@@ -103,32 +104,37 @@ def failed_path(path: Path, status: str) -> Path:
     return path.with_name(f"{path.stem}.{status}{path.suffix or '.mcap'}")
 
 
-def check_output(path: Path) -> None:
-    """Raise :class:`LogError` when ``path`` cannot take a log: a folder, a file that is not an
-    MCAP log, a parent that is not a folder or cannot be made."""
+def check_output(path: Path, *, kind: str = "log", magic: bytes | None = MAGIC) -> None:
+    """Raise :class:`LogError` when ``path`` cannot take a log (or another ``kind`` of output):
+    a folder, an existing file that does not start with ``magic``, a parent that is not a
+    folder, cannot be made or takes no files."""
     if path.is_dir():
-        raise LogError(f"cannot write log {path}: it is a folder (give a file name)")
-    if path.exists():
+        raise LogError(f"cannot write {kind} {path}: it is a folder (give a file name)")
+    if path.exists() and magic is not None:
         try:
             with open(path, "rb") as f:
-                head = f.read(len(MAGIC))
+                head = f.read(len(magic))
         except OSError as exc:
-            raise LogError(f"cannot write log {path}: {exc.strerror}") from None
-        if head != MAGIC and path.stat().st_size > 0:
-            raise LogError(f"will not overwrite {path}: it is not an MCAP log")
+            raise LogError(f"cannot write {kind} {path}: {exc.strerror}") from None
+        if head != magic and path.stat().st_size > 0:
+            what = "an MCAP log" if magic == MAGIC else f"an earlier {kind} (JSON)"
+            raise LogError(f"will not overwrite {path}: it is not {what}")
     parent = path.parent
     for p in (parent, *parent.parents):
         if p.exists():
             if not p.is_dir():
-                raise LogError(f"cannot write log {path}: {p} is a file, not a folder")
+                raise LogError(f"cannot write {kind} {path}: {p} is a file, not a folder")
             break
     try:
         parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise LogError(f"cannot write log {path}: cannot make folder {parent} "
+        raise LogError(f"cannot write {kind} {path}: cannot make folder {parent} "
                        f"({exc.strerror})") from None
-    if not os.access(parent, os.W_OK):
-        raise LogError(f"cannot write log {path}: folder {parent} is not writable")
+    try:
+        tempfile.TemporaryFile(dir=parent).close()      # can a file be made there at all?
+    except OSError as exc:
+        raise LogError(f"cannot write {kind} {path}: folder {parent} takes no files "
+                       f"({exc.strerror})") from None
 
 
 class LogWriter:
