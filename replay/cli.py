@@ -14,13 +14,13 @@ from replay import registry
 from replay.log import LogError, LogReader
 from replay.log.writer import check_output
 from replay.papers import PAPERS
+from replay.resources import find_scenario, scenario_dir
 from replay.scenario import ScenarioError, load_scenario
 from replay.scenario.yamlio import one_line
 from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
 
 DEFAULT_LOG_DIR = Path("out/logs")
 DEFAULT_FIGURE_DIR = Path("out/figures")
-SCENARIO_DIR = Path("scenarios")
 
 
 def _fail(message: str, code: int = 2) -> None:
@@ -71,7 +71,7 @@ def main() -> None:
 
 def _load(path: str, sets=(), seed=None):
     try:
-        return load_scenario(path, sets=list(sets), seed=seed)
+        return load_scenario(find_scenario(path), sets=list(sets), seed=seed)
     except ScenarioError as exc:
         _fail(str(exc))
 
@@ -268,11 +268,11 @@ def validate(scenarios, sets, static):
     then the plug-ins are built as `run` builds them (the plant, sensors and controller, with
     any offline optimisation), so what passes here runs."""
     from replay.runner import Runner
-    paths = scenarios or sorted(str(p) for p in SCENARIO_DIR.glob("*.yaml"))
+    paths = scenarios or sorted(str(p) for p in scenario_dir().glob("*.yaml"))
     bad = 0
     for p in paths:
         try:
-            sc = load_scenario(p, sets=list(sets))
+            sc = load_scenario(find_scenario(p), sets=list(sets))
         except ScenarioError as exc:
             click.echo(f"error: {exc}", err=True)
             bad += 1
@@ -297,7 +297,7 @@ def list_(plugins):
         for kind in registry.GROUPS:
             click.echo(f"{kind}s: {', '.join(registry.names(kind)) or '-'}")
         return
-    for p in sorted(SCENARIO_DIR.glob("*.yaml")):
+    for p in sorted(scenario_dir().glob("*.yaml")):
         try:
             sc = load_scenario(p)
         except ScenarioError as exc:
@@ -546,7 +546,7 @@ def _goldens(names):
     try:
         table = load_manifest()
     except FileNotFoundError:
-        _fail("no data/golden/manifest.yaml here (run from the project root)")
+        _fail("no golden manifest shipped (data/golden/manifest.yaml is missing)")
     except ManifestError as exc:
         _fail(str(exc))
     unknown = [n for n in names if n not in table]

@@ -15,11 +15,12 @@ from pathlib import Path
 import yaml
 
 from replay.log import LogError, LogReader
+from replay.resources import shipped_root
 from replay.runner import Runner
 from replay.scenario import load_scenario
 from replay.scenario.yamlio import ScenarioError, compose, read_text, show
 
-GOLDEN_DIR = Path("data/golden")
+GOLDEN_DIR = Path("data/golden")   # under replay.resources.shipped_root()
 MANIFEST = "manifest.yaml"
 IGNORED_FIELDS = {"/scenario": {"version"}}   # the code version differs by design
 
@@ -65,7 +66,8 @@ def _tolerance(value, where: str) -> dict:
     return {k: float(v) for k, v in value.items()}
 
 
-def load_manifest(root: Path = Path(".")) -> dict[str, Golden]:
+def load_manifest(root: Path | None = None) -> dict[str, Golden]:
+    root = shipped_root() if root is None else root
     path = root / GOLDEN_DIR / MANIFEST
     if not path.is_file():
         raise FileNotFoundError(path)

@@ -12,6 +12,29 @@ import typing
 from dataclasses import dataclass, field
 from typing import Any
 
+# ---- topic names (the contract: add freely, rename none). Use these, not string literals.
+TOPIC_SCENARIO = "/scenario"                    # ScenarioInfo, once at t = 0
+TOPIC_EVENTS = "/events"                        # Event
+# air table (Higashimori et al. 2007)
+TOPIC_STICK_STATE = "/stick/state"              # StickState
+TOPIC_FINGERS_STATE = "/fingers/state"          # FingersState
+TOPIC_HAND_STATE = "/hand/state"                # the airtable plant's hand
+TOPIC_VISION_STICK = "/vision/stick"            # VisionStick
+TOPIC_STICK_ESTIMATE = "/control/stick_estimate"   # the stick controllers' estimator
+# arm plant (Namiki & Ishikawa 2003, Namiki et al. 1999)
+TOPIC_ARM_JOINT_STATE = "/arm/joint_state"      # JointState
+TOPIC_HAND_JOINT_STATE = "/hand/joint_state"    # JointState
+TOPIC_ARM_JOINT_COMMAND = "/arm/joint_command"  # JointCommand
+TOPIC_ARM_ENCODERS = "/arm/encoders"            # JointState, measured
+TOPIC_ARM_APPLIED_TORQUE = "/arm/applied_torque"
+TOPIC_OBJECT_STATE = "/object/state"            # ObjectState
+TOPIC_OBJECT_CONTACTS = "/object/contacts"
+TOPIC_EFFECTOR_STATE = "/effector/state"        # EffectorState
+TOPIC_EFFECTOR_MOTION = "/effector/motion"
+TOPIC_VISION_OBJECT = "/vision/object"          # VisionObject
+TOPIC_OPTIMIZATION_COST = "/optimization/cost"  # OptimizationCost
+TOPIC_CATCHING_STATE = "/catching/state"        # the catching controller's state
+
 
 @dataclass
 class ScenarioInfo:

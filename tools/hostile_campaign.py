@@ -168,7 +168,6 @@ def value_cases() -> list[Case]:
 def shape_cases() -> list[Case]:
     stick = (HERE / STICK).read_text()
     head = "name: shape\npaper: higashimori2007\n"
-    body = stick.split("\n", 1)[1]          # without the name line
     deep = "a: " + "[" * 1000 + "]" * 1000 + "\n"
     bomb = "x0: &a [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n"
     for i in range(1, 9):

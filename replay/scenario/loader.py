@@ -33,7 +33,8 @@ from replay.params import MAX_CHARS, MAX_FLOAT, MAX_INT, MAX_ITEMS, ParamError
 from replay.scenario.schema import Scenario
 from replay.scenario.yamlio import ScenarioError, compose, read_text, show
 
-__all__ = ["ScenarioError", "build", "build_dataclass", "load_scenario", "plugin_sections",
+__all__ = ["ScenarioError", "build", "build_dataclass", "load_scenario", "params_from_data",
+           "plugin_sections",
            "resolved_yaml", "scenario_from_text", "to_plain"]
 
 _SET_SOURCE = "<--set>"
@@ -511,6 +512,13 @@ def scenario_from_text(text: str, name: str = "<log>", sets=(), seed: int | None
     root = _compose_root(text, name)
     _pop(root, "extends")
     return _load_node(root, name, sets, seed)
+
+
+def params_from_data(cls: type, data: dict | None, path: str, source: str = "<log>") -> Any:
+    """A plug-in's typed ``Params`` (``cls``) from plain data, e.g. ``plant.params`` of a log's
+    resolved scenario, checked field by field as a scenario file is. Raises ScenarioError."""
+    node = _compose_root(yaml.safe_dump(data or {}), source)
+    return build_dataclass(node, cls, path)
 
 
 def to_plain(value: Any) -> Any:

@@ -38,7 +38,7 @@ def check_ports(sc, node_of: Callable[[str], yaml.Node]) -> None:
                             f"plant {sc.plant.type!r} takes "
                             f"{' or '.join(map(_name, accepts))}", node=where,
                             path="controller.type")
-    published = {}
+    published: dict[str, str] = {}
     for name, s in sc.sensors.items():
         cls = registry.load("sensor", s.type)
         need = getattr(cls, "spec_type", None)
@@ -49,7 +49,7 @@ def check_ports(sc, node_of: Callable[[str], yaml.Node]) -> None:
                                 path=f"sensors.{name}.type")
         topic_for = getattr(cls, "topic_for", None)
         topic = topic_for(s.params) if topic_for else getattr(cls, "topic", None)
-        published.setdefault(topic, name)
+        published.setdefault(str(topic), name)
     missing = [t for t in getattr(ctrl, "reads", ()) if t not in published]
     if missing:
         have = ", ".join(f"{t} ({n})" for t, n in published.items()) or "no sensors"

@@ -68,10 +68,8 @@ def _tag(tag: str) -> str:
 
 def _line_col(data: bytes | str, pos: int) -> tuple[int, int]:
     head = data[:pos]
-    nl = b"\n" if isinstance(head, bytes) else "\n"
-    line = head.count(nl) + 1
-    col = pos - (head.rfind(nl) + 1) + 1
-    return line, col
+    text = head.decode("latin-1") if isinstance(head, bytes) else head   # 1 byte = 1 char
+    return text.count("\n") + 1, pos - (text.rfind("\n") + 1) + 1
 
 
 def read_text(path: Path) -> str:
