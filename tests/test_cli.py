@@ -3,7 +3,9 @@
 from click.testing import CliRunner
 
 from replay.cli import main
-from replay.log import LogReader
+import pytest
+
+from replay.log import LogError, LogReader
 
 
 def invoke(*args):
@@ -148,14 +150,29 @@ def test_claims_table_states_a_partial_log(project_root, tmp_path):
     assert "is not a finished run" in r.output and "truncated" in r.output
 
 
-def test_broken_golden_manifest_is_one_line(tmp_path, monkeypatch):
+def test_broken_golden_manifest_is_one_line(tmp_path):
+    from replay.golden import ManifestError, load_manifest
     (tmp_path / "data/golden").mkdir(parents=True)
-    (tmp_path / "data/golden/manifest.yaml").write_bytes(b"stick_3step: [unclosed\n")
-    monkeypatch.chdir(tmp_path)
-    r = invoke("golden", "check")
-    assert r.exit_code == 2 and "manifest.yaml:2:" in _one_error_line(r)
-    (tmp_path / "data/golden/manifest.yaml").write_bytes(b"- a\n")
-    assert "expected a mapping" in _one_error_line(invoke("golden", "check"))
+    for data, expected in ((b"stick_3step: [unclosed\n", "manifest.yaml:2:"),
+                           (b"- a\n", "expected a mapping"), (bytes(range(256)), "not UTF-8"),
+                           (b"g: {scenario: s.yaml}\n", "log: FILE"),
+                           (b"g: {scenario: s, log: l, tolerances: {/x: {abs: -1}}}\n", "abs")):
+        (tmp_path / "data/golden/manifest.yaml").write_bytes(data)
+        with pytest.raises(ManifestError) as info:
+            load_manifest(tmp_path)
+        assert expected in str(info.value) and "\n" not in str(info.value)
+
+
+def test_golden_check_of_a_damaged_stored_log_fails_in_one_line(project_root, tmp_path):
+    from replay.golden import check, load_manifest
+    g = load_manifest()["stick_3step"]
+    g.log = tmp_path / "stored.mcap"
+    g.sets = [*g.sets, "timing.duration=0.05"]
+    for data in (b"", bytes(range(256)) * 8):
+        g.log.write_bytes(data)
+        with pytest.raises(LogError) as info:
+            check(g)
+        assert "stored golden log" in str(info.value)
 
 
 def test_optimise_without_a_file_is_one_line(project_root):

@@ -36,7 +36,8 @@ from replay.control.catching.optimise import (CostRecord, OptimResult, initial_a
                                               save_alpha)
 from replay.control.catching.problem import ProblemConfig, build_problem
 from replay.interfaces import Controller, Occurrence
-from replay.messages import EffectorState, JointCommand, OptimizationCost
+from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_VISION_OBJECT, EffectorState, JointCommand,
+                             OptimizationCost)
 from replay.params import ParamError, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
@@ -130,7 +131,7 @@ class CatchingController(Controller):
     Params = Params
     spec_type = ArmSpec
     command_type = ArmCommand
-    reads = ("/vision/object", "/arm/encoders")      # the stereo ball, the joint encoders
+    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)   # the stereo ball, the joint encoders
     description = ("Namiki & Ishikawa: direct mapping q_d = g o l_c^-1(r_o) from stereo "
                    "positions to joint targets, PD + dynamics feed-forward, hand timed by TTC")
 
