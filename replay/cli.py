@@ -413,11 +413,11 @@ def view(logs, host, port, speed, timeout):
     are overlaid in step (e.g. optimised vs unoptimised)."""
     from replay.viewer import Viewer, ViewerError
     _quiet_websockets()
-    _warn_if_exposed(host)
     try:
         viewer = Viewer.open(logs, host=host, port=port, speed=speed)
     except ViewerError as exc:
         _fail(str(exc))
+    _warn_if_exposed(host)
     if viewer.port_note:
         click.echo(f"note: {viewer.port_note}", err=True)
     for note in viewer.notes:
