@@ -436,11 +436,15 @@ def _nearest(root: yaml.Node, path: str) -> yaml.Node:
 
 
 def plugin_sections(sc: Scenario) -> Iterator[tuple[str, Any, str]]:
-    """(kind, section, path) of every plug-in the scenario names."""
+    """(kind, section, path) of every plug-in the scenario names (a section added to the
+    schema that holds plug-ins, e.g. ``tasks:`` of controllers, is listed here too)."""
     yield "plant", sc.plant, "plant"
     for name, s in sc.sensors.items():
         yield "sensor", s, f"sensors.{name}"
-    yield "controller", sc.controller, "controller"
+    if sc.controller is not None:
+        yield "controller", sc.controller, "controller"
+    for name, task in (getattr(sc, "tasks", None) or {}).items():
+        yield "controller", task, f"tasks.{name}"
 
 
 def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
@@ -465,8 +469,8 @@ def check_timing(sc: Scenario, root: yaml.Node) -> None:
         raise ScenarioError(f"expected at least one physics step (>= {1 / rate:g} s at "
                             f"{rate} Hz), got {sc.timing.duration:g} s",
                             node=_nearest(root, "timing.duration"), path="timing.duration")
-    tasks = [("controller.rate", sc.controller.rate)]
-    tasks += [(f"sensors.{n}.rate", s.rate) for n, s in sc.sensors.items()]
+    tasks = [(f"{path}.rate", spec.rate) for kind, spec, path in plugin_sections(sc)
+             if kind in ("controller", "sensor")]
     if sc.timing.state_log_rate:
         tasks.append(("timing.state_log_rate", sc.timing.state_log_rate))
     for path, r in tasks:

@@ -21,23 +21,33 @@ def _name(tp) -> str:
     return getattr(tp, "__name__", str(tp))
 
 
-def check_ports(sc, node_of: Callable[[str], yaml.Node]) -> None:
-    plant = registry.load("plant", sc.plant.type)
-    ctrl = registry.load("controller", sc.controller.type)
+def _check_controller(plant, plant_type: str, ctrl, spec, path: str, where) -> None:
     gives = getattr(plant, "spec_type", object)
-    where = node_of("controller.type")
     needs = getattr(ctrl, "spec_type", object)
     if not (isinstance(gives, type) and issubclass(gives, needs)):
-        raise ScenarioError(f"controller {sc.controller.type!r} needs a plant giving "
-                            f"{_name(needs)}; plant {sc.plant.type!r} gives {_name(gives)}",
-                            node=where, path="controller.type")
+        raise ScenarioError(f"controller {spec.type!r} needs a plant giving {_name(needs)}; "
+                            f"plant {plant_type!r} gives {_name(gives)}", node=where,
+                            path=f"{path}.type")
     command = getattr(ctrl, "command_type", object)
     accepts = tuple(getattr(plant, "command_types", (object,)))
     if not any(issubclass(command, t) for t in accepts):
-        raise ScenarioError(f"controller {sc.controller.type!r} commands {_name(command)}; "
-                            f"plant {sc.plant.type!r} takes "
-                            f"{' or '.join(map(_name, accepts))}", node=where,
-                            path="controller.type")
+        raise ScenarioError(f"controller {spec.type!r} commands {_name(command)}; plant "
+                            f"{plant_type!r} takes {' or '.join(map(_name, accepts))}",
+                            node=where, path=f"{path}.type")
+
+
+def check_ports(sc, node_of: Callable[[str], yaml.Node]) -> None:
+    """Every controller (``controller:``, and each of a ``tasks:`` section) against the plant;
+    each sensor against the plant; what ``controller:`` reads against what the sensors give."""
+    from replay.scenario.loader import plugin_sections
+    plant = registry.load("plant", sc.plant.type)
+    gives = getattr(plant, "spec_type", object)
+    for kind, spec, path in plugin_sections(sc):
+        if kind == "controller":
+            _check_controller(plant, sc.plant.type, registry.load("controller", spec.type),
+                              spec, path, node_of(f"{path}.type"))
+    ctrl = registry.load("controller", sc.controller.type) if sc.controller is not None else None
+    where = node_of("controller.type")
     published: dict[str, str] = {}
     for name, s in sc.sensors.items():
         cls = registry.load("sensor", s.type)
