@@ -186,6 +186,14 @@ def _quiet_websockets() -> None:
         logging.getLogger(name).addFilter(_NoHandshakeNoise())
 
 
+def _is_ip(host: str) -> bool:
+    try:
+        ipaddress.ip_address(host)
+        return True
+    except ValueError:
+        return False
+
+
 def _warn_if_exposed(host: str) -> None:
     try:
         local = ipaddress.ip_address(host).is_loopback
@@ -239,7 +247,8 @@ def optimise(scenario, out):
         _fail(f"controller {sc.controller.type!r} has no offline optimisation to store")
     if not (out or stored):
         _fail("the scenario sets no controller.params.alpha_file: give -o FILE")
-    path = Path(out or stored)
+    base = getattr(sc.controller.params, "scenario_dir", "")   # files resolve from the scenario
+    path = Path(out) if out else Path(base, stored).resolve() if base else Path(stored)
     if path.resolve() in set(sc.inputs) or path.suffix in (".yaml", ".yml", ".mcap"):
         _fail(f"will not write the optimisation over {path} (a scenario or a log): give -o "
               "FILE.json")
@@ -413,11 +422,15 @@ def view(logs, host, port, speed, timeout):
     are overlaid in step (e.g. optimised vs unoptimised)."""
     from replay.viewer import Viewer, ViewerError
     _quiet_websockets()
+    named = not _is_ip(host)
+    if not named:
+        _warn_if_exposed(host)          # before anything listens
     try:
         viewer = Viewer.open(logs, host=host, port=port, speed=speed)
     except ViewerError as exc:
         _fail(str(exc))
-    _warn_if_exposed(host)
+    if named:
+        _warn_if_exposed(host)          # a name: once it resolved (a bad one stays one line)
     if viewer.port_note:
         click.echo(f"note: {viewer.port_note}", err=True)
     for note in viewer.notes:

@@ -22,6 +22,7 @@ from mcap.records import Channel, Message
 from mcap.stream_reader import StreamReader
 
 from replay.log.errors import LogError, NotALogError
+from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
 MAGIC = b"\x89MCAP0\r\n"
 _RECORD_LIMIT = 1 << 30          # no record of ours is near 1 GiB: a bigger length is damage
@@ -204,12 +205,12 @@ class LogReader:
 
     def scenario(self) -> dict:
         """The ``/scenario`` message (name, paper, yaml, seed, version)."""
-        for m in self.messages("/scenario"):
+        for m in self.messages(TOPIC_SCENARIO):
             return m.data
         raise LogError(f"{self.path}: no /scenario message")
 
     def events(self) -> list[dict]:
-        return [e for e in self.series("/events") if isinstance(e.get("kind"), str)]
+        return [e for e in self.series(TOPIC_EVENTS) if isinstance(e.get("kind"), str)]
 
     def outcome(self) -> dict | None:
         """The run's final ``outcome`` event (None when the log does not reach it)."""

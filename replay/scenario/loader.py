@@ -459,6 +459,13 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
         if not isinstance(raw, yaml.Node):  # no params given: all defaults
             raw = yaml.MappingNode(_MAP, [], _nearest(root, path).start_mark, None)
         spec.params = build_dataclass(raw, cls.Params, f"{path}.params")
+    # a plug-in whose Params declare an internal ``scenario_dir`` field gets the scenario file's
+    # directory, so that its file parameters resolve relative to the scenario, not the cwd
+    src = Path(str(sc.source)) if sc.source else None
+    if src is not None and src.is_file():
+        for _, spec, _ in plugin_sections(sc):
+            if hasattr(spec.params, "scenario_dir"):
+                spec.params.scenario_dir = str(src.resolve().parent)
     return sc
 
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from replay.interfaces import Sensor
-from replay.messages import JointState
+from replay.messages import TOPIC_ARM_ENCODERS, JointState
 from replay.params import param
 from replay.scene import Scene
 
@@ -22,7 +22,7 @@ from replay.scene import Scene
 class EncoderParams:
     reading: str = param("arm", max_length=100,
                         doc="which of the plant's readings (Scene.readings) to publish")
-    topic: str = param("/arm/encoders", pattern=r"/[A-Za-z0-9_/]{1,99}",
+    topic: str = param(TOPIC_ARM_ENCODERS, pattern=r"/[A-Za-z0-9_/]{1,99}",
                        doc="log topic of the measurement")
     resolution: float = param(0.0, unit="rad", ge=0, le=10,
                               doc="angle per encoder count; 0 = exact")
@@ -31,7 +31,7 @@ class EncoderParams:
 class JointEncoders(Sensor):
     """Joint encoders: the plant's joint readings, quantised, on ``/arm/encoders``."""
     Params = EncoderParams
-    topic = "/arm/encoders"
+    topic = TOPIC_ARM_ENCODERS
 
     def __init__(self, params: EncoderParams, *, rng: np.random.Generator, spec=None) -> None:
         super().__init__(params, rng=rng, spec=spec)
