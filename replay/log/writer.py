@@ -24,6 +24,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
+import orjson
 from mcap.writer import CompressionType, Writer
 
 from replay import __version__
@@ -34,6 +35,29 @@ PART_SUFFIX = ".part"
 MAGIC = b"\x89MCAP0\r\n"
 _ENCODER = json.JSONEncoder(allow_nan=False, separators=(",", ":"))   # built once: dumps() with
                                                                        # options builds one a call
+_ORJSON = orjson.OPT_NON_STR_KEYS          # keys as the standard encoder writes them
+
+
+def encode(topic: str, payload: Any) -> bytes:
+    """A payload (dataclass or dict) as compact JSON bytes; the same payload gives the same bytes.
+
+    orjson (~10x the standard encoder's speed, dataclasses without a dict copy) writes NaN and
+    infinity as ``null``, so a message holding ``null`` is checked again by the standard encoder,
+    which refuses non-finite numbers (:class:`NonFiniteValueError`); so is a payload holding a
+    type only the standard encoder takes (e.g. ``numpy.float64``), which it then encodes.
+    """
+    try:
+        data = orjson.dumps(payload, option=_ORJSON)
+    except TypeError:
+        data = None
+    if data is None or b"null" in data:
+        body = to_dict(payload)
+        try:
+            checked = _ENCODER.encode(body).encode()
+        except ValueError:
+            raise NonFiniteValueError(topic, body) from None
+        data = checked if data is None else data
+    return data
 
 
 def seconds_to_ns(t: float) -> int:
@@ -174,11 +198,7 @@ class LogWriter:
 
     def write(self, topic: str, payload: Any, t_ns: int) -> None:
         """Write one message; ``t_ns`` (simulated time) is both log and publish time."""
-        body = to_dict(payload)
-        try:
-            data = _ENCODER.encode(body).encode()
-        except ValueError:
-            raise NonFiniteValueError(topic, body) from None
+        data = encode(topic, payload)
         with self._held:
             try:
                 channel = self._channel(topic, payload)

@@ -7,7 +7,7 @@ This sensor does the same with images:
 
 1. each camera's 8-bit 128 x 128 image is rendered from the scene's silhouettes
    (:mod:`replay.sensors.silhouette`: the sphere's exact perspective ellipse, boxes as projected
-   hulls, anti-aliased on an 8x finer grid) plus Gaussian pixel noise from the sensor's ``rng``;
+   hulls, each pixel weighted by the exact area covered) plus Gaussian pixel noise from the sensor's ``rng``;
 2. segmentation by a grey-level threshold; the target is the largest 8-connected blob (the
    arm is not in the plant's scene, so the ball is usually the only bright thing); a blob cut
    by the image border is rejected;
@@ -65,11 +65,10 @@ from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.sensors.silhouette import correct_sphere_centroid, render
+from replay.sensors.silhouette import correct_sphere_centroid, render_views
 
 _DILATE = np.ones((5, 5), np.uint8)   # the grey-moment region: the blob grown by 2 px
 _MARGIN = 4                           # px around the blob: region (2) + background ring (2)
-_MAX_SUPERSAMPLED = 1 << 24           # sub-pixels per image (memory: 16 MiB per plane)
 
 
 @dataclass
@@ -111,9 +110,6 @@ class StereoBallCameraParams:
                                             "the tracked primitive to be a Sphere: its radius)")
     background: float = param(0.1, unit="1", ge=0.0, le=1.0,
                               doc="albedo of the (uniform) background")
-    supersample: int = param(8, unit="1", ge=1, le=32,
-                             doc="anti-aliasing: silhouettes are filled on a grid this many "
-                                 "times finer")
     tracked: str = param("ball", max_length=100,
                          doc="name of the scene primitive whose position is measured")
 
@@ -128,10 +124,7 @@ class StereoBallCameraParams:
         if np.allclose(self.cam0_position, self.cam1_position):
             raise ParamError("cam1_position", "the two cameras are at the same place: no stereo "
                              "baseline")
-        if self.width * self.height * self.supersample ** 2 > _MAX_SUPERSAMPLED:
-            raise ParamError("supersample", f"{self.width} x {self.height} px x "
-                             f"{self.supersample}^2 is more than {_MAX_SUPERSAMPLED} sub-pixels "
-                             "per image")
+
 
 
 class StereoBallCamera(Sensor):
@@ -170,8 +163,7 @@ class StereoBallCamera(Sensor):
         p = params if params is not None else StereoBallCameraParams()
         cams = cameras if cameras is not None else StereoBallCamera.make_cameras(p)
         out = []
-        for cam in cams:
-            img = render(cam, scene, background=p.background, supersample=p.supersample)
+        for img in render_views(cams, scene, background=p.background):
             if rng is not None and p.noise_sigma > 0.0:
                 img += np.float32(p.noise_sigma) * rng.standard_normal(img.shape, dtype=np.float32)
             out.append(np.clip(np.rint(img), 0, 255).astype(np.uint8))
