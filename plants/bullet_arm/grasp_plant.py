@@ -44,7 +44,7 @@ HEAD_JOINTS = ("pan", "tilt")
 class BulletGraspPlant(BulletArmPlant):
     Params = GraspParams
     spec_type = GraspSpec
-    command_types = (ServoCommand,)
+    command_types = (ServoCommand,)  # type: ignore[assignment]
     hold_event = "grasp"
     description = ("PyBullet WAM-7 + 14-joint hand on velocity servos, pan/tilt head, wrist F/T, "
                    "an object moved by a human hand on a constraint plane")

@@ -5,7 +5,7 @@ array of photodetectors, each with its own processing element, read as a **binar
 Each frame: the camera's pose comes from the head's joint angles (``Scene.readings["head"]``,
 the plant's ``replay.robot.head.camera_pose``); the scene's silhouettes are rendered with
 OpenCV through that pinhole camera (:func:`replay.sensors.silhouette.render`: exact projected
-outlines, anti-aliased on a ``supersample``-times finer grid), Gaussian grey-level noise is
+outlines, each pixel's exact coverage), Gaussian grey-level noise is
 added, and each pixel is thresholded into one bit. What happens to the bits (Self Windowing,
 moments) is the method's (``replay.control.grasping``): the chip's PEs run the paper's
 algorithm, so it is not part of this sensor.
@@ -49,8 +49,6 @@ class VisionChipParams:
     background: float = param(0.1, unit="1", ge=0.0, lt=1.0, doc="albedo of the background")
     noise_sigma: float = param(0.0, unit="grey level", ge=0.0,
                                doc="Gaussian grey-level noise before thresholding (0..255)")
-    supersample: int = param(4, unit="1", ge=1, le=32,
-                             doc="silhouettes are filled on a grid this many times finer")
     reading: str = param("head", doc="the plant's reading with the camera pose")
 
 
@@ -80,8 +78,7 @@ class VisionChipSensor(Sensor):
     def image(self, scene: Scene) -> np.ndarray:
         """The binary (h, w) bool image of this frame."""
         p = self.params
-        img = render(self.camera(scene), scene, background=p.background,
-                     supersample=p.supersample)
+        img = render(self.camera(scene), scene, background=p.background)
         if p.noise_sigma > 0.0:
             img += np.float32(p.noise_sigma) * self.rng.standard_normal(img.shape,
                                                                         dtype=np.float32)
