@@ -4,12 +4,13 @@ top speed, which comes from the arm model the run's scenario names (``replay.rob
 
 Quantities (all from the log):
 
-- the loops' cycle and sensor-to-actuator latency: the runner's per-task timing records
-  (``/tasks/timing``), else the tasks' declared rates and latencies in the resolved scenario;
+- the loops' cycle and sensor-to-actuator latency: the runner's per-step task records
+  (``/tasks/loops``), else the tasks' declared rates in the resolved scenario;
 - the schedule's phases (tracking, reaching, grasping = holding, releasing) and the plant's
   ``grasp`` / ``release`` / ``drop`` / ``slip`` events;
-- the hand x^a and the reaching target x_d^a (``/effector/state``), the object's truth
-  (``/object/state``), the recognised shape (``/vision/object`` features or the method's state).
+- the hand x^a, the observed x^o and the reaching target x_d^a as eq. 2 used them
+  (``/grasping/arm``), the object's truth (``/object/state``), the recognised shape
+  (``/grasping/object``) and the hand's preshape (``/grasping/hand``).
 """
 
 from __future__ import annotations
@@ -40,27 +41,25 @@ def _ms(x: float) -> str:
 
 # ------------------------------------------------------------------------------- loops
 def loop_timing(run: GraspRun) -> dict[str, dict]:
-    """Per task: its cycle (median and max of the measured periods, s) and its sensor-to-actuator
-    latency (max, s), and where those numbers come from."""
+    """Per task: its cycle (median and max of the intervals between its ticks, s) and its
+    sensor-to-actuator latency (max over its ticks, s: the runner's "now minus the capture time
+    of the oldest of its inputs' newest messages"), from ``/tasks/loops``; without that topic,
+    the rates the scenario declares."""
     out: dict[str, dict] = {}
     if run.tasks:
-        per: dict[str, dict[str, list]] = {}
-        for m in run.tasks:
-            names = m["task"] if isinstance(m["task"], list) else [m["task"]]
-            periods = m.get("period") if isinstance(m.get("period"), list) else [m.get("period")]
-            lats = m.get("latency") if isinstance(m.get("latency"), list) else [m.get("latency")]
-            for k, n in enumerate(names):
-                d = per.setdefault(str(n), {"period": [], "latency": [], "t": []})
-                d["t"].append(m["t"])
-                if k < len(periods) and periods[k] is not None:
-                    d["period"].append(float(periods[k]))
-                if k < len(lats) and lats[k] is not None:
-                    d["latency"].append(float(lats[k]))
-        for n, d in per.items():
-            period = np.asarray(d["period"] or np.diff(d["t"]), float)
+        names = list(run.tasks[0]["names"])
+        t = np.array([m["t"] for m in run.tasks], float)
+        ticked = np.array([m["ticked"] for m in run.tasks], bool)
+        lat = np.array([[np.nan if v is None else v for v in m["latency"]] for m in run.tasks],
+                       float)
+        for k, n in enumerate(names):
+            tt = t[ticked[:, k]]
+            period = np.diff(tt)
+            lk = lat[ticked[:, k], k]
+            lk = lk[np.isfinite(lk)]
             out[n] = {"period": float(np.median(period)) if len(period) else float("nan"),
                       "period_max": float(np.max(period)) if len(period) else float("nan"),
-                      "latency": float(np.max(d["latency"])) if d["latency"] else float("nan"),
+                      "latency": float(np.max(lk)) if len(lk) else float("nan"),
                       "source": "log"}
         return out
     tasks = run.scenario.get("tasks") or {}
@@ -68,11 +67,9 @@ def loop_timing(run: GraspRun) -> dict[str, dict]:
         ((t.get("name", str(i)), t) for i, t in enumerate(tasks))
     for n, spec in items:
         rate = float((spec or {}).get("rate", 0.0) or 0.0)
-        lat = (spec or {}).get("latency")
         out[str(n)] = {"period": 1.0 / rate if rate else float("nan"),
                        "period_max": 1.0 / rate if rate else float("nan"),
-                       "latency": float(lat) if lat is not None else float("nan"),
-                       "source": "scenario"}
+                       "latency": float("nan"), "source": "scenario"}
     return out
 
 
@@ -90,8 +87,9 @@ def _loop_rows(run: GraspRun, st: dict) -> list[Claim]:
     src = next(iter(timing.values()))["source"]
     rows = [Claim("cycle of every feedback loop (Fig. 4)", f"{_ms(cyc)} (Secs. 2, 3)",
                   "; ".join(parts), "reproduced" if ok else "differs",
-                  f"from the {'runner' if src == 'log' else 'scenario'}'s task timing; "
-                  "simulated time: the loops run in step, not on 7 DSPs")]
+                  f"from the {'runner (/tasks/loops)' if src == 'log' else 'scenario'}: the "
+                  "interval between a task's ticks in simulated time (the loops run in step, "
+                  "not on 7 DSPs)")]
     lim = p["latency_max"]["value"]
     lats = {n: d["latency"] for n, d in timing.items() if np.isfinite(d["latency"])}
     if lats:
@@ -99,7 +97,9 @@ def _loop_rows(run: GraspRun, st: dict) -> list[Claim]:
         rows.append(Claim("sensor-to-actuator latency of every loop", f"< {_ms(lim)} (Sec. 4)",
                           "; ".join(f"{n} {_ms(v)}" for n, v in lats.items()),
                           "reproduced" if worst < lim else "differs",
-                          "from the sensor's capture to the command the actuator applies"))
+                          "per tick: now − the capture time of the oldest of the task's inputs' "
+                          "newest messages (the runner's /tasks/loops); the command is applied "
+                          "in the same step"))
     else:
         rows.append(Claim("sensor-to-actuator latency of every loop", f"< {_ms(lim)} (Sec. 4)",
                           "(no latency recorded)", "not run"))
@@ -175,23 +175,19 @@ def _timing_rows(run: GraspRun, st: dict) -> list[Claim]:
 
 # ------------------------------------------------------------------------------- shape
 def recognised_shapes(run: GraspRun) -> list[str]:
-    shapes = [f.get("shape") for f in run.vis_features if f.get("shape")]
-    if not shapes:
-        shapes = [m.get("shape") for m in run.state if m.get("shape")]
-    return [str(s) for s in shapes]
+    """The recognition task's shape for every frame it found the object in."""
+    return [str(f["shape"]) for f in run.vis_features if f.get("shape")]
 
 
 def _preshape_rows(run: GraspRun, st: dict) -> list[Claim]:
     kind = str(run.plant_params.get("object", "box"))
     want = ROUND.get(kind, kind)
     shapes = recognised_shapes(run)
-    pre = [str(m["preshape"]) for m in run.state if m.get("preshape")]
-    cycles = run.cycles()
+    pre = [str(m["preshape"]) for m in run.hand_task if m.get("preshape")]
     at_reach = []
-    for c in cycles:
-        m = next((m for m in run.state if m["t"] >= c["reach"].t0 - 1e-9 and m.get("preshape")),
-                 None)
-        at_reach.append(str(m["preshape"]) if m else None)
+    for c in run.cycles():              # the hand task's preshape when each reach starts
+        m = next((m for m in run.hand_task if m["t"] >= c["reach"].t0 - 1e-9), None)
+        at_reach.append(str(m.get("preshape")) if m else None)
     if not shapes and not pre:
         return [Claim(f"{run.name}: preshape by shape", st["results"]["preshape"]["value"],
                       "(no recognised shape in the log)", "not run")]
@@ -205,8 +201,8 @@ def _preshape_rows(run: GraspRun, st: dict) -> list[Claim]:
     return [Claim(f"{run.name}: the preshape matches the shape (Figs. 5b, 8)",
                   "circle → sphere grasp, rectangle → hexahedron grasp", measured,
                   "reproduced" if ok else "differs",
-                  "shape from the binarised 16 × 16 image's moments; frames before the object "
-                  "is in sight count as wrong")]
+                  "the recognition task's shape (moments of the binarised 16 × 16 image) over "
+                  "the frames it found the object in")]
 
 
 # ------------------------------------------------------------------------------- grasp holds
@@ -317,15 +313,24 @@ def tracking_lag(run: GraspRun, max_lag: float = 0.1) -> float | None:
 def _prediction_rows(run: GraspRun, st: dict) -> list[Claim]:
     lag = tracking_lag(run)
     used = []
-    if run.state and len(run.t_vis) and "x_o" in run.state[0]:
-        ts = np.array([m["t"] for m in run.state])
-        xo = np.array([m["x_o"][:3] for m in run.state], float)
-        i = np.clip(np.searchsorted(run.t_vis, ts + 1e-9) - 1, 0, len(run.t_vis) - 1)
-        used.append(float(np.max(np.linalg.norm(xo - run.vis[i], axis=1))))
+    if len(run.t_eff) and len(run.t_vis):
+        # x^o that eq. 2 used vs the recognition results captured in the 5 ms before the tick:
+        # a measured value, not an extrapolation, matches one of them exactly
+        d = np.full(len(run.t_eff), np.inf)
+        hi = np.searchsorted(run.t_vis, run.t_eff + 1e-9)
+        for back in range(1, 6):
+            i = hi - back
+            ok = i >= 0
+            dd = np.linalg.norm(run.seen[ok] - run.vis[np.maximum(i[ok], 0)], axis=1)
+            d[ok] = np.minimum(d[ok], dd)
+        seen = np.isfinite(d)
+        if seen.any():
+            used.append(float(np.max(d[seen])))
     measured = ("hand Y follows the object Y with a best-fit delay of "
                 f"{_ms(lag)}" if lag is not None else "(no hand track)")
     if used:
-        measured += f"; x^o in eq. 2 = the latest vision frame within {1000 * used[0]:.3g} mm"
+        measured += (f"; x^o in eq. 2 is a recognition result captured ≤ 5 ms before each tick "
+                     f"(worst mismatch {1000 * used[0]:.3g} mm)")
     ok = lag is not None and lag >= 0.0 and (not used or used[0] < 1e-6)
     return [Claim(f"{run.name}: no prediction of the object's motion",
                   "no prediction methods are used (Sec. 4)", measured,
@@ -336,13 +341,11 @@ def _prediction_rows(run: GraspRun, st: dict) -> list[Claim]:
 
 # ------------------------------------------------------------------------------- vision
 def _vision_rows(run: GraspRun, st: dict) -> list[Claim]:
-    if len(run.t_vis) < 2:
+    if len(run.t_chip) < 2:
         return []
     p = st["parameters"]
-    rate = (len(run.t_vis) - 1) / (run.t_vis[-1] - run.t_vis[0])
-    sens = next((s for s in (run.scenario.get("sensors") or {}).values()
-                 if isinstance(s, dict) and "width" in (s.get("params") or {})), {})
-    w, h = (sens.get("params") or {}).get("width"), (sens.get("params") or {}).get("height")
+    rate = (len(run.t_chip) - 1) / (run.t_chip[-1] - run.t_chip[0])
+    w, h = run.chip_size
     ok = abs(rate - p["vision_rate"]["value"]) < 1.0 and [w, h] == p["vision_pixels"]["value"]
     return [Claim("vision chip rate and resolution", "1 kHz, 16 × 16 (SPE-256, Sec. 3.2)",
                   f"{rate:.0f} Hz, {w} × {h} ({run.name})", "reproduced" if ok else "differs")]

@@ -21,8 +21,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
-from analysis.grasp_run import (GRASP_PHASES, HOLDING, REACHING, RELEASING, GraspRun,  # noqa: E402
-                                load_run)
+from analysis.grasp_run import (GRASP_PHASES, REACHING, RELEASING, GraspRun,  # noqa: E402
+                                head_camera_at, load_run)
 from replay.log import LogReader  # noqa: E402
 
 C_OBJ, C_HAND, C_TARGET = "tab:orange", "tab:blue", "tab:green"
@@ -162,16 +162,10 @@ def _index(t_series: np.ndarray, t: float) -> int:
     return int(min(max(np.searchsorted(t_series, t + 1e-9) - 1, 0), len(t_series) - 1))
 
 
-def _head_position(run: GraspRun) -> np.ndarray | None:
-    from analysis.grasp_run import head_position
-    return head_position(run)
-
-
 def filmstrip(run: GraspRun, title: str):
     robot = _Robot(run.plant_params)
     picks = filmstrip_times(run)
     fig, axes = plt.subplots(2, 3, figsize=(9.6, 6.6))
-    head = _head_position(run)
     near = [_project(run.obj)]             # the close-up frames the hand and the object
     drawn = []
     for t, label in picks:
@@ -199,11 +193,12 @@ def filmstrip(run: GraspRun, title: str):
             ax.fill(*_project(palm).T, color="0.55", alpha=0.8, lw=0)
         for f in fingers:
             ax.plot(*_project(f).T, "-", color=C_HAND, lw=1.6)
-        if head is not None:
-            h2 = _project(head)
+        cam = head_camera_at(run, t)
+        if cam is not None:                  # the head camera and its optical axis (OpenCV z)
+            axis = cam[0] + _quat_matrix(cam[1])[:, 2] * np.linalg.norm(run.obj[io] - cam[0])
+            h2, a2 = _project(cam[0]), _project(axis)
             ax.plot(*h2, "s", color="0.2", ms=6)
-            ax.plot([h2[0], _project(run.obj[io])[0]], [h2[1], _project(run.obj[io])[1]],
-                    color="tab:purple", lw=0.6, ls="--")
+            ax.plot([h2[0], a2[0]], [h2[1], a2[1]], color="tab:purple", lw=0.7, ls="--")
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         ax.set_aspect("equal")
@@ -212,8 +207,8 @@ def filmstrip(run: GraspRun, title: str):
         ax.set_title(f"t = {t:.3f} s  {label}", fontsize=8)
     fig.suptitle(title, fontsize=10)
     fig.text(0.01, 0.005, "close-up drawn from the log: WAM-7 joint frames (grey), palm and 14-joint hand "
-             "(blue), object and its last 0.3 s (orange), head and its line of sight (purple); "
-             f"view azimuth {math.degrees(VIEW[0]):.0f}°, elevation {math.degrees(VIEW[1]):.0f}°",
+             "(blue), object and its last 0.3 s (orange),\nhead camera and its optical axis "
+             f"(purple, as long as the distance to the object); view azimuth {math.degrees(VIEW[0]):.0f}°, elevation {math.degrees(VIEW[1]):.0f}°",
              fontsize=7, color="0.35")
     fig.tight_layout(rect=(0, 0.02, 1, 0.96))
     return fig

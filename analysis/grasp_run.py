@@ -1,11 +1,12 @@
 """One grasping run's log (Namiki, Nakabo, Ishii & Ishikawa 1999) as arrays: what the figures and
 the claims table of this paper read.
 
-Frames: the constraint plane is the tracking plane of eq. 3 (y, z, roll tracked: s_i = 1), its
-normal x the reaching direction (s_x = 0). The run's ``/effector/state`` gives the hand x^a
-(``position``) and the reaching target x_d^a (``desired_position``); ``/object/state`` the
-object's true pose (the "human hand" moves it); the schedule's phases come from the method's
-state topic (``phase`` per control step) or, failing that, from the plant's grasp/release events.
+Frames (docs/DESIGN.md, "Grasping runs"): the constraint plane x = plane_x is the tracking plane of
+eq. 3 (y, z, roll tracked: s_i = 1), its normal x the reaching direction (s_x = 0). The arm
+task's ``/grasping/arm`` gives the hand x^a, the observed object x^o and the reaching target
+x_d^a that eq. 2 used; ``/object/state`` the object's true pose (the "human hand" moves it); the
+schedule's phases come from ``/grasping/state`` (``phase`` every step) or, failing that, from the
+plant's grasp/release events.
 """
 
 from __future__ import annotations
@@ -18,17 +19,19 @@ import yaml
 from analysis.series import events
 from replay.log import LogReader
 
-T_EFFECTOR = "/effector/state"
+T_ARM_TASK = "/grasping/arm"         # x_a, x_o, x_d (eq. 2), per arm-task tick
 T_OBJECT = "/object/state"
 T_ARM = "/arm/joint_state"
 T_HAND = "/hand/joint_state"
-T_HEAD = "/head/joint_state"
-T_VISION = "/vision/object"
-T_STATE = "/grasping/state"          # the method's per-step state: phase, preshape, shape ...
-T_TASKS = "/tasks/timing"            # per task and step: its period and sensor-to-actuator latency
+T_HEAD = "/head/state"               # pan, tilt, camera_position, camera_orientation
+T_VISION = "/grasping/object"        # recognition: found, xi, phi, x_o, shape, ...
+T_CHIP = "/vision/chip"              # the 16 x 16 binary images
+T_HAND_TASK = "/grasping/hand"       # preshape, theta_d, load, command (eq. 4)
+T_STATE = "/grasping/state"          # the schedule: phase, cycle, x_d, grasp
+T_TASKS = "/tasks/loops"             # runner: names, ticked, latency per task, every step
 
 # the schedule's phases: what the hand does (the arm tracks in all of them)
-REACHING, HOLDING, RELEASING, TRACKING = "reaching", "grasping", "releasing", "tracking"
+TRACKING, REACHING, HOLDING, RELEASING = "track", "reach", "hold", "release"
 GRASP_PHASES = (REACHING, HOLDING)   # shaded as "grasp" in Fig. 9
 
 
@@ -51,9 +54,10 @@ class Phase:
 class GraspRun:
     name: str
     scenario: dict
-    t_eff: np.ndarray
+    t_eff: np.ndarray                # arm-task ticks
     hand: np.ndarray                 # x^a position (n, 3)
     target: np.ndarray               # x_d^a position (n, 3), reaching target
+    seen: np.ndarray                 # x^o position (n, 3), as eq. 2 used it
     t_obj: np.ndarray
     obj: np.ndarray                  # (m, 3)
     obj_orn: np.ndarray              # (m, 4) xyzw
@@ -65,9 +69,14 @@ class GraspRun:
     hand_names: list
     t_head: np.ndarray
     head_q: np.ndarray
-    t_vis: np.ndarray
-    vis: np.ndarray
-    vis_features: list
+    head_camera: np.ndarray          # (k, 3) camera position
+    head_orn: np.ndarray             # (k, 4) camera-to-world xyzw
+    t_vis: np.ndarray                # recognition results (capture times)
+    vis: np.ndarray                  # x_o position (3) where found
+    vis_features: list               # the /grasping/object messages
+    t_chip: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    chip_size: tuple = (0, 0)
+    hand_task: list = field(default_factory=list)  # T_HAND_TASK messages
     state: list = field(default_factory=list)      # T_STATE messages
     tasks: list = field(default_factory=list)      # T_TASKS messages
     events: list = field(default_factory=list)
@@ -141,52 +150,54 @@ def _phases_from_state(state: list[dict]) -> list[Phase]:
 
 
 def _phases_from_events(evs: list[dict], t_end: float) -> list[Phase]:
-    """Without a state topic: tracking until each grasp command (or grasp event), holding until
-    the release, releasing until the hand is open again (``release`` -> next ``open`` or 0.3 s)."""
-    marks = [(e["t"], e["kind"]) for e in evs if e["kind"] in ("reach", "grasp", "release")]
-    out, cur, t = [], TRACKING, 0.0
-    for te, kind in marks:
-        nxt = {"reach": REACHING, "grasp": HOLDING, "release": RELEASING}[kind]
-        if nxt == cur:
+    """Without the schedule's state topic: the method's ``phase`` events."""
+    out: list[Phase] = []
+    for e in evs:
+        if e["kind"] != "phase":
             continue
-        out.append(Phase(cur, t, te))
-        cur, t = nxt, te
-    out.append(Phase(cur, t, t_end))
+        if out:
+            out[-1].t1 = float(e["t"])
+        out.append(Phase(str(e["data"].get("phase")), float(e["t"]), t_end))
     return [p for p in out if p.t1 > p.t0]
+
+
+def _first3(rows: list[dict], key: str) -> np.ndarray:
+    return np.array([r[key][:3] for r in rows], dtype=float).reshape(len(rows), 3)
 
 
 def load_run(log: LogReader, name: str | None = None) -> GraspRun:
     sc = yaml.safe_load(log.scenario()["yaml"])
-    eff = [m for m in log.series(T_EFFECTOR) if m.get("position") and m.get("desired_position")]
+    eff = [m for m in log.series(T_ARM_TASK) if m.get("x_a") and m.get("x_d") and m.get("x_o")]
     ob = log.series(T_OBJECT)
     arm = log.series(T_ARM)
     hj = log.series(T_HAND)
-    hd = log.series(T_HEAD)
-    vi = log.series(T_VISION)
+    hd = [m for m in log.series(T_HEAD) if m.get("camera_position")]
+    vi = [m for m in log.series(T_VISION) if m.get("found") and m.get("position")]
+    chip = log.series(T_CHIP)
     st = log.series(T_STATE)
     run = GraspRun(
         name=name or sc["name"], scenario=sc,
-        t_eff=_vec(eff, "t"), hand=_vec(eff, "position", 3)[:, :3],
-        target=_vec(eff, "desired_position", 3)[:, :3],
+        t_eff=_vec(eff, "t"), hand=_first3(eff, "x_a"), target=_first3(eff, "x_d"),
+        seen=_first3(eff, "x_o"),
         t_obj=_vec(ob, "t"), obj=_vec(ob, "position", 3), obj_orn=_vec(ob, "orientation", 4),
         t_arm=_vec(arm, "t"), arm_q=_vec(arm, "position", 1),
         arm_names=list(arm[0]["name"]) if arm else [],
         t_hand=_vec(hj, "t"), hand_q=_vec(hj, "position", 1),
         hand_names=list(hj[0]["name"]) if hj else [],
-        t_head=_vec(hd, "t"), head_q=_vec(hd, "position", 1),
-        t_vis=_vec(vi, "t"), vis=_vec(vi, "position", 3),
-        vis_features=[m.get("features") or {} for m in vi],
-        state=st, tasks=log.series(T_TASKS), events=events(log))
+        t_head=_vec(hd, "t"), head_q=np.array([[m["pan"], m["tilt"]] for m in hd], float),
+        head_camera=_vec(hd, "camera_position", 3), head_orn=_vec(hd, "camera_orientation", 4),
+        t_vis=_vec(vi, "t"), vis=_first3(vi, "position"), vis_features=vi,
+        t_chip=_vec(chip, "t"),
+        chip_size=(int(chip[0]["width"]), int(chip[0]["height"])) if chip else (0, 0),
+        hand_task=log.series(T_HAND_TASK), state=st, tasks=log.series(T_TASKS),
+        events=events(log))
     run.phases = _phases_from_state(st) or _phases_from_events(run.events, run.t_end)
     return run
 
 
-def head_position(run: GraspRun) -> np.ndarray | None:
-    """Where the pan/tilt head stands (world, m): the plant's or a sensor's ``head_position``."""
-    p = run.plant_params.get("head_position")
-    if p is None:
-        for s in (run.scenario.get("sensors") or {}).values():
-            p = ((s or {}).get("params") or {}).get("head_position")
-            if p is not None:
-                break
-    return None if p is None else np.asarray(p, float)
+def head_camera_at(run: GraspRun, t: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The head camera's position (m) and camera-to-world orientation (xyzw) at t."""
+    if not len(run.t_head):
+        return None
+    i = int(np.clip(np.searchsorted(run.t_head, t + 1e-9) - 1, 0, len(run.t_head) - 1))
+    return run.head_camera[i], run.head_orn[i]

@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from analysis.grasp_run import (HOLDING, REACHING, RELEASING, T_ARM, T_EFFECTOR, T_HAND, T_HEAD,
-                                T_OBJECT, T_STATE, T_TASKS, T_VISION, TRACKING)
+from analysis.grasp_run import (HOLDING, REACHING, RELEASING, T_ARM, T_ARM_TASK, T_CHIP, T_HAND,
+                                T_HAND_TASK, T_HEAD, T_OBJECT, T_STATE, T_TASKS, T_VISION,
+                                TRACKING)
 from replay.log import LogWriter, seconds_to_ns
-from replay.messages import (EffectorState, Event, JointState, ObjectState, ScenarioInfo,
-                             VisionObject)
+from replay.messages import Event, JointState, ObjectState, ScenarioInfo
 
 PLANE_X = 0.65
 STANDOFF = 0.15             # m, the hand's distance from the plane while only tracking
@@ -101,7 +101,8 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
                 q = q + J.T @ np.linalg.solve(J @ J.T + 1e-4 * np.eye(3), e)
             hand = chain.tool_position(q)
             if ph != prev_phase:
-                kind = {REACHING: "reach", HOLDING: "grasp", RELEASING: "release"}.get(ph)
+                log.write("/events", Event(t, "phase", {"phase": ph, "cycle": 0}), ns)
+                kind = {HOLDING: "grasp", RELEASING: "release"}.get(ph)
                 if kind:
                     data = {"parts": ["palm", "index", "thumb"]} if kind == "grasp" else {}
                     log.write("/events", Event(t, kind, {**data, "position": o.tolist()}), ns)
@@ -114,18 +115,31 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
                                          [0.0] * 14, [0.0] * 14), ns)
             d = o - np.array(HEAD)
             pan, tilt = math.atan2(d[1], d[0]), math.atan2(d[2], math.hypot(d[0], d[1]))
-            log.write(T_HEAD, JointState(t, ["pan", "tilt"], [pan, tilt], [0.0, 0.0],
-                                         [0.0, 0.0]), ns)
-            log.write(T_EFFECTOR, EffectorState(t, hand.tolist(),
-                                                [_reach_x(t), lagged[1], lagged[2]]), ns)
+            log.write("/head/joint_state", JointState(t, ["pan", "tilt"], [pan, tilt],
+                                                      [0.0, 0.0], [0.0, 0.0]), ns)
+            z = d / np.linalg.norm(d)                       # optical axis at the object
+            x = np.cross(z, [0.0, 0.0, 1.0])
+            x /= np.linalg.norm(x)
+            R = np.column_stack([x, np.cross(z, x), z])     # OpenCV: x right, y down, z ahead
+            from replay.robot.serial_chain import matrix_to_quaternion
+            log.write(T_HEAD, {"t": t, "pan": pan, "tilt": tilt, "velocity": [0.0, 0.0],
+                               "camera_position": HEAD,
+                               "camera_orientation": matrix_to_quaternion(R).tolist()}, ns)
+            seen = object_path(max(t - 0.001, 0.0))
+            six = lambda p: [*p, 0.0, 0.0, 0.0]  # noqa: E731
+            log.write(T_ARM_TASK, {"t": t, "x_a": six(hand.tolist()), "x_o": six(seen.tolist()),
+                                   "x_d": six([_reach_x(t), lagged[1], lagged[2]])}, ns)
             log.write(T_OBJECT, ObjectState(t, o.tolist(), [0.0, 0.0, 0.0, 1.0],
                                             [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]), ns)
-            seen = object_path(max(t - 0.001, 0.0))
-            log.write(T_VISION, VisionObject(t, seen.tolist(), {
-                "xi": [0.0, 0.0], "phi": 0.0, "shape": preshape, "area": 20}), ns)
-            log.write(T_STATE, {"t": t, "phase": ph, "shape": preshape, "preshape": preshape,
-                                "x_o": seen.tolist()}, ns)
-            log.write(T_TASKS, {"t": t, "task": TASKS, "period": [1.0 / rate] * 4,
+            log.write(T_CHIP, {"t": t, "width": 16, "height": 16, "rows": [0] * 16,
+                               "count": 20}, ns)
+            log.write(T_VISION, {"t": t - 0.001, "found": True, "xi": [8.0, 8.0], "phi": 0.0,
+                                 "area": 20, "position": seen.tolist(), "x_o": six(seen.tolist()),
+                                 "shape": preshape}, ns)
+            log.write(T_HAND_TASK, {"t": t, "preshape": preshape, "theta_d": hq.tolist()}, ns)
+            log.write(T_STATE, {"t": t, "phase": ph, "cycle": 0, "x_d": six([_reach_x(t), 0, 0]),
+                                "grasp": ph in (REACHING, HOLDING)}, ns)
+            log.write(T_TASKS, {"t": t, "names": TASKS, "ticked": [True] * 4,
                                 "latency": [0.001, 0.001, 0.0012, 0.0011]}, ns)
         log.write("/events", Event(duration, "outcome", {"success": True,
                                                          "reason": "completed"}),
