@@ -62,7 +62,10 @@ def _reach_x(t: float) -> float:
 
 
 def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = "box",
-                    name: str = "synthetic_grasp") -> Path:
+                    name: str = "synthetic_grasp", lag: float = LAG,
+                    slip_at: float | None = None) -> Path:
+    """``lag`` < 0 makes the hand lead the object (as a predictor would); ``slip_at`` adds a
+    ``slip`` event and lets the object slide off the palm from then on."""
     from replay.robot.hand import GRASP4
     from replay.robot.wam import wam_chain, wam_joint_names
     chain = wam_chain(7)
@@ -72,10 +75,12 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
               "initial_qd": [], "locked_joints": [], "torque_limit_set": "public_urdf",
               "torque_limits": [], "velocity_limits": [], "hand": "grasp4", "hand_initial": [],
               "object": obj, "object_radius": 0.03, "object_size": [0.05, 0.05, 0.05],
-              "object_position": object_path(0.0).tolist(), "head_position": HEAD}
+              "object_position": object_path(0.0).tolist(), "plane_normal": [1.0, 0.0, 0.0],
+              "head_position": HEAD}
     sc = {"name": name, "paper": "namiki1999", "description": "synthetic grasping log",
           "seed": 0, "timing": {"physics_rate": rate, "duration": duration},
-          "plant": {"type": "bullet_arm", "params": params}, "sensors": {},
+          "plant": {"type": "bullet_grasp", "params": params}, "sensors": {"chip": {"type": "vision_chip", "rate": float(rate), "params": {
+              "fov": 0.21, "width": 16, "height": 16}}},
           "controller": {"type": "none", "rate": float(rate), "params": {}},
           "tasks": {k: {"rate": float(rate)} for k in TASKS},
           "stop": {"on_events": [], "after": 0.0}, "notes": ""}
@@ -93,7 +98,12 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
             ns = seconds_to_ns(t)
             ph = _phase(t)
             o = object_path(t)
-            lagged = object_path(max(t - LAG, 0.0))
+            if slip_at is not None and t >= slip_at:
+                o = o + np.array([0.0, 0.0, -0.2 * (t - slip_at)])
+                if t - slip_at < 0.5 / rate:
+                    log.write("/events", Event(t, "slip", {"speed": 0.2,
+                                                           "position": o.tolist()}), ns)
+            lagged = object_path(max(t - lag, 0.0))
             goal = np.array([_reach_x(t), lagged[1], lagged[2]])
             for _ in range(1 if k else 60):       # damped least squares to the goal
                 J = chain.position_jacobian(q)
@@ -131,7 +141,7 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
                                    "x_d": six([_reach_x(t), lagged[1], lagged[2]])}, ns)
             log.write(T_OBJECT, ObjectState(t, o.tolist(), [0.0, 0.0, 0.0, 1.0],
                                             [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]), ns)
-            log.write(T_CHIP, {"t": t, "width": 16, "height": 16, "rows": [0] * 16,
+            log.write(T_CHIP, {"t": t, "width": 16, "height": 16, "rows": [0x07C0 if 5 <= v < 10 else 0 for v in range(16)],
                                "count": 20}, ns)
             log.write(T_VISION, {"t": t - 0.001, "found": True, "xi": [8.0, 8.0], "phi": 0.0,
                                  "area": 20, "position": seen.tolist(), "x_o": six(seen.tolist()),

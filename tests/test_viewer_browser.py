@@ -28,6 +28,7 @@ Image = pytest.importorskip("PIL.Image")
 
 from replay.viewer import Viewer  # noqa: E402
 from replay.viewer.synthetic import write_arm_log, write_stick_log  # noqa: E402
+from grasp_synthetic import write_grasp_log  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = "/usr/bin/chromium"
@@ -68,6 +69,7 @@ def _cases() -> list[tuple[str, object]]:
              ("catch", lambda d: [write_arm_log(d / "catch.mcap")]),
              ("grasp", lambda d: [write_arm_log(d / "grasp.mcap", name="synthetic_grasp",
                                                 arm="wam7", hand="grasp4", obj="box")]),
+             ("grasp_scene", lambda d: [write_grasp_log(d / "grasp_scene.mcap", duration=1.2)]),
              ("overlay", lambda d: [write_stick_log(d / "a.mcap", name="spin_4"),
                                     write_stick_log(d / "b.mcap", name="spin_9", spin=9.0)])]
     extra = sorted((ROOT / "data" / "golden").glob("*.mcap"))

@@ -456,6 +456,8 @@ class ArmScene(RunScene):
 
 
 SCENES: dict[str, type[RunScene]] = {"airtable": AirTableScene, "bullet_arm": ArmScene}
+from replay.viewer.scene_grasp import GraspScene  # noqa: E402  (its own module; builds on ArmScene)
+SCENES["bullet_grasp"] = GraspScene
 
 
 def scene_class(run: RunData) -> type[RunScene]:
