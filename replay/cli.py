@@ -196,7 +196,8 @@ def params_markdown() -> str:
     import dataclasses
 
     from replay.params import describe
-    from replay.scenario.schema import ControllerSpec, PlantSpec, Scenario, SensorSpec
+    from replay.scenario.schema import (ControllerSpec, PlantSpec, Scenario, SensorSpec,
+                                        TaskSpec)
 
     def table(cls, prefix: str) -> list[str]:
         rows = ["| field | unit | default | allowed | meaning |", "|---|---|---|---|---|"]
@@ -221,7 +222,7 @@ def params_markdown() -> str:
              "Units are SI. A field without a default is required.", "", "## Scenario", ""]
     lines += table(Scenario, "")
     for title, cls in (("plant", PlantSpec), ("sensors.NAME", SensorSpec),
-                       ("controller", ControllerSpec)):
+                       ("controller", ControllerSpec), ("tasks.NAME", TaskSpec)):
         lines += ["", f"### `{title}`", ""] + table(cls, f"{title}.")
     for kind in ("plant", "sensor", "controller"):
         for name in registry.names(kind):

@@ -24,16 +24,20 @@ def param(
     lt: float | None = None,
     choices: tuple | None = None,
     length: int | None = None,
+    omit_empty: bool = False,
 ) -> Any:
     """A dataclass field with validation metadata.
 
     ``unit`` is the SI unit of the value ("m", "kg", "kg*m^2", "s", "rad", "rad/s", "m/s", "Hz",
     "1" for dimensionless). ``ge/gt/le/lt`` bound numbers (and every item of a list of numbers),
     ``choices`` lists the allowed values, ``length`` fixes the length of a list.
-    A field without a default is required in the YAML.
+    A field without a default is required in the YAML. ``omit_empty``: left out of the resolved
+    scenario when empty (a field added later, so older scenarios resolve to the same text).
     """
     meta = {"unit": unit, "doc": doc, "ge": ge, "gt": gt, "le": le, "lt": lt,
             "choices": choices, "length": length}
+    if omit_empty:
+        meta["omit_empty"] = True
     if isinstance(default, (list, dict)):
         value = default
         return dataclasses.field(default_factory=lambda: _copy(value), metadata=meta)

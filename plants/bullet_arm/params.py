@@ -97,3 +97,54 @@ class Params:
     miss_height: float = param(0.0, unit="m",
                                doc="object centre below this world z: drop (after a catch) or "
                                    "miss")
+
+
+@dataclass
+class GraspParams(Params):
+    """The grasping rig (Namiki et al. 1999): velocity-commanded servos on the arm and hand, a
+    pan/tilt head, a wrist F/T sensor, the object held by a human hand on a constraint plane.
+    Every value here is an assumption unless a scenario says otherwise (the paper gives none)."""
+    arm_servo_bandwidth: float = param(
+        500.0, unit="rad/s", gt=0.0, le=1500.0,
+        doc="velocity-loop bandwidth of the arm's AC servo amplifiers (assumed ~80 Hz; the "
+            "explicit 1 kHz loop needs bandwidth * dt well below 2)")
+    hand_servo_bandwidth: float = param(
+        500.0, unit="rad/s", gt=0.0, le=1500.0,
+        doc="velocity-loop bandwidth of the hand's DC servos (assumed)")
+    plane_normal: list = param([1.0, 0.0, 0.0], unit="1", length=3,
+                               doc="normal of the constraint plane through the object's initial "
+                                   "centre (world); the human moves the object in it")
+    human_speed: float = param(0.10, unit="m/s", ge=0.0,
+                               doc="RMS in-plane speed of the human's path")
+    human_roll_rate: float = param(0.2, unit="rad/s", ge=0.0,
+                                   doc="RMS rate of the human's roll about the plane normal")
+    human_f_min: float = param(0.1, unit="Hz", gt=0.0, doc="lowest frequency of the path")
+    human_f_max: float = param(1.0, unit="Hz", gt=0.0, doc="band limit of the path")
+    human_components: int = param(6, ge=1, doc="sinusoids per path axis")
+    human_max_force: float = param(30.0, unit="N", gt=0.0,
+                                   doc="force limit of the human's hold (grip and arm strength)")
+    human_start: float = param(0.0, unit="s", ge=0.0, doc="the human starts moving at this time")
+    head_position: list = param([0.0, 0.0, 1.0], unit="m", length=3,
+                                doc="world point where the pan and tilt axes meet")
+    head_yaw: float = param(0.0, unit="rad", doc="heading of the head's base about world +z")
+    head_camera_offset: float = param(0.03, unit="m", ge=0.0,
+                                      doc="camera ahead of the tilt axis along the line of sight")
+    head_initial: list = param([], unit="rad",
+                               doc="initial (pan, tilt); [] = looking at the object's centre")
+    head_lower: list = param([-1.5, -1.0], unit="rad", length=2, doc="(pan, tilt) lower stops")
+    head_upper: list = param([1.5, 1.0], unit="rad", length=2, doc="(pan, tilt) upper stops")
+    head_inertia: list = param([2.0e-3, 1.0e-3], unit="kg*m^2", length=2, gt=0.0,
+                               doc="inertia about the pan and tilt axes (camera platform)")
+    head_torque_limit: list = param([0.5, 0.5], unit="N*m", length=2, gt=0.0,
+                                    doc="DC servo torque limits (pan, tilt)")
+    head_velocity_limit: list = param([10.0, 10.0], unit="rad/s", length=2, gt=0.0,
+                                      doc="(pan, tilt) speed the method may command")
+    head_servo_bandwidth: float = param(300.0, unit="rad/s", gt=0.0,
+                                        doc="velocity-loop bandwidth of the head's DC servos")
+    slip_speed: float = param(0.02, unit="m/s", gt=0.0,
+                              doc="while grasped, object speed relative to the palm above this "
+                                  "is a slip")
+    grasp_min_grasps: int = param(1, ge=1, doc="grasps a successful run has")
+    grasp_min_hold: float = param(0.3, unit="s", ge=0.0,
+                                  doc="a successful run holds one grasp at least this long while "
+                                      "the human moves the object")

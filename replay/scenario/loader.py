@@ -344,7 +344,13 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
         return build_dataclass(raw, cls.Params, f"{path}.params")
 
     sc.plant.params = params_of("plant", sc.plant, "plant")
-    sc.controller.params = params_of("controller", sc.controller, "controller")
+    if (sc.controller is None) == (not sc.tasks):
+        raise ScenarioError("give either controller: or tasks:, not "
+                            + ("both" if sc.tasks else "neither"), node=root, path="controller")
+    if sc.controller is not None:
+        sc.controller.params = params_of("controller", sc.controller, "controller")
+    for name, task in sc.tasks.items():
+        task.params = params_of("controller", task, f"tasks.{name}")
     for name, s in sc.sensors.items():
         s.params = params_of("sensor", s, f"sensors.{name}")
     return sc
@@ -352,7 +358,8 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
 
 def check_rates(sc: Scenario, node: yaml.Node | None = None) -> None:
     rate = sc.timing.physics_rate
-    tasks = [("controller.rate", sc.controller.rate)]
+    tasks = [("controller.rate", sc.controller.rate)] if sc.controller is not None else []
+    tasks += [(f"tasks.{n}.rate", t.rate) for n, t in sc.tasks.items()]
     tasks += [(f"sensors.{n}.rate", s.rate) for n, s in sc.sensors.items()]
     if sc.timing.state_log_rate:
         tasks.append(("timing.state_log_rate", sc.timing.state_log_rate))
@@ -397,7 +404,8 @@ def to_plain(value: Any) -> Any:
     """Dataclasses, tuples and lists as plain YAML-ready values, every default filled in."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return {f.name: to_plain(getattr(value, f.name)) for f in dataclasses.fields(value)
-                if not f.metadata.get("internal")}
+                if not f.metadata.get("internal")
+                and not (f.metadata.get("omit_empty") and not getattr(value, f.name))}
     if isinstance(value, (list, tuple)):
         return [to_plain(v) for v in value]
     if isinstance(value, dict):

@@ -44,6 +44,18 @@ class ControllerSpec:
 
 
 @dataclass(kw_only=True)
+class TaskSpec:
+    """One of several parallel tasks (a scenario's ``tasks:``): a controller plug-in with its own
+    rate, the topics it reads and what it writes (Namiki et al. 1999, Fig. 4)."""
+    type: str = param(doc="controller plug-in name")
+    rate: float = param(1000.0, unit="Hz", gt=0, doc="task rate; must divide the physics rate")
+    inputs: list[str] = param([], doc="topics it reads (sensors' or other tasks' outputs)")
+    outputs: list[str] = param([], doc="topics it publishes for other tasks, and the command "
+                                       "fields it writes (e.g. arm, hand, head)")
+    params: dict[str, Any] = param({}, doc="the task's own parameters")
+
+
+@dataclass(kw_only=True)
 class Stop:
     on_events: list[str] = param([], doc="event kinds that end the run (e.g. [capture, rest])")
     after: float = param(0.0, unit="s", ge=0, doc="keep running this long after a stop event")
@@ -58,7 +70,9 @@ class Scenario:
     timing: Timing = field(default_factory=Timing)
     plant: PlantSpec = param(doc="the simulated world")
     sensors: dict[str, SensorSpec] = param({}, doc="name -> sensor")
-    controller: ControllerSpec = param(doc="the paper's method")
+    controller: ControllerSpec | None = param(None, doc="the paper's method (one controller), or")
+    tasks: dict[str, TaskSpec] = param({}, doc="name -> task: the method as parallel tasks, run "
+                                               "in this order each step", omit_empty=True)
     stop: Stop = field(default_factory=Stop)
     notes: str = param("", doc="free text: derivations, assumptions, deviations")
 
