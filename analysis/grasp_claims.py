@@ -158,7 +158,9 @@ def _timing_rows(run: GraspRun, st: dict) -> list[Claim]:
                   "seconds", stated.replace("ms", "s"), measured,
                   "reproduced" if ok else "differs",
                   "the schedule's times are the scenario's; the grasp event is the plant's "
-                  "(several hand parts in contact, the object still relative to the palm)")]
+                  "(several hand parts in contact and the object still relative to the palm for "
+                  f"{float(run.plant_params.get('catch_hold_time', 0.0)) * 1000:.0f} ms before "
+                  "it fires)")]
     dur_ms = (t_done - t_reach) * 1e-3
     need = ct["travel"] / dur_ms
     top = _arm_top_speed(run)
@@ -207,25 +209,34 @@ def _preshape_rows(run: GraspRun, st: dict) -> list[Claim]:
 
 # ------------------------------------------------------------------------------- grasp holds
 def holds(run: GraspRun) -> list[dict]:
-    """For each holding phase: the object's travel (path length, m), its largest displacement
-    relative to the palm since the grasp (m), and drop/slip events inside."""
+    """For each holding phase, from the plant's grasp event in it (the object held) to the end of
+    the phase: the object's travel (path length, m) and span (m), its largest displacement
+    relative to the hand x^a since the grasp (m), and the drop/slip events; ``grasp`` None if the
+    plant never reported the object held in that phase."""
     out = []
     for p in run.phases:
         if p.name != HOLDING:
             continue
-        wo = run.window(run.t_obj, p.t0, p.t1)
+        g = next((e for e in run.kinds("grasp") if p.t0 - 1e-9 <= e["t"] <= p.t1 + 1e-9), None)
+        t0 = g["t"] if g is not None else p.t0
+        wo = run.window(run.t_obj, t0, p.t1)
         if wo.sum() < 2:
             continue
         obj = run.obj[wo]
-        hand = run.hand_at(run.t_obj[wo])
-        rel = obj - hand
-        drift = float(np.max(np.linalg.norm(rel - rel[0], axis=1)))
-        travel = float(np.sum(np.linalg.norm(np.diff(obj, axis=0), axis=1)))
+        rel = obj - run.hand_at(run.t_obj[wo])
         bad = [e for e in run.events if e["kind"] in ("drop", "slip")
-               and p.t0 - 1e-9 <= e["t"] <= p.t1 + 1e-9]
-        out.append({"t0": p.t0, "t1": p.t1, "travel": travel, "drift": drift, "bad": bad,
+               and t0 - 1e-9 <= e["t"] <= p.t1 + 1e-9]
+        out.append({"t0": t0, "t1": p.t1, "grasp": g, "bad": bad,
+                    "travel": float(np.sum(np.linalg.norm(np.diff(obj, axis=0), axis=1))),
+                    "drift": float(np.max(np.linalg.norm(rel - rel[0], axis=1))),
                     "span": float(np.max(np.ptp(obj, axis=0)))})
     return out
+
+
+def _event_summary(evs: list[dict], kind: str) -> str:
+    if len(evs) == 1:
+        return f"{kind} at {evs[0]['t']:.3f} s"
+    return f"{len(evs)} {kind}s ({evs[0]['t']:.3f}-{evs[-1]['t']:.3f} s)"
 
 
 def _hold_rows(run: GraspRun, st: dict) -> list[Claim]:
@@ -235,17 +246,24 @@ def _hold_rows(run: GraspRun, st: dict) -> list[Claim]:
                       "(no holding phase)", "not run")]
     parts, ok = [], True
     for d in h:
-        bad = ", ".join(f"{e['kind']} at {e['t']:.3f} s" for e in d["bad"])
-        parts.append(f"{d['t0']:.2f}-{d['t1']:.2f} s: object moved {1000 * d['travel']:.0f} mm "
-                     f"(span {1000 * d['span']:.0f} mm), drift from the palm "
+        if d["grasp"] is None:
+            parts.append(f"hold phase to {d['t1']:.2f} s: the plant never reported the object "
+                         "held")
+            ok = False
+            continue
+        bad = "; ".join(_event_summary([e for e in d["bad"] if e["kind"] == k], k)
+                        for k in ("drop", "slip") if any(e["kind"] == k for e in d["bad"]))
+        parts.append(f"grasped {d['t0']:.3f}-{d['t1']:.2f} s: object moved {1000 * d['travel']:.0f}"
+                     f" mm (span {1000 * d['span']:.0f} mm), drift from the hand "
                      f"{1000 * d['drift']:.1f} mm" + (f"; {bad}" if bad else ""))
         ok &= not d["bad"] and d["drift"] < HOLD_DRIFT
     moved = all(d["span"] > 2 * HOLD_DRIFT for d in h)
     return [Claim(f"{run.name}: the grasp holds while the human keeps moving the object",
                   "stable grasping during the grasping phase (Fig. 9)", "; ".join(parts),
                   "reproduced" if ok and moved else "differs",
-                  f"holds: no drop/slip and the object within {1000 * HOLD_DRIFT:.0f} mm of "
-                  "where it was grasped relative to the palm" +
+                  f"holds: from the plant's grasp event on, no drop or slip and the object "
+                  f"within {1000 * HOLD_DRIFT:.0f} mm of where it was grasped relative to the "
+                  "hand x^a" +
                   ("" if moved else "; the object hardly moved, so this shows little"))]
 
 
@@ -282,7 +300,8 @@ def _tracking_rows(run: GraspRun, st: dict) -> list[Claim]:
             f"{run.name}: tracking error on the plane (Y, Z), {label}",
             "responsive tracking by visual feedback (Fig. 9; no number given)",
             f"RMS {1000 * te['rms']:.1f} mm, max {1000 * te['max']:.1f} mm over "
-            f"{te['duration']:.2f} s; the object's RMS excursion {1000 * te['excursion']:.1f} mm",
+            f"{te['duration']:.2f} s; the object's RMS excursion {1000 * te['excursion']:.1f} mm "
+            f"(ratio {te['rms'] / te['excursion']:.2f})",
             "reproduced" if ok else "differs",
             f"responsive: RMS error under {TRACK_RATIO:g} × the object's excursion"))
     return rows
