@@ -18,16 +18,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import yaml
 
 from analysis.claims import Claim
 from analysis.series import events
+from plants.bullet_arm.params import Params as ArmParams
+from plants.bullet_arm.settings import ArmSettings, resolve
 from replay.log import LogReader
+from replay.resources import data_path
+from replay.scenario import params_from_data
 
-STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "namiki2003.yaml"
+STATED = data_path("claims", "namiki2003.yaml")
 ACTIVE = (0, 1, 3)                      # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
 JOINTS = ("J1", "J2", "J4")
 
@@ -71,6 +74,7 @@ class CatchRun:
     hand_qd: np.ndarray
     t_vision: np.ndarray
     vision: np.ndarray
+    settings: ArmSettings           # the arm plant's, from the log's resolved scenario
     cs_t: np.ndarray = field(default_factory=lambda: np.zeros(0))   # /catching/state
     cs_qd_desired: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
     cs_r_o: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -104,6 +108,12 @@ class CatchRun:
         return self.scenario["controller"]["params"]
 
 
+def arm_settings(sc: dict) -> ArmSettings:
+    """The arm plant's settings for a log's resolved scenario (its typed params, rebuilt by the
+    scenario loader, then the plant's own resolver)."""
+    return resolve(params_from_data(ArmParams, sc["plant"].get("params"), "plant.params"))
+
+
 def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     sc = _scenario(log)
     eff = [m for m in log.series("/effector/state") if m["desired_position"] and m["position"]]
@@ -134,7 +144,7 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
         costs=sorted(log.series("/optimization/cost"), key=lambda c: c["iteration"]),
         cs_t=_vec(cs, "t"), cs_qd_desired=_vec(cs, "velocity_desired"),
         cs_r_o=_vec(cs, "r_o").reshape(-1, 3),
-        events=ev)
+        settings=arm_settings(sc), events=ev)
     run.t0 = float(cs[0]["t"]) if cs else None
     hold = run.first_event("mapping_hold")
     if hold is not None:
@@ -282,30 +292,19 @@ def vision_accuracy(run: CatchRun) -> tuple[float, float, float] | None:
 
 
 # ------------------------------------------------------------------------ the arm model
-def arm_capability(sc: dict) -> dict:
+def arm_capability(arm: ArmSettings) -> dict:
     """What the scenario's arm model can do at the tool: max speed with its joint-speed limits
-    (at q0 and over a sample of the joint-limit box, axis 3 at 0) and acceleration from rest at
-    q0 with its torque limits (replay.robot.capability)."""
+    (at q0 and over a sample of the joint-limit box, locked axes at q0) and acceleration from
+    rest at q0 with its torque limits (replay.robot.capability)."""
     from replay.robot.capability import max_tool_speed, tool_acceleration_from_rest
-    from replay.robot.hand import HANDS, hand_body
-    from replay.robot.wam import (DEFAULT_VELOCITY_LIMIT, TORQUE_LIMIT_SETS, wam_chain,
-                                  wam_joint_limits)
-    p = sc["plant"]["params"]
-    dof = 4 if p.get("arm", "wam4") == "wam4" else 7
-    tool_d = p.get("tool_d", -1.0)
-    hand = HANDS.get(p.get("hand", "catch3"))
-    chain = wam_chain(dof, tool_d=None if tool_d is None or tool_d < 0 else tool_d,
-                      base_position=p.get("base_position", [0, 0, 0]),
-                      base_rpy=p.get("base_rpy", [0, 0, 0]), gravity=p.get("gravity", 9.81),
-                      payload=hand_body(hand) if hand is not None else None)
-    vel = p.get("velocity_limits") or [DEFAULT_VELOCITY_LIMIT] * dof
-    tau = p.get("torque_limits") or list(TORQUE_LIMIT_SETS[p.get("torque_limit_set",
-                                                                  "public_urdf")][:dof])
-    q0 = np.asarray(p.get("initial_q") or [0.0] * dof, float)
-    act = [i for i, n in enumerate(chain.joint_names) if n not in set(p.get("locked_joints", []))]
-    lo, hi = wam_joint_limits(dof)
+    dof = arm.dof
+    chain = arm.chain()
+    vel = arm.velocity_limits.tolist()
+    tau = arm.torque_limits.tolist()
+    q0 = arm.initial_q
+    act = list(arm.active)
     rng = np.random.default_rng(0)
-    Q = rng.uniform(lo, hi, size=(400, dof))
+    Q = rng.uniform(arm.lower, arm.upper, size=(400, dof))
     for i in range(dof):
         if i not in act:
             Q[:, i] = q0[i]
@@ -373,11 +372,8 @@ def _cost_rows(opt: CatchRun | None, st: dict) -> list[Claim]:
 
 
 def _opt_limits(run: CatchRun) -> tuple[list, list]:
-    cp, pp = run.controller_params, run.plant_params
-    from replay.robot.wam import DEFAULT_VELOCITY_LIMIT, TORQUE_LIMIT_SETS
-    tau = pp.get("torque_limits") or list(TORQUE_LIMIT_SETS[pp.get("torque_limit_set",
-                                                                   "public_urdf")][:4])
-    vel = pp.get("velocity_limits") or [DEFAULT_VELOCITY_LIMIT] * 4
+    cp = run.controller_params
+    tau, vel = run.settings.torque_limits.tolist(), run.settings.velocity_limits.tolist()
     t = cp.get("opt_torque_limits") or [tau[i] for i in ACTIVE]
     w = cp.get("opt_velocity_limits") or [vel[i] for i in ACTIVE]
     return t, w
@@ -493,7 +489,7 @@ def _capability_rows(run: CatchRun, st: dict) -> list[Claim]:
     p = st["parameters"]
     v_stated = p["max_effector_speed"]["value"]
     a_stated = p["max_effector_acceleration"]["value"]
-    cap = arm_capability(run.scenario)
+    cap = arm_capability(run.settings)
     contact = first_contact(run)
     v_run, a_run = tool_peaks(run, contact["t"] if contact else None)
     w = run.t_arm <= (contact["t"] if contact else np.inf) + 1e-9

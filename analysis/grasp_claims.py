@@ -128,13 +128,17 @@ def cycle_timing(run: GraspRun) -> dict | None:
 
 
 def _arm_top_speed(run: GraspRun) -> float | None:
-    """The scenario arm model's top tool speed with its joint speed limits (any posture in a
-    sample of its joint box), as the catching claims compute it."""
+    """The run's arm model's top tool speed with its joint speed limits (over a sample of its
+    joint box), as the catching claims compute it, from the rig's own settings."""
+    from analysis.catch_claims import arm_capability
+    from plants.bullet_arm.params import GraspParams
+    from plants.bullet_arm.settings import resolve
+    from replay.scenario import ScenarioError, params_from_data
     try:
-        from analysis.catch_claims import arm_capability
-        return float(arm_capability(run.scenario)["v_max"])
-    except Exception:  # noqa: BLE001 - a scenario the capability model cannot read
+        arm = resolve(params_from_data(GraspParams, run.plant_params, "plant.params"))
+    except (ScenarioError, ValueError):
         return None
+    return float(arm_capability(arm)["v_max"])
 
 
 def _timing_rows(run: GraspRun, st: dict) -> list[Claim]:
@@ -165,7 +169,7 @@ def _timing_rows(run: GraspRun, st: dict) -> list[Claim]:
     need = ct["travel"] / dur_ms
     top = _arm_top_speed(run)
     rows.append(Claim(
-        "the same times read as printed (ms)", stated,
+        f"{run.name}: the same times read as printed (ms)", stated,
         f"a {1000 * ct['travel']:.0f} mm reach in {_ms(dur_ms)} needs {need:.0f} m/s on average; "
         f"the run's hand peaked at {ct['peak_speed']:.2f} m/s" +
         (f", the WAM-7 model tops out at {top:.1f} m/s" if top else ""),

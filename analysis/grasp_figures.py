@@ -44,8 +44,12 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> None:
                         xycoords=("data", "axes fraction"), xytext=(2, -9),
                         textcoords="offset points", fontsize=7, color="0.3")
     for e in run.events:
-        if e["kind"] in EVENT_KINDS:
-            ax.axvline(e["t"], color="0.5", lw=0.6, ls=":" if e["kind"] != "drop" else "-")
+        if e["kind"] in EVENT_KINDS and e["kind"] != "slip":
+            ax.axvline(e["t"], color="0.45", lw=0.7, ls=":" if e["kind"] != "drop" else "-")
+    slips = [e["t"] for e in run.events if e["kind"] == "slip"]
+    if slips:                                  # a rug along the bottom edge
+        ax.plot(slips, [0.02] * len(slips), "|", color="tab:red", ms=6,
+                transform=ax.get_xaxis_transform())
 
 
 def fig9(run: GraspRun):
@@ -65,8 +69,8 @@ def fig9(run: GraspRun):
     ax_x.set_xlabel("time [s]")
     ax_y.set_title(f"Feedback response: {run.name} (cf. Fig. 9)", fontsize=10)
     fig.text(0.01, 0.005, "Y: tracking on the constraint plane (S = 1); X: reaching along its "
-             "normal (S = 0). Blue: grasp phases (reach, hold); red: releasing;\ndotted: grasp, "
-             "release, slip events", fontsize=7, color="0.35")
+             "normal (S = 0). Blue: grasp phases (reach, hold); red: releasing;\ndotted: the "
+             "plant's grasp and release events; red ticks at the bottom: slip events", fontsize=7, color="0.35")
     fig.tight_layout(rect=(0, 0.04, 1, 1))
     return fig
 
@@ -183,7 +187,7 @@ def filmstrip(run: GraspRun, title: str):
         ax.plot(*_project(run.obj[trail]).T, color=C_OBJ, lw=0.8, alpha=0.6)
         kind, shape = _object_outline(run, io)
         if kind == "circle":
-            ax.add_patch(plt.Circle(shape[:2], shape[2], color=C_OBJ, alpha=0.8))
+            ax.add_patch(plt.Circle(shape[:2], shape[2], color=C_OBJ, alpha=0.55, zorder=1))
         else:
             for a, b in shape:
                 ax.plot([a[0], b[0]], [a[1], b[1]], color=C_OBJ, lw=1.2)
@@ -192,7 +196,7 @@ def filmstrip(run: GraspRun, title: str):
         if len(palm):
             ax.fill(*_project(palm).T, color="0.55", alpha=0.8, lw=0)
         for f in fingers:
-            ax.plot(*_project(f).T, "-", color=C_HAND, lw=1.6)
+            ax.plot(*_project(f).T, "-", color=C_HAND, lw=1.6, zorder=3)
         cam = head_camera_at(run, t)
         if cam is not None:                  # the head camera and its optical axis (OpenCV z)
             axis = cam[0] + _quat_matrix(cam[1])[:, 2] * np.linalg.norm(run.obj[io] - cam[0])

@@ -8,18 +8,18 @@ real 10 mm width instead of Assumption 5's negligible width). A missing log give
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import yaml
 
 from analysis.claims import Claim, within
 from analysis.series import arrays, events
-from replay.control.stick.collision import (pure_rotation_min_spin, pure_rotation_residual_spin,
-                                            pure_rotation_stop_distance)
 from replay.log import LogReader
+from replay.resources import data_path
+from replay.robot.stick_impact import (pure_rotation_min_spin, pure_rotation_residual_spin,
+                                       pure_rotation_stop_distance)
 
-STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "higashimori2007.yaml"
+STATED = data_path("claims", "higashimori2007.yaml")
 
 
 def _stated() -> dict:

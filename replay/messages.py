@@ -14,6 +14,41 @@ from typing import Any
 
 import numpy as np
 
+# ---- topic names (the contract: add freely, rename none). Use these, not string literals.
+TOPIC_SCENARIO = "/scenario"                    # ScenarioInfo, once at t = 0
+TOPIC_EVENTS = "/events"                        # Event
+# air table (Higashimori et al. 2007)
+TOPIC_STICK_STATE = "/stick/state"              # StickState
+TOPIC_FINGERS_STATE = "/fingers/state"          # FingersState
+TOPIC_HAND_STATE = "/hand/state"                # the airtable plant's hand
+TOPIC_VISION_STICK = "/vision/stick"            # VisionStick
+TOPIC_STICK_ESTIMATE = "/control/stick_estimate"   # the stick controllers' estimator
+# arm plant (Namiki & Ishikawa 2003, Namiki et al. 1999)
+TOPIC_ARM_JOINT_STATE = "/arm/joint_state"      # JointState
+TOPIC_HAND_JOINT_STATE = "/hand/joint_state"    # JointState
+TOPIC_ARM_JOINT_COMMAND = "/arm/joint_command"  # JointCommand
+TOPIC_ARM_ENCODERS = "/arm/encoders"            # JointState, measured
+TOPIC_ARM_APPLIED_TORQUE = "/arm/applied_torque"
+TOPIC_OBJECT_STATE = "/object/state"            # ObjectState
+TOPIC_OBJECT_CONTACTS = "/object/contacts"
+TOPIC_EFFECTOR_STATE = "/effector/state"        # EffectorState
+TOPIC_EFFECTOR_MOTION = "/effector/motion"
+TOPIC_VISION_OBJECT = "/vision/object"          # VisionObject
+TOPIC_OPTIMIZATION_COST = "/optimization/cost"  # OptimizationCost
+TOPIC_CATCHING_STATE = "/catching/state"        # the catching controller's state
+# grasping rig (Namiki et al. 1999; docs/DESIGN.md, "Grasping runs")
+TOPIC_HAND_ENCODERS = "/hand/encoders"
+TOPIC_HEAD_ENCODERS = "/head/encoders"
+TOPIC_VISION_CHIP = "/vision/chip"
+TOPIC_WRIST_WRENCH = "/wrist/wrench"
+TOPIC_HAND_TORQUE = "/hand/joint_torque"
+TOPIC_GRASP_OBJECT = "/grasping/object"
+TOPIC_GRASP_STATE = "/grasping/state"
+TOPIC_GRASP_HEAD = "/grasping/head"
+TOPIC_GRASP_ARM = "/grasping/arm"
+TOPIC_GRASP_HAND = "/grasping/hand"
+TOPIC_TASK_LOOPS = "/tasks/loops"
+
 
 @dataclass
 class ScenarioInfo:
@@ -169,18 +204,3 @@ def unpack_rows(rows, width: int) -> np.ndarray:
     r = np.asarray(rows, dtype=np.int64)[:, None]
     return ((r >> np.arange(width, dtype=np.int64)) & 1).astype(bool)
 
-
-# grasping runs (docs/DESIGN.md, "Grasping runs"): topic names
-TOPIC_EVENTS = "/events"
-TOPIC_ARM_ENCODERS = "/arm/encoders"
-TOPIC_HAND_ENCODERS = "/hand/encoders"
-TOPIC_HEAD_ENCODERS = "/head/encoders"
-TOPIC_VISION_CHIP = "/vision/chip"
-TOPIC_WRIST_WRENCH = "/wrist/wrench"
-TOPIC_HAND_TORQUE = "/hand/joint_torque"
-TOPIC_GRASP_OBJECT = "/grasping/object"
-TOPIC_GRASP_STATE = "/grasping/state"
-TOPIC_GRASP_HEAD = "/grasping/head"
-TOPIC_GRASP_ARM = "/grasping/arm"
-TOPIC_GRASP_HAND = "/grasping/hand"
-TOPIC_TASK_LOOPS = "/tasks/loops"

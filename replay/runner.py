@@ -102,9 +102,11 @@ class Runner:
                 for name, ts in scenario.tasks.items()], rate)
             self.ctrl_div = 1
         else:
-            ctrl_cls = registry.load("controller", scenario.controller.type)
-            self.controller = ctrl_cls(scenario.controller.params, spec=spec)
-            self.ctrl_div = _divider(rate, scenario.controller.rate)
+            cs = scenario.controller
+            assert cs is not None            # the loader requires controller: or tasks:
+            ctrl_cls = registry.load("controller", cs.type)
+            self.controller = ctrl_cls(cs.params, spec=spec)
+            self.ctrl_div = _divider(rate, cs.rate)
         self.log_div = (_divider(rate, scenario.timing.state_log_rate)
                         if scenario.timing.state_log_rate else 1)
 

@@ -47,7 +47,6 @@ class TaskError(RuntimeError):
 
 
 class TaskSet(Controller):
-    Params = None
     description = "parallel tasks (scenario tasks:)"
 
     def __init__(self, tasks: list[Task], physics_rate: int) -> None:
@@ -113,7 +112,7 @@ class TaskSet(Controller):
         return commands or None
 
     def telemetry(self, t: float) -> dict[str, Any]:
-        out = dict(self._telemetry)
+        out: dict[str, Any] = dict(self._telemetry)
         out[TOPIC_TASK_LOOPS] = TaskLoops(
             t, [x.name for x in self.tasks], list(self._ticked),
             [self._latency[x.name] for x in self.tasks],

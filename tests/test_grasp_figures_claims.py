@@ -88,7 +88,7 @@ def test_timing_read_as_ms_is_inconsistent_with_the_arm(rows, logs):
     ct = cycle_timing(load_run(logs["grasp_hexahedron"]))
     assert ct["track"] == pytest.approx(0.5, abs=1e-3)
     assert 0.05 < ct["travel"] < 0.3                                  # m: a reach of centimetres
-    ms = rows["the same times read as printed (ms)"]
+    ms = _row(rows, "grasp_hexahedron", "the same times read as printed (ms)")
     assert ms.status == "inconsistent"
     assert f"{ct['travel'] / 3e-4:.0f} m/s" in ms.measured
 
@@ -140,12 +140,12 @@ def test_no_prediction_the_hand_follows_the_object(rows, logs):
 
 def test_the_viewer_draws_the_real_run(logs):
     from replay.viewer import Viewer
-    from replay.viewer.scene_grasp import GraspScene
+    from plants.bullet_arm.grasp_viewer_scene import GraspScene
     v = Viewer.open([Path(logs["grasp_sphere"].path)], port=0)
     try:
         s = v.scenes[0]
         assert isinstance(s, GraspScene) and s.urdf is not None and not s.notes, s.notes
-        assert s.obj.kind == "ball"
+        assert s.params.object == "ball"
         v.seek(0.3)
         a = (tuple(s.head.wxyz), s.frustum.image.copy())
         v.seek(1.5)

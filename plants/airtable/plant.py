@@ -29,11 +29,13 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec
+from replay.robot.hand2d import AirTableSpec, HandCommand
 from replay.interfaces import Occurrence, Plant
 from replay.messages import FingersState, StickState
-from replay.scene import Box, Cylinder, Scene, yaw_quaternion
+from replay.scene import Box, Cylinder, Scene
+from replay.spatial import yaw_quaternion
 
+from plants.airtable import settings
 from plants.airtable.hand import HandServo
 from plants.airtable.params import Params
 
@@ -60,7 +62,7 @@ class AirTablePlant(Plant):
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
         p = params
-        self._hand_spec = self._make_hand_spec(p)
+        self._hand_spec = settings.hand_spec(p)
         self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
 
         space = pymunk.Space()
@@ -117,23 +119,6 @@ class AirTablePlant(Plant):
         self._rest_since: float | None = None
         self._rest_reported = False
         self._nan_reported = False
-
-    # -- construction helpers -------------------------------------------------------------
-
-    @staticmethod
-    def _make_hand_spec(p: Params) -> HandSpec:
-        h = p.hand
-        return HandSpec(
-            root_offsets=(tuple(map(float, h.root_offset0)), tuple(map(float, h.root_offset1))),
-            link_lengths=(float(h.link_lengths[0]), float(h.link_lengths[1])),
-            joint_limits=(tuple(map(float, h.q1_limits)), tuple(map(float, h.q2_limits))),
-            joint_speed=float(h.joint_speed),
-            base_limits=(tuple(map(float, h.base_x_limits)), tuple(map(float, h.base_y_limits))),
-            base_speed=float(h.base_speed),
-            tip_radius=float(h.tip_radius),
-            start_base=(float(h.base[0]), float(h.base[1])),
-            start_joints=(tuple(map(float, h.joints0)), tuple(map(float, h.joints1))),
-        )
 
     # -- Plant interface ------------------------------------------------------------------
 
@@ -269,13 +254,7 @@ class AirTablePlant(Plant):
         return Scene(prims)
 
     def spec(self) -> AirTableSpec:
-        st = self.params.stick
-        # Nominal values only: the method must not need mu (Assumption 10 and the paper's point).
-        # The width is the one the fingertips collide with (it sets where contact happens).
-        return AirTableSpec(hand=self._hand_spec,
-                            stick=StickSpec(mass=st.mass, inertia=st.inertia, length=st.length,
-                                            width=st.collision_width,
-                                            restitution=st.restitution))
+        return settings.spec(self.params, self._hand_spec)   # nominal: no friction
 
     def close(self) -> None:
         self._pending = []

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from replay.robot.serial_chain import cross3
+from replay.spatial import cross3
 
 
 class WristFT:

@@ -36,7 +36,7 @@ from replay.robot.arm_types import GraspSpec, PlaneSpec, ServoCommand
 from replay.robot.hand import palm_body
 from replay.robot.head import HeadSpec, camera_pose, look_angles
 from replay.scene import Scene
-from replay.robot.serial_chain import matrix_to_quaternion
+from replay.spatial import matrix_to_quaternion
 
 HEAD_JOINTS = ("pan", "tilt")
 
@@ -56,6 +56,7 @@ class BulletGraspPlant(BulletArmPlant):
         P = params
         bc = self.bc
         self._palm_j = self._jidx["palm_joint"]
+        assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
         # the servos: every arm and hand joint's own inertia at the initial posture
@@ -104,9 +105,11 @@ class BulletGraspPlant(BulletArmPlant):
             u = np.array([0.0, 1.0, 0.0])
         u = u / np.linalg.norm(u)
         v = np.cross(n, u)
-        self.plane = PlaneSpec(point=tuple(float(x) for x in P.object_position),
-                               normal=tuple(float(x) for x in n))
+        op = [float(x) for x in P.object_position]
+        self.plane = PlaneSpec(point=(op[0], op[1], op[2]),
+                               normal=(float(n[0]), float(n[1]), float(n[2])))
         self._u, self._v = u, v
+        assert self.obj is not None and self._palm_link is not None
         self.human = HumanHand(bc, self.obj, rng, origin=P.object_position, rpy0=P.object_rpy,
                                u=u, v=v, n=n, speed=P.human_speed, roll_rate=P.human_roll_rate,
                                f_min=P.human_f_min, f_max=P.human_f_max,
@@ -122,7 +125,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._touched: set = set()
         self._track_sq = 0.0
         self._track_n = 0
-        self._last_pos = None
+        self._last_pos: np.ndarray | None = None
         self._read()
         self._spec = self._grasp_spec(self._spec)
 
@@ -169,7 +172,7 @@ class BulletGraspPlant(BulletArmPlant):
         return self._obj
 
     # ------------------------------------------------------------------ command
-    def apply(self, command: ServoCommand) -> None:
+    def apply(self, command: ServoCommand) -> None:  # type: ignore[override]
         if not isinstance(command, ServoCommand):
             raise TypeError(f"the grasping rig takes ServoCommand, got {type(command).__name__}")
         if command.arm is not None:
@@ -226,7 +229,7 @@ class BulletGraspPlant(BulletArmPlant):
         if self.caught:
             if self._last_pos is not None:
                 self._held_path += float(np.linalg.norm(pos - self._last_pos))
-            rel = float(np.linalg.norm(v - self._link_point_velocity(self._palm_link, pos)))
+            rel = float(np.linalg.norm(v - self._link_point_velocity(self._palm_link or -1, pos)))
             if rel > self.params.slip_speed and not self._slipping:
                 self._slips += 1
                 self._events.append(Occurrence("slip", {"speed": rel, "position": pos.tolist()}))

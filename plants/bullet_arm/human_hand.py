@@ -20,6 +20,8 @@ import math
 import numpy as np
 import pybullet as p
 
+from replay.spatial import matrix_to_quaternion, rpy_to_matrix
+
 
 def band_limited_path(rng: np.random.Generator, *, components: int, f_min: float, f_max: float,
                       rms_rate: float, axes: int):
@@ -85,10 +87,8 @@ class HumanHand:
 
 
 def _rpy_matrix(rpy) -> np.ndarray:
-    from replay.robot.serial_chain import rpy_to_matrix
     return rpy_to_matrix(rpy)
 
 
 def _quat(R) -> list[float]:
-    from replay.robot.serial_chain import matrix_to_quaternion
     return [float(x) for x in matrix_to_quaternion(R)]

@@ -104,6 +104,6 @@ class ServoCommand:
     every arm joint), the hand's (eq. 4's theta_d^h) and the head's (eq. 1's theta_d^v). A field
     left None keeps that servo's previous command, so several tasks can each command their own
     actuators."""
-    arm: Sequence[float] | None = None
-    hand: Sequence[float] | None = None
-    head: Sequence[float] | None = None
+    arm: Sequence[float] | np.ndarray | None = None
+    hand: Sequence[float] | np.ndarray | None = None
+    head: Sequence[float] | np.ndarray | None = None

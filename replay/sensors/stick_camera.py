@@ -47,7 +47,8 @@ import numpy as np
 from replay.interfaces import Sensor
 from replay.messages import VisionStick
 from replay.params import param
-from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix, wrap_half_pi
+from replay.scene import Box, Cylinder, Scene, Sphere
+from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera
 
 _RIM = 48             # vertices of a polygon standing in for a circle

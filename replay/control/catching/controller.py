@@ -243,7 +243,6 @@ class CatchingController(Controller):
             elif topic in ("/arm/encoders", "/arm/joint_state"):
                 self._joint_state(m)
         P = self.params
-        act = list(self.active)
         qdd_d = np.zeros(self.n)
         if self.est.n and not self.holding:
             r, v, a = self.est.state(t) if P.latency_compensation else self.est.state(

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -34,8 +35,8 @@ from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_GRASP_ARM, TOPIC_GRASP_OB
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.hand import hand_body
-from replay.robot.serial_chain import cross3, dh_transform
-from replay.scene import wrap_half_pi
+from replay.robot.serial_chain import dh_transform
+from replay.spatial import cross3, wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])        # eq. 3
 
@@ -76,21 +77,24 @@ class ArmControlTask(Controller):
         self.chain = spec.model
         self.dh = [(r.alpha, r.a, r.d, r.theta_offset) for r in self.chain.dh]
         self.tool = self.chain.tool
+        if spec.plane is None or spec.hand is None:
+            raise ValueError("arm control needs a plant with a hand and a constraint plane")
         self.n_plane = np.asarray(spec.plane.normal, float)
         self.hand = hand_body(spec.hand.table)
         self.g = np.array([0.0, 0.0, -spec.gravity])
         self.vlim = np.asarray(spec.velocity_limits, float)
         self.dt = spec.dt                       # the task's period (from its update times)
-        self._t_last = None
+        self._t_last: float | None = None
         self.K_a1, self.K_a2 = np.asarray(params.K_a1, float), np.asarray(params.K_a2, float)
         self.q = np.asarray(spec.initial_q, float).copy()
         self.qd = np.zeros(len(self.q))
-        self.obj = None
-        self.state = None
-        self.wrench_raw = None
-        self.bias = None
-        self._out = None
-        self.track_sq = {}
+        self.obj: Any = None
+        self.state: Any = None
+        self.wrench_raw: Any = None
+        self.bias: np.ndarray | None = None
+        self.filtered = np.zeros(6)
+        self._out: ArmLoop | None = None
+        self.track_sq: dict[str, list] = {}
 
     def kinematics(self, q):
         """(tool transform, 6 x n geometric Jacobian at the tool origin)."""

@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -70,26 +71,29 @@ class HandControlTask(Controller):
 
     def __init__(self, params: HandParams, *, spec: GraspSpec) -> None:
         super().__init__(params, spec=spec)
-        n = spec.hand.n
+        hand = spec.hand
+        if hand is None:
+            raise ValueError("hand control needs a plant with a hand")
+        n = hand.n
         if n != 14:
             raise ValueError(f"the grasping hand has 14 joints, this plant's has {n}")
         self.postures = {"rectangle": (np.asarray(params.rectangle_preshape, float),
                                        np.asarray(params.rectangle_grip, float)),
                          "circle": (np.asarray(params.circle_preshape, float),
                                     np.asarray(params.circle_grip, float))}
-        self.open = np.asarray(spec.hand.open_posture, float)
-        self.lo, self.hi = np.asarray(spec.hand.lower, float), np.asarray(spec.hand.upper, float)
-        self.vmax = float(spec.hand.closing_speed)
+        self.open = np.asarray(hand.open_posture, float)
+        self.lo, self.hi = np.asarray(hand.lower, float), np.asarray(hand.upper, float)
+        self.vmax = float(hand.closing_speed)
         self.q = self.open.copy()
         self.qd = np.zeros(n)
         self.load = np.zeros(n)
         self.shape = "unknown"
         self.preshape = "none"
         self.dt = spec.dt
-        self._t_last = None
-        self.state = None
+        self._t_last: float | None = None
+        self.state: Any = None
         self._events: list[Occurrence] = []
-        self._out = None
+        self._out: HandLoop | None = None
         self._holds: dict[int, float] = {}       # cycle -> peak summed |F^h| in its hold
         self._shape_at_grasp: dict[int, str] = {}
 
@@ -150,7 +154,7 @@ class HandControlTask(Controller):
         missed = [{"cycle": c, "why": f"the fingers closed on nothing (peak load {v:.3f} N m "
                    f"< {self.params.contact_load:g} N m)"}
                   for c, v in sorted(self._holds.items()) if v < self.params.contact_load]
-        out = {"preshape": self.preshape,
+        out: dict[str, Any] = {"preshape": self.preshape,
                "preshape_at_grasp": [self._shape_at_grasp[c] for c in sorted(self._shape_at_grasp)],
                "hold_peak_load": [self._holds[c] for c in sorted(self._holds)],
                "missed": missed}

@@ -10,6 +10,7 @@ only damped (the second term).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -44,10 +45,12 @@ class HeadTrackingTask(Controller):
         self.xi_d = (np.asarray(params.xi_d, float) if params.xi_d else
                      np.array([(params.width - 1) / 2.0, (params.height - 1) / 2.0]))
         self.K_v, self.K_vv = np.asarray(params.K_v, float), np.asarray(params.K_vv, float)
+        if spec.head is None:
+            raise ValueError("head tracking needs a plant with a head")
         self.limit = np.asarray(spec.head.velocity_limit, float)
         self.rate = np.zeros(2)
-        self.obj = None
-        self._out = None
+        self.obj: Any = None
+        self._out: HeadLoop | None = None
 
     def update(self, t: float, measurements) -> ServoCommand:
         for topic, m in measurements:

@@ -28,7 +28,7 @@ from replay.messages import (TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISI
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import HeadSpec, camera_pose
-from replay.scene import wrap_half_pi
+from replay.spatial import wrap_half_pi
 
 
 @dataclass

@@ -53,9 +53,11 @@ class ScheduleTask(Controller):
     def __init__(self, params: ScheduleParams, *, spec: GraspSpec) -> None:
         super().__init__(params, spec=spec)
         P = params
+        if spec.plane is None:
+            raise ValueError("the schedule needs a plant with a constraint plane")
         self.point = [float(x) for x in spec.plane.point]
         self.normal = [float(x) for x in spec.plane.normal]
-        self.segments = []                       # (start, end, phase, cycle)
+        self.segments: list[tuple[float, float, str, int]] = []   # (start, end, phase, cycle)
         t = 0.0
         for c in range(P.cycles):
             track = P.track_time if c == 0 else P.track_time_next
@@ -72,9 +74,9 @@ class ScheduleTask(Controller):
             t += P.release_time
         else:
             self.segments.append((t, float("inf"), "track", P.cycles))
-        self._phase = None
+        self._phase: tuple[str, int] | None = None
         self._events: list[Occurrence] = []
-        self._out = None
+        self._out: GraspState | None = None
 
     def at(self, t: float) -> GraspState:
         P = self.params
@@ -95,8 +97,8 @@ class ScheduleTask(Controller):
         return GraspState(t, phase, cycle, [*x, 0.0, 0.0, 0.0], s, grasp, tau)
 
     def update(self, t: float, measurements) -> None:
-        self._out = self.at(t)
-        key = (self._out.phase, self._out.cycle)
+        out = self._out = self.at(t)
+        key = (out.phase, out.cycle)
         if key != self._phase:
             self._phase = key
             self._events.append(Occurrence("phase", {"phase": key[0], "cycle": key[1]}))

@@ -1,26 +1,42 @@
-"""The grasping scene (Namiki, Nakabo, Ishii & Ishikawa 1999): what ``ArmScene`` draws (the WAM-7
-and the 14-joint hand from the plant's URDF at the logged joint angles, the object at its pose,
-its path) plus the pan/tilt head with the vision chip's camera frustum, showing the chip's
+"""The grasping rig (``bullet_grasp``) in the browser viewer (Namiki, Nakabo, Ishii & Ishikawa 1999):
+what ``ArmScene`` draws (the WAM-7 and the 14-joint hand from the plant's URDF at the logged joint
+angles, the object at its pose, its path) plus the pan/tilt head with the vision chip's camera frustum, showing the chip's
 16 x 16 binary image, at the logged camera pose (``/head/state``), the constraint plane, the
 object as recognised (``/grasping/object``), the reaching target x_d^a (``/grasping/arm``), and the
 schedule's phase (``phase`` events). Plots: the hand and the object along Y, the hand and the
 reaching target along X (Fig. 9).
+
+Registered under the plant's type in ``pyproject.toml`` (``paper_replay.viewer_scenes``,
+``bullet_grasp``). The URDF is the plant's own, from its typed ``GraspParams`` through its
+resolver. No simulator is imported.
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
+from plants.bullet_arm.params import GraspParams
+from plants.bullet_arm.settings import resolve
+from plants.bullet_arm.viewer_scene import ArmScene
+from replay.scenario import params_from_data
+from replay.spatial import xyzw_to_wxyz
 from replay.viewer.data import RunData
-from replay.viewer.scenes import ArmScene, PlotSeries, PlotSpec, xyzw_to_wxyz
+from replay.viewer.scenes import PlotSeries, PlotSpec
 
 T_HEAD = "/head/state"
 T_CHIP = "/vision/chip"
 T_RECOGNISED = "/grasping/object"
 T_ARM_TASK = "/grasping/arm"
 DEFAULT_FOV = math.radians(30.0)      # when the chip sensor's params give none
+
+
+def grasp_urdf(p: dict) -> Path:
+    """The rig's URDF for these ``plant.params`` (as logged), by the plant's own resolver: the
+    very file (same cached path) ``BulletGraspPlant`` loads."""
+    return Path(resolve(params_from_data(GraspParams, p, "plant.params")).arm_model().write())
 
 
 def chip_fov(sensors: dict) -> tuple[float, int, int]:
@@ -56,16 +72,23 @@ class GraspScene(ArmScene):
     def expected(self):
         return self.optional
 
+    def plant_params(self, cls: type):
+        """The rig's ``GraspParams`` (``ArmScene`` asks for the arm plant's ``Params``)."""
+        return super().plant_params(GraspParams)
+
     def _cameras(self, scale: float) -> None:
         """The only camera is the head's, drawn on the head at its logged pose."""
 
     def build(self) -> None:
+        self.options.setdefault("urdf_for", None)
+        if self.options["urdf_for"] is None:
+            self.options["urdf_for"] = grasp_urdf
         super().build()
         sc, r = self.scene, self.root
-        p = self.run.plant_params
+        p = self.params
         self.seen.visible = False              # ArmScene's /vision/object marker: not used here
-        if p.get("object_position") is not None:       # the constraint plane through it
-            n = np.asarray(p.get("plane_normal") or [1.0, 0.0, 0.0], float)
+        if p.object_position:                  # the constraint plane through it
+            n = np.asarray(p.plane_normal, float)
             n /= np.linalg.norm(n) or 1.0
             axis = np.cross([1.0, 0.0, 0.0], n)
             angle = math.atan2(np.linalg.norm(axis), n[0])
@@ -73,7 +96,7 @@ class GraspScene(ArmScene):
             wxyz = (math.cos(angle / 2), *(math.sin(angle / 2) * axis))
             self._add(sc.add_box(f"{r}/plane", color=(120, 160, 220), opacity=0.15,
                                  dimensions=(0.002, 0.5, 0.5), wxyz=wxyz,
-                                 position=tuple(float(v) for v in p["object_position"])))
+                                 position=tuple(float(v) for v in p.object_position)))
         self.fov, self.chip_w, self.chip_h = chip_fov(self.run.sensors)
         color = (60, 60, 60) if not self.ghost else self.color
         self.head = self._add(sc.add_frame(f"{r}/head", show_axes=False, visible=False))
