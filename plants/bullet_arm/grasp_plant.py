@@ -29,7 +29,7 @@ from plants.bullet_arm.human_hand import HumanHand
 from plants.bullet_arm.params import GraspParams
 from plants.bullet_arm.payloads import HeadState, HumanState, ServoState, Wrench
 from plants.bullet_arm.plant import BulletArmPlant
-from plants.bullet_arm.servo import VelocityServos, apply_torques
+from plants.bullet_arm.servo import VelocityMotors, VelocityServos, apply_torques
 from replay.interfaces import Occurrence
 from replay.messages import JointState
 from replay.robot.arm_types import GraspSpec, PlaneSpec, ServoCommand
@@ -74,16 +74,14 @@ class BulletGraspPlant(BulletArmPlant):
         self.arm_servos = VelocityServos([inertia[j] for j in self._arm_j],
                                          self.torque_limits[list(self.active)],
                                          P.arm_servo_bandwidth, dt)
-        self.hand_servos = VelocityServos([inertia[j] for j in self._hand_j],
-                                          [P.hand_max_torque] * len(self._hand_j),
-                                          P.hand_servo_bandwidth, dt)
-        self._servo_j = self._arm_j + self._hand_j
+        self.hand_servos = VelocityMotors(bc, self.robot, self._hand_j,
+                                          [P.hand_max_torque] * len(self._hand_j))
+        self._servo_j = self._arm_j
         # the servos have been holding the robot still before t = 0: their integrals carry the
         # static torques (gravity) at the initial posture
         g = bc.calculateInverseDynamics(self.robot, pos, [0.0] * len(dofs), [0.0] * len(dofs))
         tau0 = {j: g[i] for i, j in enumerate(dofs)}
         self.arm_servos.preload([tau0[j] for j in self._arm_j])
-        self.hand_servos.preload([tau0[j] for j in self._hand_j])
         # the head
         self.head = HeadSpec(position=tuple(P.head_position), yaw=float(P.head_yaw),
                              camera_offset=float(P.head_camera_offset),
@@ -156,7 +154,8 @@ class BulletGraspPlant(BulletArmPlant):
         hs = st[na:na + nh]
         self._hq = np.array([s[0] for s in hs])
         self._hqd = np.array([s[1] for s in hs])
-        self._htau = self.hand_servos.torque.copy()
+        self.hand_servos.read(hs)
+        self._htau = self.hand_servos.torque
         self._wrench = self.ft.convert(st[-1][2])
         pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
         v, w = self.bc.getBaseVelocity(self.obj)
@@ -188,9 +187,8 @@ class BulletGraspPlant(BulletArmPlant):
     def step(self) -> None:
         self.human.drive(self._t)
         act = list(self.active)
-        tau = np.concatenate([self.arm_servos.torques(self._qd[act]),
-                              self.hand_servos.torques(self._hqd)])
-        apply_torques(self.bc, self.robot, self._servo_j, tau)
+        apply_torques(self.bc, self.robot, self._servo_j, self.arm_servos.torques(self._qd[act]))
+        self.hand_servos.actuate()
         self.head_servo.step()
         self._obj_vel_before = self._obj[2]
         self.bc.stepSimulation()

@@ -106,9 +106,6 @@ class GraspParams(Params):
         500.0, unit="rad/s", gt=0.0, le=1500.0,
         doc="velocity-loop bandwidth of the arm's AC servo amplifiers (assumed ~80 Hz; the "
             "explicit 1 kHz loop needs bandwidth * dt well below 2)")
-    hand_servo_bandwidth: float = param(
-        500.0, unit="rad/s", gt=0.0, le=1500.0,
-        doc="velocity-loop bandwidth of the hand's DC servos (assumed)")
     plane_normal: list = param([1.0, 0.0, 0.0], unit="1", length=3,
                                doc="normal of the constraint plane through the object's initial "
                                    "centre (world); the human moves the object in it")

@@ -64,3 +64,34 @@ class VelocityServos:
 
 def apply_torques(bc, body: int, joints: list, torques: np.ndarray) -> None:
     bc.setJointMotorControlArray(body, joints, p.TORQUE_CONTROL, forces=torques.tolist())
+
+
+class VelocityMotors:
+    """Stiff geared velocity servos: PyBullet's velocity motor (solved implicitly with the
+    contacts) drives each joint at its commanded rate with at most its torque limit. A finger's
+    geared DC motor reflects an inertia far above the light finger link's, so a velocity loop
+    on the link's own inertia would let the fingers flop under the arm's accelerations; the
+    implicit motor is that stiff drive. The torque it gave (``appliedJointMotorTorque``) is what
+    the joint's strain gauge reads."""
+
+    def __init__(self, bc, body: int, joints, torque_limits) -> None:
+        self.bc, self.body, self.joints = bc, body, list(joints)
+        self.limits = np.asarray(torque_limits, float).reshape(-1)
+        self._forces = [float(x) for x in self.limits]
+        self.command = np.zeros(len(self.joints))
+        self.torque = np.zeros(len(self.joints))
+
+    def set_command(self, qd) -> None:
+        v = np.asarray(qd, float).reshape(-1)
+        if v.shape != self.command.shape:
+            raise ValueError(f"velocity command needs {len(self.joints)} values, got {v.shape[0]}")
+        self.command = np.where(np.isfinite(v), v, 0.0)
+
+    def actuate(self) -> None:
+        self.bc.setJointMotorControlArray(self.body, self.joints, p.VELOCITY_CONTROL,
+                                          targetVelocities=self.command.tolist(),
+                                          forces=self._forces)
+
+    def read(self, states) -> None:
+        """The motors' torques from this step's joint states (index 3)."""
+        self.torque = np.array([s[3] for s in states])

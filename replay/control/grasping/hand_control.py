@@ -9,8 +9,10 @@
 - theta_d^h = preshape + c (grip - preshape): ``c`` (0..1) follows the reaching motion x_d^a
   (the schedule's reach progress: closing from ``close_from`` to the grasp position, held
   closed, opened on release). Preshape and grip postures are chosen by the recognised shape
-  (Fig. 5(b)): a rectangle gets fingers side by side, a circle fingers spread (the index and
-  ring knuckles abducted) and pre-curled. Before the shape is known the hand stays open.
+  (Fig. 5(b)): a rectangle gets straight fingers side by side (a flat hand, closing like a
+  parallel gripper on the box's faces), a circle a cupped hand: the fingers opened wide at the
+  knuckle and curled at their distal joints, the index and ring turned in towards the middle
+  finger, wrapping the ball. Before the shape is known the hand stays open.
 """
 
 from __future__ import annotations
@@ -31,8 +33,9 @@ from replay.robot.arm_types import GraspSpec, ServoCommand
 # thumb (flex x3). Assumed postures (rad), none from the paper.
 _RECT_PRE = [0.0, 0.0, 0.05, 0.05, 0.0, 0.05, 0.05, 0.0, 0.0, 0.05, 0.05, 0.0, 0.05, 0.05]
 _RECT_GRIP = [0.0, 1.10, 0.80, 0.60, 1.10, 0.80, 0.60, 0.0, 1.10, 0.80, 0.60, 1.10, 0.80, 0.60]
-_CIRC_PRE = [0.30, 0.35, 0.30, 0.30, 0.35, 0.30, 0.30, -0.30, 0.35, 0.30, 0.30, 0.35, 0.30, 0.30]
-_CIRC_GRIP = [0.30, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, -0.30, 1.20, 0.90, 0.80, 1.20, 0.90,
+_CIRC_PRE = [-0.10, -0.15, 0.20, 0.20, -0.15, 0.20, 0.20, 0.10, -0.15, 0.20, 0.20, -0.15, 0.20,
+             0.20]
+_CIRC_GRIP = [-0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, 0.20, 1.20, 0.90, 0.80, 1.20, 0.90,
               0.80]
 
 
@@ -47,7 +50,7 @@ class HandParams:
     rectangle_grip: list = param(_RECT_GRIP, unit="rad", length=14,
                                  doc="theta_d^h fully closed on a rectangle (past the contact)")
     circle_preshape: list = param(_CIRC_PRE, unit="rad", length=14,
-                                  doc="theta_d^h before closing on a circle: fingers spread")
+                                  doc="theta_d^h before closing on a circle: a cupped hand")
     circle_grip: list = param(_CIRC_GRIP, unit="rad", length=14,
                               doc="theta_d^h fully closed on a circle")
     close_from: float = param(0.8, unit="1", ge=0.0, lt=1.0,
@@ -56,9 +59,10 @@ class HandParams:
                                doc="time constant of the first-order low-pass on F^h: the gauge "
                                    "reads the drive's own torque, so unfiltered feedback through "
                                    "a stiff servo chatters")
-    contact_load: float = param(0.05, unit="N*m", gt=0.0,
-                                doc="a hold phase whose summed |F^h| never exceeds this closed on "
-                                    "nothing (a missed grasp)")
+    free_closure: float = param(0.1, unit="rad", gt=0.0,
+                                doc="a hold phase in which every finger reaches its grip posture "
+                                    "within this closed on nothing (a missed grasp): an object "
+                                    "stops them ~0.4 rad short")
 
 
 class HandControlTask(Controller):
@@ -94,7 +98,7 @@ class HandControlTask(Controller):
         self.state: Any = None
         self._events: list[Occurrence] = []
         self._out: HandLoop | None = None
-        self._holds: dict[int, float] = {}       # cycle -> peak summed |F^h| in its hold
+        self._holds: dict[int, float] = {}       # cycle -> least closure deficit in its hold
         self._shape_at_grasp: dict[int, str] = {}
 
     def update(self, t: float, measurements) -> ServoCommand | None:
@@ -137,8 +141,8 @@ class HandControlTask(Controller):
         cmd = np.clip(cmd, -self.vmax, self.vmax)
         if st.phase == "hold":
             self._shape_at_grasp.setdefault(st.cycle, self.preshape)
-            peak = float(np.abs(self.load).sum())
-            self._holds[st.cycle] = max(self._holds.get(st.cycle, 0.0), peak)
+            deficit = float(np.max(np.abs(theta_d - self.q)))
+            self._holds[st.cycle] = min(self._holds.get(st.cycle, np.inf), deficit)
         self._out = HandLoop(t, self.preshape, c, theta_d.tolist(), self.load.tolist(),
                              cmd.tolist())
         return ServoCommand(hand=cmd)
@@ -151,12 +155,12 @@ class HandControlTask(Controller):
         return ev
 
     def outcome(self, t: float) -> dict:
-        missed = [{"cycle": c, "why": f"the fingers closed on nothing (peak load {v:.3f} N m "
-                   f"< {self.params.contact_load:g} N m)"}
-                  for c, v in sorted(self._holds.items()) if v < self.params.contact_load]
+        missed = [{"cycle": c, "why": f"the fingers closed on nothing (all within {v:.3f} rad "
+                   "of their grip posture)"}
+                  for c, v in sorted(self._holds.items()) if v < self.params.free_closure]
         out: dict[str, Any] = {"preshape": self.preshape,
                "preshape_at_grasp": [self._shape_at_grasp[c] for c in sorted(self._shape_at_grasp)],
-               "hold_peak_load": [self._holds[c] for c in sorted(self._holds)],
+               "hold_closure_deficit": [self._holds[c] for c in sorted(self._holds)],
                "missed": missed}
         if missed:
             out.update(success=False, reason=f"missed grasp in cycle {missed[0]['cycle']}: "
