@@ -26,7 +26,7 @@ from analysis.grasp_run import (GRASP_PHASES, HOLDING, RELEASING, TRACKING, Gras
 from replay.log import LogReader
 
 STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "namiki1999.yaml"
-ROUND = {"box": "rectangle", "hexahedron": "rectangle", "ball": "circle", "sphere": "circle"}
+ROUND = {"box": "rectangle", "ball": "circle"}      # the rig's object -> its image's shape
 HOLD_DRIFT = 0.01          # m: a grasp "holds" while the object stays within this of the palm
 TRACK_RATIO = 0.2          # tracking is "responsive" if RMS error < this x the object's excursion
 
@@ -131,12 +131,10 @@ def _arm_top_speed(run: GraspRun) -> float | None:
     """The run's arm model's top tool speed with its joint speed limits (over a sample of its
     joint box), as the catching claims compute it, from the rig's own settings."""
     from analysis.catch_claims import arm_capability
-    from plants.bullet_arm.params import GraspParams
     from plants.bullet_arm.settings import resolve
-    from replay.scenario import ScenarioError, params_from_data
     try:
-        arm = resolve(params_from_data(GraspParams, run.plant_params, "plant.params"))
-    except (ScenarioError, ValueError):
+        arm = resolve(run.params)
+    except ValueError:
         return None
     return float(arm_capability(arm)["v_max"])
 
@@ -163,7 +161,7 @@ def _timing_rows(run: GraspRun, st: dict) -> list[Claim]:
                   "reproduced" if ok else "differs",
                   "the schedule's times are the scenario's; the grasp event is the plant's "
                   "(several hand parts in contact and the object still relative to the palm for "
-                  f"{float(run.plant_params.get('catch_hold_time', 0.0)) * 1000:.0f} ms before "
+                  f"{run.params.catch_hold_time * 1000:.0f} ms before "
                   "it fires)")]
     dur_ms = (t_done - t_reach) * 1e-3
     need = ct["travel"] / dur_ms
@@ -186,7 +184,7 @@ def recognised_shapes(run: GraspRun) -> list[str]:
 
 
 def _preshape_rows(run: GraspRun, st: dict) -> list[Claim]:
-    kind = str(run.plant_params.get("object", "box"))
+    kind = run.params.object
     want = ROUND.get(kind, kind)
     shapes = recognised_shapes(run)
     pre = [str(m["preshape"]) for m in run.hand_task if m.get("preshape")]

@@ -24,6 +24,7 @@ from analysis.figure_files import save  # noqa: E402
 from analysis.grasp_run import (GRASP_PHASES, REACHING, RELEASING, GraspRun,  # noqa: E402
                                 head_camera_at, load_run)
 from replay.log import LogReader  # noqa: E402
+from replay.spatial import quaternion_matrix  # noqa: E402
 
 C_OBJ, C_HAND, C_TARGET = "tab:orange", "tab:blue", "tab:green"
 SHADE = {"grasp": ("tab:blue", 0.10), RELEASING: ("tab:red", 0.10)}
@@ -85,17 +86,14 @@ def _project(p: np.ndarray) -> np.ndarray:
 
 
 class _Robot:
-    """The run's arm and hand models, as the plant builds them from ``plant.params``."""
+    """The run's arm and hand models, from the rig's own settings (``plants.bullet_arm``'s
+    resolver on the log's ``plant.params``)."""
 
-    def __init__(self, params: dict) -> None:
-        from replay.robot.hand import HANDS
-        from replay.robot.wam import wam_chain
-        dof = 4 if params.get("arm", "wam7") == "wam4" else 7
-        tool_d = float(params.get("tool_d", -1.0) if params.get("tool_d") is not None else -1.0)
-        self.chain = wam_chain(dof, tool_d=None if tool_d < 0 else tool_d,
-                               base_position=params.get("base_position", [0, 0, 0]),
-                               base_rpy=params.get("base_rpy", [0, 0, 0]))
-        self.hand = HANDS.get(str(params.get("hand", "grasp4")))
+    def __init__(self, params) -> None:
+        from plants.bullet_arm.settings import resolve
+        arm = resolve(params)
+        self.chain = arm.chain()
+        self.hand = arm.hand
 
     def segments(self, q_arm, q_hand) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
         """Arm polyline (world), finger polylines (world), palm corners (world)."""
@@ -122,21 +120,13 @@ class _Robot:
         return arm, fingers, palm
 
 
-def _quat_matrix(q) -> np.ndarray:
-    x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-
 def _object_outline(run: GraspRun, i: int) -> tuple[str, np.ndarray]:
-    p = run.plant_params
+    p = run.params
     pos = run.obj[i]
-    if str(p.get("object", "box")) in ("ball", "sphere"):
-        r = float(p.get("object_radius", 0.03))
-        return "circle", np.array([*_project(pos), r])
-    size = np.asarray(p.get("object_size", [0.05, 0.05, 0.05]), float) / 2.0
-    R = _quat_matrix(run.obj_orn[i]) if len(run.obj_orn) else np.eye(3)
+    if p.object == "ball":
+        return "circle", np.array([*_project(pos), p.object_radius])
+    size = np.asarray(p.object_size, float) / 2.0
+    R = quaternion_matrix(run.obj_orn[i]) if len(run.obj_orn) else np.eye(3)
     corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     world = pos + (corners * size) @ R.T
     edges = [(a, b) for a in range(8) for b in range(a + 1, 8)
@@ -167,7 +157,7 @@ def _index(t_series: np.ndarray, t: float) -> int:
 
 
 def filmstrip(run: GraspRun, title: str):
-    robot = _Robot(run.plant_params)
+    robot = _Robot(run.params)
     picks = filmstrip_times(run)
     fig, axes = plt.subplots(2, 3, figsize=(9.6, 6.6))
     near = [_project(run.obj)]             # the close-up frames the hand and the object
@@ -199,7 +189,7 @@ def filmstrip(run: GraspRun, title: str):
             ax.plot(*_project(f).T, "-", color=C_HAND, lw=1.6, zorder=3)
         cam = head_camera_at(run, t)
         if cam is not None:                  # the head camera and its optical axis (OpenCV z)
-            axis = cam[0] + _quat_matrix(cam[1])[:, 2] * np.linalg.norm(run.obj[io] - cam[0])
+            axis = cam[0] + quaternion_matrix(cam[1])[:, 2] * np.linalg.norm(run.obj[io] - cam[0])
             h2, a2 = _project(cam[0]), _project(axis)
             ax.plot(*h2, "s", color="0.2", ms=6)
             ax.plot([h2[0], a2[0]], [h2[1], a2[1]], color="tab:purple", lw=0.7, ls="--")
@@ -228,8 +218,7 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
             continue
         paths += save(fig9(run), out, f"{name}_fig9")
         if len(run.t_arm):
-            shape = str(run.plant_params.get("object", "box"))
-            what = "a sphere (cf. Fig. 8)" if shape in ("ball", "sphere") else \
+            what = "a sphere (cf. Fig. 8)" if run.params.object == "ball" else \
                 "a hexahedron (cf. Figs. 6, 7)"
             paths += save(filmstrip(run, f"Grasping of {what}: {name}"), out,
                           f"{name}_filmstrip")

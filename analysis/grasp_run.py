@@ -12,6 +12,7 @@ plant's grasp/release events.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import yaml
@@ -86,6 +87,14 @@ class GraspRun:
     @property
     def plant_params(self) -> dict:
         return (self.scenario.get("plant") or {}).get("params") or {}
+
+    @cached_property
+    def params(self):
+        """The rig's typed ``GraspParams``, rebuilt from the log's resolved scenario (every
+        default the plant's own)."""
+        from plants.bullet_arm.params import GraspParams
+        from replay.scenario import params_from_data
+        return params_from_data(GraspParams, self.plant_params, "plant.params")
 
     @property
     def t_end(self) -> float:

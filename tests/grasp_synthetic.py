@@ -18,6 +18,7 @@ from analysis.grasp_run import (HOLDING, REACHING, RELEASING, T_ARM, T_ARM_TASK,
                                 TRACKING)
 from replay.log import LogWriter, seconds_to_ns
 from replay.messages import Event, JointState, ObjectState, ScenarioInfo
+from replay.spatial import matrix_to_quaternion
 
 PLANE_X = 0.65
 STANDOFF = 0.15             # m, the hand's distance from the plane while only tracking
@@ -131,7 +132,6 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
             x = np.cross(z, [0.0, 0.0, 1.0])
             x /= np.linalg.norm(x)
             R = np.column_stack([x, np.cross(z, x), z])     # OpenCV: x right, y down, z ahead
-            from replay.robot.serial_chain import matrix_to_quaternion
             log.write(T_HEAD, {"t": t, "pan": pan, "tilt": tilt, "velocity": [0.0, 0.0],
                                "camera_position": HEAD,
                                "camera_orientation": matrix_to_quaternion(R).tolist()}, ns)
