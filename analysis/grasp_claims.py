@@ -341,9 +341,9 @@ def _prediction_rows(run: GraspRun, st: dict) -> list[Claim]:
         hi = np.searchsorted(run.t_vis, run.t_eff + 1e-9)
         for back in range(1, 6):
             i = hi - back
-            ok = i >= 0
-            dd = np.linalg.norm(run.seen[ok] - run.vis[np.maximum(i[ok], 0)], axis=1)
-            d[ok] = np.minimum(d[ok], dd)
+            has = i >= 0
+            dd = np.linalg.norm(run.seen[has] - run.vis[np.maximum(i[has], 0)], axis=1)
+            d[has] = np.minimum(d[has], dd)
         seen = np.isfinite(d)
         if seen.any():
             used.append(float(np.max(d[seen])))

@@ -177,7 +177,8 @@ def filmstrip(run: GraspRun, title: str):
         ax.plot(*_project(run.obj[trail]).T, color=C_OBJ, lw=0.8, alpha=0.6)
         kind, shape = _object_outline(run, io)
         if kind == "circle":
-            ax.add_patch(plt.Circle(shape[:2], shape[2], color=C_OBJ, alpha=0.55, zorder=1))
+            ax.add_patch(plt.Circle((float(shape[0]), float(shape[1])), float(shape[2]),
+                                    color=C_OBJ, alpha=0.55, zorder=1))
         else:
             for a, b in shape:
                 ax.plot([a[0], b[0]], [a[1], b[1]], color=C_OBJ, lw=1.2)

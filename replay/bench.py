@@ -83,7 +83,6 @@ def bench_grasp(path: str = GRASP, repeat: int = 2) -> dict:
     ``stepSimulation`` calls, as many, on a fresh client holding the same bodies (arm, hand,
     object; the plant's Python servo and bookkeeping excluded). CPU time (``process_time``) so
     that other processes on the machine do not count; PyBullet runs in this process (DIRECT)."""
-    import pybullet as p
     sc = load_scenario(path)
     best = float("inf")
     with tempfile.TemporaryDirectory() as tmp:
@@ -93,13 +92,13 @@ def bench_grasp(path: str = GRASP, repeat: int = 2) -> dict:
             result = runner.run(Path(tmp) / f"grasp{i}.mcap")
             best = min(best, time.process_time() - c0)
     plant = type(runner.plant)(sc.plant.params, dt=runner.dt, rng=runner.plant.rng)
-    client = plant.client
-    bodies = p.getNumBodies(physicsClientId=client)
+    bc = plant.bc                                    # the plant's pybullet BulletClient
+    bodies = bc.getNumBodies()
     bare = float("inf")
     for _ in range(repeat):
         c0 = time.process_time()
         for _ in range(result.steps):
-            p.stepSimulation(physicsClientId=client)
+            bc.stepSimulation()
         bare = min(bare, time.process_time() - c0)
     plant.close()
     return {"scenario": sc.name, "sim_time": result.t_end, "steps": result.steps,

@@ -30,6 +30,9 @@ T_HEAD = "/head/state"
 T_CHIP = "/vision/chip"
 T_RECOGNISED = "/grasping/object"
 T_ARM_TASK = "/grasping/arm"
+# the topics a grasping run has (a missing one is noted in the view)
+EXPECTED = ("/arm/joint_state", "/hand/joint_state", "/object/state", T_HEAD, T_RECOGNISED,
+            T_ARM_TASK)
 DEFAULT_FOV = math.radians(30.0)      # when the chip sensor's params give none
 
 
@@ -63,14 +66,26 @@ def chip_image(rows, width: int, height: int) -> np.ndarray:
     return img.repeat(8, axis=0).repeat(8, axis=1)
 
 
+def _xyz(v) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def _row(run: RunData, topic: str, t: float, *fields: str) -> list | None:
+    """``fields`` of ``topic``'s last message at or before t, or None (no such topic, field, or
+    message yet)."""
+    tr = run.track(topic)
+    if tr is None or not all(tr.has(f) for f in fields):
+        return None
+    i = tr.index(t)
+    return None if i < 0 else [tr.fields[f][i] for f in fields]
+
+
 class GraspScene(ArmScene):
     kind = "grasping"
     needs = ("/arm/joint_state", "/object/state")
-    optional = ("/arm/joint_state", "/hand/joint_state", "/object/state", T_HEAD,
-                T_RECOGNISED, T_ARM_TASK)
 
     def expected(self):
-        return self.optional
+        return EXPECTED
 
     def plant_params(self, cls: type):
         """The rig's ``GraspParams`` (``ArmScene`` asks for the arm plant's ``Params``)."""
@@ -96,7 +111,7 @@ class GraspScene(ArmScene):
             wxyz = (math.cos(angle / 2), *(math.sin(angle / 2) * axis))
             self._add(sc.add_box(f"{r}/plane", color=(120, 160, 220), opacity=0.15,
                                  dimensions=(0.002, 0.5, 0.5), wxyz=wxyz,
-                                 position=tuple(float(v) for v in p.object_position)))
+                                 position=_xyz(p.object_position)))
         self.fov, self.chip_w, self.chip_h = chip_fov(self.run.sensors)
         color = (60, 60, 60) if not self.ghost else self.color
         self.head = self._add(sc.add_frame(f"{r}/head", show_axes=False, visible=False))
@@ -119,37 +134,32 @@ class GraspScene(ArmScene):
     def update(self, run: RunData, t: float) -> None:
         super().update(run, t)
         self.seen.visible = False
-        hs = run.track(T_HEAD)
-        i = hs.index(t) if hs is not None and hs.has("camera_position") else -1
-        self.head.visible = i >= 0
-        if i >= 0:
-            self.head.position = tuple(float(v) for v in hs.fields["camera_position"][i])
-            self.head.wxyz = xyzw_to_wxyz(hs.fields["camera_orientation"][i])
+        cam = _row(run, T_HEAD, t, "camera_position", "camera_orientation")
+        self.head.visible = cam is not None
+        if cam is not None:
+            self.head.position = _xyz(cam[0])
+            self.head.wxyz = xyzw_to_wxyz(cam[1])
         chip = run.track(T_CHIP)
         j = chip.index(t) if chip is not None and chip.has("rows") else -1
-        if j >= 0 and j != self._chip_i:
+        if chip is not None and j >= 0 and j != self._chip_i:
             self._chip_i = j
             self.frustum.image = chip_image(chip.fields["rows"][j], self.chip_w, self.chip_h)
-        rec = run.track(T_RECOGNISED)
-        j = rec.index(t) if rec is not None and rec.has("position") else -1
-        ok = j >= 0 and bool(np.all(np.isfinite(rec.fields["position"][j])))
-        if ok and rec.has("found"):
-            ok = bool(rec.fields["found"][j])
+        rec = _row(run, T_RECOGNISED, t, "position", "found")
+        ok = rec is not None and bool(np.all(np.isfinite(rec[0]))) and bool(rec[1])
         self.recognised.visible = ok
-        if ok:
-            self.recognised.position = tuple(float(v) for v in rec.fields["position"][j])
-        arm = run.track(T_ARM_TASK)
-        j = arm.index(t) if arm is not None and arm.has("x_d") else -1
-        ok = j >= 0 and bool(np.all(np.isfinite(arm.fields["x_d"][j][:3])))
+        if rec is not None and ok:
+            self.recognised.position = _xyz(rec[0])
+        xd = _row(run, T_ARM_TASK, t, "x_d")
+        ok = xd is not None and bool(np.all(np.isfinite(xd[0][:3])))
         self.reach.visible = ok
-        if ok:
-            self.reach.position = tuple(float(v) for v in arm.fields["x_d"][j][:3])
+        if xd is not None and ok:
+            self.reach.position = _xyz(xd[0][:3])
         phase = next((name for te, name in reversed(self.phases) if te <= t + 1e-12), None)
         self.phase_label.visible = phase is not None and self.body.visible
         if phase is not None and self.body.visible:
             self.phase_label.text = f"{phase}"
-            self.phase_label.position = tuple(float(v) + d for v, d in
-                                              zip(self.body.position, (0.0, 0.0, 0.06)))
+            x, y, z = self.body.position
+            self.phase_label.position = (float(x), float(y), float(z) + 0.06)
 
     def plots(self) -> list[PlotSpec]:
         def column(topic: str, field: str, k: int):
