@@ -113,3 +113,13 @@ def test_grasp_rate_over_other_human_paths_and_speeds(tmp_path, project_root):
     rate = sum(ok) / len(ok)
     print(f"grasp rate {sum(ok)}/{len(ok)} = {rate:.0%}")
     assert rate >= 0.75
+
+
+def test_same_seed_same_log(tmp_path, project_root):
+    logs = []
+    for sub in ("a", "b"):
+        (tmp_path / sub).mkdir()
+        logs.append(run(tmp_path / sub, "grasp_hexahedron", ["timing.duration=0.15"])[1])
+    for topic in ("/vision/chip", "/grasping/object", "/grasping/arm", "/object/state",
+                  "/human/state", "/wrist/wrench"):
+        assert logs[0].series(topic) == logs[1].series(topic), topic

@@ -228,10 +228,13 @@ class BulletGraspPlant(BulletArmPlant):
             if self._last_pos is not None:
                 self._held_path += float(np.linalg.norm(pos - self._last_pos))
             rel = float(np.linalg.norm(v - self._link_point_velocity(self._palm_link or -1, pos)))
+            # a slip episode: faster than slip_speed on the hand, over when below half of it
             if rel > self.params.slip_speed and not self._slipping:
                 self._slips += 1
+                self._slipping = True
                 self._events.append(Occurrence("slip", {"speed": rel, "position": pos.tolist()}))
-            self._slipping = rel > self.params.slip_speed
+            elif self._slipping and rel < 0.5 * self.params.slip_speed:
+                self._slipping = False
         else:
             self._slipping = False
             self._track_sq += float((d @ self._u) ** 2 + (d @ self._v) ** 2)

@@ -136,9 +136,9 @@ class GraspParams(Params):
                                       doc="(pan, tilt) speed the method may command")
     head_servo_bandwidth: float = param(300.0, unit="rad/s", gt=0.0,
                                         doc="velocity-loop bandwidth of the head's DC servos")
-    slip_speed: float = param(0.02, unit="m/s", gt=0.0,
+    slip_speed: float = param(0.05, unit="m/s", gt=0.0,
                               doc="while grasped, object speed relative to the palm above this "
-                                  "is a slip")
+                                  "starts a slip (a slip event), below half of it ends it")
     grasp_min_grasps: int = param(1, ge=1, doc="grasps a successful run has")
     grasp_min_hold: float = param(0.3, unit="s", ge=0.0,
                                   doc="a successful run holds one grasp at least this long while "

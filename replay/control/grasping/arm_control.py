@@ -44,7 +44,7 @@ S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])        # eq. 3
 @dataclass
 class ArmParams:
     K_ap: float = param(1.0, unit="1", ge=0.0, doc="eq. 2's K^ap (a scalar times I)")
-    K_a1: list = param([0.0, 25.0, 25.0, 15.0, 0.0, 0.0], unit="1/s", length=6, ge=0.0,
+    K_a1: list = param([0.0, 40.0, 40.0, 20.0, 0.0, 0.0], unit="1/s", length=6, ge=0.0,
                        doc="eq. 2's K^a1 (tracking; only the S components act; assumed)")
     K_a2: list = param([15.0, 0.0, 0.0, 0.0, 10.0, 10.0], unit="1/s", length=6, ge=0.0,
                        doc="eq. 2's K^a2 (reaching; only the I - S components act; assumed)")
