@@ -16,11 +16,12 @@ from analysis.figure_files import save  # noqa: E402
 from analysis.series import arrays, events  # noqa: E402
 from plants.airtable.params import Params  # noqa: E402
 from replay.log import LogReader  # noqa: E402
+from replay.messages import TOPIC_STICK_STATE  # noqa: E402
 from replay.scenario import ScenarioError, params_from_data  # noqa: E402
 
 
 def fig7(log: LogReader, title: str = ""):
-    s = arrays(log, "/stick/state", ["vx", "vy", "omega"])
+    s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy", "omega"])
     speed = np.hypot(s["vx"], s["vy"])
     fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
     ax_v.plot(s["t"], speed, color="tab:blue", lw=1.4, label="simulated (Pymunk)")
@@ -56,7 +57,7 @@ def friction_overlay(logs: dict[str, LogReader]):
     fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
     for name, log in sorted(logs.items()):
         mu = _mu(log)
-        s = arrays(log, "/stick/state", ["vx", "vy", "omega"])
+        s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy", "omega"])
         label = f"{name} (μ = {mu:g})" if mu is not None else name
         ax_v.plot(s["t"], np.hypot(s["vx"], s["vy"]), lw=1.2, label=label)
         ax_w.plot(s["t"], s["omega"], lw=1.2, label=label)

@@ -147,9 +147,10 @@ def optimise(scenario, out):
     stored = getattr(sc.controller.params, "alpha_file", None)
     if stored is None:
         _fail(f"controller {sc.controller.type!r} has no offline optimisation to store")
-    path = Path(out or stored)
-    if not str(path):
+    if not out and not stored:
         _fail("the scenario sets no controller.params.alpha_file: give -o FILE")
+    base = getattr(sc.controller.params, "scenario_dir", "")   # files resolve from the scenario
+    path = Path(out) if out else Path(base, stored).resolve() if base else Path(stored)
     runner = Runner(_load(scenario, ["controller.params.alpha_file=''"]))
     runner.controller.write_alpha_file(path)
     runner.plant.close()

@@ -15,13 +15,14 @@ from pathlib import Path
 import yaml
 
 from replay.log import LogReader
+from replay.messages import TOPIC_SCENARIO
 from replay.resources import shipped_root
 from replay.runner import Runner
 from replay.scenario import load_scenario
 
 GOLDEN_DIR = Path("data/golden")   # under replay.resources.shipped_root()
 MANIFEST = "manifest.yaml"
-IGNORED_FIELDS = {"/scenario": {"version"}}   # the code version differs by design
+IGNORED_FIELDS = {TOPIC_SCENARIO: {"version"}}   # the code version differs by design
 
 
 @dataclass

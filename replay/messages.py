@@ -141,18 +141,18 @@ class OptimizationCost:
 
 # topic -> payload type, for the contract topics
 TOPICS: dict[str, type] = {
-    "/scenario": ScenarioInfo,
-    "/events": Event,
-    "/stick/state": StickState,
-    "/fingers/state": FingersState,
-    "/vision/stick": VisionStick,
-    "/arm/joint_state": JointState,
-    "/hand/joint_state": JointState,
-    "/arm/joint_command": JointCommand,
-    "/object/state": ObjectState,
-    "/effector/state": EffectorState,
-    "/vision/object": VisionObject,
-    "/optimization/cost": OptimizationCost,
+    TOPIC_SCENARIO: ScenarioInfo,
+    TOPIC_EVENTS: Event,
+    TOPIC_STICK_STATE: StickState,
+    TOPIC_FINGERS_STATE: FingersState,
+    TOPIC_VISION_STICK: VisionStick,
+    TOPIC_ARM_JOINT_STATE: JointState,
+    TOPIC_HAND_JOINT_STATE: JointState,
+    TOPIC_ARM_JOINT_COMMAND: JointCommand,
+    TOPIC_OBJECT_STATE: ObjectState,
+    TOPIC_EFFECTOR_STATE: EffectorState,
+    TOPIC_VISION_OBJECT: VisionObject,
+    TOPIC_OPTIMIZATION_COST: OptimizationCost,
 }
 
 _JSON_TYPES = {float: "number", int: "integer", str: "string", bool: "boolean",

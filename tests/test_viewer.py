@@ -32,7 +32,7 @@ from plants.airtable import Params as AirTableParams
 from plants.airtable.viewer_scene import AirTableScene, StickGeometry
 from plants.bullet_arm.viewer_scene import ArmScene, plant_models_urdf
 from replay.viewer.geometry import cameras
-from replay.viewer.scenes import scene_class
+from replay.viewer.scenes import RunScene, scene_class
 from replay.viewer.synthetic import write_arm_log, write_stick_log
 from replay.viewer.timeline import speed_value
 
@@ -163,6 +163,39 @@ def test_scenes_are_plugins_found_by_plant_type(monkeypatch, stick_log, arm_log)
     assert scene_class(load_run(stick_log)) is AirTableScene          # does not suit it
     picky = write_stick_log(stick_log.with_name("picky.mcap"), name="picky")
     assert scene_class(load_run(picky)) is Variant
+
+
+class _ToyScene(RunScene):
+    """A scene for a plant type the viewer has never heard of: a sphere on /toy/state's x."""
+    kind = "toy"
+    needs = ("/toy/state",)
+
+    def build(self):
+        self.ball = self._add(self.scene.add_icosphere(f"{self.root}/ball", radius=0.1,
+                                                       color=self.color))
+
+    def update(self, run, t):
+        tr = run.track("/toy/state")
+        self.ball.position = (float(tr.at("x", t)), 0.0, 0.0)
+
+    def bounds(self):
+        return np.array([-1.0, -1.0, 0.0]), np.array([3.0, 1.0, 1.0])
+
+
+def test_a_new_plant_type_brings_its_own_scene(monkeypatch, tmp_path, viewer_factory):
+    path = tmp_path / "toy.mcap"
+    with LogWriter(path) as log:
+        log.write("/scenario", ScenarioInfo(0.0, "toy", "none", "plant: {type: toy_plant}\n", 0,
+                                            "x"), 0)
+        for k in range(3):
+            log.write("/toy/state", {"t": k * 0.01, "x": 1.0 * k}, k * 10_000_000)
+    with pytest.raises(ViewerError, match="nothing the viewer can draw"):
+        scene_class(load_run(path))
+    monkeypatch.setitem(registry._registered["viewer_scene"], "toy_plant", _ToyScene)
+    v = viewer_factory([path])
+    assert isinstance(v.scenes[0], _ToyScene)
+    v.seek(0.02)
+    assert v.scenes[0].ball.position[0] == 2.0
 
 
 def test_the_viewer_engine_imports_no_plugin_and_no_simulator():

@@ -31,7 +31,8 @@ import pymunk
 
 from replay.robot.hand2d import AirTableSpec, HandCommand
 from replay.interfaces import Occurrence, Plant
-from replay.messages import FingersState, StickState
+from replay.messages import (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_STICK_STATE, FingersState,
+                             StickState)
 from replay.scene import Box, Cylinder, Scene
 from replay.spatial import yaw_quaternion
 
@@ -223,12 +224,12 @@ class AirTablePlant(Plant):
     def truth(self, t: float) -> dict[str, Any]:
         b = self.stick_body
         return {
-            "/stick/state": StickState(t=t, x=b.position.x, y=b.position.y, theta=b.angle,
+            TOPIC_STICK_STATE: StickState(t=t, x=b.position.x, y=b.position.y, theta=b.angle,
                                        vx=b.velocity.x, vy=b.velocity.y,
                                        omega=b.angular_velocity),
-            "/fingers/state": FingersState(t=t, tips=[_vec(tb.position)
+            TOPIC_FINGERS_STATE: FingersState(t=t, tips=[_vec(tb.position)
                                                       for tb in self.tip_bodies]),
-            "/hand/state": {"t": t, "base": self.hand.base.tolist(),
+            TOPIC_HAND_STATE: {"t": t, "base": self.hand.base.tolist(),
                             "joints": self.hand.joints.tolist(),
                             "base_target": self.hand.base_target.tolist(),
                             "joint_targets": self.hand.joint_targets.tolist()},

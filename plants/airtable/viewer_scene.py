@@ -14,6 +14,8 @@ import numpy as np
 
 from plants.airtable.params import Params
 from plants.airtable.settings import hand_spec
+from replay.messages import (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_STICK_STATE,
+                             TOPIC_VISION_STICK)
 from replay.robot.hand2d import finger_chain
 from replay.spatial import yaw_wxyz
 from replay.viewer.data import RunData
@@ -52,11 +54,11 @@ class StickGeometry:
 class AirTableScene(RunScene):
     """Higashimori et al. 2007: stick (with its marker), fingertips and fingers, camera."""
     kind = "air table"
-    needs = ("/stick/state",)
-    optional = ("/fingers/state", "/hand/state", "/vision/stick")
+    needs = (TOPIC_STICK_STATE,)
+    optional = (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_VISION_STICK)
 
     def expected(self):
-        return tuple(t for t in self.optional if t != "/vision/stick" or self.run.sensors)
+        return tuple(t for t in self.optional if t != TOPIC_VISION_STICK or self.run.sensors)
 
     def build(self) -> None:
         g = self.geo = StickGeometry.of(self.plant_params(Params))
@@ -106,13 +108,13 @@ class AirTableScene(RunScene):
 
     def bounds(self):
         pts = []
-        st = self.run.track("/stick/state")
+        st = self.run.track(TOPIC_STICK_STATE)
         if st is not None:
             pts.append(np.column_stack([st.fields["x"], st.fields["y"]]))
-        fi = self.run.track("/fingers/state")
+        fi = self.run.track(TOPIC_FINGERS_STATE)
         if fi is not None and fi.has("tips"):
             pts.append(fi.fields["tips"].reshape(-1, 2))
-        hs = self.run.track("/hand/state")
+        hs = self.run.track(TOPIC_HAND_STATE)
         if hs is not None and hs.has("base"):
             pts.append(hs.fields["base"].reshape(-1, 2))
         if not pts:
@@ -124,7 +126,7 @@ class AirTableScene(RunScene):
 
     def update(self, run: RunData, t: float) -> None:
         g = self.geo
-        st = run.track("/stick/state")
+        st = run.track(TOPIC_STICK_STATE)
         i = st.index(t) if st is not None else -1
         self.stick.visible = i >= 0
         if i >= 0:
@@ -136,21 +138,21 @@ class AirTableScene(RunScene):
             self._update_path(xyz, i)
         else:
             self._update_path(None, -1)
-        vs = run.track("/vision/stick")
+        vs = run.track(TOPIC_VISION_STICK)
         j = vs.index(t) if vs is not None else -1
         self.vision.visible = j >= 0
         if j >= 0:
             self.vision.position = (float(vs.fields["x"][j]), float(vs.fields["y"][j]),
                                     g.thickness / 2.0 + 0.0003)
             self.vision.wxyz = yaw_wxyz(float(vs.fields["theta"][j]))
-        fi = run.track("/fingers/state")
+        fi = run.track(TOPIC_FINGERS_STATE)
         j = fi.index(t) if fi is not None and fi.has("tips") else -1
         for k, tip in enumerate(self.tips):
             tip.visible = j >= 0
             if j >= 0:
                 x, y = fi.fields["tips"][j, k]
                 tip.position = (float(x), float(y), g.tip_height / 2.0)
-        hs = run.track("/hand/state")
+        hs = run.track(TOPIC_HAND_STATE)
         j = hs.index(t) if hs is not None and hs.has("base") and hs.has("joints") else -1
         self.base.visible = j >= 0
         if j >= 0:
@@ -172,11 +174,11 @@ class AirTableScene(RunScene):
 
     def plots(self) -> list[PlotSpec]:
         def speed(run):
-            st = run.track("/stick/state")
+            st = run.track(TOPIC_STICK_STATE)
             return None if st is None else (st.t, np.hypot(st.fields["vx"], st.fields["vy"]))
 
         def omega(run):
-            st = run.track("/stick/state")
+            st = run.track(TOPIC_STICK_STATE)
             return None if st is None else (st.t, st.fields["omega"])
         return [PlotSpec("stick speed |v| (m/s)", [PlotSeries("|v|", speed)]),
                 PlotSpec("stick angular velocity ω (rad/s)", [PlotSeries("ω", omega)])]

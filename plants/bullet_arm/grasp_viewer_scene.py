@@ -7,21 +7,17 @@ schedule's phase (``phase`` events). Plots: the hand and the object along Y, the
 reaching target along X (Fig. 9).
 
 Registered under the plant's type in ``pyproject.toml`` (``paper_replay.viewer_scenes``,
-``bullet_grasp``). The URDF is the plant's own, from its typed ``GraspParams`` through its
-resolver. No simulator is imported.
+``bullet_grasp``). The URDF is the plant's own: ``ArmScene`` builds it from the rig's typed
+``GraspParams`` through the plant's resolver. No simulator is imported.
 """
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
-
 import numpy as np
 
 from plants.bullet_arm.params import GraspParams
-from plants.bullet_arm.settings import resolve
 from plants.bullet_arm.viewer_scene import ArmScene
-from replay.scenario import params_from_data
 from replay.spatial import xyzw_to_wxyz
 from replay.viewer.data import RunData
 from replay.viewer.scenes import PlotSeries, PlotSpec
@@ -34,12 +30,6 @@ T_ARM_TASK = "/grasping/arm"
 EXPECTED = ("/arm/joint_state", "/hand/joint_state", "/object/state", T_HEAD, T_RECOGNISED,
             T_ARM_TASK)
 DEFAULT_FOV = math.radians(30.0)      # when the chip sensor's params give none
-
-
-def grasp_urdf(p: dict) -> Path:
-    """The rig's URDF for these ``plant.params`` (as logged), by the plant's own resolver: the
-    very file (same cached path) ``BulletGraspPlant`` loads."""
-    return Path(resolve(params_from_data(GraspParams, p, "plant.params")).arm_model().write())
 
 
 def chip_fov(sensors: dict) -> tuple[float, int, int]:
@@ -82,22 +72,17 @@ def _row(run: RunData, topic: str, t: float, *fields: str) -> list | None:
 
 class GraspScene(ArmScene):
     kind = "grasping"
+    Params = GraspParams        # ArmScene rebuilds these from the log and the URDF through them
     needs = ("/arm/joint_state", "/object/state")
 
     def expected(self):
         return EXPECTED
 
-    def plant_params(self, cls: type):
-        """The rig's ``GraspParams`` (``ArmScene`` asks for the arm plant's ``Params``)."""
-        return super().plant_params(GraspParams)
 
     def _cameras(self, scale: float) -> None:
         """The only camera is the head's, drawn on the head at its logged pose."""
 
     def build(self) -> None:
-        self.options.setdefault("urdf_for", None)
-        if self.options["urdf_for"] is None:
-            self.options["urdf_for"] = grasp_urdf
         super().build()
         sc, r = self.scene, self.root
         p = self.params

@@ -19,12 +19,15 @@ import math
 
 import numpy as np
 
+from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
 from plants.bullet_arm.settings import resolve
 from replay.interfaces import Occurrence, Plant
-from replay.messages import JointState, ObjectState
+from replay.messages import (TOPIC_ARM_APPLIED_TORQUE, TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_MOTION,
+                             TOPIC_HAND_JOINT_STATE, TOPIC_OBJECT_CONTACTS, TOPIC_OBJECT_STATE,
+                             JointState, ObjectState)
 from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
 from replay.robot.hand import hand_mass
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
@@ -149,6 +152,11 @@ class BulletArmPlant(Plant):
                                 else np.zeros(3))
         self._contacts: list = []
         self._spec = self._make_spec(q0)
+        ht = self.hand_table          # the catch verdict (outcome.py): a free object and a hand
+        self._watch = (CatchWatch(kind=P.object, palm_radius=ht.palm_size[0] if ht.palm_shape ==
+                                  "cylinder" else min(ht.palm_size[:2]) / 2,
+                                  palm_thickness=ht.palm_thickness)
+                       if self.obj is not None and ht is not None else None)
 
     # ------------------------------------------------------------------ spec
     def _make_spec(self, q0: np.ndarray) -> ArmSpec:
@@ -356,18 +364,27 @@ class BulletArmPlant(Plant):
             kind = "drop" if self._ever_caught else "miss"
             self._events.append(Occurrence(kind, {"position": pos.tolist(),
                                                   "velocity": v.tolist()}))
+        if self._watch is not None:
+            pe, oe, ve, we = self.effector_state()
+            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
         return ev
 
+    def outcome(self, t: float) -> dict | None:
+        """Caught or not, and why, with the first touch's metrics (plants/bullet_arm/outcome.py)."""
+        if self._watch is None:
+            return None
+        return self._watch.verdict(caught=self.caught, ever_caught=self._ever_caught)
+
     # ------------------------------------------------------------------ log and scene
     def truth(self, t: float) -> dict:
         q, qd = self.arm_state()
         out = {
-            "/arm/joint_state": JointState(t, list(self.joint_names), q.tolist(), qd.tolist(),
+            TOPIC_ARM_JOINT_STATE: JointState(t, list(self.joint_names), q.tolist(), qd.tolist(),
                                            self._tau_applied.tolist()),
-            "/arm/applied_torque": AppliedTorque(t, list(self.joint_names),
+            TOPIC_ARM_APPLIED_TORQUE: AppliedTorque(t, list(self.joint_names),
                                                  [float(x) if math.isfinite(x) else None
                                                   for x in self._tau_cmd.tolist()],
                                                  self._tau_applied.tolist(),
@@ -375,18 +392,18 @@ class BulletArmPlant(Plant):
         }
         if self._hand_j:
             hq, hqd, heff = self.hand_state()
-            out["/hand/joint_state"] = JointState(t, list(self.hand_names), hq.tolist(),
+            out[TOPIC_HAND_JOINT_STATE] = JointState(t, list(self.hand_names), hq.tolist(),
                                                   hqd.tolist(), heff.tolist())
         # the tool frame's motion; /effector/state (actual and desired point) is the controller's
         pe, oe, ve, we = self.effector_state()
-        out["/effector/motion"] = EffectorMotion(t, pe.tolist(), oe.tolist(), ve.tolist(),
+        out[TOPIC_EFFECTOR_MOTION] = EffectorMotion(t, pe.tolist(), oe.tolist(), ve.tolist(),
                                                  we.tolist(), float(np.linalg.norm(ve)))
         if self.obj is not None:
             pos, orn, v, w = self.object_state()
-            out["/object/state"] = ObjectState(t, pos.tolist(), orn.tolist(), v.tolist(),
+            out[TOPIC_OBJECT_STATE] = ObjectState(t, pos.tolist(), orn.tolist(), v.tolist(),
                                                w.tolist())
             links = sorted({self._link_name[c[4]] for c in self._contacts})
-            out["/object/contacts"] = ObjectContacts(
+            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(
                 t, sorted({self.model.part_of_link.get(l, "arm") for l in links}), links,
                 float(sum(c[9] for c in self._contacts)))
         return out

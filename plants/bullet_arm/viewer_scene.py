@@ -16,6 +16,8 @@ import numpy as np
 
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.settings import resolve
+from replay.messages import (TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_STATE, TOPIC_HAND_JOINT_STATE,
+                             TOPIC_OBJECT_STATE, TOPIC_VISION_OBJECT)
 from replay.scenario import params_from_data
 from replay.spatial import rpy_to_wxyz, xyzw_to_wxyz
 from replay.viewer.data import RunData, Track
@@ -23,19 +25,22 @@ from replay.viewer.errors import ViewerError
 from replay.viewer.scenes import PlotSeries, PlotSpec, RunScene
 
 
-def plant_models_urdf(p: dict) -> Path:
+def plant_models_urdf(p: dict, params_cls: type = Params) -> Path:
     """The arm plant's URDF for these ``plant.params`` (as logged), built by the plant's own
-    resolver, so it is the very file (same cached path) the plant loads."""
-    return Path(resolve(params_from_data(Params, p, "plant.params")).arm_model().write())
+    resolver, so it is the very file (same cached path) the plant loads. ``params_cls``: the
+    plant's ``Params`` (this one's, or a subclass for a plant built on it)."""
+    return Path(resolve(params_from_data(params_cls, p, "plant.params")).arm_model().write())
 
 
-# Where an arm run's URDF comes from: ``plant.params`` -> path. Tests and other plants may
-# point this elsewhere (``Viewer(urdf_for=...)`` takes precedence).
-URDF_FOR: Callable[[dict], Path] = plant_models_urdf
+# Where an arm run's URDF comes from: ``plant.params`` -> path; None = the plant's own
+# (plant_models_urdf). Tests and other plants may point this elsewhere (``Viewer(urdf_for=...)``
+# takes precedence).
+URDF_FOR: Callable[[dict], Path] | None = None
 
 
-def arm_urdf(p: dict, urdf_for: Callable[[dict], Path] | None = None) -> Path:
-    fn = urdf_for or URDF_FOR
+def arm_urdf(p: dict, urdf_for: Callable[[dict], Path] | None = None,
+             params_cls: type = Params) -> Path:
+    fn = urdf_for or URDF_FOR or (lambda d: plant_models_urdf(d, params_cls))
     try:
         path = Path(fn(p))
     except Exception as exc:  # noqa: BLE001 - any failure is one line in the view
@@ -51,23 +56,25 @@ class ArmScene(RunScene):
     plant's URDF, the free object (ball / hexahedron) and its path, cameras."""
     kind = "arm"
     view_direction = (0.3, -1.05, 0.4)
-    needs = ("/arm/joint_state", "/object/state")
-    optional = ("/arm/joint_state", "/hand/joint_state", "/object/state", "/vision/object")
+    Params: type = Params       # the plant's params; a scene for a plant built on this one
+                                # (e.g. with Params(Params) subclassed) sets its own
+    needs = (TOPIC_ARM_JOINT_STATE, TOPIC_OBJECT_STATE)
+    optional = (TOPIC_ARM_JOINT_STATE, TOPIC_HAND_JOINT_STATE, TOPIC_OBJECT_STATE, TOPIC_VISION_OBJECT)
 
     def expected(self):
         p = self.params
         skip = set()
         if p.object == "none":
-            skip.add("/object/state")
+            skip.add(TOPIC_OBJECT_STATE)
         if p.hand == "none":
-            skip.add("/hand/joint_state")
+            skip.add(TOPIC_HAND_JOINT_STATE)
         if not self.run.sensors:
-            skip.add("/vision/object")
+            skip.add(TOPIC_VISION_OBJECT)
         return tuple(t for t in self.optional if t not in skip)
 
     def build(self) -> None:
         from viser.extras import ViserUrdf
-        p = self.params = self.plant_params(Params)
+        p = self.params = self.plant_params(self.Params)
         self.check_topics()
         self._path_thickness = 3.0
         sc, r = self.scene, self.root
@@ -83,9 +90,9 @@ class ArmScene(RunScene):
         self._add(sc.add_frame(                 # the base plate's pose; the URDF hangs here
             f"{r}/arm", show_axes=False,
             position=tuple(float(v) for v in p.base_position), wxyz=rpy_to_wxyz(p.base_rpy)))
-        if self.run.track("/arm/joint_state") is not None or self.run.plant_type:
+        if self.run.track(TOPIC_ARM_JOINT_STATE) is not None or self.run.plant_type:
             try:
-                path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"))
+                path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
                 override = None if not self.ghost else (*(c / 255 for c in self.color), 0.45)
                 self.urdf = ViserUrdf(self.server, path, root_node_name=f"{r}/arm",
                                       mesh_color_override=override)
@@ -126,7 +133,7 @@ class ArmScene(RunScene):
     def bounds(self):
         pts = [np.zeros((1, 3)), np.array([[0.0, 0.0, 1.2]])]
         pts.append(np.asarray([self.params.base_position], float))
-        ob = self.run.track("/object/state")
+        ob = self.run.track(TOPIC_OBJECT_STATE)
         if ob is not None and ob.has("position"):
             pts.append(ob.fields["position"])
         p = np.concatenate(pts)
@@ -146,7 +153,7 @@ class ArmScene(RunScene):
     def update(self, run: RunData, t: float) -> None:
         if self.urdf is not None:
             changed = False
-            for topic in ("/arm/joint_state", "/hand/joint_state"):
+            for topic in (TOPIC_ARM_JOINT_STATE, TOPIC_HAND_JOINT_STATE):
                 tr = run.track(topic)
                 if tr is None or not tr.has("position"):
                     continue
@@ -161,7 +168,7 @@ class ArmScene(RunScene):
                         changed = True
             if changed:
                 self.urdf.update_cfg(self._cfg)
-        ob = run.track("/object/state")
+        ob = run.track(TOPIC_OBJECT_STATE)
         i = ob.index(t) if ob is not None and ob.has("position") else -1
         self.body.visible = i >= 0
         if i >= 0:
@@ -171,12 +178,12 @@ class ArmScene(RunScene):
             self._update_path(ob.fields["position"], i)
         else:
             self._update_path(None, -1)
-        vo = run.track("/vision/object")
+        vo = run.track(TOPIC_VISION_OBJECT)
         j = vo.index(t) if vo is not None and vo.has("position") else -1
         self.seen.visible = j >= 0
         if j >= 0:
             self.seen.position = tuple(float(v) for v in vo.fields["position"][j])
-        ef = run.track("/effector/state")
+        ef = run.track(TOPIC_EFFECTOR_STATE)
         j = ef.index(t) if ef is not None and ef.has("desired_position") else -1
         ok = j >= 0 and ef.fields["desired_position"].shape[1:] == (3,) and \
             bool(np.all(np.isfinite(ef.fields["desired_position"][j])))
@@ -189,12 +196,12 @@ class ArmScene(RunScene):
     def plots(self) -> list[PlotSpec]:
         def joint(field: str, k: int):
             def signal(run):
-                tr = run.track("/arm/joint_state")
+                tr = run.track(TOPIC_ARM_JOINT_STATE)
                 if tr is None or not tr.has(field) or tr.fields[field].shape[1] <= k:
                     return None
                 return tr.t, tr.fields[field][:, k]
             return signal
-        tr = self.run.track("/arm/joint_state")
+        tr = self.run.track(TOPIC_ARM_JOINT_STATE)
         if tr is None:
             return []
         names = list(tr.labels.get("name") or

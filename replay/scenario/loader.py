@@ -353,6 +353,14 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
         task.params = params_of("controller", task, f"tasks.{name}")
     for name, s in sc.sensors.items():
         s.params = params_of("sensor", s, f"sensors.{name}")
+    # a plug-in whose Params declare an internal ``scenario_dir`` field gets the scenario file's
+    # directory, so that its file parameters resolve relative to the scenario, not the cwd
+    src = Path(str(sc.source)) if sc.source else None
+    if src is not None and src.is_file():
+        for params in (sc.plant.params, sc.controller.params,
+                       *(s.params for s in sc.sensors.values())):
+            if hasattr(params, "scenario_dir"):
+                params.scenario_dir = str(src.resolve().parent)
     return sc
 
 

@@ -25,7 +25,7 @@ we define as the minimum-norm alpha satisfying only the initial constraint C alp
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +36,9 @@ from replay.control.catching.optimise import (CostRecord, OptimResult, initial_a
                                               save_alpha)
 from replay.control.catching.problem import ProblemConfig, build_problem
 from replay.interfaces import Controller, Occurrence
-from replay.messages import EffectorState, JointCommand, OptimizationCost
+from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE,
+                             TOPIC_CATCHING_STATE, TOPIC_EFFECTOR_STATE, TOPIC_OPTIMIZATION_COST,
+                             TOPIC_VISION_OBJECT, EffectorState, JointCommand, OptimizationCost)
 from replay.params import param
 from replay.robot.arm_types import ArmCommand
 
@@ -46,8 +48,9 @@ class Params:
     mapping: str = param("optimised", choices=("optimised", "initial"),
                          doc="b(q) parameters: 'optimised' (eq. 25 under eq. 13) or 'initial' "
                              "(minimum-norm alpha meeting only the initial constraint, eq. 13)")
-    alpha_file: str = param("", doc="JSON with precomputed alpha (write_alpha_file); used when its "
-                                    "key matches this configuration, else alpha is recomputed")
+    alpha_file: str = param("", doc="JSON with precomputed alpha (write_alpha_file), relative to the "
+                                    "scenario file; used when its key matches this "
+                                    "configuration, else alpha is recomputed")
     q_alpha: float = param(math.pi / 2, unit="rad", doc="catching angle of the selected joint "
                                                         "(Sec. IV-A: pi/2)")
     selected_joint: str = param("J4", doc="the joint i of eq. 6 (Sec. IV-A: axis 4)")
@@ -79,6 +82,12 @@ class Params:
     w_omega: float = param(1.0, unit="1", gt=0.0, doc="K_omega = w_omega diag(1/omega_max^2)")
     limit_penalty: float = param(100.0, unit="1", ge=0.0,
                                  doc="weight of the hinge penalties for eqs. 22 and 24")
+    torque_limit_penalty: float = param(-1.0, unit="1",
+                                        doc="weight of eq. 22's hinge alone; < 0 = "
+                                            "limit_penalty")
+    approach_weight: float = param(0.0, unit="1", ge=0.0,
+                                   doc="weight of the approach-direction term (not in the paper, "
+                                       "approach.py): the ball down the palm axis; 0 = eq. 25 only")
     max_iterations: int = param(40, ge=0, doc="Levenberg-Marquardt iterations at most")
     kp: list = param([900.0, 1500.0, 300.0, 150.0], unit="N*m/rad", ge=0.0,
                      doc="PD stiffness per arm joint")
@@ -93,6 +102,16 @@ class Params:
                                                  "(arrival - closing time)")
     after_catch: str = param("hold", choices=("hold", "track"),
                              doc="at the catch surface: freeze q_d ('hold') or keep mapping")
+    scenario_dir: str = field(default="", metadata={"internal": True})   # set by the loader
+
+
+def alpha_path(params: Params) -> Path | None:
+    """``alpha_file`` resolved against the scenario file's directory (absolute paths kept)."""
+    if not params.alpha_file:
+        return None
+    path = Path(params.alpha_file)
+    return path if path.is_absolute() or not params.scenario_dir else \
+        Path(params.scenario_dir) / path
 
 
 @dataclass
@@ -153,7 +172,9 @@ class CatchingController(Controller):
             speeds=tuple(P.throw_speeds), spread=P.throw_spread, grid=P.throw_grid,
             n_samples=P.samples_per_throw, gravity=-float(self.gravity[2]),
             tau_max=tuple(tau_max.tolist()), omega_max=tuple(om_max.tolist()), w_tau=P.w_tau,
-            w_omega=P.w_omega, penalty=P.limit_penalty, max_iter=P.max_iterations)
+            w_omega=P.w_omega, penalty=P.limit_penalty,
+            torque_penalty=P.torque_limit_penalty, approach_weight=P.approach_weight,
+            max_iter=P.max_iterations)
         self.problem = build_problem(model, self.config)
         self.history: list[CostRecord] = []
         self.result = None
@@ -204,7 +225,7 @@ class CatchingController(Controller):
     # ------------------------------------------------------------------ parameters
     def _optimised_alpha(self) -> np.ndarray:
         key = self.config.key(self.model)
-        path = Path(self.params.alpha_file) if self.params.alpha_file else None
+        path = alpha_path(self.params)
         if path is not None and path.is_file():
             data = load_alpha(path)
             if data.get("meta", {}).get("key") == key:
@@ -238,9 +259,9 @@ class CatchingController(Controller):
     def update(self, t: float, measurements: list) -> ArmCommand:
         self._t = t
         for topic, m in measurements:
-            if topic == "/vision/object":
+            if topic == TOPIC_VISION_OBJECT:
                 self.est.add(m.t, m.position)
-            elif topic in ("/arm/encoders", "/arm/joint_state"):
+            elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
                 self._joint_state(m)
         P = self.params
         qdd_d = np.zeros(self.n)
@@ -318,21 +339,29 @@ class CatchingController(Controller):
                 out["catch_point"] = st[0].tolist()
         return out
 
+    def outcome(self, t: float) -> dict:
+        """The method's metrics for the run's outcome: which mapping, when it predicted the ball
+        on the catch surface (t_c of eq. 4) and whether it reached it (``mapping_hold``)."""
+        out = {"mapping": self.params.mapping, "reached_catch_surface": self.holding}
+        if self.t_catch is not None:
+            out["predicted_catch_time"] = round(float(self.t_catch), 6)
+        return out
+
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
         return ev
 
     def telemetry(self, t: float) -> dict:
-        out = {"/arm/joint_command": JointCommand(t, position=self.q_d.tolist(),
+        out = {TOPIC_ARM_JOINT_COMMAND: JointCommand(t, position=self.q_d.tolist(),
                                                   torque=self.tau.tolist()),
-               "/effector/state": EffectorState(
+               TOPIC_EFFECTOR_STATE: EffectorState(
                    t, position=self.model.fk(self.q).tolist() if self.q is not None else [],
                    desired_position=self.model.fk(self.q_d).tolist())}
         if not self._costs_logged:       # the offline optimisation's history, once (t = 0)
             self._costs_logged = True
-            out["/optimization/cost"] = self.optimization_costs()
+            out[TOPIC_OPTIMIZATION_COST] = self.optimization_costs()
         if self._r is not None:
-            out["/catching/state"] = CatchingState(
+            out[TOPIC_CATCHING_STATE] = CatchingState(
                 t, self._r.tolist(), self._v.tolist(), self._q_o.tolist(), self.qd_d.tolist(),
                 self._in_domain, float(self.t_catch) if self.t_catch is not None else -1.0,
                 self.closing, self.holding)
