@@ -357,7 +357,9 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
     # directory, so that its file parameters resolve relative to the scenario, not the cwd
     src = Path(str(sc.source)) if sc.source else None
     if src is not None and src.is_file():
-        for params in (sc.plant.params, sc.controller.params,
+        for params in (sc.plant.params,
+                       *((sc.controller.params,) if sc.controller is not None else ()),
+                       *(t.params for t in sc.tasks.values()),
                        *(s.params for s in sc.sensors.values())):
             if hasattr(params, "scenario_dir"):
                 params.scenario_dir = str(src.resolve().parent)
