@@ -53,6 +53,7 @@ class BulletGraspPlant(BulletArmPlant):
         if params.object == "none" or params.hand == "none":
             raise ValueError("the grasping rig needs a hand and an object")
         super().__init__(params, dt=dt, rng=rng)
+        self._watch = None                 # the catch verdict's watcher: this rig's is outcome()
         P = params
         bc = self.bc
         self._palm_j = self._jidx["palm_joint"]
