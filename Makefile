@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed
 OUT    ?= out
 
 # the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md
-SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml)
+SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml scenarios/grasp_*.yaml)
 
 .PHONY: install run lint test bench ablations golden-check clean
 

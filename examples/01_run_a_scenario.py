@@ -25,8 +25,9 @@ def main(out_dir: Path) -> None:
                            sets=["timing.duration=0.3"], seed=0)
     except ScenarioError as exc:           # one line: file:line:col, the field, what was expected
         sys.exit(f"error: {exc}")
+    method = sc.controller.type if sc.controller else f"tasks {sorted(sc.tasks)}"
     print(f"scenario {sc.name} ({sc.paper}): plant {sc.plant.type}, controller "
-          f"{sc.controller.type}, sensors {sorted(sc.sensors)}")
+          f"{method}, sensors {sorted(sc.sensors)}")
     p = sc.plant.params                    # the plant's own typed Params, every default filled in
     assert isinstance(p, AirTableParams)
     print(f"the stick's mass: {p.stick.mass} kg, restitution {p.stick.restitution}")

@@ -21,11 +21,12 @@ import tempfile
 import time
 from pathlib import Path
 
+from replay.resources import scenario_dir
 from replay.runner import COMPONENTS, Runner
 from replay.scenario import load_scenario
 
-DEFAULT = ["scenarios/stick_3step.yaml", "scenarios/catch_optimised.yaml",
-           *sorted(str(p) for p in Path("scenarios").glob("grasp_*.yaml"))[:1]]
+DEFAULT = [str(scenario_dir() / f"{name}.yaml")
+           for name in ("stick_3step", "catch_optimised", "grasp_hexahedron")]
 
 
 def bare_stepper(runner: Runner):

@@ -12,6 +12,8 @@ import typing
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 # ---- topic names (the contract: add freely, rename none). Use these, not string literals.
 TOPIC_SCENARIO = "/scenario"                    # ScenarioInfo, once at t = 0
 TOPIC_EVENTS = "/events"                        # Event
@@ -34,6 +36,18 @@ TOPIC_EFFECTOR_MOTION = "/effector/motion"
 TOPIC_VISION_OBJECT = "/vision/object"          # VisionObject
 TOPIC_OPTIMIZATION_COST = "/optimization/cost"  # OptimizationCost
 TOPIC_CATCHING_STATE = "/catching/state"        # the catching controller's state
+# grasping rig (Namiki et al. 1999; docs/DESIGN.md, "Grasping runs")
+TOPIC_HAND_ENCODERS = "/hand/encoders"
+TOPIC_HEAD_ENCODERS = "/head/encoders"
+TOPIC_VISION_CHIP = "/vision/chip"
+TOPIC_WRIST_WRENCH = "/wrist/wrench"
+TOPIC_HAND_TORQUE = "/hand/joint_torque"
+TOPIC_GRASP_OBJECT = "/grasping/object"
+TOPIC_GRASP_STATE = "/grasping/state"
+TOPIC_GRASP_HEAD = "/grasping/head"
+TOPIC_GRASP_ARM = "/grasping/arm"
+TOPIC_GRASP_HAND = "/grasping/hand"
+TOPIC_TASK_LOOPS = "/tasks/loops"
 
 
 @dataclass
@@ -168,3 +182,25 @@ def to_dict(payload: Any) -> dict[str, Any]:
     if names is None:
         names = _FIELD_NAMES[cls] = tuple(f.name for f in dataclasses.fields(payload))
     return {name: getattr(payload, name) for name in names}
+
+
+@dataclass
+class VisionChip:
+    t: float             # capture time
+    width: int
+    height: int
+    rows: list           # rows[v]: bit u set = pixel (u, v) is 1
+    count: int           # pixels set
+
+
+def pack_rows(bits: np.ndarray) -> list[int]:
+    """A (h, w) 0/1 array as h ints, bit u of row v = bits[v, u]."""
+    weights = 1 << np.arange(bits.shape[1], dtype=np.int64)
+    return [int(x) for x in (bits.astype(np.int64) @ weights)]
+
+
+def unpack_rows(rows, width: int) -> np.ndarray:
+    """The inverse of :func:`pack_rows`: a (len(rows), width) bool array."""
+    r = np.asarray(rows, dtype=np.int64)[:, None]
+    return ((r >> np.arange(width, dtype=np.int64)) & 1).astype(bool)
+

@@ -3,7 +3,8 @@
 Time is an integer count of physics steps k (t = k / physics_rate), so rates never drift. Each
 step: cameras due at k capture the plant's scene (logged at the capture time, delivered to the
 controller ``latency`` later), the controller due at k reads what was delivered and commands the
-plant, the plant's state is logged, the plant steps, and the physics events of that step are
+plant (or, with ``tasks:``, each due task reads its inputs and writes its part of the command:
+``replay.tasks``), the plant's state is logged, the plant steps, and the physics events of that step are
 logged at its end, collisions with the controller's intent attached. The run stops at
 ``timing.duration`` or ``stop.after`` seconds after one of ``stop.on_events``.
 """
@@ -25,6 +26,7 @@ from replay import __version__, registry
 from replay.log import LogWriter, NonFiniteValueError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
 from replay.scenario import Scenario, resolved_yaml
+from replay.tasks import Task, TaskSet
 
 
 class RunInterrupted(Exception):
@@ -100,9 +102,18 @@ class Runner:
             sensor = cls(s.params, rng=np.random.default_rng(seeds[2 + i]), spec=spec)
             self.sensors.append((name, sensor, _divider(rate, s.rate),
                                  int(round(s.latency * rate))))
-        ctrl_cls = registry.load("controller", scenario.controller.type)
-        self.controller = ctrl_cls(scenario.controller.params, spec=spec)
-        self.ctrl_div = _divider(rate, scenario.controller.rate)
+        if scenario.tasks:       # the method as parallel tasks (replay/tasks.py)
+            self.controller = TaskSet([
+                Task(name, registry.load("controller", ts.type)(ts.params, spec=spec),
+                     _divider(rate, ts.rate), frozenset(ts.inputs), frozenset(ts.outputs))
+                for name, ts in scenario.tasks.items()], rate)
+            self.ctrl_div = 1
+        else:
+            cs = scenario.controller
+            assert cs is not None            # the loader requires controller: or tasks:
+            ctrl_cls = registry.load("controller", cs.type)
+            self.controller = ctrl_cls(cs.params, spec=spec)
+            self.ctrl_div = _divider(rate, cs.rate)
         self.log_div = (_divider(rate, scenario.timing.state_log_rate)
                         if scenario.timing.state_log_rate else 1)
         self._t_log = 0.0          # seconds in log writes (and observers) this run
@@ -162,7 +173,11 @@ class Runner:
                     command = self.controller.update(t, delivered)
                     c1 = clock()
                     t_controller += c1 - c0
-                    if command is not None:
+                    if isinstance(command, list):          # parallel tasks' partial commands
+                        for c in command:
+                            self.plant.apply(c)
+                        t_plant += clock() - c1
+                    elif command is not None:
                         self.plant.apply(command)
                         t_plant += clock() - c1
                     for occ in self.controller.pop_events():
@@ -243,7 +258,9 @@ class Runner:
         result.steps = k
         result.t_end = k / self.sc.timing.physics_rate
         result.messages = log.count
-        log.close()
+        # a failed or interrupted run never replaces a finished log at ``out``: NAME.failed.mcap
+        result.path = log.close({"error": "failed", "interrupted": "interrupted"}.get(
+            result.stopped_by, ""))
         result.wall_time = time.perf_counter() - wall0
 
     def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:

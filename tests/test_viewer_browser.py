@@ -28,6 +28,7 @@ Image = pytest.importorskip("PIL.Image")
 
 from replay.viewer import Viewer  # noqa: E402
 from replay.viewer.synthetic import write_arm_log, write_stick_log  # noqa: E402
+from grasp_synthetic import write_grasp_log  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = "/usr/bin/chromium"
@@ -37,7 +38,9 @@ FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-backgroun
 VIEWPORT = {"width": 1280, "height": 800}
 # the 3-D canvas without the GUI panel (right) and the software-WebGL toast (top left)
 SCENE = (slice(170, 780), slice(330, 930))
-SERVER_LIFETIME = 240.0       # s: the watchdog stops a server left running by a failed test
+SERVER_LIFETIME = 420.0       # s: the watchdog stops a server left running by a failed test
+SHOT_TIMEOUT = 90_000         # ms: software WebGL on a loaded 2-core machine can take ~60 s a frame
+PAGE_DEADLINE = 300.0         # s: for the whole page (first frame, two slider moves)
 
 
 def _ensure_chromium() -> str:
@@ -68,6 +71,7 @@ def _cases() -> list[tuple[str, object]]:
              ("catch", lambda d: [write_arm_log(d / "catch.mcap")]),
              ("grasp", lambda d: [write_arm_log(d / "grasp.mcap", name="synthetic_grasp",
                                                 arm="wam7", hand="grasp4", obj="box")]),
+             ("grasp_scene", lambda d: [write_grasp_log(d / "grasp_scene.mcap", duration=1.2)]),
              ("overlay", lambda d: [write_stick_log(d / "a.mcap", name="spin_4"),
                                     write_stick_log(d / "b.mcap", name="spin_9", spin=9.0)])]
     extra = sorted((ROOT / "data" / "golden").glob("*.mcap"))
@@ -94,7 +98,7 @@ def _changed(a: np.ndarray, b: np.ndarray) -> float:
 def _poll(page, ok, deadline: float, what: str) -> np.ndarray:
     last = None
     while time.monotonic() < deadline:
-        last = _image(page.screenshot())
+        last = _image(page.screenshot(timeout=SHOT_TIMEOUT))
         if ok(last):
             return last
         time.sleep(0.4)
@@ -139,7 +143,7 @@ def test_viewer_draws_and_moves_in_a_browser(browser, name, make, tmp_path):
     try:
         assert viewer.url.startswith("http://127.0.0.1:")
         page.goto(viewer.url)
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + PAGE_DEADLINE
         first = _poll(page, lambda img: _colours(img) > 60, deadline, "the scene to be drawn")
         _close_toasts(page)
         t0, t1 = viewer.timeline.t0, viewer.timeline.t1
@@ -148,12 +152,12 @@ def test_viewer_draws_and_moves_in_a_browser(browser, name, make, tmp_path):
         a = _poll(page, lambda img: _changed(img, first) > 0.0005, deadline,
                   "the scene to move to the first slider position")
         time.sleep(1.0)                            # let the frame settle, then take it
-        a = _image(page.screenshot(path=str(tmp_path / f"{name}_a.png")))
+        a = _image(page.screenshot(path=str(tmp_path / f"{name}_a.png"), timeout=SHOT_TIMEOUT))
         _set_time(page, viewer, tb, deadline)
         b = _poll(page, lambda img: _changed(img, a) > 0.001, deadline,
                   "the scene to change between the two slider positions")
         time.sleep(1.0)
-        b = _image(page.screenshot(path=str(tmp_path / f"{name}_b.png")))
+        b = _image(page.screenshot(path=str(tmp_path / f"{name}_b.png"), timeout=SHOT_TIMEOUT))
         assert _colours(a) > 60 and _colours(b) > 60, "the canvas is not drawn"
         assert _changed(a, b) > 0.001, "the scene did not change between the slider positions"
         keep = os.environ.get("PAPER_REPLAY_SCREENSHOTS")

@@ -53,6 +53,8 @@ class AirTablePlant(Plant):
     """Stick on an air table and a two-fingered hand on an XY slider (Pymunk)."""
 
     Params = Params
+    spec_type = AirTableSpec
+    command_types = (HandCommand,)
     description = ("Pymunk air table: a free stick (no table friction) and two position-"
                    "commanded fingertip discs on an XY slider hand (Higashimori et al. 2007)")
 

@@ -42,7 +42,10 @@ with quiet_c_output():                          # PyBullet's import prints a bui
 
 class BulletArmPlant(Plant):
     Params = Params
+    spec_type = ArmSpec
+    command_types = (ArmCommand,)
     description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"
+    hold_event = "catch"      # the event kind of "held by the hand" (the grasping rig: "grasp")
 
     def __init__(self, params: Params, *, dt: float, rng: np.random.Generator) -> None:
         super().__init__(params, dt=dt, rng=rng)
@@ -381,7 +384,7 @@ class BulletArmPlant(Plant):
         eps = 1e-9
         if held and not self.caught and self._hold >= P.catch_hold_time - eps:
             self.caught = self._ever_caught = True
-            self._events.append(Occurrence("catch", {
+            self._events.append(Occurrence(self.hold_event, {
                 "parts": hand_parts, "links": links, "position": pos.tolist(),
                 "hold_time": float(self._hold)}))
         if self.caught and not held and self._unhold >= P.catch_hold_time - eps:

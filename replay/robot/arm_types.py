@@ -12,6 +12,7 @@ from typing import Sequence
 import numpy as np
 
 from replay.robot.hand import HandTable
+from replay.robot.head import HeadSpec
 from replay.robot.serial_chain import SerialChain
 
 
@@ -80,3 +81,29 @@ class ArmCommand:
     hand joints towards their targets no faster than the hand's closing speed."""
     torque: Sequence[float]
     hand: Sequence[float] | None = None
+
+
+@dataclass(frozen=True)
+class PlaneSpec:
+    """A constraint plane given beforehand (Namiki et al. 1999, Sec. 4.1.1): a point and a unit
+    normal (world). The object moves on it."""
+    point: tuple[float, float, float]
+    normal: tuple[float, float, float]
+
+
+@dataclass(frozen=True, eq=False)
+class GraspSpec(ArmSpec):
+    """An :class:`ArmSpec` with the active-vision head and the constraint plane (grasping)."""
+    head: HeadSpec | None = None
+    plane: PlaneSpec | None = None
+
+
+@dataclass
+class ServoCommand:
+    """Velocity commands to velocity-controlled servos (rad/s): the arm's (eq. 2's theta_d^a,
+    every arm joint), the hand's (eq. 4's theta_d^h) and the head's (eq. 1's theta_d^v). A field
+    left None keeps that servo's previous command, so several tasks can each command their own
+    actuators."""
+    arm: Sequence[float] | np.ndarray | None = None
+    hand: Sequence[float] | np.ndarray | None = None
+    head: Sequence[float] | np.ndarray | None = None

@@ -2,8 +2,9 @@
 
 from replay.scenario.loader import (ScenarioError, load_scenario, params_from_data,
                                     resolved_yaml, scenario_from_text, to_plain)
-from replay.scenario.schema import ControllerSpec, PlantSpec, Scenario, SensorSpec, Stop, Timing
+from replay.scenario.schema import (ControllerSpec, PlantSpec, Scenario, SensorSpec, Stop,
+                                    TaskSpec, Timing)
 
 __all__ = ["ControllerSpec", "PlantSpec", "Scenario", "ScenarioError", "SensorSpec", "Stop",
-           "Timing", "load_scenario", "params_from_data", "resolved_yaml", "scenario_from_text",
-           "to_plain"]
+           "TaskSpec", "Timing", "load_scenario", "params_from_data", "resolved_yaml",
+           "scenario_from_text", "to_plain"]

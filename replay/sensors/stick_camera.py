@@ -46,10 +46,10 @@ import numpy as np
 
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_STICK, VisionStick
-from replay.params import param
+from replay.params import ParamError, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
-from replay.sensors.pinhole import PinholeCamera
+from replay.sensors.pinhole import PinholeCamera, look_at_rotation
 from replay.sensors.raster import composite
 
 _RIM = 48             # vertices of a polygon standing in for a circle
@@ -212,28 +212,34 @@ def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> floa
 
 @dataclass
 class StickCameraParams:
-    width: int = param(512, unit="px", ge=16, doc="image width")
-    height: int = param(512, unit="px", ge=16, doc="image height")
-    position: list[float] = param([0.0, 0.0, 1.0], unit="m", length=3,
+    width: int = param(512, unit="px", ge=16, le=4096, doc="image width")
+    height: int = param(512, unit="px", ge=16, le=4096, doc="image height")
+    position: list[float] = param([0.0, 0.0, 1.0], unit="m", length=3, ge=-100, le=100,
                                   doc="optical centre (world); paper: 1 m above the table")
-    target: list[float] = param([0.0, 0.0, 0.0], unit="m", length=3,
+    target: list[float] = param([0.0, 0.0, 0.0], unit="m", length=3, ge=-100, le=100,
                                 doc="world point on the optical axis; default: straight down "
                                     "at the table centre")
-    up: list[float] = param([0.0, 1.0, 0.0], unit="1", length=3,
+    up: list[float] = param([0.0, 1.0, 0.0], unit="1", length=3, ge=-1e3, le=1e3,
                             doc="world direction shown as 'up' in the image (not along the axis)")
     fov_x: float = param(0.62, unit="rad", gt=0, lt=math.pi,
                          doc="horizontal field of view, edge to edge; 0.62 rad (35.5 deg) from "
                              "1 m: 0.640 m of table across 512 px, 1.25 mm per pixel")
-    noise_sigma: float = param(0.0, unit="grey level", ge=0,
+    noise_sigma: float = param(0.0, unit="grey level", ge=0, le=1000,
                                doc="standard deviation of Gaussian pixel noise (0..255 scale)")
-    position_offset: list[float] = param([0.0, 0.0], unit="m", length=2,
+    position_offset: list[float] = param([0.0, 0.0], unit="m", length=2, ge=-10, le=10,
                                          doc="constant bias added to the measured (x, y)")
     threshold: float = param(192.0, unit="grey level", ge=0, le=255,
                              doc="pixels brighter than this are marker (white 255 vs stick)")
-    min_pixels: int = param(20, unit="px", ge=1,
+    min_pixels: int = param(20, unit="px", ge=1, le=4096 * 4096,
                             doc="smallest marker blob (pixels above threshold) accepted")
     background: float = param(0.1, unit="1", ge=0, le=1, doc="albedo of the table (dark)")
-    marker: str = param("marker", doc="name of the Box the camera tracks")
+    marker: str = param("marker", max_length=100, doc="name of the Box the camera tracks")
+
+    def __post_init__(self) -> None:
+        try:
+            look_at_rotation(self.position, self.target, self.up)
+        except ValueError as exc:
+            raise ParamError("target" if "coincide" in str(exc) else "up", str(exc)) from None
 
 
 class StickCamera(Sensor):

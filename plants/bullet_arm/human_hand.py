@@ -1,0 +1,94 @@
+"""A human hand moving the object on its constraint plane: a seeded, band-limited random path
+applied through a force-limited constraint.
+
+The path (in the plane's two in-plane axes u, v and the roll about its normal) is a sum of
+``components`` sinusoids per axis with frequencies drawn uniformly in ``[f_min, f_max]`` Hz,
+random phases and amplitudes ~ 1/f (slower motions larger, as a hand moves), scaled so that the
+RMS in-plane speed over time is ``speed`` (m/s) and the RMS roll rate is ``roll_rate`` (rad/s).
+It starts at the object's initial pose. Irregular and not known to the robot (Sec. 5: "moved by
+a human hand, its trajectory is irregular and difficult to predict").
+
+The hand holds the object with a PyBullet fixed constraint to the path's pose whose force is
+limited to ``max_force`` (a human's grip-and-arm strength): the object follows the path unless
+something (the robot's grasp) resists harder; the constraint force is read back.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pybullet as p
+
+from replay.spatial import matrix_to_quaternion, rpy_to_matrix
+
+
+def band_limited_path(rng: np.random.Generator, *, components: int, f_min: float, f_max: float,
+                      rms_rate: float, axes: int):
+    """(omega (axes, n), amplitude (axes, n), phase (axes, n)): sum_i a_i sin(w_i t + phi_i) per
+    axis, with sum over axes and components of (a w)^2 / 2 = rms_rate^2."""
+    f = rng.uniform(f_min, f_max, size=(axes, components))
+    w = 2.0 * math.pi * f
+    a = 1.0 / f
+    phi = rng.uniform(0.0, 2.0 * math.pi, size=(axes, components))
+    ms = float(np.sum((a * w) ** 2) / 2.0)
+    a *= rms_rate / math.sqrt(ms) if ms > 0.0 else 0.0
+    return w, a, phi
+
+
+class HumanHand:
+    def __init__(self, bc, obj: int, rng: np.random.Generator, *, origin, rpy0, u, v, n,
+                 speed: float, roll_rate: float, f_min: float, f_max: float, components: int,
+                 max_force: float, start: float) -> None:
+        self.bc, self.obj = bc, obj
+        self.origin = np.asarray(origin, float)
+        self.u, self.v, self.n = (np.asarray(x, float) for x in (u, v, n))
+        self.start = float(start)
+        self.max_force = float(max_force)
+        self.w, self.a, self.phi = band_limited_path(rng, components=components, f_min=f_min,
+                                                     f_max=f_max, rms_rate=speed, axes=2)
+        self.rw, self.ra, self.rphi = band_limited_path(rng, components=components, f_min=f_min,
+                                                        f_max=f_max, rms_rate=roll_rate, axes=1)
+        self._s0 = np.sin(self.phi)
+        self._rs0 = np.sin(self.rphi)
+        self.R0 = _rpy_matrix(rpy0)
+        self.q0 = _quat(self.R0)
+        self.target = self.origin.copy()
+        self.roll = 0.0
+        self.cid = bc.createConstraint(obj, -1, -1, -1, p.JOINT_FIXED, [0.0, 0.0, 0.0],
+                                       [0.0, 0.0, 0.0], self.origin.tolist(),
+                                       childFrameOrientation=_quat(self.R0))
+        bc.changeConstraint(self.cid, maxForce=self.max_force)
+
+    def offset(self, t: float) -> tuple[float, float, float]:
+        """(du, dv, droll) of the path from the start pose at time ``t``."""
+        tt = max(t - self.start, 0.0)
+        d = (self.a * (np.sin(self.w * tt + self.phi) - self._s0)).sum(axis=1)
+        r = float((self.ra * (np.sin(self.rw * tt + self.rphi) - self._rs0)).sum())
+        return float(d[0]), float(d[1]), r
+
+    def drive(self, t: float) -> None:
+        du, dv, dr = self.offset(t)
+        self.target = self.origin + du * self.u + dv * self.v
+        self.roll = dr
+        # the start orientation turned by dr about the plane normal: q = q_n(dr) q0
+        s, c = math.sin(dr / 2.0), math.cos(dr / 2.0)
+        ax, ay, az = (float(x) * s for x in self.n)
+        bx, by, bz, bw = self.q0
+        q = [c * bx + ax * bw + ay * bz - az * by, c * by - ax * bz + ay * bw + az * bx,
+             c * bz + ax * by - ay * bx + az * bw, c * bw - ax * bx - ay * by - az * bz]
+        self.bc.changeConstraint(self.cid, jointChildPivot=self.target.tolist(),
+                                 jointChildFrameOrientation=q, maxForce=self.max_force)
+
+    def force(self) -> list[float]:
+        """The constraint's force on the object (N, world), from the last step."""
+        st = self.bc.getConstraintState(self.cid)
+        return [float(st[0]), float(st[1]), float(st[2])]
+
+
+def _rpy_matrix(rpy) -> np.ndarray:
+    return rpy_to_matrix(rpy)
+
+
+def _quat(R) -> list[float]:
+    return [float(x) for x in matrix_to_quaternion(R)]

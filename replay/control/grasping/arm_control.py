@@ -1,0 +1,194 @@
+"""Tracking and reaching control of the arm (Namiki et al. 1999, Sec. 4.2, eqs. 2-3), pure NumPy:
+
+    theta_dot_d^a = K^ap J^a+ S K^a1 (x^o - x^a) + K^ap J^a+ (I - S) K^a2 (x_d^a - x^a)
+                    - K^av theta_dot^a + K^af J^aT F^a                                 (2)
+    S = diag(s_i),  s_i = 1 for i = y, z, roll, else 0                                (3)
+
+- x = (x, y, z, roll, pitch, yaw) in the world; the constraint plane's normal is world x, so
+  tracking (S) acts in the plane (y, z) and about its normal (roll), reaching (I - S) along the
+  normal (x) and on pitch/yaw (the palm kept facing the plane). Orientation errors are rotation
+  vectors (world): roll = the angle from the palm's finger-row axis to the object's long axis
+  about the plane normal (modulo pi; zero for a circle, which has none), pitch/yaw = n_palm x
+  n_plane. x^a is the hand's grasp point (``grasp_point`` ahead of the palm's back face) from
+  the joint encoders through the arm's nominal kinematics.
+- The paper's arm has 6 joints in eq. 2 (J^a 6 x 6); the WAM-7 has 7: **all 7 are used with a
+  damped pseudo-inverse** J+ = J^T (J J^T + lambda^2 I)^-1 (the minimum-norm joint rates; no
+  joint is locked).
+- F^a: the wrist sensor's wrench turned into the world, minus the hand's own weight (nominal
+  mass and centre of mass, open posture) and the sensor's bias at start (tare), about the
+  flange: the external wrench on the hand (N, N m).
+- No prediction of the object's motion: x^o is the latest measurement.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from replay.control.grasping.payloads import ArmLoop
+from replay.interfaces import Controller
+from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_GRASP_ARM, TOPIC_GRASP_OBJECT,
+                             TOPIC_GRASP_STATE, TOPIC_WRIST_WRENCH)
+from replay.params import param
+from replay.robot.arm_types import GraspSpec, ServoCommand
+from replay.robot.hand import hand_body
+from replay.robot.serial_chain import dh_transform
+from replay.spatial import cross3, wrap_half_pi
+
+S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])        # eq. 3
+
+
+@dataclass
+class ArmParams:
+    K_ap: float = param(1.0, unit="1", ge=0.0, doc="eq. 2's K^ap (a scalar times I)")
+    K_a1: list = param([0.0, 40.0, 40.0, 20.0, 0.0, 0.0], unit="1/s", length=6, ge=0.0,
+                       doc="eq. 2's K^a1 (tracking; only the S components act; assumed)")
+    K_a2: list = param([15.0, 0.0, 0.0, 0.0, 10.0, 10.0], unit="1/s", length=6, ge=0.0,
+                       doc="eq. 2's K^a2 (reaching; only the I - S components act; assumed)")
+    K_av: float = param(0.05, unit="1", ge=0.0, doc="eq. 2's K^av (scalar times I)")
+    K_af: float = param(0.005, unit="rad/(s*N*m)", ge=0.0,
+                        doc="eq. 2's K^af (scalar times I): compliance to the wrist wrench")
+    grasp_point: float = param(0.045, unit="m", ge=0.0,
+                               doc="x^a: the hand's grasp point this far along the palm normal "
+                                   "from its back face (between the fingers)")
+    damping: float = param(0.01, unit="m", gt=0.0, doc="lambda of the damped pseudo-inverse")
+    force_deadband: float = param(1.0, unit="N", ge=0.0,
+                                  doc="external forces below this are taken as zero (sensor "
+                                      "noise and the hand's inertia)")
+    force_filter: float = param(0.01, unit="s", ge=0.0,
+                                doc="time constant of the first-order low-pass on F^a: the "
+                                    "wrist also feels the hand's inertia (m a), and feeding that "
+                                    "back through the 1 ms loop unfiltered is unstable")
+
+
+class ArmControlTask(Controller):
+    """Eqs. 2-3: arm tracking (S) and reaching (I - S) with wrist force feedback."""
+    Params = ArmParams
+    spec_type = GraspSpec
+    command_type = ServoCommand
+    reads = (TOPIC_ARM_ENCODERS, TOPIC_WRIST_WRENCH, TOPIC_GRASP_OBJECT, TOPIC_GRASP_STATE)
+    description = "eqs. 2-3: arm tracking (S) and reaching (I - S) with wrist force feedback"
+
+    def __init__(self, params: ArmParams, *, spec: GraspSpec) -> None:
+        super().__init__(params, spec=spec)
+        self.chain = spec.model
+        self.dh = [(r.alpha, r.a, r.d, r.theta_offset) for r in self.chain.dh]
+        self.tool = self.chain.tool
+        if spec.plane is None or spec.hand is None:
+            raise ValueError("arm control needs a plant with a hand and a constraint plane")
+        self.n_plane = np.asarray(spec.plane.normal, float)
+        self.hand = hand_body(spec.hand.table)
+        self.g = np.array([0.0, 0.0, -spec.gravity])
+        self.vlim = np.asarray(spec.velocity_limits, float)
+        self.dt = spec.dt                       # the task's period (from its update times)
+        self._t_last: float | None = None
+        self.K_a1, self.K_a2 = np.asarray(params.K_a1, float), np.asarray(params.K_a2, float)
+        self.q = np.asarray(spec.initial_q, float).copy()
+        self.qd = np.zeros(len(self.q))
+        self.obj: Any = None
+        self.state: Any = None
+        self.wrench_raw: Any = None
+        self.bias: np.ndarray | None = None
+        self.filtered = np.zeros(6)
+        self._out: ArmLoop | None = None
+        self.track_sq: dict[str, list] = {}
+
+    def kinematics(self, q):
+        """(tool transform, 6 x n geometric Jacobian at the tool origin)."""
+        T = self.chain.base
+        axes, origins = [], []
+        for (alpha, a, d, off), qi in zip(self.dh, q):
+            axes.append(T[:3, 2])
+            origins.append(T[:3, 3])
+            T = T @ dh_transform(alpha, a, d, qi + off)
+        T = T @ self.tool
+        p = T[:3, 3]
+        Z = np.array(axes).T
+        O = np.array(origins).T
+        J = np.vstack([cross3(Z, p[:, None] - O), Z])
+        return T, J
+
+    def external_wrench(self, R: np.ndarray) -> np.ndarray:
+        """F^a (world, about the flange): the sensor's wrench minus the hand's weight and bias."""
+        f = R @ np.asarray(self.wrench_raw.force, float)
+        m = R @ np.asarray(self.wrench_raw.torque, float)
+        w_hand = self.hand.mass * self.g
+        r = R @ np.asarray(self.hand.com, float)
+        ext = np.concatenate([f - w_hand, m - cross3(r, w_hand)])
+        if self.bias is None:
+            self.bias = ext.copy()              # tare at start: the sensor's offset
+            self.filtered = np.zeros(6)
+        ext = ext - self.bias
+        a = self.dt / (self.params.force_filter + self.dt)
+        self.filtered += a * (ext - self.filtered)
+        out = self.filtered.copy()
+        if np.linalg.norm(out[:3]) < self.params.force_deadband:
+            out[:] = 0.0
+        return out
+
+    def update(self, t: float, measurements) -> ServoCommand | None:
+        for topic, m in measurements:
+            if topic == TOPIC_ARM_ENCODERS:
+                self.q, self.qd = np.asarray(m.position, float), np.asarray(m.velocity, float)
+            elif topic == TOPIC_WRIST_WRENCH:
+                self.wrench_raw = m
+            elif topic == TOPIC_GRASP_OBJECT:
+                if m.found:
+                    self.obj = m
+            elif topic == TOPIC_GRASP_STATE:
+                self.state = m
+        if self._t_last is not None and t > self._t_last:
+            self.dt = t - self._t_last
+        self._t_last = t
+        if self.state is None:
+            return None
+        P = self.params
+        T, J = self.kinematics(self.q)
+        R = T[:3, :3]
+        gp = T[:3, 3] + P.grasp_point * R[:, 2]
+        # the Jacobian of the grasp point: v_gp = v_tool + w x (gp - tool)
+        r = gp - T[:3, 3]
+        Jg = J.copy()
+        Jg[:3] -= cross3(r[:, None], J[3:])
+        n_palm, row = R[:, 2], R[:, 1]
+        # x^a (the hand) and its errors to x^o and x_d^a, as world 6-vectors
+        e_track = np.zeros(6)
+        if self.obj is not None:
+            xo = np.asarray(self.obj.position, float)
+            e_track[:3] = xo - gp
+            if self.obj.roll is not None and self.obj.shape != "circle":
+                row_roll = math.atan2(float(row[2]), float(row[1]))
+                e_track[3] = wrap_half_pi(self.obj.roll - row_roll)
+        xd = np.asarray(self.state.x_d, float)
+        e_reach = np.zeros(6)
+        e_reach[:3] = xd[:3] - gp
+        e_reach[3:] = cross3(n_palm, self.n_plane)
+        JJt = Jg @ Jg.T + (P.damping ** 2) * np.eye(6)
+        Jpinv = Jg.T @ np.linalg.solve(JJt, np.eye(6))
+        track = P.K_ap * Jpinv @ (S_DIAG * self.K_a1 * e_track)
+        reach = P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach)
+        damp = -P.K_av * self.qd
+        F = self.external_wrench(R) if self.wrench_raw is not None else np.zeros(6)
+        force = P.K_af * (J.T @ F)
+        cmd = np.clip(track + reach + damp + force, -self.vlim, self.vlim)
+        self._out = ArmLoop(t, [*gp.tolist(), 0.0, 0.0, 0.0],
+                            (self.obj.x_o if self.obj is not None else []), xd.tolist(),
+                            [float(e_track[1]), float(e_track[2]), float(e_track[3])],
+                            F.tolist(), {"track": track.tolist(), "reach": reach.tolist(),
+                                         "damp": damp.tolist(), "force": force.tolist()},
+                            cmd.tolist())
+        ph = self.state.phase
+        acc = self.track_sq.setdefault(ph, [0.0, 0])
+        acc[0] += float(e_track[1] ** 2 + e_track[2] ** 2)
+        acc[1] += 1
+        return ServoCommand(arm=cmd)
+
+    def telemetry(self, t: float) -> dict:
+        return {TOPIC_GRASP_ARM: self._out} if self._out is not None else {}
+
+    def outcome(self, t: float) -> dict:
+        return {"tracking_error_rms_by_phase": {
+            ph: math.sqrt(s / n) for ph, (s, n) in sorted(self.track_sq.items()) if n}}

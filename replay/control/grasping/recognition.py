@@ -1,0 +1,231 @@
+"""Object recognition by visual information (Namiki et al. 1999, Sec. 4.1.1), pure NumPy.
+
+Each chip frame: Self Windowing extracts the target (``self_window``); its moments give the image
+centre xi and rotation phi (``features``); the viewing ray through xi, from the camera pose at
+the frame's capture (the head's encoders then, through the head model ``replay.robot.head``),
+meets the constraint plane given beforehand at the object's 3-D position; a second ray along
+the principal axis gives the roll about the plane's normal, so ``x_o = (x, y, z, roll, pitch,
+yaw)`` with pitch and yaw those of the plane (0 here: the plane's normal is the reference). The
+pixel extents at that depth give the size; the fill of the smallest bounding box the shape
+(rectangle vs circle: :func:`shape_of`), decided by a vote over the first ``shape_frames`` whole views (not cut by
+the image border) and then kept. The image Jacobian of the head (d xi / d(pan, tilt), for eq. 1)
+is that of the same model at the estimated point. Nothing here predicts motion.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from replay.control.grasping.features import blob
+from replay.control.grasping.payloads import GraspObject
+from replay.control.grasping.self_window import track
+from replay.interfaces import Controller, Occurrence
+from replay.messages import (TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP,
+                             unpack_rows)
+from replay.params import param
+from replay.robot.arm_types import GraspSpec, ServoCommand
+from replay.robot.head import HeadSpec, camera_pose
+from replay.spatial import wrap_half_pi
+
+
+@dataclass
+class RecognitionParams:
+    fov: float = param(math.radians(12.0), unit="rad", gt=0.0, lt=math.pi,
+                       doc="the chip's calibrated horizontal field of view (= the sensor's)")
+    width: int = param(16, unit="px", ge=2, doc="chip width (= the sensor's)")
+    height: int = param(16, unit="px", ge=2, doc="chip height (= the sensor's)")
+    rectangle_fill: float = param(0.9, unit="1", gt=0.0, lt=1.0,
+                                  doc="fill of the smallest bounding box above which the shape "
+                                      "is a rectangle (an axis-aligned rectangle ~1, a disc "
+                                      "pi/4 = 0.79; a rolled one's jagged 16 x 16 edges ~0.75)")
+    rectangle_elongation: float = param(1.3, unit="1", ge=1.0,
+                                        doc="elongation above which the shape is a rectangle "
+                                            "(a disc's is 1; measured 1.01-1.11 on the chip)")
+    min_area: int = param(6, unit="px", ge=1, doc="smallest target used to judge the shape")
+    shape_frames: int = param(20, ge=1, doc="whole views voted on before the shape is decided")
+    axis_elongation: float = param(1.25, unit="1", ge=1.0,
+                                   doc="elongation above which the target's axis (roll) is used")
+
+
+def shape_of(b, params: RecognitionParams) -> str:
+    """Rectangle or circle from one target's features (Fig. 5(b)): a rectangle is elongated or
+    fills its bounding box; a circle neither. (A square face is told from a disc only by the
+    fill, i.e. when its edges line up with the pixels: at 16 x 16 a rolled square's jagged
+    outline fills ~0.75 of its box, like a disc.)"""
+    if b.elongation >= params.rectangle_elongation or b.fill >= params.rectangle_fill:
+        return "rectangle"
+    return "circle"
+
+
+def plane_basis(normal) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(u, v, n): in-plane axes (u horizontal) of a plane with this normal."""
+    n = np.asarray(normal, float)
+    n = n / np.linalg.norm(n)
+    u = np.cross([0.0, 0.0, 1.0], n)
+    if np.linalg.norm(u) < 1e-9:
+        u = np.array([0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    return u, np.cross(n, u), n
+
+
+class Camera:
+    """The chip's pinhole model on the head: pixel rays and projections at given head angles."""
+
+    def __init__(self, head: HeadSpec, fov: float, width: int, height: int) -> None:
+        self.head = head
+        self.f = (width / 2.0) / math.tan(fov / 2.0)
+        self.c = np.array([(width - 1) / 2.0, (height - 1) / 2.0])
+
+    def ray(self, angles, pixel) -> tuple[np.ndarray, np.ndarray]:
+        R, o = camera_pose(self.head, *angles)
+        d = R @ np.array([(pixel[0] - self.c[0]) / self.f, (pixel[1] - self.c[1]) / self.f, 1.0])
+        return o, d
+
+    def project(self, angles, point) -> np.ndarray:
+        R, o = camera_pose(self.head, *angles)
+        pc = R.T @ (np.asarray(point, float) - o)
+        return self.c + self.f * pc[:2] / pc[2]
+
+    def jacobian(self, angles, point) -> np.ndarray:
+        """d pixel / d (pan, tilt) at ``angles`` for a fixed world point. The camera turns about
+        the head's centre h: about world z (pan) and the panned y axis (tilt, positive down), so
+        the point in the camera frame moves by -R^T (k x (X - h)) per radian about axis k."""
+        R, o = camera_pose(self.head, *angles)
+        X = np.asarray(point, float)
+        pc = R.T @ (X - o)
+        r = X - np.asarray(self.head.position, float)
+        a = self.head.yaw + angles[0]
+        J = np.zeros((2, 2))
+        for i, k in enumerate(((0.0, 0.0, 1.0), (-math.sin(a), math.cos(a), 0.0))):
+            kxr = np.array([k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2],
+                            k[0] * r[1] - k[1] * r[0]])
+            d = -(R.T @ kxr)
+            J[:, i] = self.f * (d[:2] * pc[2] - pc[:2] * d[2]) / (pc[2] * pc[2])
+        return J
+
+
+def meet_plane(o, d, point, normal) -> np.ndarray | None:
+    denom = float(d @ normal)
+    if abs(denom) < 1e-12:
+        return None
+    s = float((np.asarray(point) - o) @ normal) / denom
+    return o + s * d if s > 0.0 else None
+
+
+class RecognitionTask(Controller):
+    """Self Windowing, moments, 3-D pose on the constraint plane, shape: ``/grasping/object``."""
+    Params = RecognitionParams
+    spec_type = GraspSpec
+    command_type = ServoCommand
+    reads = (TOPIC_VISION_CHIP, TOPIC_HEAD_ENCODERS)
+    description = "Sec. 4.1.1: Self Windowing, moments, x_o from the constraint plane, shape"
+
+    def __init__(self, params: RecognitionParams, *, spec: GraspSpec) -> None:
+        super().__init__(params, spec=spec)
+        if spec.head is None or spec.plane is None:
+            raise ValueError("recognition needs a plant with a head and a constraint plane")
+        self.camera = Camera(spec.head, params.fov, params.width, params.height)
+        self.plane_point = np.asarray(spec.plane.point, float)
+        self.pu, self.pv, self.pn = plane_basis(spec.plane.normal)
+        self._head: dict[float, tuple[float, float]] = {}
+        self._target: np.ndarray | None = None
+        self._had_target = False
+        self._votes = {"rectangle": 0, "circle": 0}
+        self.shape = "unknown"
+        self._events: list[Occurrence] = []
+        self._out: GraspObject | None = None
+        self.frames = 0
+        self.lost_frames = 0
+
+    def update(self, t: float, measurements) -> None:
+        self._out = None
+        chip = None
+        for topic, m in measurements:
+            if topic == TOPIC_HEAD_ENCODERS:
+                self._head[round(m.t, 9)] = (m.position[0], m.position[1])
+            elif topic == TOPIC_VISION_CHIP:
+                chip = m
+        if len(self._head) > 16:
+            for key in sorted(self._head)[:-16]:
+                del self._head[key]
+        if chip is not None:
+            self._out = self._frame(chip)
+        return None
+
+    def _angles_at(self, t: float):
+        key = round(t, 9)
+        if key in self._head:
+            return self._head[key]
+        older = [k for k in self._head if k <= key]
+        return self._head[max(older)] if older else None
+
+    def _frame(self, chip) -> GraspObject | None:
+        angles = self._angles_at(chip.t)
+        if angles is None:
+            return None
+        image = unpack_rows(chip.rows, chip.width)
+        target, reacquired = track(self._target, image)
+        window = int(chip.count) if reacquired else int(target.sum())
+        self._target = target
+        self.frames += 1
+        b = blob(target, fill=self.shape == "unknown")
+        if b is None:
+            self.lost_frames += 1
+            if self._had_target:
+                self._events.append(Occurrence("lost", {"t_image": chip.t}))
+                self._had_target = False
+            return GraspObject(chip.t, False, [], 0.0, 0, window, [], None, [], [], self.shape,
+                               0.0, 0.0, [], list(angles))
+        if reacquired and self.frames > 1:
+            self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
+        self._had_target = True
+        o, d = self.camera.ray(angles, (b.u, b.v))
+        X = meet_plane(o, d, self.plane_point, self.pn)
+        if X is None:
+            return None
+        axis = (math.cos(b.phi), math.sin(b.phi))
+        o2, d2 = self.camera.ray(angles, (b.u + axis[0], b.v + axis[1]))
+        X2 = meet_plane(o2, d2, self.plane_point, self.pn)
+        roll = None
+        if X2 is not None and b.elongation >= self.params.axis_elongation:
+            e = X2 - X
+            roll = wrap_half_pi(math.atan2(float(e @ self.pv), float(e @ self.pu)))
+        scale = float(np.linalg.norm(X - o)) / self.camera.f       # m per px at the object
+        if not b.touches_border and b.area >= self.params.min_area:
+            self._vote(b)
+        J = self.camera.jacobian(angles, X)
+        x_o = [float(X[0]), float(X[1]), float(X[2]), roll if roll is not None else 0.0,
+               0.0, 0.0]
+        return GraspObject(chip.t, True, [b.u, b.v], b.phi, b.area, window, X.tolist(), roll,
+                           x_o, [b.length * scale, b.width * scale], self.shape,
+                           b.fill if b.fill == b.fill else None,
+                           b.elongation, J.tolist(), list(angles))
+
+    def _vote(self, b) -> None:
+        kind = shape_of(b, self.params)
+        self._votes[kind] += 1
+        if self.shape == "unknown" and sum(self._votes.values()) >= self.params.shape_frames:
+            self.shape = max(self._votes, key=lambda k: (self._votes[k], k))
+            self._events.append(Occurrence("shape", {"shape": self.shape,
+                                                     "votes": dict(self._votes),
+                                                     "fill": b.fill,
+                                                     "elongation": b.elongation}))
+
+    def telemetry(self, t: float) -> dict:
+        return {TOPIC_GRASP_OBJECT: self._out} if self._out is not None else {}
+
+    def pop_events(self) -> list[Occurrence]:
+        ev, self._events = self._events, []
+        return ev
+
+    def outcome(self, t: float) -> dict:
+        out = {"shape": self.shape, "vision_frames": self.frames,
+               "vision_lost_frames": self.lost_frames}
+        if self.shape == "unknown":
+            out.update(success=False, reason="the object's shape was never recognised "
+                       f"({sum(self._votes.values())} whole views of "
+                       f"{self.params.shape_frames} needed)")
+        return out
