@@ -75,7 +75,7 @@ class Params:
     object_angular_velocity: list[float] = param([0.0, 0.0, 0.0], unit="rad/s", length=3,
                                                 ge=-1e4, le=1e4,
                                           doc="initial angular velocity")
-    object_impulses: list = param([], doc="external impulses on the object, [[t, Jx, Jy, Jz], "
+    object_impulses: list[list[float]] = param([], doc="external impulses on the object, [[t, Jx, Jy, Jz], "
                                           "...] (s, N*s, world): a disturbance such as a "
                                           "mid-flight kick (plants/bullet_arm/impulse.py)")
     object_gravity: bool = param(True, doc="gravity acts on the object (false: it floats)")
