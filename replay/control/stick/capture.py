@@ -189,6 +189,9 @@ class StickCaptureController(Controller):
         self._next_try = -math.inf          # no new plan attempt before this time
         self.extra = 0                      # spin-stop collisions added so far
         self._lost: tuple | None = None     # (time of a contact chance not yet planned, numbers)
+        self._infeasible: list[dict] = []   # the ``infeasible`` reports, in order
+        self._missed = 0                    # ``missed`` reports
+        self._t_capture: float | None = None
 
     # -- Controller interface -----------------------------------------------------------------
     def update(self, t: float, measurements) -> HandCommand:
@@ -217,6 +220,48 @@ class StickCaptureController(Controller):
     def pop_events(self) -> list[Occurrence]:
         out, self._events = self._events, []
         return out
+
+    def outcome(self, t: float) -> dict:
+        """The method's metrics and, when it has not captured the stick, why (the last thing that
+        stopped it: out of reach, r_x beyond the stick, no feasible plan, or the run ended first)."""
+        out = {"method_captured": self.captured, "t_capture_method": self._t_capture,
+               "phase": self.phase, "collisions_done": self.step - 1,
+               "extra_spin_stops": self.extra, "missed": self._missed,
+               "infeasible": [d["reason"] + f"@{d['step']}" for d in self._infeasible],
+               "as_planned": not self._infeasible and not self._missed}
+        if self.captured:
+            return out
+        # the runner keeps the plant's reason when both fail: method_reason keeps this one too
+        out["success"] = False
+        out["reason"] = out["method_reason"] = self._why_not(t)
+        return out
+
+    def _why_not(self, t: float) -> str:
+        last = self._infeasible[-1] if self._infeasible else None
+        where = f"phase {self.phase}, collision {self.step}"
+        if self._lost is not None and t > self._lost[0]:        # a chance passed, not reported
+            last = {"reason": "unreachable", "step": self.step, "t_contact": self._lost[0],
+                    "t_needed": _finite_or_none(self._lost[1].t_needed),
+                    "t_available": self._lost[1].t_available}
+        if last is None:
+            if self.phase == "observe" and not self.est.ready():
+                return f"timed out before capture: no estimate of the stick ({where})"
+            return f"timed out before capture ({where})"
+        step = last["step"]
+        if last["reason"] == "unreachable":
+            need = last.get("t_needed")
+            how = ("no hand posture reaches it clear of the stick" if need is None else
+                   f"needs {need:.3f} s, had {last.get('t_available', 0.0):.3f} s")
+            return f"out of reach: the hand cannot get to contact {step} in time ({how})"
+        if last["reason"] == "r_x_beyond_stick":
+            return (f"infeasible: r_x beyond the stick at collision {step} (|r_x| = "
+                    f"{abs(last['r_x']) * 1e3:.1f} mm > L/2 = {last['limit'] * 1e3:.1f} mm); "
+                    f"the clamped fallback did not capture ({where})")
+        if last["reason"] in ("no_solution", "no_crossing"):
+            what = ("no root of eq. 25/28 passes eq. 26" if last["reason"] == "no_solution"
+                    else "the stick never turns to alpha(v)")
+            return f"infeasible: no feasible plan for collision {step} ({what}; {where})"
+        return f"infeasible: {last['reason']} at collision {step} ({where})"
 
     def telemetry(self, t: float) -> dict:
         e = self.est.estimate()
@@ -261,6 +306,8 @@ class StickCaptureController(Controller):
         clean = {k: (_finite_or_none(v) if isinstance(v, (float, np.floating)) else v)
                  for k, v in data.items()}
         self._events.append(Occurrence(kind=kind, data=clean))
+        if kind == "infeasible":
+            self._infeasible.append(clean)
 
     def _on_break(self, t: float) -> None:
         t_break = self.est.breaks[-1]
@@ -282,6 +329,7 @@ class StickCaptureController(Controller):
                 else:
                     self.phase = "close"
         else:
+            self._missed += 1
             self._events.append(Occurrence("missed", {
                 "index": plan.index, "reason": "early_contact", "t_planned": float(plan.t),
                 "t_break": float(t_break)}))
@@ -293,6 +341,7 @@ class StickCaptureController(Controller):
         p = self.params
         if self.phase in ("observe", "approach"):
             if self.plan is not None and est.t_ref > self.plan.t + p.detect_window:
+                self._missed += 1
                 self._events.append(Occurrence("missed", {
                     "index": self.plan.index, "reason": "no_collision",
                     "t_planned": float(self.plan.t), "t_now": float(t)}))
@@ -474,6 +523,7 @@ class StickCaptureController(Controller):
             self._capture_since = t
         if t - self._capture_since >= p.capture_hold and not self.captured:
             self.captured = True
+            self._t_capture = float(self._capture_since)
             self.phase = "captured"
             self._events.append(Occurrence("capture", {
                 "t_since": float(self._capture_since), "speed": float(est.speed),
