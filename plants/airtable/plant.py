@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec
+from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec, root_distance
 from replay.interfaces import Occurrence, Plant
 from replay.messages import FingersState, StickState
 from replay.scene import Box, Cylinder, Scene, yaw_quaternion
@@ -241,13 +241,7 @@ class AirTablePlant(Plant):
         finger root anywhere on the slider's range: a loose, purely geometric bound."""
         h, b = self._hand_spec, self.stick_body
         reach = sum(h.link_lengths) + h.tip_radius + 0.5 * self.params.stick.length
-        (xlo, xhi), (ylo, yhi) = h.base_limits
-        for ox, oy in h.root_offsets:
-            dx = max(xlo + ox - b.position.x, 0.0, b.position.x - xhi - ox)
-            dy = max(ylo + oy - b.position.y, 0.0, b.position.y - yhi - oy)
-            if math.hypot(dx, dy) <= reach:
-                return True
-        return False
+        return root_distance(h, (b.position.x, b.position.y)) <= reach
 
     def _held(self) -> bool:
         """Slow (``hold_speed``, ``hold_omega``) with a fingertip at each face: between the

@@ -82,6 +82,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from replay.robot import hand2d
 from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec
 from replay.interfaces import Controller, Occurrence
 from replay.params import param
@@ -90,6 +91,7 @@ from replay.control.stick.close import ClosePlan, ClosePlanner
 from replay.control.stick.estimator import StickEstimate, StickEstimator
 from replay.control.stick.hand_model import Config, HandModel
 from replay.control.stick.plan import ContactPlan, ContactPlanner, Shortfall
+from replay.control.stick.sweep import Motion
 
 TOPIC_VISION = "/vision/stick"
 TOPIC_ESTIMATE = "/control/stick_estimate"
@@ -148,6 +150,16 @@ class StickCaptureParams:
                                 doc="capture: estimated |omega| below this")
     capture_hold: float = param(0.05, unit="s", ge=0.0, le=5.0,
                                 doc="capture: conditions held this long")
+    respin: float = param(2.0, unit="rad/s", ge=0.0, le=100.0,
+                          doc="a closing to be (re)planned on a stick spinning faster than this "
+                              "gets a spin-stop collision (eq. 30) first, up to max_extra")
+    keep_in_reach: float = param(0.3, unit="s", ge=0.0, le=5.0,
+                                 doc="a contact after which the stick's predicted centre is still "
+                                     "within reach_fraction of the fingers' reach this long is "
+                                     "preferred (the next steps need it there; our choice)")
+    reach_fraction: float = param(0.85, unit="1", gt=0.0, le=2.0,
+                                  doc="'within reach' for keep_in_reach: this fraction of l1 + l2 "
+                                      "from a finger root the slider can reach")
 
 
 def _finite_or_none(v) -> float | None:
@@ -317,7 +329,12 @@ class StickCaptureController(Controller):
         self._report_clamp(plan)
         self._next_try = -math.inf
         self._lost = None
-        if abs(t_break - plan.t) <= self.params.detect_window:
+        # the planned time within the break's unseen gap (the last fitted sample .. the first
+        # deviating one; the stick may have been out of the camera's view) is the plan's
+        dw = self.params.detect_window
+        prev = self.est.before_break
+        t_seen = prev.t_ref if prev is not None else t_break
+        if t_seen - dw <= plan.t <= t_break + dw:
             self.last_finger = plan.finger
             self.plan = None
             self.step += 1
@@ -352,12 +369,21 @@ class StickCaptureController(Controller):
                     self._plan_step(t, est)
                     if self.plan is None and self.phase != "close":
                         self._next_try = t + p.retry_interval
-            elif t < self.plan.t - p.freeze and len(self.plan.route) <= 1:
+            elif t < self.plan.t - p.freeze:
+                # staged routes too: a plan made from the few samples after a collision
+                # extrapolates a noisy velocity (e.g. 0.05 m/s from 6 samples: 2 cm in 0.4 s)
                 self._refine(t, est)
         elif self.phase == "close":
             if self.close is not None and t > self.close.t_meet + p.close_retry \
                     and self._capture_since is None:
                 self.close = None
+            if self.close is None and abs(est.omega) >= p.respin \
+                    and self.extra < p.max_extra and self._capture_since is None:
+                self.extra += 1          # still spinning: one more spin-stop collision (eq. 30)
+                self.step = max(self.step, self.n_steps + 1)
+                self.phase = "observe"
+                self._next_try = -math.inf
+                return
             if self.close is None:
                 if t >= self._next_try:
                     self._plan_close(t, est)
@@ -386,20 +412,23 @@ class StickCaptureController(Controller):
         shortfall = Shortfall()
         crossings_any = False
         first = math.inf
-        for sol, raw in usable:
-            crossings = self.planner.crossings(t, est, sol.theta)
-            crossings_any |= bool(crossings)
-            first = min([first, *crossings])
-            fingers, strict = self._finger_order(sol, step)
-            for t_c in crossings:
-                plan = self.planner.reach(self.step, t, est, sol, raw, t_c, fingers, strict,
-                                          shortfall)
-                if plan is not None:
-                    self.plan = plan
-                    self._lost = None
-                    self.phase = "approach"
-                    self._events.append(Occurrence("plan", plan.intent(self.stick.width)))
-                    return
+        for keep in (True, False):    # first the contacts that leave the stick within reach
+            for sol, raw in usable:
+                crossings = self.planner.crossings(t, est, sol.theta)
+                crossings_any |= bool(crossings)
+                first = min([first, *crossings])
+                fingers, strict = self._finger_order(sol, step)
+                for t_c in crossings:
+                    if keep and not self._stays_in_reach(est, sol, t_c):
+                        continue
+                    plan = self.planner.reach(self.step, t, est, sol, raw, t_c, fingers,
+                                              strict, shortfall)
+                    if plan is not None:
+                        self.plan = plan
+                        self._lost = None
+                        self.phase = "approach"
+                        self._events.append(Occurrence("plan", plan.intent(self.stick.width)))
+                        return
         if not crossings_any:
             if abs(est.omega) < 1e-6:
                 self._report("infeasible", (step, "no_crossing"), step=step,
@@ -407,6 +436,13 @@ class StickCaptureController(Controller):
                 self._to_close()
             return                      # else the next crossing is beyond the horizon: wait
         self._lost_chance(t, first, shortfall)
+
+    def _stays_in_reach(self, est: StickEstimate, sol: sc.ContactSolution, t_c: float) -> bool:
+        """The stick's centre, moving with J_i u (eq. 22) after the contact at t_c, is within
+        ``reach_fraction`` of the fingers' reach ``keep_in_reach`` later."""
+        p = self.params
+        c = Motion(est, t_c, sol.u_after).pose(t_c + p.keep_in_reach)[0]
+        return hand2d.root_distance(self.hand, c) <= p.reach_fraction * sum(self.hand.link_lengths)
 
     def _lost_chance(self, t: float, deadline: float, shortfall: Shortfall) -> None:
         """Report ``unreachable`` once a contact opportunity has passed unplanned (an attempt
