@@ -8,8 +8,8 @@ A throw (our choice; the paper gives no distribution): speed 0.8-1.4 m/s, headin
 of straight at the palm (-y), spin 4-14 rad/s either way, orientation uniform, and a pass point:
 the stick's centre would cross y = 0.12 m (the paper's first collision, Sec. IV-B) at
 x in +-0.06 m, 0.20-0.35 s after the start (the start is then on the 300 fps camera's view).
-``out_of_reach=True`` moves the pass point 0.35-0.45 m to one side instead, where no fingertip can
-get (slider +-0.2 m, finger reach 0.14 m + 0.03 m root offset).
+``out_of_reach=True`` throws it across the table instead, along x at y = 0.50-0.58 m, where no
+fingertip can get (slider +-0.2 m, finger reach 0.14 m: y <= 0.34 m).
 
     .venv/bin/python -m analysis.stick_throws --n 20 [--strategy stick_2step] [--seed 1]
 """
@@ -46,15 +46,17 @@ class Throw:
 
 
 def random_throw(rng: np.random.Generator, out_of_reach: bool = False) -> Throw:
-    speed = rng.uniform(0.8, 1.4)
+    speed = rng.uniform(0.8, 1.4)                       # all drawn whatever out_of_reach
     heading = math.radians(rng.uniform(-15.0, 15.0))
     omega = rng.uniform(4.0, 14.0) * rng.choice([-1.0, 1.0])
     theta = rng.uniform(0.0, math.pi)
-    if out_of_reach:
-        x_pass = rng.choice([-1.0, 1.0]) * rng.uniform(0.35, 0.45)
-        heading = 0.0
-    else:
-        x_pass = rng.uniform(-0.06, 0.06)
+    if out_of_reach:            # across the table at y = 0.50-0.58 m, moving along +-x
+        t_pass = rng.uniform(0.20, 0.35)
+        sign = float(rng.choice([-1.0, 1.0]))
+        vx, vy = sign * speed * math.cos(heading), speed * math.sin(heading)
+        return Throw(x=-vx * t_pass, y=rng.uniform(0.50, 0.58) - vy * t_pass, theta=theta,
+                     vx=vx, vy=vy, omega=omega)
+    x_pass = rng.uniform(-0.06, 0.06)
     t_pass = rng.uniform(0.20, 0.35)
     vx, vy = speed * math.sin(heading), -speed * math.cos(heading)
     return Throw(x=x_pass - vx * t_pass, y=PASS_Y - vy * t_pass, theta=theta, vx=vx, vy=vy,

@@ -262,9 +262,10 @@ class StickCaptureController(Controller):
         step = last["step"]
         if last["reason"] == "unreachable":
             need = last.get("t_needed")
-            how = ("no hand posture reaches it clear of the stick" if need is None else
-                   f"needs {need:.3f} s, had {last.get('t_available', 0.0):.3f} s")
-            return f"out of reach: the hand cannot get to contact {step} in time ({how})"
+            if need is None:
+                return f"out of reach: no hand posture reaches contact {step} clear of the stick"
+            return (f"out of reach: the hand cannot get to contact {step} in time (needs "
+                    f"{need:.3f} s, had {last.get('t_available', 0.0):.3f} s)")
         if last["reason"] == "r_x_beyond_stick":
             return (f"infeasible: r_x beyond the stick at collision {step} (|r_x| = "
                     f"{abs(last['r_x']) * 1e3:.1f} mm > L/2 = {last['limit'] * 1e3:.1f} mm); "

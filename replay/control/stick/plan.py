@@ -46,6 +46,14 @@ CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long b
 GO_DELAY = 0.003       # s, a staged tip moves in this long after the stick's last pass
 
 
+def _body_point(motion: Motion, t: float, point) -> tuple[float, float]:
+    """``point`` (world) in the stick frame at time ``t``."""
+    c, th = motion.pose(t)
+    d = np.asarray(point, dtype=float) - c
+    cs, sn = math.cos(th), math.sin(th)
+    return float(d[0] * cs + d[1] * sn), float(-d[0] * sn + d[1] * cs)
+
+
 # ------------------------------------------------------------------------------------------
 # The plan and the shortfall of failed attempts
 # ------------------------------------------------------------------------------------------
@@ -248,7 +256,12 @@ class ContactPlanner:
                          hand.tip_radius - 5e-4).any():
             return None
         if check_idle:
-            grow = np.where(moving, hand.tip_radius - 5e-4, hand.tip_radius + p.sweep_margin)
+            # on the way the idle tip keeps sweep_margin, or at least the clearance it has now
+            # (it may start at the stick it just hit): a route grazing the stick at speed is a hit
+            xb, yb = _body_point(motion, t, tips[0, 1 - k])
+            gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
+            on_way = max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
+            grow = np.where(moving, on_way, hand.tip_radius + p.sweep_margin)
             if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow).any():
                 return None
         return arrival
