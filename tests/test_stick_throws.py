@@ -16,9 +16,15 @@ import math
 import numpy as np
 import pytest
 
+from click.testing import CliRunner
+
 from analysis.stick_throws import random_throw, run_throw
+from replay.cli import main
 
 N_THROWS = {"stick_2step": 14, "stick_3step": 10}   # ~2 s and ~4 s of CPU per run
+# s: a run stops 0.1 s after the capture; the 3-step's clamped second contact leaves ~30 % of
+# the spin, and the spin-stop collision added then waits up to half a turn of it (~1 s)
+DURATION = {"stick_2step": 2.0, "stick_3step": 3.0}
 SEED = 2026
 MIN_RATE = 0.8
 
@@ -33,7 +39,7 @@ def throws(tmp_path_factory):
         for i in range(n):
             throw = random_throw(rng)
             runs.append((throw, run_throw(strategy, throw, out / f"{strategy}_{i}.mcap",
-                                          duration=2.0)))
+                                          duration=DURATION[strategy])))
         results[strategy] = runs
     return results
 
@@ -74,3 +80,6 @@ def test_a_throw_beyond_reach_says_so(strategy, tmp_path):
     assert o["success"] is False and not o["captured"]
     assert "reach" in o["reason"]                          # the plant: never within reach
     assert "out of reach" in o["method_reason"]            # the method knew it too
+    r = CliRunner().invoke(main, ["info", str(tmp_path / "far.mcap")])
+    assert r.exit_code == 0
+    assert f"outcome: FAILED: {o['reason']}" in r.output and "method_reason=out of reach" in r.output

@@ -27,11 +27,16 @@ Cycle of one planned collision i:
    spinning stick waits outside it (``stage_margin``) and moves in just after the stick's last
    pass; a fingertip inside the stick's reach is first pulled out of it. Every route is checked
    against the predicted sweep along the hand's own motion (each axis at its speed limit, as
-   the plant moves). The first crossing that works is the plan; it is refined with every new
-   estimate until ``freeze`` before the contact.
-4. A model break of the estimator within ``detect_window`` of the planned time is the planned
-   collision; the plan for the next step is then made from fresh estimates. A break much earlier,
-   or none by ``detect_window`` after the plan, is reported (``missed``) and the step re-planned.
+   the plant moves). The first crossing that works, among those after which the stick (moving
+   with J_i u, eq. 22) is still within ``reach_fraction`` of the fingers' reach
+   ``keep_in_reach`` later (else among all), is the plan; it is refined with every new estimate
+   until ``freeze`` before the contact (staged routes too: a plan made from the few samples just
+   after a collision extrapolates a noisy velocity).
+4. A model break of the estimator within ``detect_window`` of the planned time, or whose unseen
+   gap (last fitted sample .. first deviating one, e.g. the stick out of the camera's view)
+   contains it, is the planned collision; the plan for the next step is then made from fresh
+   estimates. A break much earlier, or none by ``detect_window`` after the plan, is reported
+   (``missed``) and the step re-planned.
 
 Closing (eqs. 32, 33, 38): once the stick translates, the finger that made the last collision is
 behind it; the other waits on the line through the centre of mass along v, ahead of the stick, at
@@ -40,7 +45,8 @@ stick when it starts behind it); the rear fingertip waits behind the stick while
 moves (finger joints cannot hold a tip still against a moving slider), then follows the stick
 along that line (``follow_gap`` behind) to the final gap W + 2 tip_radius + grip_clearance.
 Whatever spin is left is ignored by the closing plan (the fingers then squeeze a turning stick:
-not friction independent).
+not friction independent); but a closing to be (re)planned on a stick spinning faster than
+``respin`` first gets a spin-stop collision (eq. 30), up to ``max_extra`` in all.
 A ``capture`` event is emitted once the estimated speed stays below ``capture_speed`` and spin
 below ``capture_spin`` for ``capture_hold`` with both modelled fingertips at the stick's two faces.
 
@@ -68,7 +74,9 @@ A step whose job is to stop the spin is skipped when |omega| < ``min_spin`` alre
 
 Events (``pop_events``): ``plan`` (a contact is committed; data = the intent), ``infeasible``,
 ``missed`` (the model broke well before the planned time, or not by ``detect_window`` after it),
-``skip``, ``capture``. ``intent()``: index, finger, t, theta, r_x, r_y, side, v_after,
+``skip``, ``capture``. ``outcome()``: the method's metrics, and when it has not captured the stick
+``success: False`` with why (out of reach, r_x beyond the stick, no feasible plan, timed out).
+``intent()``: index, finger, t, theta, r_x, r_y, side, v_after,
 omega_after, contact and tip (world, m), clamped, r_x_solved. theta is the estimator's continuous
 orientation (it starts from the camera's first reading in (-pi/2, pi/2]); r_x, r_y and side are
 in that body frame (the solution's frame theta* = alpha(.) may differ from it by pi).
@@ -376,8 +384,8 @@ class StickCaptureController(Controller):
                 self._refine(t, est)
         elif self.phase == "close":
             if self.close is not None and t > self.close.t_meet + p.close_retry \
-                    and self._capture_since is None:
-                self.close = None
+                    and self._capture_since is None and not self._between_tips(t, est):
+                self.close = None        # (a stick already between the tips is left to settle)
             if self.close is None and abs(est.omega) >= p.respin \
                     and self.extra < p.max_extra and self._capture_since is None:
                 self.extra += 1          # still spinning: one more spin-stop collision (eq. 30)
@@ -536,23 +544,28 @@ class StickCaptureController(Controller):
             if self.phase == "close":
                 self.model.target = self.closing.command(t, self.close, self.est)
 
+    def _between_tips(self, t: float, est: StickEstimate) -> bool:
+        """Both modelled fingertips at the estimated stick's two faces (between its ends)."""
+        p, st, hand = self.params, self.stick, self.hand
+        x, y, th = est.at(t)
+        cs, sn = math.cos(th), math.sin(th)
+        sides = []
+        for k in (0, 1):
+            d = self.model.config.tip(hand, k) - np.array([x, y])
+            xb, yb = d[0] * cs + d[1] * sn, -d[0] * sn + d[1] * cs
+            at = abs(xb) <= 0.5 * st.length and \
+                abs(yb) <= 0.5 * st.width + hand.tip_radius + p.grip_clearance + 0.003
+            sides.append(yb if at else 0.0)
+        return sides[0] * sides[1] < 0.0
+
     def _check_capture(self, t: float) -> None:
         if self.phase != "close" or self.close is None or not self.est.ready():
             return
-        p, st, hand = self.params, self.stick, self.hand
+        p, hand = self.params, self.hand
         est = self.est.estimate()
         x, y, th = est.at(t)
-        ok = est.speed < p.capture_speed and abs(est.omega) < p.capture_spin
-        if ok:
-            cs, sn = math.cos(th), math.sin(th)
-            sides = []
-            for k in (0, 1):
-                d = self.model.config.tip(hand, k) - np.array([x, y])
-                xb, yb = d[0] * cs + d[1] * sn, -d[0] * sn + d[1] * cs
-                at = abs(xb) <= 0.5 * st.length and \
-                    abs(yb) <= 0.5 * st.width + hand.tip_radius + p.grip_clearance + 0.003
-                sides.append(yb if at else 0.0)
-            ok = sides[0] * sides[1] < 0.0
+        ok = est.speed < p.capture_speed and abs(est.omega) < p.capture_spin \
+            and self._between_tips(t, est)
         if not ok:
             self._capture_since = None
             return
