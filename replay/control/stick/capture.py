@@ -161,6 +161,11 @@ class StickCaptureParams:
     respin: float = param(2.0, unit="rad/s", ge=0.0, le=100.0,
                           doc="a closing to be (re)planned on a stick spinning faster than this "
                               "gets a spin-stop collision (eq. 30) first, up to max_extra")
+    view: list = param([-0.40, 0.40, -0.20, 0.60], unit="m", length=4, ge=-10.0, le=10.0,
+                       doc="[x_min, x_max, y_min, y_max] of the stick's centre where the camera "
+                           "sees the whole stick (the scenarios' camera: a 0.9 m square about "
+                           "(0, 0.2), less L/2); contacts there are preferred (the method sees "
+                           "their result)")
     keep_in_reach: float = param(0.3, unit="s", ge=0.0, le=5.0,
                                  doc="a contact after which the stick's predicted centre is still "
                                      "within reach_fraction of the fingers' reach this long is "
@@ -264,8 +269,12 @@ class StickCaptureController(Controller):
                     "t_needed": _finite_or_none(self._lost[1].t_needed),
                     "t_available": self._lost[1].t_available}
         if last is None:
-            if self.phase == "observe" and not self.est.ready():
-                return f"timed out before capture: no estimate of the stick ({where})"
+            e = self.est.estimate()
+            if e is None:
+                return f"timed out before capture: the stick was never seen ({where})"
+            if t - e.t_ref > 0.1:
+                return (f"timed out before capture: the stick out of sight since t = "
+                        f"{e.t_ref:.3f} s ({where})")
             return f"timed out before capture ({where})"
         step = last["step"]
         if last["reason"] == "unreachable":
@@ -421,14 +430,17 @@ class StickCaptureController(Controller):
         shortfall = Shortfall()
         crossings_any = False
         first = math.inf
-        for keep in (True, False):    # first the contacts that leave the stick within reach
+        # first the contacts in view that leave the stick within reach, then those in view, then any
+        for keep in (2, 1, 0):
             for sol, raw in usable:
                 crossings = self.planner.crossings(t, est, sol.theta)
                 crossings_any |= bool(crossings)
                 first = min([first, *crossings])
                 fingers, strict = self._finger_order(sol, step)
                 for t_c in crossings:
-                    if keep and not self._stays_in_reach(est, sol, t_c):
+                    if keep and not self._in_view(est, sol, t_c):
+                        continue
+                    if keep == 2 and not self._stays_in_reach(est, sol, t_c):
                         continue
                     plan = self.planner.reach(self.step, t, est, sol, raw, t_c, fingers,
                                               strict, shortfall)
@@ -445,6 +457,16 @@ class StickCaptureController(Controller):
                 self._to_close()
             return                      # else the next crossing is beyond the horizon: wait
         self._lost_chance(t, first, shortfall)
+
+    def _in_view(self, est: StickEstimate, sol: sc.ContactSolution, t_c: float) -> bool:
+        """The stick's centre within ``view`` at the contact and ``keep_in_reach`` after it."""
+        x0, x1, y0, y1 = self.params.view
+        motion = Motion(est, t_c, sol.u_after)
+        for tt in (t_c, t_c + self.params.keep_in_reach):
+            c = motion.pose(tt)[0]
+            if not (x0 <= c[0] <= x1 and y0 <= c[1] <= y1):
+                return False
+        return True
 
     def _stays_in_reach(self, est: StickEstimate, sol: sc.ContactSolution, t_c: float) -> bool:
         """The stick's centre, moving with J_i u (eq. 22) after the contact at t_c, is within
