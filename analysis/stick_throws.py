@@ -11,7 +11,7 @@ x in +-0.06 m, 0.20-0.35 s after the start (the start is then on the 300 fps cam
 ``out_of_reach=True`` throws it across the table instead, along x at y = 0.50-0.58 m, where no
 fingertip can get (slider +-0.2 m, finger reach 0.14 m: y <= 0.34 m).
 
-    .venv/bin/python -m analysis.stick_throws --n 20 [--strategy stick_2step] [--seed 1]
+    .venv/bin/python -m analysis.stick_throws --n 20 [--strategy stick_2step] [--seed 1] [-v]
 """
 
 from __future__ import annotations
@@ -29,6 +29,9 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENARIO = {"stick_2step": ROOT / "scenarios" / "stick_2step.yaml",
             "stick_3step": ROOT / "scenarios" / "stick_3step.yaml"}
 PASS_Y = 0.12            # m, where the paper's first collision happens (Sec. IV-B)
+# s, per strategy: a run stops 0.1 s after the capture; the 3-step's clamped second contact
+# leaves ~30 % of the spin and the spin-stop collision added then waits up to half a turn (~1 s)
+DURATION = {"stick_2step": 2.0, "stick_3step": 3.0}
 
 
 @dataclass(frozen=True)
@@ -63,8 +66,9 @@ def random_throw(rng: np.random.Generator, out_of_reach: bool = False) -> Throw:
                  omega=omega)
 
 
-def run_throw(strategy: str, throw: Throw, out: Path, duration: float = 1.6) -> dict:
-    """The run's ``outcome`` event data."""
+def run_throw(strategy: str, throw: Throw, out: Path, duration: float | None = None) -> dict:
+    """The run's ``outcome`` event data (``duration`` default: ``DURATION[strategy]``)."""
+    duration = DURATION[strategy] if duration is None else duration
     from replay.runner import Runner
     from replay.scenario import load_scenario
     sc = load_scenario(SCENARIO[strategy], sets=throw.sets() + [f"timing.duration={duration}"])
@@ -76,7 +80,8 @@ def main(argv=None) -> None:
     ap.add_argument("--n", type=int, default=20, help="throws per strategy")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--strategy", choices=sorted(SCENARIO), action="append")
-    ap.add_argument("--duration", type=float, default=1.6)
+    ap.add_argument("--duration", type=float, help="s (default: 2.0 for the 2-step, 3.0 for "
+                    "the 3-step)")
     ap.add_argument("--out-of-reach", action="store_true")
     ap.add_argument("-v", "--verbose", action="store_true")
     a = ap.parse_args(argv)

@@ -22,9 +22,6 @@ from analysis.stick_throws import random_throw, run_throw
 from replay.cli import main
 
 N_THROWS = {"stick_2step": 14, "stick_3step": 10}   # ~2 s and ~4 s of CPU per run
-# s: a run stops 0.1 s after the capture; the 3-step's clamped second contact leaves ~30 % of
-# the spin, and the spin-stop collision added then waits up to half a turn of it (~1 s)
-DURATION = {"stick_2step": 2.0, "stick_3step": 3.0}
 SEED = 2026
 MIN_RATE = 0.8
 
@@ -38,8 +35,7 @@ def throws(tmp_path_factory):
         runs = []
         for i in range(n):
             throw = random_throw(rng)
-            runs.append((throw, run_throw(strategy, throw, out / f"{strategy}_{i}.mcap",
-                                          duration=DURATION[strategy])))
+            runs.append((throw, run_throw(strategy, throw, out / f"{strategy}_{i}.mcap")))
         results[strategy] = runs
     return results
 
