@@ -189,7 +189,7 @@ class ContactPlanner:
                 if best is None or cost < best[0]:
                     best = (cost, ContactPlan(index, k, t_c, th_c, sol, raw, contact,
                                               tip, cfg, route,
-                                              self._exit_after(cfg, k, motion, t_c, tip)))
+                                              self._exit_after(cfg, k, motion, t_c, tip, n)))
             if best is not None and strict:
                 break
         return None if best is None else best[1]
@@ -271,8 +271,10 @@ class ContactPlanner:
                 return None
         return arrival
 
-    def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip) -> Config | None:
-        """Finger k's tip pulled radially out of the stick's reach just after the contact when
+    def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip,
+                    n) -> Config | None:
+        """Finger k's tip backed away along -n (the way it came, away from the face the contact
+        pushes off) out of the stick's reach just after the contact when
         the predicted motion after it (J_i u, eq. 22: e.g. a stick left spinning in place)
         would sweep over the tip within half a turn (or ``post_horizon``); the stick may be out of the camera's
         view then, so this cannot wait for the next estimate. None when not needed or not
@@ -286,11 +288,12 @@ class ContactPlanner:
             return None
         c, _ = motion.pose(t_c)
         d = np.asarray(tip) - c
-        dist = float(np.linalg.norm(d))
-        if dist < 1e-9:
-            return None
-        out = c + d / dist * (0.5 * st.length + hand.tip_radius + p.stage_margin)
-        q = hand2d.finger_ik(hand, cfg.base, k, out, q_near=cfg.joints[k])
+        r_out = 0.5 * st.length + hand.tip_radius + p.stage_margin
+        dn = float(np.dot(d, n))
+        # |d - s n| = r_out, s > 0
+        s = dn + math.sqrt(max(dn * dn + r_out * r_out - float(np.dot(d, d)), 0.0))
+        q = hand2d.finger_ik(hand, cfg.base, k, np.asarray(tip) - s * np.asarray(n),
+                             q_near=cfg.joints[k])
         return None if q is None else cfg.with_finger(k, q)
 
     def _exit_config(self, t: float, now: Config, motion: Motion) -> Config | None:
