@@ -8,7 +8,7 @@ OUT    ?= out
 # the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md
 SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml)
 
-.PHONY: install run test bench golden-check clean
+.PHONY: install run lint test bench golden-check clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -22,6 +22,11 @@ run: $(STAMP)
 	@for s in $(SCENARIOS); do $(REPLAY) run $$s -o $(OUT)/logs/$$(basename $$s .yaml).mcap || exit $$?; done
 	$(REPLAY) figures $(OUT)/logs/*.mcap -o $(OUT)/figures
 	$(REPLAY) claims $(OUT)/logs/*.mcap --markdown $(OUT)/claims.md
+
+# ruff (lint only: `ruff format` is not applied to the tree yet) and mypy, configured in pyproject.toml
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/mypy
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -18,16 +18,21 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import yaml
 
 from analysis.claims import Claim
 from analysis.series import events
+from plants.bullet_arm.settings import ArmSettings, resolve
 from replay.log import LogReader
+from replay.messages import (TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE, TOPIC_CATCHING_STATE,
+                             TOPIC_EFFECTOR_MOTION, TOPIC_EFFECTOR_STATE, TOPIC_HAND_JOINT_STATE,
+                             TOPIC_OBJECT_STATE, TOPIC_OPTIMIZATION_COST, TOPIC_VISION_OBJECT)
+from replay.resources import data_path
+from replay.scenario import scenario_from_text
 
-STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "namiki2003.yaml"
+STATED = data_path("claims", "namiki2003.yaml")
 ACTIVE = (0, 1, 3)                      # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
 JOINTS = ("J1", "J2", "J4")
 
@@ -71,6 +76,7 @@ class CatchRun:
     hand_qd: np.ndarray
     t_vision: np.ndarray
     vision: np.ndarray
+    settings: ArmSettings           # the arm plant's, from the log's resolved scenario
     cs_t: np.ndarray = field(default_factory=lambda: np.zeros(0))   # /catching/state
     cs_qd_desired: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
     cs_r_o: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -106,22 +112,23 @@ class CatchRun:
 
 def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     sc = _scenario(log)
-    eff = [m for m in log.series("/effector/state") if m["desired_position"] and m["position"]]
-    cmd = log.series("/arm/joint_command")
+    typed = scenario_from_text(log.scenario()["yaml"], name=f"{log.path.name}:/scenario")
+    eff = [m for m in log.series(TOPIC_EFFECTOR_STATE) if m["desired_position"] and m["position"]]
+    cmd = log.series(TOPIC_ARM_JOINT_COMMAND)
     cmd_t = {round(m["t"], 9): m for m in cmd}
     eff = [m for m in eff if round(m["t"], 9) in cmd_t]
     cmd = [cmd_t[round(m["t"], 9)] for m in eff]
-    js = log.series("/arm/joint_state")
-    ob = log.series("/object/state")
-    mo = log.series("/effector/motion")
-    hj = log.series("/hand/joint_state")
-    vi = log.series("/vision/object")
-    cs = log.series("/catching/state")
+    js = log.series(TOPIC_ARM_JOINT_STATE)
+    ob = log.series(TOPIC_OBJECT_STATE)
+    mo = log.series(TOPIC_EFFECTOR_MOTION)
+    hj = log.series(TOPIC_HAND_JOINT_STATE)
+    vi = log.series(TOPIC_VISION_OBJECT)
+    cs = log.series(TOPIC_CATCHING_STATE)
     ev = events(log)
     run = CatchRun(
         name=name or sc["name"], scenario=sc,
-        mapping=sc["controller"]["params"].get("mapping", "optimised"),
-        dt=1.0 / float(sc["controller"].get("rate", 1000.0)),
+        mapping=str(typed.controller.params.mapping),      # the typed scenario: no default here
+        dt=1.0 / float(typed.controller.rate),
         t_ctrl=_vec(eff, "t"), effector=_vec(eff, "position").reshape(-1, 3),
         effector_desired=_vec(eff, "desired_position").reshape(-1, 3),
         q_desired=_vec(cmd, "position"), torque=_vec(cmd, "torque"),
@@ -131,10 +138,10 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
         t_tool=_vec(mo, "t"), tool_velocity=_vec(mo, "velocity").reshape(-1, 3),
         t_hand=_vec(hj, "t"), hand_q=_vec(hj, "position"), hand_qd=_vec(hj, "velocity"),
         t_vision=_vec(vi, "t"), vision=_vec(vi, "position").reshape(-1, 3),
-        costs=sorted(log.series("/optimization/cost"), key=lambda c: c["iteration"]),
+        costs=sorted(log.series(TOPIC_OPTIMIZATION_COST), key=lambda c: c["iteration"]),
         cs_t=_vec(cs, "t"), cs_qd_desired=_vec(cs, "velocity_desired"),
         cs_r_o=_vec(cs, "r_o").reshape(-1, 3),
-        events=ev)
+        settings=resolve(typed.plant.params), events=ev)
     run.t0 = float(cs[0]["t"]) if cs else None
     hold = run.first_event("mapping_hold")
     if hold is not None:
@@ -282,30 +289,19 @@ def vision_accuracy(run: CatchRun) -> tuple[float, float, float] | None:
 
 
 # ------------------------------------------------------------------------ the arm model
-def arm_capability(sc: dict) -> dict:
+def arm_capability(arm: ArmSettings) -> dict:
     """What the scenario's arm model can do at the tool: max speed with its joint-speed limits
-    (at q0 and over a sample of the joint-limit box, axis 3 at 0) and acceleration from rest at
-    q0 with its torque limits (replay.robot.capability)."""
+    (at q0 and over a sample of the joint-limit box, locked axes at q0) and acceleration from
+    rest at q0 with its torque limits (replay.robot.capability)."""
     from replay.robot.capability import max_tool_speed, tool_acceleration_from_rest
-    from replay.robot.hand import HANDS, hand_body
-    from replay.robot.wam import (DEFAULT_VELOCITY_LIMIT, TORQUE_LIMIT_SETS, wam_chain,
-                                  wam_joint_limits)
-    p = sc["plant"]["params"]
-    dof = 4 if p.get("arm", "wam4") == "wam4" else 7
-    tool_d = p.get("tool_d", -1.0)
-    hand = HANDS.get(p.get("hand", "catch3"))
-    chain = wam_chain(dof, tool_d=None if tool_d is None or tool_d < 0 else tool_d,
-                      base_position=p.get("base_position", [0, 0, 0]),
-                      base_rpy=p.get("base_rpy", [0, 0, 0]), gravity=p.get("gravity", 9.81),
-                      payload=hand_body(hand) if hand is not None else None)
-    vel = p.get("velocity_limits") or [DEFAULT_VELOCITY_LIMIT] * dof
-    tau = p.get("torque_limits") or list(TORQUE_LIMIT_SETS[p.get("torque_limit_set",
-                                                                  "public_urdf")][:dof])
-    q0 = np.asarray(p.get("initial_q") or [0.0] * dof, float)
-    act = [i for i, n in enumerate(chain.joint_names) if n not in set(p.get("locked_joints", []))]
-    lo, hi = wam_joint_limits(dof)
+    dof = arm.dof
+    chain = arm.chain()
+    vel = arm.velocity_limits.tolist()
+    tau = arm.torque_limits.tolist()
+    q0 = arm.initial_q
+    act = list(arm.active)
     rng = np.random.default_rng(0)
-    Q = rng.uniform(lo, hi, size=(400, dof))
+    Q = rng.uniform(arm.lower, arm.upper, size=(400, dof))
     for i in range(dof):
         if i not in act:
             Q[:, i] = q0[i]
@@ -373,11 +369,8 @@ def _cost_rows(opt: CatchRun | None, st: dict) -> list[Claim]:
 
 
 def _opt_limits(run: CatchRun) -> tuple[list, list]:
-    cp, pp = run.controller_params, run.plant_params
-    from replay.robot.wam import DEFAULT_VELOCITY_LIMIT, TORQUE_LIMIT_SETS
-    tau = pp.get("torque_limits") or list(TORQUE_LIMIT_SETS[pp.get("torque_limit_set",
-                                                                   "public_urdf")][:4])
-    vel = pp.get("velocity_limits") or [DEFAULT_VELOCITY_LIMIT] * 4
+    cp = run.controller_params
+    tau, vel = run.settings.torque_limits.tolist(), run.settings.velocity_limits.tolist()
     t = cp.get("opt_torque_limits") or [tau[i] for i in ACTIVE]
     w = cp.get("opt_velocity_limits") or [vel[i] for i in ACTIVE]
     return t, w
@@ -493,7 +486,7 @@ def _capability_rows(run: CatchRun, st: dict) -> list[Claim]:
     p = st["parameters"]
     v_stated = p["max_effector_speed"]["value"]
     a_stated = p["max_effector_acceleration"]["value"]
-    cap = arm_capability(run.scenario)
+    cap = arm_capability(run.settings)
     contact = first_contact(run)
     v_run, a_run = tool_peaks(run, contact["t"] if contact else None)
     w = run.t_arm <= (contact["t"] if contact else np.inf) + 1e-9

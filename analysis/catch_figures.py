@@ -20,7 +20,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 
 from analysis.catch_claims import (ACTIVE, JOINTS, CatchRun, _opt_limits, _pair,  # noqa: E402
                                    first_contact, load_run)

@@ -8,18 +8,21 @@ real 10 mm width instead of Assumption 5's negligible width). A missing log give
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import yaml
 
 from analysis.claims import Claim, within
 from analysis.series import arrays, events
-from replay.control.stick.collision import (pure_rotation_min_spin, pure_rotation_residual_spin,
-                                            pure_rotation_stop_distance)
+from plants.airtable.params import Params as AirTableParams
 from replay.log import LogReader
+from replay.messages import TOPIC_STICK_STATE
+from replay.resources import data_path
+from replay.scenario import scenario_from_text
+from replay.robot.stick_impact import (pure_rotation_min_spin, pure_rotation_residual_spin,
+                                       pure_rotation_stop_distance)
 
-STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "higashimori2007.yaml"
+STATED = data_path("claims", "higashimori2007.yaml")
 
 
 def _stated() -> dict:
@@ -39,16 +42,12 @@ def _speed(v) -> float:
 
 def _t_stopped(log: LogReader, speed: float = 0.02) -> float | None:
     """First time after which the stick's speed stays below ``speed`` m/s."""
-    s = arrays(log, "/stick/state", ["vx", "vy"])
+    s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy"])
     moving = np.hypot(s["vx"], s["vy"]) >= speed
     if not len(moving) or moving[-1]:
         return None
     last = np.nonzero(moving)[0]
     return float(s["t"][last[-1] + 1]) if len(last) else float(s["t"][0])
-
-
-def _scenario(log: LogReader) -> dict:
-    return yaml.safe_load(log.scenario()["yaml"])
 
 
 def _not_run(quantity: str, stated: str, name: str) -> Claim:
@@ -63,7 +62,9 @@ def _friction_rows(logs: dict[str, LogReader]) -> list[Claim]:
     outcomes = {}
     for name, log in runs.items():
         c = _collision(log, 1)
-        mu = _scenario(log)["plant"]["params"]["stick"]["friction"]
+        plant = scenario_from_text(log.scenario()["yaml"]).plant.params   # typed by the loader
+        assert isinstance(plant, AirTableParams)
+        mu = plant.stick.friction
         if c is not None:
             outcomes[mu] = np.array([*c["data"]["v_after"], c["data"]["omega_after"] * 0.05])
     if len(outcomes) < 2:

@@ -10,14 +10,18 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import yaml  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
 from analysis.series import arrays, events  # noqa: E402
+from plants.airtable.params import Params  # noqa: E402
 from replay.log import LogReader  # noqa: E402
+from replay.messages import TOPIC_STICK_STATE  # noqa: E402
+from replay.scenario import ScenarioError, params_from_data  # noqa: E402
 
 
 def fig7(log: LogReader, title: str = ""):
-    s = arrays(log, "/stick/state", ["vx", "vy", "omega"])
+    s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy", "omega"])
     speed = np.hypot(s["vx"], s["vy"])
     fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
     ax_v.plot(s["t"], speed, color="tab:blue", lw=1.4, label="simulated (Pymunk)")
@@ -53,7 +57,7 @@ def friction_overlay(logs: dict[str, LogReader]):
     fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
     for name, log in sorted(logs.items()):
         mu = _mu(log)
-        s = arrays(log, "/stick/state", ["vx", "vy", "omega"])
+        s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy", "omega"])
         label = f"{name} (μ = {mu:g})" if mu is not None else name
         ax_v.plot(s["t"], np.hypot(s["vx"], s["vy"]), lw=1.2, label=label)
         ax_w.plot(s["t"], s["omega"], lw=1.2, label=label)
@@ -68,12 +72,16 @@ def friction_overlay(logs: dict[str, LogReader]):
     return fig
 
 
+def _params(log: LogReader) -> Params:
+    """The air table's typed params, rebuilt from the log's resolved scenario by the loader."""
+    sc = yaml.safe_load(log.scenario()["yaml"])
+    return params_from_data(Params, sc["plant"].get("params"), "plant.params")
+
+
 def _mu(log: LogReader):
-    import yaml
     try:
-        sc = yaml.safe_load(log.scenario()["yaml"])
-        return float(sc["plant"]["params"]["stick"]["friction"])
-    except (KeyError, TypeError, ValueError):
+        return float(_params(log).stick.friction)
+    except (KeyError, TypeError, ValueError, ScenarioError):
         return None
 
 
@@ -84,9 +92,8 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
         paths += save(fig7(log, f"{name}: velocities vs time (cf. Fig. 7)"), out, f"{name}_fig7")
     by_strategy: dict[str, dict[str, LogReader]] = {}
     for name, log in logs.items():
-        import yaml
         sc = yaml.safe_load(log.scenario()["yaml"])
-        if float(sc["plant"]["params"]["stick"].get("collision_width", 0.0)) == 0.0:
+        if _params(log).stick.collision_width == 0.0:
             by_strategy.setdefault(sc["controller"]["type"], {})[name] = log
     for strategy, group in sorted(by_strategy.items()):
         if len({_mu(log) for log in group.values()}) > 1:

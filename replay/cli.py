@@ -11,12 +11,12 @@ import click
 from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
+from replay.resources import find_scenario, scenario_dir
 from replay.scenario import ScenarioError, load_scenario
 from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
 
 DEFAULT_LOG_DIR = Path("out/logs")
 DEFAULT_FIGURE_DIR = Path("out/figures")
-SCENARIO_DIR = Path("scenarios")
 
 
 def _fail(message: str, code: int = 2) -> None:
@@ -52,7 +52,7 @@ def main() -> None:
 
 def _load(path: str, sets=(), seed=None):
     try:
-        return load_scenario(path, sets=list(sets), seed=seed)
+        return load_scenario(find_scenario(path), sets=list(sets), seed=seed)
     except ScenarioError as exc:
         _fail(str(exc))
 
@@ -161,11 +161,11 @@ def optimise(scenario, out):
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
 def validate(scenarios, sets):
     """Check scenario files without running them (all of scenarios/ by default)."""
-    paths = scenarios or sorted(str(p) for p in SCENARIO_DIR.glob("*.yaml"))
+    paths = scenarios or sorted(str(p) for p in scenario_dir().glob("*.yaml"))
     bad = 0
     for p in paths:
         try:
-            load_scenario(p, sets=list(sets))
+            load_scenario(find_scenario(p), sets=list(sets))
             click.echo(f"ok: {p}")
         except ScenarioError as exc:
             click.echo(f"error: {exc}", err=True)
@@ -182,7 +182,7 @@ def list_(plugins):
         for kind in registry.GROUPS:
             click.echo(f"{kind}s: {', '.join(registry.names(kind)) or '-'}")
         return
-    for p in sorted(SCENARIO_DIR.glob("*.yaml")):
+    for p in sorted(scenario_dir().glob("*.yaml")):
         try:
             sc = load_scenario(p)
         except ScenarioError as exc:
@@ -381,7 +381,7 @@ def _goldens(names):
     try:
         table = load_manifest()
     except FileNotFoundError:
-        _fail("no data/golden/manifest.yaml here (run from the project root)")
+        _fail("no golden manifest shipped (data/golden/manifest.yaml is missing)")
     unknown = [n for n in names if n not in table]
     if unknown:
         _fail(f"unknown golden log {unknown[0]!r} (known: {', '.join(table)})")

@@ -15,12 +15,14 @@ from pathlib import Path
 import yaml
 
 from replay.log import LogReader
+from replay.messages import TOPIC_SCENARIO
+from replay.resources import shipped_root
 from replay.runner import Runner
 from replay.scenario import load_scenario
 
-GOLDEN_DIR = Path("data/golden")
+GOLDEN_DIR = Path("data/golden")   # under replay.resources.shipped_root()
 MANIFEST = "manifest.yaml"
-IGNORED_FIELDS = {"/scenario": {"version"}}   # the code version differs by design
+IGNORED_FIELDS = {TOPIC_SCENARIO: {"version"}}   # the code version differs by design
 
 
 @dataclass
@@ -51,7 +53,8 @@ class Difference:
         return f"{where}: golden {self.golden!r} vs run {self.run!r}{tol}"
 
 
-def load_manifest(root: Path = Path(".")) -> dict[str, Golden]:
+def load_manifest(root: Path | None = None) -> dict[str, Golden]:
+    root = shipped_root() if root is None else root
     path = root / GOLDEN_DIR / MANIFEST
     data = yaml.safe_load(path.read_text()) or {}
     out = {}

@@ -12,6 +12,29 @@ import typing
 from dataclasses import dataclass, field
 from typing import Any
 
+# ---- topic names (the contract: add freely, rename none). Use these, not string literals.
+TOPIC_SCENARIO = "/scenario"                    # ScenarioInfo, once at t = 0
+TOPIC_EVENTS = "/events"                        # Event
+# air table (Higashimori et al. 2007)
+TOPIC_STICK_STATE = "/stick/state"              # StickState
+TOPIC_FINGERS_STATE = "/fingers/state"          # FingersState
+TOPIC_HAND_STATE = "/hand/state"                # the airtable plant's hand
+TOPIC_VISION_STICK = "/vision/stick"            # VisionStick
+TOPIC_STICK_ESTIMATE = "/control/stick_estimate"   # the stick controllers' estimator
+# arm plant (Namiki & Ishikawa 2003, Namiki et al. 1999)
+TOPIC_ARM_JOINT_STATE = "/arm/joint_state"      # JointState
+TOPIC_HAND_JOINT_STATE = "/hand/joint_state"    # JointState
+TOPIC_ARM_JOINT_COMMAND = "/arm/joint_command"  # JointCommand
+TOPIC_ARM_ENCODERS = "/arm/encoders"            # JointState, measured
+TOPIC_ARM_APPLIED_TORQUE = "/arm/applied_torque"
+TOPIC_OBJECT_STATE = "/object/state"            # ObjectState
+TOPIC_OBJECT_CONTACTS = "/object/contacts"
+TOPIC_EFFECTOR_STATE = "/effector/state"        # EffectorState
+TOPIC_EFFECTOR_MOTION = "/effector/motion"
+TOPIC_VISION_OBJECT = "/vision/object"          # VisionObject
+TOPIC_OPTIMIZATION_COST = "/optimization/cost"  # OptimizationCost
+TOPIC_CATCHING_STATE = "/catching/state"        # the catching controller's state
+
 
 @dataclass
 class ScenarioInfo:
@@ -104,18 +127,18 @@ class OptimizationCost:
 
 # topic -> payload type, for the contract topics
 TOPICS: dict[str, type] = {
-    "/scenario": ScenarioInfo,
-    "/events": Event,
-    "/stick/state": StickState,
-    "/fingers/state": FingersState,
-    "/vision/stick": VisionStick,
-    "/arm/joint_state": JointState,
-    "/hand/joint_state": JointState,
-    "/arm/joint_command": JointCommand,
-    "/object/state": ObjectState,
-    "/effector/state": EffectorState,
-    "/vision/object": VisionObject,
-    "/optimization/cost": OptimizationCost,
+    TOPIC_SCENARIO: ScenarioInfo,
+    TOPIC_EVENTS: Event,
+    TOPIC_STICK_STATE: StickState,
+    TOPIC_FINGERS_STATE: FingersState,
+    TOPIC_VISION_STICK: VisionStick,
+    TOPIC_ARM_JOINT_STATE: JointState,
+    TOPIC_HAND_JOINT_STATE: JointState,
+    TOPIC_ARM_JOINT_COMMAND: JointCommand,
+    TOPIC_OBJECT_STATE: ObjectState,
+    TOPIC_EFFECTOR_STATE: EffectorState,
+    TOPIC_VISION_OBJECT: VisionObject,
+    TOPIC_OPTIMIZATION_COST: OptimizationCost,
 }
 
 _JSON_TYPES = {float: "number", int: "integer", str: "string", bool: "boolean",

@@ -4,6 +4,7 @@ core edit: declare it in a package's ``pyproject.toml`` under one of these group
 from __future__ import annotations
 
 from importlib.metadata import entry_points
+from typing import Any
 
 GROUPS = {
     "plant": "paper_replay.plants",
@@ -11,6 +12,7 @@ GROUPS = {
     "controller": "paper_replay.controllers",
     "figures": "paper_replay.figures",     # paper key -> make(logs_by_name, outdir) -> paths
     "claims": "paper_replay.claims",       # paper key -> evaluate(logs_by_name) -> [Claim]
+    "viewer_scene": "paper_replay.viewer_scenes",   # plant type -> replay.viewer RunScene class
 }
 
 
@@ -34,8 +36,8 @@ def register(kind: str, name: str, cls: type) -> None:
     _registered[kind][name] = cls
 
 
-def _entries(kind: str) -> dict:
-    found = {ep.name: ep for ep in entry_points(group=GROUPS[kind])}
+def _entries(kind: str) -> dict[str, Any]:
+    found: dict[str, Any] = {ep.name: ep for ep in entry_points(group=GROUPS[kind])}
     found.update({name: _Loaded(cls) for name, cls in _registered[kind].items()})
     return found
 
@@ -44,7 +46,7 @@ def names(kind: str) -> list[str]:
     return sorted(_entries(kind))
 
 
-def load(kind: str, name: str) -> type:
+def load(kind: str, name: str) -> Any:
     """The plug-in class called ``name``; an unknown name answers with the known ones."""
     entries = _entries(kind)
     if name not in entries:

@@ -23,7 +23,7 @@ import numpy as np
 
 from replay import __version__, registry
 from replay.log import LogWriter, NonFiniteValueError
-from replay.messages import Event, ScenarioInfo
+from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
 from replay.scenario import Scenario, resolved_yaml
 
 
@@ -114,7 +114,7 @@ class Runner:
         text = resolved_yaml(sc)
         log.metadata("scenario", {"yaml": text})
         version = f"{__version__}+{commit}"
-        self._write(log, "/scenario", ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version),
+        self._write(log, TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version),
                     0)
         # (deliver at step, sequence, topic, payload): a heap, so readings reach the controller in
         # time order whatever the sensors' order and latencies
@@ -171,14 +171,14 @@ class Runner:
         except NonFiniteValueError as exc:
             result.stopped_by = "error"
             result.error = str(exc)
-            self._write(log, "/events", Event(k / rate, "error", {
+            self._write(log, TOPIC_EVENTS, Event(k / rate, "error", {
                 "reason": "non-finite value", "topic": exc.topic, "fields": exc.fields}),
                 self.t_ns(k))
             self._outcome(log, result, k, {"success": False,
                                            "reason": f"error: non-finite value on {exc.topic}"})
         except KeyboardInterrupt:
             result.stopped_by = "interrupted"
-            self._write(log, "/events", Event(k / rate, "interrupted", {}), self.t_ns(k))
+            self._write(log, TOPIC_EVENTS, Event(k / rate, "interrupted", {}), self.t_ns(k))
             self._outcome(log, result, k, {"success": False, "reason": "interrupted"})
             self._finish(log, result, k, wall0)
             raise RunInterrupted(result) from None
@@ -203,7 +203,7 @@ class Runner:
     def _outcome(self, log: LogWriter, result: RunResult, k: int, verdict: dict) -> None:
         """Every run ends with one ``outcome`` event: the one place a user or a sweep reads it."""
         result.outcome = verdict
-        self._write(log, "/events", Event(k / self.sc.timing.physics_rate, "outcome", verdict),
+        self._write(log, TOPIC_EVENTS, Event(k / self.sc.timing.physics_rate, "outcome", verdict),
                     self.t_ns(k))
 
     def _finish(self, log: LogWriter, result: RunResult, k: int, wall0: float) -> None:
@@ -219,10 +219,10 @@ class Runner:
             observe(topic, payload, t_ns)
 
     def _event(self, log, occ, t, t_ns, result, stop_at, k):
-        self._write(log, "/events", Event(t, occ.kind, occ.data), t_ns)
+        self._write(log, TOPIC_EVENTS, Event(t, occ.kind, occ.data), t_ns)
         result.events[occ.kind] = result.events.get(occ.kind, 0) + 1
         if occ.kind == "nan":
-            raise NonFiniteValueError("/events", occ.data)
+            raise NonFiniteValueError(TOPIC_EVENTS, occ.data)
         if stop_at is None and occ.kind in self.sc.stop.on_events:
             result.stopped_by = occ.kind
             stop_at = k + int(round(self.sc.stop.after * self.sc.timing.physics_rate))

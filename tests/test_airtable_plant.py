@@ -13,7 +13,8 @@ from plants.airtable import AirTablePlant, Params
 from replay.robot.hand2d import AirTableSpec, HandCommand, finger_ik, finger_tip, travel_time
 from replay.interfaces import Plant
 from replay.messages import FingersState, StickState, to_dict
-from replay.scene import Box, Cylinder, quaternion_yaw
+from replay.scene import Box, Cylinder
+from replay.spatial import quaternion_yaw
 
 DT = 1.0 / 3000.0
 

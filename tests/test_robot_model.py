@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from replay.robot.hand import CATCH3, GRASP4, HANDS, hand_body, hand_mass
-from replay.robot.serial_chain import (RigidBody, matrix_to_quaternion, matrix_to_rpy,
-                                       rpy_to_matrix)
+from replay.robot.serial_chain import RigidBody
 from replay.robot.wam import load_wam_table, wam_chain, wam_joint_limits
-from replay.scene import quaternion_matrix
+from replay.spatial import (matrix_to_quaternion, matrix_to_rpy, quaternion_matrix,
+                            rpy_to_matrix)
 
 START = np.array([0.0, math.pi / 4, 0.0, 0.0])        # Namiki & Ishikawa IV-A initial pose
 CATCH = np.array([0.0, math.pi / 4, 0.0, math.pi / 2])  # q4 = q_alpha = pi/2

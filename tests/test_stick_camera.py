@@ -8,7 +8,8 @@ import pytest
 
 from replay.interfaces import Sensor
 from replay.messages import VisionStick
-from replay.scene import Box, Cylinder, Scene, Sphere, yaw_quaternion
+from replay.scene import Box, Cylinder, Scene, Sphere
+from replay.spatial import yaw_quaternion
 from replay.sensors.pinhole import PinholeCamera
 from replay.sensors.stick_camera import (StickCamera, StickCameraParams, polygon_coverage,
                                         render_scene, wrap_half_pi)

@@ -9,7 +9,7 @@ import yaml
 
 from analysis.stick_claims import evaluate
 from analysis.stick_figures import make_figures
-from replay.control.stick.collision import spin_before_pure_rotation
+from replay.robot.stick_impact import spin_before_pure_rotation
 from replay.log import LogReader
 from replay.runner import Runner
 from replay.scenario import load_scenario

@@ -14,6 +14,7 @@ from hypothesis import given, settings, strategies as st
 
 from replay.robot import hand2d
 from replay.control.stick import collision as sc
+from replay.robot import stick_impact as si
 from replay.control.stick.strategy import (HandModel, ThreeStepController, ThreeStepParams,
                                            TwoStepController, TwoStepParams, Config)
 from replay.robot.hand2d import AirTableSpec, HandSpec, StickSpec
@@ -146,7 +147,7 @@ def test_two_step_first_collision(heading, w0):
 
 def test_three_step_first_collision_fig7():
     """Fig. 7: v_0 = 1.1 m/s stopped, omega_1 = -10 rad/s; eq. 35 picks r_x = -25.75 mm."""
-    (w0, d), _ = sc.spin_before_pure_rotation(M, INERTIA, E, V0, OMEGA_1)
+    (w0, d), _ = si.spin_before_pure_rotation(M, INERTIA, E, V0, OMEGA_1)
     u0 = np.array([V0, 0.0, w0])
     sol = sc.three_step_first(M, INERTIA, E, u0, L)                      # eq. 34
     after = np.array(sol.u_after)
@@ -169,7 +170,7 @@ def test_three_step_second_collision_follows_lambda(lam, w1):
     assert sol.theta == pytest.approx(sc.alpha(lam))
     assert after[2] == pytest.approx(0.0, abs=1e-9)                      # omega_2 = 0
     assert np.allclose(after[:2] / np.linalg.norm(after[:2]), lam)       # eq. 37
-    assert abs(sol.r_x) == pytest.approx(sc.pure_rotation_stop_distance(M, INERTIA, E))
+    assert abs(sol.r_x) == pytest.approx(si.pure_rotation_stop_distance(M, INERTIA, E))
     assert not sol.within                                                # 86.5 mm > L/2
 
 
@@ -188,7 +189,7 @@ def test_closing_contact_reverses_the_translation():
 
 
 def test_initial_spin_for_fig7():
-    pairs = sc.spin_before_pure_rotation(M, INERTIA, E, V0, OMEGA_1)
+    pairs = si.spin_before_pure_rotation(M, INERTIA, E, V0, OMEGA_1)
     (w_a, d_a), (w_b, d_b) = pairs
     assert w_a == pytest.approx(9.92, abs=0.01) and d_a == pytest.approx(0.02575, abs=1e-5)
     assert w_b == pytest.approx(32.71, abs=0.01) and d_b == pytest.approx(0.0552, abs=1e-4)
@@ -197,15 +198,15 @@ def test_initial_spin_for_fig7():
         after = J(sc.alpha([V0, 0.0]), -d, -1, [V0, 0.0, w0])
         assert np.allclose(after, [0.0, 0.0, OMEGA_1], atol=1e-9)
     # no initial spin leaves less than this spin after a full stop at 1.1 m/s
-    w_min = sc.pure_rotation_min_spin(M, INERTIA, E, V0)
+    w_min = si.pure_rotation_min_spin(M, INERTIA, E, V0)
     assert w_min == pytest.approx(9.314, abs=1e-3)
-    assert sc.spin_before_pure_rotation(M, INERTIA, E, V0, -0.999 * w_min) == []
-    assert len(sc.spin_before_pure_rotation(M, INERTIA, E, V0, -1.001 * w_min)) == 2
+    assert si.spin_before_pure_rotation(M, INERTIA, E, V0, -0.999 * w_min) == []
+    assert len(si.spin_before_pure_rotation(M, INERTIA, E, V0, -1.001 * w_min)) == 2
 
 
 def test_second_collision_distance_with_the_stated_numbers():
     """Sec. IV-B states r_x,2 = 48.7 mm < L/2; with m, I, e of Sec. IV-A eq. 25 gives 86.5 mm."""
-    d = sc.pure_rotation_stop_distance(M, INERTIA, E)
+    d = si.pure_rotation_stop_distance(M, INERTIA, E)
     assert d == pytest.approx(0.0865, abs=5e-4)
     assert d > L / 2
     sol = sc.solve_contact(M, INERTIA, E, math.pi / 2, 1, [0.0, 0.0, OMEGA_1], omega=0.0, length=L)
@@ -213,7 +214,7 @@ def test_second_collision_distance_with_the_stated_numbers():
     # what the stated 48.7 mm would need: e = I / (m r^2) = 0.60 with the same m and I
     assert INERTIA / (M * 0.0487 ** 2) == pytest.approx(0.60, abs=0.01)
     # the least spin at the stick's tip (fallback) and what it leaves
-    ratio = sc.pure_rotation_residual_spin(M, INERTIA, E, 0.045)
+    ratio = si.pure_rotation_residual_spin(M, INERTIA, E, 0.045)
     assert ratio == pytest.approx(0.301, abs=1e-3)
     after = J(math.pi / 2, 0.045, -1, [0.0, 0.0, OMEGA_1])
     assert after[2] == pytest.approx(ratio * OMEGA_1)
@@ -355,7 +356,7 @@ def test_first_collision_is_planned_at_alpha_and_the_right_spot(cls, params):
 
 def test_three_step_reports_the_86_mm_second_collision_and_falls_back():
     spec = air_spec()
-    w0, _ = sc.spin_before_pure_rotation(M, INERTIA, E, V0, OMEGA_1)[0]
+    w0, _ = si.spin_before_pure_rotation(M, INERTIA, E, V0, OMEGA_1)[0]
     stick = SyntheticStick([-0.45, 0.0, 0.3, V0, 0.0, w0])
     ctrl = ThreeStepController(ThreeStepParams(), spec=spec)
     done = []
@@ -377,7 +378,7 @@ def test_three_step_reports_the_86_mm_second_collision_and_falls_back():
     assert abs(data["r_x"]) == pytest.approx(0.0865, abs=5e-4)
     assert data["limit"] == pytest.approx(L / 2)
     assert abs(data["fallback_r_x"]) == pytest.approx(L / 2 - ctrl.params.tip_margin)
-    ratio = sc.pure_rotation_residual_spin(M, INERTIA, E, abs(data["fallback_r_x"]))
+    ratio = si.pure_rotation_residual_spin(M, INERTIA, E, abs(data["fallback_r_x"]))
     assert data["omega_after"] == pytest.approx(ratio * OMEGA_1, rel=1e-3)
     plan2 = [ev.data for _, ev in events if ev.kind == "plan" and ev.data["index"] == 2]
     assert plan2 and plan2[0]["clamped"]

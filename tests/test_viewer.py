@@ -23,12 +23,16 @@ from replay.interfaces import Controller, Plant
 from replay.log import LogReader, LogWriter
 from replay.messages import ScenarioInfo, StickState
 from replay.params import param
+from replay.scenario import params_from_data
 from replay.scene import Scene
 from replay.viewer import SPEEDS, ViewerError, load_run
 from replay.viewer import app as viewer_app
 from replay.viewer.app import Viewer, free_port
-from replay.viewer.geometry import StickGeometry, cameras, plant_models_urdf
-from replay.viewer.scenes import AirTableScene, ArmScene, scene_class
+from plants.airtable import Params as AirTableParams
+from plants.airtable.viewer_scene import AirTableScene, StickGeometry
+from plants.bullet_arm.viewer_scene import ArmScene, plant_models_urdf
+from replay.viewer.geometry import cameras
+from replay.viewer.scenes import RunScene, scene_class
 from replay.viewer.synthetic import write_arm_log, write_stick_log
 from replay.viewer.timeline import speed_value
 
@@ -119,9 +123,10 @@ def test_names_are_kept_once_and_ragged_fields_noted(tmp_path):
 def test_geometry_from_the_resolved_scenario(tmp_path):
     path = write_stick_log(tmp_path / "long.mcap", length=0.2)
     run = load_run(path)
-    g = StickGeometry.from_params(run.plant_params)
+    g = StickGeometry.of(params_from_data(AirTableParams, run.plant_params, "plant.params"))
     assert g.length == 0.2 and g.visual_width == 0.01 and g.tip_radius == 0.005
-    assert StickGeometry.from_params({}) == StickGeometry()       # the plant's defaults
+    d = StickGeometry.of(AirTableParams())                         # the plant's defaults
+    assert (d.length, d.tip_height, d.link_lengths) == (0.1, 0.02, (0.07, 0.07))
     # the fingers' kinematics match the logged fingertips (replay.robot.hand2d's convention)
     hs, fi = run.track("/hand/state"), run.track("/fingers/state")
     pts = g.finger_points(hs.fields["base"][100], hs.fields["joints"][100])
@@ -144,6 +149,65 @@ def test_cameras_from_sensor_params(stick_log, arm_log):
     cams, missing = cameras({"cam": {"type": "stick_camera", "params": {"noise": 0.1}},
                              "enc": {"type": "joint_encoders"}})
     assert cams == [] and missing == ["cam"]
+
+
+def test_scenes_are_plugins_found_by_plant_type(monkeypatch, stick_log, arm_log):
+    assert scene_class(load_run(stick_log)) is AirTableScene
+    assert scene_class(load_run(arm_log)) is ArmScene
+
+    class Variant(AirTableScene):
+        @classmethod
+        def suits(cls, run):
+            return run.label == "picky"
+    monkeypatch.setitem(registry._registered["viewer_scene"], "airtable.picky", Variant)
+    assert scene_class(load_run(stick_log)) is AirTableScene          # does not suit it
+    picky = write_stick_log(stick_log.with_name("picky.mcap"), name="picky")
+    assert scene_class(load_run(picky)) is Variant
+
+
+class _ToyScene(RunScene):
+    """A scene for a plant type the viewer has never heard of: a sphere on /toy/state's x."""
+    kind = "toy"
+    needs = ("/toy/state",)
+
+    def build(self):
+        self.ball = self._add(self.scene.add_icosphere(f"{self.root}/ball", radius=0.1,
+                                                       color=self.color))
+
+    def update(self, run, t):
+        tr = run.track("/toy/state")
+        self.ball.position = (float(tr.at("x", t)), 0.0, 0.0)
+
+    def bounds(self):
+        return np.array([-1.0, -1.0, 0.0]), np.array([3.0, 1.0, 1.0])
+
+
+def test_a_new_plant_type_brings_its_own_scene(monkeypatch, tmp_path, viewer_factory):
+    path = tmp_path / "toy.mcap"
+    with LogWriter(path) as log:
+        log.write("/scenario", ScenarioInfo(0.0, "toy", "none", "plant: {type: toy_plant}\n", 0,
+                                            "x"), 0)
+        for k in range(3):
+            log.write("/toy/state", {"t": k * 0.01, "x": 1.0 * k}, k * 10_000_000)
+    with pytest.raises(ViewerError, match="nothing the viewer can draw"):
+        scene_class(load_run(path))
+    monkeypatch.setitem(registry._registered["viewer_scene"], "toy_plant", _ToyScene)
+    v = viewer_factory([path])
+    assert isinstance(v.scenes[0], _ToyScene)
+    v.seek(0.02)
+    assert v.scenes[0].ball.position[0] == 2.0
+
+
+def test_the_viewer_engine_imports_no_plugin_and_no_simulator():
+    import subprocess
+    import sys
+    code = ("import sys; import replay.viewer.app; "
+            "assert not [m for m in sys.modules if m.startswith('plants')], 'a plug-in'; "
+            "from replay.viewer.scenes import scene_classes; s = scene_classes(); "
+            "assert {'airtable', 'bullet_arm'} <= set(s), s; "
+            "assert 'pybullet' not in sys.modules and 'pymunk' not in sys.modules, 'simulator'")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
 
 
 # ----------------------------------------------------------------------------- bad logs

@@ -29,11 +29,14 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec, StickSpec, root_distance
+from replay.robot.hand2d import AirTableSpec, HandCommand, root_distance
 from replay.interfaces import Occurrence, Plant
-from replay.messages import FingersState, StickState
-from replay.scene import Box, Cylinder, Scene, yaw_quaternion
+from replay.messages import (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_STICK_STATE, FingersState,
+                             StickState)
+from replay.scene import Box, Cylinder, Scene
+from replay.spatial import yaw_quaternion
 
+from plants.airtable import settings
 from plants.airtable.hand import HandServo
 from plants.airtable.params import Params
 
@@ -60,7 +63,7 @@ class AirTablePlant(Plant):
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
         p = params
-        self._hand_spec = self._make_hand_spec(p)
+        self._hand_spec = settings.hand_spec(p)
         self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
 
         space = pymunk.Space()
@@ -120,23 +123,6 @@ class AirTablePlant(Plant):
         self._collisions = 0
         self._held_since: float | None = None    # the stick held between the tips since
         self._reached = self._in_reach()         # the stick ever within the hand's reach
-
-    # -- construction helpers -------------------------------------------------------------
-
-    @staticmethod
-    def _make_hand_spec(p: Params) -> HandSpec:
-        h = p.hand
-        return HandSpec(
-            root_offsets=(tuple(map(float, h.root_offset0)), tuple(map(float, h.root_offset1))),
-            link_lengths=(float(h.link_lengths[0]), float(h.link_lengths[1])),
-            joint_limits=(tuple(map(float, h.q1_limits)), tuple(map(float, h.q2_limits))),
-            joint_speed=float(h.joint_speed),
-            base_limits=(tuple(map(float, h.base_x_limits)), tuple(map(float, h.base_y_limits))),
-            base_speed=float(h.base_speed),
-            tip_radius=float(h.tip_radius),
-            start_base=(float(h.base[0]), float(h.base[1])),
-            start_joints=(tuple(map(float, h.joints0)), tuple(map(float, h.joints1))),
-        )
 
     # -- Plant interface ------------------------------------------------------------------
 
@@ -304,12 +290,12 @@ class AirTablePlant(Plant):
     def truth(self, t: float) -> dict[str, Any]:
         b = self.stick_body
         return {
-            "/stick/state": StickState(t=t, x=b.position.x, y=b.position.y, theta=b.angle,
+            TOPIC_STICK_STATE: StickState(t=t, x=b.position.x, y=b.position.y, theta=b.angle,
                                        vx=b.velocity.x, vy=b.velocity.y,
                                        omega=b.angular_velocity),
-            "/fingers/state": FingersState(t=t, tips=[_vec(tb.position)
+            TOPIC_FINGERS_STATE: FingersState(t=t, tips=[_vec(tb.position)
                                                       for tb in self.tip_bodies]),
-            "/hand/state": {"t": t, "base": self.hand.base.tolist(),
+            TOPIC_HAND_STATE: {"t": t, "base": self.hand.base.tolist(),
                             "joints": self.hand.joints.tolist(),
                             "base_target": self.hand.base_target.tolist(),
                             "joint_targets": self.hand.joint_targets.tolist()},
@@ -335,13 +321,7 @@ class AirTablePlant(Plant):
         return Scene(prims)
 
     def spec(self) -> AirTableSpec:
-        st = self.params.stick
-        # Nominal values only: the method must not need mu (Assumption 10 and the paper's point).
-        # The width is the one the fingertips collide with (it sets where contact happens).
-        return AirTableSpec(hand=self._hand_spec,
-                            stick=StickSpec(mass=st.mass, inertia=st.inertia, length=st.length,
-                                            width=st.collision_width,
-                                            restitution=st.restitution))
+        return settings.spec(self.params, self._hand_spec)   # nominal: no friction
 
     def close(self) -> None:
         self._pending = []

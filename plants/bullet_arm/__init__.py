@@ -1,10 +1,16 @@
-"""PyBullet arm plant: a WAM (4/7 axes, torque control), a hand (position control), an object."""
+"""PyBullet arm plant: a WAM (4/7 axes, torque control), a hand (position control), an object.
 
-from plants.bullet_arm.quiet import quiet_c_output
+``params``, ``settings`` and ``viewer_scene`` import no simulator; ``BulletArmPlant`` (PyBullet)
+is imported when first asked for.
+"""
 
-with quiet_c_output():
-    import pybullet  # noqa: F401  (its import prints a build banner)
-
-from plants.bullet_arm.plant import BulletArmPlant, Params  # noqa: E402
+from plants.bullet_arm.params import Params
 
 __all__ = ["BulletArmPlant", "Params"]
+
+
+def __getattr__(name: str):
+    if name == "BulletArmPlant":
+        from plants.bullet_arm.plant import BulletArmPlant
+        return BulletArmPlant
+    raise AttributeError(f"module 'plants.bullet_arm' has no attribute {name!r}")

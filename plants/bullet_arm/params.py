@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from replay.params import param
+from replay.robot.hand import CATCH_CLOSING_SPEED   # Namiki & Ishikawa IV-A: 90 deg in 20 ms
 from replay.robot.wam import TORQUE_LIMIT_SETS
-
-_CATCH_CLOSING_SPEED = (math.pi / 2.0) / 0.020   # Namiki & Ishikawa IV-A: 90 deg in 20 ms
 
 
 @dataclass
@@ -48,7 +46,7 @@ class Params:
     hand: str = param("catch3", choices=("catch3", "grasp4", "none"),
                       doc="hand table: catch3 (3 fingers, 3 axes), grasp4 (4 fingers, 14 joints, "
                           "provisional sizes), none")
-    hand_closing_speed: float = param(_CATCH_CLOSING_SPEED, unit="rad/s", gt=0.0,
+    hand_closing_speed: float = param(CATCH_CLOSING_SPEED, unit="rad/s", gt=0.0,
                                       doc="hand joints' speed limit; 90 deg in 20 ms = 78.54")
     hand_max_torque: float = param(2.0, unit="N*m", gt=0.0,
                                    doc="each hand joint's actuator torque limit (assumed)")

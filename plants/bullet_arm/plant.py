@@ -18,22 +18,24 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet as p
-from pybullet_utils import bullet_client
 
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
-from plants.models.arm import build_arm
+from plants.bullet_arm.settings import resolve
 from replay.interfaces import Occurrence, Plant
-from replay.messages import JointState, ObjectState
+from replay.messages import (TOPIC_ARM_APPLIED_TORQUE, TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_MOTION,
+                             TOPIC_HAND_JOINT_STATE, TOPIC_OBJECT_CONTACTS, TOPIC_OBJECT_STATE,
+                             JointState, ObjectState)
 from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
-from replay.robot.hand import HANDS, hand_body, hand_mass
-from replay.robot.serial_chain import rpy_to_matrix, matrix_to_quaternion
-from replay.robot.wam import (DEFAULT_VELOCITY_LIMIT, TORQUE_LIMIT_SETS, default_tool_d,
-                              load_wam_table, wam_chain, wam_joint_limits)
+from replay.robot.hand import hand_mass
+from replay.spatial import matrix_to_quaternion, rpy_to_matrix
+from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
 from replay.scene import Box, Scene, Sphere
 
+with quiet_c_output():                          # PyBullet's import prints a build banner
+    import pybullet as p
+    from pybullet_utils import bullet_client
 
 
 class BulletArmPlant(Plant):
@@ -43,33 +45,19 @@ class BulletArmPlant(Plant):
     def __init__(self, params: Params, *, dt: float, rng: np.random.Generator) -> None:
         super().__init__(params, dt=dt, rng=rng)
         P = params
-        self.dof = 4 if P.arm == "wam4" else 7
-        self._table = load_wam_table()
-        dof = self.dof
-        self.tool_d = default_tool_d(dof, self._table) if P.tool_d < 0 else float(P.tool_d)
-        self.hand_table = HANDS.get(P.hand) if P.hand != "none" else None
-        q0 = np.zeros(dof) if not P.initial_q else np.asarray(P.initial_q, float)
-        qd0 = np.zeros(dof) if not P.initial_qd else np.asarray(P.initial_qd, float)
-        if q0.shape != (dof,) or qd0.shape != (dof,):
-            raise ValueError(f"initial_q/initial_qd need {dof} values for {P.arm}")
-        self.torque_limits = (np.asarray(P.torque_limits, float) if P.torque_limits
-                              else np.asarray(TORQUE_LIMIT_SETS[P.torque_limit_set][:dof]))
-        self.velocity_limits = (np.asarray(P.velocity_limits, float) if P.velocity_limits
-                                else np.full(dof, DEFAULT_VELOCITY_LIMIT))
-        if self.torque_limits.shape != (dof,) or self.velocity_limits.shape != (dof,):
-            raise ValueError(f"torque_limits/velocity_limits need {dof} values for {P.arm}")
-        names = tuple(r["joint"] for r in self._table["dh"][:dof])
-        for n in P.locked_joints:
-            if n not in names:
-                raise ValueError(f"locked_joints: unknown joint {n!r} (joints: {names})")
-        self.locked = {n: float(q0[names.index(n)]) for n in P.locked_joints}
-        qd0[[names.index(n) for n in self.locked]] = 0.0
-        self.model = build_arm(dof, tool_d=self.tool_d, hand=self.hand_table, locked=self.locked,
-                               torque_limits=self.torque_limits,
-                               velocity_limits=self.velocity_limits, table=self._table)
+        S = self.settings = resolve(P)         # every default worked out (also for the viewer)
+        self.dof = dof = S.dof
+        self.tool_d = S.tool_d
+        self.hand_table = S.hand
+        q0, qd0 = S.initial_q.copy(), S.initial_qd.copy()
+        self.torque_limits = S.torque_limits.copy()
+        self.velocity_limits = S.velocity_limits.copy()
+        names = S.joint_names
+        self.locked = dict(S.locked)
+        self.model = S.arm_model()
         self.urdf_path = self.model.write()
         self.joint_names = names
-        self.lower, self.upper = wam_joint_limits(dof, self._table)
+        self.lower, self.upper = S.lower, S.upper
 
         # ---- the world
         with quiet_c_output():                           # connect prints "argv[0]="
@@ -108,10 +96,7 @@ class BulletArmPlant(Plant):
         bc.setJointMotorControlArray(self.robot, self._arm_j, p.VELOCITY_CONTROL,
                                      forces=[0.0] * len(self._arm_j))
         ht = self.hand_table
-        h0 = (np.asarray(P.hand_initial, float) if P.hand_initial
-              else (ht.open_posture if ht else np.zeros(0)))
-        if h0.shape != (len(self._hand_j),):
-            raise ValueError(f"hand_initial needs {len(self._hand_j)} values")
+        h0 = S.hand_initial.copy()
         for j, v in zip(self._hand_j, h0):
             bc.resetJointState(self.robot, j, float(v), 0.0)
         self._hand_target = h0.copy()
@@ -170,10 +155,7 @@ class BulletArmPlant(Plant):
     def _make_spec(self, q0: np.ndarray) -> ArmSpec:
         P = self.params
         ht = self.hand_table
-        payload = hand_body(ht, self._hand_target) if ht is not None else None
-        model = wam_chain(self.dof, tool_d=self.tool_d, base_position=P.base_position,
-                          base_rpy=P.base_rpy, gravity=P.gravity, payload=payload,
-                          table=self._table)
+        model = self.settings.chain(self._hand_target)
         hand = None
         if ht is not None:
             hand = HandSpec(name=ht.name, joint_names=ht.joint_names, lower=self._hand_lo,
@@ -384,9 +366,9 @@ class BulletArmPlant(Plant):
     def truth(self, t: float) -> dict:
         q, qd = self.arm_state()
         out = {
-            "/arm/joint_state": JointState(t, list(self.joint_names), q.tolist(), qd.tolist(),
+            TOPIC_ARM_JOINT_STATE: JointState(t, list(self.joint_names), q.tolist(), qd.tolist(),
                                            self._tau_applied.tolist()),
-            "/arm/applied_torque": AppliedTorque(t, list(self.joint_names),
+            TOPIC_ARM_APPLIED_TORQUE: AppliedTorque(t, list(self.joint_names),
                                                  [float(x) if math.isfinite(x) else None
                                                   for x in self._tau_cmd.tolist()],
                                                  self._tau_applied.tolist(),
@@ -394,18 +376,18 @@ class BulletArmPlant(Plant):
         }
         if self._hand_j:
             hq, hqd, heff = self.hand_state()
-            out["/hand/joint_state"] = JointState(t, list(self.hand_names), hq.tolist(),
+            out[TOPIC_HAND_JOINT_STATE] = JointState(t, list(self.hand_names), hq.tolist(),
                                                   hqd.tolist(), heff.tolist())
         # the tool frame's motion; /effector/state (actual and desired point) is the controller's
         pe, oe, ve, we = self.effector_state()
-        out["/effector/motion"] = EffectorMotion(t, pe.tolist(), oe.tolist(), ve.tolist(),
+        out[TOPIC_EFFECTOR_MOTION] = EffectorMotion(t, pe.tolist(), oe.tolist(), ve.tolist(),
                                                  we.tolist(), float(np.linalg.norm(ve)))
         if self.obj is not None:
             pos, orn, v, w = self.object_state()
-            out["/object/state"] = ObjectState(t, pos.tolist(), orn.tolist(), v.tolist(),
+            out[TOPIC_OBJECT_STATE] = ObjectState(t, pos.tolist(), orn.tolist(), v.tolist(),
                                                w.tolist())
             links = sorted({self._link_name[c[4]] for c in self._contacts})
-            out["/object/contacts"] = ObjectContacts(
+            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(
                 t, sorted({self.model.part_of_link.get(l, "arm") for l in links}), links,
                 float(sum(c[9] for c in self._contacts)))
         return out
@@ -424,40 +406,6 @@ class BulletArmPlant(Plant):
         q, qd = self.arm_state()
         encoders = {"name": list(self.joint_names), "position": q.tolist(), "velocity": qd.tolist()}
         return Scene(prims, readings={"arm": encoders})
-
-    # ------------------------------------------------------------------ cross-checks (tests)
-    def _full_dofs(self, q_arm, qd_arm=None, qdd_arm=None):
-        hq, _, _ = self.hand_state()
-        pos, vel, acc = [], [], []
-        arm_of = {self._jidx[self.joint_names[i]]: i for i in self.active}
-        hand_of = {j: k for k, j in enumerate(self._hand_j)}
-        for j in self._dofs:
-            if j in arm_of:
-                i = arm_of[j]
-                pos.append(float(q_arm[i]))
-                vel.append(0.0 if qd_arm is None else float(qd_arm[i]))
-                acc.append(0.0 if qdd_arm is None else float(qdd_arm[i]))
-            else:
-                pos.append(float(hq[hand_of[j]]))
-                vel.append(0.0)
-                acc.append(0.0)
-        return pos, vel, acc, [self._dofs.index(self._jidx[self.joint_names[i]])
-                               for i in self.active]
-
-    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
-        """PyBullet's inverse dynamics for the arm (hand joints frozen at their current angles);
-        locked joints' entries are NaN. For cross-checks in tests."""
-        pos, vel, acc, cols = self._full_dofs(q, qd, qdd)
-        tau = np.array(self.bc.calculateInverseDynamics(self.robot, pos, vel, acc))
-        out = np.full(self.dof, np.nan)
-        out[list(self.active)] = tau[cols]
-        return out
-
-    def mass_matrix(self, q) -> np.ndarray:
-        """PyBullet's mass matrix of the active arm joints (hand frozen), len(active) square."""
-        pos, _, _, cols = self._full_dofs(q)
-        M = np.array(self.bc.calculateMassMatrix(self.robot, pos))
-        return M[np.ix_(cols, cols)]
 
     def close(self) -> None:
         if getattr(self, "bc", None) is not None:

@@ -21,7 +21,7 @@ import numpy as np
 
 from plants.models.urdf import Geometry, Joint, Link, robot_xml, segment_cylinder, write_cached
 from replay.robot.hand import HandTable, joint_axis, link_body, palm_body, root_transform
-from replay.robot.serial_chain import rot_x, rot_z, transform
+from replay.spatial import rot_x, rot_z, transform
 from replay.robot.wam import (DEFAULT_VELOCITY_LIMIT, default_tool_d, load_wam_table, wam_dh,
                               wam_joint_limits, wam_joint_names, wam_links, wam_torque_limits)
 
@@ -56,8 +56,8 @@ def _dh_const(row) -> np.ndarray:
 
 def build_arm(dof: int = 4, *, tool_d: float | None = None, hand: HandTable | None = None,
               locked: Mapping[str, float] | None = None,
-              torque_limits: Sequence[float] | None = None,
-              velocity_limits: Sequence[float] | None = None,
+              torque_limits: Sequence[float] | np.ndarray | None = None,
+              velocity_limits: Sequence[float] | np.ndarray | None = None,
               table: dict | None = None) -> ArmModel:
     """Build the URDF text of a ``dof``-axis WAM (+ ``hand``), see the module docstring."""
     t = table or load_wam_table()

@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from replay.robot.serial_chain import RigidBody, matrix_to_rpy
+from replay.robot.serial_chain import RigidBody
+from replay.spatial import matrix_to_rpy
 
 
 def fmt(x: float) -> str:

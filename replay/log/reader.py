@@ -20,6 +20,7 @@ from mcap.records import Message
 from mcap.stream_reader import StreamReader
 
 from replay.log.errors import LogError, NotALogError
+from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
 MAGIC = b"\x89MCAP0\r\n"
 
@@ -113,9 +114,9 @@ class LogReader:
 
     def scenario(self) -> dict:
         """The ``/scenario`` message (name, paper, yaml, seed, version)."""
-        for m in self.messages("/scenario"):
+        for m in self.messages(TOPIC_SCENARIO):
             return m.data
         raise LogError(f"{self.path}: no /scenario message")
 
     def events(self) -> list[dict]:
-        return self.series("/events")
+        return self.series(TOPIC_EVENTS)

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.robot.serial_chain import RigidBody, rot_x, rot_y, rot_z, transform
+from replay.robot.serial_chain import RigidBody
+from replay.spatial import rot_x, rot_y, rot_z, transform
 
 
 @dataclass(frozen=True)
@@ -163,7 +164,7 @@ def hand_mass(hand: HandTable) -> float:
 # Only the 3 fingers, 3 axes and 90 deg / 20 ms are from the paper; the dimensions and masses are
 # assumed (a light hand around a palm a bit wider than a ~4 cm ball): fingers at 120 deg on the
 # rim of a 45 mm-radius disc palm, open along the palm normal, closing 90 deg towards its centre.
-_CATCH_SPEED = (math.pi / 2.0) / 0.020          # 90 deg in 20 ms = 78.54 rad/s
+CATCH_CLOSING_SPEED = (math.pi / 2.0) / 0.020   # 90 deg in 20 ms = 78.54 rad/s
 
 
 def _catch_finger(k: int) -> Finger:
@@ -180,7 +181,7 @@ def _catch_finger(k: int) -> Finger:
 CATCH3 = HandTable(
     name="catch3", palm_shape="cylinder", palm_size=(0.045, 0.045, 0.012), palm_mass=0.25,
     fingers=tuple(_catch_finger(k) for k in range(3)),
-    closing_speed=_CATCH_SPEED,
+    closing_speed=CATCH_CLOSING_SPEED,
     max_torque=2.0,   # assumed: ~28 N at a 70 mm finger's tip
     note="Namiki & Ishikawa Sec. IV-A: 3 fingers, 3 axes, 90 deg in 20 ms; sizes/masses assumed")
 
@@ -213,7 +214,7 @@ GRASP4 = HandTable(
         _grasp_finger("thumb", 0.0, -0.045, 0.0, ("flex", "flex", "flex"),
                       (0.045, 0.032, 0.025)),
     ),
-    closing_speed=_CATCH_SPEED,   # assumed same drive as the catching hand
+    closing_speed=CATCH_CLOSING_SPEED,   # assumed same drive as the catching hand
     max_torque=2.0,
     note="Namiki et al. Sec. 3.3: 4 fingers, 14 joints, thumb opposite; split 4/3/4/3 and "
          "all sizes assumed")

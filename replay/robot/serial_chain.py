@@ -22,30 +22,6 @@ from typing import Sequence
 import numpy as np
 
 
-def rot_x(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def rot_y(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def rot_z(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def transform(rotation: np.ndarray | None = None, translation=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """A 4x4 homogeneous transform."""
-    T = np.eye(4)
-    if rotation is not None:
-        T[:3, :3] = rotation
-    T[:3, 3] = translation
-    return T
-
-
 def dh_transform(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
     """Standard DH: Rz(theta) Tz(d) Tx(a) Rx(alpha)."""
     ct, st = np.cos(theta), np.sin(theta)
@@ -54,49 +30,6 @@ def dh_transform(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
                      [st, ct * ca, -ct * sa, a * st],
                      [0.0, sa, ca, d],
                      [0.0, 0.0, 0.0, 1.0]])
-
-
-def matrix_to_quaternion(R: np.ndarray) -> np.ndarray:
-    """3x3 rotation matrix -> [qx, qy, qz, qw] with qw >= 0 (inverse of
-    :func:`replay.scene.quaternion_matrix`)."""
-    m = np.asarray(R, dtype=float)
-    tr = m[0, 0] + m[1, 1] + m[2, 2]
-    if tr > 0:
-        s = 2.0 * np.sqrt(tr + 1.0)
-        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        q = [0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
-    elif m[1, 1] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-        q = [(m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
-    else:
-        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s, (m[1, 0] - m[0, 1]) / s]
-    q = np.array(q)
-    q /= np.linalg.norm(q)
-    return -q if q[3] < 0 else q
-
-
-def rpy_to_matrix(rpy) -> np.ndarray:
-    """URDF roll-pitch-yaw (fixed axes x, y, z): R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    r, p, y = rpy
-    return rot_z(y) @ rot_y(p) @ rot_x(r)
-
-
-def matrix_to_rpy(R: np.ndarray) -> tuple[float, float, float]:
-    """Inverse of :func:`rpy_to_matrix` (pitch in [-pi/2, pi/2])."""
-    R = np.asarray(R, dtype=float)
-    sp = -R[2, 0]
-    if abs(sp) < 1.0 - 1e-12:
-        pitch = float(np.arcsin(np.clip(sp, -1.0, 1.0)))
-        roll = float(np.arctan2(R[2, 1], R[2, 2]))
-        yaw = float(np.arctan2(R[1, 0], R[0, 0]))
-    else:  # gimbal lock: put everything in yaw
-        pitch = float(np.copysign(np.pi / 2, sp))
-        roll = 0.0
-        yaw = float(np.arctan2(-R[0, 1], R[1, 1]))
-    return roll, pitch, yaw
 
 
 @dataclass(frozen=True, eq=False)
@@ -168,10 +101,6 @@ class SerialChain:
         last = self.links[-1].combined(body.transformed(self.tool))
         return SerialChain(self.dh, self.links[:-1] + (last,), base=self.base, tool=self.tool,
                            gravity=self.gravity, joint_names=self.joint_names)
-
-    def with_gravity(self, gravity: Sequence[float]) -> SerialChain:
-        return SerialChain(self.dh, self.links, base=self.base, tool=self.tool, gravity=gravity,
-                           joint_names=self.joint_names)
 
     # ------------------------------------------------------------------ kinematics
     def _q(self, q) -> np.ndarray:
@@ -455,6 +384,4 @@ def active_block(x: np.ndarray, active: Sequence[int]) -> np.ndarray:
     return x[idx]
 
 
-__all__ = ["DHRow", "RigidBody", "SerialChain", "active_block", "dh_transform", "transform",
-           "rot_x", "rot_y", "rot_z", "matrix_to_quaternion",
-           "rpy_to_matrix", "matrix_to_rpy"]
+__all__ = ["DHRow", "RigidBody", "SerialChain", "active_block", "dh_transform"]

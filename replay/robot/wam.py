@@ -18,9 +18,11 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from replay.robot.serial_chain import DHRow, RigidBody, SerialChain, transform, rpy_to_matrix
+from replay.resources import data_path
+from replay.robot.serial_chain import DHRow, RigidBody, SerialChain
+from replay.spatial import rpy_to_matrix, transform
 
-WAM_YAML = Path(__file__).resolve().parents[2] / "data" / "robots" / "wam.yaml"
+WAM_YAML = data_path("robots", "wam.yaml")
 
 # Joint torque limits (N*m). Sources disagree (wam.yaml, torque_limits_notes):
 #  - "libbarrett": the control-signal limits of libbarrett's joint controllers (wam4.conf:

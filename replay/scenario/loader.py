@@ -393,6 +393,13 @@ def scenario_from_text(text: str, name: str = "<log>", sets=(), seed: int | None
     return _load_node(root, name, sets, seed)
 
 
+def params_from_data(cls: type, data: dict | None, path: str, source: str = "<log>") -> Any:
+    """A plug-in's typed ``Params`` (``cls``) from plain data, e.g. ``plant.params`` of a log's
+    resolved scenario, checked field by field as a scenario file is. Raises ScenarioError."""
+    node = _compose(yaml.safe_dump(data or {}), source)
+    return build_dataclass(node, cls, path)
+
+
 def to_plain(value: Any) -> Any:
     """Dataclasses, tuples and lists as plain YAML-ready values, every default filled in."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from replay.interfaces import Sensor
-from replay.messages import JointState
+from replay.messages import TOPIC_ARM_ENCODERS, JointState
 from replay.params import param
 from replay.scene import Scene
 
@@ -21,7 +21,7 @@ from replay.scene import Scene
 @dataclass
 class EncoderParams:
     reading: str = param("arm", doc="which of the plant's readings (Scene.readings) to publish")
-    topic: str = param("/arm/encoders", doc="log topic of the measurement")
+    topic: str = param(TOPIC_ARM_ENCODERS, doc="log topic of the measurement")
     resolution: float = param(0.0, unit="rad", ge=0,
                               doc="angle per encoder count; 0 = exact")
 
@@ -29,7 +29,7 @@ class EncoderParams:
 class JointEncoders(Sensor):
     """Joint encoders: the plant's joint readings, quantised, on ``/arm/encoders``."""
     Params = EncoderParams
-    topic = "/arm/encoders"
+    topic = TOPIC_ARM_ENCODERS
 
     def __init__(self, params: EncoderParams, *, rng: np.random.Generator, spec=None) -> None:
         super().__init__(params, rng=rng, spec=spec)

@@ -36,7 +36,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix
+from replay.scene import Box, Cylinder, Scene, Sphere
+from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
 
 SHIFT = 8               # fractional bits of vertices given to cv2.fillConvexPoly

@@ -61,7 +61,7 @@ import cv2
 import numpy as np
 
 from replay.interfaces import Sensor
-from replay.messages import VisionObject
+from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
@@ -129,7 +129,7 @@ class StereoBallCameraParams:
 class StereoBallCamera(Sensor):
     """Two 128 x 128 cameras, blob moments and triangulation: ``/vision/object`` (``r_o``)."""
     Params = StereoBallCameraParams
-    topic = "/vision/object"
+    topic = TOPIC_VISION_OBJECT
     description = ("two 128x128 pinhole cameras either side of the throw; threshold, image "
                    "moments, cv2.triangulatePoints -> ball position r_o")
 

@@ -45,9 +45,10 @@ import cv2
 import numpy as np
 
 from replay.interfaces import Sensor
-from replay.messages import VisionStick
+from replay.messages import TOPIC_VISION_STICK, VisionStick
 from replay.params import param
-from replay.scene import Box, Cylinder, Scene, Sphere, quaternion_matrix, wrap_half_pi
+from replay.scene import Box, Cylinder, Scene, Sphere
+from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera
 
 _RIM = 48             # vertices of a polygon standing in for a circle
@@ -265,7 +266,7 @@ class StickCameraParams:
 class StickCamera(Sensor):
     """Overhead camera measuring the stick's marker: ``/vision/stick`` (x, y, theta)."""
     Params = StickCameraParams
-    topic = "/vision/stick"
+    topic = TOPIC_VISION_STICK
     description = ("overhead pinhole camera 1 m above the table; white-marker centroid and "
                    "second moments -> stick x, y, theta (mod pi)")
 

@@ -20,7 +20,7 @@ import numpy as np
 from replay.viewer.data import RunAccumulator, RunData, load_run
 from replay.viewer.errors import ViewerError
 from replay.viewer.plots import PlotPanel
-from replay.viewer.scenes import ArmScene, RunScene, run_color, scene_class
+from replay.viewer.scenes import RunScene, run_color, scene_class
 from replay.viewer.timeline import DEFAULT_SPEED, Timeline
 
 DEFAULT_HOST = "127.0.0.1"
@@ -141,10 +141,7 @@ class Viewer:
         c = (lo + hi) / 2.0
         size = float(max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.2))
         cam = self.server.initial_camera
-        if isinstance(self.scenes[0], ArmScene):
-            cam.position = tuple(c + np.array([0.3, -1.05, 0.4]) * size)
-        else:
-            cam.position = tuple(c + np.array([0.0, -0.62, 0.8]) * size)
+        cam.position = tuple(c + np.array(self.scenes[0].view_direction) * size)
         cam.look_at = tuple(c)
         cam.up = (0.0, 0.0, 1.0)
 

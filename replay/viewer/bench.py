@@ -40,9 +40,9 @@ def main(argv=None) -> None:
         for kind, path in logs.items():
             n = sum(LogReader(path).topic_counts().values())
             size = path.stat().st_size / 1024
-            load = _best(lambda: load_run(path), args.repeat)
+            load = _best(lambda path=path: load_run(path), args.repeat)
 
-            def open_view():
+            def open_view(path=path):
                 Viewer.open([path], port=0).stop()
             whole = _best(open_view, args.repeat)
             print(f"{kind}: {args.duration:g} s at {args.rate} Hz, {n} messages, {size:.0f} KiB")

@@ -18,11 +18,11 @@ import numpy as np
 import yaml
 
 from replay.log import LogError, LogReader
-from replay.messages import to_dict
+from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, to_dict
 from replay.viewer.errors import ViewerError
 
 # topics kept as Python objects rather than columns (few messages, free-form data)
-OBJECT_TOPICS = ("/scenario", "/events")
+OBJECT_TOPICS = (TOPIC_SCENARIO, TOPIC_EVENTS)
 
 
 @dataclass
@@ -177,9 +177,9 @@ class RunAccumulator:
     def add(self, topic: str, t_ns: int, data: dict) -> None:
         with self._lock:
             self.t_last = max(self.t_last, t_ns * 1e-9)
-            if topic == "/scenario":
+            if topic == TOPIC_SCENARIO:
                 self.scenario = data
-            elif topic == "/events":
+            elif topic == TOPIC_EVENTS:
                 self.events.append({"t": t_ns * 1e-9, **data} if "t" not in data else data)
             else:
                 b = self.builders.get(topic)

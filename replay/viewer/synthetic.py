@@ -16,7 +16,11 @@ import numpy as np
 import yaml
 
 from replay.log import LogWriter, seconds_to_ns
-from replay.messages import (EffectorState, Event, FingersState, JointCommand, JointState,
+from replay.messages import (TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_STATE,
+                             TOPIC_EVENTS, TOPIC_FINGERS_STATE, TOPIC_HAND_JOINT_STATE,
+                             TOPIC_HAND_STATE, TOPIC_OBJECT_STATE, TOPIC_SCENARIO,
+                             TOPIC_STICK_STATE, TOPIC_VISION_OBJECT, TOPIC_VISION_STICK,
+                             EffectorState, Event, FingersState, JointCommand, JointState,
                              ObjectState, ScenarioInfo, StickState, VisionObject, VisionStick)
 
 
@@ -61,7 +65,7 @@ def write_stick_log(path, *, duration: float = 1.0, rate: int = 1000, length: fl
     v, w = (params["initial"]["vx"], params["initial"]["vy"]), spin
     cam_div = max(1, int(round(rate / 300.0)))
     with LogWriter(path) as log:
-        log.write("/scenario", ScenarioInfo(0.0, name, "higashimori2007", text, 0, "synthetic"),
+        log.write(TOPIC_SCENARIO, ScenarioInfo(0.0, name, "higashimori2007", text, 0, "synthetic"),
                   0)
         for k in range(n + 1):
             t = k / rate
@@ -71,23 +75,23 @@ def write_stick_log(path, *, duration: float = 1.0, rate: int = 1000, length: fl
             tips = _finger_tips(base, joints)
             for t_hit, finger, v_after, w_after in hits:
                 if abs(t - t_hit) < 0.5 / rate:
-                    log.write("/events", Event(t, "collision", {
+                    log.write(TOPIC_EVENTS, Event(t, "collision", {
                         "index": hits.index((t_hit, finger, v_after, w_after)) + 1,
                         "finger": finger, "r_x": 0.02, "r_y": 0.0, "theta": th,
                         "v_before": list(v), "omega_before": w, "v_after": list(v_after),
                         "omega_after": w_after, "contact": tips[finger],
                         "planned": {"r_x": 0.02}}), t_ns)
                     v, w = v_after, w_after
-            log.write("/stick/state", StickState(t, x, y, th, v[0], v[1], w), t_ns)
-            log.write("/fingers/state", FingersState(t, tips), t_ns)
-            log.write("/hand/state", {"t": t, "base": base, "joints": joints,
+            log.write(TOPIC_STICK_STATE, StickState(t, x, y, th, v[0], v[1], w), t_ns)
+            log.write(TOPIC_FINGERS_STATE, FingersState(t, tips), t_ns)
+            log.write(TOPIC_HAND_STATE, {"t": t, "base": base, "joints": joints,
                                       "base_target": base, "joint_targets": joints}, t_ns)
             if k % cam_div == 0:
                 e = rng.normal(0.0, 0.0005, 3)
-                log.write("/vision/stick", VisionStick(t, x + e[0], y + e[1], th + 10 * e[2]),
+                log.write(TOPIC_VISION_STICK, VisionStick(t, x + e[0], y + e[1], th + 10 * e[2]),
                           t_ns)
             if abs(t - 0.9) < 0.5 / rate:
-                log.write("/events", Event(t, "rest", {"x": x, "y": y}), t_ns)
+                log.write(TOPIC_EVENTS, Event(t, "rest", {"x": x, "y": y}), t_ns)
             x, y, th = x + v[0] / rate, y + v[1] / rate, th + w / rate
     return Path(path)
 
@@ -137,7 +141,7 @@ def write_arm_log(path, *, duration: float = 0.8, rate: int = 1000, name: str = 
     v0 = (grip - p0 - 0.5 * g * t_catch ** 2) / t_catch
     kind = "catch" if obj == "ball" else "grasp"
     with LogWriter(path) as log:
-        log.write("/scenario", ScenarioInfo(0.0, name, paper, text, 0, "synthetic"), 0)
+        log.write(TOPIC_SCENARIO, ScenarioInfo(0.0, name, paper, text, 0, "synthetic"), 0)
         q_prev = q_at(0.0)
         for k in range(n + 1):
             t = k / rate
@@ -148,15 +152,15 @@ def write_arm_log(path, *, duration: float = 0.8, rate: int = 1000, name: str = 
             tau = 5.0 * np.sin(2 * math.pi * t / duration + np.arange(dof))
             tau[[names.index(j) for j in locked]] = 0.0
             close = min(max((t - 0.8 * t_catch) / 0.02, 0.0), 1.0)
-            log.write("/arm/joint_state", JointState(t, names, q.tolist(), qd.tolist(),
+            log.write(TOPIC_ARM_JOINT_STATE, JointState(t, names, q.tolist(), qd.tolist(),
                                                      tau.tolist()), t_ns)
             if table:
                 hq = h_open + close * (h_closed - h_open)
-                log.write("/hand/joint_state", JointState(
+                log.write(TOPIC_HAND_JOINT_STATE, JointState(
                     t, hand_names, hq.tolist(), [0.0] * len(hq), [0.0] * len(hq)), t_ns)
-            log.write("/arm/joint_command", JointCommand(t, q.tolist(), tau.tolist()), t_ns)
+            log.write(TOPIC_ARM_JOINT_COMMAND, JointCommand(t, q.tolist(), tau.tolist()), t_ns)
             tool = chain.tool_position(q)
-            log.write("/effector/state", EffectorState(t, tool.tolist(), grip.tolist()), t_ns)
+            log.write(TOPIC_EFFECTOR_STATE, EffectorState(t, tool.tolist(), grip.tolist()), t_ns)
             if obj == "none":
                 continue
             if t <= t_catch:
@@ -164,15 +168,15 @@ def write_arm_log(path, *, duration: float = 0.8, rate: int = 1000, name: str = 
             else:
                 pos, vel = tool, np.zeros(3)
             yaw = 6.0 * min(t, t_catch)
-            log.write("/object/state", ObjectState(
+            log.write(TOPIC_OBJECT_STATE, ObjectState(
                 t, pos.tolist(), [0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)], vel.tolist(),
                 [0.0, 0.0, 6.0 if t <= t_catch else 0.0]), t_ns)
             if t <= t_catch:
-                log.write("/vision/object", VisionObject(t, (pos + 0.002).tolist()), t_ns)
+                log.write(TOPIC_VISION_OBJECT, VisionObject(t, (pos + 0.002).tolist()), t_ns)
             if abs(t - t_catch) < 0.5 / rate:
-                log.write("/events", Event(t, "contact", {"parts": ["palm"],
+                log.write(TOPIC_EVENTS, Event(t, "contact", {"parts": ["palm"],
                                                           "position": pos.tolist()}), t_ns)
             if abs(t - (t_catch + 0.05)) < 0.5 / rate:
-                log.write("/events", Event(t, kind, {"parts": ["palm", "f1", "f2"],
+                log.write(TOPIC_EVENTS, Event(t, kind, {"parts": ["palm", "f1", "f2"],
                                                      "position": pos.tolist()}), t_ns)
     return Path(path)

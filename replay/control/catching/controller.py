@@ -36,7 +36,9 @@ from replay.control.catching.optimise import (CostRecord, OptimResult, initial_a
                                               save_alpha)
 from replay.control.catching.problem import ProblemConfig, build_problem
 from replay.interfaces import Controller, Occurrence
-from replay.messages import EffectorState, JointCommand, OptimizationCost
+from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE,
+                             TOPIC_CATCHING_STATE, TOPIC_EFFECTOR_STATE, TOPIC_OPTIMIZATION_COST,
+                             TOPIC_VISION_OBJECT, EffectorState, JointCommand, OptimizationCost)
 from replay.params import param
 from replay.robot.arm_types import ArmCommand
 
@@ -238,12 +240,11 @@ class CatchingController(Controller):
     def update(self, t: float, measurements: list) -> ArmCommand:
         self._t = t
         for topic, m in measurements:
-            if topic == "/vision/object":
+            if topic == TOPIC_VISION_OBJECT:
                 self.est.add(m.t, m.position)
-            elif topic in ("/arm/encoders", "/arm/joint_state"):
+            elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
                 self._joint_state(m)
         P = self.params
-        act = list(self.active)
         qdd_d = np.zeros(self.n)
         if self.est.n and not self.holding:
             r, v, a = self.est.state(t) if P.latency_compensation else self.est.state(
@@ -324,16 +325,16 @@ class CatchingController(Controller):
         return ev
 
     def telemetry(self, t: float) -> dict:
-        out = {"/arm/joint_command": JointCommand(t, position=self.q_d.tolist(),
+        out = {TOPIC_ARM_JOINT_COMMAND: JointCommand(t, position=self.q_d.tolist(),
                                                   torque=self.tau.tolist()),
-               "/effector/state": EffectorState(
+               TOPIC_EFFECTOR_STATE: EffectorState(
                    t, position=self.model.fk(self.q).tolist() if self.q is not None else [],
                    desired_position=self.model.fk(self.q_d).tolist())}
         if not self._costs_logged:       # the offline optimisation's history, once (t = 0)
             self._costs_logged = True
-            out["/optimization/cost"] = self.optimization_costs()
+            out[TOPIC_OPTIMIZATION_COST] = self.optimization_costs()
         if self._r is not None:
-            out["/catching/state"] = CatchingState(
+            out[TOPIC_CATCHING_STATE] = CatchingState(
                 t, self._r.tolist(), self._v.tolist(), self._q_o.tolist(), self.qd_d.tolist(),
                 self._in_domain, float(self.t_catch) if self.t_catch is not None else -1.0,
                 self.closing, self.holding)

@@ -66,9 +66,6 @@ class ArmModel:
         return self.inverse_dynamics_full(self.full(p), self.full_rate(pd),
                                           self.full_rate(pdd))[self.active]
 
-    def tau_full(self, p, pd, pdd) -> np.ndarray:
-        return self.inverse_dynamics_full(self.full(p), self.full_rate(pd), self.full_rate(pdd))
-
     def mass(self, p) -> np.ndarray:
         M = np.asarray(self._M(self.full(p)), float)
         return M[np.ix_(self.active, self.active)]

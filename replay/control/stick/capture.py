@@ -100,9 +100,7 @@ from replay.control.stick.estimator import StickEstimate, StickEstimator
 from replay.control.stick.hand_model import Config, HandModel
 from replay.control.stick.plan import ContactPlan, ContactPlanner, Shortfall
 from replay.control.stick.sweep import Motion
-
-TOPIC_VISION = "/vision/stick"
-TOPIC_ESTIMATE = "/control/stick_estimate"
+from replay.messages import TOPIC_STICK_ESTIMATE, TOPIC_VISION_STICK
 
 
 # ------------------------------------------------------------------------------------------
@@ -223,7 +221,7 @@ class StickCaptureController(Controller):
         self.model.advance(t)
         broke = fresh = False
         for topic, m in measurements:
-            if topic != TOPIC_VISION or m is None:
+            if topic != TOPIC_VISION_STICK or m is None:
                 continue
             broke |= self.est.add(m.t, m.x, m.y, m.theta)
             fresh = True
@@ -302,7 +300,7 @@ class StickCaptureController(Controller):
             msg.update({"t_ref": e.t_ref, "x": x, "y": y, "theta": th, "vx": e.vx, "vy": e.vy,
                         "omega": e.omega, "n": e.n, "rms_xy": e.rms_xy,
                         "rms_theta": e.rms_theta})
-        return {TOPIC_ESTIMATE: msg}
+        return {TOPIC_STICK_ESTIMATE: msg}
 
     # -- strategy hooks -------------------------------------------------------------------------
     def _options(self, est: StickEstimate, step: int) -> list[sc.ContactSolution]:

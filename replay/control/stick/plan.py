@@ -35,7 +35,7 @@ import numpy as np
 
 from replay.robot import hand2d
 from replay.robot.hand2d import HandSpec
-from replay.scene import wrap_half_pi
+from replay.spatial import wrap_half_pi
 from replay.control.stick import collision as sc
 from replay.control.stick.estimator import StickEstimate
 from replay.control.stick.hand_model import (Config, HandModel, base_candidates, posture_grid,

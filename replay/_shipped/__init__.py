@@ -1,0 +1,1 @@
+"""Package data of an installed wheel: data/ and scenarios/ (see replay.resources)."""

@@ -1,0 +1,46 @@
+"""Where the shipped files are: scenarios, robot tables, the papers' stated numbers, precomputed
+inputs and golden logs.
+
+In a source checkout they are the top-level ``scenarios/`` and ``data/`` folders; in an installed
+wheel the same folders are package data under ``replay._shipped`` (pyproject.toml maps them), found
+with :mod:`importlib.resources`. Nothing here depends on the working directory.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+_CHECKOUT = Path(__file__).resolve().parents[1]
+
+
+def _root(kind: str) -> Path:
+    local = _CHECKOUT / kind
+    if (_CHECKOUT / "pyproject.toml").is_file() and local.is_dir():
+        return local                                  # a source checkout (editable install)
+    return Path(str(resources.files("replay._shipped") / kind))   # an installed wheel
+
+
+def shipped_root() -> Path:
+    """The folder holding ``data/`` and ``scenarios/`` (paths in data/golden/manifest.yaml are
+    relative to it)."""
+    return _root("data").parent
+
+
+def data_path(*parts: str) -> Path:
+    """A file or folder under the shipped ``data/`` (e.g. ``data_path("robots", "wam.yaml")``)."""
+    return _root("data").joinpath(*parts)
+
+
+def scenario_dir() -> Path:
+    """The shipped scenarios folder."""
+    return _root("scenarios")
+
+
+def find_scenario(arg: str) -> str:
+    """A scenario argument as a path: an existing file wins; else a bare name (``stick_3step``)
+    is a shipped scenario; else the argument as given (the loader says it does not exist)."""
+    if Path(arg).exists() or "/" in arg or arg.endswith((".yaml", ".yml")):
+        return arg
+    shipped = scenario_dir() / f"{arg}.yaml"
+    return str(shipped) if shipped.is_file() else arg

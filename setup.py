@@ -1,0 +1,12 @@
+"""Packaging details pyproject.toml cannot say: the top-level data/ and scenarios/ folders ship in
+the wheel as package data under replay._shipped (found by replay.resources)."""
+
+from setuptools import find_namespace_packages, setup
+
+SHIPPED = {"replay._shipped.data": "data", "replay._shipped.scenarios": "scenarios"}
+
+setup(
+    packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
+    package_dir=SHIPPED,
+    package_data={"replay._shipped.data": ["**/*"], "replay._shipped.scenarios": ["*.yaml"]},
+)
