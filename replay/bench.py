@@ -1,97 +1,191 @@
-"""``make bench``: speed of whole runs, reported as ratios measured in one run.
+"""``make bench``: speed of whole runs, measured so that it can be trusted on a shared machine.
 
-For each benchmarked scenario: the real-time factor of a full run (vision, controller and full
-logging), the same number of bare simulator steps, and their ratio; the interpreter's start-up
-and import time separately. Nothing here is a test: it prints, it does not judge.
+For each benchmarked scenario, in one process: a warm-up run, then ``--runs`` full runs (vision,
+controller and full logging); medians with min-max of CPU time (``time.process_time``: what other
+users of the machine do not inflate much) and wall time; the real-time factor (simulated seconds
+per second, CPU and wall); the CPU time per simulated second; the ratio of a full run's CPU time
+to the bare engine's stepping the same scene the same number of steps (Pymunk ``space.step``,
+PyBullet ``stepSimulation``, nothing else); the share of each part of the loop (the runner's own
+timers: sensors, controller, plant, logging, runner); and, apart, the interpreter's start-up and
+the imports a run needs. Nothing here is a test: it prints, it does not judge.
 """
 
 from __future__ import annotations
 
 import argparse
+import resource
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from replay.runner import Runner
+from replay.runner import COMPONENTS, Runner
 from replay.scenario import load_scenario
 
-DEFAULT = ["scenarios/stick_3step.yaml", "scenarios/catch_optimised.yaml"]
+DEFAULT = ["scenarios/stick_3step.yaml", "scenarios/catch_optimised.yaml",
+           *sorted(str(p) for p in Path("scenarios").glob("grasp_*.yaml"))[:1]]
 
 
-def _bare_stepper(runner: Runner):
-    """One bare simulator step of a fresh plant, with no runner, sensors, control or logging."""
+def bare_stepper(runner: Runner):
+    """(engine name, one bare engine step) of a fresh plant of the runner's scenario: no runner,
+    sensors, control, logging or plant wrapper."""
     plant = type(runner.plant)(runner.sc.plant.params, dt=runner.dt, rng=runner.plant.rng)
-    if hasattr(plant, "space"):                      # Pymunk
-        space, dt = plant.space, plant.dt
-        return lambda: space.step(dt)
-    if hasattr(plant, "client"):                     # PyBullet
+    space = getattr(plant, "space", None)
+    if space is not None and hasattr(space, "step"):               # Pymunk
+        dt = plant.dt
+        return "pymunk space.step", plant, lambda: space.step(dt)
+    bc = getattr(plant, "bc", None)
+    if bc is not None:                                             # PyBullet (a BulletClient)
         import pybullet as p
-        client = plant.client
-        return lambda: p.stepSimulation(physicsClientId=client)
-    return plant.step
+        client = bc._client
+        return "pybullet stepSimulation", plant, lambda: p.stepSimulation(physicsClientId=client)
+    return "plant.step (no bare engine found)", plant, plant.step
 
 
-def _startup(modules: list[str]) -> tuple[float, float]:
-    def wall(code: str) -> float:
-        best = float("inf")
-        for _ in range(3):
+def engine_in_run(sc, out: Path) -> tuple[float, float, int]:
+    """(CPU s of the whole run, CPU s inside the engine's own step, steps) of one run with the
+    engine's step call timed: the engine's share of a real run, where contacts and motors make
+    it work harder than bare stepping of the initial scene."""
+    runner = Runner(sc)
+    plant, spent = runner.plant, [0.0, 0]
+    clock = time.process_time
+
+    def timed(step):
+        def wrapper(*args, **kw):
+            c0 = clock()
+            out = step(*args, **kw)
+            spent[0] += clock() - c0
+            spent[1] += 1
+            return out
+        return wrapper
+    space, bc = getattr(plant, "space", None), getattr(plant, "bc", None)
+    if space is not None and hasattr(space, "step"):
+        space.step = timed(space.step)
+    elif bc is not None:
+        bc.stepSimulation = timed(bc.stepSimulation)
+    c0 = clock()
+    runner.run(out)
+    return clock() - c0, spent[0], spent[1]
+
+
+def _stats(values: list[float]) -> tuple[float, float, float]:
+    return statistics.median(values), min(values), max(values)
+
+
+def _startup(modules: list[str], repeat: int = 3) -> dict:
+    """Median wall and CPU seconds of ``python -c pass`` and, beyond it, of the imports."""
+    def child(code: str) -> tuple[float, float]:
+        walls, cpus = [], []
+        for _ in range(repeat):
+            r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
             subprocess.run([sys.executable, "-c", code], check=True)
-            best = min(best, time.perf_counter() - t0)
-        return best
-    bare = wall("pass")
-    return bare, wall("import " + ", ".join(modules)) - bare
+            walls.append(time.perf_counter() - t0)
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpus.append(r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime)
+        return statistics.median(walls), statistics.median(cpus)
+    bare = child("pass")
+    imp = child("import " + ", ".join(modules))
+    return {"python": bare, "imports": (imp[0] - bare[0], imp[1] - bare[1])}
 
 
-def bench(path: str, repeat: int = 3) -> dict:
+def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True) -> dict:
     sc = load_scenario(path)
-    best, result = float("inf"), None
+    cpu, wall, shares, result, runner = [], [], {c: [] for c in COMPONENTS}, None, None
     with tempfile.TemporaryDirectory() as tmp:
-        for i in range(repeat):
+        for i in range(runs + 1):                      # run 0 warms up (imports, caches, files)
             runner = Runner(sc)
-            t0 = time.perf_counter()
+            c0, w0 = time.process_time(), time.perf_counter()
             result = runner.run(Path(tmp) / f"run{i}.mcap")
-            best = min(best, time.perf_counter() - t0)
-    step = _bare_stepper(Runner(sc))
-    bare = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
+            c1, w1 = time.process_time(), time.perf_counter()
+            if i == 0:
+                continue
+            cpu.append(c1 - c0)
+            wall.append(w1 - w0)
+            total = sum(result.timings.values())
+            for c in COMPONENTS:
+                shares[c].append(result.timings[c] / total)
+        run_cpu, engine_cpu, engine_steps = engine_in_run(sc, Path(tmp) / "engine.mcap")
+    engine, plant, step = bare_stepper(Runner(sc))
+    bare = []
+    for _ in range(max(runs, 3)):
+        c0 = time.process_time()
         for _ in range(result.steps):
             step()
-        bare = min(bare, time.perf_counter() - t0)
-    modules = sorted({type(runner.plant).__module__, type(runner.controller).__module__,
-                      *(type(s).__module__ for _, s, _, _ in runner.sensors), "replay.runner"})
-    optimiser = None
+        bare.append(time.process_time() - c0)
+    plant.close()
+    out = {"scenario": sc.name, "sim_time": result.t_end, "steps": result.steps,
+           "messages": result.messages, "runs": runs, "cpu": _stats(cpu), "wall": _stats(wall),
+           "engine": engine, "bare": _stats(bare),
+           "engine_in_run": (engine_cpu / run_cpu, engine_cpu / max(engine_steps, 1)),
+           "shares": {c: statistics.median(v) for c, v in shares.items()}}
+    for key in ("cpu", "wall"):                  # (median, min, max) of simulated s per second
+        med, lo, hi = out[key]
+        out["rtf_" + key] = (result.t_end / med, result.t_end / hi, result.t_end / lo)
+    out["ratio"] = out["cpu"][0] / out["bare"][0]
+    if startup:
+        modules = sorted({type(runner.plant).__module__, type(runner.controller).__module__,
+                          *(type(s).__module__ for _, s, _, _ in runner.sensors),
+                          "replay.runner"})
+        out["startup"] = _startup(modules)
+    out["optimiser"] = None
     problem = getattr(runner.controller, "problem", None)      # an offline optimisation (eq. 25)
-    if problem is not None and hasattr(problem, "solve"):
-        t0 = time.perf_counter()
+    if optimiser and problem is not None and hasattr(problem, "solve"):
+        c0, t0 = time.process_time(), time.perf_counter()
         solved = problem.solve()
-        optimiser = (time.perf_counter() - t0, len(solved.history) - 1)
-    return {"optimiser": optimiser,"scenario": sc.name, "sim_time": result.t_end, "steps": result.steps,
-            "messages": result.messages, "wall": best, "bare": bare,
-            "rtf": result.t_end / best, "ratio": best / bare, "startup": _startup(modules)}
+        out["optimiser"] = (time.process_time() - c0, time.perf_counter() - t0,
+                            len(solved.history) - 1)
+    return out
+
+
+def _range(s: tuple[float, float, float], fmt: str) -> str:
+    med, lo, hi = s
+    return f"{med:{fmt}} ({lo:{fmt}}-{hi:{fmt}})"
+
+
+def report(r: dict) -> str:
+    sim = r["sim_time"]
+    lines = [
+        f"{r['scenario']}: {sim:.3f} s simulated, {r['steps']} physics steps, "
+        f"{r['messages']} log messages; median (min-max) of {r['runs']} runs after a warm-up",
+        f"  CPU time:  {_range(r['cpu'], '.3f')} s = {r['cpu'][0] / sim:.3f} s per simulated s; "
+        f"real-time factor {_range(r['rtf_cpu'], '.1f')}x",
+        f"  wall time: {_range(r['wall'], '.3f')} s; real-time factor "
+        f"{_range(r['rtf_wall'], '.1f')}x (shared machine: wall is noisy)",
+        f"  bare engine ({r['engine']}, same scene and steps): {_range(r['bare'], '.4f')} s CPU "
+        f"= {1e6 * r['bare'][0] / max(r['steps'], 1):.1f} us a step; "
+        f"full run / bare = {r['ratio']:.0f}x; inside a run the engine takes "
+        f"{1e6 * r['engine_in_run'][1]:.1f} us a step, {100 * r['engine_in_run'][0]:.1f} % of the "
+        "run's CPU (contacts, motors)",
+        "  where the time goes (runner's timers, share of the loop): "
+        + ", ".join(f"{c} {100 * r['shares'][c]:.0f} %" for c in COMPONENTS)
+        + "  [" + ", ".join(f"{c} {1e3 * r['shares'][c] * r['cpu'][0] / sim:.0f}"
+                            for c in COMPONENTS) + " ms CPU per simulated s]",
+    ]
+    if "startup" in r:
+        (pw, pc), (iw, ic) = r["startup"]["python"], r["startup"]["imports"]
+        lines.append(f"  not counted above: interpreter start-up {pw:.3f} s wall ({pc:.3f} s CPU),"
+                     f" imports {iw:.3f} s wall ({ic:.3f} s CPU)")
+    if r.get("optimiser") is not None:
+        c, w, iterations = r["optimiser"]
+        lines.append(f"  offline optimisation from scratch: {c:.2f} s CPU ({w:.2f} s wall), "
+                     f"{iterations} iterations (the runs read its result from a file)")
+    return "\n".join(lines)
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenarios", nargs="*", default=DEFAULT)
+    ap.add_argument("--runs", type=int, default=5, help="timed runs after the warm-up")
+    ap.add_argument("--no-startup", action="store_true", help="skip the start-up timing")
+    ap.add_argument("--no-optimiser", action="store_true",
+                    help="skip timing an offline optimisation from scratch")
     args = ap.parse_args(argv)
     for path in args.scenarios:
-        r = bench(path)
-        py, imports = r["startup"]
-        print(f"{r['scenario']}: {r['sim_time']:.3f} s simulated, {r['steps']} physics steps, "
-              f"{r['messages']} log messages")
-        print(f"  full run (vision + control + logging): {r['wall']:.3f} s wall "
-              f"= {r['rtf']:.1f}x real time")
-        print(f"  bare simulator steps:                  {r['bare']:.4f} s wall; "
-              f"full run / bare = {r['ratio']:.1f}x")
-        print(f"  not counted above: interpreter start-up {py:.3f} s, imports {imports:.3f} s")
-        if r["optimiser"] is not None:
-            wall, iterations = r["optimiser"]
-            print(f"  offline optimisation from scratch: {wall:.2f} s wall, {iterations} "
-                  "iterations (the runs read its result from a file)")
+        print(report(bench(path, runs=args.runs, startup=not args.no_startup,
+                           optimiser=not args.no_optimiser)), flush=True)
 
 
 if __name__ == "__main__":

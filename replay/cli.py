@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import ipaddress
+import logging
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -10,9 +12,11 @@ import click
 
 from replay import registry
 from replay.log import LogError, LogReader
+from replay.log.writer import check_output
 from replay.papers import PAPERS
 from replay.resources import find_scenario, scenario_dir
 from replay.scenario import ScenarioError, load_scenario
+from replay.scenario.yamlio import one_line
 from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
 
 DEFAULT_LOG_DIR = Path("out/logs")
@@ -20,8 +24,12 @@ DEFAULT_FIGURE_DIR = Path("out/figures")
 
 
 def _fail(message: str, code: int = 2) -> None:
-    click.echo(f"error: {message}", err=True)
+    click.echo(f"error: {one_line(message)}", err=True)
     sys.exit(code)
+
+
+def _warn(message: str) -> None:
+    click.echo(f"warning: {one_line(message)}", err=True)
 
 
 class _Progress:
@@ -44,7 +52,18 @@ class _Progress:
             sys.stderr.flush()
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _Group(click.Group):
+    """Ctrl-C outside a run (loading, reading logs, figures) exits 130 quietly, not "Aborted!"."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            click.echo("interrupted", err=True)
+            sys.exit(130)
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="paper-replay")
 def main() -> None:
     """paper-replay: re-run landmark high-speed robotics experiments from YAML scenarios."""
@@ -59,7 +78,7 @@ def _load(path: str, sets=(), seed=None):
 
 @main.command()
 @click.argument("scenario", type=click.Path(dir_okay=False))
-@click.option("-o", "--out", type=click.Path(dir_okay=False), help="log path "
+@click.option("-o", "--out", type=click.Path(), help="log path "
               "(default out/logs/NAME.mcap)")
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE",
               help="override a scenario field (repeatable)")
@@ -72,11 +91,14 @@ def run(scenario, out, sets, seed, quiet, view):
     from replay.runner import RunInterrupted, Runner
     sc = _load(scenario, sets, seed)
     out = Path(out) if out else DEFAULT_LOG_DIR / f"{sc.name}.mcap"
+    _check_log_path(out, sc)
     progress = _Progress(sc.name, not quiet)
+    runner = _runner(scenario, sc, Runner, progress=progress)
     live = _live_viewer() if view else None
-    observers = (live.observe,) if live else ()
+    if live:
+        runner.observers = (live.observe,)
     try:
-        result = Runner(sc, progress=progress, observers=observers).run(out)
+        result = runner.run(out)
     except RunInterrupted as exc:
         progress.done()
         if live:
@@ -89,6 +111,12 @@ def run(scenario, out, sets, seed, quiet, view):
         if live:
             live.stop()
         _fail(str(exc))
+    except Exception as exc:  # noqa: BLE001 - a plug-in failed mid-run: one line, the .part kept
+        progress.done()
+        if live:
+            live.stop()
+        part = out.with_name(out.name + ".part")
+        _fail(f"the run failed: {type(exc).__name__}: {exc}; partial log: {part}", code=1)
     progress.done()
     failed = result.stopped_by == "error"
     if failed and not live:
@@ -107,9 +135,79 @@ def run(scenario, out, sets, seed, quiet, view):
             sys.exit(1)
 
 
+def _check_log_path(out: Path, sc) -> None:
+    """One line before anything runs: never overwrite an input, a folder or a non-log."""
+    try:
+        target = out.resolve()
+    except (OSError, RuntimeError) as exc:
+        _fail(f"bad log path {out}: {exc}")
+    if target in set(getattr(sc, "inputs", ())):
+        _fail(f"will not write the log over the scenario file {out} (give another -o)")
+    try:
+        check_output(out)
+    except LogError as exc:
+        _fail(str(exc))
+
+
+_REFUSED = (ValueError, TypeError, KeyError, IndexError, ArithmeticError, OSError, LogError)
+_PARTS = (("/plants/", "plant"), ("/replay/sensors/", "sensors"), ("/replay/control/", "controller"))
+
+
+def _refusal(scenario: str, exc: BaseException) -> str:
+    """One line: which plug-in refused the scenario (from where it raised) and why."""
+    part = "plug-ins"
+    tb = exc.__traceback__
+    while tb is not None:
+        name = tb.tb_frame.f_code.co_filename.replace("\\", "/")
+        found = next((label for key, label in _PARTS if key in name), None)
+        if found:
+            part = found
+            break
+        tb = tb.tb_next
+    return f"{scenario}: {part}: refused the scenario: {type(exc).__name__}: {exc}"
+
+
+def _runner(scenario: str, sc, Runner, **kw):
+    """The plug-ins built from a validated scenario (what ``validate`` also does); a plug-in
+    that still refuses it (a condition only its own model knows) gives one line."""
+    try:
+        return Runner(sc, **kw)
+    except _REFUSED as exc:
+        _fail(_refusal(scenario, exc))
+
+
+def _quiet_websockets() -> None:
+    """A bare TCP connect (a port scanner, a health check) is no reason for a traceback."""
+    class _NoHandshakeNoise(logging.Filter):
+        def filter(self, record):
+            return "opening handshake failed" not in record.getMessage()
+
+    for name in ("websockets.server", "websockets"):
+        logging.getLogger(name).addFilter(_NoHandshakeNoise())
+
+
+def _is_ip(host: str) -> bool:
+    try:
+        ipaddress.ip_address(host)
+        return True
+    except ValueError:
+        return False
+
+
+def _warn_if_exposed(host: str) -> None:
+    try:
+        local = ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        local = host == "localhost"
+    if not local:
+        _warn(f"serving on {host}: anyone who can reach this machine on the network can see "
+              "the viewer (use --host 127.0.0.1 to keep it local)")
+
+
 def _live_viewer():
     """A browser viewer fed by the runner (``run --view``); its URL printed at once."""
     from replay.viewer import LiveSession, ViewerError
+    _quiet_websockets()
     try:
         live = LiveSession()
     except ViewerError as exc:
@@ -147,29 +245,55 @@ def optimise(scenario, out):
     stored = getattr(sc.controller.params, "alpha_file", None)
     if stored is None:
         _fail(f"controller {sc.controller.type!r} has no offline optimisation to store")
-    path = Path(out or stored)
-    if not str(path):
+    if not (out or stored):
         _fail("the scenario sets no controller.params.alpha_file: give -o FILE")
-    runner = Runner(_load(scenario, ["controller.params.alpha_file=''"]))
-    runner.controller.write_alpha_file(path)
-    runner.plant.close()
+    base = getattr(sc.controller.params, "scenario_dir", "")   # files resolve from the scenario
+    path = Path(out) if out else Path(base, stored).resolve() if base else Path(stored)
+    if path.resolve() in set(sc.inputs) or path.suffix in (".yaml", ".yml", ".mcap"):
+        _fail(f"will not write the optimisation over {path} (a scenario or a log): give -o "
+              "FILE.json")
+    try:
+        check_output(path, kind="optimisation result", magic=b"{")
+    except LogError as exc:
+        _fail(str(exc))
+    runner = _runner(scenario, _load(scenario, ["controller.params.alpha_file=''"]), Runner)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        runner.controller.write_alpha_file(path)
+    except OSError as exc:
+        _fail(f"cannot write {path}: {exc.strerror or exc}")
+    finally:
+        runner.plant.close()
     click.echo(f"wrote {path}")
 
 
 @main.command()
 @click.argument("scenarios", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
-def validate(scenarios, sets):
-    """Check scenario files without running them (all of scenarios/ by default)."""
+@click.option("--static", is_flag=True, help="only the scenario checks: do not build the "
+              "plug-ins (faster; a plug-in's own model checks are left to `run`)")
+def validate(scenarios, sets, static):
+    """Check scenario files without running them (all of scenarios/ by default): every field,
+    then the plug-ins are built as `run` builds them (the plant, sensors and controller, with
+    any offline optimisation), so what passes here runs."""
+    from replay.runner import Runner
     paths = scenarios or sorted(str(p) for p in scenario_dir().glob("*.yaml"))
     bad = 0
     for p in paths:
         try:
-            load_scenario(find_scenario(p), sets=list(sets))
-            click.echo(f"ok: {p}")
+            sc = load_scenario(find_scenario(p), sets=list(sets))
         except ScenarioError as exc:
             click.echo(f"error: {exc}", err=True)
             bad += 1
+            continue
+        if not static:
+            try:
+                Runner(sc).plant.close()
+            except _REFUSED as exc:
+                click.echo(f"error: {one_line(_refusal(p, exc))}", err=True)
+                bad += 1
+                continue
+        click.echo(f"ok: {p}")
     if bad:
         sys.exit(2)
 
@@ -188,7 +312,7 @@ def list_(plugins):
         except ScenarioError as exc:
             click.echo(f"{p.stem:<28} (invalid: {exc})")
             continue
-        click.echo(f"{p.stem:<28} {sc.paper:<16} {sc.description}")
+        click.echo(one_line(f"{p.stem:<28} {sc.paper:<16} {sc.description}"))
 
 
 def params_markdown() -> str:
@@ -243,9 +367,14 @@ def describe():
 
 def _reader(path: str) -> LogReader:
     try:
-        return LogReader(path)
+        return LogReader(path).check()
     except LogError as exc:
         _fail(str(exc))
+
+
+def _log_notes(name: str, r: LogReader) -> list[str]:
+    """One line per thing a reader of this log must know (truncated, damaged, missing)."""
+    return [f"{name}: {n}" for n in r.describe_problems()]
 
 
 @main.command()
@@ -255,30 +384,36 @@ def info(log):
     r = _reader(log)
     try:
         sc = r.scenario()
-        click.echo(f"scenario: {sc['name']} (paper {sc['paper']}, seed {sc['seed']}, "
-                   f"code {sc['version']})")
+        click.echo(one_line(f"scenario: {sc.get('name', '?')} (paper {sc.get('paper', '?')}, "
+                            f"seed {sc.get('seed', '?')}, code {sc.get('version', '?')})"))
     except LogError:
         click.echo("scenario: (no /scenario message)")
     t0, t1 = r.time_range()
-    click.echo(f"duration: {t1 - t0:.4f} s simulated{'  [TRUNCATED log]' if r.truncated else ''}")
+    flag = {"truncated": "  [TRUNCATED log]", "damaged": "  [DAMAGED log]"}.get(r.status, "")
+    click.echo(f"duration: {t1 - t0:.4f} s simulated{flag}")
     events = r.events()
     outcome = next((e["data"] for e in reversed(events) if e["kind"] == "outcome"), None)
     if outcome is None:
         click.echo("outcome: (none: the run did not finish)")
     else:
         metrics = {k: v for k, v in outcome.items() if k not in ("success", "reason")}
-        click.echo(f"outcome: {'success' if outcome.get('success') else 'FAILED'}: "
-                   f"{outcome.get('reason', '')}")
+        click.echo(one_line(f"outcome: {'success' if outcome.get('success') else 'FAILED'}: "
+                            f"{outcome.get('reason', '')}"))
         if metrics:
             click.echo("  " + ", ".join(f"{k}={_short(v)}" for k, v in metrics.items()))
     click.echo("topics:")
     for topic, n in r.topic_counts().items():
-        click.echo(f"  {topic:<28} {n:>8}")
+        click.echo(one_line(f"  {topic:<28} {n:>8}"))
     click.echo(f"events: {len(events)}")
     for e in events:
         data = e.get("data", {})
+        data = data if isinstance(data, dict) else {"data": data}
         brief = ", ".join(f"{k}={_short(v)}" for k, v in list(data.items())[:6])
-        click.echo(f"  t = {e['t']:8.4f} s  {e['kind']:<12} {brief}")
+        t = e.get("t")
+        t = f"{t:8.4f}" if isinstance(t, (int, float)) else f"{'?':>8}"
+        click.echo(one_line(f"  t = {t} s  {e['kind']:<12} {brief}"))
+    for note in _log_notes(log, r):
+        _warn(note)
 
 
 @main.command()
@@ -295,10 +430,16 @@ def view(logs, host, port, speed, timeout):
     """Replay LOGS in the browser (Viser): 3-D scene, timeline, events, plots. Several logs
     are overlaid in step (e.g. optimised vs unoptimised)."""
     from replay.viewer import Viewer, ViewerError
+    _quiet_websockets()
+    named = not _is_ip(host)
+    if not named:
+        _warn_if_exposed(host)          # before anything listens
     try:
         viewer = Viewer.open(logs, host=host, port=port, speed=speed)
     except ViewerError as exc:
         _fail(str(exc))
+    if named:
+        _warn_if_exposed(host)          # a name: once it resolved (a bad one stays one line)
     if viewer.port_note:
         click.echo(f"note: {viewer.port_note}", err=True)
     for note in viewer.notes:
@@ -328,8 +469,28 @@ def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
             sc = r.scenario()
         except LogError as exc:
             _fail(str(exc))
-        by_paper[sc["paper"]][sc["name"]] = r
+        paper, name = sc.get("paper"), sc.get("name")
+        if not (isinstance(paper, str) and paper and isinstance(name, str) and name):
+            _fail(f"{p}: its /scenario message names no paper or scenario (not a run log?)")
+        by_paper[paper][name] = r
     return by_paper
+
+
+def _partial(readers: dict[str, LogReader]) -> dict[str, list[str]]:
+    """name -> notes, for the logs that are truncated or damaged."""
+    out = {}
+    for name, r in readers.items():
+        notes = r.describe_problems()
+        if notes:
+            out[name] = notes
+    return out
+
+
+def _analysis_failed(what: str, paper: str, readers, exc: Exception) -> None:
+    partial = _partial(readers)
+    why = (f" (partial logs: {', '.join(partial)})" if partial else "")
+    _fail(f"{what} for {paper} could not be made from {', '.join(readers)}{why}: "
+          f"{type(exc).__name__}: {exc}", code=1)
 
 
 @main.command()
@@ -338,14 +499,29 @@ def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
               show_default=True)
 def figures(logs, out):
     """Regenerate the papers' figures (PNG and SVG) from LOGS (default: out/logs/*.mcap)."""
-    for paper, readers in _logs_by_paper(logs).items():
+    by_paper = _logs_by_paper(logs)
+    try:
+        Path(out).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        _fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+    for paper, readers in by_paper.items():
         try:
             make = registry.load("figures", paper)
         except registry.UnknownPlugin:
             click.echo(f"{paper}: no figures defined yet ({', '.join(readers)})", err=True)
             continue
-        for path in make(readers, Path(out)):
+        try:
+            paths = make(readers, Path(out))
+        except OSError as exc:
+            _fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+        except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
+            _analysis_failed("figures", paper, readers, exc)
+        for path in paths:
             click.echo(f"figure: {path}")
+        for name, notes in _partial(readers).items():
+            for note in notes:
+                _warn(f"{name} is not a finished run ({note}): its figures show only what "
+                      "was logged")
 
 
 @main.command()
@@ -355,20 +531,31 @@ def claims(logs, markdown):
     """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
     from analysis.claims import format_table
     sections = []
-    for paper, readers in _logs_by_paper(logs).items():
+    by_paper = _logs_by_paper(logs)
+    inputs = {Path(r.path).resolve() for readers in by_paper.values() for r in readers.values()}
+    if markdown and (Path(markdown).resolve() in inputs or
+                     Path(markdown).suffix in (".mcap", ".yaml", ".yml")):
+        _fail(f"will not write the claims table over {markdown} (a log or a scenario)")
+    for paper, readers in by_paper.items():
         try:
             evaluate = registry.load("claims", paper)
         except registry.UnknownPlugin:
             click.echo(f"{paper}: no claims defined yet", err=True)
             continue
-        rows = evaluate(readers)
+        try:
+            rows = evaluate(readers)
+        except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
+            _analysis_failed("claims", paper, readers, exc)
         title = PAPERS[paper].title if paper in PAPERS else paper
-        sections.append(format_table(title, rows))
+        sections.append(format_table(title, rows, partial=_partial(readers)))
     text = "\n\n".join(sections)
     click.echo(text)
     if markdown:
-        Path(markdown).parent.mkdir(parents=True, exist_ok=True)
-        Path(markdown).write_text(text + "\n")
+        try:
+            Path(markdown).parent.mkdir(parents=True, exist_ok=True)
+            Path(markdown).write_text(text + "\n")
+        except OSError as exc:
+            _fail(f"cannot write {markdown}: {exc.strerror or exc}")
 
 
 @main.group()
@@ -377,11 +564,13 @@ def golden():
 
 
 def _goldens(names):
-    from replay.golden import load_manifest
+    from replay.golden import ManifestError, load_manifest
     try:
         table = load_manifest()
     except FileNotFoundError:
         _fail("no golden manifest shipped (data/golden/manifest.yaml is missing)")
+    except ManifestError as exc:
+        _fail(str(exc))
     unknown = [n for n in names if n not in table]
     if unknown:
         _fail(f"unknown golden log {unknown[0]!r} (known: {', '.join(table)})")
@@ -400,7 +589,12 @@ def golden_check(names):
                        f"{g.name}`)")
             failed += 1
             continue
-        diffs = check(g)
+        try:
+            diffs = check(g)
+        except (LogError, ScenarioError) as exc:
+            failed += 1
+            click.echo(one_line(f"FAIL {g.name}: {exc}"))
+            continue
         if diffs:
             failed += 1
             click.echo(f"FAIL {g.name}: first difference: {diffs[0]}")
@@ -418,7 +612,10 @@ def golden_update(names):
     """Rewrite golden logs; commit them with the reason in the message."""
     from replay.golden import update
     for g in _goldens(names):
-        path = update(g)
+        try:
+            path = update(g)
+        except (LogError, ScenarioError) as exc:
+            _fail(f"{g.name}: {exc}")
         click.echo(f"updated {path} ({path.stat().st_size / 1024:.0f} KiB)")
     click.echo("commit the golden logs with the reason for the change in the commit message")
 

@@ -14,11 +14,12 @@ from pathlib import Path
 
 import yaml
 
-from replay.log import LogReader
+from replay.log import LogError, LogReader
 from replay.messages import TOPIC_SCENARIO
 from replay.resources import shipped_root
 from replay.runner import Runner
 from replay.scenario import load_scenario
+from replay.scenario.yamlio import ScenarioError, compose, read_text, show
 
 GOLDEN_DIR = Path("data/golden")   # under replay.resources.shipped_root()
 MANIFEST = "manifest.yaml"
@@ -53,17 +54,53 @@ class Difference:
         return f"{where}: golden {self.golden!r} vs run {self.run!r}{tol}"
 
 
+class ManifestError(ValueError):
+    """The golden manifest is missing or malformed (one line: file:line:col and what)."""
+
+
+def _tolerance(value, where: str) -> dict:
+    if not (isinstance(value, dict) and set(value) <= {"abs", "rel"} and
+            all(isinstance(v, (int, float)) and not isinstance(v, bool) and 0 <= v < 1e9
+                for v in value.values())):
+        raise ManifestError(f"{where}: expected {{abs: number >= 0, rel: number >= 0}}, got "
+                            f"{show(value)}")
+    return {k: float(v) for k, v in value.items()}
+
+
 def load_manifest(root: Path | None = None) -> dict[str, Golden]:
     root = shipped_root() if root is None else root
     path = root / GOLDEN_DIR / MANIFEST
-    data = yaml.safe_load(path.read_text()) or {}
+    if not path.is_file():
+        raise FileNotFoundError(path)
+    try:
+        text = read_text(path)
+        compose(text, str(path), what="a manifest")     # encoding, shape and size checks
+        data = yaml.safe_load(text) or {}
+    except ScenarioError as exc:
+        raise ManifestError(str(exc)) from None
+    except yaml.YAMLError as exc:
+        raise ManifestError(f"{path}: not valid YAML: {exc}") from None
+    if not isinstance(data, dict):
+        raise ManifestError(f"{path}: expected a mapping of golden names, got "
+                            f"{type(data).__name__}")
     out = {}
     for name, g in data.items():
-        out[name] = Golden(name=name, scenario=root / g["scenario"],
-                           log=root / GOLDEN_DIR / g["log"], sets=list(g.get("sets", [])),
-                           tolerances=g.get("tolerances", {}),
-                           default_tolerance=g.get("default_tolerance",
-                                                   {"abs": 1e-9, "rel": 1e-9}))
+        where = f"{path}: {name}"
+        if not (isinstance(g, dict) and isinstance(g.get("scenario"), str) and
+                isinstance(g.get("log"), str)):
+            raise ManifestError(f"{where}: expected a mapping with scenario: FILE and log: FILE")
+        sets = g.get("sets", [])
+        if not (isinstance(sets, list) and all(isinstance(x, str) for x in sets)):
+            raise ManifestError(f"{where}.sets: expected a list of key.path=value strings")
+        tolerances = g.get("tolerances", {})
+        if not isinstance(tolerances, dict):
+            raise ManifestError(f"{where}.tolerances: expected a mapping topic -> tolerance")
+        out[str(name)] = Golden(
+            name=str(name), scenario=root / g["scenario"], log=root / GOLDEN_DIR / g["log"],
+            sets=sets, tolerances={str(t): _tolerance(v, f"{where}.tolerances.{t}")
+                                   for t, v in tolerances.items()},
+            default_tolerance=_tolerance(g.get("default_tolerance", {"abs": 1e-9, "rel": 1e-9}),
+                                         f"{where}.default_tolerance"))
     return out
 
 
@@ -109,9 +146,12 @@ def compare_logs(golden_path: Path, run_path: Path, tolerances: dict,
                  default_tolerance: dict | None = None) -> list[Difference]:
     """The first difference of each topic (empty when the run matches)."""
     default_tolerance = default_tolerance or {"abs": 1e-9, "rel": 1e-9}
-    golden, run = LogReader(golden_path), LogReader(run_path)
-    g_counts, r_counts = golden.topic_counts(), run.topic_counts()
+    golden, run = LogReader(golden_path).check(), LogReader(run_path).check()
     diffs: list[Difference] = []
+    for label, log in (("golden", golden), ("run", run)):
+        for note in log.describe_problems():
+            diffs.append(Difference("(file)", 0, 0.0, f"the {label} log", note, log.status))
+    g_counts, r_counts = golden.topic_counts(), run.topic_counts()
     for topic in sorted(set(g_counts) | set(r_counts)):
         tol = {**default_tolerance, **tolerances.get(topic, {})}
         tol_text = f"abs {tol.get('abs', 0):g}, rel {tol.get('rel', 0):g}"
@@ -139,9 +179,14 @@ def compare_logs(golden_path: Path, run_path: Path, tolerances: dict,
 
 
 def check(g: Golden) -> list[Difference]:
+    """The differences of a fresh run from the stored log. Raises :class:`LogError` when the
+    stored log cannot be read at all, ``ScenarioError`` when its scenario is bad."""
     with tempfile.TemporaryDirectory() as tmp:
         out = run_golden(g, Path(tmp) / f"{g.name}.mcap")
-        return compare_logs(g.log, out, g.tolerances, g.default_tolerance)
+        try:
+            return compare_logs(g.log, out, g.tolerances, g.default_tolerance)
+        except LogError as exc:
+            raise LogError(f"stored golden log: {exc}") from None
 
 
 def update(g: Golden) -> Path:

@@ -13,6 +13,20 @@
 Each plug-in declares ``Params``, a dataclass of :func:`replay.params.param` fields, validated from
 the scenario's ``params:`` mapping. Plug-ins are found by name through entry points
 (``paper_replay.plants``, ``paper_replay.sensors``, ``paper_replay.controllers``).
+
+Typed ports: what a plug-in gives and takes is declared on its class, and the scenario loader
+(:mod:`replay.scenario.ports`) checks that the plant, sensors and controller of a scenario fit
+before anything runs:
+
+- ``Plant.spec_type``: the type ``spec()`` returns; ``Plant.command_types``: what ``apply()``
+  accepts;
+- ``Controller.spec_type``: the spec it needs (the plant's must be it or a subclass);
+  ``Controller.command_type``: what ``update()`` returns; ``Controller.reads``: the topics it
+  reads, each of which some sensor of the scenario must publish;
+- ``Sensor.spec_type``: the spec it needs, or None; ``Sensor.topic`` (or its params' ``topic``):
+  what it publishes.
+
+``object`` (the default) fits anything, so a plug-in that declares nothing is not checked.
 """
 
 from __future__ import annotations
@@ -36,6 +50,8 @@ class Occurrence:
 class Plant(ABC):
     Params: ClassVar[type]
     description: ClassVar[str] = ""
+    spec_type: ClassVar[type] = object                   # what spec() returns
+    command_types: ClassVar[tuple[type, ...]] = (object,)   # what apply() accepts
 
     def __init__(self, params: Any, *, dt: float, rng: np.random.Generator) -> None:
         self.params = params
@@ -80,6 +96,12 @@ class Sensor(ABC):
     Params: ClassVar[type]
     topic: ClassVar[str]
     description: ClassVar[str] = ""
+    spec_type: ClassVar[type | None] = None              # the plant spec it needs, or None
+
+    @classmethod
+    def topic_for(cls, params: Any) -> str:
+        """The topic this sensor publishes with ``params`` (a ``topic`` param, else ``topic``)."""
+        return getattr(params, "topic", None) or cls.topic
 
     def __init__(self, params: Any, *, rng: np.random.Generator, spec: Any = None) -> None:
         self.params = params
@@ -94,6 +116,9 @@ class Sensor(ABC):
 class Controller(ABC):
     Params: ClassVar[type]
     description: ClassVar[str] = ""
+    spec_type: ClassVar[type] = object                   # the plant spec it needs
+    command_type: ClassVar[type] = object                # what update() returns
+    reads: ClassVar[tuple[str, ...]] = ()                # topics it reads (sensors must give them)
 
     def __init__(self, params: Any, *, spec: Any) -> None:
         self.params = params

@@ -1,8 +1,20 @@
 """Declaring scenario parameters: a dataclass field with its unit, range and meaning.
 
 Every plug-in (plant, controller, sensor) declares a ``Params`` dataclass whose fields are made
-with :func:`param`. The scenario loader validates YAML against it field by field (type, range,
-choices) and the docs list the unit of each field, so the YAML mirrors the code field for field.
+with :func:`param`. The scenario loader validates YAML against it field by field (type, every list
+item and the list's length, finiteness, range, choices) and the docs list the unit of each field,
+so the YAML mirrors the code field for field.
+
+Defaults that hold unless a field says otherwise (so that memory and run time stay bounded and no
+meaningless number reaches a simulator):
+
+- a float is finite (NaN never; +-inf only with ``allow_inf=True``) and ``|x| <= MAX_FLOAT``;
+- an integer is ``|n| <= MAX_INT``;
+- a list has at most ``MAX_ITEMS`` items, a string at most ``MAX_CHARS`` characters.
+
+Checks between fields (a lower limit above its upper limit, a list as long as the arm's joints)
+go in the dataclass's ``__post_init__`` and raise :class:`ParamError` naming the field, so the
+error points at that field's line.
 """
 
 from __future__ import annotations
@@ -11,6 +23,21 @@ import dataclasses
 from typing import Any
 
 _MISSING = dataclasses.MISSING
+
+MAX_FLOAT = 1e9          # SI: no scenario quantity is larger (a field may set its own bounds)
+MAX_INT = 2 ** 31 - 1
+MAX_ITEMS = 256
+MAX_CHARS = 10_000
+
+
+class ParamError(ValueError):
+    """A check of a ``Params`` (``__post_init__``) failed; ``field`` is the dotted field name
+    relative to that dataclass (e.g. ``initial_q`` or ``initial_q[2]``)."""
+
+    def __init__(self, field: str, message: str) -> None:
+        self.field = field
+        self.message = message
+        super().__init__(f"{field}: {message}")
 
 
 def param(
@@ -24,16 +51,23 @@ def param(
     lt: float | None = None,
     choices: tuple | None = None,
     length: int | None = None,
+    min_length: int | None = None,
+    max_length: int | None = None,
+    allow_inf: bool = False,
+    pattern: str | None = None,
 ) -> Any:
     """A dataclass field with validation metadata.
 
     ``unit`` is the SI unit of the value ("m", "kg", "kg*m^2", "s", "rad", "rad/s", "m/s", "Hz",
     "1" for dimensionless). ``ge/gt/le/lt`` bound numbers (and every item of a list of numbers),
-    ``choices`` lists the allowed values, ``length`` fixes the length of a list.
+    ``choices`` lists the allowed values, ``length`` fixes the length of a list (``min_length``,
+    ``max_length`` bound it; of a string: its characters), ``allow_inf`` admits +-inf for a
+    float (meaning "no limit"), ``pattern`` is a regular expression a string must match whole.
     A field without a default is required in the YAML.
     """
     meta = {"unit": unit, "doc": doc, "ge": ge, "gt": gt, "le": le, "lt": lt,
-            "choices": choices, "length": length}
+            "choices": choices, "length": length, "min_length": min_length,
+            "max_length": max_length, "allow_inf": allow_inf, "pattern": pattern}
     if isinstance(default, (list, dict)):
         value = default
         return dataclasses.field(default_factory=lambda: _copy(value), metadata=meta)
@@ -64,6 +98,11 @@ def describe(cls) -> list[dict]:
                 bounds.append(f"{sym} {m[key]}")
         if m.get("choices"):
             bounds.append("one of " + ", ".join(map(str, m["choices"])))
+        if m.get("length") is not None:
+            bounds.append(f"{m['length']} items")
+        elif m.get("min_length") is not None or m.get("max_length") is not None:
+            bounds.append(f"{m.get('min_length') or 0}..{m.get('max_length') or MAX_ITEMS} "
+                          "items")
         rows.append({"name": f.name, "type": str(f.type), "unit": m.get("unit", ""),
                      "default": default, "range": ", ".join(bounds), "doc": m.get("doc", "")})
     return rows

@@ -46,6 +46,13 @@ class RunResult:
     wall_time: float = 0.0
     error: str = ""
     outcome: dict = field(default_factory=dict)   # the final ``outcome`` event's data
+    # wall seconds spent in each part of the loop (COMPONENTS); "runner" is the rest of the run
+    timings: dict = field(default_factory=dict)
+
+
+# The parts of a run timed by the runner itself (perf_counter around each call: ~0.1 us a call),
+# so `make bench` shows where the time goes without a profiler.
+COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 
 def _git_commit() -> str:
@@ -98,6 +105,7 @@ class Runner:
         self.ctrl_div = _divider(rate, scenario.controller.rate)
         self.log_div = (_divider(rate, scenario.timing.state_log_rate)
                         if scenario.timing.state_log_rate else 1)
+        self._t_log = 0.0          # seconds in log writes (and observers) this run
 
     def t_ns(self, k: int) -> int:
         return k * 1_000_000_000 // self.sc.timing.physics_rate
@@ -123,6 +131,9 @@ class Runner:
         stop_at: int | None = None
         collisions = 0
         k = 0
+        clock = time.perf_counter
+        t_sensors = t_controller = t_plant = 0.0
+        self._t_log = 0.0
         try:
             while k < n_steps and (stop_at is None or k < stop_at):
                 t = k / rate
@@ -130,8 +141,14 @@ class Runner:
                 scene = None
                 for name, sensor, div, latency in self.sensors:
                     if k % div == 0:
-                        scene = scene if scene is not None else self.plant.scene()
+                        c0 = clock()
+                        if scene is None:
+                            scene = self.plant.scene()
+                            c1 = clock()
+                            t_plant += c1 - c0
+                            c0 = c1
                         m = sensor.measure(t, scene)
+                        t_sensors += clock() - c0
                         if m is not None:
                             self._write(log, sensor.topic, m, t_ns)
                             heapq.heappush(pending, (k + latency, seq, sensor.topic, m))
@@ -141,18 +158,31 @@ class Runner:
                     while pending and pending[0][0] <= k:
                         _, _, topic, m = heapq.heappop(pending)
                         delivered.append((topic, m))
+                    c0 = clock()
                     command = self.controller.update(t, delivered)
+                    c1 = clock()
+                    t_controller += c1 - c0
                     if command is not None:
                         self.plant.apply(command)
+                        t_plant += clock() - c1
                     for occ in self.controller.pop_events():
                         stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
-                    for topic, payload in self.controller.telemetry(t).items():
+                    c0 = clock()
+                    telemetry = self.controller.telemetry(t)
+                    t_controller += clock() - c0
+                    for topic, payload in telemetry.items():
                         for item in (payload if isinstance(payload, list) else [payload]):
                             self._write(log, topic, item, t_ns)
+                c0 = clock()
                 if k % self.log_div == 0:
-                    for topic, payload in self.plant.truth(t).items():
+                    truth = self.plant.truth(t)
+                    c1 = clock()
+                    t_plant += c1 - c0
+                    for topic, payload in truth.items():
                         self._write(log, topic, payload, t_ns)
+                    c0 = clock()
                 self.plant.step()
+                t_plant += clock() - c0
                 k += 1
                 t1, t1_ns = k / rate, self.t_ns(k)
                 for occ in self.plant.pop_events():
@@ -185,6 +215,9 @@ class Runner:
         finally:
             self.plant.close()
         self._finish(log, result, k, wall0)
+        result.timings = {"sensors": t_sensors, "controller": t_controller, "plant": t_plant,
+                          "logging": self._t_log}
+        result.timings["runner"] = result.wall_time - sum(result.timings.values())
         return result
 
     def _verdict(self, t: float) -> dict:
@@ -210,13 +243,17 @@ class Runner:
         result.steps = k
         result.t_end = k / self.sc.timing.physics_rate
         result.messages = log.count
-        log.close()
+        # a failed or interrupted run never replaces a finished log at ``out``: NAME.failed.mcap
+        result.path = log.close({"error": "failed", "interrupted": "interrupted"}.get(
+            result.stopped_by, ""))
         result.wall_time = time.perf_counter() - wall0
 
     def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:
+        c0 = time.perf_counter()
         log.write(topic, payload, t_ns)
         for observe in self.observers:
             observe(topic, payload, t_ns)
+        self._t_log += time.perf_counter() - c0
 
     def _event(self, log, occ, t, t_ns, result, stop_at, k):
         self._write(log, TOPIC_EVENTS, Event(t, occ.kind, occ.data), t_ns)

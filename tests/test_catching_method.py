@@ -53,9 +53,9 @@ def problem():
 
 @pytest.fixture(scope="module")
 def solved(problem):
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     res = problem.solve()
-    return res, time.perf_counter() - t0
+    return res, time.process_time() - t0          # CPU time: wall time is noisy on a shared host
 
 
 @pytest.fixture(scope="module")
@@ -248,8 +248,8 @@ def test_initial_alpha_is_min_norm_and_feasible(problem):
 
 
 def test_optimisation_keeps_equality_and_lowers_both_costs(problem, solved):
-    res, wall = solved
-    assert wall < 30.0
+    res, cpu = solved
+    assert cpu < 60.0                             # a bound on the work (make bench times it)
     assert res.constraint_residual < 1e-8
     first, last = res.history[0], res.history[-1]
     assert last.torque_cost < first.torque_cost
@@ -328,9 +328,8 @@ def _closed_loop(ctl, spec, speed=9.0, offset=(0.0, 0.0, 0.0)):
 
 def test_controller_catches_nominal_throw(alpha_file):
     spec = _spec()
-    t0 = time.perf_counter()
     ctl = CatchingController(Params(alpha_file=alpha_file), spec=spec)
-    assert time.perf_counter() - t0 < 2.0                      # read from the file, not solved
+    assert ctl.result is None                                  # read from the file, not solved
     T, out = _closed_loop(ctl, spec)
     dist = np.array([o[1] for o in out])
     assert dist.min() < 0.01
@@ -376,3 +375,51 @@ def test_controller_holds_pose_before_the_ball_is_seen():
     assert np.allclose(np.asarray(cmd.torque)[[0, 1, 3]], g[[0, 1, 3]], atol=1e-9)
     assert np.allclose(cmd.hand, spec.hand.open_posture)
     assert "/catching/state" not in ctl.telemetry(0.0)
+
+
+# ---------------------------------------------------------------------------- approach (extension)
+@pytest.fixture(scope="module")
+def approach_problem():
+    """The default throw set with eq. 24's omega_max that eq. 4 permits and the approach term."""
+    return build_problem(_model(), ProblemConfig(tau_max=(60.0, 60.0, 30.0),
+                                                 omega_max=(4.0, 14.0, 40.0),
+                                                 approach_weight=10.0, max_iter=15))
+
+
+def test_approach_term_is_the_relative_acceleration_at_tc(approach_problem):
+    """r_e''(t_c) of approach.py (linear in alpha) against a central difference of
+    r_e(t) = l(f(r_o(t))) - r_o(t) along the sampled throws, for two alphas."""
+    pb = approach_problem
+    term = pb.objective.approach
+    rng = np.random.default_rng(3)
+    alphas = [initial_alpha(pb.C, pb.rhs), initial_alpha(pb.C, pb.rhs)
+              + 0.05 * rng.standard_normal(pb.poly.n_alpha)]
+    h = 2e-4
+    for alpha in alphas:
+        acc = term.accel(alpha)
+        for k, th in enumerate(pb.throws.throws[:: 4]):
+            kk = 4 * k
+            t_c = th.t[-1]
+            v0 = th.rd[0]
+            rs = [th.r[0] + v0 * t + 0.5 * G * t * t for t in (t_c - h, t_c, t_c + h)]
+            A = np.asarray(alpha).reshape(pb.poly.n_mono, 3)
+            re = [pb.model.point(pb.mapping.evaluate(r[None], A=A)[0][0]) - r for r in rs]
+            fd = (re[0] + re[2] - 2 * re[1]) / (h * h)
+            assert np.linalg.norm(re[1]) < 1e-9                     # eq. 4 at t_c
+            assert np.allclose(acc[kk], fd, rtol=1e-3, atol=1e-2 * np.linalg.norm(fd)), kk
+    # the ball approaches from in front of the palm (angle < 90 deg) with the initial alpha
+    assert np.all(term.angles(alphas[0]) < 30.0)
+
+
+def test_approach_jacobian_and_the_extension_lowers_it(approach_problem):
+    pb = approach_problem
+    term = pb.objective.approach
+    a0 = initial_alpha(pb.C, pb.rhs)
+    rng = np.random.default_rng(5)
+    d = rng.standard_normal(a0.shape) * 1e-3
+    fd = (term.residuals(a0 + d) - term.residuals(a0 - d)) / 2
+    assert np.allclose(term.jacobian() @ d, fd, atol=1e-10)     # linear in alpha
+    res = pb.solve()
+    assert res.history[-1].approach_cost < res.history[0].approach_cost
+    assert res.history[-1].objective < res.history[0].objective
+    assert res.constraint_residual < 1e-9

@@ -3,6 +3,9 @@
 from click.testing import CliRunner
 
 from replay.cli import main
+import pytest
+
+from replay.log import LogError, LogReader
 
 
 def invoke(*args):
@@ -84,3 +87,117 @@ def test_optimise_regenerates_the_catching_alpha(project_root, tmp_path):
                                    [b["torque_cost"], b["velocity_cost"]], rtol=1e-6)
     r = invoke("optimise", "scenarios/stick_3step.yaml")
     assert r.exit_code == 2 and "no offline optimisation" in r.output
+
+
+def _one_error_line(r):
+    lines = [l for l in r.output.splitlines() if l.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: "), r.output
+    assert "Traceback" not in r.output
+    return lines[0]
+
+
+def test_output_never_overwrites_an_input_or_a_non_log(toy_yaml, tmp_path):
+    before = toy_yaml.read_bytes()
+    r = invoke("run", toy_yaml, "-o", toy_yaml)
+    assert r.exit_code == 2 and "scenario file" in _one_error_line(r)
+    assert toy_yaml.read_bytes() == before
+    notes = tmp_path / "notes.txt"
+    notes.write_text("mine")
+    r = invoke("run", toy_yaml, "-o", notes)
+    assert r.exit_code == 2 and "not an MCAP log" in _one_error_line(r)
+    assert notes.read_text() == "mine"
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    r = invoke("run", toy_yaml, "-o", afile / "x.mcap")
+    assert r.exit_code == 2 and "is a file, not a folder" in _one_error_line(r)
+    r = invoke("run", toy_yaml, "-o", tmp_path)
+    assert r.exit_code == 2 and "folder" in _one_error_line(r)
+
+
+def test_a_failed_run_leaves_the_old_log(toy_yaml, tmp_path):
+    out = tmp_path / "run.mcap"
+    assert invoke("run", toy_yaml, "-o", out, "-q").exit_code == 0
+    good = out.read_bytes()
+    r = invoke("run", toy_yaml, "-o", out, "--set", "plant.params.blow_up_at=0.2")
+    assert r.exit_code == 1 and "run.failed.mcap" in r.output
+    assert out.read_bytes() == good
+    assert LogReader(tmp_path / "run.failed.mcap").events()[-1]["data"]["success"] is False
+
+
+def test_truncated_and_damaged_logs_say_so(toy_yaml, tmp_path):
+    out = tmp_path / "run.mcap"
+    assert invoke("run", toy_yaml, "-o", out, "-q").exit_code == 0
+    data = out.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) // 2])
+    r = invoke("info", cut)
+    assert r.exit_code == 0 and "TRUNCATED" in r.output and "no outcome event" in r.output
+    flipped = bytearray(data)
+    for i in range(200, 264):
+        flipped[i] ^= 0xFF
+    bad = tmp_path / "flipped.mcap"
+    bad.write_bytes(bytes(flipped))
+    r = invoke("info", bad)
+    assert "Traceback" not in r.output and ("DAMAGED" in r.output or r.exit_code == 2)
+
+
+def test_claims_table_states_a_partial_log(project_root, tmp_path):
+    data = (project_root / "data/golden/stick_3step.mcap").read_bytes()
+    cut = tmp_path / "stick_3step.mcap"
+    cut.write_bytes(data[: len(data) * 9 // 10])
+    r = invoke("claims", cut)
+    assert r.exit_code == 0, r.output
+    assert "is not a finished run" in r.output and "truncated" in r.output
+
+
+def test_broken_golden_manifest_is_one_line(tmp_path):
+    from replay.golden import ManifestError, load_manifest
+    (tmp_path / "data/golden").mkdir(parents=True)
+    for data, expected in ((b"stick_3step: [unclosed\n", "manifest.yaml:2:"),
+                           (b"- a\n", "expected a mapping"), (bytes(range(256)), "not UTF-8"),
+                           (b"g: {scenario: s.yaml}\n", "log: FILE"),
+                           (b"g: {scenario: s, log: l, tolerances: {/x: {abs: -1}}}\n", "abs")):
+        (tmp_path / "data/golden/manifest.yaml").write_bytes(data)
+        with pytest.raises(ManifestError) as info:
+            load_manifest(tmp_path)
+        assert expected in str(info.value) and "\n" not in str(info.value)
+
+
+def test_golden_check_of_a_damaged_stored_log_fails_in_one_line(project_root, tmp_path):
+    from replay.golden import check, load_manifest
+    g = load_manifest()["stick_3step"]
+    g.log = tmp_path / "stored.mcap"
+    g.sets = [*g.sets, "timing.duration=0.05"]
+    for data in (b"", bytes(range(256)) * 8):
+        g.log.write_bytes(data)
+        with pytest.raises(LogError) as info:
+            check(g)
+        assert "stored golden log" in str(info.value)
+
+
+def test_optimise_without_a_file_is_one_line(project_root):
+    r = invoke("optimise", "scenarios/catch_initial.yaml")
+    assert r.exit_code == 2 and "alpha_file" in _one_error_line(r)
+    r = invoke("optimise", "scenarios/catch_optimised.yaml", "-o",
+               "scenarios/catch_optimised.yaml")
+    assert r.exit_code == 2 and "will not write" in _one_error_line(r)
+
+
+def test_ctrl_c_while_starting_exits_130(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+    codes = []
+    for delay in (0.2, 0.3, 0.6):
+        p = subprocess.Popen([sys.executable, "-m", "replay.entry", "list"], cwd=tmp_path,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(delay)
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=60)
+        if "init_import_site" in err or p.returncode == -signal.SIGINT:
+            continue          # the interpreter itself was not up yet: nothing of ours ran
+        codes.append(p.returncode)
+        assert p.returncode in (130, 0), (p.returncode, err)
+        assert "Traceback" not in err and "Aborted!" not in err
+    assert codes

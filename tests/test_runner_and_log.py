@@ -176,7 +176,9 @@ main()
 
 
 def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
-    out = tmp_path / "interrupted.mcap"
+    """The interrupted run is closed properly under its own name; an old log at -o stays."""
+    out = tmp_path / "run.mcap"
+    old = Runner(load_scenario(toy_yaml, sets=["timing.duration=0.1"])).run(out).path.read_bytes()
     code = INTERRUPTED_RUN.format(tests=os.path.dirname(__file__), yaml=str(toy_yaml),
                                   out=str(out))
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
@@ -189,8 +191,43 @@ def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
         proc.kill()
     assert proc.returncode == 130
     assert "interrupted at t = " in err and "partial log kept" in err and "Traceback" not in err
-    r = LogReader(out)                      # finished properly: summary, final name
+    assert out.read_bytes() == old
+    kept = tmp_path / "run.interrupted.mcap"
+    assert str(kept) in err
+    r = LogReader(kept)                     # finished properly: summary, its own name
     assert not r.truncated
     assert [e["kind"] for e in r.events()[-2:]] == ["interrupted", "outcome"]
     assert r.events()[-1]["data"] == {"success": False, "reason": "interrupted"}
     assert 0.9 < r.time_range()[1] < 1.2
+
+
+def test_sigint_mid_record_is_held_until_the_record_is_whole(tmp_path):
+    """Ctrl-C while a record is written is raised only once the write is done, so the log never
+    holds a torn record; after close the default handler is back."""
+    w = LogWriter(tmp_path / "x.mcap", chunk_size=100)
+    with pytest.raises(KeyboardInterrupt):
+        with w._held:                                   # what write() does around a record
+            os.kill(os.getpid(), signal.SIGINT)
+            w._writer.add_message(channel_id=w._channel("/events", Event(0.0, "a")),
+                                  log_time=0, publish_time=0, data=b'{"t":0,"kind":"a"}', sequence=0)
+            reached = True
+    assert reached
+    w.write("/events", Event(0.001, "interrupted"), 1_000_000)
+    assert w.close("interrupted") == tmp_path / "x.interrupted.mcap"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    r = LogReader(tmp_path / "x.interrupted.mcap").check()
+    assert r.status == "complete" and [e["kind"] for e in r.events()] == ["a", "interrupted"]
+
+
+def test_messages_that_are_not_json_objects_are_skipped_and_said(tmp_path):
+    from mcap.writer import Writer
+    with open(tmp_path / "x.mcap", "wb") as f:
+        w = Writer(f)
+        w.start()
+        c = w.register_channel("/events", "json", w.register_schema("s", "jsonschema", b"{}"))
+        for i, data in enumerate([b'{"t": 0, "kind": "a"}', b"\xff\xfe", b"[1]", b"{bad"]):
+            w.add_message(c, log_time=i, publish_time=i, data=data)
+        w.finish()
+    r = LogReader(tmp_path / "x.mcap").check()
+    assert [e["kind"] for e in r.events()] == ["a"]
+    assert r.damaged and any("3 message(s) not a JSON object" in p for p in r.problems)

@@ -11,8 +11,7 @@ from replay.messages import VisionStick
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import yaw_quaternion
 from replay.sensors.pinhole import PinholeCamera
-from replay.sensors.stick_camera import (StickCamera, StickCameraParams, polygon_coverage,
-                                        render_scene, wrap_half_pi)
+from replay.sensors.stick_camera import StickCamera, StickCameraParams, render_scene, wrap_half_pi
 
 STICK = (0.100, 0.010, 0.005)          # L x W (paper) x an assumed thickness (m)
 
@@ -209,36 +208,6 @@ def test_render_covers_the_true_area():
     half_angle = math.asin(0.05 / 1.0)
     expected = math.pi * (eye.intrinsics.fx * math.tan(half_angle)) ** 2
     assert img.sum() / 255.0 == pytest.approx(expected, rel=0.002)
-
-
-def test_polygon_coverage_is_the_area_in_each_pixel():
-    rng = np.random.default_rng(12)
-    g = (np.arange(400) + 0.5) / 400 - 0.5                     # 400 x 400 samples per pixel
-    for k in range(60):
-        c, r = rng.uniform(7, 13, 2), rng.uniform(0.3, 6.0)
-        ang = np.sort(rng.uniform(0, 2 * np.pi, rng.integers(3, 12)))
-        if k % 3 == 0:                                          # (nearly) grid-aligned squares
-            ang = np.array([0, 0.5, 1, 1.5]) * np.pi + rng.choice([0.0, 1e-14, 1e-9])
-        poly = c + r * np.column_stack([np.cos(ang), np.sin(ang)])
-        if k % 2:
-            poly = poly[::-1]                                   # either orientation
-        cov = polygon_coverage(poly, 0, 0, 20, 20)
-        area = 0.5 * abs(np.sum(poly[:, 0] * np.roll(poly[:, 1], -1)
-                                - np.roll(poly[:, 0], -1) * poly[:, 1]))
-        assert cov.sum() == pytest.approx(area, abs=1e-9)
-        assert cov.min() > -1e-12 and cov.max() < 1 + 1e-12
-        ccw = poly if np.sum(poly[:, 0] * np.roll(poly[:, 1], -1)
-                             - np.roll(poly[:, 0], -1) * poly[:, 1]) > 0 else poly[::-1]
-        i, j = np.rint(c + rng.uniform(-r, r, 2)).astype(int)
-        X, Y = np.meshgrid(i + g, j + g)
-        inside = np.ones_like(X, bool)
-        for (xa, ya), (xb, yb) in zip(ccw, np.roll(ccw, -1, axis=0)):
-            inside &= (xb - xa) * (Y - ya) - (yb - ya) * (X - xa) >= 0
-        assert cov[j, i] == pytest.approx(inside.mean(), abs=0.005)
-    # an offset block sees the same pixels
-    poly = np.array([[3.2, 4.1], [9.7, 5.0], [6.0, 11.3]])
-    np.testing.assert_allclose(polygon_coverage(poly, 2, 3, 8, 9),
-                               polygon_coverage(poly, 0, 0, 20, 20)[3:12, 2:10], atol=1e-12)
 
 
 @pytest.mark.parametrize("a,expected", [(0.0, 0.0), (math.pi / 2, math.pi / 2),

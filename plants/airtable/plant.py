@@ -53,6 +53,8 @@ class AirTablePlant(Plant):
     """Stick on an air table and a two-fingered hand on an XY slider (Pymunk)."""
 
     Params = Params
+    spec_type = AirTableSpec
+    command_types = (HandCommand,)
     description = ("Pymunk air table: a free stick (no table friction) and two position-"
                    "commanded fingertip discs on an XY slider hand (Higashimori et al. 2007)")
 
@@ -145,20 +147,22 @@ class AirTablePlant(Plant):
         dt = self.dt
         # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
         self.hand.advance(dt)
-        for tb, tip in zip(self.tip_bodies, self.hand.tips()):
-            tb.velocity = ((float(tip[0]) - tb.position.x) / dt,
-                           (float(tip[1]) - tb.position.y) / dt)
+        for tb, tip in zip(self.tip_bodies, self.hand.tips().tolist()):
+            x, y = tb.position
+            tb.velocity = ((tip[0] - x) / dt, (tip[1] - y) / dt)
         b = self.stick_body
-        self._before = (_vec(b.velocity), float(b.angular_velocity))
+        vx, vy = b.velocity
+        self._before = ([vx, vy], b.angular_velocity)
         self._pending = []
         self.space.step(dt)
         self._steps += 1
-        v_after, w_after = _vec(b.velocity), float(b.angular_velocity)
-        for c in self._pending:
-            c["v_after"], c["omega_after"] = v_after, w_after
-            self._events.append(Occurrence("collision", c))
-        self._collisions += len(self._pending)
-        self._pending = []
+        if self._pending:
+            v_after, w_after = _vec(b.velocity), float(b.angular_velocity)
+            for c in self._pending:
+                c["v_after"], c["omega_after"] = v_after, w_after
+                self._events.append(Occurrence("collision", c))
+            self._collisions += len(self._pending)
+            self._pending = []
         self._check_state()
         self._check_held()
 
@@ -196,19 +200,20 @@ class AirTablePlant(Plant):
 
     def _check_state(self) -> None:
         b = self.stick_body
-        values = {"x": b.position.x, "y": b.position.y, "theta": b.angle,
-                  "vx": b.velocity.x, "vy": b.velocity.y, "omega": b.angular_velocity}
-        for k, tb in enumerate(self.tip_bodies):
-            values[f"tip{k}_x"], values[f"tip{k}_y"] = tb.position.x, tb.position.y
-        bad = sorted(k for k, v in values.items() if not math.isfinite(v))
-        if bad:
+        (x, y), (vx, vy), angle, omega = b.position, b.velocity, b.angle, b.angular_velocity
+        tips = [tb.position for tb in self.tip_bodies]
+        if not all(map(math.isfinite, (x, y, angle, vx, vy, omega, *(c for tip in tips for c in tip)))):
+            values = {"x": x, "y": y, "theta": angle, "vx": vx, "vy": vy, "omega": omega}
+            for k, (tx, ty) in enumerate(tips):
+                values[f"tip{k}_x"], values[f"tip{k}_y"] = tx, ty
+            bad = sorted(k for k, v in values.items() if not math.isfinite(v))
             if not self._nan_reported:
                 self._nan_reported = True
                 self._events.append(Occurrence("nan", {"fields": bad, "step": self._steps}))
             return
         t = self.time
-        slow = (math.hypot(b.velocity.x, b.velocity.y) < self.params.rest_speed
-                and abs(b.angular_velocity) < self.params.rest_omega)
+        slow = (math.hypot(vx, vy) < self.params.rest_speed
+                and abs(omega) < self.params.rest_omega)
         if not slow:
             self._rest_since = None
             self._rest_reported = False        # moving again: a later rest is a new event
@@ -218,9 +223,9 @@ class AirTablePlant(Plant):
         if not self._rest_reported and t - self._rest_since >= self.params.rest_time - 1e-12:
             self._rest_reported = True
             self._events.append(Occurrence("rest", {
-                "since": self._rest_since, "x": b.position.x, "y": b.position.y,
-                "theta": b.angle, "speed": math.hypot(b.velocity.x, b.velocity.y),
-                "omega": b.angular_velocity}))
+                "since": self._rest_since, "x": x, "y": y,
+                "theta": angle, "speed": math.hypot(vx, vy),
+                "omega": omega}))
 
     def _in_reach(self) -> bool:
         """The stick's centre within finger reach (l1 + l2, joint limits ignored) plus L/2 of a
@@ -289,9 +294,9 @@ class AirTablePlant(Plant):
 
     def truth(self, t: float) -> dict[str, Any]:
         b = self.stick_body
+        (x, y), (vx, vy) = b.position, b.velocity
         return {
-            TOPIC_STICK_STATE: StickState(t=t, x=b.position.x, y=b.position.y, theta=b.angle,
-                                       vx=b.velocity.x, vy=b.velocity.y,
+            TOPIC_STICK_STATE: StickState(t=t, x=x, y=y, theta=b.angle, vx=vx, vy=vy,
                                        omega=b.angular_velocity),
             TOPIC_FINGERS_STATE: FingersState(t=t, tips=[_vec(tb.position)
                                                       for tb in self.tip_bodies]),

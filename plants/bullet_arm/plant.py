@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
@@ -40,6 +41,8 @@ with quiet_c_output():                          # PyBullet's import prints a bui
 
 class BulletArmPlant(Plant):
     Params = Params
+    spec_type = ArmSpec
+    command_types = (ArmCommand,)
     description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"
 
     def __init__(self, params: Params, *, dt: float, rng: np.random.Generator) -> None:
@@ -149,7 +152,13 @@ class BulletArmPlant(Plant):
         self._obj_vel_before = (np.asarray(P.object_velocity, float) if self.obj is not None
                                 else np.zeros(3))
         self._contacts: list = []
+        self._cache = None
         self._spec = self._make_spec(q0)
+        ht = self.hand_table          # the catch verdict (outcome.py): a free object and a hand
+        self._watch = (CatchWatch(kind=P.object, palm_radius=ht.palm_size[0] if ht.palm_shape ==
+                                  "cylinder" else min(ht.palm_size[:2]) / 2,
+                                  palm_thickness=ht.palm_thickness)
+                       if self.obj is not None and ht is not None else None)
 
     # ------------------------------------------------------------------ spec
     def _make_spec(self, q0: np.ndarray) -> ArmSpec:
@@ -183,27 +192,45 @@ class BulletArmPlant(Plant):
         return self._spec
 
     # ------------------------------------------------------------------ state
+    def _state(self) -> tuple:
+        """((q, qd), hand (q, qd, effort), object (pos, orn, v, w) or None), read from PyBullet
+        once after each step and kept until the next one (``invalidate_state`` after changing
+        the simulation other than by stepping it)."""
+        if self._cache is None:
+            q = np.zeros(self.dof)
+            qd = np.zeros(self.dof)
+            for n, v in self.locked.items():
+                q[self.joint_names.index(n)] = v
+            for k, st in enumerate(self.bc.getJointStates(self.robot, self._arm_j)):
+                q[self.active[k]], qd[self.active[k]] = st[0], st[1]
+            if self._hand_j:
+                st = self.bc.getJointStates(self.robot, self._hand_j)
+                hand = (np.array([s[0] for s in st]), np.array([s[1] for s in st]),
+                        np.array([s[3] for s in st]))
+            else:
+                hand = (np.zeros(0), np.zeros(0), np.zeros(0))
+            obj = None
+            if self.obj is not None:
+                pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
+                v, w = self.bc.getBaseVelocity(self.obj)
+                obj = (np.array(pos), np.array(orn), np.array(v), np.array(w))
+            self._cache = ((q, qd), hand, obj)
+        return self._cache
+
+    def invalidate_state(self) -> None:
+        """Forget the state read from PyBullet (after a reset* call: the next read is fresh)."""
+        self._cache = None
+
     def arm_state(self) -> tuple[np.ndarray, np.ndarray]:
         """(q, qd) of every arm joint (locked ones at their lock value, zero speed)."""
-        q = np.zeros(self.dof)
-        qd = np.zeros(self.dof)
-        for n, v in self.locked.items():
-            q[self.joint_names.index(n)] = v
-        for k, st in enumerate(self.bc.getJointStates(self.robot, self._arm_j)):
-            q[self.active[k]], qd[self.active[k]] = st[0], st[1]
-        return q, qd
+        q, qd = self._state()[0]
+        return q.copy(), qd.copy()
 
     def hand_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        if not self._hand_j:
-            return np.zeros(0), np.zeros(0), np.zeros(0)
-        st = self.bc.getJointStates(self.robot, self._hand_j)
-        return (np.array([s[0] for s in st]), np.array([s[1] for s in st]),
-                np.array([s[3] for s in st]))
+        return tuple(a.copy() for a in self._state()[1])
 
     def object_state(self):
-        pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
-        v, w = self.bc.getBaseVelocity(self.obj)
-        return np.array(pos), np.array(orn), np.array(v), np.array(w)
+        return tuple(a.copy() for a in self._state()[2])
 
     def effector_state(self):
         """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity."""
@@ -270,6 +297,7 @@ class BulletArmPlant(Plant):
                                                      * self.params.gravity],
                                       pos.tolist(), p.WORLD_FRAME)
         bc.stepSimulation()
+        self._cache = None
         self._steps += 1
         self._t = self._steps * self.dt
         self._check_events()
@@ -357,10 +385,19 @@ class BulletArmPlant(Plant):
             kind = "drop" if self._ever_caught else "miss"
             self._events.append(Occurrence(kind, {"position": pos.tolist(),
                                                   "velocity": v.tolist()}))
+        if self._watch is not None:
+            pe, oe, ve, we = self.effector_state()
+            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
         return ev
+
+    def outcome(self, t: float) -> dict | None:
+        """Caught or not, and why, with the first touch's metrics (plants/bullet_arm/outcome.py)."""
+        if self._watch is None:
+            return None
+        return self._watch.verdict(caught=self.caught, ever_caught=self._ever_caught)
 
     # ------------------------------------------------------------------ log and scene
     def truth(self, t: float) -> dict:

@@ -4,87 +4,85 @@
   key, anything else is replaced, and a plug-in section whose ``type:`` changes is replaced
   whole.
 - ``--set key.path=value`` overrides one field (the value is read as YAML).
-- Every plug-in's ``params`` are checked against its ``Params`` dataclass.
-- Unknown keys, wrong types, missing fields and out-of-range values raise :class:`ScenarioError`
-  naming ``file:line:column``, the field path and what was expected.
+- Every value passes one validation layer before a run starts: its type (every list item too,
+  and the list's length), finiteness, range, choices, size; then the checks between fields
+  (each ``Params.__post_init__``, rates that divide the physics rate) and between plug-ins
+  (:mod:`replay.scenario.ports`). So ``replay validate`` accepts exactly what ``replay run``
+  can run.
+- Any failure raises :class:`ScenarioError` naming ``file:line:column`` of the field's own
+  node, the field path and what was expected.
+
+A new scenario section is a field of :class:`~replay.scenario.schema.Scenario`; a section that
+holds plug-ins (``type:`` + ``params:``) is also listed in :func:`plugin_sections`.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
+import re
 import types
 import typing
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import yaml
 
 from replay import registry
+from replay.params import MAX_CHARS, MAX_FLOAT, MAX_INT, MAX_ITEMS, ParamError
 from replay.scenario.schema import Scenario
+from replay.scenario.yamlio import ScenarioError, compose, read_text, show
+
+__all__ = ["ScenarioError", "build", "build_dataclass", "load_scenario", "params_from_data",
+           "plugin_sections",
+           "resolved_yaml", "scenario_from_text", "to_plain"]
 
 _SET_SOURCE = "<--set>"
-
-
-class ScenarioError(Exception):
-    def __init__(self, message: str, *, node: yaml.Node | None = None, path: str = "",
-                 file: str | None = None) -> None:
-        self.message = message
-        self.path = path
-        if node is not None:
-            mark = node.start_mark
-            self.where = f"{mark.name}:{mark.line + 1}:{mark.column + 1}"
-        else:
-            self.where = file or "<scenario>"
-        super().__init__(f"{self.where}: {path + ': ' if path else ''}{message}")
+MAX_EXTENDS = 16                 # extends chains at most this long
+MAX_SET_CHARS = 100_000
+_STR = "tag:yaml.org,2002:str"
+_MAP = "tag:yaml.org,2002:map"
+_PLAIN_FLOAT = re.compile(r"[-+]?(\d[\d_]*\.?\d*|\.\d+)[eE][-+]?\d+")   # 1e-3: YAML 1.1 says str
 
 
 # -- reading YAML into node trees ----------------------------------------------------------------
 
-def _compose(text: str, name: str) -> yaml.Node:
-    try:
-        node = yaml.compose(text, Loader=_NamedLoader.with_name(name))
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark
-        where = f"{name}:{mark.line + 1}:{mark.column + 1}" if mark else name
-        raise ScenarioError(f"not valid YAML: {exc.problem}", file=where) from None
+def _compose_root(text: str, name: str) -> yaml.MappingNode:
+    node = compose(text, name)
     if node is None:
         raise ScenarioError("empty scenario", file=name)
     if not isinstance(node, yaml.MappingNode):
-        raise ScenarioError("a scenario is a mapping of fields", node=node)
+        raise ScenarioError(f"a scenario is a mapping of fields, got {_kind(node)}", node=node)
     return node
 
 
-class _NamedLoader(yaml.SafeLoader):
-    source_name = "<string>"
-
-    def __init__(self, stream):
-        super().__init__(stream)
-        self.name = self.source_name
-
-    @classmethod
-    def with_name(cls, name: str):
-        return type("NamedLoader", (cls,), {"source_name": name})
-
-
-def _compose_file(path: Path, seen: tuple[Path, ...] = ()) -> yaml.MappingNode:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario: {exc.strerror}", file=str(path)) from None
-    node = _compose(text, str(path))
+def _compose_file(path: Path, seen: tuple[Path, ...] = (), *, inputs: list[Path]
+                  ) -> yaml.MappingNode:
+    """The file's tree merged onto its ``extends`` chain; ``seen``: the files below it,
+    ``inputs`` collects every file read."""
+    inputs.append(path.resolve())
+    node = _compose_root(read_text(path), str(path))
     base_node = _pop(node, "extends")
     if base_node is None:
         return node
-    if not (isinstance(base_node, yaml.ScalarNode) and base_node.tag.endswith(":str")):
+    if not (isinstance(base_node, yaml.ScalarNode) and base_node.tag == _STR and
+            base_node.value):
         raise ScenarioError("expected a file name", node=base_node, path="extends")
-    base_path = (path.parent / base_node.value).resolve()
-    if base_path in seen:
-        raise ScenarioError(f"extends loop through {base_path.name}", node=base_node,
+    try:
+        base_path = (path.parent / base_node.value).resolve()
+    except (OSError, RuntimeError, ValueError):
+        raise ScenarioError(f"bad file name {show(base_node.value)}", node=base_node,
+                            path="extends") from None
+    if base_path in seen or base_path == path.resolve():
+        raise ScenarioError(f"extends loop through {show(base_path.name)}", node=base_node,
+                            path="extends")
+    if len(seen) >= MAX_EXTENDS:
+        raise ScenarioError(f"extends chain longer than {MAX_EXTENDS} files", node=base_node,
                             path="extends")
     if not base_path.is_file():
-        raise ScenarioError(f"no such scenario file {base_node.value!r}", node=base_node,
+        raise ScenarioError(f"no such scenario file {show(base_node.value)}", node=base_node,
                             path="extends")
-    return _merge(_compose_file(base_path, seen + (path.resolve(),)), node)
+    return _merge(_compose_file(base_path, seen + (path.resolve(),), inputs=inputs), node)
 
 
 def _pop(mapping: yaml.MappingNode, key: str) -> yaml.Node | None:
@@ -124,17 +122,18 @@ def _merge(base: yaml.Node, over: yaml.Node) -> yaml.Node:
 
 def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
     if "=" not in assignment:
-        raise ScenarioError(f"--set expects key.path=value, got {assignment!r}", file=_SET_SOURCE)
+        raise ScenarioError(f"--set expects key.path=value, got {show(assignment)}",
+                            file=_SET_SOURCE)
     key_path, text = assignment.split("=", 1)
-    keys = [k for k in key_path.strip().split(".")]
+    keys = [k.strip() for k in key_path.strip().split(".")]
     if not all(keys):
-        raise ScenarioError(f"--set: bad key path {key_path!r}", file=_SET_SOURCE)
-    try:
-        value = yaml.compose(text if text.strip() else "''",
-                             Loader=_NamedLoader.with_name(f"<--set {key_path}>"))
-    except yaml.YAMLError:
-        raise ScenarioError(f"--set {key_path}: value {text!r} is not valid YAML",
-                            file=_SET_SOURCE) from None
+        raise ScenarioError(f"--set: bad key path {show(key_path)}", file=_SET_SOURCE)
+    if len(text) > MAX_SET_CHARS:
+        raise ScenarioError(f"--set {key_path}: value longer than {MAX_SET_CHARS} characters",
+                            file=_SET_SOURCE)
+    value = compose(text if text.strip() else "''", f"<--set {key_path}>", what="a value")
+    if value is None:      # "key=" followed by a comment only
+        value = compose("''", f"<--set {key_path}>")
     node = root
     for depth, key in enumerate(keys):
         last = depth == len(keys) - 1
@@ -143,17 +142,20 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
             if found:
                 node.value[node.value.index(found)] = (found[0], value)
             else:
-                node.value.append((yaml.ScalarNode("tag:yaml.org,2002:str", key,
-                                                   value.start_mark, value.end_mark), value))
+                node.value.append((yaml.ScalarNode(_STR, key, value.start_mark,
+                                                   value.end_mark), value))
             return
         if found is None:
-            child = yaml.MappingNode("tag:yaml.org,2002:map", [], value.start_mark,
-                                     value.end_mark)
-            node.value.append((yaml.ScalarNode("tag:yaml.org,2002:str", key, value.start_mark,
-                                               value.end_mark), child))
+            child = yaml.MappingNode(_MAP, [], value.start_mark, value.end_mark)
+            node.value.append((yaml.ScalarNode(_STR, key, value.start_mark, value.end_mark),
+                               child))
             node = child
         elif isinstance(found[1], yaml.MappingNode):
             node = found[1]
+        elif isinstance(found[1], yaml.ScalarNode) and found[1].tag.endswith(":null"):
+            child = yaml.MappingNode(_MAP, [], value.start_mark, value.end_mark)
+            node.value[node.value.index(found)] = (found[0], child)
+            node = child
         else:
             raise ScenarioError(f"--set {key_path}: {'.'.join(keys[:depth + 1])} is not a "
                                 "mapping", file=_SET_SOURCE)
@@ -161,11 +163,12 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
 
 # -- node trees into typed values ------------------------------------------------------------
 
-def _scalar(node: yaml.Node, path: str) -> Any:
+def _scalar(node: yaml.ScalarNode, path: str) -> Any:
     try:
         return yaml.SafeLoader("").construct_object(node, deep=True)
-    except yaml.constructor.ConstructorError as exc:
-        raise ScenarioError(f"not allowed: {exc.problem} (scenarios are data, not code)",
+    except (yaml.constructor.ConstructorError, ValueError, OverflowError) as exc:
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ScenarioError(f"not allowed: {problem} (scenarios are data, not code)",
                             node=node, path=path) from None
 
 
@@ -186,25 +189,74 @@ def _describe(tp) -> str:
     return str(tp)
 
 
-def _bounds(meta) -> str:
+def _limits(meta: dict, default: float) -> tuple[float, float]:
+    """The effective (low, high) of a number: its own bounds, else +-default."""
+    low = next((meta[k] for k in ("ge", "gt") if meta.get(k) is not None), -default)
+    high = next((meta[k] for k in ("le", "lt") if meta.get(k) is not None), default)
+    return low, high
+
+
+def _bounds(meta: dict, default: float | None = None) -> str:
     parts = []
     for key, sym in (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")):
         if meta.get(key) is not None:
             parts.append(f"{sym} {meta[key]:g}")
+    if default is not None:
+        if not any(meta.get(k) is not None for k in ("ge", "gt")):
+            parts.insert(0, f">= {-default:g}")
+        if not any(meta.get(k) is not None for k in ("le", "lt")):
+            parts.append(f"<= {default:g}")
     text = " and ".join(parts)
     if meta.get("unit") and meta["unit"] != "1":
         text += f" ({meta['unit']})"
     return text.strip()
 
 
-def _check_range(value: float, meta, node, path) -> None:
-    ok = ((meta.get("ge") is None or value >= meta["ge"]) and
-          (meta.get("gt") is None or value > meta["gt"]) and
-          (meta.get("le") is None or value <= meta["le"]) and
-          (meta.get("lt") is None or value < meta["lt"]))
+def _check_range(value: float, meta: dict, node, path, default: float) -> None:
+    low, high = _limits(meta, default)
+    ok = ((value > low if meta.get("gt") is not None else value >= low) and
+          (value < high if meta.get("lt") is not None else value <= high))
     if not ok:
-        raise ScenarioError(f"expected a number {_bounds(meta)}, got {value:g}", node=node,
+        what = "a whole number" if isinstance(value, int) else "a number"
+        got = show(value, 24) if isinstance(value, int) else f"{value:g}"
+        raise ScenarioError(f"expected {what} {_bounds(meta, default)}, got {got}", node=node,
                             path=path)
+
+
+def _number(node: yaml.ScalarNode, path: str, meta: dict) -> float:
+    if node.tag == _STR and node.style is None and _PLAIN_FLOAT.fullmatch(node.value):
+        value: Any = float(node.value.replace("_", ""))      # 1e-3 (YAML 1.1 reads a string)
+    else:
+        value = _scalar(node, path)
+    bounds = _bounds(meta, MAX_FLOAT)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ScenarioError(f"expected a number {bounds}, got {show(node.value)}", node=node,
+                            path=path)
+    if isinstance(value, float) and math.isnan(value):
+        raise ScenarioError(f"expected a number {bounds}, got NaN", node=node, path=path)
+    if isinstance(value, float) and math.isinf(value):
+        if not meta.get("allow_inf"):
+            raise ScenarioError(f"expected a finite number {bounds}, got {value}", node=node,
+                                path=path)
+        low, high = _limits(meta, math.inf)
+        if not low <= value <= high:
+            raise ScenarioError(f"expected a number {_bounds(meta)}, got {value}", node=node,
+                                path=path)
+        return value
+    _check_range(value, meta, node, path, MAX_FLOAT)     # exact for huge ints: no overflow
+    return float(value)
+
+
+def _check_length(n: int, meta: dict, node, path, what: str) -> None:
+    exact = meta.get("length")
+    if exact is not None:
+        if n != exact:
+            raise ScenarioError(f"expected {what} of {exact}, got {n}", node=node, path=path)
+        return
+    low = meta.get("min_length") or 0
+    high = meta.get("max_length") or (MAX_CHARS if what == "a string" else MAX_ITEMS)
+    if not low <= n <= high:
+        raise ScenarioError(f"expected {what} of {low} to {high}, got {n}", node=node, path=path)
 
 
 def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
@@ -224,57 +276,87 @@ def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
     if dataclasses.is_dataclass(tp):
         return build_dataclass(node, tp, path)
     if origin in (list, tuple):
-        if not isinstance(node, yaml.SequenceNode):
-            raise ScenarioError(f"expected {_describe(tp)}, got {_kind(node)}", node=node,
-                                path=path)
-        args = typing.get_args(tp) or (Any,)
-        n = meta.get("length")
-        if n is not None and len(node.value) != n:
-            raise ScenarioError(f"expected a list of {n} items, got {len(node.value)}",
-                                node=node, path=path)
-        if origin is tuple and len(args) > 1 and args[1] is not Ellipsis:
-            if len(node.value) != len(args):
-                raise ScenarioError(f"expected a list of {len(args)} items, got "
-                                    f"{len(node.value)}", node=node, path=path)
-            item_types = args
-        else:
-            item_types = [args[0]] * len(node.value)
-        items = [_scalar(v, f"{path}[{i}]") if t is Any else
-                 build(v, t, f"{path}[{i}]", {**meta, "length": None})
-                 for i, (v, t) in enumerate(zip(node.value, item_types))]
-        return tuple(items) if origin is tuple else items
+        return _build_list(node, tp, path, meta)
     if origin is dict:
-        if not isinstance(node, yaml.MappingNode):
-            raise ScenarioError(f"expected a mapping, got {_kind(node)}", node=node, path=path)
-        _, vt = typing.get_args(tp) or (str, Any)
-        if vt is Any:
-            return node
-        return {k.value: build(v, vt, f"{path}.{k.value}") for k, v in node.value}
+        return _build_dict(node, tp, path, meta)
     if not isinstance(node, yaml.ScalarNode):
         raise ScenarioError(f"expected {_describe(tp)}, got {_kind(node)}", node=node, path=path)
-    value = _scalar(node, path)
     if tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ScenarioError(f"expected a number{' ' + _bounds(meta) if _bounds(meta) else ''}"
-                                f", got {node.value!r}", node=node, path=path)
-        value = float(value)
-        _check_range(value, meta, node, path)
-    elif tp is int:
+        value = _number(node, path, meta)
+    else:
+        value = _scalar(node, path)
+    if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ScenarioError(f"expected a whole number, got {node.value!r}", node=node,
+            raise ScenarioError(f"expected a whole number, got {show(node.value)}", node=node,
                                 path=path)
-        _check_range(value, meta, node, path)
+        _check_range(value, meta, node, path, MAX_INT)
     elif tp is bool:
         if not isinstance(value, bool):
-            raise ScenarioError(f"expected true or false, got {node.value!r}", node=node,
+            raise ScenarioError(f"expected true or false, got {show(node.value)}", node=node,
                                 path=path)
     elif tp is str:
         if not isinstance(value, str):
-            raise ScenarioError(f"expected a string, got {node.value!r}", node=node, path=path)
+            raise ScenarioError(f"expected a string, got {show(node.value)}", node=node,
+                                path=path)
+        _check_length(len(value), meta, node, path, "a string")
+        pattern = meta.get("pattern")
+        if pattern and not re.fullmatch(pattern, value):
+            raise ScenarioError(f"expected a name matching {pattern}, got {show(value)}",
+                                node=node, path=path)
+    elif tp is Any or tp is object:
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ScenarioError(f"expected a finite value, got {value}", node=node, path=path)
     if meta.get("choices") and value not in meta["choices"]:
         raise ScenarioError(f"expected one of {', '.join(map(str, meta['choices']))}, got "
-                            f"{value!r}", node=node, path=path)
+                            f"{show(value)}", node=node, path=path)
     return value
+
+
+def _build_list(node: yaml.Node, tp: Any, path: str, meta: dict) -> list | tuple:
+    origin = typing.get_origin(tp)
+    if not isinstance(node, yaml.SequenceNode):
+        raise ScenarioError(f"expected {_describe(tp)}, got {_kind(node)}", node=node, path=path)
+    args = typing.get_args(tp) or (Any,)
+    if origin is tuple and len(args) > 1 and args[1] is not Ellipsis:
+        meta = {**meta, "length": len(args)}
+        item_types = list(args)
+    else:
+        item_types = [args[0]] * len(node.value)
+    _check_length(len(node.value), meta, node, path, "a list")
+    item_meta = {k: v for k, v in meta.items()
+                 if k not in ("length", "min_length", "max_length")}
+    items = []
+    for i, (v, t) in enumerate(zip(node.value, item_types)):
+        sub = f"{path}[{i}]"
+        if t is Any:
+            if not isinstance(v, yaml.ScalarNode):
+                raise ScenarioError(f"expected a number, string or true/false, got {_kind(v)}",
+                                    node=v, path=sub)
+            t = object
+        items.append(build(v, t, sub, item_meta))
+    return tuple(items) if origin is tuple else items
+
+
+_KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_-]{0,63}")
+
+
+def _build_dict(node: yaml.Node, tp: Any, path: str, meta: dict) -> Any:
+    if not isinstance(node, yaml.MappingNode):
+        raise ScenarioError(f"expected a mapping, got {_kind(node)}", node=node, path=path)
+    _, vt = typing.get_args(tp) or (str, Any)
+    if vt is Any:
+        return node
+    _check_length(len(node.value), {"max_length": meta.get("max_length") or 32}, node, path,
+                  "a mapping")
+    out = {}
+    for k, v in node.value:
+        if not _KEY.fullmatch(k.value):
+            raise ScenarioError(f"expected a name (letters, digits, _ and -), got "
+                                f"{show(k.value)}", node=k, path=f"{path}.{k.value}")
+        if k.value in out:
+            raise ScenarioError("given twice", node=k, path=f"{path}.{k.value}")
+        out[k.value] = build(v, vt, f"{path}.{k.value}")
+    return out
 
 
 def _kind(node: yaml.Node) -> str:
@@ -282,10 +364,14 @@ def _kind(node: yaml.Node) -> str:
         return "a mapping"
     if isinstance(node, yaml.SequenceNode):
         return "a list"
-    return repr(node.value)
+    if node.tag.endswith(":null"):
+        return "nothing (null)"
+    return show(node.value)
 
 
 def build_dataclass(node: yaml.Node, cls: type, path: str) -> Any:
+    if isinstance(node, yaml.ScalarNode) and node.tag.endswith(":null"):
+        node = yaml.MappingNode(_MAP, [], node.start_mark, node.end_mark)   # "key:" = defaults
     if not isinstance(node, yaml.MappingNode):
         raise ScenarioError(f"expected a mapping of {cls.__name__} fields, got {_kind(node)}",
                             node=node, path=path)
@@ -296,7 +382,7 @@ def build_dataclass(node: yaml.Node, cls: type, path: str) -> Any:
         key = k.value
         sub = f"{path}.{key}" if path else str(key)
         if key not in fields:
-            raise ScenarioError(f"unknown field {key!r} (expected one of: "
+            raise ScenarioError(f"unknown field {show(key)} (expected one of: "
                                 f"{', '.join(fields)})", node=k, path=sub)
         if key in values:
             raise ScenarioError("field given twice", node=k, path=sub)
@@ -311,69 +397,111 @@ def build_dataclass(node: yaml.Node, cls: type, path: str) -> Any:
                                 node=node, path=path or "(top level)")
     try:
         return cls(**values)
-    except (ValueError, TypeError) as exc:  # a Params __post_init__ check
+    except ParamError as exc:     # a Params __post_init__ check naming its field
+        sub = f"{path}.{exc.field}" if path else exc.field
+        raise ScenarioError(exc.message, node=node_at(node, exc.field) or node,
+                            path=sub) from None
+    except (ValueError, TypeError, ArithmeticError) as exc:   # any other Params check
         raise ScenarioError(str(exc), node=node, path=path) from None
 
 
 # -- scenarios --------------------------------------------------------------------------------
 
-def _node_at(root: yaml.Node, path: str) -> yaml.Node | None:
+def node_at(root: yaml.Node, path: str) -> yaml.Node | None:
+    """The node of a field path (``a.b[2].c``) under ``root``, or None when it is not given."""
     node = root
-    for key in path.split("."):
+    for part in re.findall(r"[^.\[\]]+|\[\d+\]", path):
+        if part.startswith("["):
+            if not isinstance(node, yaml.SequenceNode) or int(part[1:-1]) >= len(node.value):
+                return None
+            node = node.value[int(part[1:-1])]
+            continue
         if not isinstance(node, yaml.MappingNode):
             return None
-        found = _get(node, key)
+        found = _get(node, part)
         if found is None:
             return None
         node = found[1]
     return node
 
 
+def _nearest(root: yaml.Node, path: str) -> yaml.Node:
+    """The node of ``path``, else of its nearest given parent, else the root."""
+    parts = path.split(".")
+    for n in range(len(parts), 0, -1):
+        found = node_at(root, ".".join(parts[:n]))
+        if found is not None:
+            return found
+    return root
+
+
+def plugin_sections(sc: Scenario) -> Iterator[tuple[str, Any, str]]:
+    """(kind, section, path) of every plug-in the scenario names (a section added to the
+    schema that holds plug-ins, e.g. ``tasks:`` of controllers, is listed here too)."""
+    yield "plant", sc.plant, "plant"
+    for name, s in sc.sensors.items():
+        yield "sensor", s, f"sensors.{name}"
+    if sc.controller is not None:
+        yield "controller", sc.controller, "controller"
+    for name, task in (getattr(sc, "tasks", None) or {}).items():
+        yield "controller", task, f"tasks.{name}"
+
+
 def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
     """Replace each plug-in's raw ``params`` node by its validated ``Params`` instance."""
-    def params_of(kind: str, spec, path: str):
+    for kind, spec, path in plugin_sections(sc):
         try:
             cls = registry.load(kind, spec.type)
         except registry.UnknownPlugin as exc:
-            raise ScenarioError(str(exc), node=_node_at(root, f"{path}.type"),
+            raise ScenarioError(str(exc), node=_nearest(root, f"{path}.type"),
                                 path=f"{path}.type") from None
         raw = spec.params
         if not isinstance(raw, yaml.Node):  # no params given: all defaults
-            raw = yaml.MappingNode("tag:yaml.org,2002:map", [],
-                                   (_node_at(root, path) or root).start_mark, None)
-        return build_dataclass(raw, cls.Params, f"{path}.params")
-
-    sc.plant.params = params_of("plant", sc.plant, "plant")
-    sc.controller.params = params_of("controller", sc.controller, "controller")
-    for name, s in sc.sensors.items():
-        s.params = params_of("sensor", s, f"sensors.{name}")
+            raw = yaml.MappingNode(_MAP, [], _nearest(root, path).start_mark, None)
+        spec.params = build_dataclass(raw, cls.Params, f"{path}.params")
+    # a plug-in whose Params declare an internal ``scenario_dir`` field gets the scenario file's
+    # directory, so that its file parameters resolve relative to the scenario, not the cwd
+    src = Path(str(sc.source)) if sc.source else None
+    if src is not None and src.is_file():
+        for _, spec, _ in plugin_sections(sc):
+            if hasattr(spec.params, "scenario_dir"):
+                spec.params.scenario_dir = str(src.resolve().parent)
     return sc
 
 
-def check_rates(sc: Scenario, node: yaml.Node | None = None) -> None:
+def check_timing(sc: Scenario, root: yaml.Node) -> None:
+    """Every task rate divides the physics rate; the run has at least one physics step."""
     rate = sc.timing.physics_rate
-    tasks = [("controller.rate", sc.controller.rate)]
-    tasks += [(f"sensors.{n}.rate", s.rate) for n, s in sc.sensors.items()]
+    if sc.timing.duration * rate < 1:
+        raise ScenarioError(f"expected at least one physics step (>= {1 / rate:g} s at "
+                            f"{rate} Hz), got {sc.timing.duration:g} s",
+                            node=_nearest(root, "timing.duration"), path="timing.duration")
+    tasks = [(f"{path}.rate", spec.rate) for kind, spec, path in plugin_sections(sc)
+             if kind in ("controller", "sensor")]
     if sc.timing.state_log_rate:
         tasks.append(("timing.state_log_rate", sc.timing.state_log_rate))
     for path, r in tasks:
         ratio = rate / r
-        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+        if abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio) or round(ratio) < 1:
             raise ScenarioError(f"expected a rate that divides timing.physics_rate = {rate} Hz, "
-                                f"got {r:g} Hz", node=node, path=path)
+                                f"got {r:g} Hz", node=_nearest(root, path), path=path)
 
 
 def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = None) -> Scenario:
+    from replay.scenario.ports import check_ports
     for s in sets:
         _apply_set(root, s)
     sc = build_dataclass(root, Scenario, "")
     sc.source = source
     if seed is not None:
-        if seed < 0:
-            raise ScenarioError(f"expected a seed >= 0, got {seed}", path="seed")
+        if not 0 <= seed <= 2 ** 63 - 1:
+            raise ScenarioError(f"expected a seed from 0 to 2^63 - 1, got {show(seed, 24)}",
+                                path="seed", file="--seed")
         sc.seed = seed
-    check_rates(sc, root)
-    return _resolve_plugins(sc, root)
+    check_timing(sc, root)
+    _resolve_plugins(sc, root)
+    check_ports(sc, lambda path: _nearest(root, path))
+    return sc
 
 
 def load_scenario(path: str | Path, sets: list[str] | tuple = (), seed: int | None = None
@@ -382,13 +510,17 @@ def load_scenario(path: str | Path, sets: list[str] | tuple = (), seed: int | No
     path = Path(path)
     if not path.is_file():
         raise ScenarioError("no such scenario file", file=str(path))
-    return _load_node(_compose_file(path), str(path), sets, seed)
+    inputs: list[Path] = []
+    root = _compose_file(path, inputs=inputs)
+    sc = _load_node(root, str(path), sets, seed)
+    sc.inputs = tuple(inputs)
+    return sc
 
 
 def scenario_from_text(text: str, name: str = "<log>", sets=(), seed: int | None = None
                        ) -> Scenario:
     """A resolved scenario text (e.g. from a log's /scenario message) back into a Scenario."""
-    root = _compose(text, name)
+    root = _compose_root(text, name)
     _pop(root, "extends")
     return _load_node(root, name, sets, seed)
 
@@ -396,7 +528,7 @@ def scenario_from_text(text: str, name: str = "<log>", sets=(), seed: int | None
 def params_from_data(cls: type, data: dict | None, path: str, source: str = "<log>") -> Any:
     """A plug-in's typed ``Params`` (``cls``) from plain data, e.g. ``plant.params`` of a log's
     resolved scenario, checked field by field as a scenario file is. Raises ScenarioError."""
-    node = _compose(yaml.safe_dump(data or {}), source)
+    node = _compose_root(yaml.safe_dump(data or {}), source)
     return build_dataclass(node, cls, path)
 
 

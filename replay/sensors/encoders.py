@@ -20,9 +20,11 @@ from replay.scene import Scene
 
 @dataclass
 class EncoderParams:
-    reading: str = param("arm", doc="which of the plant's readings (Scene.readings) to publish")
-    topic: str = param(TOPIC_ARM_ENCODERS, doc="log topic of the measurement")
-    resolution: float = param(0.0, unit="rad", ge=0,
+    reading: str = param("arm", max_length=100,
+                        doc="which of the plant's readings (Scene.readings) to publish")
+    topic: str = param(TOPIC_ARM_ENCODERS, pattern=r"/[A-Za-z0-9_/]{1,99}",
+                       doc="log topic of the measurement")
+    resolution: float = param(0.0, unit="rad", ge=0, le=10,
                               doc="angle per encoder count; 0 = exact")
 
 

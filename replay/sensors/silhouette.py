@@ -1,4 +1,4 @@
-"""Fast anti-aliased silhouettes of scene primitives through a pinhole camera (OpenCV raster).
+"""Fast anti-aliased silhouettes of scene primitives through a pinhole camera.
 
 A camera at 1 kHz cannot afford a 3-D renderer (PyBullet's TinyRenderer takes ~5 ms for 128 x 128);
 a ball camera needs only silhouettes, which are known in closed form:
@@ -15,16 +15,12 @@ a ball camera needs only silhouettes, which are known in closed form:
 - **Box**: the convex hull of its 8 projected corners; **Cylinder**: the hull of two projected
   rims. Both are exact silhouettes of convex bodies entirely in front of the camera.
 
-Rasterising (:func:`fill_convex`): each silhouette is a convex polygon in pixels, filled with
-``cv2.fillConvexPoly`` (``LINE_AA``, 8 fractional bits) on a ``supersample``-times finer grid
-over its bounding box only, area-averaged back to pixels (``INTER_AREA``) and alpha-composited
-far to near (painter's order by the distance of each primitive's centre: right for a small ball
-in front of or behind a larger body, not for interpenetrating or interleaved bodies). A pixel's
-value is then close to the fraction of its area covered: OpenCV's anti-aliased fill grows a
-polygon outward by ~0.65 fine pixel (measured 0.64-0.68 for 4-40 px radii), so the ellipse's
-semi-axes are reduced by that much first, and its ``N``-gon is scaled to the ellipse's area.
-Boxes and cylinders are not shrunk (their outlines come out ~0.65 / supersample px too large).
-Primitives reaching behind the camera's plane are not drawn. Image conventions are
+Rasterising: each silhouette is a convex polygon in pixels (a sphere's ellipse as an N-gon scaled
+to the ellipse's area), composited far to near (painter's order by the distance of each
+primitive's centre: right for a small ball in front of or behind a larger body, not for
+interpenetrating or interleaved bodies) with each pixel weighted by the exact area the polygon
+covers in it (:mod:`replay.sensors.raster`, the stick camera's rasteriser too). Primitives
+reaching behind the camera's plane are not drawn. Image conventions are
 :mod:`replay.sensors.pinhole`'s: integer pixel coordinates are pixel centres.
 """
 
@@ -39,9 +35,8 @@ import numpy as np
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
+from replay.sensors.raster import coverage_blocks, paint
 
-SHIFT = 8               # fractional bits of vertices given to cv2.fillConvexPoly
-AA_GROWTH = 0.65        # fine px by which cv2's LINE_AA fill grows a convex polygon
 ELLIPSE_VERTICES = 48   # vertices of the polygon standing in for an ellipse
 _NEAR = 1e-6            # m: nearest depth drawn
 # an N-gon inscribed at equal parameter steps has N/2 sin(2 pi/N) / pi of the ellipse's area
@@ -145,8 +140,7 @@ def _hull_points(prim) -> np.ndarray:
 
 def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse] | None:
     """(distance (m) from the optical centre to the primitive's centre, convex polygon (N, 2) in
-    pixels) of a primitive, or None if it reaches behind the camera. Spheres give their ellipse
-    (not yet inset for anti-aliasing)."""
+    pixels) of a primitive, or None if it reaches behind the camera. Spheres give their ellipse."""
     distance = float(np.linalg.norm(np.asarray(prim.position, float) - camera.position))
     if isinstance(prim, Sphere):
         e = sphere_ellipse(camera, prim.position, prim.radius)
@@ -167,43 +161,41 @@ def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse
 
 # --- raster --------------------------------------------------------------------------------
 
-def fill_convex(img: np.ndarray, poly: np.ndarray, grey: float, supersample: int) -> None:
-    """Alpha-composite a convex polygon (pixels, already inset for anti-aliasing if wanted) of
-    grey level ``grey`` onto a float32 image, in place."""
-    h, w = img.shape
+def _block(poly: np.ndarray, w: int, h: int):
+    """The pixel block (x0, y0, w, h) of a polygon's bounding box plus a pixel, clipped to a
+    w x h image, or None if it is off the image."""
     x0 = max(int(math.floor(poly[:, 0].min())) - 1, 0)
     y0 = max(int(math.floor(poly[:, 1].min())) - 1, 0)
     x1 = min(int(math.ceil(poly[:, 0].max())) + 2, w)
     y1 = min(int(math.ceil(poly[:, 1].max())) + 2, h)
-    if x1 <= x0 or y1 <= y0:
-        return
-    k = int(supersample)
-    q = (poly - (x0, y0) + 0.5) * k - 0.5                  # pixel centres stay pixel centres
-    if np.abs(q).max() > 2 ** (30 - SHIFT):                # would overflow cv2's fixed point
-        q = np.clip(q, -2 ** 20, 2 ** 20)                  # (bends only far-off edges)
-    fine = np.zeros(((y1 - y0) * k, (x1 - x0) * k), np.uint8)
-    cv2.fillConvexPoly(fine, np.round(q * (1 << SHIFT)).astype(np.int32), 255, cv2.LINE_AA, SHIFT)
-    if k > 1:
-        fine = cv2.resize(fine, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA)
-    roi = img[y0:y1, x0:x1]
-    roi += fine.astype(np.float32) * np.float32(1.0 / 255.0) * (np.float32(grey) - roi)
+    return (x0, y0, x1 - x0, y1 - y0) if x1 > x0 and y1 > y0 else None
 
 
-def render(camera: PinholeCamera, scene: Scene, *, background: float = 0.1,
-           supersample: int = 8) -> np.ndarray:
+def render_views(cameras, scene: Scene, *, background: float = 0.1) -> list[np.ndarray]:
+    """:func:`render` for several cameras at once: the coverage of every silhouette in every
+    view is computed in one pass (:func:`~replay.sensors.raster.coverage_blocks`)."""
+    images, jobs = [], []                                  # (view, polygon, grey, block)
+    for view, camera in enumerate(cameras):
+        k = camera.intrinsics
+        images.append(np.full((k.height, k.width), 255.0 * background, np.float32))
+        items = []
+        for i, prim in enumerate(scene.primitives):
+            s = silhouette(camera, prim)
+            if s is not None:
+                items.append((-s[0], i, prim, s[1]))
+        items.sort(key=lambda it: (it[0], it[1]))          # far first
+        for _, _, prim, shape in items:
+            poly = shape.polygon() if isinstance(shape, Ellipse) else shape
+            block = _block(poly, k.width, k.height) if len(poly) >= 3 else None
+            if block is not None:
+                jobs.append((view, poly, 255.0 * float(prim.albedo), block))
+    covs = coverage_blocks([j[1] for j in jobs], [j[3] for j in jobs])
+    for (view, _, grey, (x0, y0, w, h)), cov in zip(jobs, covs):   # in each view far to near
+        paint(images[view][y0:y0 + h, x0:x0 + w], cov, grey)
+    return images
+
+
+def render(camera: PinholeCamera, scene: Scene, *, background: float = 0.1) -> np.ndarray:
     """A noiseless float32 grey image (0..255) of the scene's silhouettes, each at grey level
     ``255 * albedo``, on a uniform background of albedo ``background``."""
-    k = camera.intrinsics
-    img = np.full((k.height, k.width), 255.0 * background, np.float32)
-    items = []
-    for i, prim in enumerate(scene.primitives):
-        s = silhouette(camera, prim)
-        if s is not None:
-            items.append((-s[0], i, prim, s[1]))
-    items.sort(key=lambda it: (it[0], it[1]))              # far first
-    inset = AA_GROWTH / supersample
-    for _, _, prim, shape in items:
-        poly = shape.polygon(inset) if isinstance(shape, Ellipse) else shape
-        if len(poly) >= 3:
-            fill_convex(img, poly, 255.0 * float(prim.albedo), supersample)
-    return img
+    return render_views([camera], scene, background=background)[0]

@@ -7,7 +7,7 @@ This sensor does the same with images:
 
 1. each camera's 8-bit 128 x 128 image is rendered from the scene's silhouettes
    (:mod:`replay.sensors.silhouette`: the sphere's exact perspective ellipse, boxes as projected
-   hulls, anti-aliased on an 8x finer grid) plus Gaussian pixel noise from the sensor's ``rng``;
+   hulls, each pixel weighted by the exact area covered) plus Gaussian pixel noise from the sensor's ``rng``;
 2. segmentation by a grey-level threshold; the target is the largest 8-connected blob (the
    arm is not in the plant's scene, so the ball is usually the only bright thing); a blob cut
    by the image border is rejected;
@@ -62,10 +62,10 @@ import numpy as np
 
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_OBJECT, VisionObject
-from replay.params import param
+from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.sensors.silhouette import correct_sphere_centroid, render
+from replay.sensors.silhouette import correct_sphere_centroid, render_views
 
 _DILATE = np.ones((5, 5), np.uint8)   # the grey-moment region: the blob grown by 2 px
 _MARGIN = 4                           # px around the blob: region (2) + background ring (2)
@@ -74,33 +74,33 @@ _MARGIN = 4                           # px around the blob: region (2) + backgro
 @dataclass
 class StereoBallCameraParams:
     cam0_position: list[float] = param(
-        [2.6, 0.4, 0.8], unit="m", length=3,
+        [2.6, 0.4, 0.8], unit="m", length=3, ge=-100, le=100,
         doc="optical centre of camera 0 (world). Default: 0.4 m to the +y side of the flight "
             "path, 0.6 m in front of the release (the ball is thrown between the two cameras)")
     cam0_target: list[float] = param(
-        [1.9, 0.0, 0.8], unit="m", length=3,
+        [1.9, 0.0, 0.8], unit="m", length=3, ge=-100, le=100,
         doc="world point on camera 0's optical axis. Default: on the flight path, chosen to "
             "centre the ball's image from x = 2.2 m to the catch point (0.7, 0, 0.5) m")
     cam1_position: list[float] = param(
-        [2.6, -0.4, 0.8], unit="m", length=3,
+        [2.6, -0.4, 0.8], unit="m", length=3, ge=-100, le=100,
         doc="optical centre of camera 1 (world); default: the mirror image of camera 0, a "
             "0.8 m stereo baseline")
-    cam1_target: list[float] = param([1.9, 0.0, 0.8], unit="m", length=3,
+    cam1_target: list[float] = param([1.9, 0.0, 0.8], unit="m", length=3, ge=-100, le=100,
                                      doc="world point on camera 1's optical axis")
-    up: list[float] = param([0.0, 0.0, 1.0], unit="1", length=3,
+    up: list[float] = param([0.0, 0.0, 1.0], unit="1", length=3, ge=-1e3, le=1e3,
                             doc="world direction shown as 'up' in both images")
     fov: float = param(math.radians(60.0), unit="rad", gt=0.0, lt=math.pi,
                        doc="vertical field of view, edge to edge (square pixels; 60 deg default: "
                            "f = 110.9 px)")
-    width: int = param(128, unit="px", ge=8, doc="image width; paper: 128 (CPV)")
-    height: int = param(128, unit="px", ge=8, doc="image height; paper: 128 (CPV)")
-    noise_sigma: float = param(0.0, unit="grey level", ge=0.0,
+    width: int = param(128, unit="px", ge=8, le=2048, doc="image width; paper: 128 (CPV)")
+    height: int = param(128, unit="px", ge=8, le=2048, doc="image height; paper: 128 (CPV)")
+    noise_sigma: float = param(0.0, unit="grey level", ge=0.0, le=1000,
                                doc="standard deviation of Gaussian pixel noise (0..255 scale)")
     threshold: float = param(100.0, unit="grey level", ge=0.0, le=255.0,
                              doc="pixels brighter than this are ball (ball 0.9 * 255 on "
                                  "0.1 * 255): a pixel 37 % covered by the ball passes, so a "
                                  "1.5 px ball is still seen")
-    min_pixels: int = param(1, unit="px", ge=1,
+    min_pixels: int = param(1, unit="px", ge=1, le=2048 * 2048,
                             doc="smallest blob (pixels above threshold) accepted")
     moments: str = param("grey", choices=("grey", "binary"),
                          doc="grey: moments of grey level above the local background in the blob "
@@ -110,10 +110,8 @@ class StereoBallCameraParams:
                                             "the tracked primitive to be a Sphere: its radius)")
     background: float = param(0.1, unit="1", ge=0.0, le=1.0,
                               doc="albedo of the (uniform) background")
-    supersample: int = param(8, unit="1", ge=1, le=32,
-                             doc="anti-aliasing: silhouettes are filled on a grid this many "
-                                 "times finer")
-    tracked: str = param("ball", doc="name of the scene primitive whose position is measured")
+    tracked: str = param("ball", max_length=100,
+                         doc="name of the scene primitive whose position is measured")
 
     def __post_init__(self) -> None:
         for i, (eye, target) in enumerate(((self.cam0_position, self.cam0_target),
@@ -121,9 +119,12 @@ class StereoBallCameraParams:
             try:
                 look_at_rotation(eye, target, self.up)
             except ValueError as exc:
-                raise ValueError(f"camera {i}: {exc}") from None
+                raise ParamError(f"cam{i}_target" if "coincide" in str(exc) else "up",
+                                 f"camera {i}: {exc}") from None
         if np.allclose(self.cam0_position, self.cam1_position):
-            raise ValueError("the two cameras are at the same place: no stereo baseline")
+            raise ParamError("cam1_position", "the two cameras are at the same place: no stereo "
+                             "baseline")
+
 
 
 class StereoBallCamera(Sensor):
@@ -162,8 +163,7 @@ class StereoBallCamera(Sensor):
         p = params if params is not None else StereoBallCameraParams()
         cams = cameras if cameras is not None else StereoBallCamera.make_cameras(p)
         out = []
-        for cam in cams:
-            img = render(cam, scene, background=p.background, supersample=p.supersample)
+        for img in render_views(cams, scene, background=p.background):
             if rng is not None and p.noise_sigma > 0.0:
                 img += np.float32(p.noise_sigma) * rng.standard_normal(img.shape, dtype=np.float32)
             out.append(np.clip(np.rint(img), 0, 255).astype(np.uint8))

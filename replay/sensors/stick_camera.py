@@ -20,8 +20,8 @@ off vertical), as a real camera with image moments would have.
 
 Rendering (:func:`render_scene`) is exactly anti-aliased so that the moments resolve sub-pixel
 motion: each primitive's silhouette (the convex hull of its projected outline) is composited
-far-to-near with each pixel weighted by the area it covers (:func:`polygon_coverage`, closed
-form). (OpenCV's ``fillConvexPoly`` with LINE_AA and fractional bits was tried first: it grows a
+far-to-near with each pixel weighted by the area it covers (:func:`replay.sensors.raster.coverage`,
+exact). (OpenCV's ``fillConvexPoly`` with LINE_AA and fractional bits was tried first: it grows a
 polygon by 0.6-0.8 px, which must be corrected by hand, and even drawn 4x finer and area-averaged
 it left 0.03 px periodic centroid errors, visible as a 0.2 mm step measured as 0.24 mm.)
 Moments are taken on the segmented blob dilated by two pixels, weighted by grey level above the
@@ -46,22 +46,26 @@ import numpy as np
 
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_STICK, VisionStick
-from replay.params import param
+from replay.params import ParamError, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
-from replay.sensors.pinhole import PinholeCamera
+from replay.sensors.pinhole import PinholeCamera, look_at_rotation
+from replay.sensors.raster import composite
 
 _RIM = 48             # vertices of a polygon standing in for a circle
 
 
 # --- geometry of primitives ----------------------------------------------------------------
 
+_BOX_SIGNS = np.array([[sx, sy, sz] for sz in (-1.0, 1.0)
+                       for sx, sy in ((1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0))])
+
+
 def box_corners(box: Box) -> np.ndarray:
     """The 8 corners (8, 3) of a box in world coordinates; the last 4 are the body +z face."""
-    hx, hy, hz = (0.5 * float(s) for s in box.size)
-    body = np.array([[sx * hx, sy * hy, sz * hz]
-                     for sz in (-1, 1) for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
-    return body @ quaternion_matrix(box.orientation).T + np.asarray(box.position, dtype=float)
+    half = np.array([0.5 * float(s) for s in box.size])
+    return (_BOX_SIGNS * half) @ quaternion_matrix(box.orientation).T + np.asarray(
+        box.position, dtype=float)
 
 
 def _circle(n: int) -> np.ndarray:
@@ -71,13 +75,16 @@ def _circle(n: int) -> np.ndarray:
     return scale * np.column_stack([np.cos(a), np.sin(a)])
 
 
+_CIRCLE = _circle(_RIM)
+
+
 def _outline_points(camera: PinholeCamera, prim) -> np.ndarray:
     """World points whose projections' convex hull is the primitive's silhouette."""
     if isinstance(prim, Box):
         return box_corners(prim)
     if isinstance(prim, Cylinder):
         R = quaternion_matrix(prim.orientation)
-        ring = prim.radius * _circle(_RIM)
+        ring = prim.radius * _CIRCLE
         pts = [np.column_stack([ring, np.full(_RIM, s * prim.length / 2.0)]) for s in (-1, 1)]
         return np.vstack(pts) @ R.T + np.asarray(prim.position, dtype=float)
     if isinstance(prim, Sphere):
@@ -92,62 +99,9 @@ def _outline_points(camera: PinholeCamera, prim) -> np.ndarray:
         a /= np.linalg.norm(a)
         b = np.cross(u, a)
         rho = prim.radius * math.sqrt(1.0 - (prim.radius / d) ** 2)
-        ring = _circle(_RIM)
+        ring = _CIRCLE
         return c + prim.radius ** 2 / d * u + rho * (ring[:, :1] * a + ring[:, 1:] * b)
     raise TypeError(f"cannot render {type(prim).__name__}")
-
-
-def _positive_part_integral(g0: np.ndarray, g1: np.ndarray, length: np.ndarray) -> np.ndarray:
-    """The integral of max(g, 0) over an interval of ``length`` where g runs linearly g0 -> g1
-    (written without differences of squares, which lose precision on nearly flat edges)."""
-    hi, lo = np.maximum(g0, g1), np.minimum(g0, g1)
-    crossing = (hi > 0.0) & (lo < 0.0)
-    partial = length * np.maximum(hi, 0.0) ** 2 / (2.0 * np.where(crossing, hi - lo, 1.0))
-    return np.where(lo >= 0.0, length * (g0 + g1) / 2.0, np.where(crossing, partial, 0.0))
-
-
-def polygon_coverage(poly: np.ndarray, x0: int, y0: int, w: int, h: int) -> np.ndarray:
-    """Exact area (0..1) of a simple polygon (N, 2, pixels) inside each pixel of the h x w block
-    whose first pixel is (x0, y0); pixel (i, j) spans [i - 0.5, i + 0.5] x [j - 0.5, j + 0.5].
-
-    With F(x, y) the polygon's area in the quadrant {X <= x, Y <= y}, a pixel's coverage is the
-    second difference of F over its corners; by Green's theorem F = -(loop integral over the
-    boundary, X <= x, of min(Y, y) dX), edge by edge in closed form (signed, then oriented).
-    """
-    P = np.asarray(poly, dtype=float)
-    Q = np.roll(P, -1, axis=0)
-    sloped = P[:, 0] != Q[:, 0]                           # vertical edges add nothing
-    P, Q = P[sloped], Q[sloped]
-    sign = np.where(Q[:, 0] > P[:, 0], 1.0, -1.0)[:, None, None]
-    left = np.where(Q[:, :1] > P[:, :1], P, Q)            # each edge from its left end ...
-    right = np.where(Q[:, :1] > P[:, :1], Q, P)           # ... to its right end
-    xa, ya = left[:, 0, None, None], left[:, 1, None, None]
-    xb, yb = right[:, 0, None, None], right[:, 1, None, None]
-    xs = (x0 - 0.5 + np.arange(w + 1, dtype=float))[None, None, :]
-    ys = (y0 - 0.5 + np.arange(h + 1, dtype=float))[None, :, None]
-    length = np.clip(xs, xa, xb) - xa                     # X runs over [xa, min(x, xb)]
-    yq = ya + (yb - ya) * length / (xb - xa)
-    min_integral = length * (ya + yq) / 2.0 - _positive_part_integral(ya - ys, yq - ys, length)
-    F = -np.sum(sign * min_integral, axis=0)
-    cov = F[1:, 1:] - F[:-1, 1:] - F[1:, :-1] + F[:-1, :-1]
-    V = np.asarray(poly, dtype=float)
-    area2 = float(np.sum(V[:, 0] * np.roll(V[:, 1], -1) - np.roll(V[:, 0], -1) * V[:, 1]))
-    return cov if area2 >= 0.0 else -cov
-
-
-def _fill(img: np.ndarray, poly: np.ndarray, grey: float) -> None:
-    """Alpha-composite a polygon (pixels) of grey level ``grey`` onto a float image, each pixel
-    weighted by the area the polygon covers in it (exact anti-aliasing)."""
-    h, w = img.shape
-    x0 = max(int(math.floor(poly[:, 0].min() + 0.5)), 0)
-    y0 = max(int(math.floor(poly[:, 1].min() + 0.5)), 0)
-    x1 = min(int(math.floor(poly[:, 0].max() + 0.5)) + 1, w)
-    y1 = min(int(math.floor(poly[:, 1].max() + 0.5)) + 1, h)
-    if x1 <= x0 or y1 <= y0:
-        return
-    alpha = np.clip(polygon_coverage(poly, x0, y0, x1 - x0, y1 - y0), 0.0, 1.0).astype(np.float32)
-    roi = img[y0:y1, x0:x1]
-    roi += alpha * (np.float32(grey) - roi)
 
 
 def _projected_items(camera: PinholeCamera, scene: Scene) -> list:
@@ -156,13 +110,27 @@ def _projected_items(camera: PinholeCamera, scene: Scene) -> list:
     on a stick, centred above the stick's centre, is nearer to any camera above the table;
     nearest depth fails for oblique views of such stacks). Primitives reaching behind the camera
     are not drawn."""
-    items = []
+    prims, outlines = [], []
     for prim in scene.primitives:
         pts = _outline_points(camera, prim)
-        if len(pts) == 0 or np.any(camera.to_camera(pts)[:, 2] <= 1e-6):
+        if len(pts):
+            prims.append(prim)
+            outlines.append(pts)
+    if not prims:
+        return []
+    pc = camera.to_camera(np.concatenate(outlines))         # all outlines in one projection
+    k = camera.intrinsics
+    z = pc[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        uv = np.column_stack([k.fx * pc[:, 0] / z + k.cx,
+                              k.fy * pc[:, 1] / z + k.cy]).astype(np.float32)
+    items = []
+    end = 0
+    for prim, pts in zip(prims, outlines):
+        start, end = end, end + len(pts)
+        if np.any(z[start:end] <= 1e-6):
             continue
-        uv = camera.project(pts).astype(np.float32)
-        hull = cv2.convexHull(uv).reshape(-1, 2).astype(np.float64)
+        hull = cv2.convexHull(uv[start:end]).reshape(-1, 2).astype(np.float64)
         if len(hull) >= 3:
             distance = float(np.linalg.norm(np.asarray(prim.position, dtype=float)
                                             - camera.position))
@@ -194,13 +162,19 @@ def render_scene(camera: PinholeCamera, scene: Scene, *, background: float = 0.1
     k = camera.intrinsics
     x0, y0, x1, y1 = window if window is not None else (0, 0, k.width, k.height)
     img = np.full((y1 - y0, x1 - x0), 255.0 * background, np.float32)
-    offset = np.array([x0, y0], dtype=float)
+    polys, greys = [], []
     for _, albedo, hull, _ in (items if items is not None else _projected_items(camera, scene)):
         lo, hi = hull.min(axis=0), hull.max(axis=0)
         if hi[0] < x0 - 1 or hi[1] < y0 - 1 or lo[0] > x1 or lo[1] > y1:
             continue                                     # wholly outside the window
-        _fill(img, hull - offset, 255.0 * albedo)
+        polys.append(hull)
+        greys.append(255.0 * albedo)
+    composite(img, polys, greys, origin=(x0, y0))
     return img
+
+
+# (along, across) offsets in px of the 9 samples beyond each end of the blob
+_END_SAMPLES = np.array([[s, o] for s in (2.0, 3.0, 4.0) for o in (-1.0, 0.0, 1.0)])
 
 
 def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> float | None:
@@ -226,8 +200,7 @@ def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> floa
     levels = []
     for end in (along.max(), along.min()):             # the blob's extreme pixels on its axis
         sign = 1.0 if end > 0 else -1.0
-        pts = np.array([c + (end + sign * s) * e + o * n
-                        for s in (2.0, 3.0, 4.0) for o in (-1.0, 0.0, 1.0)])
+        pts = c + (end + sign * _END_SAMPLES[:, :1]) * e + _END_SAMPLES[:, 1:] * n
         ij = np.rint(pts).astype(int)
         ok = (ij[:, 0] >= 0) & (ij[:, 0] < w) & (ij[:, 1] >= 0) & (ij[:, 1] < h)
         if ok.any():
@@ -239,28 +212,34 @@ def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> floa
 
 @dataclass
 class StickCameraParams:
-    width: int = param(512, unit="px", ge=16, doc="image width")
-    height: int = param(512, unit="px", ge=16, doc="image height")
-    position: list[float] = param([0.0, 0.0, 1.0], unit="m", length=3,
+    width: int = param(512, unit="px", ge=16, le=4096, doc="image width")
+    height: int = param(512, unit="px", ge=16, le=4096, doc="image height")
+    position: list[float] = param([0.0, 0.0, 1.0], unit="m", length=3, ge=-100, le=100,
                                   doc="optical centre (world); paper: 1 m above the table")
-    target: list[float] = param([0.0, 0.0, 0.0], unit="m", length=3,
+    target: list[float] = param([0.0, 0.0, 0.0], unit="m", length=3, ge=-100, le=100,
                                 doc="world point on the optical axis; default: straight down "
                                     "at the table centre")
-    up: list[float] = param([0.0, 1.0, 0.0], unit="1", length=3,
+    up: list[float] = param([0.0, 1.0, 0.0], unit="1", length=3, ge=-1e3, le=1e3,
                             doc="world direction shown as 'up' in the image (not along the axis)")
     fov_x: float = param(0.62, unit="rad", gt=0, lt=math.pi,
                          doc="horizontal field of view, edge to edge; 0.62 rad (35.5 deg) from "
                              "1 m: 0.640 m of table across 512 px, 1.25 mm per pixel")
-    noise_sigma: float = param(0.0, unit="grey level", ge=0,
+    noise_sigma: float = param(0.0, unit="grey level", ge=0, le=1000,
                                doc="standard deviation of Gaussian pixel noise (0..255 scale)")
-    position_offset: list[float] = param([0.0, 0.0], unit="m", length=2,
+    position_offset: list[float] = param([0.0, 0.0], unit="m", length=2, ge=-10, le=10,
                                          doc="constant bias added to the measured (x, y)")
     threshold: float = param(192.0, unit="grey level", ge=0, le=255,
                              doc="pixels brighter than this are marker (white 255 vs stick)")
-    min_pixels: int = param(20, unit="px", ge=1,
+    min_pixels: int = param(20, unit="px", ge=1, le=4096 * 4096,
                             doc="smallest marker blob (pixels above threshold) accepted")
     background: float = param(0.1, unit="1", ge=0, le=1, doc="albedo of the table (dark)")
-    marker: str = param("marker", doc="name of the Box the camera tracks")
+    marker: str = param("marker", max_length=100, doc="name of the Box the camera tracks")
+
+    def __post_init__(self) -> None:
+        try:
+            look_at_rotation(self.position, self.target, self.up)
+        except ValueError as exc:
+            raise ParamError("target" if "coincide" in str(exc) else "up", str(exc)) from None
 
 
 class StickCamera(Sensor):

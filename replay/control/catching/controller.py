@@ -25,7 +25,7 @@ we define as the minimum-norm alpha satisfying only the initial constraint C alp
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -39,8 +39,11 @@ from replay.interfaces import Controller, Occurrence
 from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE,
                              TOPIC_CATCHING_STATE, TOPIC_EFFECTOR_STATE, TOPIC_OPTIMIZATION_COST,
                              TOPIC_VISION_OBJECT, EffectorState, JointCommand, OptimizationCost)
-from replay.params import param
-from replay.robot.arm_types import ArmCommand
+from replay.params import ParamError, param
+from replay.robot.arm_types import ArmCommand, ArmSpec
+
+
+_JOINTS = tuple(f"J{i}" for i in range(1, 8))     # an arm's joints as ArmSpec names them
 
 
 @dataclass
@@ -48,53 +51,84 @@ class Params:
     mapping: str = param("optimised", choices=("optimised", "initial"),
                          doc="b(q) parameters: 'optimised' (eq. 25 under eq. 13) or 'initial' "
                              "(minimum-norm alpha meeting only the initial constraint, eq. 13)")
-    alpha_file: str = param("", doc="JSON with precomputed alpha (write_alpha_file); used when its "
-                                    "key matches this configuration, else alpha is recomputed")
-    q_alpha: float = param(math.pi / 2, unit="rad", doc="catching angle of the selected joint "
-                                                        "(Sec. IV-A: pi/2)")
-    selected_joint: str = param("J4", doc="the joint i of eq. 6 (Sec. IV-A: axis 4)")
-    held_joints: list = param(["J3"], doc="joints held at their initial angle (Sec. IV-A: axis 3 "
-                                          "at 0); with them the arm must keep 3 active joints")
-    order: int = param(4, ge=2, doc="N of eq. 12 (Sec. IV-B: 4th order)")
-    catch_q: list = param([0.0, math.pi / 4], unit="rad", length=2,
+    alpha_file: str = param("", max_length=1000,
+                            doc="JSON with precomputed alpha (write_alpha_file), relative to the "
+                                "scenario file; used when its key matches this "
+                                "configuration, else alpha is recomputed")
+    q_alpha: float = param(math.pi / 2, unit="rad", ge=-10, le=10,
+                           doc="catching angle of the selected joint (Sec. IV-A: pi/2)")
+    selected_joint: str = param("J4", choices=_JOINTS,
+                                doc="the joint i of eq. 6 (Sec. IV-A: axis 4)")
+    held_joints: list[str] = param(["J3"], choices=_JOINTS, max_length=7,
+                                   doc="joints held at their initial angle (Sec. IV-A: axis 3 "
+                                       "at 0); with them the arm must keep 3 active joints")
+    order: int = param(4, ge=2, le=8, doc="N of eq. 12 (Sec. IV-B: 4th order)")
+    catch_q: list[float] = param([0.0, math.pi / 4], unit="rad", length=2, ge=-10, le=10,
                           doc="(q1, q2) of the nominal catching point l(q)|q4=q_alpha; also the "
                               "branch l_c^-1 prefers")
-    catch_offset: float = param(-1.0, unit="m",
+    catch_offset: float = param(-1.0, unit="m", ge=-1.0, le=1.0,
                                 doc="l(q) is this far along the tool z axis (the ball centre on "
                                     "the palm); negative = palm thickness + ball radius from the "
                                     "spec (0 without hand/ball)")
-    throw_start: list = param([3.2, 0.0, 1.0], unit="m", length=3,
+    throw_start: list[float] = param([3.2, 0.0, 1.0], unit="m", length=3, ge=-100, le=100,
                               doc="r_o(t0): where the ball is first seen in the nominal throw; "
                                   "every throw of the optimisation set starts here")
-    throw_speeds: list = param([8.0, 9.0, 10.0], unit="m/s", gt=0.0,
+    throw_speeds: list[float] = param([8.0, 9.0, 10.0], unit="m/s", gt=0.0, le=100,
+                                      min_length=1, max_length=10,
                                doc="launch speeds of the set (Sec. IV-B: 8 ~ 10 m/s); the middle "
                                    "one is the nominal throw of eq. 13")
-    throw_spread: float = param(0.1, unit="m", ge=0.0,
+    throw_spread: float = param(0.1, unit="m", ge=0.0, le=10,
                                 doc="half-width of the arrival grid around the catching point")
-    throw_grid: int = param(3, ge=1, doc="arrival grid points per axis (grid x grid)")
-    samples_per_throw: int = param(15, ge=2, doc="samples of each throw from t0 to arrival")
-    opt_torque_limits: list = param([], unit="N*m", gt=0.0,
+    throw_grid: int = param(3, ge=1, le=10, doc="arrival grid points per axis (grid x grid)")
+    samples_per_throw: int = param(15, ge=2, le=200, doc="samples of each throw from t0 to arrival")
+    opt_torque_limits: list[float] = param([], unit="N*m", gt=0.0, le=1e4, max_length=7,
                                     doc="tau_max of eq. 22 for the active joints; [] = spec")
-    opt_velocity_limits: list = param([], unit="rad/s", gt=0.0,
+    opt_velocity_limits: list[float] = param([], unit="rad/s", gt=0.0, le=1000, max_length=7,
                                       doc="omega_max of eq. 24 for the active joints; [] = spec")
-    w_tau: float = param(1.0, unit="1", gt=0.0, doc="K_tau = w_tau diag(1/tau_max^2)")
-    w_omega: float = param(1.0, unit="1", gt=0.0, doc="K_omega = w_omega diag(1/omega_max^2)")
-    limit_penalty: float = param(100.0, unit="1", ge=0.0,
+    w_tau: float = param(1.0, unit="1", gt=0.0, le=1e6, doc="K_tau = w_tau diag(1/tau_max^2)")
+    w_omega: float = param(1.0, unit="1", gt=0.0, le=1e6,
+                           doc="K_omega = w_omega diag(1/omega_max^2)")
+    limit_penalty: float = param(100.0, unit="1", ge=0.0, le=1e9,
                                  doc="weight of the hinge penalties for eqs. 22 and 24")
-    max_iterations: int = param(40, ge=0, doc="Levenberg-Marquardt iterations at most")
-    kp: list = param([900.0, 1500.0, 300.0, 150.0], unit="N*m/rad", ge=0.0,
-                     doc="PD stiffness per arm joint")
-    kd: list = param([30.0, 45.0, 10.0, 4.0], unit="N*m*s/rad", ge=0.0,
-                     doc="PD damping per arm joint")
+    torque_limit_penalty: float = param(-1.0, unit="1", ge=-1.0, le=1e9,
+                                        doc="weight of eq. 22's hinge alone; < 0 = "
+                                            "limit_penalty")
+    approach_weight: float = param(0.0, unit="1", ge=0.0, le=1e9,
+                                   doc="weight of the approach-direction term (not in the paper, "
+                                       "approach.py): the ball down the palm axis; 0 = eq. 25 only")
+    max_iterations: int = param(40, ge=0, le=1000, doc="Levenberg-Marquardt iterations at most")
+    kp: list[float] = param([900.0, 1500.0, 300.0, 150.0], unit="N*m/rad", ge=0.0, le=1e6,
+                            min_length=1, max_length=7, doc="PD stiffness per arm joint")
+    kd: list[float] = param([30.0, 45.0, 10.0, 4.0], unit="N*m*s/rad", ge=0.0, le=1e6,
+                            min_length=1, max_length=7, doc="PD damping per arm joint")
     feedforward: str = param("dynamics", choices=("dynamics", "gravity", "none"),
                              doc="tau_ff: eq. 17 at q_d ('dynamics'), g(q) or none")
     latency_compensation: bool = param(True, doc="carry r_o forward over the measurement's age "
                                                  "with the fitted velocity")
-    fit_window: float = param(0.1, unit="s", gt=0.0, doc="ballistic fit over this much history")
-    close_lead: float = param(0.0, unit="s", doc="start closing this much earlier than "
-                                                 "(arrival - closing time)")
+    fit_window: float = param(0.1, unit="s", gt=0.0, le=10,
+                              doc="ballistic fit over this much history")
+    close_lead: float = param(0.0, unit="s", ge=-1, le=1,
+                              doc="start closing this much earlier than (arrival - closing time)")
     after_catch: str = param("hold", choices=("hold", "track"),
                              doc="at the catch surface: freeze q_d ('hold') or keep mapping")
+    scenario_dir: str = field(default="", metadata={"internal": True})   # set by the loader
+
+
+def alpha_path(params: Params) -> Path | None:
+    """``alpha_file`` resolved against the scenario file's directory (absolute paths kept)."""
+    if not params.alpha_file:
+        return None
+    path = Path(params.alpha_file)
+    return path if path.is_absolute() or not params.scenario_dir else \
+        Path(params.scenario_dir) / path
+
+    def __post_init__(self) -> None:
+        if self.selected_joint in self.held_joints:
+            raise ParamError("selected_joint", f"{self.selected_joint} is also held "
+                             "(held_joints): the selected joint must move")
+        if len(self.kp) != len(self.kd):
+            raise ParamError("kd", f"expected one value per joint as kp ({len(self.kp)}), "
+                             f"got {len(self.kd)}")
 
 
 @dataclass
@@ -113,6 +147,9 @@ class CatchingState:
 
 class CatchingController(Controller):
     Params = Params
+    spec_type = ArmSpec
+    command_type = ArmCommand
+    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)   # the stereo ball, the joint encoders
     description = ("Namiki & Ishikawa: direct mapping q_d = g o l_c^-1(r_o) from stereo "
                    "positions to joint targets, PD + dynamics feed-forward, hand timed by TTC")
 
@@ -155,7 +192,9 @@ class CatchingController(Controller):
             speeds=tuple(P.throw_speeds), spread=P.throw_spread, grid=P.throw_grid,
             n_samples=P.samples_per_throw, gravity=-float(self.gravity[2]),
             tau_max=tuple(tau_max.tolist()), omega_max=tuple(om_max.tolist()), w_tau=P.w_tau,
-            w_omega=P.w_omega, penalty=P.limit_penalty, max_iter=P.max_iterations)
+            w_omega=P.w_omega, penalty=P.limit_penalty,
+            torque_penalty=P.torque_limit_penalty, approach_weight=P.approach_weight,
+            max_iter=P.max_iterations)
         self.problem = build_problem(model, self.config)
         self.history: list[CostRecord] = []
         self.result = None
@@ -206,7 +245,7 @@ class CatchingController(Controller):
     # ------------------------------------------------------------------ parameters
     def _optimised_alpha(self) -> np.ndarray:
         key = self.config.key(self.model)
-        path = Path(self.params.alpha_file) if self.params.alpha_file else None
+        path = alpha_path(self.params)
         if path is not None and path.is_file():
             data = load_alpha(path)
             if data.get("meta", {}).get("key") == key:
@@ -318,6 +357,14 @@ class CatchingController(Controller):
             out["close_start"] = self.t_catch - self.close_time - self.params.close_lead
             if st is not None:
                 out["catch_point"] = st[0].tolist()
+        return out
+
+    def outcome(self, t: float) -> dict:
+        """The method's metrics for the run's outcome: which mapping, when it predicted the ball
+        on the catch surface (t_c of eq. 4) and whether it reached it (``mapping_hold``)."""
+        out = {"mapping": self.params.mapping, "reached_catch_surface": self.holding}
+        if self.t_catch is not None:
+            out["predicted_catch_time"] = round(float(self.t_catch), 6)
         return out
 
     def pop_events(self) -> list[Occurrence]:

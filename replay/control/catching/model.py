@@ -16,9 +16,10 @@ import numpy as np
 class ArmModel:
     def __init__(self, fk: Callable, mass_matrix: Callable, bias: Callable, gravity: Callable, *,
                  n: int = 4, active: Sequence[int] = (0, 1, 3), q_fixed=None,
-                 inverse_dynamics: Callable | None = None) -> None:
+                 inverse_dynamics: Callable | None = None, axis: Callable | None = None) -> None:
         self._fk, self._M, self._bias, self._g = fk, mass_matrix, bias, gravity
         self._id = inverse_dynamics
+        self._axis = axis            # q -> the tool z axis (the palm normal), world (3,)
         self.n = n
         self.active = np.asarray(active, dtype=int)
         self.q_fixed = np.zeros(n) if q_fixed is None else np.asarray(q_fixed, float).copy()
@@ -31,10 +32,13 @@ class ArmModel:
         def fk(q):
             return (chain.frames(q)[-1] @ chain.tool @ pt)[:3]
 
+        def axis(q):
+            return (chain.frames(q)[-1] @ chain.tool)[:3, 2]
+
         return cls(fk, chain.mass_matrix,
                    lambda q, qd: chain.rnea(q, qd, np.zeros(chain.n)),
                    chain.gravity_torque, n=chain.n, active=active, q_fixed=q_fixed,
-                   inverse_dynamics=chain.rnea)
+                   inverse_dynamics=chain.rnea, axis=axis)
 
     # ---- coordinates
     def full(self, p) -> np.ndarray:
@@ -54,6 +58,27 @@ class ArmModel:
     def point(self, p) -> np.ndarray:
         """l(q) (eq. 3) at active coordinates p."""
         return self.fk(self.full(p))
+
+    def tool_axis(self, p) -> np.ndarray:
+        """The tool frame's z axis (the palm normal) at active coordinates p."""
+        if self._axis is None:
+            raise ValueError("this ArmModel was built without the tool axis")
+        return np.asarray(self._axis(self.full(p)), float)
+
+    def point_acceleration(self, p, pd, pdd, h: float = 1e-4) -> tuple[np.ndarray, np.ndarray]:
+        """d^2 l/dt^2 = J pdd + pd^T H pd (central differences) and J = dl/dp (3, 3)."""
+        p, pd = np.asarray(p, float), np.asarray(pd, float)
+        J = np.empty((3, len(p)))
+        for k in range(len(p)):
+            e = np.zeros(len(p))
+            e[k] = h
+            J[:, k] = (self.point(p + e) - self.point(p - e)) / (2 * h)
+        w = float(np.linalg.norm(pd))
+        quad = np.zeros(3)
+        if w > 0:
+            u = pd / w * h
+            quad = (self.point(p + u) + self.point(p - u) - 2 * self.point(p)) / (h * h) * w * w
+        return J @ np.asarray(pdd, float) + quad, J
 
     # ---- dynamics: eq. 15, full joint vector in and out
     def inverse_dynamics_full(self, q, qd, qdd) -> np.ndarray:

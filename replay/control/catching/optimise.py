@@ -38,6 +38,7 @@ class CostRecord:
     objective: float          # torque_cost + velocity_cost + penalty
     max_torque_ratio: float   # max_i,samples |tau_i| / tau_max_i
     max_velocity_ratio: float
+    approach_cost: float = 0.0    # the optional approach-direction term (approach.py), in objective
 
 
 @dataclass
@@ -62,17 +63,21 @@ def null_space(C: np.ndarray) -> np.ndarray:
 
 
 class Objective:
-    """E(alpha) of eq. 25 over fixed samples, with its residuals and Jacobian."""
+    """E(alpha) of eq. 25 over fixed samples, with its residuals and Jacobian (plus, optionally, the
+    approach-direction term of approach.py, which is not in the paper)."""
 
     def __init__(self, mapping: DirectMapping, model: ArmModel, feats: Features,
                  tau_max, omega_max, w_tau: float = 1.0, w_omega: float = 1.0,
-                 penalty: float = 100.0) -> None:
+                 penalty: float = 100.0, approach=None, torque_penalty: float | None = None
+                 ) -> None:
         self.mp, self.model, self.f = mapping, model, feats
+        self.approach = approach                     # ApproachTerm or None (eq. 25 as stated)
         self.tau_max = np.asarray(tau_max, float)
         self.omega_max = np.asarray(omega_max, float)
         self.kt = w_tau / self.tau_max ** 2          # K_tau = diag(w_tau / tau_max^2)
         self.kw = w_omega / self.omega_max ** 2      # K_omega = diag(w_omega / omega_max^2)
-        self.wp = penalty
+        self.wp = penalty                            # hinge weight of eq. 24 (omega)
+        self.wpt = penalty if torque_penalty is None else torque_penalty   # of eq. 22 (tau)
         self.nm, self.m = mapping.poly.n_mono, mapping.poly.m
 
     def trajectory(self, alpha):
@@ -95,18 +100,22 @@ class Objective:
         tc = float(np.sum(self.kt * tau ** 2))
         vc = float(np.sum(self.kw * omega ** 2))
         ht, hw = self._parts(tau, omega)
-        pen = float(self.wp * (np.sum(ht ** 2) + np.sum(hw ** 2)))
-        return CostRecord(it, tc, vc, pen, tc + vc + pen,
+        pen = float(self.wpt * np.sum(ht ** 2) + self.wp * np.sum(hw ** 2))
+        ac = self.approach.cost(alpha) if self.approach is not None else 0.0
+        return CostRecord(it, tc, vc, pen, tc + vc + pen + ac,
                           float(np.max(np.abs(tau) / self.tau_max)),
-                          float(np.max(np.abs(omega) / self.omega_max)))
+                          float(np.max(np.abs(omega) / self.omega_max)), ac)
 
     def residuals(self, alpha, tau=None):
         tau = self.torques(alpha) if tau is None else tau
         _, omega, _ = self.trajectory(alpha)
         ht, hw = self._parts(tau, omega)
-        sp = np.sqrt(self.wp)
-        return np.concatenate([(np.sqrt(self.kt) * tau).ravel(), (np.sqrt(self.kw) * omega).ravel(),
-                               sp * ht.ravel(), sp * hw.ravel()]), tau
+        sp, spt = np.sqrt(self.wp), np.sqrt(self.wpt)
+        parts = [(np.sqrt(self.kt) * tau).ravel(), (np.sqrt(self.kw) * omega).ravel(),
+                 spt * ht.ravel(), sp * hw.ravel()]
+        if self.approach is not None:
+            parts.append(self.approach.residuals(alpha))
+        return np.concatenate(parts), tau
 
     def jacobian(self, alpha):
         """Residuals, torques and d residuals / d alpha (rows as in :meth:`residuals`)."""
@@ -124,12 +133,13 @@ class Objective:
         Jw = np.einsum("nj,ik->nijk", f.m1, np.eye(self.m)).reshape(n, self.m, -1)
         omega = qd
         ht, hw = self._parts(tau, omega)
-        sp = np.sqrt(self.wp)
+        sp, spt = np.sqrt(self.wp), np.sqrt(self.wpt)
         Jht = (ht > 0)[..., None] * (np.sign(tau) / self.tau_max)[..., None] * Jt
         Jhw = (hw > 0)[..., None] * (np.sign(omega) / self.omega_max)[..., None] * Jw
         J = np.concatenate([(np.sqrt(self.kt)[:, None] * Jt).reshape(-1, Jt.shape[-1]),
                             (np.sqrt(self.kw)[:, None] * Jw).reshape(-1, Jw.shape[-1]),
-                            sp * Jht.reshape(-1, Jt.shape[-1]), sp * Jhw.reshape(-1, Jw.shape[-1])])
+                            spt * Jht.reshape(-1, Jt.shape[-1]), sp * Jhw.reshape(-1, Jw.shape[-1])]
+                           + ([self.approach.jacobian()] if self.approach is not None else []))
         r, _ = self.residuals(alpha, tau)
         return r, tau, J
 

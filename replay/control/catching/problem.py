@@ -11,7 +11,8 @@ import numpy as np
 
 from replay.control.catching.mapping import CatchGeometry, DirectMapping, PolynomialB
 from replay.control.catching.model import ArmModel
-from replay.control.catching.optimise import Objective, OptimResult, optimise
+from replay.control.catching.approach import approach_term
+from replay.control.catching.optimise import Objective, OptimResult, initial_alpha, optimise
 from replay.control.catching.trajectories import ThrowSet, launch_velocity, throw_set
 
 
@@ -32,6 +33,8 @@ class ProblemConfig:
     w_tau: float = 1.0                           # K_tau = w_tau diag(1 / tau_max^2)
     w_omega: float = 1.0                         # K_omega = w_omega diag(1 / omega_max^2)
     penalty: float = 100.0                       # weight of the limit hinge penalties
+    torque_penalty: float = -1.0                 # of eq. 22's alone; < 0 = ``penalty``
+    approach_weight: float = 0.0                 # w_app of the extension (approach.py); 0 = off
     max_iter: int = 40
 
     def key(self, model: ArmModel | None = None) -> str:
@@ -88,8 +91,14 @@ def build_problem(model: ArmModel, cfg: ProblemConfig | None = None) -> Catching
     feats = mapping.features(r, rd, rdd)
     if not np.all(feats.in_domain):
         raise ValueError("a sampled throw leaves the domain of l_c^-1")
+    approach = None
+    if cfg.approach_weight > 0.0:                # not in the paper: see approach.py
+        last = np.arange(cfg.n_samples - 1, len(r), cfg.n_samples)   # t_c of every throw
+        approach = approach_term(mapping, model, feats, last, g, initial_alpha(C, rhs),
+                                 cfg.approach_weight * cfg.n_samples)
     obj = Objective(mapping, model, feats, cfg.tau_max, cfg.omega_max, cfg.w_tau, cfg.w_omega,
-                    cfg.penalty)
+                    cfg.penalty, approach,
+                    cfg.torque_penalty if cfg.torque_penalty >= 0 else None)
     return CatchingProblem(cfg, model, geo, poly, mapping, throws, catch_point, nominal_v, C, rhs,
                            obj)
 

@@ -188,6 +188,9 @@ class StickCaptureController(Controller):
     """Shared machinery; subclasses give the contact of each step (``_options``)."""
 
     Params: ClassVar[type] = StickCaptureParams
+    spec_type: ClassVar[type] = AirTableSpec
+    command_type: ClassVar[type] = HandCommand
+    reads: ClassVar[tuple[str, ...]] = (TOPIC_VISION_STICK,)
     n_steps: ClassVar[int] = 1
 
     def __init__(self, params, *, spec: AirTableSpec) -> None:

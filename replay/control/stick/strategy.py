@@ -13,12 +13,13 @@ events and the capture check: see ``capture``). Pure NumPy.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
-from replay.params import param
+from replay.params import ParamError, param
 from replay.control.stick import collision as sc
 from replay.control.stick.capture import StickCaptureController, StickCaptureParams
 from replay.control.stick.estimator import StickEstimate
@@ -41,13 +42,17 @@ class TwoStepParams(StickCaptureParams):
 
 @dataclass
 class ThreeStepParams(StickCaptureParams):
-    lambda_2: list = param([1.0, 0.0], unit="1", length=2, ge=-1.0, le=1.0,
+    lambda_2: list[float] = param([1.0, 0.0], unit="1", length=2, ge=-1.0, le=1.0,
                            doc="selection vector lambda_2 of eq. 36: the direction of v_2 "
                                "(default: along world x, the stick perpendicular to the palm)")
     lambda_2_auto_sign: bool = param(True, unit="1", choices=(True, False),
                                      doc="use -lambda_2 when that sends the stick toward the "
                                          "centre of the base range (tried first; the other "
                                          "sign only if it cannot be reached)")
+
+    def __post_init__(self) -> None:
+        if math.hypot(*self.lambda_2) < 1e-6:
+            raise ParamError("lambda_2", "expected a direction, got the zero vector")
 
 
 # ------------------------------------------------------------------------------------------

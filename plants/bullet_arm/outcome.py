@@ -1,0 +1,123 @@
+"""The bullet_arm plant's physical verdict on a free object and the hand: caught or not, and why.
+
+Physics only (no method): :class:`CatchWatch` follows the object and the palm frame (the arm's tool
+frame: z is the palm normal, the contact face at z = palm_thickness, see replay/robot/hand.py)
+every step, keeps the state just before the first touch and the closest approach, and turns them
+into the run's ``outcome`` data (replay/runner.py ``_verdict``):
+
+- success: ``caught`` (the plant's ``catch`` event and still held at the end);
+- failures say why: ``<object> dropped after the catch``, ``<object> bounced off the palm rim``
+  (first touch on the palm with the object's centre outside the palm disc), ``... off the palm
+  face``, ``... off finger f2``, ``<object> hit the arm``, ``<object> passed below / above / beside
+  the hand`` (no touch at all; the direction of the closest approach from the palm centre),
+  ``<object> touched the hand but was not held``, ``the run ended before the <object> reached the
+  hand``;
+- metrics: ``catch_time``; ``first_contact_time``, ``contact_part``, ``contact_speed`` (object
+  relative to the palm, m/s, the step before the touch), ``contact_offset`` (object centre from the
+  palm axis, m), ``approach_angle`` (deg between the relative velocity and the palm's inward
+  normal: 0 = straight down the palm axis); without a touch ``closest_distance`` (m, object centre
+  to the palm face centre) and ``closest_time``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from replay.spatial import quaternion_matrix
+
+
+@dataclass
+class PalmSample:
+    t: float
+    offset: float          # m: object centre from the palm axis
+    height: float          # m: object centre above the palm face (palm z)
+    rel_speed: float       # m/s: object velocity relative to the palm point under it
+    approach_angle: float  # deg: relative velocity vs the palm's inward normal (-z)
+    world_offset: np.ndarray   # object centre - palm face centre (world, m)
+
+
+class CatchWatch:
+    def __init__(self, *, kind: str, palm_radius: float, palm_thickness: float) -> None:
+        self.kind = kind
+        self.palm_radius = float(palm_radius)
+        self.palm_thickness = float(palm_thickness)
+        self.last: PalmSample | None = None
+        self.first_contact: tuple[PalmSample, list] | None = None
+        self.closest: PalmSample | None = None
+        self.catch_time: float | None = None
+        self.approaching = True
+
+    def observe(self, t: float, obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega,
+                parts: list, caught: bool) -> None:
+        """One step: the object's and the palm's state (world) and the parts touching now."""
+        R = quaternion_matrix(palm_quat)
+        centre = np.asarray(palm_pos, float) + R[:, 2] * self.palm_thickness
+        d = np.asarray(obj_pos, float) - centre
+        local = R.T @ d
+        v_point = np.asarray(palm_vel, float) + np.cross(palm_omega, np.asarray(obj_pos) - palm_pos)
+        rel = np.asarray(obj_vel, float) - v_point
+        speed = float(np.linalg.norm(rel))
+        inward = -(R.T @ rel)[2]                 # towards the palm face, along its normal
+        angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
+        sample = PalmSample(t, float(math.hypot(local[0], local[1])), float(local[2]), speed,
+                            angle, d)
+        if self.closest is None or np.linalg.norm(d) < np.linalg.norm(self.closest.world_offset):
+            self.closest = sample
+        self.approaching = self.closest is sample        # still closing in at the last step
+        if parts and self.first_contact is None:
+            before = self.last or sample
+            self.first_contact = (PalmSample(t, sample.offset, sample.height, before.rel_speed,
+                                             before.approach_angle, sample.world_offset),
+                                  sorted(parts))
+        if caught and self.catch_time is None:
+            self.catch_time = t
+        self.last = sample
+
+    def verdict(self, *, caught: bool, ever_caught: bool) -> dict:
+        k = self.kind
+        out: dict = {}
+        if self.first_contact is not None:
+            c, parts = self.first_contact
+            part = _first_part(parts)
+            out.update(first_contact_time=round(c.t, 6), contact_part=part,
+                       contact_speed=c.rel_speed, contact_offset=c.offset,
+                       approach_angle=c.approach_angle)
+        if self.catch_time is not None:
+            out["catch_time"] = round(self.catch_time, 6)
+        if caught:
+            return {"success": True, "reason": "caught", **out}
+        if ever_caught:
+            return {"success": False, "reason": f"{k} dropped after the catch", **out}
+        if self.first_contact is not None:
+            c, parts = self.first_contact
+            part = _first_part(parts)
+            if self.last is not None and self.last.t - c.t < 0.06 and \
+                    np.linalg.norm(self.last.world_offset) < 2 * self.palm_radius:
+                return {"success": False, "reason": f"{k} touched the hand but was not held",
+                        **out}
+            if part == "palm":
+                where = "rim" if c.offset > self.palm_radius else "face"
+                return {"success": False, "reason": f"{k} bounced off the palm {where}", **out}
+            if part == "arm":
+                return {"success": False, "reason": f"{k} hit the arm", **out}
+            return {"success": False, "reason": f"{k} bounced off finger {part}", **out}
+        if self.closest is None:
+            return {"success": False, "reason": f"the run ended before the {k} reached the hand"}
+        cl = self.closest
+        out.update(closest_distance=float(np.linalg.norm(cl.world_offset)),
+                   closest_time=round(cl.t, 6))
+        if self.approaching:
+            return {"success": False, "reason": f"the run ended before the {k} reached the hand",
+                    **out}
+        dy, dz = abs(cl.world_offset[1]), cl.world_offset[2]
+        side = ("below" if dz < 0 else "above") if abs(dz) >= dy else "beside"
+        return {"success": False, "reason": f"{k} passed {side} the hand", **out}
+
+
+def _first_part(parts: list) -> str:
+    """The part a first touch is attributed to: the palm if it is among them, else the first."""
+    return "palm" if "palm" in parts else (parts[0] if parts else "arm")
+
