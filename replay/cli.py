@@ -392,10 +392,19 @@ def info(log):
     t0, t1 = r.time_range()
     flag = {"truncated": "  [TRUNCATED log]", "damaged": "  [DAMAGED log]"}.get(r.status, "")
     click.echo(f"duration: {t1 - t0:.4f} s simulated{flag}")
+    events = r.events()
+    outcome = next((e["data"] for e in reversed(events) if e["kind"] == "outcome"), None)
+    if outcome is None:
+        click.echo("outcome: (none: the run did not finish)")
+    else:
+        metrics = {k: v for k, v in outcome.items() if k not in ("success", "reason")}
+        click.echo(one_line(f"outcome: {'success' if outcome.get('success') else 'FAILED'}: "
+                            f"{outcome.get('reason', '')}"))
+        if metrics:
+            click.echo("  " + ", ".join(f"{k}={_short(v)}" for k, v in metrics.items()))
     click.echo("topics:")
     for topic, n in r.topic_counts().items():
         click.echo(one_line(f"  {topic:<28} {n:>8}"))
-    events = r.events()
     click.echo(f"events: {len(events)}")
     for e in events:
         data = e.get("data", {})

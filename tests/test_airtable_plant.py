@@ -305,3 +305,58 @@ def test_two_identical_runs_give_identical_truth():
     a, b = _record(p), _record(p)
     assert a == b
     assert any(ev for _, ev in a)                 # the run did contain a collision
+
+
+# -- the outcome (the physical verdict of a run) ------------------------------------------
+
+def held_params(vx=0.0, omega=0.0) -> Params:
+    """A horizontal stick at (0, 0.1) with fingertip 0 just below and 1 just above it."""
+    p = Params()
+    hand = AirTablePlant(p, dt=DT).spec().hand
+    gap = p.hand.tip_radius + 0.001
+    for k, (name, y) in enumerate((("joints0", 0.1 - gap), ("joints1", 0.1 + gap))):
+        q = finger_ik(hand, (0.0, 0.0), k, (0.0, y), q_near=hand.start_joints[k])
+        assert q is not None
+        setattr(p.hand, name, [float(q[0]), float(q[1])])
+    p.initial.x, p.initial.y, p.initial.theta = 0.0, 0.1, 0.0
+    p.initial.vx, p.initial.omega = vx, omega
+    return p
+
+
+def test_outcome_captured_when_held_between_the_tips():
+    plant = AirTablePlant(held_params(), dt=DT)
+    run(plant, 300)
+    o = plant.outcome(plant.time)
+    assert o["success"] is True and o["captured"] is True and o["reason"] == "captured"
+    assert o["t_capture"] == pytest.approx(DT, abs=1e-12)
+    assert o["speed"] == pytest.approx(0.0, abs=1e-9) and o["collisions"] == 0
+    json.dumps(o, allow_nan=False)
+
+
+def test_outcome_needs_the_hold_time():
+    plant = AirTablePlant(held_params(), dt=DT)
+    run(plant, 60)                                       # 20 ms < hold_time = 50 ms
+    o = plant.outcome(plant.time)
+    assert o["success"] is False and "only for the last" in o["reason"]
+
+
+@pytest.mark.parametrize("kw,words", [({"vx": 0.05}, "still moves"),
+                                      ({"omega": 2.0}, "still moves")])
+def test_outcome_not_captured_while_the_stick_moves(kw, words):
+    plant = AirTablePlant(held_params(**kw), dt=DT)
+    run(plant, 300)
+    o = plant.outcome(plant.time)
+    assert o["success"] is False and not o["captured"] and words in o["reason"]
+    assert o["t_capture"] is None
+
+
+def test_outcome_stopped_elsewhere_or_never_in_reach():
+    p = far_stick_params(x=0.0, y=0.25, vy=0.0)          # at rest, within reach, not held
+    plant = AirTablePlant(p, dt=DT)
+    run(plant, 300)
+    assert plant.outcome(plant.time)["reason"] == \
+        "not captured: the stick stopped but not between the fingertips"
+    plant = AirTablePlant(far_stick_params(), dt=DT)    # 0.21 m beyond any finger root
+    run(plant, 300)
+    o = plant.outcome(plant.time)
+    assert o["reason"] == "not captured: the stick never came within the hand's reach"

@@ -392,6 +392,13 @@ def test_three_step_reports_the_86_mm_second_collision_and_falls_back():
     expected = sc.two_step_first(M, INERTIA, E, u2, L)
     assert abs(plan3[0]["r_x"]) == pytest.approx(abs(expected.r_x), abs=1e-4)
     assert abs(plan3[0]["omega_after"]) < 1e-6 and abs(plan3[0]["r_x"]) < L / 2
+    # the outcome (not captured yet: this synthetic stick ignores the later contacts) names the
+    # 86.5 mm of collision 2 once the run ends
+    o = ctrl.outcome(1.60)
+    assert o["infeasible"] == ["r_x_beyond_stick@2"] and o["as_planned"] is False
+    assert o["success"] is False and o["method_reason"] == o["reason"]
+    assert o["reason"].startswith("infeasible: r_x beyond the stick at collision 2 (|r_x| = 86.5 mm")
+    json.dumps(o, allow_nan=False)
 
 
 class IdealTable:
@@ -445,6 +452,10 @@ def test_two_step_captures_on_the_ideal_table():
     json.dumps(ctrl.telemetry(0.8), allow_nan=False)
     kinds = [ev.kind for _, ev in events]
     assert "capture" in kinds and "infeasible" not in kinds
+    o = ctrl.outcome(0.8)
+    assert "success" not in o and o["method_captured"] and o["as_planned"]
+    assert o["t_capture_method"] == pytest.approx(
+        [ev.data["t_since"] for _, ev in events if ev.kind == "capture"][0])
     t1, k1, r1, u1, intent = table.collisions[0]
     assert intent["index"] == 1 and k1 == intent["finger"]
     assert t1 == pytest.approx(intent["t"], abs=1e-3)
@@ -501,6 +512,8 @@ def test_out_of_reach_is_reported_once_the_chance_has_passed():
     assert len(lost) == 1
     t, data = lost[0]
     assert data["reason"] == "unreachable" and data["step"] == 1
+    o = ctrl.outcome(0.7)
+    assert o["success"] is False and o["reason"].startswith("out of reach: ")
     assert data["t_contact"] < t                          # reported after the chance passed
     theta_star = sc.alpha([V0, 0.0])
     th = stick.state(data["t_contact"])[2]

@@ -134,3 +134,13 @@ class Params:
     rest_omega: float = param(0.1, unit="rad/s", gt=0, le=100,
                               doc="... and turns slower than this ...")
     rest_time: float = param(0.05, unit="s", gt=0, le=600, doc="... for this long")
+    hold_speed: float = param(0.02, unit="m/s", gt=0, le=10,
+                              doc="the outcome's 'captured': the stick slower than this ...")
+    hold_omega: float = param(0.5, unit="rad/s", gt=0, le=100,
+                              doc="... turning slower than this ...")
+    hold_gap: float = param(0.003, unit="m", ge=0, le=0.1,
+                            doc="... with a fingertip on each face, its centre within W/2 + "
+                                "tip_radius + this of the stick's axis and between its ends ...")
+    hold_time: float = param(0.05, unit="s", gt=0, le=600,
+                             doc="... for this long at the end of the run (our choice; the "
+                                 "paper defines no capture test)")

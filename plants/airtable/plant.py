@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from replay.robot.hand2d import AirTableSpec, HandCommand
+from replay.robot.hand2d import AirTableSpec, HandCommand, root_distance
 from replay.interfaces import Occurrence, Plant
 from replay.messages import (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_STICK_STATE, FingersState,
                              StickState)
@@ -122,6 +122,9 @@ class AirTablePlant(Plant):
         self._rest_since: float | None = None
         self._rest_reported = False
         self._nan_reported = False
+        self._collisions = 0
+        self._held_since: float | None = None    # the stick held between the tips since
+        self._reached = self._in_reach()         # the stick ever within the hand's reach
 
     # -- Plant interface ------------------------------------------------------------------
 
@@ -158,8 +161,10 @@ class AirTablePlant(Plant):
             for c in self._pending:
                 c["v_after"], c["omega_after"] = v_after, w_after
                 self._events.append(Occurrence("collision", c))
+            self._collisions += len(self._pending)
             self._pending = []
         self._check_state()
+        self._check_held()
 
     def _on_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         """A fingertip started touching the stick (called after position integration, before
@@ -221,6 +226,67 @@ class AirTablePlant(Plant):
                 "since": self._rest_since, "x": x, "y": y,
                 "theta": angle, "speed": math.hypot(vx, vy),
                 "omega": omega}))
+
+    def _in_reach(self) -> bool:
+        """The stick's centre within finger reach (l1 + l2, joint limits ignored) plus L/2 of a
+        finger root anywhere on the slider's range: a loose, purely geometric bound."""
+        h, b = self._hand_spec, self.stick_body
+        reach = sum(h.link_lengths) + h.tip_radius + 0.5 * self.params.stick.length
+        return root_distance(h, (b.position.x, b.position.y)) <= reach
+
+    def _held(self) -> bool:
+        """Slow (``hold_speed``, ``hold_omega``) with a fingertip at each face: between the
+        stick's ends and within W/2 + tip_radius + ``hold_gap`` of its axis, on opposite sides."""
+        p, b = self.params, self.stick_body
+        if math.hypot(b.velocity.x, b.velocity.y) >= p.hold_speed \
+                or abs(b.angular_velocity) >= p.hold_omega:
+            return False
+        c, s = math.cos(b.angle), math.sin(b.angle)
+        reach_y = 0.5 * p.stick.collision_width + p.hand.tip_radius + p.hold_gap
+        sides = []
+        for tb in self.tip_bodies:
+            dx, dy = tb.position.x - b.position.x, tb.position.y - b.position.y
+            xb, yb = c * dx + s * dy, -s * dx + c * dy
+            if abs(xb) > 0.5 * p.stick.length or abs(yb) > reach_y:
+                return False
+            sides.append(yb)
+        return sides[0] * sides[1] < 0.0
+
+    def _check_held(self) -> None:
+        self._reached = self._reached or self._in_reach()
+        if self._held():
+            if self._held_since is None:
+                self._held_since = self.time
+        else:
+            self._held_since = None
+
+    def outcome(self, t: float) -> dict:
+        """Captured: the stick held between the fingertips (``_held``) for the last
+        ``hold_time`` of the run; ``t_capture`` = since when. Else why not, physically."""
+        p, b = self.params, self.stick_body
+        speed, omega = math.hypot(b.velocity.x, b.velocity.y), float(b.angular_velocity)
+        held = self._held_since is not None and t - self._held_since >= p.hold_time - 1e-12
+        out = {"success": held, "reason": "captured", "captured": held,
+               "t_capture": self._held_since if held else None,
+               "speed": speed, "omega": omega, "collisions": self._collisions,
+               "x": float(b.position.x), "y": float(b.position.y), "theta": float(b.angle)}
+        if held:
+            return out
+        if not math.isfinite(speed + omega):
+            out["reason"] = "not captured: the simulation diverged"
+            out["speed"] = out["omega"] = None
+        elif not self._reached:
+            out["reason"] = "not captured: the stick never came within the hand's reach"
+        elif self._held_since is not None:
+            out["reason"] = (f"not captured: held between the fingertips only for the last "
+                             f"{t - self._held_since:.3f} s (< {p.hold_time:g} s)")
+        elif speed >= p.hold_speed or abs(omega) >= p.hold_omega:
+            where = "" if self._in_reach() else ", out of the hand's reach"
+            out["reason"] = (f"not captured: the stick still moves ({speed:.3f} m/s, "
+                             f"{omega:.2f} rad/s{where})")
+        else:
+            out["reason"] = "not captured: the stick stopped but not between the fingertips"
+        return out
 
     def pop_events(self) -> list[Occurrence]:
         out, self._events = self._events, []

@@ -99,3 +99,15 @@ def travel_time(hand: HandSpec, base_from, base_to, joints_from, joints_to) -> f
     t_base = max(abs(b - a) for a, b in zip(base_from, base_to)) / hand.base_speed
     t_joint = max(abs(b - a) for qa, qb in zip(joints_from, joints_to) for a, b in zip(qa, qb))
     return max(t_base, t_joint / hand.joint_speed)
+
+
+def root_distance(hand: HandSpec, point) -> float:
+    """Least distance (m) from ``point`` to a finger root anywhere on the slider's range (0 when a
+    root can be right under it): with ``sum(link_lengths)`` a loose bound of what can be reached."""
+    (xlo, xhi), (ylo, yhi) = hand.base_limits
+    best = math.inf
+    for ox, oy in hand.root_offsets:
+        dx = max(xlo + ox - point[0], 0.0, point[0] - xhi - ox)
+        dy = max(ylo + oy - point[1], 0.0, point[1] - yhi - oy)
+        best = min(best, math.hypot(dx, dy))
+    return best

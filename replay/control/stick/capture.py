@@ -27,11 +27,16 @@ Cycle of one planned collision i:
    spinning stick waits outside it (``stage_margin``) and moves in just after the stick's last
    pass; a fingertip inside the stick's reach is first pulled out of it. Every route is checked
    against the predicted sweep along the hand's own motion (each axis at its speed limit, as
-   the plant moves). The first crossing that works is the plan; it is refined with every new
-   estimate until ``freeze`` before the contact.
-4. A model break of the estimator within ``detect_window`` of the planned time is the planned
-   collision; the plan for the next step is then made from fresh estimates. A break much earlier,
-   or none by ``detect_window`` after the plan, is reported (``missed``) and the step re-planned.
+   the plant moves). The first crossing that works, among those after which the stick (moving
+   with J_i u, eq. 22) is still within ``reach_fraction`` of the fingers' reach
+   ``keep_in_reach`` later (else among all), is the plan; it is refined with every new estimate
+   until ``freeze`` before the contact (staged routes too: a plan made from the few samples just
+   after a collision extrapolates a noisy velocity).
+4. A model break of the estimator within ``detect_window`` of the planned time, or whose unseen
+   gap (last fitted sample .. first deviating one, e.g. the stick out of the camera's view)
+   contains it, is the planned collision; the plan for the next step is then made from fresh
+   estimates. A break much earlier, or none by ``detect_window`` after the plan, is reported
+   (``missed``) and the step re-planned.
 
 Closing (eqs. 32, 33, 38): once the stick translates, the finger that made the last collision is
 behind it; the other waits on the line through the centre of mass along v, ahead of the stick, at
@@ -40,7 +45,8 @@ stick when it starts behind it); the rear fingertip waits behind the stick while
 moves (finger joints cannot hold a tip still against a moving slider), then follows the stick
 along that line (``follow_gap`` behind) to the final gap W + 2 tip_radius + grip_clearance.
 Whatever spin is left is ignored by the closing plan (the fingers then squeeze a turning stick:
-not friction independent).
+not friction independent); but a closing to be (re)planned on a stick spinning faster than
+``respin`` first gets a spin-stop collision (eq. 30), up to ``max_extra`` in all.
 A ``capture`` event is emitted once the estimated speed stays below ``capture_speed`` and spin
 below ``capture_spin`` for ``capture_hold`` with both modelled fingertips at the stick's two faces.
 
@@ -68,7 +74,9 @@ A step whose job is to stop the spin is skipped when |omega| < ``min_spin`` alre
 
 Events (``pop_events``): ``plan`` (a contact is committed; data = the intent), ``infeasible``,
 ``missed`` (the model broke well before the planned time, or not by ``detect_window`` after it),
-``skip``, ``capture``. ``intent()``: index, finger, t, theta, r_x, r_y, side, v_after,
+``skip``, ``capture``. ``outcome()``: the method's metrics, and when it has not captured the stick
+``success: False`` with why (out of reach, r_x beyond the stick, no feasible plan, timed out).
+``intent()``: index, finger, t, theta, r_x, r_y, side, v_after,
 omega_after, contact and tip (world, m), clamped, r_x_solved. theta is the estimator's continuous
 orientation (it starts from the camera's first reading in (-pi/2, pi/2]); r_x, r_y and side are
 in that body frame (the solution's frame theta* = alpha(.) may differ from it by pi).
@@ -82,6 +90,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from replay.robot import hand2d
 from replay.robot.hand2d import AirTableSpec, HandCommand, HandSpec
 from replay.interfaces import Controller, Occurrence
 from replay.params import param
@@ -90,6 +99,7 @@ from replay.control.stick.close import ClosePlan, ClosePlanner
 from replay.control.stick.estimator import StickEstimate, StickEstimator
 from replay.control.stick.hand_model import Config, HandModel
 from replay.control.stick.plan import ContactPlan, ContactPlanner, Shortfall
+from replay.control.stick.sweep import Motion
 from replay.messages import TOPIC_STICK_ESTIMATE, TOPIC_VISION_STICK
 
 
@@ -146,6 +156,21 @@ class StickCaptureParams:
                                 doc="capture: estimated |omega| below this")
     capture_hold: float = param(0.05, unit="s", ge=0.0, le=5.0,
                                 doc="capture: conditions held this long")
+    respin: float = param(2.0, unit="rad/s", ge=0.0, le=100.0,
+                          doc="a closing to be (re)planned on a stick spinning faster than this "
+                              "gets a spin-stop collision (eq. 30) first, up to max_extra")
+    view: list = param([-0.40, 0.40, -0.20, 0.60], unit="m", length=4, ge=-10.0, le=10.0,
+                       doc="[x_min, x_max, y_min, y_max] of the stick's centre where the camera "
+                           "sees the whole stick (the scenarios' camera: a 0.9 m square about "
+                           "(0, 0.2), less L/2); contacts there are preferred (the method sees "
+                           "their result)")
+    keep_in_reach: float = param(0.3, unit="s", ge=0.0, le=5.0,
+                                 doc="a contact after which the stick's predicted centre is still "
+                                     "within reach_fraction of the fingers' reach this long is "
+                                     "preferred (the next steps need it there; our choice)")
+    reach_fraction: float = param(0.85, unit="1", gt=0.0, le=2.0,
+                                  doc="'within reach' for keep_in_reach: this fraction of l1 + l2 "
+                                      "from a finger root the slider can reach")
 
 
 def _finite_or_none(v) -> float | None:
@@ -190,6 +215,9 @@ class StickCaptureController(Controller):
         self._next_try = -math.inf          # no new plan attempt before this time
         self.extra = 0                      # spin-stop collisions added so far
         self._lost: tuple | None = None     # (time of a contact chance not yet planned, numbers)
+        self._infeasible: list[dict] = []   # the ``infeasible`` reports, in order
+        self._missed = 0                    # ``missed`` reports
+        self._t_capture: float | None = None
 
     # -- Controller interface -----------------------------------------------------------------
     def update(self, t: float, measurements) -> HandCommand:
@@ -218,6 +246,53 @@ class StickCaptureController(Controller):
     def pop_events(self) -> list[Occurrence]:
         out, self._events = self._events, []
         return out
+
+    def outcome(self, t: float) -> dict:
+        """The method's metrics and, when it has not captured the stick, why (the last thing that
+        stopped it: out of reach, r_x beyond the stick, no feasible plan, or the run ended first)."""
+        out = {"method_captured": self.captured, "t_capture_method": self._t_capture,
+               "phase": self.phase, "collisions_done": self.step - 1,
+               "extra_spin_stops": self.extra, "missed": self._missed,
+               "infeasible": [d["reason"] + f"@{d['step']}" for d in self._infeasible],
+               "as_planned": not self._infeasible and not self._missed}
+        if self.captured:
+            return out
+        # the runner keeps the plant's reason when both fail: method_reason keeps this one too
+        out["success"] = False
+        out["reason"] = out["method_reason"] = self._why_not(t)
+        return out
+
+    def _why_not(self, t: float) -> str:
+        last = self._infeasible[-1] if self._infeasible else None
+        where = f"phase {self.phase}, collision {self.step}"
+        if self._lost is not None and t > self._lost[0]:        # a chance passed, not reported
+            last = {"reason": "unreachable", "step": self.step, "t_contact": self._lost[0],
+                    "t_needed": _finite_or_none(self._lost[1].t_needed),
+                    "t_available": self._lost[1].t_available}
+        if last is None:
+            e = self.est.estimate()
+            if e is None:
+                return f"timed out before capture: the stick was never seen ({where})"
+            if t - e.t_ref > 0.1:
+                return (f"timed out before capture: the stick out of sight since t = "
+                        f"{e.t_ref:.3f} s ({where})")
+            return f"timed out before capture ({where})"
+        step = last["step"]
+        if last["reason"] == "unreachable":
+            need = last.get("t_needed")
+            if need is None:
+                return f"out of reach: no hand posture reaches contact {step} clear of the stick"
+            return (f"out of reach: the hand cannot get to contact {step} in time (needs "
+                    f"{need:.3f} s, had {last.get('t_available', 0.0):.3f} s)")
+        if last["reason"] == "r_x_beyond_stick":
+            return (f"infeasible: r_x beyond the stick at collision {step} (|r_x| = "
+                    f"{abs(last['r_x']) * 1e3:.1f} mm > L/2 = {last['limit'] * 1e3:.1f} mm); "
+                    f"the clamped fallback did not capture ({where})")
+        if last["reason"] in ("no_solution", "no_crossing"):
+            what = ("no root of eq. 25/28 passes eq. 26" if last["reason"] == "no_solution"
+                    else "the stick never turns to alpha(v)")
+            return f"infeasible: no feasible plan for collision {step} ({what}; {where})"
+        return f"infeasible: {last['reason']} at collision {step} ({where})"
 
     def telemetry(self, t: float) -> dict:
         e = self.est.estimate()
@@ -262,6 +337,8 @@ class StickCaptureController(Controller):
         clean = {k: (_finite_or_none(v) if isinstance(v, (float, np.floating)) else v)
                  for k, v in data.items()}
         self._events.append(Occurrence(kind=kind, data=clean))
+        if kind == "infeasible":
+            self._infeasible.append(clean)
 
     def _on_break(self, t: float) -> None:
         t_break = self.est.breaks[-1]
@@ -271,7 +348,12 @@ class StickCaptureController(Controller):
         self._report_clamp(plan)
         self._next_try = -math.inf
         self._lost = None
-        if abs(t_break - plan.t) <= self.params.detect_window:
+        # the planned time within the break's unseen gap (the last fitted sample .. the first
+        # deviating one; the stick may have been out of the camera's view) is the plan's
+        dw = self.params.detect_window
+        prev = self.est.before_break
+        t_seen = prev.t_ref if prev is not None else t_break
+        if t_seen - dw <= plan.t <= t_break + dw:
             self.last_finger = plan.finger
             self.plan = None
             self.step += 1
@@ -283,6 +365,7 @@ class StickCaptureController(Controller):
                 else:
                     self.phase = "close"
         else:
+            self._missed += 1
             self._events.append(Occurrence("missed", {
                 "index": plan.index, "reason": "early_contact", "t_planned": float(plan.t),
                 "t_break": float(t_break)}))
@@ -294,6 +377,7 @@ class StickCaptureController(Controller):
         p = self.params
         if self.phase in ("observe", "approach"):
             if self.plan is not None and est.t_ref > self.plan.t + p.detect_window:
+                self._missed += 1
                 self._events.append(Occurrence("missed", {
                     "index": self.plan.index, "reason": "no_collision",
                     "t_planned": float(self.plan.t), "t_now": float(t)}))
@@ -304,12 +388,21 @@ class StickCaptureController(Controller):
                     self._plan_step(t, est)
                     if self.plan is None and self.phase != "close":
                         self._next_try = t + p.retry_interval
-            elif t < self.plan.t - p.freeze and len(self.plan.route) <= 1:
+            elif t < self.plan.t - p.freeze:
+                # staged routes too: a plan made from the few samples after a collision
+                # extrapolates a noisy velocity (e.g. 0.05 m/s from 6 samples: 2 cm in 0.4 s)
                 self._refine(t, est)
         elif self.phase == "close":
             if self.close is not None and t > self.close.t_meet + p.close_retry \
-                    and self._capture_since is None:
-                self.close = None
+                    and self._capture_since is None and not self._between_tips(t, est):
+                self.close = None        # (a stick already between the tips is left to settle)
+            if self.close is None and abs(est.omega) >= p.respin \
+                    and self.extra < p.max_extra and self._capture_since is None:
+                self.extra += 1          # still spinning: one more spin-stop collision (eq. 30)
+                self.step = max(self.step, self.n_steps + 1)
+                self.phase = "observe"
+                self._next_try = -math.inf
+                return
             if self.close is None:
                 if t >= self._next_try:
                     self._plan_close(t, est)
@@ -338,20 +431,26 @@ class StickCaptureController(Controller):
         shortfall = Shortfall()
         crossings_any = False
         first = math.inf
-        for sol, raw in usable:
-            crossings = self.planner.crossings(t, est, sol.theta)
-            crossings_any |= bool(crossings)
-            first = min([first, *crossings])
-            fingers, strict = self._finger_order(sol, step)
-            for t_c in crossings:
-                plan = self.planner.reach(self.step, t, est, sol, raw, t_c, fingers, strict,
-                                          shortfall)
-                if plan is not None:
-                    self.plan = plan
-                    self._lost = None
-                    self.phase = "approach"
-                    self._events.append(Occurrence("plan", plan.intent(self.stick.width)))
-                    return
+        # first the contacts in view that leave the stick within reach, then those in view, then any
+        for keep in (2, 1, 0):
+            for sol, raw in usable:
+                crossings = self.planner.crossings(t, est, sol.theta)
+                crossings_any |= bool(crossings)
+                first = min([first, *crossings])
+                fingers, strict = self._finger_order(sol, step)
+                for t_c in crossings:
+                    if keep and not self._in_view(est, sol, t_c):
+                        continue
+                    if keep == 2 and not self._stays_in_reach(est, sol, t_c):
+                        continue
+                    plan = self.planner.reach(self.step, t, est, sol, raw, t_c, fingers,
+                                              strict, shortfall)
+                    if plan is not None:
+                        self.plan = plan
+                        self._lost = None
+                        self.phase = "approach"
+                        self._events.append(Occurrence("plan", plan.intent(self.stick.width)))
+                        return
         if not crossings_any:
             if abs(est.omega) < 1e-6:
                 self._report("infeasible", (step, "no_crossing"), step=step,
@@ -359,6 +458,23 @@ class StickCaptureController(Controller):
                 self._to_close()
             return                      # else the next crossing is beyond the horizon: wait
         self._lost_chance(t, first, shortfall)
+
+    def _in_view(self, est: StickEstimate, sol: sc.ContactSolution, t_c: float) -> bool:
+        """The stick's centre within ``view`` at the contact and ``keep_in_reach`` after it."""
+        x0, x1, y0, y1 = self.params.view
+        motion = Motion(est, t_c, sol.u_after)
+        for tt in (t_c, t_c + self.params.keep_in_reach):
+            c = motion.pose(tt)[0]
+            if not (x0 <= c[0] <= x1 and y0 <= c[1] <= y1):
+                return False
+        return True
+
+    def _stays_in_reach(self, est: StickEstimate, sol: sc.ContactSolution, t_c: float) -> bool:
+        """The stick's centre, moving with J_i u (eq. 22) after the contact at t_c, is within
+        ``reach_fraction`` of the fingers' reach ``keep_in_reach`` later."""
+        p = self.params
+        c = Motion(est, t_c, sol.u_after).pose(t_c + p.keep_in_reach)[0]
+        return hand2d.root_distance(self.hand, c) <= p.reach_fraction * sum(self.hand.link_lengths)
 
     def _lost_chance(self, t: float, deadline: float, shortfall: Shortfall) -> None:
         """Report ``unreachable`` once a contact opportunity has passed unplanned (an attempt
@@ -451,23 +567,28 @@ class StickCaptureController(Controller):
             if self.phase == "close":
                 self.model.target = self.closing.command(t, self.close, self.est)
 
+    def _between_tips(self, t: float, est: StickEstimate) -> bool:
+        """Both modelled fingertips at the estimated stick's two faces (between its ends)."""
+        p, st, hand = self.params, self.stick, self.hand
+        x, y, th = est.at(t)
+        cs, sn = math.cos(th), math.sin(th)
+        sides = []
+        for k in (0, 1):
+            d = self.model.config.tip(hand, k) - np.array([x, y])
+            xb, yb = d[0] * cs + d[1] * sn, -d[0] * sn + d[1] * cs
+            at = abs(xb) <= 0.5 * st.length and \
+                abs(yb) <= 0.5 * st.width + hand.tip_radius + p.grip_clearance + 0.003
+            sides.append(yb if at else 0.0)
+        return sides[0] * sides[1] < 0.0
+
     def _check_capture(self, t: float) -> None:
         if self.phase != "close" or self.close is None or not self.est.ready():
             return
-        p, st, hand = self.params, self.stick, self.hand
+        p, hand = self.params, self.hand
         est = self.est.estimate()
         x, y, th = est.at(t)
-        ok = est.speed < p.capture_speed and abs(est.omega) < p.capture_spin
-        if ok:
-            cs, sn = math.cos(th), math.sin(th)
-            sides = []
-            for k in (0, 1):
-                d = self.model.config.tip(hand, k) - np.array([x, y])
-                xb, yb = d[0] * cs + d[1] * sn, -d[0] * sn + d[1] * cs
-                at = abs(xb) <= 0.5 * st.length and \
-                    abs(yb) <= 0.5 * st.width + hand.tip_radius + p.grip_clearance + 0.003
-                sides.append(yb if at else 0.0)
-            ok = sides[0] * sides[1] < 0.0
+        ok = est.speed < p.capture_speed and abs(est.omega) < p.capture_spin \
+            and self._between_tips(t, est)
         if not ok:
             self._capture_since = None
             return
@@ -475,6 +596,7 @@ class StickCaptureController(Controller):
             self._capture_since = t
         if t - self._capture_since >= p.capture_hold and not self.captured:
             self.captured = True
+            self._t_capture = float(self._capture_since)
             self.phase = "captured"
             self._events.append(Occurrence("capture", {
                 "t_since": float(self._capture_since), "speed": float(est.speed),

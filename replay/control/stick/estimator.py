@@ -84,7 +84,10 @@ class StickEstimator:
     # -- input ------------------------------------------------------------------------------
     def add(self, t: float, x: float, y: float, theta: float) -> bool:
         """Add a measurement (theta modulo pi). True when it confirms a collision (model break)."""
-        near = self._predict_theta(t)
+        # deviating samples (a collision, maybe after an unseen gap) chain to each other: the old
+        # fit's prediction may be half a turn off by then, and two of them a branch apart would
+        # fake a spin of pi per frame
+        near = self._pending[-1][3] if self._pending else self._predict_theta(t)
         sample = (float(t), float(x), float(y), unwrap_to(float(theta), near))
         if not self.ready() or not self._deviates(sample):
             self._pending.clear()           # isolated outliers are dropped

@@ -46,6 +46,14 @@ CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long b
 GO_DELAY = 0.003       # s, a staged tip moves in this long after the stick's last pass
 
 
+def _body_point(motion: Motion, t: float, point) -> tuple[float, float]:
+    """``point`` (world) in the stick frame at time ``t``."""
+    c, th = motion.pose(t)
+    d = np.asarray(point, dtype=float) - c
+    cs, sn = math.cos(th), math.sin(th)
+    return float(d[0] * cs + d[1] * sn), float(-d[0] * sn + d[1] * cs)
+
+
 # ------------------------------------------------------------------------------------------
 # The plan and the shortfall of failed attempts
 # ------------------------------------------------------------------------------------------
@@ -63,13 +71,17 @@ class ContactPlan:
     tip: np.ndarray          # world fingertip centre (m)
     config: Config           # the hand at the contact
     route: list = field(default_factory=list)   # [(t_start, Config)], the last one = config
+    exit: Config | None = None   # just after the contact: the tip out of the stick's sweep
+
 
     @property
     def clamped(self) -> bool:
         return self.raw_r_x is not None
 
     def target(self, t: float) -> Config:
-        """The waypoint to command at time ``t``."""
+        """The waypoint to command at time ``t`` (``exit`` from GO_DELAY after the contact)."""
+        if self.exit is not None and t >= self.t + GO_DELAY:
+            return self.exit
         return route_target(self.route, t, self.config)
 
     def frame_flip(self) -> int:
@@ -176,7 +188,8 @@ class ContactPlanner:
                 route, cost = found
                 if best is None or cost < best[0]:
                     best = (cost, ContactPlan(index, k, t_c, th_c, sol, raw, contact,
-                                              tip, cfg, route))
+                                              tip, cfg, route,
+                                              self._exit_after(cfg, k, motion, t_c, tip, n)))
             if best is not None and strict:
                 break
         return None if best is None else best[1]
@@ -248,10 +261,40 @@ class ContactPlanner:
                          hand.tip_radius - 5e-4).any():
             return None
         if check_idle:
-            grow = np.where(moving, hand.tip_radius - 5e-4, hand.tip_radius + p.sweep_margin)
+            # on the way the idle tip keeps sweep_margin, or at least the clearance it has now
+            # (it may start at the stick it just hit): a route grazing the stick at speed is a hit
+            xb, yb = _body_point(motion, t, tips[0, 1 - k])
+            gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
+            on_way = max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
+            grow = np.where(moving, on_way, hand.tip_radius + p.sweep_margin)
             if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow).any():
                 return None
         return arrival
+
+    def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip,
+                    n) -> Config | None:
+        """Finger k's tip backed away along -n (the way it came, away from the face the contact
+        pushes off) out of the stick's reach just after the contact when
+        the predicted motion after it (J_i u, eq. 22: e.g. a stick left spinning in place)
+        would sweep over the tip within half a turn (or ``post_horizon``); the stick may be out of the camera's
+        view then, so this cannot wait for the next estimate. None when not needed or not
+        reachable (base kept)."""
+        p, st, hand = self.params, self.stick, self.hand
+        w = abs(motion.u_after[2])
+        span = max(p.post_horizon, min(p.horizon, math.pi / w + 0.02 if w > 1e-6 else 0.0))
+        times = sample_times(t_c + 2.0 * GO_DELAY, t_c + span)       # up to half a turn
+        if not covered(motion, times, [tip], 0.5 * st.length, 0.5 * st.width,
+                       hand.tip_radius).any():
+            return None
+        c, _ = motion.pose(t_c)
+        d = np.asarray(tip) - c
+        r_out = 0.5 * st.length + hand.tip_radius + p.stage_margin
+        dn = float(np.dot(d, n))
+        # |d - s n| = r_out, s > 0
+        s = dn + math.sqrt(max(dn * dn + r_out * r_out - float(np.dot(d, d)), 0.0))
+        q = hand2d.finger_ik(hand, cfg.base, k, np.asarray(tip) - s * np.asarray(n),
+                             q_near=cfg.joints[k])
+        return None if q is None else cfg.with_finger(k, q)
 
     def _exit_config(self, t: float, now: Config, motion: Motion) -> Config | None:
         """``now`` with every fingertip within the stick's reach moved radially out of it
