@@ -21,8 +21,12 @@ def _full_dofs(plant, q_arm, qd_arm=None, qdd_arm=None):
             pos.append(float(hq[hand_of[j]]))
             vel.append(0.0)
             acc.append(0.0)
-    return pos, vel, acc, [plant._dofs.index(plant._jidx[plant.joint_names[i]])
-                           for i in plant.active]
+    return (
+        pos,
+        vel,
+        acc,
+        [plant._dofs.index(plant._jidx[plant.joint_names[i]]) for i in plant.active],
+    )
 
 
 def inverse_dynamics(plant, q, qd, qdd) -> np.ndarray:

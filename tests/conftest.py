@@ -10,6 +10,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 @pytest.fixture(autouse=True, scope="session")
 def _toy_plugins():
     import toy_plugins
+
     toy_plugins.install()
 
 

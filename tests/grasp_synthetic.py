@@ -13,20 +13,40 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from analysis.grasp_run import (HOLDING, REACHING, RELEASING, T_ARM, T_ARM_TASK, T_CHIP, T_HAND,
-                                T_HAND_TASK, T_HEAD, T_OBJECT, T_STATE, T_TASKS, T_VISION,
-                                TRACKING)
+from analysis.grasp_run import (
+    HOLDING,
+    REACHING,
+    RELEASING,
+    T_ARM,
+    T_ARM_TASK,
+    T_CHIP,
+    T_HAND,
+    T_HAND_TASK,
+    T_HEAD,
+    T_OBJECT,
+    T_STATE,
+    T_TASKS,
+    T_VISION,
+    TRACKING,
+)
 from replay.log import LogWriter, seconds_to_ns
 from replay.messages import Event, JointState, ObjectState, ScenarioInfo
 from replay.spatial import matrix_to_quaternion
 
 PLANE_X = 0.65
-STANDOFF = 0.15             # m, the hand's distance from the plane while only tracking
-GRIP_X = PLANE_X - 0.04     # the palm's x when grasping (box half depth + palm)
-LAG = 0.003                 # s, the tracking lag
+STANDOFF = 0.15  # m, the hand's distance from the plane while only tracking
+GRIP_X = PLANE_X - 0.04  # the palm's x when grasping (box half depth + palm)
+LAG = 0.003  # s, the tracking lag
 # (phase, start): track, reach, hold, release, track, reach, hold
-SCHEDULE = [(TRACKING, 0.0), (REACHING, 0.5), (HOLDING, 0.8), (RELEASING, 1.3),
-            (TRACKING, 1.5), (REACHING, 1.7), (HOLDING, 2.0)]
+SCHEDULE = [
+    (TRACKING, 0.0),
+    (REACHING, 0.5),
+    (HOLDING, 0.8),
+    (RELEASING, 1.3),
+    (TRACKING, 1.5),
+    (REACHING, 1.7),
+    (HOLDING, 2.0),
+]
 TASKS = ["vision", "head", "arm", "hand"]
 HEAD = [0.0, -0.6, 0.9]
 
@@ -44,9 +64,13 @@ def _phase_start(t: float) -> float:
 
 
 def object_path(t: float) -> np.ndarray:
-    return np.array([PLANE_X, 0.05 * math.sin(2 * math.pi * 0.7 * t)
-                     + 0.02 * math.sin(2 * math.pi * 1.6 * t + 1.0),
-                     0.55 + 0.02 * math.sin(2 * math.pi * 0.9 * t)])
+    return np.array(
+        [
+            PLANE_X,
+            0.05 * math.sin(2 * math.pi * 0.7 * t) + 0.02 * math.sin(2 * math.pi * 1.6 * t + 1.0),
+            0.55 + 0.02 * math.sin(2 * math.pi * 0.9 * t),
+        ]
+    )
 
 
 def _reach_x(t: float) -> float:
@@ -62,29 +86,62 @@ def _reach_x(t: float) -> float:
     return PLANE_X - STANDOFF
 
 
-def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = "box",
-                    name: str = "synthetic_grasp", lag: float = LAG,
-                    slip_at: float | None = None) -> Path:
+def write_grasp_log(
+    path,
+    *,
+    duration: float = 2.3,
+    rate: int = 500,
+    obj: str = "box",
+    name: str = "synthetic_grasp",
+    lag: float = LAG,
+    slip_at: float | None = None,
+) -> Path:
     """``lag`` < 0 makes the hand lead the object (as a predictor would); ``slip_at`` adds a
     ``slip`` event and lets the object slide off the palm from then on."""
     from replay.robot.hand import GRASP4
     from replay.robot.wam import wam_chain, wam_joint_names
+
     chain = wam_chain(7)
     names = list(wam_joint_names(7))
-    params = {"arm": "wam7", "tool_d": -1.0, "base_position": [0.0, 0.0, 0.0],
-              "base_rpy": [0.0, 0.0, 0.0], "initial_q": [0.0, 0.9, 0.0, 1.6, 0.0, -0.9, 0.0],
-              "initial_qd": [], "locked_joints": [], "torque_limit_set": "public_urdf",
-              "torque_limits": [], "velocity_limits": [], "hand": "grasp4", "hand_initial": [],
-              "object": obj, "object_radius": 0.03, "object_size": [0.05, 0.05, 0.05],
-              "object_position": object_path(0.0).tolist(), "plane_normal": [1.0, 0.0, 0.0],
-              "head_position": HEAD}
-    sc = {"name": name, "paper": "namiki1999", "description": "synthetic grasping log",
-          "seed": 0, "timing": {"physics_rate": rate, "duration": duration},
-          "plant": {"type": "bullet_grasp", "params": params}, "sensors": {"chip": {"type": "vision_chip", "rate": float(rate), "params": {
-              "fov": 0.21, "width": 16, "height": 16}}},
-          "controller": {"type": "none", "rate": float(rate), "params": {}},
-          "tasks": {k: {"rate": float(rate)} for k in TASKS},
-          "stop": {"on_events": [], "after": 0.0}, "notes": ""}
+    params = {
+        "arm": "wam7",
+        "tool_d": -1.0,
+        "base_position": [0.0, 0.0, 0.0],
+        "base_rpy": [0.0, 0.0, 0.0],
+        "initial_q": [0.0, 0.9, 0.0, 1.6, 0.0, -0.9, 0.0],
+        "initial_qd": [],
+        "locked_joints": [],
+        "torque_limit_set": "public_urdf",
+        "torque_limits": [],
+        "velocity_limits": [],
+        "hand": "grasp4",
+        "hand_initial": [],
+        "object": obj,
+        "object_radius": 0.03,
+        "object_size": [0.05, 0.05, 0.05],
+        "object_position": object_path(0.0).tolist(),
+        "plane_normal": [1.0, 0.0, 0.0],
+        "head_position": HEAD,
+    }
+    sc = {
+        "name": name,
+        "paper": "namiki1999",
+        "description": "synthetic grasping log",
+        "seed": 0,
+        "timing": {"physics_rate": rate, "duration": duration},
+        "plant": {"type": "bullet_grasp", "params": params},
+        "sensors": {
+            "chip": {
+                "type": "vision_chip",
+                "rate": float(rate),
+                "params": {"fov": 0.21, "width": 16, "height": 16},
+            }
+        },
+        "controller": {"type": "none", "rate": float(rate), "params": {}},
+        "tasks": {k: {"rate": float(rate)} for k in TASKS},
+        "stop": {"on_events": [], "after": 0.0},
+        "notes": "",
+    }
     text = yaml.safe_dump(sc, sort_keys=False)
     n = int(round(duration * rate))
     q = np.array(params["initial_q"], float)
@@ -102,11 +159,12 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
             if slip_at is not None and t >= slip_at:
                 o = o + np.array([0.0, 0.0, -0.2 * (t - slip_at)])
                 if t - slip_at < 0.5 / rate:
-                    log.write("/events", Event(t, "slip", {"speed": 0.2,
-                                                           "position": o.tolist()}), ns)
+                    log.write(
+                        "/events", Event(t, "slip", {"speed": 0.2, "position": o.tolist()}), ns
+                    )
             lagged = object_path(max(t - lag, 0.0))
             goal = np.array([_reach_x(t), lagged[1], lagged[2]])
-            for _ in range(1 if k else 60):       # damped least squares to the goal
+            for _ in range(1 if k else 60):  # damped least squares to the goal
                 J = chain.position_jacobian(q)
                 e = goal - chain.tool_position(q)
                 q = q + J.T @ np.linalg.solve(J @ J.T + 1e-4 * np.eye(3), e)
@@ -118,40 +176,108 @@ def write_grasp_log(path, *, duration: float = 2.3, rate: int = 500, obj: str = 
                     data = {"parts": ["palm", "index", "thumb"]} if kind == "grasp" else {}
                     log.write("/events", Event(t, kind, {**data, "position": o.tolist()}), ns)
                 prev_phase = ph
-            close = {REACHING: min((t - _phase_start(t)) / 0.3, 1.0), HOLDING: 1.0,
-                     RELEASING: max(1.0 - (t - _phase_start(t)) / 0.1, 0.0)}.get(ph, 0.0)
+            close = {
+                REACHING: min((t - _phase_start(t)) / 0.3, 1.0),
+                HOLDING: 1.0,
+                RELEASING: max(1.0 - (t - _phase_start(t)) / 0.1, 0.0),
+            }.get(ph, 0.0)
             hq = h_open + close * (h_closed - h_open)
             log.write(T_ARM, JointState(t, names, q.tolist(), [0.0] * 7, [0.0] * 7), ns)
-            log.write(T_HAND, JointState(t, list(GRASP4.joint_names), hq.tolist(),
-                                         [0.0] * 14, [0.0] * 14), ns)
+            log.write(
+                T_HAND,
+                JointState(t, list(GRASP4.joint_names), hq.tolist(), [0.0] * 14, [0.0] * 14),
+                ns,
+            )
             d = o - np.array(HEAD)
             pan, tilt = math.atan2(d[1], d[0]), math.atan2(d[2], math.hypot(d[0], d[1]))
-            log.write("/head/joint_state", JointState(t, ["pan", "tilt"], [pan, tilt],
-                                                      [0.0, 0.0], [0.0, 0.0]), ns)
-            z = d / np.linalg.norm(d)                       # optical axis at the object
+            log.write(
+                "/head/joint_state",
+                JointState(t, ["pan", "tilt"], [pan, tilt], [0.0, 0.0], [0.0, 0.0]),
+                ns,
+            )
+            z = d / np.linalg.norm(d)  # optical axis at the object
             x = np.cross(z, [0.0, 0.0, 1.0])
             x /= np.linalg.norm(x)
-            R = np.column_stack([x, np.cross(z, x), z])     # OpenCV: x right, y down, z ahead
-            log.write(T_HEAD, {"t": t, "pan": pan, "tilt": tilt, "velocity": [0.0, 0.0],
-                               "camera_position": HEAD,
-                               "camera_orientation": matrix_to_quaternion(R).tolist()}, ns)
+            R = np.column_stack([x, np.cross(z, x), z])  # OpenCV: x right, y down, z ahead
+            log.write(
+                T_HEAD,
+                {
+                    "t": t,
+                    "pan": pan,
+                    "tilt": tilt,
+                    "velocity": [0.0, 0.0],
+                    "camera_position": HEAD,
+                    "camera_orientation": matrix_to_quaternion(R).tolist(),
+                },
+                ns,
+            )
             seen = object_path(max(t - 0.001, 0.0))
             six = lambda p: [*p, 0.0, 0.0, 0.0]  # noqa: E731
-            log.write(T_ARM_TASK, {"t": t, "x_a": six(hand.tolist()), "x_o": six(seen.tolist()),
-                                   "x_d": six([_reach_x(t), lagged[1], lagged[2]])}, ns)
-            log.write(T_OBJECT, ObjectState(t, o.tolist(), [0.0, 0.0, 0.0, 1.0],
-                                            [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]), ns)
-            log.write(T_CHIP, {"t": t, "width": 16, "height": 16, "rows": [0x07C0 if 5 <= v < 10 else 0 for v in range(16)],
-                               "count": 20}, ns)
-            log.write(T_VISION, {"t": t - 0.001, "found": True, "xi": [8.0, 8.0], "phi": 0.0,
-                                 "area": 20, "position": seen.tolist(), "x_o": six(seen.tolist()),
-                                 "shape": preshape}, ns)
+            log.write(
+                T_ARM_TASK,
+                {
+                    "t": t,
+                    "x_a": six(hand.tolist()),
+                    "x_o": six(seen.tolist()),
+                    "x_d": six([_reach_x(t), lagged[1], lagged[2]]),
+                },
+                ns,
+            )
+            log.write(
+                T_OBJECT,
+                ObjectState(t, o.tolist(), [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
+                ns,
+            )
+            log.write(
+                T_CHIP,
+                {
+                    "t": t,
+                    "width": 16,
+                    "height": 16,
+                    "rows": [0x07C0 if 5 <= v < 10 else 0 for v in range(16)],
+                    "count": 20,
+                },
+                ns,
+            )
+            log.write(
+                T_VISION,
+                {
+                    "t": t - 0.001,
+                    "found": True,
+                    "xi": [8.0, 8.0],
+                    "phi": 0.0,
+                    "area": 20,
+                    "position": seen.tolist(),
+                    "x_o": six(seen.tolist()),
+                    "shape": preshape,
+                },
+                ns,
+            )
             log.write(T_HAND_TASK, {"t": t, "preshape": preshape, "theta_d": hq.tolist()}, ns)
-            log.write(T_STATE, {"t": t, "phase": ph, "cycle": 0, "x_d": six([_reach_x(t), 0, 0]),
-                                "grasp": ph in (REACHING, HOLDING)}, ns)
-            log.write(T_TASKS, {"t": t, "names": TASKS, "ticked": [True] * 4,
-                                "latency": [0.001, 0.001, 0.0012, 0.0011]}, ns)
-        log.write("/events", Event(duration, "outcome", {"success": True,
-                                                         "reason": "completed"}),
-                  seconds_to_ns(duration))
+            log.write(
+                T_STATE,
+                {
+                    "t": t,
+                    "phase": ph,
+                    "cycle": 0,
+                    "x_d": six([_reach_x(t), 0, 0]),
+                    "grasp": ph in (REACHING, HOLDING),
+                },
+                ns,
+            )
+            log.write(
+                T_TASKS,
+                {
+                    "t": t,
+                    "names": TASKS,
+                    "ticked": [True] * 4,
+                    "latency": [0.001, 0.001, 0.0012, 0.0011],
+                },
+                ns,
+            )
+        log.write(
+            "/events",
+            Event(duration, "outcome", {"success": True, "reason": "completed"}),
+            seconds_to_ns(duration),
+        )
     return Path(path)

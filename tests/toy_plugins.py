@@ -81,7 +81,7 @@ class ToyController(Controller):
 
     def __init__(self, params, *, spec):
         super().__init__(params, spec=spec)
-        self.seen = []     # (t_now, t_captured)
+        self.seen = []  # (t_now, t_captured)
         self.last = None
         self.done = False
         self.out = []
@@ -89,11 +89,19 @@ class ToyController(Controller):
     def update(self, t, measurements):
         for _, m in measurements:
             self.seen.append((t, m["t"]))
-            v = 0.0 if self.last is None else (m["x"] - self.last[1]) / max(m["t"] - self.last[0], 1e-9)
+            v = (
+                0.0
+                if self.last is None
+                else (m["x"] - self.last[1]) / max(m["t"] - self.last[0], 1e-9)
+            )
             self.last = (m["t"], m["x"], v)
         if self.last is None:
             return 0.0
-        if not self.done and abs(self.last[1] - self.params.target) < 1e-3 and abs(self.last[2]) < 1e-3:
+        if (
+            not self.done
+            and abs(self.last[1] - self.params.target) < 1e-3
+            and abs(self.last[2]) < 1e-3
+        ):
             self.done = True
             self.out.append(Occurrence("arrived", {"x": self.last[1]}))
         return self.params.kp * (self.params.target - self.last[1]) - self.params.kd * self.last[2]

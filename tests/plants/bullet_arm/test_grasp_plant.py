@@ -1,0 +1,235 @@
+"""The grasping rig's physics (plants/bullet_arm/grasp_plant.py): what the wrist F/T sensor reads
+for known static loads, the velocity servos' torque limits, the pan/tilt head's servo, the human
+hand's path, the F^h the strain gauges read, and the rig's events."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pybullet as p
+import pytest
+
+from plants.bullet_arm.grasp_plant import BulletGraspPlant
+from plants.bullet_arm.head import HeadServo
+from plants.bullet_arm.human_hand import band_limited_path
+from plants.bullet_arm.params import GraspParams
+from replay.robot.arm_types import ServoCommand
+from replay.robot.hand import GRASP4, hand_body, hand_mass
+from replay.robot.head import HeadSpec, camera_pose, look_angles
+
+DT = 1e-3
+Q0 = [0.0, 0.533482, 0.0, 2.134676, 0.0, -1.0973, 0.0]  # scenarios/grasp_hexahedron.yaml
+
+
+def rig(**kw) -> BulletGraspPlant:
+    base = dict(
+        arm="wam7",
+        hand="grasp4",
+        object="box",
+        object_size=[0.05, 0.10, 0.05],
+        object_mass=0.1,
+        object_position=[0.75, 0.0, 0.55],
+        initial_q=Q0,
+        head_position=[0.0, 0.15, 0.70],
+        human_speed=0.0,
+        human_roll_rate=0.0,
+        velocity_limits=[3.0] * 7,
+    )
+    base.update(kw)
+    return BulletGraspPlant(GraspParams(**base), dt=DT, rng=np.random.default_rng(0))
+
+
+def settle(plant, n=300):
+    for _ in range(n):
+        plant.apply(ServoCommand(arm=[0.0] * 7, hand=[0.0] * 14, head=[0.0, 0.0]))
+        plant.step()
+
+
+def palm_rotation(plant) -> np.ndarray:
+    orn = plant.bc.getLinkState(plant.robot, plant._tool_link)[5]
+    return np.array(p.getMatrixFromQuaternion(orn)).reshape(3, 3)
+
+
+def test_wrist_sensor_reads_the_hands_weight_when_still():
+    """Known static load 1: the open hand (0.72 kg) hanging still from the flange. Recorded:
+    F = (7.0632, 0, 0) N in the palm frame (palm x points down here), i.e. m g along gravity,
+    and M = r_com x m g about the flange-palm joint (0.2478 N m about palm y)."""
+    plant = rig()
+    try:
+        settle(plant)
+        w = plant._wrench
+        R = palm_rotation(plant)
+        m = hand_mass(GRASP4)
+        g = np.array([0.0, 0.0, -9.81])
+        np.testing.assert_allclose(R @ w[:3], m * g, atol=2e-3)
+        com = hand_body(GRASP4, plant.hand_state()[0]).com
+        np.testing.assert_allclose(R @ w[3:], np.cross(R @ com, m * g), atol=2e-3)
+        assert w[0] == pytest.approx(7.0632, abs=2e-3)  # the recorded reading
+        assert w[4] == pytest.approx(0.2478, abs=2e-3)
+    finally:
+        plant.close()
+
+
+def test_wrist_sensor_reads_an_added_static_force():
+    """Known static load 2: 5 N along world +y pushed on the palm's centre (0.0075 m ahead of
+    the joint) while the servos hold the arm: the reading grows by the force, the torque by
+    r x F."""
+    plant = rig()
+    try:
+        settle(plant)
+        base = plant._wrench.copy()
+        F = np.array([0.0, 5.0, 0.0])
+        for _ in range(400):
+            pos = plant.bc.getLinkState(plant.robot, plant._palm_link)[0]  # the palm's CoM
+            plant.bc.applyExternalForce(
+                plant.robot, plant._palm_link, F.tolist(), pos, p.WORLD_FRAME
+            )
+            plant.apply(ServoCommand(arm=[0.0] * 7, hand=[0.0] * 14))
+            plant.step()
+        R = palm_rotation(plant)
+        extra = plant._wrench - base
+        # the hand pushed +y; it loads the flange with the same force (palm frame)
+        np.testing.assert_allclose(R @ extra[:3], F, atol=0.05)
+        r = R @ np.array([0.0, 0.0, GRASP4.palm_size[2] / 2.0])
+        np.testing.assert_allclose(R @ extra[3:], np.cross(r, F), atol=0.01)
+    finally:
+        plant.close()
+
+
+def test_arm_servo_torque_is_limited_and_the_joint_lags():
+    plant = rig()
+    try:
+        lim = plant.torque_limits
+        for _ in range(30):
+            plant.apply(ServoCommand(arm=[3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
+            plant.step()
+            assert np.all(np.abs(plant._tau_applied) <= lim + 1e-9)
+        assert plant._clamped[0]  # J1 at its 60 N m
+        assert abs(plant._tau_applied[0]) == pytest.approx(lim[0])
+        assert 0.0 < plant._qd[0] < 3.0  # not an ideal joint: it lags
+        kinds = [e.kind for e in plant.pop_events()]
+        assert "torque_limit" in kinds
+    finally:
+        plant.close()
+
+
+def test_arm_servo_follows_a_feasible_velocity_command():
+    plant = rig()
+    try:
+        cmd = np.array([0.2, 0.0, -0.1, 0.0, 0.3, 0.0, -0.2])
+        err = []
+        for k in range(400):
+            plant.apply(ServoCommand(arm=cmd))
+            plant.step()
+            if k >= 200:
+                err.append(plant._qd - cmd)
+        err = np.abs(np.array(err))
+        # the mean follows; the redundant axes (J1, J3, J5, J7 nearly coupled at this posture)
+        # keep a ~10 Hz wobble of a few 0.01 rad/s with the fingers
+        assert err.mean() < 0.01 and err.max() < 0.06
+        assert not plant._clamped.any()
+    finally:
+        plant.close()
+
+
+def test_head_servo_reaches_its_rate_within_its_torque_limit():
+    head = HeadSpec(
+        (0.0, 0.0, 1.0), 0.0, 0.03, (-1.5, -1.0), (1.5, 1.0), (2e-3, 1e-3), (0.5, 0.5), (10.0, 10.0)
+    )
+    servo = HeadServo(head, 300.0, DT, [0.0, 0.0])
+    servo.set_command([2.0, -1.0])
+    peak = 0.0
+    for _ in range(100):
+        servo.step()
+        peak = max(peak, float(np.abs(servo.torque).max()))
+    np.testing.assert_allclose(servo.qd, [2.0, -1.0], atol=1e-6)
+    assert peak <= 0.5 + 1e-12
+    servo.set_command([500.0, 0.0])  # beyond what 0.5 N m gives in 1 ms
+    servo.step()
+    assert servo.qd[0] == pytest.approx(2.0 + DT * 0.5 / 2e-3, rel=1e-9)
+
+
+def test_camera_pose_looks_where_look_angles_says():
+    head = HeadSpec((0.0, 0.15, 0.7), 0.2, 0.0, (-2, -2), (2, 2), (1, 1), (1, 1), (1, 1))
+    target = np.array([0.75, -0.05, 0.5])
+    R, c = camera_pose(head, *look_angles(head, target))
+    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-12)
+    d = R.T @ (target - c)
+    assert d[2] > 0 and abs(d[0]) < 1e-12 and abs(d[1]) < 1e-12
+    assert R[2, 1] < 0.0  # image down has a -z component
+
+
+def test_human_path_has_the_scenarios_rms_speed():
+    w, a, phi = band_limited_path(
+        np.random.default_rng(5), components=6, f_min=0.1, f_max=1.0, rms_rate=0.1, axes=2
+    )
+    assert np.sum((a * w) ** 2) / 2.0 == pytest.approx(0.01, rel=1e-12)
+    t = np.arange(0.0, 400.0, 0.01)  # long enough to average
+    v = (a[..., None] * w[..., None] * np.cos(w[..., None] * t + phi[..., None])).sum(axis=1)
+    assert math.sqrt(np.mean(np.sum(v**2, axis=0))) == pytest.approx(0.1, rel=0.15)
+    assert np.all(w <= 2 * math.pi * 1.0 + 1e-12) and np.all(w >= 2 * math.pi * 0.1 - 1e-12)
+
+
+def test_human_moves_the_object_and_seeds_give_other_paths():
+    paths = []
+    for seed in (0, 1):
+        plant = BulletGraspPlant(
+            GraspParams(
+                arm="wam7",
+                hand="grasp4",
+                object="box",
+                object_size=[0.05, 0.10, 0.05],
+                object_mass=0.1,
+                object_position=[0.75, 0.0, 0.55],
+                initial_q=Q0,
+                human_speed=0.1,
+            ),
+            dt=DT,
+            rng=np.random.default_rng(seed),
+        )
+        try:
+            pos = []
+            for _ in range(500):
+                plant.step()
+                pos.append(plant.object_state()[0])
+            pos = np.array(pos)
+            target = plant.human.target
+            np.testing.assert_allclose(pos[-1], target, atol=2e-3)  # follows its hand
+            assert np.ptp(pos[:, 0]) < 1e-3  # stays on the plane x
+            paths.append(pos)
+        finally:
+            plant.close()
+    assert np.abs(paths[0] - paths[1]).max() > 5e-3
+
+
+def test_strain_gauges_read_the_servo_torque_and_the_scene_has_the_readings():
+    plant = rig()
+    try:
+        settle(plant, 50)
+        sc = plant.scene()
+        assert set(sc.readings) >= {"arm", "hand", "hand_torque", "head", "wrist"}
+        np.testing.assert_allclose(sc.readings["hand_torque"]["torque"], plant.hand_servos.torque)
+        assert len(sc.readings["hand"]["position"]) == 14
+        truth = plant.truth(0.05)
+        assert {
+            "/head/state",
+            "/human/state",
+            "/wrist/wrench_truth",
+            "/arm/servo",
+            "/head/joint_state",
+        } <= set(truth)
+        assert "/arm/applied_torque" not in truth
+    finally:
+        plant.close()
+
+
+def test_the_rig_refuses_a_torque_command():
+    from replay.robot.arm_types import ArmCommand
+
+    plant = rig()
+    try:
+        with pytest.raises(TypeError):
+            plant.apply(ArmCommand(torque=[0.0] * 7))
+    finally:
+        plant.close()

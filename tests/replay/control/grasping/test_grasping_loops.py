@@ -1,0 +1,153 @@
+"""The grasping method's arm and hand loops in isolation (eqs. 2-4): the task partition S keeps
+tracking and reaching orthogonal, and the hand's compliance balances at F^h = -(K^hg/K^hf) e."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
+from test_grasp_plant import rig  # noqa: E402
+
+from replay.control.grasping.arm_control import ArmControlTask, ArmParams  # noqa: E402
+from replay.control.grasping.hand_control import HandControlTask, HandParams  # noqa: E402
+from replay.control.grasping.payloads import GraspObject, GraspState  # noqa: E402
+from replay.messages import (
+    TOPIC_ARM_ENCODERS,
+    TOPIC_GRASP_OBJECT,
+    TOPIC_GRASP_STATE,  # noqa: E402
+    TOPIC_HAND_ENCODERS,
+    TOPIC_HAND_TORQUE,
+    JointState,
+)
+from replay.sensors.force import JointTorque  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def spec():
+    plant = rig()
+    s = plant.spec()
+    plant.close()
+    return s
+
+
+def obj(position, roll=None, shape="rectangle"):
+    return GraspObject(
+        0.0,
+        True,
+        [7.5, 7.5],
+        0.0,
+        40,
+        40,
+        list(position),
+        roll,
+        [*position, roll or 0.0, 0.0, 0.0],
+        [0.1, 0.05],
+        shape,
+        1.0,
+        2.0,
+        [[1.0, 0.0], [0.0, 1.0]],
+        [0.0, 0.0],
+    )
+
+
+def state(x_d, phase="track", s=0.0):
+    return GraspState(0.0, phase, 0, [*x_d, 0.0, 0.0, 0.0], s, phase in ("reach", "hold"), 0.0)
+
+
+def arm_velocity(spec, task, measurements):
+    cmd = task.update(0.0, measurements)
+    _, J = task.kinematics(np.asarray(spec.initial_q))
+    T, _ = task.kinematics(np.asarray(spec.initial_q))
+    r = task.params.grasp_point * T[:3, 2]
+    v = J[:3] @ cmd.arm + np.cross(J[3:] @ cmd.arm, r)  # the grasp point's velocity
+    return v, J[3:] @ cmd.arm
+
+
+def test_task_partition_tracks_in_the_plane_and_reaches_along_its_normal(spec):
+    q0 = list(spec.initial_q)
+    enc = JointState(0.0, list(spec.joint_names), q0, [0.0] * 7, [0.0] * 7)
+    task = ArmControlTask(ArmParams(K_af=0.0, K_av=0.0), spec=spec)
+    T, _ = task.kinematics(np.asarray(q0))
+    gp = T[:3, 3] + task.params.grasp_point * T[:3, 2]
+    # the object 2 cm to +y and 5 cm beyond the hand along x; x_d^a at the hand: only y moves
+    v, w = arm_velocity(
+        spec,
+        task,
+        [
+            (TOPIC_ARM_ENCODERS, enc),
+            (TOPIC_GRASP_OBJECT, obj(gp + [0.05, 0.02, 0.0])),
+            (TOPIC_GRASP_STATE, state(gp)),
+        ],
+    )
+    assert v[1] == pytest.approx(task.K_a1[1] * 0.02, rel=0.02)
+    assert abs(v[0]) < 0.02 * abs(v[1]) and abs(v[2]) < 0.02 * abs(v[1])
+    # x_d^a 3 cm ahead and 1 cm up; the object where the hand is: only x moves (z is tracked)
+    task = ArmControlTask(ArmParams(K_af=0.0, K_av=0.0), spec=spec)
+    v, w = arm_velocity(
+        spec,
+        task,
+        [
+            (TOPIC_ARM_ENCODERS, enc),
+            (TOPIC_GRASP_OBJECT, obj(gp)),
+            (TOPIC_GRASP_STATE, state(gp + [0.03, 0.0, 0.01])),
+        ],
+    )
+    assert v[0] == pytest.approx(task.K_a2[0] * 0.03, rel=0.02)
+    assert abs(v[1]) < 0.02 * v[0] and abs(v[2]) < 0.02 * v[0]
+    # the box rolled by 0.2 rad: the hand turns about the plane normal (x) only
+    task = ArmControlTask(ArmParams(K_af=0.0, K_av=0.0), spec=spec)
+    v, w = arm_velocity(
+        spec,
+        task,
+        [
+            (TOPIC_ARM_ENCODERS, enc),
+            (TOPIC_GRASP_OBJECT, obj(gp, roll=0.2)),
+            (TOPIC_GRASP_STATE, state(gp)),
+        ],
+    )
+    assert w[0] == pytest.approx(task.K_a1[3] * 0.2, rel=0.05)
+    assert np.linalg.norm(v) < 0.01 and abs(w[1]) < 0.05 * w[0] and abs(w[2]) < 0.05 * w[0]
+    # a circle has no axis: no roll
+    task = ArmControlTask(ArmParams(K_af=0.0, K_av=0.0), spec=spec)
+    v, w = arm_velocity(
+        spec,
+        task,
+        [
+            (TOPIC_ARM_ENCODERS, enc),
+            (TOPIC_GRASP_OBJECT, obj(gp, roll=0.2, shape="circle")),
+            (TOPIC_GRASP_STATE, state(gp)),
+        ],
+    )
+    assert abs(w[0]) < 1e-6 and np.linalg.norm(w) < 2e-3  # (pitch/yaw: the start's residue)
+
+
+def test_hand_compliance_balances_the_load_against_the_overclosure(spec):
+    """Eq. 4 at rest: the command vanishes where K^hg (theta_d - theta) = -K^hf F^h."""
+    P = HandParams(load_filter=0.0)
+    task = HandControlTask(P, spec=spec)
+    theta = np.full(14, 0.3)
+    hold = state([0.0, 0.0, 0.0], phase="hold", s=1.0)
+    shape = obj([0.75, 0.0, 0.55])
+    theta_d = np.asarray(P.rectangle_grip)
+    tau = P.K_hg / P.K_hf * (theta_d - theta)  # the drives' torque at equilibrium
+    enc = JointState(0.0, list(spec.hand.joint_names), theta.tolist(), [0.0] * 14, [0.0] * 14)
+    cmd = task.update(
+        0.0,
+        [
+            (TOPIC_GRASP_OBJECT, shape),
+            (TOPIC_GRASP_STATE, hold),
+            (TOPIC_HAND_ENCODERS, enc),
+            (TOPIC_HAND_TORQUE, JointTorque(0.0, [], tau.tolist())),
+        ],
+    )
+    np.testing.assert_allclose(cmd.hand, 0.0, atol=1e-12)
+    # less load than that: it closes further; before the shape is known the hand stays open
+    cmd = task.update(0.001, [(TOPIC_HAND_TORQUE, JointTorque(0.001, [], (0.5 * tau).tolist()))])
+    assert np.all(np.asarray(cmd.hand)[theta_d > theta] > 0)
+    fresh = HandControlTask(P, spec=spec)
+    cmd = fresh.update(0.0, [(TOPIC_GRASP_STATE, hold), (TOPIC_HAND_ENCODERS, enc)])
+    assert fresh.preshape == "none" and np.all(np.asarray(cmd.hand) <= 0)

@@ -1,0 +1,244 @@
+"""The grasping method's vision (replay/control/grasping/self_window.py, features.py,
+recognition.py) and head loop (eq. 1), on images rendered by the vision chip sensor: Self
+Windowing including what happens when the image moves more than a pixel a frame, moments and
+shape, x_o from the constraint plane, and the head's tracking."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
+from test_grasp_plant import rig  # noqa: E402
+
+from plants.bullet_arm.head import HeadServo  # noqa: E402
+from replay.control.grasping.features import blob  # noqa: E402
+from replay.control.grasping.head_tracking import HeadParams, HeadTrackingTask  # noqa: E402
+from replay.control.grasping.recognition import (
+    RecognitionParams,
+    RecognitionTask,  # noqa: E402
+    shape_of,
+)
+from replay.control.grasping.self_window import dilate4, self_window, track  # noqa: E402
+from replay.messages import (
+    TOPIC_GRASP_OBJECT,
+    TOPIC_HEAD_ENCODERS,
+    TOPIC_VISION_CHIP,
+    JointState,
+    pack_rows,
+    unpack_rows,
+)  # noqa: E402
+from replay.robot.head import camera_pose, look_angles  # noqa: E402
+from replay.scene import Box, Scene, Sphere  # noqa: E402
+from replay.sensors.vision_chip import VisionChipParams, VisionChipSensor  # noqa: E402
+
+FOV = math.radians(12.0)
+
+
+@pytest.fixture(scope="module")
+def spec():
+    plant = rig()
+    s = plant.spec()
+    plant.close()
+    return s
+
+
+def chip_sensor(**kw):
+    return VisionChipSensor(VisionChipParams(fov=FOV, **kw), rng=np.random.default_rng(0))
+
+
+def head_scene(spec, prim, angles) -> Scene:
+    R, c = camera_pose(spec.head, *angles)
+    return Scene(
+        [prim],
+        readings={
+            "head": {
+                "name": ["pan", "tilt"],
+                "position": list(angles),
+                "velocity": [0.0, 0.0],
+                "camera_rotation": R,
+                "camera_position": c,
+            }
+        },
+    )
+
+
+def bar(x0: int, w: int = 4, h: int = 3) -> np.ndarray:
+    img = np.zeros((16, 16), bool)
+    img[6 : 6 + h, max(x0, 0) : max(x0 + w, 0)] = True
+    return img
+
+
+def test_dilate4_grows_by_the_4_neighbourhood():
+    img = np.zeros((5, 5), bool)
+    img[2, 2] = True
+    d = dilate4(img)
+    assert d.sum() == 5 and d[1, 2] and d[3, 2] and d[2, 1] and d[2, 3] and not d[1, 1]
+
+
+def test_pack_and_unpack_rows_round_trip():
+    img = np.random.default_rng(1).random((16, 16)) > 0.5
+    np.testing.assert_array_equal(unpack_rows(pack_rows(img), 16), img)
+
+
+def frames_until_lost(speed: int, width: int = 4, frames: int = 12) -> int | None:
+    target = bar(2, width)
+    for k in range(1, frames):
+        target = self_window(target, bar(2 + speed * k, width))
+        if not target.any():
+            return k
+    return None
+
+
+def test_self_window_keeps_a_target_that_moves_a_pixel_a_frame():
+    target = bar(2)
+    for k in range(1, 11):
+        target = self_window(target, bar(2 + k))
+        assert target.sum() == 12  # whole: 4 x 3 pixels every frame
+
+
+@pytest.mark.parametrize("speed", [2, 3, 5])
+def test_self_window_loses_a_faster_target_after_width_over_speed_minus_one_frames(speed):
+    """Moving s > 1 px a frame, the target keeps only what lies within a pixel of the old one:
+    it loses s - 1 columns a frame and is gone after ceil(width / (s - 1)) frames
+    (docs/grasping.md)."""
+    width = 4
+    assert frames_until_lost(speed, width) == math.ceil(width / (speed - 1))
+    assert frames_until_lost(1, width) is None
+
+
+def test_track_reacquires_from_the_whole_image():
+    img = bar(5)
+    target, again = track(None, img)
+    assert again and target.sum() == img.sum()
+    target, again = track(np.zeros_like(img), img)
+    assert again
+
+
+def test_moments_give_centre_and_rotation():
+    img = np.zeros((16, 16), bool)
+    img[5:8, 3:11] = True  # 8 x 3, along u
+    b = blob(img)
+    assert (b.u, b.v) == pytest.approx((6.5, 6.0))
+    assert b.phi == pytest.approx(0.0, abs=1e-12)
+    assert b.fill == pytest.approx(1.0) and b.elongation > 2.0
+    assert blob(img.T).phi == pytest.approx(math.pi / 2, abs=1e-12)
+
+
+def test_shape_from_chip_images_over_random_poses(spec):
+    """Seeded randomised: boxes and balls at random places on the plane (within +-4 cm of the
+    view's centre) and box rolls, seen by the 16 x 16 chip; reports the recognition rate."""
+    rng = np.random.default_rng(7)
+    sensor = chip_sensor()
+    centre = np.array([0.75, 0.0, 0.55])
+    angles = look_angles(spec.head, centre)
+    params = RecognitionParams(fov=FOV)
+    right, n = 0, 0
+    for kind in ("rectangle", "circle"):
+        for _ in range(30):
+            p = centre + np.array([0.0, *rng.uniform(-0.04, 0.04, 2)])
+            if kind == "rectangle":
+                roll = rng.uniform(-0.5, 0.5)
+                prim = Box(
+                    "box",
+                    tuple(p),
+                    (math.sin(roll / 2), 0.0, 0.0, math.cos(roll / 2)),
+                    (0.05, 0.10, 0.05),
+                    0.9,
+                )
+            else:
+                prim = Sphere("ball", tuple(p), 0.035, 0.9)
+            b = blob(sensor.image(head_scene(spec, prim, angles)))
+            right += shape_of(b, params) == kind
+            n += 1
+    rate = right / n
+    print(f"shape recognised in {right}/{n} views ({rate:.0%})")
+    assert rate >= 0.9
+
+
+def recognise(spec, prim, angles, frames=1):
+    task = RecognitionTask(RecognitionParams(fov=FOV, shape_frames=1), spec=spec)
+    sensor = chip_sensor()
+    out = None
+    for k in range(frames):
+        t = k * 1e-3
+        chip = sensor.measure(t, head_scene(spec, prim, angles))
+        enc = JointState(t, ["pan", "tilt"], list(angles), [0.0, 0.0], [0.0, 0.0])
+        task.update(t, [(TOPIC_HEAD_ENCODERS, enc), (TOPIC_VISION_CHIP, chip)])
+        out = task.telemetry(t)[TOPIC_GRASP_OBJECT]
+    return task, out
+
+
+def test_position_on_the_constraint_plane_from_one_chip_image(spec):
+    """A ball on the plane anywhere in the view: x_o from the 16 x 16 image within 5 mm (a pixel
+    is ~11 mm there); the box's roll within 0.1 rad."""
+    rng = np.random.default_rng(3)
+    centre = np.array([0.75, 0.0, 0.55])
+    angles = look_angles(spec.head, centre)
+    errs = []
+    for _ in range(20):
+        p = centre + np.array([0.0, *rng.uniform(-0.03, 0.03, 2)])
+        _, out = recognise(spec, Sphere("ball", tuple(p), 0.035, 0.9), angles)
+        assert out.found and out.shape == "circle"
+        errs.append(np.linalg.norm(np.asarray(out.position) - p))
+    print(
+        f"ball position error: median {np.median(errs) * 1e3:.1f} mm, "
+        f"max {np.max(errs) * 1e3:.1f} mm"
+    )
+    assert max(errs) < 0.005
+    roll = 0.3
+    box = Box(
+        "box",
+        tuple(centre),
+        (math.sin(roll / 2), 0.0, 0.0, math.cos(roll / 2)),
+        (0.05, 0.10, 0.05),
+        0.9,
+    )
+    _, out = recognise(spec, box, angles)
+    assert out.shape == "rectangle"
+    assert out.roll == pytest.approx(roll, abs=0.1)
+
+
+def test_head_loop_centres_the_target(spec):
+    """Eq. 1 with the head model's image Jacobian: a ball 4 cm off the line of sight is brought
+    to the image centre by the head's servo within 0.15 s, no prediction involved."""
+    centre = np.array([0.75, 0.0, 0.55])
+    prim = Sphere("ball", (0.75, 0.04, 0.58), 0.035, 0.9)
+    angles = np.array(look_angles(spec.head, centre))
+    servo = HeadServo(spec.head, 300.0, 1e-3, angles)
+    rec = RecognitionTask(RecognitionParams(fov=FOV), spec=spec)
+    head = HeadTrackingTask(HeadParams(), spec=spec)
+    sensor = chip_sensor()
+    err = None
+    for k in range(150):
+        t = k * 1e-3
+        chip = sensor.measure(t, head_scene(spec, prim, servo.q))
+        enc = JointState(t, ["pan", "tilt"], servo.q.tolist(), servo.qd.tolist(), [0.0, 0.0])
+        rec.update(t, [(TOPIC_HEAD_ENCODERS, enc), (TOPIC_VISION_CHIP, chip)])
+        obj = rec.telemetry(t)[TOPIC_GRASP_OBJECT]
+        cmd = head.update(t, [(TOPIC_GRASP_OBJECT, obj), (TOPIC_HEAD_ENCODERS, enc)])
+        servo.set_command(cmd.head)
+        servo.step()
+        err = np.asarray(obj.xi) - 7.5
+    assert np.linalg.norm(err) < 0.5
+
+
+def test_image_jacobian_is_the_head_models(spec):
+    from replay.control.grasping.recognition import Camera
+
+    cam = Camera(spec.head, FOV, 16, 16)
+    X = np.array([0.75, 0.03, 0.52])
+    a = np.array(look_angles(spec.head, X)) + [0.02, -0.03]
+    J = cam.jacobian(a, X)
+    h = 1e-6
+    num = np.column_stack(
+        [
+            (cam.project(a + e, X) - cam.project(a - e, X)) / (2 * h)
+            for e in (np.array([h, 0.0]), np.array([0.0, h]))
+        ]
+    )
+    np.testing.assert_allclose(J, num, rtol=1e-5, atol=1e-4)

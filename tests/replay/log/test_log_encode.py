@@ -1,0 +1,48 @@
+"""The log's JSON encoding (replay/log/writer.py ``encode``): the standard encoder's values, the
+same bytes for the same payload, and non-finite numbers refused."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from replay.log import NonFiniteValueError
+from replay.log.writer import encode
+from replay.messages import Event, JointState, StickState, to_dict
+
+
+PAYLOADS = [
+    StickState(0.1, 1.0, -2.5e-5, 3.141592653589793, 1e300, -0.0, 7),
+    JointState(0.2, ["J1", "J2"], [0.1, 0.2], [1e-12, -3.0], [0.0, 5.5]),
+    Event(
+        0.3,
+        "collision",
+        {
+            "index": 1,
+            "planned": {"r_x": 0.0257},
+            "ok": True,
+            "none": None,
+            "tuple": (1, 2.5),
+            7: "int key",
+        },
+    ),
+    {"t": 0.4, "base": [0.1, 0.2], "numpy": np.float64(0.3), "text": 'é "q" \n'},
+]
+
+
+@pytest.mark.parametrize("payload", PAYLOADS, ids=lambda p: type(p).__name__)
+def test_encode_decodes_to_the_standard_encoders_values(payload):
+    data = encode("/x", payload)
+    standard = json.dumps(to_dict(payload), allow_nan=False, separators=(",", ":"))
+    assert json.loads(data) == json.loads(standard)
+    assert encode("/x", payload) == data  # deterministic bytes
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf, np.float64("nan")])
+def test_non_finite_values_are_refused_with_their_field(bad):
+    with pytest.raises(NonFiniteValueError) as err:
+        encode("/stick/state", StickState(0.0, 1.0, bad, 0.0, 0.0, 0.0, 0.0))
+    assert err.value.fields == ["y"]
+    with pytest.raises(NonFiniteValueError):
+        encode("/events", Event(0.0, "x", {"deep": [1.0, {"v": bad}]}))

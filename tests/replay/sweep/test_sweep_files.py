@@ -1,0 +1,71 @@
+"""The ablations' sweep files (sweeps/*.yaml): they load, vary real fields, carry the throws that
+analysis/ablation_throws.py derives, and their plots and sentences come from their tables."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from analysis.ablation_throws import release
+from replay.sweep import ablations
+from replay.sweep.table import read_table
+from replay.sweep.variants import check_keys, expand
+from replay.sweep.worker import load_function
+
+NAMES = ablations.names()
+
+
+def test_there_are_catching_and_stick_ablations():
+    assert {
+        "catch_vision",
+        "catch_throw_speed",
+        "catch_arm_limits",
+        "catch_direct_vs_predictive",
+        "stick_friction",
+        "stick_vision",
+    } <= set(NAMES)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_sweep_file_expands_into_valid_variants(project_root, name):
+    sf = ablations.load(name)
+    check_keys(sf.scenario, sf.spec, sf.sets)
+    variants = expand(sf.scenario, sf.spec, sf.seed, sets=sf.sets, version="test")
+    assert len(variants) >= 5
+    assert not [v.error for v in variants if v.error]
+    assert len({v.key for v in variants}) == len(variants)
+    for ref in (sf.plot, sf.summary) + ((sf.metrics,) if sf.metrics else ()):
+        assert callable(load_function(ref))
+    assert sf.caption and sf.paper
+
+
+def _throws(sf):
+    for axis in sf.spec.grid:
+        if axis.values and isinstance(axis.values[0], dict):
+            for label, sets in zip(axis.labels, axis.values):
+                if "plant.params.object_position" in sets:
+                    yield label, sets
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if n.startswith("catch_")])
+def test_throws_are_the_derived_ones(name):
+    sf = ablations.load(name)
+    for label, sets in _throws(sf):
+        speed = float(label.split()[0])
+        offset = (0.0, 0.05, 0.0) if "+5 cm y" in label else (0.0, 0.0, 0.0)
+        pos, vel = release(speed, offset)
+        np.testing.assert_allclose(sets["plant.params.object_position"], pos, atol=2e-5)
+        np.testing.assert_allclose(sets["plant.params.object_velocity"], vel, atol=3e-5)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_plot_and_sentence_from_the_stored_table(name, tmp_path):
+    sf = ablations.load(name)
+    table = ablations.STORED_DIR / f"{name}.csv"
+    assert table.is_file(), f"no stored table: run `replay ablate {name} --store`"
+    rows = read_table(table)
+    assert len(rows) == len(expand(sf.scenario, sf.spec, sf.seed, sets=sf.sets, version="t"))
+    paths = ablations.plot(sf, table, tmp_path)
+    assert [p.suffix for p in paths] == [".png", ".svg"] and all(p.stat().st_size for p in paths)
+    sentence = load_function(sf.summary)(rows)
+    assert sentence.endswith(".") and len(sentence) > 20

@@ -1,0 +1,253 @@
+"""The runner's timing (multi-rate, latency), events and stop conditions, and the MCAP log contract."""
+
+import json
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from replay.log import LogReader, LogWriter, NotALogError
+from replay.messages import Event
+from replay.runner import Runner
+from replay.scenario import load_scenario
+
+
+def _run(toy_yaml, tmp_path, sets=(), name="run.mcap"):
+    sc = load_scenario(toy_yaml, sets=list(sets))
+    runner = Runner(sc)
+    result = runner.run(tmp_path / name)
+    return runner, result, LogReader(result.path)
+
+
+def test_rates_and_latency(toy_yaml, tmp_path):
+    runner, result, log = _run(toy_yaml, tmp_path)
+    counts = log.topic_counts()
+    assert counts["/toy/measured"] == 100  # 100 Hz for 1 s
+    assert counts["/toy/state"] == 1000 + 1  # every physics step, plus the final state
+    assert counts["/scenario"] == 1
+    # every measurement reached the controller 20 ms (latency) after capture, at a 500 Hz tick
+    seen = runner.controller.seen
+    assert seen and all(abs((now - cap) - 0.02) < 1e-9 for now, cap in seen)
+    # log time is simulated time
+    for m in log.messages("/toy/measured"):
+        assert m.t_ns == round(m.data["t"] * 1e9)
+
+
+def test_readings_reach_the_controller_in_time_order(toy_yaml, tmp_path):
+    """A zero-latency reading is delivered at its capture step even when a slower sensor's
+    reading, captured at the same step, was queued ahead of it."""
+    sc = load_scenario(
+        toy_yaml,
+        sets=["sensors.fast={type: toy_sensor, rate: 100, latency: 0.0}", "controller.rate=1000"],
+    )
+    assert list(sc.sensors) == ["cam", "fast"]  # the 20 ms sensor comes first
+    runner = Runner(sc)
+    runner.run(tmp_path / "order.mcap")
+    delays = sorted({round(now - cap, 9) for now, cap in runner.controller.seen})
+    assert delays == [0.0, 0.02]
+
+
+def test_every_run_ends_with_an_outcome(toy_yaml, tmp_path):
+    _, result, log = _run(toy_yaml, tmp_path)
+    events = log.events()
+    assert events[-1]["kind"] == "outcome"
+    assert events[-1]["data"] == {"success": True, "reason": "completed"} == result.outcome
+    _, result, log = _run(toy_yaml, tmp_path, sets=["plant.params.blow_up_at=0.2"], name="nan.mcap")
+    last = log.events()[-1]
+    assert last["kind"] == "outcome" and last["data"]["success"] is False
+    assert "non-finite" in last["data"]["reason"]
+
+
+def test_controller_drives_plant(toy_yaml, tmp_path):
+    _, _, log = _run(toy_yaml, tmp_path, sets=["timing.duration=3.0"])
+    last = log.series("/toy/state")[-1]
+    assert abs(last["x"] - 1.0) < 0.05
+
+
+def test_events_and_stop_condition(toy_yaml, tmp_path):
+    _, result, log = _run(
+        toy_yaml,
+        tmp_path,
+        sets=[
+            "plant.params.wall=0.5",
+            "stop.on_events=[collision]",
+            "stop.after=0.1",
+            "timing.duration=5",
+        ],
+    )
+    events = log.events()
+    assert [e["kind"] for e in events] == ["collision", "outcome"]
+    e = events[0]
+    assert e["data"]["index"] == 1 and e["data"]["planned"] == {"target": 1.0}
+    assert result.stopped_by == "collision"
+    assert abs(result.t_end - (e["t"] + 0.1)) < 1.5e-3
+
+
+def test_same_seed_same_bytes_other_seed_differs(toy_yaml, tmp_path):
+    sets = ["sensors.cam.params.noise=0.01"]
+    _, a, _ = _run(toy_yaml, tmp_path, sets, "a.mcap")
+    _, b, _ = _run(toy_yaml, tmp_path, sets, "b.mcap")
+    assert a.path.read_bytes() == b.path.read_bytes()
+    sc = load_scenario(toy_yaml, sets=sets, seed=4)
+    c = Runner(sc).run(tmp_path / "c.mcap")
+    assert c.path.read_bytes() != a.path.read_bytes()
+
+
+def test_nan_becomes_an_error_event(toy_yaml, tmp_path):
+    _, result, log = _run(toy_yaml, tmp_path, sets=["plant.params.blow_up_at=0.3"])
+    assert result.stopped_by == "error"
+    err, outcome = log.events()[-2:]
+    assert outcome["kind"] == "outcome" and outcome["data"]["success"] is False
+    assert err["kind"] == "error" and err["data"]["topic"] in ("/toy/state", "/toy/measured")
+    assert "x" in err["data"]["fields"]
+    assert abs(err["t"] - 0.3) < 2e-3
+
+
+def test_provenance_in_metadata_and_scenario_topic(toy_yaml, tmp_path):
+    _, _, log = _run(toy_yaml, tmp_path)
+    meta = log.metadata()
+    assert meta["provenance"]["seed"] == "3" and "numpy" in meta["provenance"]
+    sc = log.scenario()
+    assert sc["name"] == "toy" and "kp: 100.0" in sc["yaml"] and sc["seed"] == 3
+
+
+def test_truncated_log_is_readable_to_its_last_chunk(tmp_path):
+    w = LogWriter(tmp_path / "x.mcap", chunk_size=2000)
+    for k in range(5000):
+        w.write("/events", Event(k * 1e-3, "tick", {"k": k}), k * 1_000_000)
+    w.close()
+    data = (tmp_path / "x.mcap").read_bytes()
+    (tmp_path / "cut.mcap").write_bytes(data[: len(data) // 2])
+    r = LogReader(tmp_path / "cut.mcap")
+    assert r.truncated
+    ks = [m.data["data"]["k"] for m in r.messages()]
+    assert 1000 < len(ks) < 5000 and ks == list(range(len(ks)))
+
+
+def test_not_a_log(tmp_path):
+    p = tmp_path / "x.mcap"
+    p.write_text("hello")
+    with pytest.raises(NotALogError):
+        LogReader(p)
+
+
+KILLED_RUN = r"""
+import sys, time
+sys.path.insert(0, {tests!r})
+import toy_plugins; toy_plugins.install()
+from replay.scenario import load_scenario
+from replay.runner import Runner
+sc = load_scenario({yaml!r}, sets=["timing.duration=600", "timing.physics_rate=1000"])
+class Slow:
+    def __call__(self, t, d):
+        if t > 10.0:
+            print("ready", flush=True); time.sleep(60)
+Runner(sc, progress=Slow()).run({out!r})
+"""
+
+
+def test_killed_run_leaves_a_readable_part_file(toy_yaml, tmp_path):
+    out = tmp_path / "killed.mcap"
+    code = KILLED_RUN.format(
+        tests=str(Path(__file__).resolve().parents[1]), yaml=str(toy_yaml), out=str(out)
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=30)
+    assert not out.exists()
+    part = tmp_path / "killed.mcap.part"
+    r = LogReader(part)
+    assert r.truncated
+    states = r.series("/toy/state")
+    assert len(states) > 100 and json.dumps(states[-1])
+
+
+INTERRUPTED_RUN = r"""
+import sys, time
+sys.path.insert(0, {tests!r})
+import toy_plugins; toy_plugins.install()
+from replay.cli import main
+import replay.runner as runner
+orig = runner.Runner.run
+def run(self, out):
+    def tick(t, d):
+        if t > 1.0:
+            print("ready", flush=True); time.sleep(60)
+    self.progress = tick
+    return orig(self, out)
+runner.Runner.run = run
+sys.argv = ["replay", "run", {yaml!r}, "-o", {out!r}, "--set", "timing.duration=600"]
+main()
+"""
+
+
+def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
+    """The interrupted run is closed properly under its own name; an old log at -o stays."""
+    out = tmp_path / "run.mcap"
+    old = Runner(load_scenario(toy_yaml, sets=["timing.duration=0.1"])).run(out).path.read_bytes()
+    code = INTERRUPTED_RUN.format(
+        tests=str(Path(__file__).resolve().parents[1]), yaml=str(toy_yaml), out=str(out)
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130
+    assert "interrupted at t = " in err and "partial log kept" in err and "Traceback" not in err
+    assert out.read_bytes() == old
+    kept = tmp_path / "run.interrupted.mcap"
+    assert str(kept) in err
+    r = LogReader(kept)  # finished properly: summary, its own name
+    assert not r.truncated
+    assert [e["kind"] for e in r.events()[-2:]] == ["interrupted", "outcome"]
+    assert r.events()[-1]["data"] == {"success": False, "reason": "interrupted"}
+    assert 0.9 < r.time_range()[1] < 1.2
+
+
+def test_sigint_mid_record_is_held_until_the_record_is_whole(tmp_path):
+    """Ctrl-C while a record is written is raised only once the write is done, so the log never
+    holds a torn record; after close the default handler is back."""
+    w = LogWriter(tmp_path / "x.mcap", chunk_size=100)
+    with pytest.raises(KeyboardInterrupt):
+        with w._held:  # what write() does around a record
+            os.kill(os.getpid(), signal.SIGINT)
+            w._writer.add_message(
+                channel_id=w._channel("/events", Event(0.0, "a")),
+                log_time=0,
+                publish_time=0,
+                data=b'{"t":0,"kind":"a"}',
+                sequence=0,
+            )
+            reached = True
+    assert reached
+    w.write("/events", Event(0.001, "interrupted"), 1_000_000)
+    assert w.close("interrupted") == tmp_path / "x.interrupted.mcap"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    r = LogReader(tmp_path / "x.interrupted.mcap").check()
+    assert r.status == "complete" and [e["kind"] for e in r.events()] == ["a", "interrupted"]
+
+
+def test_messages_that_are_not_json_objects_are_skipped_and_said(tmp_path):
+    from mcap.writer import Writer
+
+    with open(tmp_path / "x.mcap", "wb") as f:
+        w = Writer(f)
+        w.start()
+        c = w.register_channel("/events", "json", w.register_schema("s", "jsonschema", b"{}"))
+        for i, data in enumerate([b'{"t": 0, "kind": "a"}', b"\xff\xfe", b"[1]", b"{bad"]):
+            w.add_message(c, log_time=i, publish_time=i, data=data)
+        w.finish()
+    r = LogReader(tmp_path / "x.mcap").check()
+    assert [e["kind"] for e in r.events()] == ["a"]
+    assert r.damaged and any("3 message(s) not a JSON object" in p for p in r.problems)
