@@ -30,9 +30,10 @@ run: $(STAMP)
 ablations: $(STAMP)
 	$(REPLAY) ablate --store --no-logs
 
-# ruff (lint only: `ruff format` is not applied to the tree yet) and mypy, configured in pyproject.toml
+# ruff (lint and format: run `ruff format .` before committing) and mypy, configured in pyproject.toml
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 	$(VENV)/bin/mypy
 
 test: $(STAMP)

@@ -3,12 +3,18 @@ folders ship in the wheel as package data under replay._shipped (found by replay
 
 from setuptools import find_namespace_packages, setup
 
-SHIPPED = {"replay._shipped.data": "data", "replay._shipped.scenarios": "scenarios",
-           "replay._shipped.sweeps": "sweeps"}
+SHIPPED = {
+    "replay._shipped.data": "data",
+    "replay._shipped.scenarios": "scenarios",
+    "replay._shipped.sweeps": "sweeps",
+}
 
 setup(
     packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
     package_dir=SHIPPED,
-    package_data={"replay._shipped.data": ["**/*"], "replay._shipped.scenarios": ["*.yaml"],
-                  "replay._shipped.sweeps": ["*.yaml"]},
+    package_data={
+        "replay._shipped.data": ["**/*"],
+        "replay._shipped.scenarios": ["*.yaml"],
+        "replay._shipped.sweeps": ["*.yaml"],
+    },
 )

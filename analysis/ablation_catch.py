@@ -11,8 +11,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from analysis.ablation_table import (caught, mean_by, overall, pct, rate_at,  # noqa: E402
-                                     rate_by)
+from analysis.ablation_table import (
+    caught,
+    mean_by,
+    overall,
+    pct,
+    rate_at,  # noqa: E402
+    rate_by,
+)
 from analysis.figure_files import save  # noqa: E402
 
 
@@ -23,9 +29,13 @@ def catch_metrics(log) -> dict:
     contact with the palm or fingers."""
     from analysis.series import arrays, events
     from replay.messages import TOPIC_EFFECTOR_STATE, TOPIC_OBJECT_STATE
+
     ball = arrays(log, TOPIC_OBJECT_STATE, ["position"])
-    hand = arrays(log, TOPIC_EFFECTOR_STATE, ["position"]) if log.topic_counts().get(
-        TOPIC_EFFECTOR_STATE) else {"t": np.zeros(0)}
+    hand = (
+        arrays(log, TOPIC_EFFECTOR_STATE, ["position"])
+        if log.topic_counts().get(TOPIC_EFFECTOR_STATE)
+        else {"t": np.zeros(0)}
+    )
     out: dict = {}
     if len(ball["t"]) and len(hand["t"]) and hand["position"].ndim == 2:
         # the ball's state at the hand's stamps (both are logged at the control rate)
@@ -35,8 +45,11 @@ def catch_metrics(log) -> dict:
         out.update(min_distance=float(d[k]), t_min_distance=float(hand["t"][k]))
     for e in events(log, "contact"):
         if set(e["data"].get("parts", [])) - {"arm"}:
-            out.update(contact_speed=e["data"]["speed"], contact_t=e["t"],
-                       contact_parts="+".join(e["data"]["parts"]))
+            out.update(
+                contact_speed=e["data"]["speed"],
+                contact_t=e["t"],
+                contact_parts="+".join(e["data"]["parts"]),
+            )
             break
     return out
 
@@ -62,8 +75,9 @@ def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     x, line = "sensors.stereo.rate", "sensors.stereo.latency"
     speeds = mean_by(rows, x, line, "x.contact_speed")
-    for lat, (xs, ys) in sorted(rate_by(rows, x, line, caught).items(),
-                                key=lambda kv: float(kv[0])):
+    for lat, (xs, ys) in sorted(
+        rate_by(rows, x, line, caught).items(), key=lambda kv: float(kv[0])
+    ):
         ax.plot(xs, ys, "o-", label=f"latency {float(lat) * 1e3:g} ms")
         ax2.plot(*speeds[lat], "o-")
     _rate_axes(ax, "", log_x=True)
@@ -76,12 +90,17 @@ def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 def plot_throw_speed(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
-    (xs, ys), = rate_by(rows, "throw_speed", None, caught).values()
+    ((xs, ys),) = rate_by(rows, "throw_speed", None, caught).values()
     ax.plot(xs, ys, "o-", color="tab:blue")
     ax2.plot(*mean_by(rows, "throw_speed", None, "x.contact_speed")[""], "o-", color="tab:blue")
     for a in (ax, ax2):
-        a.axvspan(8.0, 10.0, color="tab:green", alpha=0.1,
-                  label="optimised for 8-10 m/s" if a is ax else None)
+        a.axvspan(
+            8.0,
+            10.0,
+            color="tab:green",
+            alpha=0.1,
+            label="optimised for 8-10 m/s" if a is ax else None,
+        )
     _rate_axes(ax, "")
     _near_axes(ax2, "throw speed [m/s]", log_x=False)
     ax.legend(fontsize=8)
@@ -94,8 +113,9 @@ def plot_arm_limits(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     x, line = "joint_speed_limit", "torque_scale"
     speeds = mean_by(rows, x, line, "x.contact_speed")
-    for scale, (xs, ys) in sorted(rate_by(rows, x, line, caught).items(),
-                                  key=lambda kv: float(kv[0])):
+    for scale, (xs, ys) in sorted(
+        rate_by(rows, x, line, caught).items(), key=lambda kv: float(kv[0])
+    ):
         ax.plot(xs, ys, "o-", label=f"torque limits x{scale}")
         ax2.plot(*speeds[scale], "o-")
     _rate_axes(ax, "", log_x=True)
@@ -108,14 +128,21 @@ def plot_arm_limits(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 def plot_direct_vs_predictive(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.0))
-    styles = {"catch_optimised": ("tab:blue", "direct mapping"),
-              "predictive_catch": ("tab:orange", "predict-then-intercept")}
+    styles = {
+        "catch_optimised": ("tab:blue", "direct mapping"),
+        "predictive_catch": ("tab:orange", "predict-then-intercept"),
+    }
     for (method, kick), sub in sorted(_split(rows, "scenario", "kick").items()):
-        (xs, ys), = rate_by(sub, "camera", None, caught).values()
+        ((xs, ys),) = rate_by(sub, "camera", None, caught).values()
         color, label = styles.get(method, ("0.4", method))
         style = "o-" if kick == "none" else "s--"
-        ax.plot(xs, ys, style, color=color,
-                label=f"{label}, {'no kick' if kick == 'none' else 'mid-flight kick'}")
+        ax.plot(
+            xs,
+            ys,
+            style,
+            color=color,
+            label=f"{label}, {'no kick' if kick == 'none' else 'mid-flight kick'}",
+        )
         ax2.plot(*mean_by(sub, "camera", None, "x.contact_speed")[""], style, color=color)
     _rate_axes(ax, "", log_x=True)
     _near_axes(ax2, "stereo frame rate [Hz] (latency one frame)")
@@ -134,26 +161,33 @@ def _split(rows, *cols):
 
 # -- one sentence per plot (the report's text), computed from the same table -------------------
 
+
 def summary_vision(rows: list[dict]) -> str:
     curves = rate_by(rows, "sensors.stereo.rate", "sensors.stereo.latency", caught)
     parts = []
     for lat in sorted(curves, key=float):
         xs, ys = curves[lat]
-        parts.append(f"latency {float(lat) * 1e3:g} ms: {pct(ys[-1])} at {xs[-1]:g} Hz, "
-                     f"{pct(ys[0])} at {xs[0]:.0f} Hz")
+        parts.append(
+            f"latency {float(lat) * 1e3:g} ms: {pct(ys[-1])} at {xs[-1]:g} Hz, "
+            f"{pct(ys[0])} at {xs[0]:.0f} Hz"
+        )
     return f"Direct mapping ({overall(rows, caught, 'caught')}): " + "; ".join(parts) + "."
 
 
 def summary_throw_speed(rows: list[dict]) -> str:
-    (xs, ys), = rate_by(rows, "throw_speed", None, caught).values()
+    ((xs, ys),) = rate_by(rows, "throw_speed", None, caught).values()
     yes = [f"{x:g}" for x, y in zip(xs, ys) if y > 0]
     sx, sv = mean_by(rows, "throw_speed", None, "x.contact_speed")[""]
     near = ""
     if sv and not np.all(np.isnan(sv)):
-        near = (f"; the ball met the hand at {sv[0]:.1f} m/s relative to it at {sx[0]:g} m/s "
-                f"and {sv[-1]:.1f} m/s at {sx[-1]:g} m/s")
-    return (f"Caught at {', '.join(yes) or 'no'} m/s of {', '.join(f'{x:g}' for x in xs)} m/s "
-            f"({overall(rows, caught, 'caught')}){near}.")
+        near = (
+            f"; the ball met the hand at {sv[0]:.1f} m/s relative to it at {sx[0]:g} m/s "
+            f"and {sv[-1]:.1f} m/s at {sx[-1]:g} m/s"
+        )
+    return (
+        f"Caught at {', '.join(yes) or 'no'} m/s of {', '.join(f'{x:g}' for x in xs)} m/s "
+        f"({overall(rows, caught, 'caught')}){near}."
+    )
 
 
 def summary_arm_limits(rows: list[dict]) -> str:
@@ -162,9 +196,19 @@ def summary_arm_limits(rows: list[dict]) -> str:
     for scale in sorted(curves, key=float):
         xs, ys = curves[scale]
         yes = [f"{x:g}" for x, y in zip(xs, ys) if y > 0]
-        parts.append(f"torque x{scale}: " + (f"caught at {', '.join(yes)} rad/s" if yes
-                                             else f"no catch from {xs[0]:g} to {xs[-1]:g} rad/s"))
-    return f"With the speed limit enforced ({overall(rows, caught, 'caught')}): " + "; ".join(parts) + "."
+        parts.append(
+            f"torque x{scale}: "
+            + (
+                f"caught at {', '.join(yes)} rad/s"
+                if yes
+                else f"no catch from {xs[0]:g} to {xs[-1]:g} rad/s"
+            )
+        )
+    return (
+        f"With the speed limit enforced ({overall(rows, caught, 'caught')}): "
+        + "; ".join(parts)
+        + "."
+    )
 
 
 def summary_direct_vs_predictive(rows: list[dict]) -> str:
@@ -180,24 +224,29 @@ def summary_direct_vs_predictive(rows: list[dict]) -> str:
     hi, lo = xs[-1], xs[0]
     d = [at("catch_optimised", k, x) for k in ("none", "kick") for x in (hi, lo)]
     p = [at("predictive_catch", k, x) for k in ("none", "kick") for x in (hi, lo)]
-    text = (f"At {hi:g} Hz the direct mapping caught {pct(d[0])} (kick: {pct(d[2])}) and the "
-            f"predictor {pct(p[0])} (kick: {pct(p[2])}); at {lo:g} Hz direct {pct(d[1])} "
-            f"(kick: {pct(d[3])}), predictor {pct(p[1])} (kick: {pct(p[3])}). ")
+    text = (
+        f"At {hi:g} Hz the direct mapping caught {pct(d[0])} (kick: {pct(d[2])}) and the "
+        f"predictor {pct(p[0])} (kick: {pct(p[2])}); at {lo:g} Hz direct {pct(d[1])} "
+        f"(kick: {pct(d[3])}), predictor {pct(p[1])} (kick: {pct(p[3])}). "
+    )
     speeds = {k: mean_by(v, "camera", None, "x.contact_speed")[""] for k, v in split.items()}
     sd = rate_at({"": speeds.get(("catch_optimised", "none"), ([], []))}, "", hi)
     sp = rate_at({"": speeds.get(("predictive_catch", "none"), ([], []))}, "", hi)
     if not (np.isnan(sd) or np.isnan(sp)):
-        text += (f"At first hand contact the ball moved at {sd:.1f} m/s relative to the hand "
-                 f"with the direct mapping and {sp:.1f} m/s with the predictor ({hi:g} Hz, no "
-                 "kick). ")
+        text += (
+            f"At first hand contact the ball moved at {sd:.1f} m/s relative to the hand "
+            f"with the direct mapping and {sp:.1f} m/s with the predictor ({hi:g} Hz, no "
+            "kick). "
+        )
     fast_gap = np.nanmean([d[0] - p[0], d[2] - p[2]])
     slow_gap = np.nanmean([d[1] - p[1], d[3] - p[3]])
     if np.isnan(fast_gap) or (max(np.nanmax(d), np.nanmax(p)) == 0):
-        text += ("Neither method caught in this sweep, so it cannot test the claim yet (the "
-                 "catching mapping misses on this code base).")
+        text += (
+            "Neither method caught in this sweep, so it cannot test the claim yet (the "
+            "catching mapping misses on this code base)."
+        )
     elif fast_gap > 0 and fast_gap > slow_gap:
-        text += ("The direct mapping's advantage grows with the camera rate, as the paper "
-                 "argues.")
+        text += "The direct mapping's advantage grows with the camera rate, as the paper argues."
     elif fast_gap > 0:
         text += "The direct mapping is ahead, but not more so with fast vision."
     else:

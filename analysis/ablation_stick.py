@@ -23,8 +23,11 @@ def first_collision(log) -> dict:
         if e["kind"] == "collision" and e["data"].get("index") == 1:
             d = e["data"]
             planned = d.get("planned") or {}
-            out = {"speed_after": math.hypot(*d["v_after"]), "omega_after": d["omega_after"],
-                   "t": e["t"]}
+            out = {
+                "speed_after": math.hypot(*d["v_after"]),
+                "omega_after": d["omega_after"],
+                "t": e["t"],
+            }
             if planned.get("v_after") is not None:
                 out["planned_speed_after"] = math.hypot(*planned["v_after"])
                 out["planned_omega_after"] = planned["omega_after"]
@@ -36,13 +39,17 @@ def plot_friction(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
     widths = sorted({as_float(r["plant.params.stick.collision_width"]) for r in rows})
     for w in widths:
-        sub = sorted((r for r in rows if as_float(r["plant.params.stick.collision_width"]) == w),
-                     key=lambda r: as_float(r["plant.params.stick.friction"]))
+        sub = sorted(
+            (r for r in rows if as_float(r["plant.params.stick.collision_width"]) == w),
+            key=lambda r: as_float(r["plant.params.stick.friction"]),
+        )
         mu = [as_float(r["plant.params.stick.friction"]) for r in sub]
-        ax_v.plot(mu, [as_float(r.get("x.speed_after")) for r in sub], "o-",
-                  label=f"W = {w * 1e3:g} mm")
-        ax_w.plot(mu, [as_float(r.get("x.omega_after")) for r in sub], "o-",
-                  label=f"W = {w * 1e3:g} mm")
+        ax_v.plot(
+            mu, [as_float(r.get("x.speed_after")) for r in sub], "o-", label=f"W = {w * 1e3:g} mm"
+        )
+        ax_w.plot(
+            mu, [as_float(r.get("x.omega_after")) for r in sub], "o-", label=f"W = {w * 1e3:g} mm"
+        )
     plan_v = [as_float(r.get("x.planned_speed_after")) for r in rows]
     plan_w = [as_float(r.get("x.planned_omega_after")) for r in rows]
     if rows and not np.all(np.isnan(plan_v)):
@@ -61,8 +68,10 @@ def plot_friction(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for noise, (xs, ys) in sorted(rate_by(rows, "camera", "sensors.camera.params.noise_sigma",
-                                          captured).items(), key=lambda kv: float(kv[0])):
+    for noise, (xs, ys) in sorted(
+        rate_by(rows, "camera", "sensors.camera.params.noise_sigma", captured).items(),
+        key=lambda kv: float(kv[0]),
+    ):
         ax.plot(xs, ys, "o-", label=f"pixel noise σ = {float(noise):g} grey levels")
     ax.axvline(300, color="0.5", lw=0.8, ls=":", label="paper: 300 fps")
     ax.set_xscale("log")
@@ -78,6 +87,7 @@ def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 def summary_friction(rows: list[dict]) -> str:
     from analysis.ablation_table import failures
+
     parts = []
     for w in sorted({as_float(r["plant.params.stick.collision_width"]) for r in rows}):
         sub = [r for r in rows if as_float(r["plant.params.stick.collision_width"]) == w]
@@ -86,8 +96,10 @@ def summary_friction(rows: list[dict]) -> str:
         if np.all(np.isnan(v)):
             parts.append(f"W = {w * 1e3:g} mm: no first collision")
             continue
-        parts.append(f"W = {w * 1e3:g} mm: |v| {np.nanmin(v):.3f}-{np.nanmax(v):.3f} m/s, "
-                     f"ω {np.nanmin(om):.2f} to {np.nanmax(om):.2f} rad/s")
+        parts.append(
+            f"W = {w * 1e3:g} mm: |v| {np.nanmin(v):.3f}-{np.nanmax(v):.3f} m/s, "
+            f"ω {np.nanmin(om):.2f} to {np.nanmax(om):.2f} rad/s"
+        )
     plan = [as_float(r.get("x.planned_omega_after")) for r in rows]
     text = "Over μ = 0-1 after collision 1: " + "; ".join(parts)
     if rows and not np.all(np.isnan(plan)):
@@ -98,10 +110,13 @@ def summary_friction(rows: list[dict]) -> str:
 
 def summary_vision(rows: list[dict]) -> str:
     from analysis.ablation_table import overall, pct
+
     curves = rate_by(rows, "camera", "sensors.camera.params.noise_sigma", captured)
     parts = []
     for noise in sorted(curves, key=float):
         xs, ys = curves[noise]
-        parts.append(f"σ = {float(noise):g}: " + ", ".join(f"{pct(y)} at {x:g} fps"
-                                                            for x, y in zip(xs[::-1], ys[::-1])))
+        parts.append(
+            f"σ = {float(noise):g}: "
+            + ", ".join(f"{pct(y)} at {x:g} fps" for x, y in zip(xs[::-1], ys[::-1]))
+        )
     return f"Capture rate ({overall(rows, captured, 'captured')}): " + "; ".join(parts) + "."

@@ -37,8 +37,9 @@ def rate_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[l
     return out
 
 
-def mean_by(rows: list[dict], x: str, line: str | None, column: str
-            ) -> dict[str, tuple[list, list]]:
+def mean_by(
+    rows: list[dict], x: str, line: str | None, column: str
+) -> dict[str, tuple[list, list]]:
     """{line value: (sorted x values, mean of a numeric column at each, nan-skipping)}."""
     groups: dict = defaultdict(lambda: defaultdict(list))
     for r in rows:
@@ -46,15 +47,23 @@ def mean_by(rows: list[dict], x: str, line: str | None, column: str
     out = {}
     for name, by_x in groups.items():
         xs = sorted(by_x)
-        out[name] = (xs, [float(np.nanmean(by_x[v])) if not np.all(np.isnan(by_x[v]))
-                          else float("nan") for v in xs])
+        out[name] = (
+            xs,
+            [
+                float(np.nanmean(by_x[v])) if not np.all(np.isnan(by_x[v])) else float("nan")
+                for v in xs
+            ],
+        )
     return out
 
 
 def failures(rows: list[dict]) -> list[str]:
     """Reasons of the variants that did not run to an outcome (errors, invalid parameters)."""
-    return [f"{r.get('index')}: {r.get('reason')}" for r in rows
-            if str(r.get("reason", "")).startswith(("error", "invalid"))]
+    return [
+        f"{r.get('index')}: {r.get('reason')}"
+        for r in rows
+        if str(r.get("reason", "")).startswith(("error", "invalid"))
+    ]
 
 
 def pct(x: float) -> str:

@@ -13,9 +13,9 @@ import numpy as np
 
 from replay.control.catching.trajectories import launch_velocity
 
-THROW_START = np.array([2.34, 0.0, 0.90])     # m, r_o(t0)
-CATCH_POINT = np.array([0.72090, 0.0, 0.46656])   # m
-T0 = 0.1                                       # s
+THROW_START = np.array([2.34, 0.0, 0.90])  # m, r_o(t0)
+CATCH_POINT = np.array([0.72090, 0.0, 0.46656])  # m
+T0 = 0.1  # s
 G = np.array([0.0, 0.0, -9.81])
 
 

@@ -26,14 +26,22 @@ from analysis.claims import Claim
 from analysis.series import events
 from plants.bullet_arm.settings import ArmSettings, resolve
 from replay.log import LogReader
-from replay.messages import (TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE, TOPIC_CATCHING_STATE,
-                             TOPIC_EFFECTOR_MOTION, TOPIC_EFFECTOR_STATE, TOPIC_HAND_JOINT_STATE,
-                             TOPIC_OBJECT_STATE, TOPIC_OPTIMIZATION_COST, TOPIC_VISION_OBJECT)
+from replay.messages import (
+    TOPIC_ARM_JOINT_COMMAND,
+    TOPIC_ARM_JOINT_STATE,
+    TOPIC_CATCHING_STATE,
+    TOPIC_EFFECTOR_MOTION,
+    TOPIC_EFFECTOR_STATE,
+    TOPIC_HAND_JOINT_STATE,
+    TOPIC_OBJECT_STATE,
+    TOPIC_OPTIMIZATION_COST,
+    TOPIC_VISION_OBJECT,
+)
 from replay.resources import data_path
 from replay.scenario import scenario_from_text
 
 STATED = data_path("claims", "namiki2003.yaml")
-ACTIVE = (0, 1, 3)                      # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
+ACTIVE = (0, 1, 3)  # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
 JOINTS = ("J1", "J2", "J4")
 
 
@@ -52,32 +60,33 @@ def _vec(rows: list[dict], key: str) -> np.ndarray:
 @dataclass
 class CatchRun:
     """One catching run's log as arrays (SI units), plus its key instants."""
+
     name: str
     scenario: dict
     mapping: str
     dt: float
     # controller side, every control step: l(q) and l(q_d) (the catch point of eqs. 2-3)
     t_ctrl: np.ndarray
-    effector: np.ndarray            # l(q)  (n, 3)
-    effector_desired: np.ndarray    # l(q_d) (n, 3)
-    q_desired: np.ndarray           # q_d (n, 4), /arm/joint_command
-    torque: np.ndarray              # commanded tau (n, 4), /arm/joint_command
+    effector: np.ndarray  # l(q)  (n, 3)
+    effector_desired: np.ndarray  # l(q_d) (n, 3)
+    q_desired: np.ndarray  # q_d (n, 4), /arm/joint_command
+    torque: np.ndarray  # commanded tau (n, 4), /arm/joint_command
     # plant side (ground truth)
     t_arm: np.ndarray
-    q: np.ndarray                   # (m, 4)
+    q: np.ndarray  # (m, 4)
     qd: np.ndarray
     t_obj: np.ndarray
-    ball: np.ndarray                # (k, 3)
+    ball: np.ndarray  # (k, 3)
     ball_velocity: np.ndarray
     t_tool: np.ndarray
-    tool_velocity: np.ndarray       # tool-frame linear velocity (/effector/motion)
+    tool_velocity: np.ndarray  # tool-frame linear velocity (/effector/motion)
     t_hand: np.ndarray
     hand_q: np.ndarray
     hand_qd: np.ndarray
     t_vision: np.ndarray
     vision: np.ndarray
-    settings: ArmSettings           # the arm plant's, from the log's resolved scenario
-    cs_t: np.ndarray = field(default_factory=lambda: np.zeros(0))   # /catching/state
+    settings: ArmSettings  # the arm plant's, from the log's resolved scenario
+    cs_t: np.ndarray = field(default_factory=lambda: np.zeros(0))  # /catching/state
     cs_qd_desired: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
     cs_r_o: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     costs: list = field(default_factory=list)
@@ -126,22 +135,35 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     cs = log.series(TOPIC_CATCHING_STATE)
     ev = events(log)
     run = CatchRun(
-        name=name or sc["name"], scenario=sc,
-        mapping=str(typed.controller.params.mapping),      # the typed scenario: no default here
+        name=name or sc["name"],
+        scenario=sc,
+        mapping=str(typed.controller.params.mapping),  # the typed scenario: no default here
         dt=1.0 / float(typed.controller.rate),
-        t_ctrl=_vec(eff, "t"), effector=_vec(eff, "position").reshape(-1, 3),
+        t_ctrl=_vec(eff, "t"),
+        effector=_vec(eff, "position").reshape(-1, 3),
         effector_desired=_vec(eff, "desired_position").reshape(-1, 3),
-        q_desired=_vec(cmd, "position"), torque=_vec(cmd, "torque"),
-        t_arm=_vec(js, "t"), q=_vec(js, "position"), qd=_vec(js, "velocity"),
-        t_obj=_vec(ob, "t"), ball=_vec(ob, "position").reshape(-1, 3),
+        q_desired=_vec(cmd, "position"),
+        torque=_vec(cmd, "torque"),
+        t_arm=_vec(js, "t"),
+        q=_vec(js, "position"),
+        qd=_vec(js, "velocity"),
+        t_obj=_vec(ob, "t"),
+        ball=_vec(ob, "position").reshape(-1, 3),
         ball_velocity=_vec(ob, "velocity").reshape(-1, 3),
-        t_tool=_vec(mo, "t"), tool_velocity=_vec(mo, "velocity").reshape(-1, 3),
-        t_hand=_vec(hj, "t"), hand_q=_vec(hj, "position"), hand_qd=_vec(hj, "velocity"),
-        t_vision=_vec(vi, "t"), vision=_vec(vi, "position").reshape(-1, 3),
+        t_tool=_vec(mo, "t"),
+        tool_velocity=_vec(mo, "velocity").reshape(-1, 3),
+        t_hand=_vec(hj, "t"),
+        hand_q=_vec(hj, "position"),
+        hand_qd=_vec(hj, "velocity"),
+        t_vision=_vec(vi, "t"),
+        vision=_vec(vi, "position").reshape(-1, 3),
         costs=sorted(log.series(TOPIC_OPTIMIZATION_COST), key=lambda c: c["iteration"]),
-        cs_t=_vec(cs, "t"), cs_qd_desired=_vec(cs, "velocity_desired"),
+        cs_t=_vec(cs, "t"),
+        cs_qd_desired=_vec(cs, "velocity_desired"),
         cs_r_o=_vec(cs, "r_o").reshape(-1, 3),
-        settings=resolve(typed.plant.params), events=ev)
+        settings=resolve(typed.plant.params),
+        events=ev,
+    )
     run.t0 = float(cs[0]["t"]) if cs else None
     hold = run.first_event("mapping_hold")
     if hold is not None:
@@ -166,9 +188,12 @@ def terminal_error(run: CatchRun) -> dict | None:
     re_prev = run.effector_desired[k - 1] - run.cs_r_o[i - 1]
     rate = float(np.linalg.norm(re - re_prev)) / (run.t_ctrl[k] - run.t_ctrl[k - 1])
     ball, _ = run.ball_at(run.t_ctrl[k])
-    return {"r_e": float(np.linalg.norm(re)), "rate": rate,
-            "r_e_true": float(np.linalg.norm(run.effector_desired[k] - ball)),
-            "speed": arrival_speed(run)}
+    return {
+        "r_e": float(np.linalg.norm(re)),
+        "rate": rate,
+        "r_e_true": float(np.linalg.norm(run.effector_desired[k] - ball)),
+        "speed": arrival_speed(run),
+    }
 
 
 def initial_error(run: CatchRun) -> tuple[float, float, float] | None:
@@ -210,9 +235,13 @@ def motion_effort(run: CatchRun) -> dict | None:
     travel = np.sum(np.abs(np.diff(run.q[wa][:, act], axis=0)), axis=0)
     travel_d = np.sum(np.abs(np.diff(run.q_desired[wc][:, act], axis=0)), axis=0)
     tau = run.torque[wc][:, act]
-    return {"travel": travel, "travel_desired": travel_d,
-            "tau_peak": np.max(np.abs(tau), axis=0), "tau_rms": np.sqrt(np.mean(tau ** 2, axis=0)),
-            "tau_rms_all": float(np.sqrt(np.mean(tau ** 2)))}
+    return {
+        "travel": travel,
+        "travel_desired": travel_d,
+        "tau_peak": np.max(np.abs(tau), axis=0),
+        "tau_rms": np.sqrt(np.mean(tau**2, axis=0)),
+        "tau_rms_all": float(np.sqrt(np.mean(tau**2))),
+    }
 
 
 def first_contact(run: CatchRun) -> dict | None:
@@ -222,9 +251,13 @@ def first_contact(run: CatchRun) -> dict | None:
         return None
     k = run.ctrl_index(c["t"])
     ball, _ = run.ball_at(run.t_ctrl[k])
-    return {"t": c["t"], "parts": c["data"].get("parts", []), "speed": c["data"].get("speed"),
-            "normal_speed": c["data"].get("normal_speed"),
-            "distance": float(np.linalg.norm(run.effector[k] - ball))}
+    return {
+        "t": c["t"],
+        "parts": c["data"].get("parts", []),
+        "speed": c["data"].get("speed"),
+        "normal_speed": c["data"].get("normal_speed"),
+        "distance": float(np.linalg.norm(run.effector[k] - ball)),
+    }
 
 
 def closest_approach(run: CatchRun, until: float | None = None) -> tuple[float, float]:
@@ -259,7 +292,7 @@ def hand_closing(run: CatchRun) -> dict | None:
     if done.any():
         out["time"] = float(t[np.argmax(done)] - e["t"])
     else:
-        out["stopped_at"] = float(np.degrees(np.max(hq[:int(min(len(hq), 0.03 / run.dt))])))
+        out["stopped_at"] = float(np.degrees(np.max(hq[: int(min(len(hq), 0.03 / run.dt))])))
     return out
 
 
@@ -281,8 +314,7 @@ def vision_accuracy(run: CatchRun) -> tuple[float, float, float] | None:
     """Measured rate (Hz), median and worst |r_o measured - truth| (m) at the capture times."""
     if len(run.t_vision) < 2:
         return None
-    truth = np.column_stack([np.interp(run.t_vision, run.t_obj, run.ball[:, i])
-                             for i in range(3)])
+    truth = np.column_stack([np.interp(run.t_vision, run.t_obj, run.ball[:, i]) for i in range(3)])
     err = np.linalg.norm(run.vision - truth, axis=1)
     rate = (len(run.t_vision) - 1) / (run.t_vision[-1] - run.t_vision[0])
     return float(rate), float(np.median(err)), float(np.max(err))
@@ -294,6 +326,7 @@ def arm_capability(arm: ArmSettings) -> dict:
     (at q0 and over a sample of the joint-limit box, locked axes at q0) and acceleration from
     rest at q0 with its torque limits (replay.robot.capability)."""
     from replay.robot.capability import max_tool_speed, tool_acceleration_from_rest
+
     dof = arm.dof
     chain = arm.chain()
     vel = arm.velocity_limits.tolist()
@@ -309,8 +342,15 @@ def arm_capability(arm: ArmSettings) -> dict:
     v_max = max(max_tool_speed(chain, q, vel, act) for q in Q)
     per_rad = max_tool_speed(chain, q0, [1.0] * dof, act)
     acc = tool_acceleration_from_rest(chain, q0, tau, act)
-    return {"v_q0": v_q0, "v_max": v_max, "per_rad": per_rad, "vel_limits": vel,
-            "tau_limits": tau, "acc_peak": acc["peak"], "acc_iso": acc["isotropic"]}
+    return {
+        "v_q0": v_q0,
+        "v_max": v_max,
+        "per_rad": per_rad,
+        "vel_limits": vel,
+        "tau_limits": tau,
+        "acc_peak": acc["peak"],
+        "acc_iso": acc["isotropic"],
+    }
 
 
 # ------------------------------------------------------------------------ the rows
@@ -328,43 +368,76 @@ def _pair(runs: dict[str, CatchRun]) -> tuple[CatchRun | None, CatchRun | None]:
         opt = next((r for r in runs.values() if r.mapping == "optimised"), None)
     if ini is None and opt is not None:
         v = opt.plant_params.get("object_velocity")
-        ini = next((r for r in runs.values() if r.mapping == "initial"
-                    and r.plant_params.get("object_velocity") == v), None)
+        ini = next(
+            (
+                r
+                for r in runs.values()
+                if r.mapping == "initial" and r.plant_params.get("object_velocity") == v
+            ),
+            None,
+        )
     return opt, ini
 
 
 def _cost_rows(opt: CatchRun | None, st: dict) -> list[Claim]:
     where = "Fig. 6"
     if opt is None or len(opt.costs) < 2:
-        return [Claim("optimisation lowers both costs (Fig. 6)", "reduced at each step",
-                      "(no optimised run with a cost history)", "not run")]
+        return [
+            Claim(
+                "optimisation lowers both costs (Fig. 6)",
+                "reduced at each step",
+                "(no optimised run with a cost history)",
+                "not run",
+            )
+        ]
     tc = [c["torque_cost"] for c in opt.costs]
     vc = [c["velocity_cost"] for c in opt.costs]
     n = len(opt.costs) - 1
     lower = tc[-1] < tc[0] and vc[-1] < vc[0]
-    rows = [Claim("optimisation lowers both costs, first vs last iterate (Fig. 6)",
-                  "Σ τᵀK_τ τ and Σ ωᵀK_ω ω reduced",
-                  f"torque {tc[0]:.0f} → {tc[-1]:.0f} ({100 * (tc[-1] / tc[0] - 1):+.1f} %), "
-                  f"velocity {vc[0]:.0f} → {vc[-1]:.0f} ({100 * (vc[-1] / vc[0] - 1):+.1f} %) "
-                  f"in {n} iterations",
-                  "reproduced" if lower else "differs",
-                  f"{where}; K = diag(1/limit²): torque limits "
-                  f"{_fmt3(_opt_limits(opt)[0])} N·m, speed limits "
-                  f"{_fmt3(_opt_limits(opt)[1])} rad/s")]
+    rows = [
+        Claim(
+            "optimisation lowers both costs, first vs last iterate (Fig. 6)",
+            "Σ τᵀK_τ τ and Σ ωᵀK_ω ω reduced",
+            f"torque {tc[0]:.0f} → {tc[-1]:.0f} ({100 * (tc[-1] / tc[0] - 1):+.1f} %), "
+            f"velocity {vc[0]:.0f} → {vc[-1]:.0f} ({100 * (vc[-1] / vc[0] - 1):+.1f} %) "
+            f"in {n} iterations",
+            "reproduced" if lower else "differs",
+            f"{where}; K = diag(1/limit²): torque limits "
+            f"{_fmt3(_opt_limits(opt)[0])} N·m, speed limits "
+            f"{_fmt3(_opt_limits(opt)[1])} rad/s",
+        )
+    ]
     up_t = [i for i in range(1, n + 1) if tc[i] > tc[i - 1]]
     up_v = [i for i in range(1, n + 1) if vc[i] > vc[i - 1]]
-    steps = lambda ups, c: ", ".join(f"{i} ({c[i - 1]:.0f} → {c[i]:.0f}, "  # noqa: E731
-                                     f"{100 * (c[i] / c[i - 1] - 1):+.2g} %)" for i in ups)
-    measured = ("both fell at every step" if not up_t and not up_v else
-                "; ".join(x for x in (f"torque cost rose at step {steps(up_t, tc)}" if up_t else "",
-                                      f"velocity cost rose at step {steps(up_v, vc)}" if up_v
-                                      else "") if x))
-    rows.append(Claim("both costs reduced at *each* optimisation step",
-                      st["results"]["costs_reduced"]["value"], measured,
-                      "reproduced" if not up_t and not up_v else "differs",
-                      "the optimiser (Levenberg-Marquardt) accepts steps that lower the sum "
-                      "E = torque + velocity cost (+ eq. 24's hinge), so either cost alone may "
-                      "rise; K_ω = diag(1/ω_max²), K_τ = diag(1/τ_max²), weights 1"))
+
+    def steps(ups, c):
+        return ", ".join(
+            f"{i} ({c[i - 1]:.0f} → {c[i]:.0f}, {100 * (c[i] / c[i - 1] - 1):+.2g} %)" for i in ups
+        )
+
+    measured = (
+        "both fell at every step"
+        if not up_t and not up_v
+        else "; ".join(
+            x
+            for x in (
+                f"torque cost rose at step {steps(up_t, tc)}" if up_t else "",
+                f"velocity cost rose at step {steps(up_v, vc)}" if up_v else "",
+            )
+            if x
+        )
+    )
+    rows.append(
+        Claim(
+            "both costs reduced at *each* optimisation step",
+            st["results"]["costs_reduced"]["value"],
+            measured,
+            "reproduced" if not up_t and not up_v else "differs",
+            "the optimiser (Levenberg-Marquardt) accepts steps that lower the sum "
+            "E = torque + velocity cost (+ eq. 24's hinge), so either cost alone may "
+            "rise; K_ω = diag(1/ω_max²), K_τ = diag(1/τ_max²), weights 1",
+        )
+    )
     return rows
 
 
@@ -386,9 +459,11 @@ def _touch(o: dict) -> str:
     """First touch as the outcome reports it: when, what, how fast, where and from where."""
     if "first_contact_time" not in o:
         return ""
-    return (f"first touch t = {o['first_contact_time']:.3f} s ({o['contact_part']}) at "
-            f"{o['contact_speed']:.1f} m/s relative, {1000 * o['contact_offset']:.0f} mm off the "
-            f"palm axis, coming in {o['approach_angle']:.0f}° off it")
+    return (
+        f"first touch t = {o['first_contact_time']:.3f} s ({o['contact_part']}) at "
+        f"{o['contact_speed']:.1f} m/s relative, {1000 * o['contact_offset']:.0f} mm off the "
+        f"palm axis, coming in {o['approach_angle']:.0f}° off it"
+    )
 
 
 def _catch_row(run: CatchRun) -> Claim:
@@ -399,19 +474,31 @@ def _catch_row(run: CatchRun) -> Claim:
         d = catch["data"]
         measured = f"caught at t = {catch['t']:.3f} s by {', '.join(d.get('parts', []))}"
         measured += f"; {touch}" if touch else ""
-        return Claim(f"{run.name}: ball caught", "caught (Figs. 10, 11)", measured, "reproduced",
-                     "plant: ≥ 2 hand parts touching, moving with the palm for 50 ms; the hand "
-                     "meets the ball at speed (arm torque-limited) and the fingers hold it")
+        return Claim(
+            f"{run.name}: ball caught",
+            "caught (Figs. 10, 11)",
+            measured,
+            "reproduced",
+            "plant: ≥ 2 hand parts touching, moving with the palm for 50 ms; the hand "
+            "meets the ball at speed (arm torque-limited) and the fingers hold it",
+        )
     contact = first_contact(run)
     d_min, t_min = closest_approach(run, contact["t"] if contact else None)
     measured = f"not caught: {o.get('reason', 'no outcome event')}"
     measured += f"; {touch}" if touch else ""
-    measured += (f"; closest approach of the ball centre to l(q) "
-                 f"{'before that ' if contact else ''}{1000 * d_min:.0f} mm (t = {t_min:.3f} s)")
-    return Claim(f"{run.name}: ball caught", "caught (Figs. 10, 11)", measured, "differs",
-                 "what decides the catch is where and from which direction the ball comes into "
-                 "the hand (next rows): eq. 4 fixes r_e and ṙ_e at t_c, not r̈_e(t_c), and eq. 25 "
-                 "does not see it")
+    measured += (
+        f"; closest approach of the ball centre to l(q) "
+        f"{'before that ' if contact else ''}{1000 * d_min:.0f} mm (t = {t_min:.3f} s)"
+    )
+    return Claim(
+        f"{run.name}: ball caught",
+        "caught (Figs. 10, 11)",
+        measured,
+        "differs",
+        "what decides the catch is where and from which direction the ball comes into "
+        "the hand (next rows): eq. 4 fixes r_e and ṙ_e at t_c, not r̈_e(t_c), and eq. 25 "
+        "does not see it",
+    )
 
 
 def _approach_rows(runs: dict[str, CatchRun]) -> list[Claim]:
@@ -421,16 +508,24 @@ def _approach_rows(runs: dict[str, CatchRun]) -> list[Claim]:
         o = run_outcome(run)
         if o is None or "approach_angle" not in o:
             continue
-        parts.append(f"{run.name}: {o['approach_angle']:.0f}°, {1000 * o['contact_offset']:.0f} mm"
-                     f" → {'caught' if o['success'] else o['reason']}")
+        parts.append(
+            f"{run.name}: {o['approach_angle']:.0f}°, {1000 * o['contact_offset']:.0f} mm"
+            f" → {'caught' if o['success'] else o['reason']}"
+        )
     if not parts:
         return []
-    return [Claim("approach of the ball at first touch (angle off the palm axis, offset from it)",
-                  "(not stated; eq. 25 weighs τ and ω only)", "; ".join(parts), "note",
-                  "near t_c the ball, seen from l(q_d), is at −r_e ≈ −½ r̈_e(t_c)(t − t_c)²: it "
-                  "comes in along −r̈_e(t_c), which α sets (the (q4 − q_α)² terms of eq. 12) and "
-                  "eqs. 4, 13-25 leave free; catch_optimised_approach adds a term for it "
-                  "(replay/control/catching/approach.py, not in the paper)")]
+    return [
+        Claim(
+            "approach of the ball at first touch (angle off the palm axis, offset from it)",
+            "(not stated; eq. 25 weighs τ and ω only)",
+            "; ".join(parts),
+            "note",
+            "near t_c the ball, seen from l(q_d), is at −r_e ≈ −½ r̈_e(t_c)(t − t_c)²: it "
+            "comes in along −r̈_e(t_c), which α sets (the (q4 − q_α)² terms of eq. 12) and "
+            "eqs. 4, 13-25 leave free; catch_optimised_approach adds a term for it "
+            "(replay/control/catching/approach.py, not in the paper)",
+        )
+    ]
 
 
 def _torque_limit_rows(opt: CatchRun | None, ini: CatchRun | None) -> list[Claim]:
@@ -448,13 +543,18 @@ def _torque_limit_rows(opt: CatchRun | None, ini: CatchRun | None) -> list[Claim
     measured = f"{opt.name}: at the limit in {_fmt1(a)} % of control steps"
     if ini is not None and ini.t0 is not None and ini.t_c is not None:
         measured += f"; {ini.name}: {_fmt1(sat(ini))} % (J1, J2, J4)"
-    return [Claim("torque limits (eq. 22) during the throw, t0 → t_c",
-                  "τ_min ≤ τ ≤ τ_max (eq. 22)", measured,
-                  "differs" if np.any(a > 0) else "reproduced",
-                  f"τ_max = {_fmt3(lim[list(ACTIVE)])} N·m (assumed; the paper gives none): no α "
-                  "meets eq. 22 at 8-10 m/s with them (the optimiser, with a hinge of weight 1e4, "
-                  "still left J2 at 2.9× its limit), so catch_optimised reports eq. 22 and does "
-                  "not impose it (torque_limit_penalty 0); the controller clamps at the limits")]
+    return [
+        Claim(
+            "torque limits (eq. 22) during the throw, t0 → t_c",
+            "τ_min ≤ τ ≤ τ_max (eq. 22)",
+            measured,
+            "differs" if np.any(a > 0) else "reproduced",
+            f"τ_max = {_fmt3(lim[list(ACTIVE)])} N·m (assumed; the paper gives none): no α "
+            "meets eq. 22 at 8-10 m/s with them (the optimiser, with a hinge of weight 1e4, "
+            "still left J2 at 2.9× its limit), so catch_optimised reports eq. 22 and does "
+            "not impose it (torque_limit_penalty 0); the controller clamps at the limits",
+        )
+    ]
 
 
 def _fmt1(x) -> str:
@@ -468,80 +568,134 @@ def _run_rows(run: CatchRun, st: dict) -> list[Claim]:
     if sp is not None:
         v0, vc = sp
         arrive = f", {vc:.2f} m/s reaching the hand" if vc is not None else ""
-        rows.append(Claim(f"{run.name}: throw speed", f"about {lo:g} ~ {hi:g} m/s",
-                          f"{v0:.2f} m/s when first seen{arrive}",
-                          "reproduced" if lo - 0.5 <= v0 <= hi + 0.5 else "differs",
-                          "set by the scenario (release velocity)"))
+        rows.append(
+            Claim(
+                f"{run.name}: throw speed",
+                f"about {lo:g} ~ {hi:g} m/s",
+                f"{v0:.2f} m/s when first seen{arrive}",
+                "reproduced" if lo - 0.5 <= v0 <= hi + 0.5 else "differs",
+                "set by the scenario (release velocity)",
+            )
+        )
     rows.append(_catch_row(run))
     te = terminal_error(run)
     if te is None:
-        rows.append(Claim(f"{run.name}: terminal constraint eq. 4", "r_e = ṙ_e = 0 at t_c",
-                          "the mapping never reached the catch surface", "differs"))
+        rows.append(
+            Claim(
+                f"{run.name}: terminal constraint eq. 4",
+                "r_e = ṙ_e = 0 at t_c",
+                "the mapping never reached the catch surface",
+                "differs",
+            )
+        )
     else:
         ok = te["r_e"] < 0.001 and te["rate"] < 0.05 * (te["speed"] or np.inf)
         c = first_contact(run)
-        touched = (f"; the ball had touched the hand at {c['t']:.3f} s" if c is not None
-                   and c["t"] <= run.t_c + 1e-9 else "")
-        rows.append(Claim(
-            f"{run.name}: terminal constraint eq. 4 (r_e = l(q_d) − r_o)",
-            "r_e(t_c) = ṙ_e(t_c) = 0",
-            f"|r_e| = {1000 * te['r_e']:.3f} mm, |ṙ_e| ≤ {te['rate']:.2f} m/s over the last 1 ms "
-            f"(ball {te['speed']:.2f} m/s) at t_c = {run.t_c:.3f} s",
-            "reproduced" if ok else "differs",
-            f"r_o as the mapping used it; with the true ball |r_e| = {1000 * te['r_e_true']:.1f} "
-            f"mm (vision, latency compensation){touched}"))
+        touched = (
+            f"; the ball had touched the hand at {c['t']:.3f} s"
+            if c is not None and c["t"] <= run.t_c + 1e-9
+            else ""
+        )
+        rows.append(
+            Claim(
+                f"{run.name}: terminal constraint eq. 4 (r_e = l(q_d) − r_o)",
+                "r_e(t_c) = ṙ_e(t_c) = 0",
+                f"|r_e| = {1000 * te['r_e']:.3f} mm, |ṙ_e| ≤ {te['rate']:.2f} m/s over the last 1 ms "
+                f"(ball {te['speed']:.2f} m/s) at t_c = {run.t_c:.3f} s",
+                "reproduced" if ok else "differs",
+                f"r_o as the mapping used it; with the true ball |r_e| = {1000 * te['r_e_true']:.1f} "
+                f"mm (vision, latency compensation){touched}",
+            )
+        )
     c = first_contact(run)
     if c is not None:
         k = run.ctrl_index(c["t"])
         lag = float(np.linalg.norm(run.effector[k] - run.effector_desired[k]))
-        rows.append(Claim(
-            f"{run.name}: the hand where the ball reaches it (first contact)",
-            "q ≈ q_d (Sec. III-D), so the hand meets the ball with r_e ≈ ṙ_e ≈ 0",
-            f"t = {c['t']:.3f} s: ball {c['speed']:.2f} m/s relative to the touched point, "
-            f"|l(q) − r_o| = {1000 * c['distance']:.0f} mm, arm behind l(q_d) by "
-            f"{1000 * lag:.0f} mm",
-            "reproduced" if c["speed"] < 1.0 else "differs",
-            "the commanded torques saturate at the end; eq. 4 holds for q_d only"))
+        rows.append(
+            Claim(
+                f"{run.name}: the hand where the ball reaches it (first contact)",
+                "q ≈ q_d (Sec. III-D), so the hand meets the ball with r_e ≈ ṙ_e ≈ 0",
+                f"t = {c['t']:.3f} s: ball {c['speed']:.2f} m/s relative to the touched point, "
+                f"|l(q) − r_o| = {1000 * c['distance']:.0f} mm, arm behind l(q_d) by "
+                f"{1000 * lag:.0f} mm",
+                "reproduced" if c["speed"] < 1.0 else "differs",
+                "the commanded torques saturate at the end; eq. 4 holds for q_d only",
+            )
+        )
     ie = initial_error(run)
     if ie is not None:
-        rows.append(Claim(f"{run.name}: initial constraint eq. 9 at t0", "q_e(t0) = q̇_e(t0) = 0",
-                          f"max |q_d − q| = {ie[0]:.4f} rad at t0 = {run.t0:.3f} s; max |q̇_d| = "
-                          f"{ie[1]:.2f} rad/s as the ball passes r_o(t0) (t = {ie[2]:.3f} s)",
-                          "reproduced" if ie[0] < 0.01 and ie[1] < 0.1 else "differs",
-                          "eq. 13 is imposed for the nominal throw (9 m/s at r_o(t0)) only; "
-                          "q̇_d extrapolated from the first two fitted-velocity steps"))
+        rows.append(
+            Claim(
+                f"{run.name}: initial constraint eq. 9 at t0",
+                "q_e(t0) = q̇_e(t0) = 0",
+                f"max |q_d − q| = {ie[0]:.4f} rad at t0 = {run.t0:.3f} s; max |q̇_d| = "
+                f"{ie[1]:.2f} rad/s as the ball passes r_o(t0) (t = {ie[2]:.3f} s)",
+                "reproduced" if ie[0] < 0.01 and ie[1] < 0.1 else "differs",
+                "eq. 13 is imposed for the nominal throw (9 m/s at r_o(t0)) only; "
+                "q̇_d extrapolated from the first two fitted-velocity steps",
+            )
+        )
     return rows
 
 
 def _pair_rows(opt: CatchRun | None, ini: CatchRun | None, st: dict) -> list[Claim]:
     if opt is None or ini is None:
-        return [Claim("optimised vs unoptimised motion (Figs. 8, 9)", "optimised moves less",
-                      "(needs catch_optimised and catch_initial logs)", "not run")]
+        return [
+            Claim(
+                "optimised vs unoptimised motion (Figs. 8, 9)",
+                "optimised moves less",
+                "(needs catch_optimised and catch_initial logs)",
+                "not run",
+            )
+        ]
     a, b = motion_effort(opt), motion_effort(ini)
     if a is None or b is None:
-        return [Claim("optimised vs unoptimised motion (Figs. 8, 9)", "optimised moves less",
-                      "a run never reached t_c", "differs")]
+        return [
+            Claim(
+                "optimised vs unoptimised motion (Figs. 8, 9)",
+                "optimised moves less",
+                "a run never reached t_c",
+                "differs",
+            )
+        ]
     rows = []
-    for key, label in (("travel_desired", "desired joint travel Σ|Δq_d|"),
-                       ("travel", "actual joint travel Σ|Δq|")):
+    for key, label in (
+        ("travel_desired", "desired joint travel Σ|Δq_d|"),
+        ("travel", "actual joint travel Σ|Δq|"),
+    ):
         ta, tb = float(np.sum(a[key])), float(np.sum(b[key]))
-        rows.append(Claim(f"{label}, t0 → t_c (Fig. 8)", "smaller when optimised",
-                          f"optimised {ta:.2f} rad {_fmt3(a[key])} vs initial {tb:.2f} rad "
-                          f"{_fmt3(b[key])} (J1, J2, J4)",
-                          "reproduced" if ta < tb else "differs"))
+        rows.append(
+            Claim(
+                f"{label}, t0 → t_c (Fig. 8)",
+                "smaller when optimised",
+                f"optimised {ta:.2f} rad {_fmt3(a[key])} vs initial {tb:.2f} rad "
+                f"{_fmt3(b[key])} (J1, J2, J4)",
+                "reproduced" if ta < tb else "differs",
+            )
+        )
     ra, rb = a["tau_rms_all"], b["tau_rms_all"]
-    rows.append(Claim("command torque RMS, t0 → t_c (Fig. 9)", "smaller when optimised",
-                      f"optimised {ra:.1f} N·m {_fmt3(a['tau_rms'])} vs initial {rb:.1f} N·m "
-                      f"{_fmt3(b['tau_rms'])} (J1, J2, J4)",
-                      "reproduced" if ra < rb else "differs",
-                      "eq. 25 weighs the unclamped eq.-17 torque over the throw set, dominated by "
-                      "its peaks near t_c (above the limits for every α); the run's commands are "
-                      "clamped at the limits (eq. 22 row)"))
+    rows.append(
+        Claim(
+            "command torque RMS, t0 → t_c (Fig. 9)",
+            "smaller when optimised",
+            f"optimised {ra:.1f} N·m {_fmt3(a['tau_rms'])} vs initial {rb:.1f} N·m "
+            f"{_fmt3(b['tau_rms'])} (J1, J2, J4)",
+            "reproduced" if ra < rb else "differs",
+            "eq. 25 weighs the unclamped eq.-17 torque over the throw set, dominated by "
+            "its peaks near t_c (above the limits for every α); the run's commands are "
+            "clamped at the limits (eq. 22 row)",
+        )
+    )
     pa, pb = a["tau_peak"], b["tau_peak"]
-    rows.append(Claim("command torque peak |τ|, t0 → t_c (Fig. 9)", "smaller when optimised",
-                      f"optimised {_fmt3(pa)} vs initial {_fmt3(pb)} N·m (J1, J2, J4)",
-                      "reproduced" if np.sum(pa) < np.sum(pb) else "differs",
-                      "peaks at the torque limits are the controller's clamp"))
+    rows.append(
+        Claim(
+            "command torque peak |τ|, t0 → t_c (Fig. 9)",
+            "smaller when optimised",
+            f"optimised {_fmt3(pa)} vs initial {_fmt3(pb)} N·m (J1, J2, J4)",
+            "reproduced" if np.sum(pa) < np.sum(pb) else "differs",
+            "peaks at the torque limits are the controller's clamp",
+        )
+    )
     return rows
 
 
@@ -557,39 +711,54 @@ def _capability_rows(run: CatchRun, st: dict) -> list[Claim]:
     rows = []
     need = arrival_speed(run) or float("nan")
     vel = cap["vel_limits"]
-    rows.append(Claim(
-        "end-effector maximum speed (model)", f"{v_stated:g} m/s (Sec. IV-A)",
-        f"model with {vel[0]:g} rad/s joints: {cap['v_q0']:.2f} m/s at q0, ≤ {cap['v_max']:.2f} "
-        f"m/s anywhere; 5 m/s at q0 needs {v_stated / cap['per_rad']:.2f} rad/s",
-        "differs" if cap["v_max"] < v_stated else "reproduced",
-        "joint speed limits are not in the paper (assumed); the plant reports, does not enforce"))
-    rows.append(Claim(
-        "hand speed eq. 4 demands at t_c vs the arm's 5 m/s", f"≤ {v_stated:g} m/s and ṙ_e(t_c) = 0",
-        f"eq. 4 needs the hand at the ball's {need:.2f} m/s; the run's tool peaked at "
-        f"{v_run:.2f} m/s before contact, joints at {_fmt3(qd_peak)} rad/s ({run.name})",
-        "inconsistent",
-        f"at 8-10 m/s, eq. 4 cannot hold with a {v_stated:g} m/s arm; here the limits are only "
-        "reported, so the simulated arm exceeds them"))
+    rows.append(
+        Claim(
+            "end-effector maximum speed (model)",
+            f"{v_stated:g} m/s (Sec. IV-A)",
+            f"model with {vel[0]:g} rad/s joints: {cap['v_q0']:.2f} m/s at q0, ≤ {cap['v_max']:.2f} "
+            f"m/s anywhere; 5 m/s at q0 needs {v_stated / cap['per_rad']:.2f} rad/s",
+            "differs" if cap["v_max"] < v_stated else "reproduced",
+            "joint speed limits are not in the paper (assumed); the plant reports, does not enforce",
+        )
+    )
+    rows.append(
+        Claim(
+            "hand speed eq. 4 demands at t_c vs the arm's 5 m/s",
+            f"≤ {v_stated:g} m/s and ṙ_e(t_c) = 0",
+            f"eq. 4 needs the hand at the ball's {need:.2f} m/s; the run's tool peaked at "
+            f"{v_run:.2f} m/s before contact, joints at {_fmt3(qd_peak)} rad/s ({run.name})",
+            "inconsistent",
+            f"at 8-10 m/s, eq. 4 cannot hold with a {v_stated:g} m/s arm; here the limits are only "
+            "reported, so the simulated arm exceeds them",
+        )
+    )
     if run.t_c is not None and len(run.cs_t):
         i = int(np.argmin(np.abs(run.cs_t - run.t_c)))
         w_c = np.abs(run.cs_qd_desired[i, list(ACTIVE)])
         w_max = np.asarray(_opt_limits(run)[1], float)
-        rows.append(Claim(
-            "joint speed limits (eq. 24) at the catch, given eq. 4",
-            "ω_min ≤ ω ≤ ω_max (eq. 24) and ṙ_e(t_c) = 0 (eq. 4)",
-            f"|q̇_d(t_c)| = {_fmt3(w_c)} rad/s vs ω_max = {_fmt3(w_max)} rad/s (J1, J2, J4)",
-            "inconsistent" if np.any(w_c > w_max) else "reproduced",
-            "at t_c, b and ∂b/∂q vanish (eq. 8), so ω(t_c) = J_c⁻¹ ṙ_o(t_c) for every α: no "
-            "α meets eq. 24 there unless ω_max exceeds it; the paper gives no ω_max: "
-            "catch_optimised takes the smallest eq. 4 permits over its throw set"))
+        rows.append(
+            Claim(
+                "joint speed limits (eq. 24) at the catch, given eq. 4",
+                "ω_min ≤ ω ≤ ω_max (eq. 24) and ṙ_e(t_c) = 0 (eq. 4)",
+                f"|q̇_d(t_c)| = {_fmt3(w_c)} rad/s vs ω_max = {_fmt3(w_max)} rad/s (J1, J2, J4)",
+                "inconsistent" if np.any(w_c > w_max) else "reproduced",
+                "at t_c, b and ∂b/∂q vanish (eq. 8), so ω(t_c) = J_c⁻¹ ṙ_o(t_c) for every α: no "
+                "α meets eq. 24 there unless ω_max exceeds it; the paper gives no ω_max: "
+                "catch_optimised takes the smallest eq. 4 permits over its throw set",
+            )
+        )
     dt = (run.t_c - run.t0) if run.t_c is not None and run.t0 is not None else float("nan")
-    rows.append(Claim(
-        "end-effector maximum acceleration", f"{a_stated:g} m/s² (Sec. IV-A)",
-        f"model from rest at q0: {cap['acc_peak']:.0f} m/s² best direction, {cap['acc_iso']:.1f} "
-        f"in every direction; eq. 4 needs ≥ {need / dt:.0f} m/s² on average (0 → {need:.1f} m/s "
-        f"in {dt:.3f} s); run peak {a_run:.0f} m/s² (5 ms, before contact)",
-        "inconsistent" if need / dt > a_stated else "reproduced",
-        f"torque limits {_fmt3(cap['tau_limits'])} N·m (assumed)"))
+    rows.append(
+        Claim(
+            "end-effector maximum acceleration",
+            f"{a_stated:g} m/s² (Sec. IV-A)",
+            f"model from rest at q0: {cap['acc_peak']:.0f} m/s² best direction, {cap['acc_iso']:.1f} "
+            f"in every direction; eq. 4 needs ≥ {need / dt:.0f} m/s² on average (0 → {need:.1f} m/s "
+            f"in {dt:.3f} s); run peak {a_run:.0f} m/s² (5 ms, before contact)",
+            "inconsistent" if need / dt > a_stated else "reproduced",
+            f"torque limits {_fmt3(cap['tau_limits'])} N·m (assumed)",
+        )
+    )
     return rows
 
 
@@ -606,14 +775,21 @@ def _hand_rows(runs: dict[str, CatchRun], st: dict) -> list[Claim]:
             parts.append(f"{run.name}: 90° in {1000 * h['time']:.0f} ms")
             ok = (ok is not False) and abs(h["time"] - p["hand_close_time"]["value"]) <= 0.0015
         else:
-            parts.append(f"{run.name}: stopped by the ball at {h['stopped_at']:.0f}°, "
-                         f"{h['peak_speed']:.1f} rad/s")
+            parts.append(
+                f"{run.name}: stopped by the ball at {h['stopped_at']:.0f}°, "
+                f"{h['peak_speed']:.1f} rad/s"
+            )
     if not parts:
         return [Claim("hand closing", stated, "(the hand never closed)", "not run")]
-    return [Claim("hand closing", stated, "; ".join(parts),
-                  "reproduced" if ok else "differs" if ok is False else "note",
-                  "from the hand_close command to every joint at 90° (one 1 ms step of "
-                  "velocity ramp)")]
+    return [
+        Claim(
+            "hand closing",
+            stated,
+            "; ".join(parts),
+            "reproduced" if ok else "differs" if ok is False else "note",
+            "from the hand_close command to every joint at 90° (one 1 ms step of velocity ramp)",
+        )
+    ]
 
 
 def _vision_rows(run: CatchRun, st: dict) -> list[Claim]:
@@ -625,11 +801,16 @@ def _vision_rows(run: CatchRun, st: dict) -> list[Claim]:
     w = stereo.get("params", {}).get("width", "?")
     h = stereo.get("params", {}).get("height", "?")
     lat = stereo.get("latency", 0.0)
-    return [Claim("stereo vision rate and resolution", "1 kHz, 128 × 128 (Sec. IV-A)",
-                  f"{va[0]:.0f} Hz, {w} × {h}, latency {1000 * lat:.0f} ms; r_o error median "
-                  f"{1000 * va[1]:.2f} mm, worst {1000 * va[2]:.2f} mm ({run.name})",
-                  "reproduced" if abs(va[0] - 1000) < 1 and w == 128 else "differs",
-                  "accuracy is not stated in the paper")]
+    return [
+        Claim(
+            "stereo vision rate and resolution",
+            "1 kHz, 128 × 128 (Sec. IV-A)",
+            f"{va[0]:.0f} Hz, {w} × {h}, latency {1000 * lat:.0f} ms; r_o error median "
+            f"{1000 * va[1]:.2f} mm, worst {1000 * va[2]:.2f} mm ({run.name})",
+            "reproduced" if abs(va[0] - 1000) < 1 and w == 128 else "differs",
+            "accuracy is not stated in the paper",
+        )
+    ]
 
 
 def evaluate(logs: dict[str, LogReader]) -> list[Claim]:
@@ -650,5 +831,12 @@ def evaluate(logs: dict[str, LogReader]) -> list[Claim]:
     rows += _hand_rows(runs, st)
     rows += _vision_rows(ref, st)
     # a "|" would split a Markdown table cell: magnitudes are written ‖x‖
-    return [Claim(*(getattr(r, f).replace("|", "‖") for f in ("quantity", "stated", "measured",
-                                                            "status", "note"))) for r in rows]
+    return [
+        Claim(
+            *(
+                getattr(r, f).replace("|", "‖")
+                for f in ("quantity", "stated", "measured", "status", "note")
+            )
+        )
+        for r in rows
+    ]

@@ -21,8 +21,15 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from analysis.catch_claims import (ACTIVE, JOINTS, CatchRun, _opt_limits, _pair,  # noqa: E402
-                                   first_contact, load_run)
+from analysis.catch_claims import (
+    ACTIVE,
+    JOINTS,
+    CatchRun,
+    _opt_limits,
+    _pair,  # noqa: E402
+    first_contact,
+    load_run,
+)
 from analysis.figure_files import save  # noqa: E402
 from replay.log import LogReader  # noqa: E402
 
@@ -57,35 +64,63 @@ def _marks(ax, run: CatchRun, style: dict, text: bool = False) -> None:
             continue
         ax.axvline(t, color="0.55", lw=0.7, ls=style.get("ls", "-"))
         if text:
-            ax.annotate(name, (t, 1.0), xycoords=("data", "axes fraction"),
-                        xytext=(2, -9 - 8 * (row % 3)), textcoords="offset points", fontsize=7,
-                        color="0.35")
+            ax.annotate(
+                name,
+                (t, 1.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(2, -9 - 8 * (row % 3)),
+                textcoords="offset points",
+                fontsize=7,
+                color="0.35",
+            )
             row += 1
 
 
 def fig6(opt: CatchRun | None, ini: CatchRun | None):
     fig, (ax_t, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.0, 5.0))
-    for run, color, label in ((opt, "tab:blue", "optimisation (eq. 25)"),
-                              (ini, "tab:red", "initial parameters (unoptimised run)")):
+    for run, color, label in (
+        (opt, "tab:blue", "optimisation (eq. 25)"),
+        (ini, "tab:red", "initial parameters (unoptimised run)"),
+    ):
         if run is None or not run.costs:
             continue
         it = [c["iteration"] for c in run.costs]
         marker = "o" if len(it) > 1 else "s"
-        ax_t.plot(it, [c["torque_cost"] for c in run.costs], marker=marker, color=color,
-                  label=label, ms=5 if len(it) > 1 else 8, fillstyle="none" if len(it) == 1
-                  else "full")
-        ax_w.plot(it, [c["velocity_cost"] for c in run.costs], marker=marker, color=color,
-                  label=label, ms=5 if len(it) > 1 else 8, fillstyle="none" if len(it) == 1
-                  else "full")
+        ax_t.plot(
+            it,
+            [c["torque_cost"] for c in run.costs],
+            marker=marker,
+            color=color,
+            label=label,
+            ms=5 if len(it) > 1 else 8,
+            fillstyle="none" if len(it) == 1 else "full",
+        )
+        ax_w.plot(
+            it,
+            [c["velocity_cost"] for c in run.costs],
+            marker=marker,
+            color=color,
+            label=label,
+            ms=5 if len(it) > 1 else 8,
+            fillstyle="none" if len(it) == 1 else "full",
+        )
     ax_t.set_ylabel("Σ τᵀ K_τ τ (dynamics)")
     ax_w.set_ylabel("Σ ωᵀ K_ω ω (kinematics)")
     ax_w.set_xlabel("optimisation iteration")
     ref = opt or ini
     if ref is not None:
         tau, w = _opt_limits(ref)
-        fig.text(0.01, 0.005, "K_τ = diag(1/τ_max²), τ_max = (" + ", ".join(f"{x:g}" for x in tau)
-                 + ") N·m;  K_ω = diag(1/ω_max²), ω_max = (" + ", ".join(f"{x:g}" for x in w)
-                 + ") rad/s;  joints 1, 2, 4", fontsize=7, color="0.35")
+        fig.text(
+            0.01,
+            0.005,
+            "K_τ = diag(1/τ_max²), τ_max = ("
+            + ", ".join(f"{x:g}" for x in tau)
+            + ") N·m;  K_ω = diag(1/ω_max²), ω_max = ("
+            + ", ".join(f"{x:g}" for x in w)
+            + ") rad/s;  joints 1, 2, 4",
+            fontsize=7,
+            color="0.35",
+        )
     for ax in (ax_t, ax_w):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
@@ -135,17 +170,32 @@ def fig7(runs: list[CatchRun], title: str):
     side.set_aspect("equal", adjustable="datalim")
     side.grid(alpha=0.3)
     side.set_title("side view (x-z): ○ l(q_d) at t_c, × ball at the first contact", fontsize=9)
-    handles = [plt.Line2D([], [], color=C_BALL, label="ball r_o (truth)"),
-               plt.Line2D([], [], color=C_DES, label="desired l(q_d)"),
-               plt.Line2D([], [], color=C_ACT, label="actual l(q)")]
-    handles += [plt.Line2D([], [], color="0.3", label=_label(r),
-                           **STYLE["optimised" if r.mapping == "optimised" else "initial"])
-                for r in runs]
+    handles = [
+        plt.Line2D([], [], color=C_BALL, label="ball r_o (truth)"),
+        plt.Line2D([], [], color=C_DES, label="desired l(q_d)"),
+        plt.Line2D([], [], color=C_ACT, label="actual l(q)"),
+    ]
+    handles += [
+        plt.Line2D(
+            [],
+            [],
+            color="0.3",
+            label=_label(r),
+            **STYLE["optimised" if r.mapping == "optimised" else "initial"],
+        )
+        for r in runs
+    ]
     side.legend(handles=handles, fontsize=7, loc="upper left")
     fig.suptitle(title, fontsize=10)
-    fig.text(0.01, 0.005, "l(q): the catch point (ball centre on the palm); vertical lines: t₀ "
-             "(first vision frame used), t_c (r_o on the catch surface, q4 = q_α), contact, "
-             "catch/miss", fontsize=7, color="0.35")
+    fig.text(
+        0.01,
+        0.005,
+        "l(q): the catch point (ball centre on the palm); vertical lines: t₀ "
+        "(first vision frame used), t_c (r_o on the catch surface, q4 = q_α), contact, "
+        "catch/miss",
+        fontsize=7,
+        color="0.35",
+    )
     fig.tight_layout(rect=(0, 0.02, 1, 0.97))
     return fig
 
@@ -160,14 +210,30 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
         wc = run.window(run.t_ctrl, t0, t1)
         for ax, j, name in zip(axes, ACTIVE, JOINTS):
             if what == "angles":
-                ax.plot(run.t_arm[wa], run.q[wa, j], color="tab:blue" if run.mapping ==
-                        "optimised" else "tab:red", label=f"q, {_label(run)}", **st)
-                ax.plot(run.t_ctrl[wc], run.q_desired[wc, j], color="0.35", lw=0.8,
-                        ls=st["ls"], label=f"q_d, {run.name}")
+                ax.plot(
+                    run.t_arm[wa],
+                    run.q[wa, j],
+                    color="tab:blue" if run.mapping == "optimised" else "tab:red",
+                    label=f"q, {_label(run)}",
+                    **st,
+                )
+                ax.plot(
+                    run.t_ctrl[wc],
+                    run.q_desired[wc, j],
+                    color="0.35",
+                    lw=0.8,
+                    ls=st["ls"],
+                    label=f"q_d, {run.name}",
+                )
                 ax.set_ylabel(f"q{name[1]} [rad]")
             else:
-                ax.plot(run.t_ctrl[wc], run.torque[wc, j], color="tab:blue" if run.mapping ==
-                        "optimised" else "tab:red", label=_label(run), **st)
+                ax.plot(
+                    run.t_ctrl[wc],
+                    run.torque[wc, j],
+                    color="tab:blue" if run.mapping == "optimised" else "tab:red",
+                    label=_label(run),
+                    **st,
+                )
                 ax.set_ylabel(f"τ{name[1]} [N·m]")
             _marks(ax, run, st, text=(run is runs[0] and j == 0))
     if what == "torques":
@@ -180,10 +246,18 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
     axes[0].legend(fontsize=7, loc="best")
     axes[-1].set_xlabel("time [s]")
     axes[0].set_title(title, fontsize=10)
-    note = ("axis 3 locked at 0; thin grey: q_d = g∘l_c⁻¹(r_o)" if what == "angles" else
-            "command torque τ = τ_ff(q_d) + PD, clipped at the limits (dotted)")
-    fig.text(0.01, 0.005, note + "; vertical lines: t₀, t_c, contact, catch/miss",
-             fontsize=7, color="0.35")
+    note = (
+        "axis 3 locked at 0; thin grey: q_d = g∘l_c⁻¹(r_o)"
+        if what == "angles"
+        else "command torque τ = τ_ff(q_d) + PD, clipped at the limits (dotted)"
+    )
+    fig.text(
+        0.01,
+        0.005,
+        note + "; vertical lines: t₀, t_c, contact, catch/miss",
+        fontsize=7,
+        color="0.35",
+    )
     fig.tight_layout(rect=(0, 0.025, 1, 1))
     return fig
 
@@ -200,15 +274,19 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     if pair:
         what = " vs ".join(r.name for r in pair)
         paths += save(fig6(opt, ini), out, "catch_fig6")
-        paths += save(fig7(pair, f"Catching trajectory: {what} (cf. Fig. 7)"), out,
-                       "catch_fig7")
-        paths += save(_joint_figure(pair, f"Joint angles: {what} (cf. Fig. 8)", "angles"), out,
-                       "catch_fig8")
-        paths += save(_joint_figure(pair, f"Command torques: {what} (cf. Fig. 9)", "torques"),
-                       out, "catch_fig9")
+        paths += save(fig7(pair, f"Catching trajectory: {what} (cf. Fig. 7)"), out, "catch_fig7")
+        paths += save(
+            _joint_figure(pair, f"Joint angles: {what} (cf. Fig. 8)", "angles"), out, "catch_fig8"
+        )
+        paths += save(
+            _joint_figure(pair, f"Command torques: {what} (cf. Fig. 9)", "torques"),
+            out,
+            "catch_fig9",
+        )
     for name, run in runs.items():
         if run in pair:
             continue
-        paths += save(fig7([run], f"Catching trajectory: {_label(run)} (cf. Fig. 7)"), out,
-                       f"{name}_fig7")
+        paths += save(
+            fig7([run], f"Catching trajectory: {_label(run)} (cf. Fig. 7)"), out, f"{name}_fig7"
+        )
     return paths

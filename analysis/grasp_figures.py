@@ -21,15 +21,21 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
-from analysis.grasp_run import (GRASP_PHASES, REACHING, RELEASING, GraspRun,  # noqa: E402
-                                head_camera_at, load_run)
+from analysis.grasp_run import (
+    GRASP_PHASES,
+    REACHING,
+    RELEASING,
+    GraspRun,  # noqa: E402
+    head_camera_at,
+    load_run,
+)
 from replay.log import LogReader  # noqa: E402
 from replay.spatial import quaternion_matrix  # noqa: E402
 
 C_OBJ, C_HAND, C_TARGET = "tab:orange", "tab:blue", "tab:green"
 SHADE = {"grasp": ("tab:blue", 0.10), RELEASING: ("tab:red", 0.10)}
 EVENT_KINDS = ("grasp", "release", "drop", "slip")
-VIEW = (math.radians(-125.0), math.radians(22.0))     # azimuth, elevation of the filmstrip view
+VIEW = (math.radians(-125.0), math.radians(22.0))  # azimuth, elevation of the filmstrip view
 
 
 # ----------------------------------------------------------------------------- Fig. 9
@@ -41,24 +47,37 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> None:
         color, alpha = SHADE[key]
         ax.axvspan(p.t0, p.t1, color=color, alpha=alpha, lw=0)
         if labels and p.name in (REACHING, RELEASING):
-            ax.annotate("grasp" if p.name == REACHING else "release", (p.t0, 1.0),
-                        xycoords=("data", "axes fraction"), xytext=(2, -9),
-                        textcoords="offset points", fontsize=7, color="0.3")
+            ax.annotate(
+                "grasp" if p.name == REACHING else "release",
+                (p.t0, 1.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(2, -9),
+                textcoords="offset points",
+                fontsize=7,
+                color="0.3",
+            )
     for e in run.events:
         if e["kind"] in EVENT_KINDS and e["kind"] != "slip":
             ax.axvline(e["t"], color="0.45", lw=0.7, ls=":" if e["kind"] != "drop" else "-")
     slips = [e["t"] for e in run.events if e["kind"] == "slip"]
-    if slips:                                  # a rug along the bottom edge
-        ax.plot(slips, [0.02] * len(slips), "|", color="tab:red", ms=6,
-                transform=ax.get_xaxis_transform())
+    if slips:  # a rug along the bottom edge
+        ax.plot(
+            slips,
+            [0.02] * len(slips),
+            "|",
+            color="tab:red",
+            ms=6,
+            transform=ax.get_xaxis_transform(),
+        )
 
 
 def fig9(run: GraspRun):
     fig, (ax_y, ax_x) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 5.2))
     ax_y.plot(run.t_obj, run.obj[:, 1], color=C_OBJ, lw=1.4, label="object (truth)")
     ax_y.plot(run.t_eff, run.hand[:, 1], color=C_HAND, lw=1.2, label="hand x^a")
-    ax_x.plot(run.t_eff, run.target[:, 0], color=C_TARGET, lw=1.4, ls="--",
-              label="reaching target x_d^a")
+    ax_x.plot(
+        run.t_eff, run.target[:, 0], color=C_TARGET, lw=1.4, ls="--", label="reaching target x_d^a"
+    )
     ax_x.plot(run.t_eff, run.hand[:, 0], color=C_HAND, lw=1.2, label="hand x^a")
     ax_x.plot(run.t_obj, run.obj[:, 0], color=C_OBJ, lw=0.8, alpha=0.7, label="object (truth)")
     for ax, name in ((ax_y, "Y"), (ax_x, "X")):
@@ -69,9 +88,15 @@ def fig9(run: GraspRun):
         _shade(ax, run, labels=ax is ax_y)
     ax_x.set_xlabel("time [s]")
     ax_y.set_title(f"Feedback response: {run.name} (cf. Fig. 9)", fontsize=10)
-    fig.text(0.01, 0.005, "Y: tracking on the constraint plane (S = 1); X: reaching along its "
-             "normal (S = 0). Blue: grasp phases (reach, hold); red: releasing;\ndotted: the "
-             "plant's grasp and release events; red ticks at the bottom: slip events", fontsize=7, color="0.35")
+    fig.text(
+        0.01,
+        0.005,
+        "Y: tracking on the constraint plane (S = 1); X: reaching along its "
+        "normal (S = 0). Blue: grasp phases (reach, hold); red: releasing;\ndotted: the "
+        "plant's grasp and release events; red ticks at the bottom: slip events",
+        fontsize=7,
+        color="0.35",
+    )
     fig.tight_layout(rect=(0, 0.04, 1, 1))
     return fig
 
@@ -91,6 +116,7 @@ class _Robot:
 
     def __init__(self, params) -> None:
         from plants.bullet_arm.settings import resolve
+
         arm = resolve(params)
         self.chain = arm.chain()
         self.hand = arm.hand
@@ -98,6 +124,7 @@ class _Robot:
     def segments(self, q_arm, q_hand) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
         """Arm polyline (world), finger polylines (world), palm corners (world)."""
         from replay.robot.hand import finger_frames
+
         frames = self.chain.frames(q_arm)
         tool = frames[-1] @ self.chain.tool
         arm = np.array([T[:3, 3] for T in frames] + [tool[:3, 3]])
@@ -106,7 +133,7 @@ class _Robot:
             k = 0
             for f in self.hand.fingers:
                 n = len(f.joints)
-                q = q_hand[k:k + n] if len(q_hand) >= k + n else np.zeros(n)
+                q = q_hand[k : k + n] if len(q_hand) >= k + n else np.zeros(n)
                 pts = [(tool @ T)[:3, 3] for T in finger_frames(f, q)]
                 fingers.append(np.array(pts))
                 k += n
@@ -129,8 +156,9 @@ def _object_outline(run: GraspRun, i: int) -> tuple[str, np.ndarray]:
     R = quaternion_matrix(run.obj_orn[i]) if len(run.obj_orn) else np.eye(3)
     corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     world = pos + (corners * size) @ R.T
-    edges = [(a, b) for a in range(8) for b in range(a + 1, 8)
-             if np.sum(corners[a] != corners[b]) == 1]
+    edges = [
+        (a, b) for a in range(8) for b in range(a + 1, 8) if np.sum(corners[a] != corners[b]) == 1
+    ]
     return "box", np.array([[_project(world[a]), _project(world[b])] for a, b in edges])
 
 
@@ -145,10 +173,14 @@ def filmstrip_times(run: GraspRun, n: int = 6) -> list[tuple[float, str]]:
     r = c["reach"]
     t_g = c["grasp"]["t"] if c["grasp"] else r.t1
     t_hold_end = c["hold"].t1 if c["hold"] else min(t_g + 0.3, run.t_end)
-    picks = [(c["track_start"], "tracking"), ((c["track_start"] + r.t0) / 2.0, "tracking"),
-             (r.t0, "reaching starts"), ((r.t0 + t_g) / 2.0, "reaching"),
-             (t_g, "grasped" if c["grasp"] else "reach ends"),
-             ((t_g + t_hold_end) / 2.0, "holding, object moving")]
+    picks = [
+        (c["track_start"], "tracking"),
+        ((c["track_start"] + r.t0) / 2.0, "tracking"),
+        (r.t0, "reaching starts"),
+        ((r.t0 + t_g) / 2.0, "reaching"),
+        (t_g, "grasped" if c["grasp"] else "reach ends"),
+        ((t_g + t_hold_end) / 2.0, "holding, object moving"),
+    ]
     return [(float(min(max(t, 0.0), run.t_end)), s) for t, s in picks[:n]]
 
 
@@ -160,7 +192,7 @@ def filmstrip(run: GraspRun, title: str):
     robot = _Robot(run.params)
     picks = filmstrip_times(run)
     fig, axes = plt.subplots(2, 3, figsize=(9.6, 6.6))
-    near = [_project(run.obj)]             # the close-up frames the hand and the object
+    near = [_project(run.obj)]  # the close-up frames the hand and the object
     drawn = []
     for t, label in picks:
         ia, io = _index(run.t_arm, t), _index(run.t_obj, t)
@@ -177,8 +209,15 @@ def filmstrip(run: GraspRun, title: str):
         ax.plot(*_project(run.obj[trail]).T, color=C_OBJ, lw=0.8, alpha=0.6)
         kind, shape = _object_outline(run, io)
         if kind == "circle":
-            ax.add_patch(plt.Circle((float(shape[0]), float(shape[1])), float(shape[2]),
-                                    color=C_OBJ, alpha=0.55, zorder=1))
+            ax.add_patch(
+                plt.Circle(
+                    (float(shape[0]), float(shape[1])),
+                    float(shape[2]),
+                    color=C_OBJ,
+                    alpha=0.55,
+                    zorder=1,
+                )
+            )
         else:
             for a, b in shape:
                 ax.plot([a[0], b[0]], [a[1], b[1]], color=C_OBJ, lw=1.2)
@@ -189,7 +228,7 @@ def filmstrip(run: GraspRun, title: str):
         for f in fingers:
             ax.plot(*_project(f).T, "-", color=C_HAND, lw=1.6, zorder=3)
         cam = head_camera_at(run, t)
-        if cam is not None:                  # the head camera and its optical axis (OpenCV z)
+        if cam is not None:  # the head camera and its optical axis (OpenCV z)
             axis = cam[0] + quaternion_matrix(cam[1])[:, 2] * np.linalg.norm(run.obj[io] - cam[0])
             h2, a2 = _project(cam[0]), _project(axis)
             ax.plot(*h2, "s", color="0.2", ms=6)
@@ -201,10 +240,15 @@ def filmstrip(run: GraspRun, title: str):
         ax.set_yticks([])
         ax.set_title(f"t = {t:.3f} s  {label}", fontsize=8)
     fig.suptitle(title, fontsize=10)
-    fig.text(0.01, 0.005, "close-up drawn from the log: WAM-7 joint frames (grey), palm and 14-joint hand "
-             "(blue), object and its last 0.3 s (orange),\nhead camera and its optical axis "
-             f"(purple, as long as the distance to the object); view azimuth {math.degrees(VIEW[0]):.0f}°, elevation {math.degrees(VIEW[1]):.0f}°",
-             fontsize=7, color="0.35")
+    fig.text(
+        0.01,
+        0.005,
+        "close-up drawn from the log: WAM-7 joint frames (grey), palm and 14-joint hand "
+        "(blue), object and its last 0.3 s (orange),\nhead camera and its optical axis "
+        f"(purple, as long as the distance to the object); view azimuth {math.degrees(VIEW[0]):.0f}°, elevation {math.degrees(VIEW[1]):.0f}°",
+        fontsize=7,
+        color="0.35",
+    )
     fig.tight_layout(rect=(0, 0.02, 1, 0.96))
     return fig
 
@@ -219,8 +263,10 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
             continue
         paths += save(fig9(run), out, f"{name}_fig9")
         if len(run.t_arm):
-            what = "a sphere (cf. Fig. 8)" if run.params.object == "ball" else \
-                "a hexahedron (cf. Figs. 6, 7)"
-            paths += save(filmstrip(run, f"Grasping of {what}: {name}"), out,
-                          f"{name}_filmstrip")
+            what = (
+                "a sphere (cf. Fig. 8)"
+                if run.params.object == "ball"
+                else "a hexahedron (cf. Figs. 6, 7)"
+            )
+            paths += save(filmstrip(run, f"Grasping of {what}: {name}"), out, f"{name}_filmstrip")
     return paths

@@ -20,20 +20,20 @@ import yaml
 from analysis.series import events
 from replay.log import LogReader
 
-T_ARM_TASK = "/grasping/arm"         # x_a, x_o, x_d (eq. 2), per arm-task tick
+T_ARM_TASK = "/grasping/arm"  # x_a, x_o, x_d (eq. 2), per arm-task tick
 T_OBJECT = "/object/state"
 T_ARM = "/arm/joint_state"
 T_HAND = "/hand/joint_state"
-T_HEAD = "/head/state"               # pan, tilt, camera_position, camera_orientation
-T_VISION = "/grasping/object"        # recognition: found, xi, phi, x_o, shape, ...
-T_CHIP = "/vision/chip"              # the 16 x 16 binary images
-T_HAND_TASK = "/grasping/hand"       # preshape, theta_d, load, command (eq. 4)
-T_STATE = "/grasping/state"          # the schedule: phase, cycle, x_d, grasp
-T_TASKS = "/tasks/loops"             # runner: names, ticked, latency per task, every step
+T_HEAD = "/head/state"  # pan, tilt, camera_position, camera_orientation
+T_VISION = "/grasping/object"  # recognition: found, xi, phi, x_o, shape, ...
+T_CHIP = "/vision/chip"  # the 16 x 16 binary images
+T_HAND_TASK = "/grasping/hand"  # preshape, theta_d, load, command (eq. 4)
+T_STATE = "/grasping/state"  # the schedule: phase, cycle, x_d, grasp
+T_TASKS = "/tasks/loops"  # runner: names, ticked, latency per task, every step
 
 # the schedule's phases: what the hand does (the arm tracks in all of them)
 TRACKING, REACHING, HOLDING, RELEASING = "track", "reach", "hold", "release"
-GRASP_PHASES = (REACHING, HOLDING)   # shaded as "grasp" in Fig. 9
+GRASP_PHASES = (REACHING, HOLDING)  # shaded as "grasp" in Fig. 9
 
 
 def _vec(rows: list[dict], key: str, width: int | None = None) -> np.ndarray:
@@ -55,13 +55,13 @@ class Phase:
 class GraspRun:
     name: str
     scenario: dict
-    t_eff: np.ndarray                # arm-task ticks
-    hand: np.ndarray                 # x^a position (n, 3)
-    target: np.ndarray               # x_d^a position (n, 3), reaching target
-    seen: np.ndarray                 # x^o position (n, 3), as eq. 2 used it
+    t_eff: np.ndarray  # arm-task ticks
+    hand: np.ndarray  # x^a position (n, 3)
+    target: np.ndarray  # x_d^a position (n, 3), reaching target
+    seen: np.ndarray  # x^o position (n, 3), as eq. 2 used it
     t_obj: np.ndarray
-    obj: np.ndarray                  # (m, 3)
-    obj_orn: np.ndarray              # (m, 4) xyzw
+    obj: np.ndarray  # (m, 3)
+    obj_orn: np.ndarray  # (m, 4) xyzw
     t_arm: np.ndarray
     arm_q: np.ndarray
     arm_names: list
@@ -70,18 +70,18 @@ class GraspRun:
     hand_names: list
     t_head: np.ndarray
     head_q: np.ndarray
-    head_camera: np.ndarray          # (k, 3) camera position
-    head_orn: np.ndarray             # (k, 4) camera-to-world xyzw
-    t_vis: np.ndarray                # recognition results (capture times)
-    vis: np.ndarray                  # x_o position (3) where found
-    vis_features: list               # the /grasping/object messages
+    head_camera: np.ndarray  # (k, 3) camera position
+    head_orn: np.ndarray  # (k, 4) camera-to-world xyzw
+    t_vis: np.ndarray  # recognition results (capture times)
+    vis: np.ndarray  # x_o position (3) where found
+    vis_features: list  # the /grasping/object messages
     t_chip: np.ndarray = field(default_factory=lambda: np.zeros(0))
     chip_size: tuple = (0, 0)
     hand_task: list = field(default_factory=list)  # T_HAND_TASK messages
-    state: list = field(default_factory=list)      # T_STATE messages
-    tasks: list = field(default_factory=list)      # T_TASKS messages
+    state: list = field(default_factory=list)  # T_STATE messages
+    tasks: list = field(default_factory=list)  # T_TASKS messages
     events: list = field(default_factory=list)
-    phases: list = field(default_factory=list)     # [Phase]
+    phases: list = field(default_factory=list)  # [Phase]
 
     # ---------------------------------------------------------------- helpers
     @property
@@ -94,6 +94,7 @@ class GraspRun:
         default the plant's own)."""
         from plants.bullet_arm.params import GraspParams
         from replay.scenario import params_from_data
+
         return params_from_data(GraspParams, self.plant_params, "plant.params")
 
     @property
@@ -134,12 +135,18 @@ class GraspRun:
         for i, p in enumerate(self.phases):
             if p.name != REACHING:
                 continue
-            hold = next((q for q in self.phases[i + 1:] if q.name == HOLDING), None)
+            hold = next((q for q in self.phases[i + 1 :] if q.name == HOLDING), None)
             end = hold.t1 if hold else p.t1
             grasp = next((e for e in self.kinds("grasp") if p.t0 - 1e-9 <= e["t"] <= end), None)
             prev = next((q for q in reversed(self.phases[:i]) if q.name != REACHING), None)
-            out.append({"reach": p, "hold": hold, "grasp": grasp,
-                        "track_start": prev.t0 if prev is not None else self.phases[0].t0})
+            out.append(
+                {
+                    "reach": p,
+                    "hold": hold,
+                    "grasp": grasp,
+                    "track_start": prev.t0 if prev is not None else self.phases[0].t0,
+                }
+            )
         return out
 
 
@@ -185,21 +192,35 @@ def load_run(log: LogReader, name: str | None = None) -> GraspRun:
     chip = log.series(T_CHIP)
     st = log.series(T_STATE)
     run = GraspRun(
-        name=name or sc["name"], scenario=sc,
-        t_eff=_vec(eff, "t"), hand=_first3(eff, "x_a"), target=_first3(eff, "x_d"),
+        name=name or sc["name"],
+        scenario=sc,
+        t_eff=_vec(eff, "t"),
+        hand=_first3(eff, "x_a"),
+        target=_first3(eff, "x_d"),
         seen=_first3(eff, "x_o"),
-        t_obj=_vec(ob, "t"), obj=_vec(ob, "position", 3), obj_orn=_vec(ob, "orientation", 4),
-        t_arm=_vec(arm, "t"), arm_q=_vec(arm, "position", 1),
+        t_obj=_vec(ob, "t"),
+        obj=_vec(ob, "position", 3),
+        obj_orn=_vec(ob, "orientation", 4),
+        t_arm=_vec(arm, "t"),
+        arm_q=_vec(arm, "position", 1),
         arm_names=list(arm[0]["name"]) if arm else [],
-        t_hand=_vec(hj, "t"), hand_q=_vec(hj, "position", 1),
+        t_hand=_vec(hj, "t"),
+        hand_q=_vec(hj, "position", 1),
         hand_names=list(hj[0]["name"]) if hj else [],
-        t_head=_vec(hd, "t"), head_q=np.array([[m["pan"], m["tilt"]] for m in hd], float),
-        head_camera=_vec(hd, "camera_position", 3), head_orn=_vec(hd, "camera_orientation", 4),
-        t_vis=_vec(vi, "t"), vis=_first3(vi, "position"), vis_features=vi,
+        t_head=_vec(hd, "t"),
+        head_q=np.array([[m["pan"], m["tilt"]] for m in hd], float),
+        head_camera=_vec(hd, "camera_position", 3),
+        head_orn=_vec(hd, "camera_orientation", 4),
+        t_vis=_vec(vi, "t"),
+        vis=_first3(vi, "position"),
+        vis_features=vi,
         t_chip=_vec(chip, "t"),
         chip_size=(int(chip[0]["width"]), int(chip[0]["height"])) if chip else (0, 0),
-        hand_task=log.series(T_HAND_TASK), state=st, tasks=log.series(T_TASKS),
-        events=events(log))
+        hand_task=log.series(T_HAND_TASK),
+        state=st,
+        tasks=log.series(T_TASKS),
+        events=events(log),
+    )
     run.phases = _phases_from_state(st) or _phases_from_events(run.events, run.t_end)
     return run
 

@@ -30,10 +30,16 @@ def fig7(log: LogReader, title: str = ""):
     for e in events(log, "collision"):
         for ax in (ax_v, ax_w):
             ax.axvline(e["t"], color="0.4", lw=0.8, ls="--")
-        if e["t"] - last_label > 0.04:   # label collisions that are far enough apart to read
-            ax_v.annotate(f"#{e['data'].get('index', '')}", (e["t"], 1.0), xytext=(2, -10),
-                          xycoords=("data", "axes fraction"), textcoords="offset points",
-                          fontsize=7, color="0.3")
+        if e["t"] - last_label > 0.04:  # label collisions that are far enough apart to read
+            ax_v.annotate(
+                f"#{e['data'].get('index', '')}",
+                (e["t"], 1.0),
+                xytext=(2, -10),
+                xycoords=("data", "axes fraction"),
+                textcoords="offset points",
+                fontsize=7,
+                color="0.3",
+            )
             last_label = e["t"]
     for e in events(log, "capture"):
         for ax in (ax_v, ax_w):
@@ -46,8 +52,13 @@ def fig7(log: LogReader, title: str = ""):
         ax.grid(alpha=0.3)
     ax_v.set_title(title or "Translational and rotational velocities (cf. Fig. 7)", fontsize=10)
     ax_v.legend(fontsize=8, loc="upper right")
-    fig.text(0.01, 0.005, "dashed: fingertip-stick collisions #index (from /events); green: capture",
-             fontsize=7, color="0.35")
+    fig.text(
+        0.01,
+        0.005,
+        "dashed: fingertip-stick collisions #index (from /events); green: capture",
+        fontsize=7,
+        color="0.35",
+    )
     fig.tight_layout()
     return fig
 

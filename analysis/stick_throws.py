@@ -26,9 +26,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-SCENARIO = {"stick_2step": ROOT / "scenarios" / "stick_2step.yaml",
-            "stick_3step": ROOT / "scenarios" / "stick_3step.yaml"}
-PASS_Y = 0.12            # m, where the paper's first collision happens (Sec. IV-B)
+SCENARIO = {
+    "stick_2step": ROOT / "scenarios" / "stick_2step.yaml",
+    "stick_3step": ROOT / "scenarios" / "stick_3step.yaml",
+}
+PASS_Y = 0.12  # m, where the paper's first collision happens (Sec. IV-B)
 # s, per strategy: a run stops 0.1 s after the capture; the 3-step's clamped second contact
 # leaves ~30 % of the spin and the spin-stop collision added then waits up to half a turn (~1 s)
 DURATION = {"stick_2step": 2.0, "stick_3step": 3.0}
@@ -44,26 +46,35 @@ class Throw:
     omega: float
 
     def sets(self) -> list[str]:
-        return [f"plant.params.initial.{k}={float(getattr(self, k))!r}"
-                for k in ("x", "y", "theta", "vx", "vy", "omega")]
+        return [
+            f"plant.params.initial.{k}={float(getattr(self, k))!r}"
+            for k in ("x", "y", "theta", "vx", "vy", "omega")
+        ]
 
 
 def random_throw(rng: np.random.Generator, out_of_reach: bool = False) -> Throw:
-    speed = rng.uniform(0.8, 1.4)                       # all drawn whatever out_of_reach
+    speed = rng.uniform(0.8, 1.4)  # all drawn whatever out_of_reach
     heading = math.radians(rng.uniform(-15.0, 15.0))
     omega = rng.uniform(4.0, 14.0) * rng.choice([-1.0, 1.0])
     theta = rng.uniform(0.0, math.pi)
-    if out_of_reach:            # across the table at y = 0.50-0.58 m, moving along +-x
+    if out_of_reach:  # across the table at y = 0.50-0.58 m, moving along +-x
         t_pass = rng.uniform(0.20, 0.35)
         sign = float(rng.choice([-1.0, 1.0]))
         vx, vy = sign * speed * math.cos(heading), speed * math.sin(heading)
-        return Throw(x=-vx * t_pass, y=rng.uniform(0.50, 0.58) - vy * t_pass, theta=theta,
-                     vx=vx, vy=vy, omega=omega)
+        return Throw(
+            x=-vx * t_pass,
+            y=rng.uniform(0.50, 0.58) - vy * t_pass,
+            theta=theta,
+            vx=vx,
+            vy=vy,
+            omega=omega,
+        )
     x_pass = rng.uniform(-0.06, 0.06)
     t_pass = rng.uniform(0.20, 0.35)
     vx, vy = speed * math.sin(heading), -speed * math.cos(heading)
-    return Throw(x=x_pass - vx * t_pass, y=PASS_Y - vy * t_pass, theta=theta, vx=vx, vy=vy,
-                 omega=omega)
+    return Throw(
+        x=x_pass - vx * t_pass, y=PASS_Y - vy * t_pass, theta=theta, vx=vx, vy=vy, omega=omega
+    )
 
 
 def run_throw(strategy: str, throw: Throw, out: Path, duration: float | None = None) -> dict:
@@ -71,6 +82,7 @@ def run_throw(strategy: str, throw: Throw, out: Path, duration: float | None = N
     duration = DURATION[strategy] if duration is None else duration
     from replay.runner import Runner
     from replay.scenario import load_scenario
+
     sc = load_scenario(SCENARIO[strategy], sets=throw.sets() + [f"timing.duration={duration}"])
     return Runner(sc).run(out).outcome
 
@@ -80,8 +92,9 @@ def main(argv=None) -> None:
     ap.add_argument("--n", type=int, default=20, help="throws per strategy")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--strategy", choices=sorted(SCENARIO), action="append")
-    ap.add_argument("--duration", type=float, help="s (default: 2.0 for the 2-step, 3.0 for "
-                    "the 3-step)")
+    ap.add_argument(
+        "--duration", type=float, help="s (default: 2.0 for the 2-step, 3.0 for the 3-step)"
+    )
     ap.add_argument("--out-of-reach", action="store_true")
     ap.add_argument("-v", "--verbose", action="store_true")
     a = ap.parse_args(argv)

@@ -21,22 +21,28 @@ ROOT = Path(__file__).resolve().parents[1]
 def main(out_dir: Path) -> None:
     try:
         # --set overrides are "key.path=value" strings, the value read as YAML
-        sc = load_scenario(ROOT / "scenarios" / "stick_3step.yaml",
-                           sets=["timing.duration=0.3"], seed=0)
-    except ScenarioError as exc:           # one line: file:line:col, the field, what was expected
+        sc = load_scenario(
+            ROOT / "scenarios" / "stick_3step.yaml", sets=["timing.duration=0.3"], seed=0
+        )
+    except ScenarioError as exc:  # one line: file:line:col, the field, what was expected
         sys.exit(f"error: {exc}")
     method = sc.controller.type if sc.controller else f"tasks {sorted(sc.tasks)}"
-    print(f"scenario {sc.name} ({sc.paper}): plant {sc.plant.type}, controller "
-          f"{method}, sensors {sorted(sc.sensors)}")
-    p = sc.plant.params                    # the plant's own typed Params, every default filled in
+    print(
+        f"scenario {sc.name} ({sc.paper}): plant {sc.plant.type}, controller "
+        f"{method}, sensors {sorted(sc.sensors)}"
+    )
+    p = sc.plant.params  # the plant's own typed Params, every default filled in
     assert isinstance(p, AirTableParams)
     print(f"the stick's mass: {p.stick.mass} kg, restitution {p.stick.restitution}")
     result = Runner(sc).run(out_dir / f"{sc.name}.mcap")
-    print(f"wrote {result.path}: {result.messages} messages, {result.steps} steps, "
-          f"t_end = {result.t_end:.3f} s, stopped by {result.stopped_by}")
+    print(
+        f"wrote {result.path}: {result.messages} messages, {result.steps} steps, "
+        f"t_end = {result.t_end:.3f} s, stopped by {result.stopped_by}"
+    )
     print(f"events: {result.events}")
-    print(f"outcome: success={result.outcome.get('success')} "
-          f"reason={result.outcome.get('reason')!r}")
+    print(
+        f"outcome: success={result.outcome.get('success')} reason={result.outcome.get('reason')!r}"
+    )
 
 
 if __name__ == "__main__":

@@ -39,8 +39,9 @@ def main(path: Path) -> None:
         # or only the plant's params, without the other plug-ins: params_from_data
         plain = yaml.safe_load(info["yaml"])
         p = params_from_data(AirTableParams, plain["plant"]["params"], "plant.params")
-        print(f"  stick: L = {p.stick.length} m, e = {p.stick.restitution}, "
-              f"mu = {p.stick.friction}")
+        print(
+            f"  stick: L = {p.stick.length} m, e = {p.stick.restitution}, mu = {p.stick.friction}"
+        )
 
     for e in log.series(TOPIC_EVENTS):
         print(f"  event t = {e['t']:.4f} s  {e['kind']}")
@@ -48,8 +49,10 @@ def main(path: Path) -> None:
     if TOPIC_STICK_STATE in log.topic_counts():
         st = log.series(TOPIC_STICK_STATE)
         speed = np.hypot([m["vx"] for m in st], [m["vy"] for m in st])
-        print(f"stick speed: {speed[0]:.3f} m/s at t = {st[0]['t']:.3f} s, "
-              f"{speed[-1]:.3f} m/s at t = {st[-1]['t']:.3f} s")
+        print(
+            f"stick speed: {speed[0]:.3f} m/s at t = {st[0]['t']:.3f} s, "
+            f"{speed[-1]:.3f} m/s at t = {st[-1]['t']:.3f} s"
+        )
 
 
 if __name__ == "__main__":

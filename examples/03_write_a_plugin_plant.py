@@ -33,7 +33,7 @@ from replay.runner import Runner
 from replay.scenario import scenario_from_text
 from replay.scene import Scene, Sphere
 
-TOPIC_CART_STATE = "/cart/state"           # new topics: add freely, rename none
+TOPIC_CART_STATE = "/cart/state"  # new topics: add freely, rename none
 TOPIC_CART_ENCODER = "/cart/encoder"
 
 
@@ -41,6 +41,7 @@ TOPIC_CART_ENCODER = "/cart/encoder"
 @dataclass
 class CartParams:
     """Checked by the scenario loader (``replay validate``) before anything runs."""
+
     mass: float = param(2.0, unit="kg", gt=0, doc="the cart's mass")
     x0: float = param(0.0, unit="m", doc="initial position")
     max_force: float = param(20.0, unit="N", gt=0, doc="actuator limit |F|")
@@ -49,6 +50,7 @@ class CartParams:
 @dataclass(frozen=True)
 class CartSpec:
     """What a controller may know of the plant: nominal values, no simulator state."""
+
     mass: float
     max_force: float
 
@@ -62,9 +64,10 @@ class CartState:
 
 class CartPlant(Plant):
     """A cart on a frictionless rail, integrated here (a real plant would step a simulator)."""
+
     Params = CartParams
-    spec_type = CartSpec                   # typed ports (common.md): what spec() gives ...
-    command_types = (float,)               # ... and what apply() takes
+    spec_type = CartSpec  # typed ports (common.md): what spec() gives ...
+    command_types = (float,)  # ... and what apply() takes
     description = "a cart on a rail pushed by a force (example)"
 
     def __init__(self, params: CartParams, *, dt: float, rng: np.random.Generator) -> None:
@@ -81,7 +84,7 @@ class CartPlant(Plant):
         self._limited = limited
         self.force = float(np.clip(f, -self.params.max_force, self.params.max_force))
 
-    def step(self) -> None:                # semi-implicit Euler: v then x
+    def step(self) -> None:  # semi-implicit Euler: v then x
         self.v += self.force / self.params.mass * self.dt
         self.x += self.v * self.dt
         self.t += self.dt
@@ -89,9 +92,11 @@ class CartPlant(Plant):
     def truth(self, t: float) -> dict:
         return {TOPIC_CART_STATE: CartState(t, self.x, self.v)}
 
-    def scene(self) -> Scene:              # what cameras could see
-        return Scene([Sphere("cart", (self.x, 0.0, 0.0), 0.05)],
-                     readings={"cart": {"x": self.x, "v": self.v}})
+    def scene(self) -> Scene:  # what cameras could see
+        return Scene(
+            [Sphere("cart", (self.x, 0.0, 0.0), 0.05)],
+            readings={"cart": {"x": self.x, "v": self.v}},
+        )
 
     def spec(self) -> CartSpec:
         return CartSpec(self.params.mass, self.params.max_force)
@@ -114,6 +119,7 @@ class CartPDParams:
 
 class CartPD(Controller):
     """PD on the encoder's readings: a method sees only what sensors deliver, and the spec."""
+
     Params = CartPDParams
     spec_type = CartSpec
     command_type = float
@@ -149,14 +155,16 @@ class CartReading:
 
 class CartEncoder(Sensor):
     """The cart's own position and speed readings (from the plant's Scene), with noise."""
+
     Params = CartEncoderParams
     spec_type = CartSpec
     topic = TOPIC_CART_ENCODER
 
     def measure(self, t: float, scene: Scene) -> CartReading:
         r = scene.readings["cart"]
-        return CartReading(t, r["x"] + self.params.noise * float(self.rng.standard_normal()),
-                           r["v"])
+        return CartReading(
+            t, r["x"] + self.params.noise * float(self.rng.standard_normal()), r["v"]
+        )
 
 
 SCENARIO = """
@@ -175,14 +183,16 @@ def main(out_dir: Path) -> None:
     registry.register("plant", "cart", CartPlant)
     registry.register("sensor", "cart_encoder", CartEncoder)
     registry.register("controller", "cart_pd", CartPD)
-    sc = scenario_from_text(SCENARIO, name="cart_example.yaml")   # validated like a file
+    sc = scenario_from_text(SCENARIO, name="cart_example.yaml")  # validated like a file
     print(f"plant params: {sc.plant.params}")
     result = Runner(sc).run(out_dir / "cart.mcap")
     print(f"wrote {result.path}: {result.messages} messages; events {result.events}")
     print(f"outcome: {result.outcome}")
     states = LogReader(result.path).series(TOPIC_CART_STATE)
-    print(f"{TOPIC_CART_STATE}: {len(states)} messages, x = {states[0]['x']:.3f} -> "
-          f"{states[-1]['x']:.3f} m")
+    print(
+        f"{TOPIC_CART_STATE}: {len(states)} messages, x = {states[0]['x']:.3f} -> "
+        f"{states[-1]['x']:.3f} m"
+    )
 
 
 if __name__ == "__main__":

@@ -25,8 +25,10 @@ from replay.resources import scenario_dir
 from replay.runner import COMPONENTS, Runner
 from replay.scenario import load_scenario
 
-DEFAULT = [str(scenario_dir() / f"{name}.yaml")
-           for name in ("stick_3step", "catch_optimised", "grasp_hexahedron")]
+DEFAULT = [
+    str(scenario_dir() / f"{name}.yaml")
+    for name in ("stick_3step", "catch_optimised", "grasp_hexahedron")
+]
 
 
 def bare_stepper(runner: Runner):
@@ -34,12 +36,13 @@ def bare_stepper(runner: Runner):
     sensors, control, logging or plant wrapper."""
     plant = type(runner.plant)(runner.sc.plant.params, dt=runner.dt, rng=runner.plant.rng)
     space = getattr(plant, "space", None)
-    if space is not None and hasattr(space, "step"):               # Pymunk
+    if space is not None and hasattr(space, "step"):  # Pymunk
         dt = plant.dt
         return "pymunk space.step", plant, lambda: space.step(dt)
     bc = getattr(plant, "bc", None)
-    if bc is not None:                                             # PyBullet (a BulletClient)
+    if bc is not None:  # PyBullet (a BulletClient)
         import pybullet as p
+
         client = bc._client
         return "pybullet stepSimulation", plant, lambda: p.stepSimulation(physicsClientId=client)
     return "plant.step (no bare engine found)", plant, plant.step
@@ -60,7 +63,9 @@ def engine_in_run(sc, out: Path) -> tuple[float, float, int]:
             spent[0] += clock() - c0
             spent[1] += 1
             return out
+
         return wrapper
+
     space, bc = getattr(plant, "space", None), getattr(plant, "bc", None)
     if space is not None and hasattr(space, "step"):
         space.step = timed(space.step)
@@ -77,6 +82,7 @@ def _stats(values: list[float]) -> tuple[float, float, float]:
 
 def _startup(modules: list[str], repeat: int = 3) -> dict:
     """Median wall and CPU seconds of ``python -c pass`` and, beyond it, of the imports."""
+
     def child(code: str) -> tuple[float, float]:
         walls, cpus = [], []
         for _ in range(repeat):
@@ -87,6 +93,7 @@ def _startup(modules: list[str], repeat: int = 3) -> dict:
             r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
             cpus.append(r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime)
         return statistics.median(walls), statistics.median(cpus)
+
     bare = child("pass")
     imp = child("import " + ", ".join(modules))
     return {"python": bare, "imports": (imp[0] - bare[0], imp[1] - bare[1])}
@@ -96,7 +103,7 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
     sc = load_scenario(path)
     cpu, wall, shares, result, runner = [], [], {c: [] for c in COMPONENTS}, None, None
     with tempfile.TemporaryDirectory() as tmp:
-        for i in range(runs + 1):                      # run 0 warms up (imports, caches, files)
+        for i in range(runs + 1):  # run 0 warms up (imports, caches, files)
             runner = Runner(sc)
             c0, w0 = time.process_time(), time.perf_counter()
             result = runner.run(Path(tmp) / f"run{i}.mcap")
@@ -117,27 +124,43 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
             step()
         bare.append(time.process_time() - c0)
     plant.close()
-    out = {"scenario": sc.name, "sim_time": result.t_end, "steps": result.steps,
-           "messages": result.messages, "runs": runs, "cpu": _stats(cpu), "wall": _stats(wall),
-           "engine": engine, "bare": _stats(bare),
-           "engine_in_run": (engine_cpu / run_cpu, engine_cpu / max(engine_steps, 1)),
-           "shares": {c: statistics.median(v) for c, v in shares.items()}}
-    for key in ("cpu", "wall"):                  # (median, min, max) of simulated s per second
+    out = {
+        "scenario": sc.name,
+        "sim_time": result.t_end,
+        "steps": result.steps,
+        "messages": result.messages,
+        "runs": runs,
+        "cpu": _stats(cpu),
+        "wall": _stats(wall),
+        "engine": engine,
+        "bare": _stats(bare),
+        "engine_in_run": (engine_cpu / run_cpu, engine_cpu / max(engine_steps, 1)),
+        "shares": {c: statistics.median(v) for c, v in shares.items()},
+    }
+    for key in ("cpu", "wall"):  # (median, min, max) of simulated s per second
         med, lo, hi = out[key]
         out["rtf_" + key] = (result.t_end / med, result.t_end / hi, result.t_end / lo)
     out["ratio"] = out["cpu"][0] / out["bare"][0]
     if startup:
-        modules = sorted({type(runner.plant).__module__, type(runner.controller).__module__,
-                          *(type(s).__module__ for _, s, _, _ in runner.sensors),
-                          "replay.runner"})
+        modules = sorted(
+            {
+                type(runner.plant).__module__,
+                type(runner.controller).__module__,
+                *(type(s).__module__ for _, s, _, _ in runner.sensors),
+                "replay.runner",
+            }
+        )
         out["startup"] = _startup(modules)
     out["optimiser"] = None
-    problem = getattr(runner.controller, "problem", None)      # an offline optimisation (eq. 25)
+    problem = getattr(runner.controller, "problem", None)  # an offline optimisation (eq. 25)
     if optimiser and problem is not None and hasattr(problem, "solve"):
         c0, t0 = time.process_time(), time.perf_counter()
         solved = problem.solve()
-        out["optimiser"] = (time.process_time() - c0, time.perf_counter() - t0,
-                            len(solved.history) - 1)
+        out["optimiser"] = (
+            time.process_time() - c0,
+            time.perf_counter() - t0,
+            len(solved.history) - 1,
+        )
     return out
 
 
@@ -162,17 +185,22 @@ def report(r: dict) -> str:
         "run's CPU (contacts, motors)",
         "  where the time goes (runner's timers, share of the loop): "
         + ", ".join(f"{c} {100 * r['shares'][c]:.0f} %" for c in COMPONENTS)
-        + "  [" + ", ".join(f"{c} {1e3 * r['shares'][c] * r['cpu'][0] / sim:.0f}"
-                            for c in COMPONENTS) + " ms CPU per simulated s]",
+        + "  ["
+        + ", ".join(f"{c} {1e3 * r['shares'][c] * r['cpu'][0] / sim:.0f}" for c in COMPONENTS)
+        + " ms CPU per simulated s]",
     ]
     if "startup" in r:
         (pw, pc), (iw, ic) = r["startup"]["python"], r["startup"]["imports"]
-        lines.append(f"  not counted above: interpreter start-up {pw:.3f} s wall ({pc:.3f} s CPU),"
-                     f" imports {iw:.3f} s wall ({ic:.3f} s CPU)")
+        lines.append(
+            f"  not counted above: interpreter start-up {pw:.3f} s wall ({pc:.3f} s CPU),"
+            f" imports {iw:.3f} s wall ({ic:.3f} s CPU)"
+        )
     if r.get("optimiser") is not None:
         c, w, iterations = r["optimiser"]
-        lines.append(f"  offline optimisation from scratch: {c:.2f} s CPU ({w:.2f} s wall), "
-                     f"{iterations} iterations (the runs read its result from a file)")
+        lines.append(
+            f"  offline optimisation from scratch: {c:.2f} s CPU ({w:.2f} s wall), "
+            f"{iterations} iterations (the runs read its result from a file)"
+        )
     return "\n".join(lines)
 
 
@@ -181,12 +209,24 @@ def main(argv=None) -> None:
     ap.add_argument("scenarios", nargs="*", default=DEFAULT)
     ap.add_argument("--runs", type=int, default=5, help="timed runs after the warm-up")
     ap.add_argument("--no-startup", action="store_true", help="skip the start-up timing")
-    ap.add_argument("--no-optimiser", action="store_true",
-                    help="skip timing an offline optimisation from scratch")
+    ap.add_argument(
+        "--no-optimiser",
+        action="store_true",
+        help="skip timing an offline optimisation from scratch",
+    )
     args = ap.parse_args(argv)
     for path in args.scenarios:
-        print(report(bench(path, runs=args.runs, startup=not args.no_startup,
-                           optimiser=not args.no_optimiser)), flush=True)
+        print(
+            report(
+                bench(
+                    path,
+                    runs=args.runs,
+                    startup=not args.no_startup,
+                    optimiser=not args.no_optimiser,
+                )
+            ),
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

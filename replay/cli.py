@@ -78,17 +78,26 @@ def _load(path: str, sets=(), seed=None):
 
 @main.command()
 @click.argument("scenario", type=click.Path(dir_okay=False))
-@click.option("-o", "--out", type=click.Path(), help="log path "
-              "(default out/logs/NAME.mcap)")
-@click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE",
-              help="override a scenario field (repeatable)")
+@click.option("-o", "--out", type=click.Path(), help="log path (default out/logs/NAME.mcap)")
+@click.option(
+    "--set",
+    "sets",
+    multiple=True,
+    metavar="KEY.PATH=VALUE",
+    help="override a scenario field (repeatable)",
+)
 @click.option("--seed", type=int, help="override the scenario's seed")
 @click.option("-q", "--quiet", is_flag=True, help="no progress, only errors")
-@click.option("--view", is_flag=True, help="show the run live in the browser viewer "
-              "(http://127.0.0.1:8080, or the next free port), then stay for replay (Ctrl-C)")
+@click.option(
+    "--view",
+    is_flag=True,
+    help="show the run live in the browser viewer "
+    "(http://127.0.0.1:8080, or the next free port), then stay for replay (Ctrl-C)",
+)
 def run(scenario, out, sets, seed, quiet, view):
     """Run SCENARIO and write its MCAP log."""
     from replay.runner import RunInterrupted, Runner
+
     sc = _load(scenario, sets, seed)
     out = Path(out) if out else DEFAULT_LOG_DIR / f"{sc.name}.mcap"
     _check_log_path(out, sc)
@@ -103,8 +112,10 @@ def run(scenario, out, sets, seed, quiet, view):
         progress.done()
         if live:
             live.stop()
-        click.echo(f"interrupted at t = {exc.result.t_end:.4f} s; partial log kept: "
-                   f"{exc.result.path}", err=True)
+        click.echo(
+            f"interrupted at t = {exc.result.t_end:.4f} s; partial log kept: {exc.result.path}",
+            err=True,
+        )
         sys.exit(130)
     except LogError as exc:
         progress.done()
@@ -122,12 +133,15 @@ def run(scenario, out, sets, seed, quiet, view):
     if failed and not live:
         _fail(f"{result.error} at t = {result.t_end:.4f} s; log kept: {result.path}", code=1)
     if failed:
-        click.echo(f"error: {result.error} at t = {result.t_end:.4f} s; log kept: "
-                   f"{result.path}", err=True)
+        click.echo(
+            f"error: {result.error} at t = {result.t_end:.4f} s; log kept: {result.path}", err=True
+        )
     if not quiet and not failed:
         events = ", ".join(f"{k} x{n}" for k, n in sorted(result.events.items())) or "none"
-        click.echo(f"{sc.name}: {result.t_end:.3f} s simulated in {result.wall_time:.2f} s "
-                   f"(stopped by {result.stopped_by}); events: {events}")
+        click.echo(
+            f"{sc.name}: {result.t_end:.3f} s simulated in {result.wall_time:.2f} s "
+            f"(stopped by {result.stopped_by}); events: {events}"
+        )
         click.echo(f"log: {result.path}")
     if live:
         _replay_live(live, result.path)
@@ -150,7 +164,11 @@ def _check_log_path(out: Path, sc) -> None:
 
 
 _REFUSED = (ValueError, TypeError, KeyError, IndexError, ArithmeticError, OSError, LogError)
-_PARTS = (("/plants/", "plant"), ("/replay/sensors/", "sensors"), ("/replay/control/", "controller"))
+_PARTS = (
+    ("/plants/", "plant"),
+    ("/replay/sensors/", "sensors"),
+    ("/replay/control/", "controller"),
+)
 
 
 def _refusal(scenario: str, exc: BaseException) -> str:
@@ -178,6 +196,7 @@ def _runner(scenario: str, sc, Runner, **kw):
 
 def _quiet_websockets() -> None:
     """A bare TCP connect (a port scanner, a health check) is no reason for a traceback."""
+
     class _NoHandshakeNoise(logging.Filter):
         def filter(self, record):
             return "opening handshake failed" not in record.getMessage()
@@ -200,13 +219,16 @@ def _warn_if_exposed(host: str) -> None:
     except ValueError:
         local = host == "localhost"
     if not local:
-        _warn(f"serving on {host}: anyone who can reach this machine on the network can see "
-              "the viewer (use --host 127.0.0.1 to keep it local)")
+        _warn(
+            f"serving on {host}: anyone who can reach this machine on the network can see "
+            "the viewer (use --host 127.0.0.1 to keep it local)"
+        )
 
 
 def _live_viewer():
     """A browser viewer fed by the runner (``run --view``); its URL printed at once."""
     from replay.viewer import LiveSession, ViewerError
+
     _quiet_websockets()
     try:
         live = LiveSession()
@@ -220,6 +242,7 @@ def _live_viewer():
 
 def _replay_live(live, log: Path) -> None:
     from replay.viewer import ViewerError
+
     if live.error:
         click.echo(f"warning: {live.error}", err=True)
     try:
@@ -235,23 +258,29 @@ def _replay_live(live, log: Path) -> None:
 
 @main.command()
 @click.argument("scenario", type=click.Path(dir_okay=False))
-@click.option("-o", "--out", type=click.Path(dir_okay=False),
-              help="where to write (default: the controller's alpha_file)")
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(dir_okay=False),
+    help="where to write (default: the controller's alpha_file)",
+)
 def optimise(scenario, out):
     """Run a controller's offline optimisation from scratch and store its result where the
     scenario reads it (the catching mapping's alpha, eq. 25)."""
     from replay.runner import Runner
+
     sc = _load(scenario)
     stored = getattr(sc.controller.params, "alpha_file", None)
     if stored is None:
         _fail(f"controller {sc.controller.type!r} has no offline optimisation to store")
     if not (out or stored):
         _fail("the scenario sets no controller.params.alpha_file: give -o FILE")
-    base = getattr(sc.controller.params, "scenario_dir", "")   # files resolve from the scenario
+    base = getattr(sc.controller.params, "scenario_dir", "")  # files resolve from the scenario
     path = Path(out) if out else Path(base, stored).resolve() if base else Path(stored)
     if path.resolve() in set(sc.inputs) or path.suffix in (".yaml", ".yml", ".mcap"):
-        _fail(f"will not write the optimisation over {path} (a scenario or a log): give -o "
-              "FILE.json")
+        _fail(
+            f"will not write the optimisation over {path} (a scenario or a log): give -o FILE.json"
+        )
     try:
         check_output(path, kind="optimisation result", magic=b"{")
     except LogError as exc:
@@ -270,13 +299,18 @@ def optimise(scenario, out):
 @main.command()
 @click.argument("scenarios", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
-@click.option("--static", is_flag=True, help="only the scenario checks: do not build the "
-              "plug-ins (faster; a plug-in's own model checks are left to `run`)")
+@click.option(
+    "--static",
+    is_flag=True,
+    help="only the scenario checks: do not build the "
+    "plug-ins (faster; a plug-in's own model checks are left to `run`)",
+)
 def validate(scenarios, sets, static):
     """Check scenario files without running them (all of scenarios/ by default): every field,
     then the plug-ins are built as `run` builds them (the plant, sensors and controller, with
     any offline optimisation), so what passes here runs."""
     from replay.runner import Runner
+
     paths = scenarios or sorted(str(p) for p in scenario_dir().glob("*.yaml"))
     bad = 0
     for p in paths:
@@ -320,8 +354,7 @@ def params_markdown() -> str:
     import dataclasses
 
     from replay.params import describe
-    from replay.scenario.schema import (ControllerSpec, PlantSpec, Scenario, SensorSpec,
-                                        TaskSpec)
+    from replay.scenario.schema import ControllerSpec, PlantSpec, Scenario, SensorSpec, TaskSpec
 
     def table(cls, prefix: str) -> list[str]:
         rows = ["| field | unit | default | allowed | meaning |", "|---|---|---|---|---|"]
@@ -334,19 +367,30 @@ def params_markdown() -> str:
             if dataclasses.is_dataclass(default):
                 nested.append((f"{prefix}{r['name']}.", type(default)))
                 default = "(see below)"
-            rows.append(f"| `{prefix}{r['name']}` | {r['unit']} | {default} | {r['range']} | "
-                        f"{r['doc']} |")
+            rows.append(
+                f"| `{prefix}{r['name']}` | {r['unit']} | {default} | {r['range']} | {r['doc']} |"
+            )
         out = rows
         for sub_prefix, sub in nested:
             out += ["", f"`{sub_prefix[:-1]}`:", ""] + table(sub, sub_prefix)
         return out
 
-    lines = ["# Scenario fields", "",
-             "Generated by `replay describe` from the code (a test keeps this file in step).",
-             "Units are SI. A field without a default is required.", "", "## Scenario", ""]
+    lines = [
+        "# Scenario fields",
+        "",
+        "Generated by `replay describe` from the code (a test keeps this file in step).",
+        "Units are SI. A field without a default is required.",
+        "",
+        "## Scenario",
+        "",
+    ]
     lines += table(Scenario, "")
-    for title, cls in (("plant", PlantSpec), ("sensors.NAME", SensorSpec),
-                       ("controller", ControllerSpec), ("tasks.NAME", TaskSpec)):
+    for title, cls in (
+        ("plant", PlantSpec),
+        ("sensors.NAME", SensorSpec),
+        ("controller", ControllerSpec),
+        ("tasks.NAME", TaskSpec),
+    ):
         lines += ["", f"### `{title}`", ""] + table(cls, f"{title}.")
     for kind in ("plant", "sensor", "controller"):
         for name in registry.names(kind):
@@ -385,8 +429,12 @@ def info(log):
     r = _reader(log)
     try:
         sc = r.scenario()
-        click.echo(one_line(f"scenario: {sc.get('name', '?')} (paper {sc.get('paper', '?')}, "
-                            f"seed {sc.get('seed', '?')}, code {sc.get('version', '?')})"))
+        click.echo(
+            one_line(
+                f"scenario: {sc.get('name', '?')} (paper {sc.get('paper', '?')}, "
+                f"seed {sc.get('seed', '?')}, code {sc.get('version', '?')})"
+            )
+        )
     except LogError:
         click.echo("scenario: (no /scenario message)")
     t0, t1 = r.time_range()
@@ -398,8 +446,12 @@ def info(log):
         click.echo("outcome: (none: the run did not finish)")
     else:
         metrics = {k: v for k, v in outcome.items() if k not in ("success", "reason")}
-        click.echo(one_line(f"outcome: {'success' if outcome.get('success') else 'FAILED'}: "
-                            f"{outcome.get('reason', '')}"))
+        click.echo(
+            one_line(
+                f"outcome: {'success' if outcome.get('success') else 'FAILED'}: "
+                f"{outcome.get('reason', '')}"
+            )
+        )
         if metrics:
             click.echo("  " + ", ".join(f"{k}={_short(v)}" for k, v in metrics.items()))
     click.echo("topics:")
@@ -419,28 +471,47 @@ def info(log):
 
 @main.command()
 @click.argument("logs", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option("--host", default="127.0.0.1", show_default=True,
-              help="address to serve on (0.0.0.0 exposes the viewer to the network)")
-@click.option("--port", type=click.IntRange(0, 65535), default=8080, show_default=True,
-              help="port (the next free one if taken; 0 = any free port)")
-@click.option("--speed", type=click.Choice(SPEEDS), default=DEFAULT_SPEED, show_default=True,
-              help="initial playback speed (simulated s per wall-clock s)")
-@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), metavar="SECONDS",
-              help="stop serving after this long (default: until Ctrl-C)")
+@click.option(
+    "--host",
+    default="127.0.0.1",
+    show_default=True,
+    help="address to serve on (0.0.0.0 exposes the viewer to the network)",
+)
+@click.option(
+    "--port",
+    type=click.IntRange(0, 65535),
+    default=8080,
+    show_default=True,
+    help="port (the next free one if taken; 0 = any free port)",
+)
+@click.option(
+    "--speed",
+    type=click.Choice(SPEEDS),
+    default=DEFAULT_SPEED,
+    show_default=True,
+    help="initial playback speed (simulated s per wall-clock s)",
+)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(min=0, min_open=True),
+    metavar="SECONDS",
+    help="stop serving after this long (default: until Ctrl-C)",
+)
 def view(logs, host, port, speed, timeout):
     """Replay LOGS in the browser (Viser): 3-D scene, timeline, events, plots. Several logs
     are overlaid in step (e.g. optimised vs unoptimised)."""
     from replay.viewer import Viewer, ViewerError
+
     _quiet_websockets()
     named = not _is_ip(host)
     if not named:
-        _warn_if_exposed(host)          # before anything listens
+        _warn_if_exposed(host)  # before anything listens
     try:
         viewer = Viewer.open(logs, host=host, port=port, speed=speed)
     except ViewerError as exc:
         _fail(str(exc))
     if named:
-        _warn_if_exposed(host)          # a name: once it resolved (a bad one stays one line)
+        _warn_if_exposed(host)  # a name: once it resolved (a bad one stays one line)
     if viewer.port_note:
         click.echo(f"note: {viewer.port_note}", err=True)
     for note in viewer.notes:
@@ -489,15 +560,23 @@ def _partial(readers: dict[str, LogReader]) -> dict[str, list[str]]:
 
 def _analysis_failed(what: str, paper: str, readers, exc: Exception) -> None:
     partial = _partial(readers)
-    why = (f" (partial logs: {', '.join(partial)})" if partial else "")
-    _fail(f"{what} for {paper} could not be made from {', '.join(readers)}{why}: "
-          f"{type(exc).__name__}: {exc}", code=1)
+    why = f" (partial logs: {', '.join(partial)})" if partial else ""
+    _fail(
+        f"{what} for {paper} could not be made from {', '.join(readers)}{why}: "
+        f"{type(exc).__name__}: {exc}",
+        code=1,
+    )
 
 
 @main.command()
 @click.argument("logs", nargs=-1, type=click.Path(dir_okay=False))
-@click.option("-o", "--out", type=click.Path(file_okay=False), default=str(DEFAULT_FIGURE_DIR),
-              show_default=True)
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(file_okay=False),
+    default=str(DEFAULT_FIGURE_DIR),
+    show_default=True,
+)
 def figures(logs, out):
     """Regenerate the papers' figures (PNG and SVG) from LOGS (default: out/logs/*.mcap)."""
     by_paper = _logs_by_paper(logs)
@@ -521,8 +600,9 @@ def figures(logs, out):
             click.echo(f"figure: {path}")
         for name, notes in _partial(readers).items():
             for note in notes:
-                _warn(f"{name} is not a finished run ({note}): its figures show only what "
-                      "was logged")
+                _warn(
+                    f"{name} is not a finished run ({note}): its figures show only what was logged"
+                )
 
 
 @main.command()
@@ -531,11 +611,13 @@ def figures(logs, out):
 def claims(logs, markdown):
     """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
     from analysis.claims import format_table
+
     sections = []
     by_paper = _logs_by_paper(logs)
     inputs = {Path(r.path).resolve() for readers in by_paper.values() for r in readers.values()}
-    if markdown and (Path(markdown).resolve() in inputs or
-                     Path(markdown).suffix in (".mcap", ".yaml", ".yml")):
+    if markdown and (
+        Path(markdown).resolve() in inputs or Path(markdown).suffix in (".mcap", ".yaml", ".yml")
+    ):
         _fail(f"will not write the claims table over {markdown} (a log or a scenario)")
     for paper, readers in by_paper.items():
         try:
@@ -566,6 +648,7 @@ def golden():
 
 def _goldens(names):
     from replay.golden import ManifestError, load_manifest
+
     try:
         table = load_manifest()
     except FileNotFoundError:
@@ -583,11 +666,13 @@ def _goldens(names):
 def golden_check(names):
     """Re-run each golden scenario and compare it with its stored log."""
     from replay.golden import check
+
     failed = 0
     for g in _goldens(names):
         if not g.log.is_file():
-            click.echo(f"FAIL {g.name}: no golden log {g.log} (run `replay golden update "
-                       f"{g.name}`)")
+            click.echo(
+                f"FAIL {g.name}: no golden log {g.log} (run `replay golden update {g.name}`)"
+            )
             failed += 1
             continue
         try:
@@ -612,6 +697,7 @@ def golden_check(names):
 def golden_update(names):
     """Rewrite golden logs; commit them with the reason in the message."""
     from replay.golden import update
+
     for g in _goldens(names):
         try:
             path = update(g)

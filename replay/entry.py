@@ -9,12 +9,13 @@ import sys
 def _while_importing(signum, frame) -> None:
     sys.stderr.write("interrupted\n")
     sys.stderr.flush()
-    os._exit(130)          # nothing is written yet: nothing to keep
+    os._exit(130)  # nothing is written yet: nothing to keep
 
 
 def main() -> None:
     signal.signal(signal.SIGINT, _while_importing)
     from replay.cli import main as cli
+
     signal.signal(signal.SIGINT, signal.default_int_handler)
     cli()
 

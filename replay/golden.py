@@ -21,9 +21,9 @@ from replay.runner import Runner
 from replay.scenario import load_scenario
 from replay.scenario.yamlio import ScenarioError, compose, read_text, show
 
-GOLDEN_DIR = Path("data/golden")   # under replay.resources.shipped_root()
+GOLDEN_DIR = Path("data/golden")  # under replay.resources.shipped_root()
 MANIFEST = "manifest.yaml"
-IGNORED_FIELDS = {TOPIC_SCENARIO: {"version"}}   # the code version differs by design
+IGNORED_FIELDS = {TOPIC_SCENARIO: {"version"}}  # the code version differs by design
 
 
 @dataclass
@@ -32,7 +32,7 @@ class Golden:
     scenario: Path
     log: Path
     sets: list = field(default_factory=list)
-    tolerances: dict = field(default_factory=dict)   # topic -> {abs, rel}
+    tolerances: dict = field(default_factory=dict)  # topic -> {abs, rel}
     default_tolerance: dict = field(default_factory=lambda: {"abs": 1e-9, "rel": 1e-9})
 
 
@@ -59,11 +59,17 @@ class ManifestError(ValueError):
 
 
 def _tolerance(value, where: str) -> dict:
-    if not (isinstance(value, dict) and set(value) <= {"abs", "rel"} and
-            all(isinstance(v, (int, float)) and not isinstance(v, bool) and 0 <= v < 1e9
-                for v in value.values())):
-        raise ManifestError(f"{where}: expected {{abs: number >= 0, rel: number >= 0}}, got "
-                            f"{show(value)}")
+    if not (
+        isinstance(value, dict)
+        and set(value) <= {"abs", "rel"}
+        and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and 0 <= v < 1e9
+            for v in value.values()
+        )
+    ):
+        raise ManifestError(
+            f"{where}: expected {{abs: number >= 0, rel: number >= 0}}, got {show(value)}"
+        )
     return {k: float(v) for k, v in value.items()}
 
 
@@ -74,20 +80,24 @@ def load_manifest(root: Path | None = None) -> dict[str, Golden]:
         raise FileNotFoundError(path)
     try:
         text = read_text(path)
-        compose(text, str(path), what="a manifest")     # encoding, shape and size checks
+        compose(text, str(path), what="a manifest")  # encoding, shape and size checks
         data = yaml.safe_load(text) or {}
     except ScenarioError as exc:
         raise ManifestError(str(exc)) from None
     except yaml.YAMLError as exc:
         raise ManifestError(f"{path}: not valid YAML: {exc}") from None
     if not isinstance(data, dict):
-        raise ManifestError(f"{path}: expected a mapping of golden names, got "
-                            f"{type(data).__name__}")
+        raise ManifestError(
+            f"{path}: expected a mapping of golden names, got {type(data).__name__}"
+        )
     out = {}
     for name, g in data.items():
         where = f"{path}: {name}"
-        if not (isinstance(g, dict) and isinstance(g.get("scenario"), str) and
-                isinstance(g.get("log"), str)):
+        if not (
+            isinstance(g, dict)
+            and isinstance(g.get("scenario"), str)
+            and isinstance(g.get("log"), str)
+        ):
             raise ManifestError(f"{where}: expected a mapping with scenario: FILE and log: FILE")
         sets = g.get("sets", [])
         if not (isinstance(sets, list) and all(isinstance(x, str) for x in sets)):
@@ -96,11 +106,17 @@ def load_manifest(root: Path | None = None) -> dict[str, Golden]:
         if not isinstance(tolerances, dict):
             raise ManifestError(f"{where}.tolerances: expected a mapping topic -> tolerance")
         out[str(name)] = Golden(
-            name=str(name), scenario=root / g["scenario"], log=root / GOLDEN_DIR / g["log"],
-            sets=sets, tolerances={str(t): _tolerance(v, f"{where}.tolerances.{t}")
-                                   for t, v in tolerances.items()},
-            default_tolerance=_tolerance(g.get("default_tolerance", {"abs": 1e-9, "rel": 1e-9}),
-                                         f"{where}.default_tolerance"))
+            name=str(name),
+            scenario=root / g["scenario"],
+            log=root / GOLDEN_DIR / g["log"],
+            sets=sets,
+            tolerances={
+                str(t): _tolerance(v, f"{where}.tolerances.{t}") for t, v in tolerances.items()
+            },
+            default_tolerance=_tolerance(
+                g.get("default_tolerance", {"abs": 1e-9, "rel": 1e-9}), f"{where}.default_tolerance"
+            ),
+        )
     return out
 
 
@@ -142,8 +158,9 @@ def _first_field_difference(a, b, tol: dict, path: str = ""):
     return None if a == b else (path, a, b)
 
 
-def compare_logs(golden_path: Path, run_path: Path, tolerances: dict,
-                 default_tolerance: dict | None = None) -> list[Difference]:
+def compare_logs(
+    golden_path: Path, run_path: Path, tolerances: dict, default_tolerance: dict | None = None
+) -> list[Difference]:
     """The first difference of each topic (empty when the run matches)."""
     default_tolerance = default_tolerance or {"abs": 1e-9, "rel": 1e-9}
     golden, run = LogReader(golden_path).check(), LogReader(run_path).check()
@@ -172,8 +189,7 @@ def compare_logs(golden_path: Path, run_path: Path, tolerances: dict,
             if len(g_msgs) != len(r_msgs):
                 n = min(len(g_msgs), len(r_msgs))
                 t = (g_msgs if len(g_msgs) > n else r_msgs)[n].t
-                diffs.append(Difference(topic, n, t, "(message count)", len(g_msgs),
-                                        len(r_msgs)))
+                diffs.append(Difference(topic, n, t, "(message count)", len(g_msgs), len(r_msgs)))
     diffs.sort(key=lambda d: d.t)
     return diffs
 

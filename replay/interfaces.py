@@ -43,6 +43,7 @@ from replay.scene import Scene
 @dataclass
 class Occurrence:
     """Something that happened, before it becomes an ``/events`` message: ``kind`` and ``data``."""
+
     kind: str
     data: dict
 
@@ -50,8 +51,8 @@ class Occurrence:
 class Plant(ABC):
     Params: ClassVar[type]
     description: ClassVar[str] = ""
-    spec_type: ClassVar[type] = object                   # what spec() returns
-    command_types: ClassVar[tuple[type, ...]] = (object,)   # what apply() accepts
+    spec_type: ClassVar[type] = object  # what spec() returns
+    command_types: ClassVar[tuple[type, ...]] = (object,)  # what apply() accepts
 
     def __init__(self, params: Any, *, dt: float, rng: np.random.Generator) -> None:
         self.params = params
@@ -96,7 +97,7 @@ class Sensor(ABC):
     Params: ClassVar[type]
     topic: ClassVar[str]
     description: ClassVar[str] = ""
-    spec_type: ClassVar[type | None] = None              # the plant spec it needs, or None
+    spec_type: ClassVar[type | None] = None  # the plant spec it needs, or None
 
     @classmethod
     def topic_for(cls, params: Any) -> str:
@@ -116,9 +117,9 @@ class Sensor(ABC):
 class Controller(ABC):
     Params: ClassVar[type]
     description: ClassVar[str] = ""
-    spec_type: ClassVar[type] = object                   # the plant spec it needs
-    command_type: ClassVar[type] = object                # what update() returns
-    reads: ClassVar[tuple[str, ...]] = ()                # topics it reads (sensors must give them)
+    spec_type: ClassVar[type] = object  # the plant spec it needs
+    command_type: ClassVar[type] = object  # what update() returns
+    reads: ClassVar[tuple[str, ...]] = ()  # topics it reads (sensors must give them)
 
     def __init__(self, params: Any, *, spec: Any) -> None:
         self.params = params

@@ -15,27 +15,27 @@ from typing import Any
 import numpy as np
 
 # ---- topic names (the contract: add freely, rename none). Use these, not string literals.
-TOPIC_SCENARIO = "/scenario"                    # ScenarioInfo, once at t = 0
-TOPIC_EVENTS = "/events"                        # Event
+TOPIC_SCENARIO = "/scenario"  # ScenarioInfo, once at t = 0
+TOPIC_EVENTS = "/events"  # Event
 # air table (Higashimori et al. 2007)
-TOPIC_STICK_STATE = "/stick/state"              # StickState
-TOPIC_FINGERS_STATE = "/fingers/state"          # FingersState
-TOPIC_HAND_STATE = "/hand/state"                # the airtable plant's hand
-TOPIC_VISION_STICK = "/vision/stick"            # VisionStick
-TOPIC_STICK_ESTIMATE = "/control/stick_estimate"   # the stick controllers' estimator
+TOPIC_STICK_STATE = "/stick/state"  # StickState
+TOPIC_FINGERS_STATE = "/fingers/state"  # FingersState
+TOPIC_HAND_STATE = "/hand/state"  # the airtable plant's hand
+TOPIC_VISION_STICK = "/vision/stick"  # VisionStick
+TOPIC_STICK_ESTIMATE = "/control/stick_estimate"  # the stick controllers' estimator
 # arm plant (Namiki & Ishikawa 2003, Namiki et al. 1999)
-TOPIC_ARM_JOINT_STATE = "/arm/joint_state"      # JointState
-TOPIC_HAND_JOINT_STATE = "/hand/joint_state"    # JointState
+TOPIC_ARM_JOINT_STATE = "/arm/joint_state"  # JointState
+TOPIC_HAND_JOINT_STATE = "/hand/joint_state"  # JointState
 TOPIC_ARM_JOINT_COMMAND = "/arm/joint_command"  # JointCommand
-TOPIC_ARM_ENCODERS = "/arm/encoders"            # JointState, measured
+TOPIC_ARM_ENCODERS = "/arm/encoders"  # JointState, measured
 TOPIC_ARM_APPLIED_TORQUE = "/arm/applied_torque"
-TOPIC_OBJECT_STATE = "/object/state"            # ObjectState
+TOPIC_OBJECT_STATE = "/object/state"  # ObjectState
 TOPIC_OBJECT_CONTACTS = "/object/contacts"
-TOPIC_EFFECTOR_STATE = "/effector/state"        # EffectorState
+TOPIC_EFFECTOR_STATE = "/effector/state"  # EffectorState
 TOPIC_EFFECTOR_MOTION = "/effector/motion"
-TOPIC_VISION_OBJECT = "/vision/object"          # VisionObject
+TOPIC_VISION_OBJECT = "/vision/object"  # VisionObject
 TOPIC_OPTIMIZATION_COST = "/optimization/cost"  # OptimizationCost
-TOPIC_CATCHING_STATE = "/catching/state"        # the catching controller's state
+TOPIC_CATCHING_STATE = "/catching/state"  # the catching controller's state
 # grasping rig (Namiki et al. 1999; docs/DESIGN.md, "Grasping runs")
 TOPIC_HAND_ENCODERS = "/hand/encoders"
 TOPIC_HEAD_ENCODERS = "/head/encoders"
@@ -55,7 +55,7 @@ class ScenarioInfo:
     t: float
     name: str
     paper: str
-    yaml: str        # the resolved scenario, every default filled in
+    yaml: str  # the resolved scenario, every default filled in
     seed: int
     version: str
 
@@ -63,7 +63,7 @@ class ScenarioInfo:
 @dataclass
 class Event:
     t: float
-    kind: str        # collision, catch, grasp, release, infeasible, rest, ...
+    kind: str  # collision, catch, grasp, release, infeasible, rest, ...
     data: dict = field(default_factory=dict)
 
 
@@ -81,12 +81,12 @@ class StickState:
 @dataclass
 class FingersState:
     t: float
-    tips: list       # [[x, y], [x, y]] fingertip centres (m)
+    tips: list  # [[x, y], [x, y]] fingertip centres (m)
 
 
 @dataclass
 class VisionStick:
-    t: float         # capture time of the image
+    t: float  # capture time of the image
     x: float
     y: float
     theta: float
@@ -104,15 +104,15 @@ class JointState:
 @dataclass
 class JointCommand:
     t: float
-    position: list   # q_d (rad)
-    torque: list     # (N*m)
+    position: list  # q_d (rad)
+    torque: list  # (N*m)
 
 
 @dataclass
 class ObjectState:
     t: float
     position: list
-    orientation: list   # [qx, qy, qz, qw]
+    orientation: list  # [qx, qy, qz, qw]
     velocity: list
     angular_velocity: list
 
@@ -127,7 +127,7 @@ class EffectorState:
 @dataclass
 class VisionObject:
     t: float
-    position: list      # measured [x, y, z] (m)
+    position: list  # measured [x, y, z] (m)
     features: dict = field(default_factory=dict)
 
 
@@ -155,8 +155,14 @@ TOPICS: dict[str, type] = {
     TOPIC_OPTIMIZATION_COST: OptimizationCost,
 }
 
-_JSON_TYPES = {float: "number", int: "integer", str: "string", bool: "boolean",
-               list: "array", dict: "object"}
+_JSON_TYPES = {
+    float: "number",
+    int: "integer",
+    str: "string",
+    bool: "boolean",
+    list: "array",
+    dict: "object",
+}
 
 
 def json_schema(cls: type) -> dict[str, Any]:
@@ -166,8 +172,12 @@ def json_schema(cls: type) -> dict[str, Any]:
     for f in dataclasses.fields(cls):
         tp = typing.get_origin(hints[f.name]) or hints[f.name]
         props[f.name] = {"type": _JSON_TYPES.get(tp, "object")}
-    return {"title": cls.__name__, "type": "object", "properties": props,
-            "required": [f.name for f in dataclasses.fields(cls)]}
+    return {
+        "title": cls.__name__,
+        "type": "object",
+        "properties": props,
+        "required": [f.name for f in dataclasses.fields(cls)],
+    }
 
 
 _FIELD_NAMES: dict[type, tuple[str, ...]] = {}
@@ -186,11 +196,11 @@ def to_dict(payload: Any) -> dict[str, Any]:
 
 @dataclass
 class VisionChip:
-    t: float             # capture time
+    t: float  # capture time
     width: int
     height: int
-    rows: list           # rows[v]: bit u set = pixel (u, v) is 1
-    count: int           # pixels set
+    rows: list  # rows[v]: bit u set = pixel (u, v) is 1
+    count: int  # pixels set
 
 
 def pack_rows(bits: np.ndarray) -> list[int]:
@@ -203,4 +213,3 @@ def unpack_rows(rows, width: int) -> np.ndarray:
     """The inverse of :func:`pack_rows`: a (len(rows), width) bool array."""
     r = np.asarray(rows, dtype=np.int64)[:, None]
     return ((r >> np.arange(width, dtype=np.int64)) & 1).astype(bool)
-

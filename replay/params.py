@@ -24,8 +24,8 @@ from typing import Any
 
 _MISSING = dataclasses.MISSING
 
-MAX_FLOAT = 1e9          # SI: no scenario quantity is larger (a field may set its own bounds)
-MAX_INT = 2 ** 31 - 1
+MAX_FLOAT = 1e9  # SI: no scenario quantity is larger (a field may set its own bounds)
+MAX_INT = 2**31 - 1
 MAX_ITEMS = 256
 MAX_CHARS = 10_000
 
@@ -67,9 +67,20 @@ def param(
     A field without a default is required in the YAML. ``omit_empty``: left out of the resolved
     scenario when empty (a field added later, so older scenarios resolve to the same text).
     """
-    meta = {"unit": unit, "doc": doc, "ge": ge, "gt": gt, "le": le, "lt": lt,
-            "choices": choices, "length": length, "min_length": min_length,
-            "max_length": max_length, "allow_inf": allow_inf, "pattern": pattern}
+    meta = {
+        "unit": unit,
+        "doc": doc,
+        "ge": ge,
+        "gt": gt,
+        "le": le,
+        "lt": lt,
+        "choices": choices,
+        "length": length,
+        "min_length": min_length,
+        "max_length": max_length,
+        "allow_inf": allow_inf,
+        "pattern": pattern,
+    }
     if omit_empty:
         meta["omit_empty"] = True
     if isinstance(default, (list, dict)):
@@ -82,6 +93,7 @@ def param(
 
 def _copy(value):
     import copy
+
     return copy.deepcopy(value)
 
 
@@ -105,8 +117,15 @@ def describe(cls) -> list[dict]:
         if m.get("length") is not None:
             bounds.append(f"{m['length']} items")
         elif m.get("min_length") is not None or m.get("max_length") is not None:
-            bounds.append(f"{m.get('min_length') or 0}..{m.get('max_length') or MAX_ITEMS} "
-                          "items")
-        rows.append({"name": f.name, "type": str(f.type), "unit": m.get("unit", ""),
-                     "default": default, "range": ", ".join(bounds), "doc": m.get("doc", "")})
+            bounds.append(f"{m.get('min_length') or 0}..{m.get('max_length') or MAX_ITEMS} items")
+        rows.append(
+            {
+                "name": f.name,
+                "type": str(f.type),
+                "unit": m.get("unit", ""),
+                "default": default,
+                "range": ", ".join(bounds),
+                "doc": m.get("doc", ""),
+            }
+        )
     return rows

@@ -10,9 +10,9 @@ GROUPS = {
     "plant": "paper_replay.plants",
     "sensor": "paper_replay.sensors",
     "controller": "paper_replay.controllers",
-    "figures": "paper_replay.figures",     # paper key -> make(logs_by_name, outdir) -> paths
-    "claims": "paper_replay.claims",       # paper key -> evaluate(logs_by_name) -> [Claim]
-    "viewer_scene": "paper_replay.viewer_scenes",   # plant type -> replay.viewer RunScene class
+    "figures": "paper_replay.figures",  # paper key -> make(logs_by_name, outdir) -> paths
+    "claims": "paper_replay.claims",  # paper key -> evaluate(logs_by_name) -> [Claim]
+    "viewer_scene": "paper_replay.viewer_scenes",  # plant type -> replay.viewer RunScene class
 }
 
 

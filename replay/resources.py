@@ -17,8 +17,8 @@ _CHECKOUT = Path(__file__).resolve().parents[1]
 def _root(kind: str) -> Path:
     local = _CHECKOUT / kind
     if (_CHECKOUT / "pyproject.toml").is_file() and local.is_dir():
-        return local                                  # a source checkout (editable install)
-    return Path(str(resources.files("replay._shipped") / kind))   # an installed wheel
+        return local  # a source checkout (editable install)
+    return Path(str(resources.files("replay._shipped") / kind))  # an installed wheel
 
 
 def shipped_root() -> Path:

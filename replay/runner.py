@@ -42,12 +42,12 @@ class RunResult:
     path: Path
     steps: int = 0
     t_end: float = 0.0
-    stopped_by: str = "duration"          # duration | event kind | error | interrupted
+    stopped_by: str = "duration"  # duration | event kind | error | interrupted
     events: dict = field(default_factory=dict)
     messages: int = 0
     wall_time: float = 0.0
     error: str = ""
-    outcome: dict = field(default_factory=dict)   # the final ``outcome`` event's data
+    outcome: dict = field(default_factory=dict)  # the final ``outcome`` event's data
     # wall seconds spent in each part of the loop (COMPONENTS); "runner" is the rest of the run
     timings: dict = field(default_factory=dict)
 
@@ -59,17 +59,27 @@ COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 def _git_commit() -> str:
     try:
-        out = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], capture_output=True,
-                             text=True, timeout=5, cwd=Path(__file__).resolve().parent)
+        out = subprocess.run(
+            ["git", "rev-parse", "--short=12", "HEAD"],
+            capture_output=True,
+            text=True,
+            timeout=5,
+            cwd=Path(__file__).resolve().parent,
+        )
         return out.stdout.strip() if out.returncode == 0 else ""
     except (OSError, subprocess.SubprocessError):
         return ""
 
 
 def provenance(sc: Scenario, commit: str) -> dict[str, str]:
-    info = {"scenario": sc.name, "paper": sc.paper, "seed": str(sc.seed),
-            "paper-replay": __version__, "python": platform.python_version(),
-            "git_commit": commit}
+    info = {
+        "scenario": sc.name,
+        "paper": sc.paper,
+        "seed": str(sc.seed),
+        "paper-replay": __version__,
+        "python": platform.python_version(),
+        "git_commit": commit,
+    }
     for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
         try:
             info[pkg] = importlib_metadata.version(pkg)
@@ -83,40 +93,56 @@ def _divider(physics_rate: int, rate: float) -> int:
 
 
 class Runner:
-    def __init__(self, scenario: Scenario, *,
-                 progress: Callable[[float, float], None] | None = None,
-                 observers: tuple = ()) -> None:
+    def __init__(
+        self,
+        scenario: Scenario,
+        *,
+        progress: Callable[[float, float], None] | None = None,
+        observers: tuple = (),
+    ) -> None:
         self.sc = scenario
         self.progress = progress
-        self.observers = observers   # callables(topic, payload, t) — e.g. a live viewer
+        self.observers = observers  # callables(topic, payload, t) — e.g. a live viewer
         rate = scenario.timing.physics_rate
         self.dt = 1.0 / rate
         seeds = np.random.SeedSequence(scenario.seed).spawn(2 + len(scenario.sensors))
         plant_cls = registry.load("plant", scenario.plant.type)
-        self.plant = plant_cls(scenario.plant.params, dt=self.dt,
-                               rng=np.random.default_rng(seeds[0]))
+        self.plant = plant_cls(
+            scenario.plant.params, dt=self.dt, rng=np.random.default_rng(seeds[0])
+        )
         spec = self.plant.spec()
         self.sensors = []
         for i, (name, s) in enumerate(scenario.sensors.items()):
             cls = registry.load("sensor", s.type)
             sensor = cls(s.params, rng=np.random.default_rng(seeds[2 + i]), spec=spec)
-            self.sensors.append((name, sensor, _divider(rate, s.rate),
-                                 int(round(s.latency * rate))))
-        if scenario.tasks:       # the method as parallel tasks (replay/tasks.py)
-            self.controller = TaskSet([
-                Task(name, registry.load("controller", ts.type)(ts.params, spec=spec),
-                     _divider(rate, ts.rate), frozenset(ts.inputs), frozenset(ts.outputs))
-                for name, ts in scenario.tasks.items()], rate)
+            self.sensors.append(
+                (name, sensor, _divider(rate, s.rate), int(round(s.latency * rate)))
+            )
+        if scenario.tasks:  # the method as parallel tasks (replay/tasks.py)
+            self.controller = TaskSet(
+                [
+                    Task(
+                        name,
+                        registry.load("controller", ts.type)(ts.params, spec=spec),
+                        _divider(rate, ts.rate),
+                        frozenset(ts.inputs),
+                        frozenset(ts.outputs),
+                    )
+                    for name, ts in scenario.tasks.items()
+                ],
+                rate,
+            )
             self.ctrl_div = 1
         else:
             cs = scenario.controller
-            assert cs is not None            # the loader requires controller: or tasks:
+            assert cs is not None  # the loader requires controller: or tasks:
             ctrl_cls = registry.load("controller", cs.type)
             self.controller = ctrl_cls(cs.params, spec=spec)
             self.ctrl_div = _divider(rate, cs.rate)
-        self.log_div = (_divider(rate, scenario.timing.state_log_rate)
-                        if scenario.timing.state_log_rate else 1)
-        self._t_log = 0.0          # seconds in log writes (and observers) this run
+        self.log_div = (
+            _divider(rate, scenario.timing.state_log_rate) if scenario.timing.state_log_rate else 1
+        )
+        self._t_log = 0.0  # seconds in log writes (and observers) this run
 
     def t_ns(self, k: int) -> int:
         return k * 1_000_000_000 // self.sc.timing.physics_rate
@@ -133,8 +159,9 @@ class Runner:
         text = resolved_yaml(sc)
         log.metadata("scenario", {"yaml": text})
         version = f"{__version__}+{commit}"
-        self._write(log, TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version),
-                    0)
+        self._write(
+            log, TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0
+        )
         # (deliver at step, sequence, topic, payload): a heap, so readings reach the controller in
         # time order whatever the sensors' order and latencies
         pending: list = []
@@ -173,7 +200,7 @@ class Runner:
                     command = self.controller.update(t, delivered)
                     c1 = clock()
                     t_controller += c1 - c0
-                    if isinstance(command, list):          # parallel tasks' partial commands
+                    if isinstance(command, list):  # parallel tasks' partial commands
                         for c in command:
                             self.plant.apply(c)
                         t_plant += clock() - c1
@@ -186,7 +213,7 @@ class Runner:
                     telemetry = self.controller.telemetry(t)
                     t_controller += clock() - c0
                     for topic, payload in telemetry.items():
-                        for item in (payload if isinstance(payload, list) else [payload]):
+                        for item in payload if isinstance(payload, list) else [payload]:
                             self._write(log, topic, item, t_ns)
                 c0 = clock()
                 if k % self.log_div == 0:
@@ -203,8 +230,11 @@ class Runner:
                 for occ in self.plant.pop_events():
                     if occ.kind == "collision":
                         collisions += 1
-                        occ.data = {"index": collisions, **occ.data,
-                                    "planned": self.controller.intent()}
+                        occ.data = {
+                            "index": collisions,
+                            **occ.data,
+                            "planned": self.controller.intent(),
+                        }
                     stop_at = self._event(log, occ, t1, t1_ns, result, stop_at, k)
                 if self.progress and k % max(1, rate // 20) == 0:
                     self.progress(t1, sc.timing.duration)
@@ -216,11 +246,22 @@ class Runner:
         except NonFiniteValueError as exc:
             result.stopped_by = "error"
             result.error = str(exc)
-            self._write(log, TOPIC_EVENTS, Event(k / rate, "error", {
-                "reason": "non-finite value", "topic": exc.topic, "fields": exc.fields}),
-                self.t_ns(k))
-            self._outcome(log, result, k, {"success": False,
-                                           "reason": f"error: non-finite value on {exc.topic}"})
+            self._write(
+                log,
+                TOPIC_EVENTS,
+                Event(
+                    k / rate,
+                    "error",
+                    {"reason": "non-finite value", "topic": exc.topic, "fields": exc.fields},
+                ),
+                self.t_ns(k),
+            )
+            self._outcome(
+                log,
+                result,
+                k,
+                {"success": False, "reason": f"error: non-finite value on {exc.topic}"},
+            )
         except KeyboardInterrupt:
             result.stopped_by = "interrupted"
             self._write(log, TOPIC_EVENTS, Event(k / rate, "interrupted", {}), self.t_ns(k))
@@ -230,8 +271,12 @@ class Runner:
         finally:
             self.plant.close()
         self._finish(log, result, k, wall0)
-        result.timings = {"sensors": t_sensors, "controller": t_controller, "plant": t_plant,
-                          "logging": self._t_log}
+        result.timings = {
+            "sensors": t_sensors,
+            "controller": t_controller,
+            "plant": t_plant,
+            "logging": self._t_log,
+        }
         result.timings["runner"] = result.wall_time - sum(result.timings.values())
         return result
 
@@ -251,16 +296,21 @@ class Runner:
     def _outcome(self, log: LogWriter, result: RunResult, k: int, verdict: dict) -> None:
         """Every run ends with one ``outcome`` event: the one place a user or a sweep reads it."""
         result.outcome = verdict
-        self._write(log, TOPIC_EVENTS, Event(k / self.sc.timing.physics_rate, "outcome", verdict),
-                    self.t_ns(k))
+        self._write(
+            log,
+            TOPIC_EVENTS,
+            Event(k / self.sc.timing.physics_rate, "outcome", verdict),
+            self.t_ns(k),
+        )
 
     def _finish(self, log: LogWriter, result: RunResult, k: int, wall0: float) -> None:
         result.steps = k
         result.t_end = k / self.sc.timing.physics_rate
         result.messages = log.count
         # a failed or interrupted run never replaces a finished log at ``out``: NAME.failed.mcap
-        result.path = log.close({"error": "failed", "interrupted": "interrupted"}.get(
-            result.stopped_by, ""))
+        result.path = log.close(
+            {"error": "failed", "interrupted": "interrupted"}.get(result.stopped_by, "")
+        )
         result.wall_time = time.perf_counter() - wall0
 
     def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:

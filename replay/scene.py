@@ -14,8 +14,8 @@ class Box:
     name: str
     position: tuple[float, float, float]
     orientation: tuple[float, float, float, float]
-    size: tuple[float, float, float]          # full extents along the body x, y, z axes (m)
-    albedo: float = 0.5                        # 0 black .. 1 white, as a camera sees it
+    size: tuple[float, float, float]  # full extents along the body x, y, z axes (m)
+    albedo: float = 0.5  # 0 black .. 1 white, as a camera sees it
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,7 @@ Primitive = Box | Sphere | Cylinder
 class Scene:
     """What sensors can measure at one instant: the visible primitives, by name, and the
     robot's own readings (e.g. joint encoders: reading name -> payload)."""
+
     primitives: list = field(default_factory=list)
     readings: dict = field(default_factory=dict)
 

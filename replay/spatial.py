@@ -90,11 +90,13 @@ def quaternion_matrix(q) -> np.ndarray:
     if n == 0.0:
         raise ValueError("zero quaternion")
     s = 2.0 / n
-    return np.array([
-        [1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
-        [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
-        [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
+            [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
+            [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)],
+        ]
+    )
 
 
 def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
@@ -145,5 +147,6 @@ def wrap_half_pi(angle: float) -> float:
 def cross3(a, b) -> np.ndarray:
     """a x b for 3-vectors, or column by column for (3, n) arrays: np.cross's speed for small
     arrays is dominated by its axis handling (~10 us a call)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                     a[0] * b[1] - a[1] * b[0]])
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )

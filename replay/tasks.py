@@ -23,14 +23,13 @@ from replay.messages import TOPIC_TASK_LOOPS
 from replay.interfaces import Controller, Occurrence
 
 
-
 @dataclass
 class TaskLoops:
     t: float
     names: list
-    ticked: list         # bool per task: ran this step
-    latency: list        # s per task (None before its inputs first arrived)
-    oldest: list         # per task: the input topic that latency is of
+    ticked: list  # bool per task: ran this step
+    latency: list  # s per task (None before its inputs first arrived)
+    oldest: list  # per task: the input topic that latency is of
 
 
 @dataclass
@@ -75,12 +74,17 @@ class TaskSet(Controller):
         cls = type(command)
         names = self._fields.get(cls)
         if names is None:
-            names = self._fields[cls] = (tuple(f.name for f in dataclasses.fields(command))
-                                         if dataclasses.is_dataclass(command) else ())
+            names = self._fields[cls] = (
+                tuple(f.name for f in dataclasses.fields(command))
+                if dataclasses.is_dataclass(command)
+                else ()
+            )
         for n in names:
             if getattr(command, n) is not None and n not in task.outputs:
-                raise TaskError(f"task {task.name!r} wrote command field {n!r}, not among its "
-                                f"outputs {sorted(task.outputs)}")
+                raise TaskError(
+                    f"task {task.name!r} wrote command field {n!r}, not among its "
+                    f"outputs {sorted(task.outputs)}"
+                )
 
     def update(self, t: float, measurements: list[tuple[str, Any]]) -> list | None:
         k = int(round(t * self.rate))
@@ -114,9 +118,12 @@ class TaskSet(Controller):
     def telemetry(self, t: float) -> dict[str, Any]:
         out: dict[str, Any] = dict(self._telemetry)
         out[TOPIC_TASK_LOOPS] = TaskLoops(
-            t, [x.name for x in self.tasks], list(self._ticked),
+            t,
+            [x.name for x in self.tasks],
+            list(self._ticked),
             [self._latency[x.name] for x in self.tasks],
-            [self._oldest[x.name] for x in self.tasks])
+            [self._oldest[x.name] for x in self.tasks],
+        )
         return out
 
     def pop_events(self) -> list[Occurrence]:

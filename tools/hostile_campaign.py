@@ -50,10 +50,10 @@ BIG_INT = "1" + "0" * 400
 class Case:
     family: str
     argv: list
-    expect: str = "reject"          # reject | ok | either
-    files: dict = field(default_factory=dict)   # name -> bytes, created in the case's folder
-    line: int | None = None         # the line the error must name
-    then_run: bool = False          # when validate accepts it: run it too
+    expect: str = "reject"  # reject | ok | either
+    files: dict = field(default_factory=dict)  # name -> bytes, created in the case's folder
+    line: int | None = None  # the line the error must name
+    then_run: bool = False  # when validate accepts it: run it too
     note: str = ""
 
 
@@ -68,9 +68,21 @@ NONNEG = ANY + ["neg"]
 INT_SIZE = ["nan", "float", "neg", "big", "huge_int", "zero"]
 RATE = ["nan", "inf", "neg", "zero", "tiny", "nodivide", "big"]
 
-VALUES = {"nan": ".nan", "inf": ".inf", "-inf": "-.inf", "big": BIG_INT, "str": "abc",
-          "map": "{a: 1}", "huge": "1.0e300", "neg": "-1", "zero": "0", "float": "1.5",
-          "huge_int": "1000000000000", "tiny": "1.0e-300", "nodivide": "7"}
+VALUES = {
+    "nan": ".nan",
+    "inf": ".inf",
+    "-inf": "-.inf",
+    "big": BIG_INT,
+    "str": "abc",
+    "map": "{a: 1}",
+    "huge": "1.0e300",
+    "neg": "-1",
+    "zero": "0",
+    "float": "1.5",
+    "huge_int": "1000000000000",
+    "tiny": "1.0e-300",
+    "nodivide": "7",
+}
 
 FIELDS = [
     # (scenario, path, kind or list of value keys, list length or None)
@@ -133,37 +145,53 @@ FIELDS = [
 
 def _list_values(n: int) -> dict:
     ok = ["0.1"] * n
-    return {"l_nan": "[" + ", ".join([".nan"] + ok[1:]) + "]",
-            "l_inf": "[" + ", ".join(ok[:-1] + [".inf"]) + "]",
-            "l_str": "[" + ", ".join(["a"] * n) + "]",
-            "l_big": "[" + ", ".join([BIG_INT] + ok[1:]) + "]",
-            "l_short": "[" + ", ".join(ok[:-1]) + "]",
-            "l_long": "[" + ", ".join(ok + ["0.1"]) + "]",
-            "l_nested": "[" + ", ".join(["[1]"] * n) + "]",
-            "l_huge": "[" + ", ".join(["1.0e300"] + ok[1:]) + "]"}
+    return {
+        "l_nan": "[" + ", ".join([".nan"] + ok[1:]) + "]",
+        "l_inf": "[" + ", ".join(ok[:-1] + [".inf"]) + "]",
+        "l_str": "[" + ", ".join(["a"] * n) + "]",
+        "l_big": "[" + ", ".join([BIG_INT] + ok[1:]) + "]",
+        "l_short": "[" + ", ".join(ok[:-1]) + "]",
+        "l_long": "[" + ", ".join(ok + ["0.1"]) + "]",
+        "l_nested": "[" + ", ".join(["[1]"] * n) + "]",
+        "l_huge": "[" + ", ".join(["1.0e300"] + ok[1:]) + "]",
+    }
 
 
-SPECIAL = {"same_as_position": "[0.0, 0.2, 1.0]", "escape": "../../../escaped",
-           "joint9": "[J9]", "joint_num": "[3]", "empty": "[]", "list_nan": "[8.0, .nan]",
-           "list_neg": "[8.0, -9.0]"}
+SPECIAL = {
+    "same_as_position": "[0.0, 0.2, 1.0]",
+    "escape": "../../../escaped",
+    "joint9": "[J9]",
+    "joint_num": "[3]",
+    "empty": "[]",
+    "list_nan": "[8.0, .nan]",
+    "list_neg": "[8.0, -9.0]",
+}
 
 
 def value_cases() -> list[Case]:
     cases = []
     for scen, path, kind, n in FIELDS:
-        values = _list_values(n) if kind == "list" else {k: SPECIAL.get(k, VALUES.get(k))
-                                                          for k in kind}
+        values = (
+            _list_values(n) if kind == "list" else {k: SPECIAL.get(k, VALUES.get(k)) for k in kind}
+        )
         if path.endswith("lambda_2"):
             values.update({"l_range": "[5, 0]", "l_zero": "[0, 0]"})
         if path.endswith("throw_start"):
             values["l_zero_x"] = "[0.0, 0.0, 0.9]"
         for key, v in values.items():
-            cases.append(Case("value", ["validate", scen, "--set", f"{path}={v}"],
-                              then_run=True, note=f"{path}={v[:40]}"))
+            cases.append(
+                Case(
+                    "value",
+                    ["validate", scen, "--set", f"{path}={v}"],
+                    then_run=True,
+                    note=f"{path}={v[:40]}",
+                )
+            )
     return cases
 
 
 # -- YAML shapes and encodings ----------------------------------------------------------------
+
 
 def shape_cases() -> list[Case]:
     stick = (HERE / STICK).read_text()
@@ -173,10 +201,12 @@ def shape_cases() -> list[Case]:
     for i in range(1, 9):
         prev = "a" if i == 1 else f"a{i - 1}"
         bomb += f"x{i}: &a{i} [" + ", ".join([f"*{prev}"] * 10) + "]\n"
-    bomb_in_list = (f"extends: {HERE / STICK}\n"
-                    "controller:\n  params:\n    lambda_2: &l [&a0 [1,1,1,1,1,1,1,1,1,1]"
-                    + "".join(f", &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]"
-                              for i in range(1, 8)) + "]\n")
+    bomb_in_list = (
+        f"extends: {HERE / STICK}\n"
+        "controller:\n  params:\n    lambda_2: &l [&a0 [1,1,1,1,1,1,1,1,1,1]"
+        + "".join(f", &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 8))
+        + "]\n"
+    )
     ext = f"extends: {HERE / STICK}\n"
     files = {
         "binary": bytes(range(256)) * 4,
@@ -186,9 +216,9 @@ def shape_cases() -> list[Case]:
         "extends_binary": b"extends: bin.yaml\n",
         "deep": (head + deep).encode(),
         "complex_key": (stick + "? [a, b]\n: 1\n").encode(),
-        "complex_key_params": stick.replace("  params:\n    lambda_2",
-                                            "  params:\n    ? [a, b]\n    : 1\n    lambda_2"
-                                            ).encode(),
+        "complex_key_params": stick.replace(
+            "  params:\n    lambda_2", "  params:\n    ? [a, b]\n    : 1\n    lambda_2"
+        ).encode(),
         "alias_bomb_top": (bomb + stick).encode(),
         "alias_bomb_list": bomb_in_list.encode(),
         "empty": b"",
@@ -196,13 +226,16 @@ def shape_cases() -> list[Case]:
         "top_list": b"- a\n- b\n",
         "top_scalar": b"hello\n",
         "duplicate_key": (stick + "seed: 4\n").encode(),
-        "python_tag": stick.replace("seed: 0", "seed: !!python/object/apply:os.system [true]"
-                                    ).encode(),
+        "python_tag": stick.replace(
+            "seed: 0", "seed: !!python/object/apply:os.system [true]"
+        ).encode(),
         "null_plant": (head + "plant:\ncontroller: {type: stick_3step}\n").encode(),
-        "int_key": stick.replace("  params:\n    lambda_2", "  params:\n    3: 4\n    lambda_2"
-                                 ).encode(),
-        "null_key": stick.replace("  params:\n    lambda_2", "  params:\n    ~: 4\n    lambda_2"
-                                  ).encode(),
+        "int_key": stick.replace(
+            "  params:\n    lambda_2", "  params:\n    3: 4\n    lambda_2"
+        ).encode(),
+        "null_key": stick.replace(
+            "  params:\n    lambda_2", "  params:\n    ~: 4\n    lambda_2"
+        ).encode(),
         "extends_loop": b"extends: extends_loop.yaml\nname: x\n",
         "extends_dir": b"extends: .\nname: x\n",
         "extends_list": b"extends: [a.yaml]\nname: x\n",
@@ -227,62 +260,145 @@ def shape_cases() -> list[Case]:
         if name in ("rate_line", "duration_line"):
             key = "rate: 7" if name == "rate_line" else "duration: 1.0e-12"
             line = next(i + 1 for i, l in enumerate(data.decode().splitlines()) if key in l)
-        cases.append(Case("shape", ["validate", f"{name}.yaml"], expect=expect, files=fs,
-                          then_run=True, note=name, line=line))
+        cases.append(
+            Case(
+                "shape",
+                ["validate", f"{name}.yaml"],
+                expect=expect,
+                files=fs,
+                then_run=True,
+                note=name,
+                line=line,
+            )
+        )
     # one bad file in a scenarios/ folder must not break `replay list`
-    cases.append(Case("shape", ["list"], expect="ok",
-                      files={"scenarios/bad.yaml": bytes(range(256)),
-                             "scenarios/good.yaml": stick.encode()}, note="list with a binary"))
+    cases.append(
+        Case(
+            "shape",
+            ["list"],
+            expect="ok",
+            files={"scenarios/bad.yaml": bytes(range(256)), "scenarios/good.yaml": stick.encode()},
+            note="list with a binary",
+        )
+    )
     return cases
 
 
 # -- plug-in mismatches -------------------------------------------------------------------------
 
+
 def mismatch_cases() -> list[Case]:
     child = f"extends: {HERE / STICK}\nplant: {{type: bullet_arm, params: {{}}}}\n"
     return [
-        Case("mismatch", ["validate", STICK, "--set", "controller.type=catching", "--set",
-                          "controller.params={}"], then_run=True, note="stick + catching"),
-        Case("mismatch", ["validate", "child.yaml"], files={"child.yaml": child.encode()},
-             then_run=True, note="stick controller on an arm"),
-        Case("mismatch", ["validate", CATCH, "--set", "plant.params.initial_q=[0,0]"],
-             then_run=True, note="initial_q of 2 on wam4"),
-        Case("mismatch", ["validate", CATCH, "--set", "plant.type=airtable", "--set",
-                          "plant.params={}"], then_run=True, note="catching on the air table"),
-        Case("mismatch", ["validate", CATCH, "--set", "plant.params.arm=wam7"], then_run=True,
-             note="wam7 with 4-joint lists"),
-        Case("mismatch", ["validate", CATCH, "--set", "plant.params.hand_initial=[0]"],
-             then_run=True, note="hand_initial of 1"),
-        Case("mismatch", ["validate", CATCH, "--set", "controller.params.held_joints=[J9]"],
-             then_run=True, note="held J9"),
-        Case("mismatch", ["validate", CATCH, "--set", "controller.params.selected_joint=J9"],
-             then_run=True, note="selected J9"),
-        Case("mismatch", ["validate", CATCH, "--set", "sensors={}"], then_run=True,
-             note="catching without sensors"),
+        Case(
+            "mismatch",
+            [
+                "validate",
+                STICK,
+                "--set",
+                "controller.type=catching",
+                "--set",
+                "controller.params={}",
+            ],
+            then_run=True,
+            note="stick + catching",
+        ),
+        Case(
+            "mismatch",
+            ["validate", "child.yaml"],
+            files={"child.yaml": child.encode()},
+            then_run=True,
+            note="stick controller on an arm",
+        ),
+        Case(
+            "mismatch",
+            ["validate", CATCH, "--set", "plant.params.initial_q=[0,0]"],
+            then_run=True,
+            note="initial_q of 2 on wam4",
+        ),
+        Case(
+            "mismatch",
+            ["validate", CATCH, "--set", "plant.type=airtable", "--set", "plant.params={}"],
+            then_run=True,
+            note="catching on the air table",
+        ),
+        Case(
+            "mismatch",
+            ["validate", CATCH, "--set", "plant.params.arm=wam7"],
+            then_run=True,
+            note="wam7 with 4-joint lists",
+        ),
+        Case(
+            "mismatch",
+            ["validate", CATCH, "--set", "plant.params.hand_initial=[0]"],
+            then_run=True,
+            note="hand_initial of 1",
+        ),
+        Case(
+            "mismatch",
+            ["validate", CATCH, "--set", "controller.params.held_joints=[J9]"],
+            then_run=True,
+            note="held J9",
+        ),
+        Case(
+            "mismatch",
+            ["validate", CATCH, "--set", "controller.params.selected_joint=J9"],
+            then_run=True,
+            note="selected J9",
+        ),
+        Case(
+            "mismatch",
+            ["validate", CATCH, "--set", "sensors={}"],
+            then_run=True,
+            note="catching without sensors",
+        ),
     ]
 
 
 # -- output paths ---------------------------------------------------------------------------------
 
+
 def output_cases() -> list[Case]:
     stick = (HERE / STICK).read_text()
     short = ["--set", "timing.duration=0.05", "-q"]
     return [
-        Case("output", ["run", STICK, "-o", "afile/x.mcap", *short],
-             files={"afile": b"I am a file"}, note="-o under a file"),
+        Case(
+            "output",
+            ["run", STICK, "-o", "afile/x.mcap", *short],
+            files={"afile": b"I am a file"},
+            note="-o under a file",
+        ),
         Case("output", ["run", STICK, "-o", "/proc/x.mcap", *short], note="-o /proc"),
-        Case("output", ["run", "self.yaml", "-o", "self.yaml", *short],
-             files={"self.yaml": stick.encode()}, note="-o = the scenario"),
-        Case("output", ["run", "esc.yaml", *short],
-             files={"esc.yaml": stick.replace("name: stick_3step", "name: ../../../x").encode()},
-             note="name leaves out/logs"),
-        Case("output", ["run", STICK, "-o", "adir", *short], files={"adir/keep": b"x"},
-             note="-o a directory"),
-        Case("output", ["run", STICK, "-o", "notes.txt", *short],
-             files={"notes.txt": b"my notes"}, note="-o an existing non-log"),
+        Case(
+            "output",
+            ["run", "self.yaml", "-o", "self.yaml", *short],
+            files={"self.yaml": stick.encode()},
+            note="-o = the scenario",
+        ),
+        Case(
+            "output",
+            ["run", "esc.yaml", *short],
+            files={"esc.yaml": stick.replace("name: stick_3step", "name: ../../../x").encode()},
+            note="name leaves out/logs",
+        ),
+        Case(
+            "output",
+            ["run", STICK, "-o", "adir", *short],
+            files={"adir/keep": b"x"},
+            note="-o a directory",
+        ),
+        Case(
+            "output",
+            ["run", STICK, "-o", "notes.txt", *short],
+            files={"notes.txt": b"my notes"},
+            note="-o an existing non-log",
+        ),
         Case("output", ["figures", "good.mcap", "-o", "/proc/figs"], note="figures -o /proc"),
-        Case("output", ["claims", "good.mcap", "--markdown", "/proc/claims.md"],
-             note="claims --markdown /proc"),
+        Case(
+            "output",
+            ["claims", "good.mcap", "--markdown", "/proc/claims.md"],
+            note="claims --markdown /proc",
+        ),
         Case("output", ["optimise", "scenarios/catch_initial.yaml"], note="optimise no file"),
         Case("output", ["optimise", CATCH, "-o", CATCH], note="optimise -o = the scenario"),
         Case("output", ["optimise", CATCH, "-o", "/proc/a.json"], note="optimise -o /proc"),
@@ -291,11 +407,13 @@ def output_cases() -> list[Case]:
 
 # -- logs --------------------------------------------------------------------------------------
 
+
 def _mcap_with(messages: list) -> bytes:
     """A well-formed MCAP file holding ``messages`` [(topic, bytes)]."""
     import io
 
     from mcap.writer import Writer
+
     buf = io.BytesIO()
     w = Writer(buf)
     w.start()
@@ -315,26 +433,32 @@ def log_files(good: bytes) -> dict:
     for _ in range(64):
         i = rng.randrange(len(MAGIC) + 64, len(flipped) - 64)
         flipped[i] ^= 0xFF
-    scen_msg = json.dumps({"t": 0.0, "name": "x", "yaml": "name: x\n", "seed": 0,
-                           "version": "0"}).encode()
+    scen_msg = json.dumps(
+        {"t": 0.0, "name": "x", "yaml": "name: x\n", "seed": 0, "version": "0"}
+    ).encode()
     return {
         "empty.mcap": b"",
         "random.mcap": bytes(rng.randrange(256) for _ in range(4096)),
         "magic_only.mcap": MAGIC,
-        "cut50.mcap": good[:len(good) // 2],
-        "cut90.mcap": good[:len(good) * 9 // 10],
+        "cut50.mcap": good[: len(good) // 2],
+        "cut90.mcap": good[: len(good) * 9 // 10],
         "flipped.mcap": bytes(flipped),
         "no_paper.mcap": _mcap_with([("/scenario", scen_msg)]),
-        "not_utf8.mcap": _mcap_with([("/scenario", b"\xff\xfe\x00bad"),
-                                     ("/events", b"\xc3\x28")]),
+        "not_utf8.mcap": _mcap_with([("/scenario", b"\xff\xfe\x00bad"), ("/events", b"\xc3\x28")]),
         "not_json.mcap": _mcap_with([("/events", b"{not json")]),
         "json_list.mcap": _mcap_with([("/scenario", b"[1, 2]"), ("/events", b"42")]),
     }
 
 
 MAGIC = b"\x89MCAP0\r\n"
-DAMAGED = {"cut50.mcap", "cut90.mcap", "flipped.mcap", "not_utf8.mcap", "not_json.mcap",
-           "json_list.mcap"}
+DAMAGED = {
+    "cut50.mcap",
+    "cut90.mcap",
+    "flipped.mcap",
+    "not_utf8.mcap",
+    "not_json.mcap",
+    "json_list.mcap",
+}
 
 
 def log_cases(good: bytes) -> list[Case]:
@@ -342,8 +466,9 @@ def log_cases(good: bytes) -> list[Case]:
     for name, data in log_files(good).items():
         for cmd in (["info", name], ["figures", name, "-o", "figs"], ["claims", name]):
             expect = "damaged" if name in DAMAGED else "reject"
-            cases.append(Case("log", cmd, expect=expect, files={name: data},
-                              note=f"{cmd[0]} {name}"))
+            cases.append(
+                Case("log", cmd, expect=expect, files={name: data}, note=f"{cmd[0]} {name}")
+            )
     return cases
 
 
@@ -354,19 +479,24 @@ def golden_cases(good: bytes) -> list[Case]:
     for label, files in {
         "empty stored log": {**base, "data/golden/stick_3step.mcap": b""},
         "random stored log": {**base, "data/golden/stick_3step.mcap": bytes(range(256)) * 8},
-        "cut stored log": {**base, "data/golden/stick_3step.mcap": good[:len(good) // 2]},
+        "cut stored log": {**base, "data/golden/stick_3step.mcap": good[: len(good) // 2]},
         "broken manifest": {"data/golden/manifest.yaml": b"stick_3step: [unclosed\n"},
         "manifest a list": {"data/golden/manifest.yaml": b"- a\n- b\n"},
-        "manifest no log key": {"data/golden/manifest.yaml":
-                                b"stick_3step: {scenario: scenarios/stick_3step.yaml}\n"},
+        "manifest no log key": {
+            "data/golden/manifest.yaml": b"stick_3step: {scenario: scenarios/stick_3step.yaml}\n"
+        },
         "manifest binary": {"data/golden/manifest.yaml": bytes(range(256))},
     }.items():
-        out.append(Case("golden", ["golden", "check", "stick_3step"], expect="fail",
-                        files=files, note=label))
+        out.append(
+            Case(
+                "golden", ["golden", "check", "stick_3step"], expect="fail", files=files, note=label
+            )
+        )
     return out
 
 
 # -- running -----------------------------------------------------------------------------------
+
 
 class Campaign:
     def __init__(self, replay: list, root: Path, work: Path, timeout: float) -> None:
@@ -383,10 +513,18 @@ class Campaign:
         env = dict(os.environ, PYTHONUNBUFFERED="1", COLUMNS="200")
         self.calls += 1
         try:
-            p = subprocess.run(self.replay + argv, cwd=cwd, capture_output=True,
-                               timeout=timeout or self.timeout, env=env)
-            return p.returncode, p.stdout.decode(errors="replace"), p.stderr.decode(
-                errors="replace")
+            p = subprocess.run(
+                self.replay + argv,
+                cwd=cwd,
+                capture_output=True,
+                timeout=timeout or self.timeout,
+                env=env,
+            )
+            return (
+                p.returncode,
+                p.stdout.decode(errors="replace"),
+                p.stderr.decode(errors="replace"),
+            )
         except subprocess.TimeoutExpired:
             return None, "", ""
 
@@ -489,8 +627,11 @@ class Campaign:
             if p.is_file() and p.read_bytes() != data:
                 self.flag("data_loss", case, f"input {name} overwritten")
         if "esc.yaml" in case.files:
-            escaped = [p for p in (d / "x.mcap", d.parent / "x.mcap", d.parent.parent / "x.mcap")
-                       if p.exists()]
+            escaped = [
+                p
+                for p in (d / "x.mcap", d.parent / "x.mcap", d.parent.parent / "x.mcap")
+                if p.exists()
+            ]
             if escaped:
                 self.flag("data_loss", case, f"wrote outside out/logs: {escaped[0]}")
                 for p in escaped:
@@ -511,10 +652,14 @@ class Campaign:
                 os.symlink(self.root / "scenarios", d / "scenarios")
                 os.symlink(self.root / "data", d / "data")
                 good = self.work / "good.mcap"
-                shutil.copy(good, d / "run.mcap")          # an old good log at the same path
+                shutil.copy(good, d / "run.mcap")  # an old good log at the same path
                 self.calls += 1
-                p = subprocess.Popen(self.replay + ["run", STICK, "-o", "run.mcap", "-q"], cwd=d,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                p = subprocess.Popen(
+                    self.replay + ["run", STICK, "-o", "run.mcap", "-q"],
+                    cwd=d,
+                    stdout=subprocess.PIPE,
+                    stderr=subprocess.PIPE,
+                )
                 time.sleep(delay)
                 p.send_signal(sig)
                 try:
@@ -546,6 +691,7 @@ class Campaign:
             self.flag("data_loss", case, f"{log.name}: no interrupted/outcome event")
         try:
             from mcap.stream_reader import StreamReader
+
             with open(log, "rb") as f:
                 for _ in StreamReader(f, skip_magic=False).records:
                     pass
@@ -562,8 +708,9 @@ class Campaign:
         good = (self.work / "good.mcap").read_bytes()
         (d / "run.mcap").write_bytes(good)
         case = Case("failed", [], note="stick with a huge speed (non-finite at run time)")
-        rc, out, err = self.call(["run", STICK, "-o", "run.mcap", "-q", "--set",
-                                  "plant.params.initial.vy=-1e200"], d)
+        rc, out, err = self.call(
+            ["run", STICK, "-o", "run.mcap", "-q", "--set", "plant.params.initial.vy=-1e200"], d
+        )
         if "Traceback" in out + err:
             self.flag("traceback", case)
         if (d / "run.mcap").read_bytes() != good and rc != 0:
@@ -577,9 +724,13 @@ class Campaign:
         for host in ("127.0.0.1", "0.0.0.0"):
             case = Case("viewer", [], note=f"bare TCP connect, --host {host}")
             self.calls += 1
-            p = subprocess.Popen(self.replay + ["view", "good.mcap", "--port", str(port),
-                                                "--host", host, "--timeout", "25"], cwd=d,
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            p = subprocess.Popen(
+                self.replay
+                + ["view", "good.mcap", "--port", str(port), "--host", host, "--timeout", "25"],
+                cwd=d,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+            )
             deadline = time.time() + 20
             connected = False
             while time.time() < deadline and not connected:
@@ -605,8 +756,11 @@ class Campaign:
                 self.flag("hang", case)
             text = (out + err).decode(errors="replace")
             if not connected:
-                self.flag("no_server", case, text.strip().splitlines()[-1:][0][:100]
-                          if text.strip() else "")
+                self.flag(
+                    "no_server",
+                    case,
+                    text.strip().splitlines()[-1:][0][:100] if text.strip() else "",
+                )
             if "Traceback" in text:
                 self.flag("traceback", case)
             if host == "0.0.0.0" and "warning" not in text.lower():
@@ -622,8 +776,12 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=90.0)
     ap.add_argument("--report", default="")
-    ap.add_argument("--sample", type=int, default=0,
-                    help="run a seeded sample of this many value cases (0: all)")
+    ap.add_argument(
+        "--sample",
+        type=int,
+        default=0,
+        help="run a seeded sample of this many value cases (0: all)",
+    )
     args = ap.parse_args()
     root = Path(args.root).resolve()
     work = Path(tempfile.mkdtemp(prefix="campaign_"))
@@ -632,14 +790,20 @@ def main() -> None:
         c.progress = args.report + ".progress"
         Path(c.progress).write_text("")
     t0 = time.time()
-    rc, out, err = c.call(["run", STICK, "-o", str(work / "good.mcap"), "-q", "--set",
-                           "timing.duration=0.6"], root)
+    rc, out, err = c.call(
+        ["run", STICK, "-o", str(work / "good.mcap"), "-q", "--set", "timing.duration=0.6"], root
+    )
     if rc != 0:
         sys.exit(f"cannot make the good log: {err}")
     good = (work / "good.mcap").read_bytes()
-    families = {"value": value_cases, "shape": shape_cases, "mismatch": mismatch_cases,
-                "output": output_cases, "log": lambda: log_cases(good),
-                "golden": lambda: golden_cases(good)}
+    families = {
+        "value": value_cases,
+        "shape": shape_cases,
+        "mismatch": mismatch_cases,
+        "output": output_cases,
+        "log": lambda: log_cases(good),
+        "golden": lambda: golden_cases(good),
+    }
     only = set(args.only.split(",")) if args.only else None
     cases = []
     for name, make in families.items():
@@ -655,11 +819,27 @@ def main() -> None:
         c.failed_run_keeps_old_log()
     if only is None or "viewer" in only:
         c.viewer_cases()
-    lines = [f"cases: {len(cases)} generated + signal/viewer; replay calls: {c.calls}; "
-             f"wall {time.time() - t0:.0f} s"]
-    for kind in ("traceback", "abort", "hang", "accepted", "ran", "run_failed", "not_one_line",
-                 "wrong_line", "silent", "data_loss", "not_rejected", "not_clean", "no_warning",
-                 "rejected_ok", "no_server"):
+    lines = [
+        f"cases: {len(cases)} generated + signal/viewer; replay calls: {c.calls}; "
+        f"wall {time.time() - t0:.0f} s"
+    ]
+    for kind in (
+        "traceback",
+        "abort",
+        "hang",
+        "accepted",
+        "ran",
+        "run_failed",
+        "not_one_line",
+        "wrong_line",
+        "silent",
+        "data_loss",
+        "not_rejected",
+        "not_clean",
+        "no_warning",
+        "rejected_ok",
+        "no_server",
+    ):
         lines.append(f"{kind:<13} {c.counts.get(kind, 0)}")
     text = "\n".join(lines + ["", *sorted(c.problems)])
     print(text)

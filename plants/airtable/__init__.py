@@ -4,15 +4,14 @@
 first asked for.
 """
 
-from plants.airtable.params import (HandParams, InitialParams, Params, SolverParams,
-                                    StickParams)
+from plants.airtable.params import HandParams, InitialParams, Params, SolverParams, StickParams
 
-__all__ = ["AirTablePlant", "Params", "StickParams", "InitialParams", "HandParams",
-           "SolverParams"]
+__all__ = ["AirTablePlant", "Params", "StickParams", "InitialParams", "HandParams", "SolverParams"]
 
 
 def __getattr__(name: str):
     if name == "AirTablePlant":
         from plants.airtable.plant import AirTablePlant
+
         return AirTablePlant
     raise AttributeError(f"module 'plants.airtable' has no attribute {name!r}")

@@ -36,8 +36,8 @@ class HandServo:
         self.joints, _ = self.clamp_joints(joints)
         self.base_target = self.base.copy()
         self.joint_targets = self.joints.copy()
-        self._settled = True          # at the targets: advance() has nothing to do
-        self._tips: np.ndarray | None = None   # tips() of the current base and joints, once computed
+        self._settled = True  # at the targets: advance() has nothing to do
+        self._tips: np.ndarray | None = None  # tips() of the current base and joints, once computed
 
     def clamp_base(self, base: np.ndarray) -> tuple[np.ndarray, bool]:
         c = np.clip(base, self._base_lo, self._base_hi)
@@ -58,9 +58,14 @@ class HandServo:
         self._settled = False
         if not (base_clamped or joints_clamped):
             return None
-        return {"base_requested": base.tolist(), "base_target": base_c.tolist(),
-                "joints_requested": joints.tolist(), "joint_targets": joints_c.tolist(),
-                "base_clamped": base_clamped, "joints_clamped": joints_clamped}
+        return {
+            "base_requested": base.tolist(),
+            "base_target": base_c.tolist(),
+            "joints_requested": joints.tolist(),
+            "joint_targets": joints_c.tolist(),
+            "base_clamped": base_clamped,
+            "joints_clamped": joints_clamped,
+        }
 
     def advance(self, dt: float) -> None:
         """One step toward the targets at the speed limits (nothing to do once on them)."""
@@ -69,13 +74,15 @@ class HandServo:
         self.base = _toward(self.base, self.base_target, self.spec.base_speed * dt)
         self.joints = _toward(self.joints, self.joint_targets, self.spec.joint_speed * dt)
         self._tips = None
-        self._settled = (np.array_equal(self.base, self.base_target)
-                         and np.array_equal(self.joints, self.joint_targets))
+        self._settled = np.array_equal(self.base, self.base_target) and np.array_equal(
+            self.joints, self.joint_targets
+        )
 
     def tips(self) -> np.ndarray:
         """Fingertip centres (2 x 2, world, m) for the current base and joints (a copy)."""
         tips = self._tips
         if tips is None:
-            tips = self._tips = np.array([finger_tip(self.spec, self.base, k, self.joints[k])
-                                          for k in (0, 1)])
+            tips = self._tips = np.array(
+                [finger_tip(self.spec, self.base, k, self.joints[k]) for k in (0, 1)]
+            )
         return tips.copy()

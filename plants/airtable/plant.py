@@ -31,8 +31,13 @@ import pymunk
 
 from replay.robot.hand2d import AirTableSpec, HandCommand, root_distance
 from replay.interfaces import Occurrence, Plant
-from replay.messages import (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_STICK_STATE, FingersState,
-                             StickState)
+from replay.messages import (
+    TOPIC_FINGERS_STATE,
+    TOPIC_HAND_STATE,
+    TOPIC_STICK_STATE,
+    FingersState,
+    StickState,
+)
 from replay.scene import Box, Cylinder, Scene
 from replay.spatial import yaw_quaternion
 
@@ -42,7 +47,7 @@ from plants.airtable.params import Params
 
 STICK_TYPE = 1
 TIP_TYPE = 2
-_TIP_GROUP = 1          # fingertips never collide with each other
+_TIP_GROUP = 1  # fingertips never collide with each other
 
 
 def _vec(v) -> list[float]:
@@ -55,11 +60,14 @@ class AirTablePlant(Plant):
     Params = Params
     spec_type = AirTableSpec
     command_types = (HandCommand,)
-    description = ("Pymunk air table: a free stick (no table friction) and two position-"
-                   "commanded fingertip discs on an XY slider hand (Higashimori et al. 2007)")
+    description = (
+        "Pymunk air table: a free stick (no table friction) and two position-"
+        "commanded fingertip discs on an XY slider hand (Higashimori et al. 2007)"
+    )
 
-    def __init__(self, params: Params | None = None, *, dt: float,
-                 rng: np.random.Generator | None = None) -> None:
+    def __init__(
+        self, params: Params | None = None, *, dt: float, rng: np.random.Generator | None = None
+    ) -> None:
         params = params if params is not None else Params()
         super().__init__(params, dt=dt, rng=rng if rng is not None else np.random.default_rng(0))
         if not dt > 0:
@@ -70,11 +78,11 @@ class AirTablePlant(Plant):
 
         space = pymunk.Space()
         space.gravity = (0.0, 0.0)
-        space.damping = 1.0                      # no velocity damping
+        space.damping = 1.0  # no velocity damping
         space.iterations = int(p.solver.iterations)
         space.collision_slop = float(p.solver.collision_slop)
         space.collision_bias = float(p.solver.collision_bias)
-        space.sleep_time_threshold = math.inf    # bodies never sleep
+        space.sleep_time_threshold = math.inf  # bodies never sleep
         self.space = space
 
         # The stick: m and I set on the body; its shape has no mass or density.
@@ -94,7 +102,7 @@ class AirTablePlant(Plant):
         shape.collision_type = STICK_TYPE
         space.add(body, shape)
         self.stick_body, self.stick_shape = body, shape
-        if body.mass != st.mass or body.moment != st.inertia:   # pragma: no cover - guard
+        if body.mass != st.mass or body.moment != st.inertia:  # pragma: no cover - guard
             raise RuntimeError("Pymunk changed the stick's mass or inertia")
 
         # The fingertips: kinematic discs (infinite mass, Assumption 8).
@@ -104,8 +112,8 @@ class AirTablePlant(Plant):
             tb = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
             tb.position = (float(tip[0]), float(tip[1]))
             ts = pymunk.Circle(tb, p.hand.tip_radius)
-            ts.elasticity = 1.0     # pair restitution = e * 1
-            ts.friction = 1.0       # pair friction = mu * 1
+            ts.elasticity = 1.0  # pair restitution = e * 1
+            ts.friction = 1.0  # pair friction = mu * 1
             ts.collision_type = TIP_TYPE
             ts.filter = pymunk.ShapeFilter(group=_TIP_GROUP)
             space.add(tb, ts)
@@ -123,8 +131,8 @@ class AirTablePlant(Plant):
         self._rest_reported = False
         self._nan_reported = False
         self._collisions = 0
-        self._held_since: float | None = None    # the stick held between the tips since
-        self._reached = self._in_reach()         # the stick ever within the hand's reach
+        self._held_since: float | None = None  # the stick held between the tips since
+        self._reached = self._in_reach()  # the stick ever within the hand's reach
 
     # -- Plant interface ------------------------------------------------------------------
 
@@ -134,10 +142,9 @@ class AirTablePlant(Plant):
         return self._steps * self.dt
 
     def apply(self, command: HandCommand) -> None:
-        key = (tuple(map(float, command.base)),
-               tuple(tuple(map(float, q)) for q in command.joints))
+        key = (tuple(map(float, command.base)), tuple(tuple(map(float, q)) for q in command.joints))
         if key == self._last_command:
-            return                      # the same target again: nothing new to clamp or report
+            return  # the same target again: nothing new to clamp or report
         self._last_command = key
         clamped = self.hand.set_targets(command.base, command.joints)
         if clamped is not None:
@@ -171,7 +178,7 @@ class AirTablePlant(Plant):
         the velocity solve: the stick's pose is that of the contact, its velocity the one before)."""
         sa, sb = arbiter.shapes
         cps = arbiter.contact_point_set
-        normal = np.array(cps.normal, dtype=float)      # from shape a to shape b
+        normal = np.array(cps.normal, dtype=float)  # from shape a to shape b
         if sa is self.stick_shape:
             tip_shape = sb
             normal = -normal
@@ -187,22 +194,30 @@ class AirTablePlant(Plant):
         theta = float(b.angle)
         c, s = math.cos(theta), math.sin(theta)
         d = contact - np.array(b.position, dtype=float)
-        r_x, r_y = c * d[0] + s * d[1], -s * d[0] + c * d[1]     # R_B(theta)^T d
+        r_x, r_y = c * d[0] + s * d[1], -s * d[0] + c * d[1]  # R_B(theta)^T d
         v_before, w_before = self._before
-        self._pending.append({
-            "finger": finger,
-            "r_x": float(r_x), "r_y": float(r_y), "theta": theta,
-            "v_before": v_before, "omega_before": w_before,
-            "contact": _vec(contact), "normal": _vec(normal),
-            "penetration": float(-min(pt.distance for pt in cps.points)),
-            "tip_velocity": _vec(self.tip_bodies[finger].velocity),
-        })
+        self._pending.append(
+            {
+                "finger": finger,
+                "r_x": float(r_x),
+                "r_y": float(r_y),
+                "theta": theta,
+                "v_before": v_before,
+                "omega_before": w_before,
+                "contact": _vec(contact),
+                "normal": _vec(normal),
+                "penetration": float(-min(pt.distance for pt in cps.points)),
+                "tip_velocity": _vec(self.tip_bodies[finger].velocity),
+            }
+        )
 
     def _check_state(self) -> None:
         b = self.stick_body
         (x, y), (vx, vy), angle, omega = b.position, b.velocity, b.angle, b.angular_velocity
         tips = [tb.position for tb in self.tip_bodies]
-        if not all(map(math.isfinite, (x, y, angle, vx, vy, omega, *(c for tip in tips for c in tip)))):
+        if not all(
+            map(math.isfinite, (x, y, angle, vx, vy, omega, *(c for tip in tips for c in tip)))
+        ):
             values = {"x": x, "y": y, "theta": angle, "vx": vx, "vy": vy, "omega": omega}
             for k, (tx, ty) in enumerate(tips):
                 values[f"tip{k}_x"], values[f"tip{k}_y"] = tx, ty
@@ -212,20 +227,28 @@ class AirTablePlant(Plant):
                 self._events.append(Occurrence("nan", {"fields": bad, "step": self._steps}))
             return
         t = self.time
-        slow = (math.hypot(vx, vy) < self.params.rest_speed
-                and abs(omega) < self.params.rest_omega)
+        slow = math.hypot(vx, vy) < self.params.rest_speed and abs(omega) < self.params.rest_omega
         if not slow:
             self._rest_since = None
-            self._rest_reported = False        # moving again: a later rest is a new event
+            self._rest_reported = False  # moving again: a later rest is a new event
             return
         if self._rest_since is None:
             self._rest_since = t
         if not self._rest_reported and t - self._rest_since >= self.params.rest_time - 1e-12:
             self._rest_reported = True
-            self._events.append(Occurrence("rest", {
-                "since": self._rest_since, "x": x, "y": y,
-                "theta": angle, "speed": math.hypot(vx, vy),
-                "omega": omega}))
+            self._events.append(
+                Occurrence(
+                    "rest",
+                    {
+                        "since": self._rest_since,
+                        "x": x,
+                        "y": y,
+                        "theta": angle,
+                        "speed": math.hypot(vx, vy),
+                        "omega": omega,
+                    },
+                )
+            )
 
     def _in_reach(self) -> bool:
         """The stick's centre within finger reach (l1 + l2, joint limits ignored) plus L/2 of a
@@ -238,8 +261,10 @@ class AirTablePlant(Plant):
         """Slow (``hold_speed``, ``hold_omega``) with a fingertip at each face: between the
         stick's ends and within W/2 + tip_radius + ``hold_gap`` of its axis, on opposite sides."""
         p, b = self.params, self.stick_body
-        if math.hypot(b.velocity.x, b.velocity.y) >= p.hold_speed \
-                or abs(b.angular_velocity) >= p.hold_omega:
+        if (
+            math.hypot(b.velocity.x, b.velocity.y) >= p.hold_speed
+            or abs(b.angular_velocity) >= p.hold_omega
+        ):
             return False
         c, s = math.cos(b.angle), math.sin(b.angle)
         reach_y = 0.5 * p.stick.collision_width + p.hand.tip_radius + p.hold_gap
@@ -266,10 +291,18 @@ class AirTablePlant(Plant):
         p, b = self.params, self.stick_body
         speed, omega = math.hypot(b.velocity.x, b.velocity.y), float(b.angular_velocity)
         held = self._held_since is not None and t - self._held_since >= p.hold_time - 1e-12
-        out = {"success": held, "reason": "captured", "captured": held,
-               "t_capture": self._held_since if held else None,
-               "speed": speed, "omega": omega, "collisions": self._collisions,
-               "x": float(b.position.x), "y": float(b.position.y), "theta": float(b.angle)}
+        out = {
+            "success": held,
+            "reason": "captured",
+            "captured": held,
+            "t_capture": self._held_since if held else None,
+            "speed": speed,
+            "omega": omega,
+            "collisions": self._collisions,
+            "x": float(b.position.x),
+            "y": float(b.position.y),
+            "theta": float(b.angle),
+        }
         if held:
             return out
         if not math.isfinite(speed + omega):
@@ -278,12 +311,15 @@ class AirTablePlant(Plant):
         elif not self._reached:
             out["reason"] = "not captured: the stick never came within the hand's reach"
         elif self._held_since is not None:
-            out["reason"] = (f"not captured: held between the fingertips only for the last "
-                             f"{t - self._held_since:.3f} s (< {p.hold_time:g} s)")
+            out["reason"] = (
+                f"not captured: held between the fingertips only for the last "
+                f"{t - self._held_since:.3f} s (< {p.hold_time:g} s)"
+            )
         elif speed >= p.hold_speed or abs(omega) >= p.hold_omega:
             where = "" if self._in_reach() else ", out of the hand's reach"
-            out["reason"] = (f"not captured: the stick still moves ({speed:.3f} m/s, "
-                             f"{omega:.2f} rad/s{where})")
+            out["reason"] = (
+                f"not captured: the stick still moves ({speed:.3f} m/s, {omega:.2f} rad/s{where})"
+            )
         else:
             out["reason"] = "not captured: the stick stopped but not between the fingertips"
         return out
@@ -296,14 +332,19 @@ class AirTablePlant(Plant):
         b = self.stick_body
         (x, y), (vx, vy) = b.position, b.velocity
         return {
-            TOPIC_STICK_STATE: StickState(t=t, x=x, y=y, theta=b.angle, vx=vx, vy=vy,
-                                       omega=b.angular_velocity),
-            TOPIC_FINGERS_STATE: FingersState(t=t, tips=[_vec(tb.position)
-                                                      for tb in self.tip_bodies]),
-            TOPIC_HAND_STATE: {"t": t, "base": self.hand.base.tolist(),
-                            "joints": self.hand.joints.tolist(),
-                            "base_target": self.hand.base_target.tolist(),
-                            "joint_targets": self.hand.joint_targets.tolist()},
+            TOPIC_STICK_STATE: StickState(
+                t=t, x=x, y=y, theta=b.angle, vx=vx, vy=vy, omega=b.angular_velocity
+            ),
+            TOPIC_FINGERS_STATE: FingersState(
+                t=t, tips=[_vec(tb.position) for tb in self.tip_bodies]
+            ),
+            TOPIC_HAND_STATE: {
+                "t": t,
+                "base": self.hand.base.tolist(),
+                "joints": self.hand.joints.tolist(),
+                "base_target": self.hand.base_target.tolist(),
+                "joint_targets": self.hand.joint_targets.tolist(),
+            },
         }
 
     def scene(self) -> Scene:
@@ -313,20 +354,37 @@ class AirTablePlant(Plant):
         q = yaw_quaternion(th)
         marker_h = 0.0005
         prims: list = [
-            Box("stick", (x, y, st.thickness / 2.0), q,
-                (st.length, st.visual_width, st.thickness), albedo=0.3),
-            Box("marker", (x, y, st.thickness + marker_h / 2.0), q,
-                (st.marker_length, st.marker_width, marker_h), albedo=1.0),
+            Box(
+                "stick",
+                (x, y, st.thickness / 2.0),
+                q,
+                (st.length, st.visual_width, st.thickness),
+                albedo=0.3,
+            ),
+            Box(
+                "marker",
+                (x, y, st.thickness + marker_h / 2.0),
+                q,
+                (st.marker_length, st.marker_width, marker_h),
+                albedo=1.0,
+            ),
         ]
         h = self.params.hand
         for k, tb in enumerate(self.tip_bodies):
-            prims.append(Cylinder(f"tip{k}", (tb.position.x, tb.position.y, h.tip_height / 2.0),
-                                  (0.0, 0.0, 0.0, 1.0), h.tip_radius, h.tip_height,
-                                  albedo=0.1))
+            prims.append(
+                Cylinder(
+                    f"tip{k}",
+                    (tb.position.x, tb.position.y, h.tip_height / 2.0),
+                    (0.0, 0.0, 0.0, 1.0),
+                    h.tip_radius,
+                    h.tip_height,
+                    albedo=0.1,
+                )
+            )
         return Scene(prims)
 
     def spec(self) -> AirTableSpec:
-        return settings.spec(self.params, self._hand_spec)   # nominal: no friction
+        return settings.spec(self.params, self._hand_spec)  # nominal: no friction
 
     def close(self) -> None:
         self._pending = []

@@ -32,6 +32,13 @@ def spec(p: Params, hand: HandSpec | None = None) -> AirTableSpec:
     """Nominal values only: the method must not need mu (Assumption 10 and the paper's point).
     The width is the one the fingertips collide with (it sets where contact happens)."""
     st = p.stick
-    return AirTableSpec(hand=hand if hand is not None else hand_spec(p),
-                        stick=StickSpec(mass=st.mass, inertia=st.inertia, length=st.length,
-                                        width=st.collision_width, restitution=st.restitution))
+    return AirTableSpec(
+        hand=hand if hand is not None else hand_spec(p),
+        stick=StickSpec(
+            mass=st.mass,
+            inertia=st.inertia,
+            length=st.length,
+            width=st.collision_width,
+            restitution=st.restitution,
+        ),
+    )

@@ -14,8 +14,12 @@ import numpy as np
 
 from plants.airtable.params import Params
 from plants.airtable.settings import hand_spec
-from replay.messages import (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_STICK_STATE,
-                             TOPIC_VISION_STICK)
+from replay.messages import (
+    TOPIC_FINGERS_STATE,
+    TOPIC_HAND_STATE,
+    TOPIC_STICK_STATE,
+    TOPIC_VISION_STICK,
+)
 from replay.robot.hand2d import finger_chain
 from replay.spatial import yaw_wxyz
 from replay.viewer.data import RunData
@@ -25,6 +29,7 @@ from replay.viewer.scenes import PlotSeries, PlotSpec, RunScene
 @dataclass(frozen=True)
 class StickGeometry:
     """What the viewer draws of the air table (m), from the plant's ``Params``."""
+
     length: float
     visual_width: float
     thickness: float
@@ -38,21 +43,32 @@ class StickGeometry:
     @classmethod
     def of(cls, p: Params) -> StickGeometry:
         st, hand = p.stick, hand_spec(p)
-        return cls(length=float(st.length), visual_width=float(st.visual_width),
-                   thickness=float(st.thickness), marker_length=float(st.marker_length),
-                   marker_width=float(st.marker_width), tip_radius=hand.tip_radius,
-                   tip_height=float(p.hand.tip_height), link_lengths=hand.link_lengths,
-                   root_offsets=hand.root_offsets)
+        return cls(
+            length=float(st.length),
+            visual_width=float(st.visual_width),
+            thickness=float(st.thickness),
+            marker_length=float(st.marker_length),
+            marker_width=float(st.marker_width),
+            tip_radius=hand.tip_radius,
+            tip_height=float(p.hand.tip_height),
+            link_lengths=hand.link_lengths,
+            root_offsets=hand.root_offsets,
+        )
 
     def finger_points(self, base, joints) -> np.ndarray:
         """(2 fingers, 3 points: root, elbow, tip, 2) from the slider base and (q1, q2) per
         finger, by ``replay.robot.hand2d``'s kinematics."""
-        return np.array([finger_chain(base, self.root_offsets[k], self.link_lengths, joints[k])
-                         for k in range(2)])
+        return np.array(
+            [
+                finger_chain(base, self.root_offsets[k], self.link_lengths, joints[k])
+                for k in range(2)
+            ]
+        )
 
 
 class AirTableScene(RunScene):
     """Higashimori et al. 2007: stick (with its marker), fingertips and fingers, camera."""
+
     kind = "air table"
     needs = (TOPIC_STICK_STATE,)
     optional = (TOPIC_FINGERS_STATE, TOPIC_HAND_STATE, TOPIC_VISION_STICK)
@@ -70,39 +86,88 @@ class AirTableScene(RunScene):
             lo, hi = self.bounds()
             size = np.maximum(hi - lo, 0.3)[:2] + 0.1
             centre = (lo + hi) / 2.0
-            self._add(sc.add_grid("/table", width=float(size[0]), height=float(size[1]),
-                                  cell_size=0.05, section_size=0.1, plane="xy",
-                                  position=(float(centre[0]), float(centre[1]), -0.0002),
-                                  plane_color=(238, 242, 246), plane_opacity=1.0,
-                                  cell_color=(205, 210, 220), section_color=(170, 178, 190),
-                                  shadow_opacity=0.2))
+            self._add(
+                sc.add_grid(
+                    "/table",
+                    width=float(size[0]),
+                    height=float(size[1]),
+                    cell_size=0.05,
+                    section_size=0.1,
+                    plane="xy",
+                    position=(float(centre[0]), float(centre[1]), -0.0002),
+                    plane_color=(238, 242, 246),
+                    plane_opacity=1.0,
+                    cell_color=(205, 210, 220),
+                    section_color=(170, 178, 190),
+                    shadow_opacity=0.2,
+                )
+            )
         self.stick = self._add(sc.add_frame(f"{r}/stick", show_axes=False))
         body_color = (55, 55, 60) if not self.ghost else self.color
-        self._add(sc.add_box(f"{r}/stick/body", color=body_color, opacity=opacity,
-                             dimensions=(g.length, g.visual_width, g.thickness),
-                             position=(0.0, 0.0, g.thickness / 2.0)))
-        self._add(sc.add_box(f"{r}/stick/marker", color=(250, 250, 250), opacity=opacity,
-                             dimensions=(g.marker_length, g.marker_width, 0.0005),
-                             position=(0.0, 0.0, g.thickness + 0.00025)))
-        self.vision = self._add(sc.add_box(
-            f"{r}/vision", color=(20, 170, 90), wireframe=True,
-            dimensions=(g.length, g.visual_width, g.thickness), visible=False))
+        self._add(
+            sc.add_box(
+                f"{r}/stick/body",
+                color=body_color,
+                opacity=opacity,
+                dimensions=(g.length, g.visual_width, g.thickness),
+                position=(0.0, 0.0, g.thickness / 2.0),
+            )
+        )
+        self._add(
+            sc.add_box(
+                f"{r}/stick/marker",
+                color=(250, 250, 250),
+                opacity=opacity,
+                dimensions=(g.marker_length, g.marker_width, 0.0005),
+                position=(0.0, 0.0, g.thickness + 0.00025),
+            )
+        )
+        self.vision = self._add(
+            sc.add_box(
+                f"{r}/vision",
+                color=(20, 170, 90),
+                wireframe=True,
+                dimensions=(g.length, g.visual_width, g.thickness),
+                visible=False,
+            )
+        )
         tip_color = (30, 30, 30) if not self.ghost else self.color
-        self.tips = [self._add(sc.add_cylinder(f"{r}/tip{i}", radius=g.tip_radius,
-                                               height=g.tip_height, color=tip_color,
-                                               opacity=opacity, visible=False))
-                     for i in range(2)]
-        self.base = self._add(sc.add_box(f"{r}/hand_base", color=(120, 120, 130),
-                                         dimensions=(0.08, 0.02, 0.01), opacity=opacity,
-                                         visible=False))
+        self.tips = [
+            self._add(
+                sc.add_cylinder(
+                    f"{r}/tip{i}",
+                    radius=g.tip_radius,
+                    height=g.tip_height,
+                    color=tip_color,
+                    opacity=opacity,
+                    visible=False,
+                )
+            )
+            for i in range(2)
+        ]
+        self.base = self._add(
+            sc.add_box(
+                f"{r}/hand_base",
+                color=(120, 120, 130),
+                dimensions=(0.08, 0.02, 0.01),
+                opacity=opacity,
+                visible=False,
+            )
+        )
         self.fingers = None
         self.markers = []
         for e in self.run.events:
             c = (e.get("data") or {}).get("contact")
             if e.get("kind") == "collision" and isinstance(c, list) and len(c) == 2:
-                h = self._add(sc.add_icosphere(
-                    f"{r}/events/{len(self.markers)}", radius=0.003, color=(220, 30, 30),
-                    position=(float(c[0]), float(c[1]), g.thickness), visible=False))
+                h = self._add(
+                    sc.add_icosphere(
+                        f"{r}/events/{len(self.markers)}",
+                        radius=0.003,
+                        color=(220, 30, 30),
+                        position=(float(c[0]), float(c[1]), g.thickness),
+                        visible=False,
+                    )
+                )
                 self.markers.append((float(e["t"]), h))
         self._cameras(scale=0.05)
 
@@ -133,8 +198,9 @@ class AirTableScene(RunScene):
             x, y, th = (float(st.fields[k][i]) for k in ("x", "y", "theta"))
             self.stick.position = (x, y, 0.0)
             self.stick.wxyz = yaw_wxyz(th)
-            xyz = np.column_stack([st.fields["x"], st.fields["y"],
-                                   np.full(len(st), g.thickness + 0.001)])
+            xyz = np.column_stack(
+                [st.fields["x"], st.fields["y"], np.full(len(st), g.thickness + 0.001)]
+            )
             self._update_path(xyz, i)
         else:
             self._update_path(None, -1)
@@ -142,8 +208,11 @@ class AirTableScene(RunScene):
         j = vs.index(t) if vs is not None else -1
         self.vision.visible = j >= 0
         if j >= 0:
-            self.vision.position = (float(vs.fields["x"][j]), float(vs.fields["y"][j]),
-                                    g.thickness / 2.0 + 0.0003)
+            self.vision.position = (
+                float(vs.fields["x"][j]),
+                float(vs.fields["y"][j]),
+                g.thickness / 2.0 + 0.0003,
+            )
             self.vision.wxyz = yaw_wxyz(float(vs.fields["theta"][j]))
         fi = run.track(TOPIC_FINGERS_STATE)
         j = fi.index(t) if fi is not None and fi.has("tips") else -1
@@ -160,12 +229,16 @@ class AirTableScene(RunScene):
             pts = g.finger_points(base, hs.fields["joints"][j])
             z = g.tip_height
             segs = [[(*pts[f, s], z), (*pts[f, s + 1], z)] for f in range(2) for s in range(2)]
-            segs.append([(*pts[0, 0], z), (*pts[1, 0], z)])          # the palm
+            segs.append([(*pts[0, 0], z), (*pts[1, 0], z)])  # the palm
             self.base.position = (float(base[0]), float(base[1]), 0.005)
             color = (90, 90, 100) if not self.ghost else self.color
             self.fingers = self.scene.add_line_segments(
-                f"{self.root}/fingers", np.asarray(segs, dtype=np.float32), color,
-                thickness=4.0, thickness_units="screen")
+                f"{self.root}/fingers",
+                np.asarray(segs, dtype=np.float32),
+                color,
+                thickness=4.0,
+                thickness_units="screen",
+            )
             self.dynamic["fingers"] = self.fingers
         elif self.fingers is not None:
             self.fingers.visible = False
@@ -180,5 +253,8 @@ class AirTableScene(RunScene):
         def omega(run):
             st = run.track(TOPIC_STICK_STATE)
             return None if st is None else (st.t, st.fields["omega"])
-        return [PlotSpec("stick speed |v| (m/s)", [PlotSeries("|v|", speed)]),
-                PlotSpec("stick angular velocity ω (rad/s)", [PlotSeries("ω", omega)])]
+
+        return [
+            PlotSpec("stick speed |v| (m/s)", [PlotSeries("|v|", speed)]),
+            PlotSpec("stick angular velocity ω (rad/s)", [PlotSeries("ω", omega)]),
+        ]

@@ -12,5 +12,6 @@ __all__ = ["BulletArmPlant", "Params"]
 def __getattr__(name: str):
     if name == "BulletArmPlant":
         from plants.bullet_arm.plant import BulletArmPlant
+
         return BulletArmPlant
     raise AttributeError(f"module 'plants.bullet_arm' has no attribute {name!r}")

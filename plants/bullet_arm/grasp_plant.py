@@ -46,14 +46,16 @@ class BulletGraspPlant(BulletArmPlant):
     spec_type = GraspSpec
     command_types = (ServoCommand,)  # type: ignore[assignment]
     hold_event = "grasp"
-    description = ("PyBullet WAM-7 + 14-joint hand on velocity servos, pan/tilt head, wrist F/T, "
-                   "an object moved by a human hand on a constraint plane")
+    description = (
+        "PyBullet WAM-7 + 14-joint hand on velocity servos, pan/tilt head, wrist F/T, "
+        "an object moved by a human hand on a constraint plane"
+    )
 
     def __init__(self, params: GraspParams, *, dt: float, rng: np.random.Generator) -> None:
         if params.object == "none" or params.hand == "none":
             raise ValueError("the grasping rig needs a hand and an object")
         super().__init__(params, dt=dt, rng=rng)
-        self._watch = None                 # the catch verdict's watcher: this rig's is outcome()
+        self._watch = None  # the catch verdict's watcher: this rig's is outcome()
         P = params
         bc = self.bc
         self._palm_j = self._jidx["palm_joint"]
@@ -61,8 +63,9 @@ class BulletGraspPlant(BulletArmPlant):
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
         # the servos: every arm and hand joint's own inertia at the initial posture
-        bc.setJointMotorControlArray(self.robot, self._hand_j, p.VELOCITY_CONTROL,
-                                     forces=[0.0] * len(self._hand_j))
+        bc.setJointMotorControlArray(
+            self.robot, self._hand_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._hand_j)
+        )
         dofs = [j for j in self._dofs]
         pos = [s[0] for s in bc.getJointStates(self.robot, dofs)]
         Minv = np.linalg.inv(np.array(bc.calculateMassMatrix(self.robot, pos)))
@@ -72,11 +75,15 @@ class BulletGraspPlant(BulletArmPlant):
         d = 1.0 / np.diag(Minv)
         coupling = float(np.max(np.linalg.eigvals(Minv * d[None, :]).real))
         inertia = {j: d[i] / coupling for i, j in enumerate(dofs)}
-        self.arm_servos = VelocityServos([inertia[j] for j in self._arm_j],
-                                         self.torque_limits[list(self.active)],
-                                         P.arm_servo_bandwidth, dt)
-        self.hand_servos = VelocityMotors(bc, self.robot, self._hand_j,
-                                          [P.hand_max_torque] * len(self._hand_j))
+        self.arm_servos = VelocityServos(
+            [inertia[j] for j in self._arm_j],
+            self.torque_limits[list(self.active)],
+            P.arm_servo_bandwidth,
+            dt,
+        )
+        self.hand_servos = VelocityMotors(
+            bc, self.robot, self._hand_j, [P.hand_max_torque] * len(self._hand_j)
+        )
         self._servo_j = self._arm_j
         # the servos have been holding the robot still before t = 0: their integrals carry the
         # static torques (gravity) at the initial posture
@@ -84,13 +91,21 @@ class BulletGraspPlant(BulletArmPlant):
         tau0 = {j: g[i] for i, j in enumerate(dofs)}
         self.arm_servos.preload([tau0[j] for j in self._arm_j])
         # the head
-        self.head = HeadSpec(position=tuple(P.head_position), yaw=float(P.head_yaw),
-                             camera_offset=float(P.head_camera_offset),
-                             lower=tuple(P.head_lower), upper=tuple(P.head_upper),
-                             inertia=tuple(P.head_inertia), torque_limit=tuple(P.head_torque_limit),
-                             velocity_limit=tuple(P.head_velocity_limit))
-        h0 = (list(P.head_initial) if P.head_initial
-              else list(look_angles(self.head, P.object_position)))
+        self.head = HeadSpec(
+            position=tuple(P.head_position),
+            yaw=float(P.head_yaw),
+            camera_offset=float(P.head_camera_offset),
+            lower=tuple(P.head_lower),
+            upper=tuple(P.head_upper),
+            inertia=tuple(P.head_inertia),
+            torque_limit=tuple(P.head_torque_limit),
+            velocity_limit=tuple(P.head_velocity_limit),
+        )
+        h0 = (
+            list(P.head_initial)
+            if P.head_initial
+            else list(look_angles(self.head, P.object_position))
+        )
         if len(h0) != 2:
             raise ValueError("head_initial needs 2 values (pan, tilt)")
         self.head_servo = HeadServo(self.head, P.head_servo_bandwidth, dt, h0)
@@ -105,15 +120,28 @@ class BulletGraspPlant(BulletArmPlant):
         u = u / np.linalg.norm(u)
         v = np.cross(n, u)
         op = [float(x) for x in P.object_position]
-        self.plane = PlaneSpec(point=(op[0], op[1], op[2]),
-                               normal=(float(n[0]), float(n[1]), float(n[2])))
+        self.plane = PlaneSpec(
+            point=(op[0], op[1], op[2]), normal=(float(n[0]), float(n[1]), float(n[2]))
+        )
         self._u, self._v = u, v
         assert self.obj is not None and self._palm_link is not None
-        self.human = HumanHand(bc, self.obj, rng, origin=P.object_position, rpy0=P.object_rpy,
-                               u=u, v=v, n=n, speed=P.human_speed, roll_rate=P.human_roll_rate,
-                               f_min=P.human_f_min, f_max=P.human_f_max,
-                               components=P.human_components, max_force=P.human_max_force,
-                               start=P.human_start)
+        self.human = HumanHand(
+            bc,
+            self.obj,
+            rng,
+            origin=P.object_position,
+            rpy0=P.object_rpy,
+            u=u,
+            v=v,
+            n=n,
+            speed=P.human_speed,
+            roll_rate=P.human_roll_rate,
+            f_min=P.human_f_min,
+            f_max=P.human_f_max,
+            components=P.human_components,
+            max_force=P.human_max_force,
+            start=P.human_start,
+        )
         # bookkeeping of the verdict
         self._grasps: list[dict] = []
         self._grasp_start = 0.0
@@ -131,8 +159,10 @@ class BulletGraspPlant(BulletArmPlant):
     # ------------------------------------------------------------------ spec
     def _grasp_spec(self, base) -> GraspSpec:
         fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
-        fields["notes"] = {**base.notes, "arm": "WAM-7 stands in for the paper's unnamed 7-axis "
-                           "arm; velocity servos"}
+        fields["notes"] = {
+            **base.notes,
+            "arm": "WAM-7 stands in for the paper's unnamed 7-axis arm; velocity servos",
+        }
         return GraspSpec(**fields, head=self.head, plane=self.plane)
 
     # ------------------------------------------------------------------ state (one read a step)
@@ -152,7 +182,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._tau_applied = self._tau_cmd = tau
         self._clamped = np.zeros(self.dof, dtype=bool)
         self._clamped[act] = self.arm_servos.saturated
-        hs = st[na:na + nh]
+        hs = st[na : na + nh]
         self._hq = np.array([s[0] for s in hs])
         self._hqd = np.array([s[1] for s in hs])
         self.hand_servos.read(hs)
@@ -197,9 +227,16 @@ class BulletGraspPlant(BulletArmPlant):
         self._t = self._steps * self.dt
         self._read()
         for i in np.flatnonzero(self._clamped & ~self._torque_episode):
-            self._events.append(Occurrence("torque_limit", {
-                "joint": self.joint_names[i], "applied": float(self._tau_applied[i]),
-                "limit": float(self.torque_limits[i])}))
+            self._events.append(
+                Occurrence(
+                    "torque_limit",
+                    {
+                        "joint": self.joint_names[i],
+                        "applied": float(self._tau_applied[i]),
+                        "limit": float(self.torque_limits[i]),
+                    },
+                )
+            )
         self._torque_episode = self._clamped
         self.clamp_count += int(self._clamped.sum())
         was_held = self.caught
@@ -218,8 +255,7 @@ class BulletGraspPlant(BulletArmPlant):
                 held = self._t - self._grasp_start
                 self._grasps[-1]["held_for"] = held
                 ev.data["held_for"] = held
-        parts = {self.model.part_of_link.get(self._link_name[c[4]], "arm")
-                 for c in self._contacts}
+        parts = {self.model.part_of_link.get(self._link_name[c[4]], "arm") for c in self._contacts}
         parts.discard("arm")
         self._touched |= parts
         self._max_parts = max(self._max_parts, len(parts))
@@ -243,38 +279,47 @@ class BulletGraspPlant(BulletArmPlant):
         self._last_pos = pos
 
     def _tool_position(self) -> np.ndarray:
-        return np.array(self.bc.getLinkState(self.robot, self._tool_link,
-                                             computeForwardKinematics=1)[4])
+        return np.array(
+            self.bc.getLinkState(self.robot, self._tool_link, computeForwardKinematics=1)[4]
+        )
 
     # ------------------------------------------------------------------ verdict
     def outcome(self, t: float) -> dict:
         P = self.params
-        holds = [(g["held_for"] if g["held_for"] is not None else t - g["t"])
-                 for g in self._grasps]
-        out = {"success": True, "reason": "grasped",
-               "grasps": len(self._grasps),
-               "first_grasp_t": self._grasps[0]["t"] if self._grasps else None,
-               "hold_time": float(sum(holds)), "longest_hold": max(holds, default=0.0),
-               "held_path": self._held_path, "slips": self._slips,
-               "tracking_error_rms": (math.sqrt(self._track_sq / self._track_n)
-                                      if self._track_n else None),
-               "hand_parts_touched": sorted(self._touched)}
+        holds = [(g["held_for"] if g["held_for"] is not None else t - g["t"]) for g in self._grasps]
+        out = {
+            "success": True,
+            "reason": "grasped",
+            "grasps": len(self._grasps),
+            "first_grasp_t": self._grasps[0]["t"] if self._grasps else None,
+            "hold_time": float(sum(holds)),
+            "longest_hold": max(holds, default=0.0),
+            "held_path": self._held_path,
+            "slips": self._slips,
+            "tracking_error_rms": (
+                math.sqrt(self._track_sq / self._track_n) if self._track_n else None
+            ),
+            "hand_parts_touched": sorted(self._touched),
+        }
         if not self._grasps:
             out["success"] = False
             if not self._touched:
                 out["reason"] = "no grasp: the hand never touched the object"
             else:
-                out["reason"] = (f"no grasp: touched by {', '.join(sorted(self._touched))} "
-                                 f"(at most {self._max_parts} parts at once, "
-                                 f"{P.catch_min_parts} needed) but never held still against "
-                                 "the palm")
+                out["reason"] = (
+                    f"no grasp: touched by {', '.join(sorted(self._touched))} "
+                    f"(at most {self._max_parts} parts at once, "
+                    f"{P.catch_min_parts} needed) but never held still against "
+                    "the palm"
+                )
         elif len(self._grasps) < P.grasp_min_grasps:
             out["success"] = False
             out["reason"] = f"only {len(self._grasps)} of {P.grasp_min_grasps} grasps"
         elif max(holds) < P.grasp_min_hold - 1e-9:
             out["success"] = False
-            out["reason"] = (f"grasp not held: longest hold {max(holds):.3f} s < "
-                             f"{P.grasp_min_hold:g} s")
+            out["reason"] = (
+                f"grasp not held: longest hold {max(holds):.3f} s < {P.grasp_min_hold:g} s"
+            )
         elif self._held_path <= 1e-3:
             out["success"] = False
             out["reason"] = "held, but the object did not move while grasped"
@@ -289,19 +334,34 @@ class BulletGraspPlant(BulletArmPlant):
         out = super().truth(t)
         del out["/arm/applied_torque"]
         act = list(self.active)
-        out["/arm/servo"] = ServoState(t, list(self.joint_names),
-                                       _full(self.dof, act, self.arm_servos.command),
-                                       _full(self.dof, act, self.arm_servos.integral),
-                                       self._tau_applied.tolist(),
-                                       [bool(c) for c in self._clamped])
+        out["/arm/servo"] = ServoState(
+            t,
+            list(self.joint_names),
+            _full(self.dof, act, self.arm_servos.command),
+            _full(self.dof, act, self.arm_servos.integral),
+            self._tau_applied.tolist(),
+            [bool(c) for c in self._clamped],
+        )
         hs = self.head_servo
-        out["/head/joint_state"] = JointState(t, list(HEAD_JOINTS), hs.q.tolist(), hs.qd.tolist(),
-                                              hs.torque.tolist())
+        out["/head/joint_state"] = JointState(
+            t, list(HEAD_JOINTS), hs.q.tolist(), hs.qd.tolist(), hs.torque.tolist()
+        )
         R, c = self._head_reading()
-        out["/head/state"] = HeadState(t, float(hs.q[0]), float(hs.q[1]), hs.qd.tolist(),
-                                       c.tolist(), [float(x) for x in matrix_to_quaternion(R)])
-        out["/human/state"] = HumanState(t, self.human.target.tolist(), float(self.human.roll),
-                                         self.human.force(), self.human.max_force)
+        out["/head/state"] = HeadState(
+            t,
+            float(hs.q[0]),
+            float(hs.q[1]),
+            hs.qd.tolist(),
+            c.tolist(),
+            [float(x) for x in matrix_to_quaternion(R)],
+        )
+        out["/human/state"] = HumanState(
+            t,
+            self.human.target.tolist(),
+            float(self.human.roll),
+            self.human.force(),
+            self.human.max_force,
+        )
         w = self._wrench
         out["/wrist/wrench_truth"] = Wrench(t, w[:3].tolist(), w[3:].tolist())
         return out
@@ -310,12 +370,19 @@ class BulletGraspPlant(BulletArmPlant):
         sc = super().scene()
         hs = self.head_servo
         R, c = self._head_reading()
-        sc.readings["hand"] = {"name": list(self.hand_names), "position": self._hq.tolist(),
-                               "velocity": self._hqd.tolist()}
+        sc.readings["hand"] = {
+            "name": list(self.hand_names),
+            "position": self._hq.tolist(),
+            "velocity": self._hqd.tolist(),
+        }
         sc.readings["hand_torque"] = {"name": list(self.hand_names), "torque": self._htau}
-        sc.readings["head"] = {"name": list(HEAD_JOINTS), "position": hs.q.tolist(),
-                               "velocity": hs.qd.tolist(), "camera_rotation": R,
-                               "camera_position": c}
+        sc.readings["head"] = {
+            "name": list(HEAD_JOINTS),
+            "position": hs.q.tolist(),
+            "velocity": hs.qd.tolist(),
+            "camera_rotation": R,
+            "camera_position": c,
+        }
         sc.readings["wrist"] = {"wrench": self._wrench}
         return sc
 
@@ -324,4 +391,3 @@ def _full(n: int, idx: list, values) -> list:
     out = np.zeros(n)
     out[idx] = values
     return out.tolist()
-

@@ -27,9 +27,15 @@ T_CHIP = "/vision/chip"
 T_RECOGNISED = "/grasping/object"
 T_ARM_TASK = "/grasping/arm"
 # the topics a grasping run has (a missing one is noted in the view)
-EXPECTED = ("/arm/joint_state", "/hand/joint_state", "/object/state", T_HEAD, T_RECOGNISED,
-            T_ARM_TASK)
-DEFAULT_FOV = math.radians(30.0)      # when the chip sensor's params give none
+EXPECTED = (
+    "/arm/joint_state",
+    "/hand/joint_state",
+    "/object/state",
+    T_HEAD,
+    T_RECOGNISED,
+    T_ARM_TASK,
+)
+DEFAULT_FOV = math.radians(30.0)  # when the chip sensor's params give none
 
 
 def chip_fov(sensors: dict) -> tuple[float, int, int]:
@@ -42,16 +48,20 @@ def chip_fov(sensors: dict) -> tuple[float, int, int]:
         fov = p.get("fov")
         if fov is None and p.get("fov_deg") is not None:
             fov = math.radians(float(p["fov_deg"]))
-        return (float(fov) if fov else DEFAULT_FOV, int(p.get("width", 16)),
-                int(p.get("height", 16)))
+        return (
+            float(fov) if fov else DEFAULT_FOV,
+            int(p.get("width", 16)),
+            int(p.get("height", 16)),
+        )
     return DEFAULT_FOV, 16, 16
 
 
 def chip_image(rows, width: int, height: int) -> np.ndarray:
     """``/vision/chip`` rows (bit u of rows[v] = pixel (u, v)) as a grey RGB image, upscaled so
     the browser shows sharp pixels."""
-    bits = np.array([[(int(r) >> u) & 1 for u in range(width)] for r in rows[:height]],
-                    dtype=np.uint8)
+    bits = np.array(
+        [[(int(r) >> u) & 1 for u in range(width)] for r in rows[:height]], dtype=np.uint8
+    )
     img = np.where(bits[..., None] > 0, 235, 30).astype(np.uint8).repeat(3, axis=2)
     return img.repeat(8, axis=0).repeat(8, axis=1)
 
@@ -72,12 +82,11 @@ def _row(run: RunData, topic: str, t: float, *fields: str) -> list | None:
 
 class GraspScene(ArmScene):
     kind = "grasping"
-    Params = GraspParams        # ArmScene rebuilds these from the log and the URDF through them
+    Params = GraspParams  # ArmScene rebuilds these from the log and the URDF through them
     needs = ("/arm/joint_state", "/object/state")
 
     def expected(self):
         return EXPECTED
-
 
     def _cameras(self, scale: float) -> None:
         """The only camera is the head's, drawn on the head at its logged pose."""
@@ -86,33 +95,64 @@ class GraspScene(ArmScene):
         super().build()
         sc, r = self.scene, self.root
         p = self.params
-        self.seen.visible = False              # ArmScene's /vision/object marker: not used here
-        if p.object_position:                  # the constraint plane through it
+        self.seen.visible = False  # ArmScene's /vision/object marker: not used here
+        if p.object_position:  # the constraint plane through it
             n = np.asarray(p.plane_normal, float)
             n /= np.linalg.norm(n) or 1.0
             axis = np.cross([1.0, 0.0, 0.0], n)
             angle = math.atan2(np.linalg.norm(axis), n[0])
             axis = axis / (np.linalg.norm(axis) or 1.0)
             wxyz = (math.cos(angle / 2), *(math.sin(angle / 2) * axis))
-            self._add(sc.add_box(f"{r}/plane", color=(120, 160, 220), opacity=0.15,
-                                 dimensions=(0.002, 0.5, 0.5), wxyz=wxyz,
-                                 position=_xyz(p.object_position)))
+            self._add(
+                sc.add_box(
+                    f"{r}/plane",
+                    color=(120, 160, 220),
+                    opacity=0.15,
+                    dimensions=(0.002, 0.5, 0.5),
+                    wxyz=wxyz,
+                    position=_xyz(p.object_position),
+                )
+            )
         self.fov, self.chip_w, self.chip_h = chip_fov(self.run.sensors)
         color = (60, 60, 60) if not self.ghost else self.color
         self.head = self._add(sc.add_frame(f"{r}/head", show_axes=False, visible=False))
-        self._add(sc.add_box(f"{r}/head/body", color=color, dimensions=(0.06, 0.06, 0.05),
-                             position=(0.0, 0.0, -0.03)))
-        self.frustum = self._add(sc.add_camera_frustum(
-            f"{r}/head/frustum", fov=self.fov, aspect=self.chip_w / max(self.chip_h, 1),
-            scale=0.15, color=color, thickness=2.0, thickness_units="screen"))
+        self._add(
+            sc.add_box(
+                f"{r}/head/body",
+                color=color,
+                dimensions=(0.06, 0.06, 0.05),
+                position=(0.0, 0.0, -0.03),
+            )
+        )
+        self.frustum = self._add(
+            sc.add_camera_frustum(
+                f"{r}/head/frustum",
+                fov=self.fov,
+                aspect=self.chip_w / max(self.chip_h, 1),
+                scale=0.15,
+                color=color,
+                thickness=2.0,
+                thickness_units="screen",
+            )
+        )
         self._add(sc.add_label(f"{r}/head/label", "vision chip", position=(0.0, -0.05, 0.0)))
-        self.recognised = self._add(sc.add_icosphere(f"{r}/recognised", radius=0.01,
-                                                     color=(20, 170, 90), visible=False))
-        self.reach = self._add(sc.add_icosphere(f"{r}/reaching_target", radius=0.01,
-                                                color=(30, 120, 230), opacity=0.7,
-                                                visible=False))
-        self.phases = [(float(e["t"]), str((e.get("data") or {}).get("phase", "")))
-                       for e in self.run.events if e.get("kind") == "phase"]
+        self.recognised = self._add(
+            sc.add_icosphere(f"{r}/recognised", radius=0.01, color=(20, 170, 90), visible=False)
+        )
+        self.reach = self._add(
+            sc.add_icosphere(
+                f"{r}/reaching_target",
+                radius=0.01,
+                color=(30, 120, 230),
+                opacity=0.7,
+                visible=False,
+            )
+        )
+        self.phases = [
+            (float(e["t"]), str((e.get("data") or {}).get("phase", "")))
+            for e in self.run.events
+            if e.get("kind") == "phase"
+        ]
         self.phase_label = self._add(sc.add_label(f"{r}/phase", "", visible=False))
         self._chip_i = -1
 
@@ -153,11 +193,23 @@ class GraspScene(ArmScene):
                 if tr is None or not tr.has(field):
                     return None
                 return tr.t, tr.fields[field][:, k]
+
             return signal
-        return [PlotSpec("Y (m): hand x^a and object (tracking, Fig. 9)",
-                         [PlotSeries("hand", column(T_ARM_TASK, "x_a", 1)),
-                          PlotSeries("object", column("/object/state", "position", 1))]),
-                PlotSpec("X (m): hand x^a and reaching target x_d^a (Fig. 9)",
-                         [PlotSeries("hand", column(T_ARM_TASK, "x_a", 0)),
-                          PlotSeries("x_d", column(T_ARM_TASK, "x_d", 0))]),
-                *super().plots()]
+
+        return [
+            PlotSpec(
+                "Y (m): hand x^a and object (tracking, Fig. 9)",
+                [
+                    PlotSeries("hand", column(T_ARM_TASK, "x_a", 1)),
+                    PlotSeries("object", column("/object/state", "position", 1)),
+                ],
+            ),
+            PlotSpec(
+                "X (m): hand x^a and reaching target x_d^a (Fig. 9)",
+                [
+                    PlotSeries("hand", column(T_ARM_TASK, "x_a", 0)),
+                    PlotSeries("x_d", column(T_ARM_TASK, "x_d", 0)),
+                ],
+            ),
+            *super().plots(),
+        ]

@@ -35,7 +35,7 @@ class HeadServo:
 
     def step(self) -> None:
         dt, J, K = self.dt, self.J, self.K
-        qd_new = (J * self.qd + dt * K * self.command) / (J + dt * K)     # implicit velocity loop
+        qd_new = (J * self.qd + dt * K * self.command) / (J + dt * K)  # implicit velocity loop
         tau = K * (self.command - qd_new)
         over = np.abs(tau) > self.tau_max
         if over.any():

@@ -23,8 +23,15 @@ import pybullet as p
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 
 
-def band_limited_path(rng: np.random.Generator, *, components: int, f_min: float, f_max: float,
-                      rms_rate: float, axes: int):
+def band_limited_path(
+    rng: np.random.Generator,
+    *,
+    components: int,
+    f_min: float,
+    f_max: float,
+    rms_rate: float,
+    axes: int,
+):
     """(omega (axes, n), amplitude (axes, n), phase (axes, n)): sum_i a_i sin(w_i t + phi_i) per
     axis, with sum over axes and components of (a w)^2 / 2 = rms_rate^2."""
     f = rng.uniform(f_min, f_max, size=(axes, components))
@@ -37,27 +44,53 @@ def band_limited_path(rng: np.random.Generator, *, components: int, f_min: float
 
 
 class HumanHand:
-    def __init__(self, bc, obj: int, rng: np.random.Generator, *, origin, rpy0, u, v, n,
-                 speed: float, roll_rate: float, f_min: float, f_max: float, components: int,
-                 max_force: float, start: float) -> None:
+    def __init__(
+        self,
+        bc,
+        obj: int,
+        rng: np.random.Generator,
+        *,
+        origin,
+        rpy0,
+        u,
+        v,
+        n,
+        speed: float,
+        roll_rate: float,
+        f_min: float,
+        f_max: float,
+        components: int,
+        max_force: float,
+        start: float,
+    ) -> None:
         self.bc, self.obj = bc, obj
         self.origin = np.asarray(origin, float)
         self.u, self.v, self.n = (np.asarray(x, float) for x in (u, v, n))
         self.start = float(start)
         self.max_force = float(max_force)
-        self.w, self.a, self.phi = band_limited_path(rng, components=components, f_min=f_min,
-                                                     f_max=f_max, rms_rate=speed, axes=2)
-        self.rw, self.ra, self.rphi = band_limited_path(rng, components=components, f_min=f_min,
-                                                        f_max=f_max, rms_rate=roll_rate, axes=1)
+        self.w, self.a, self.phi = band_limited_path(
+            rng, components=components, f_min=f_min, f_max=f_max, rms_rate=speed, axes=2
+        )
+        self.rw, self.ra, self.rphi = band_limited_path(
+            rng, components=components, f_min=f_min, f_max=f_max, rms_rate=roll_rate, axes=1
+        )
         self._s0 = np.sin(self.phi)
         self._rs0 = np.sin(self.rphi)
         self.R0 = _rpy_matrix(rpy0)
         self.q0 = _quat(self.R0)
         self.target = self.origin.copy()
         self.roll = 0.0
-        self.cid = bc.createConstraint(obj, -1, -1, -1, p.JOINT_FIXED, [0.0, 0.0, 0.0],
-                                       [0.0, 0.0, 0.0], self.origin.tolist(),
-                                       childFrameOrientation=_quat(self.R0))
+        self.cid = bc.createConstraint(
+            obj,
+            -1,
+            -1,
+            -1,
+            p.JOINT_FIXED,
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0],
+            self.origin.tolist(),
+            childFrameOrientation=_quat(self.R0),
+        )
         bc.changeConstraint(self.cid, maxForce=self.max_force)
 
     def offset(self, t: float) -> tuple[float, float, float]:
@@ -75,10 +108,18 @@ class HumanHand:
         s, c = math.sin(dr / 2.0), math.cos(dr / 2.0)
         ax, ay, az = (float(x) * s for x in self.n)
         bx, by, bz, bw = self.q0
-        q = [c * bx + ax * bw + ay * bz - az * by, c * by - ax * bz + ay * bw + az * bx,
-             c * bz + ax * by - ay * bx + az * bw, c * bw - ax * bx - ay * by - az * bz]
-        self.bc.changeConstraint(self.cid, jointChildPivot=self.target.tolist(),
-                                 jointChildFrameOrientation=q, maxForce=self.max_force)
+        q = [
+            c * bx + ax * bw + ay * bz - az * by,
+            c * by - ax * bz + ay * bw + az * bx,
+            c * bz + ax * by - ay * bx + az * bw,
+            c * bw - ax * bx - ay * by - az * bz,
+        ]
+        self.bc.changeConstraint(
+            self.cid,
+            jointChildPivot=self.target.tolist(),
+            jointChildFrameOrientation=q,
+            maxForce=self.max_force,
+        )
 
     def force(self) -> list[float]:
         """The constraint's force on the object (N, world), from the last step."""

@@ -32,11 +32,11 @@ from replay.spatial import quaternion_matrix
 @dataclass
 class PalmSample:
     t: float
-    offset: float          # m: object centre from the palm axis
-    height: float          # m: object centre above the palm face (palm z)
-    rel_speed: float       # m/s: object velocity relative to the palm point under it
+    offset: float  # m: object centre from the palm axis
+    height: float  # m: object centre above the palm face (palm z)
+    rel_speed: float  # m/s: object velocity relative to the palm point under it
     approach_angle: float  # deg: relative velocity vs the palm's inward normal (-z)
-    world_offset: np.ndarray   # object centre - palm face centre (world, m)
+    world_offset: np.ndarray  # object centre - palm face centre (world, m)
 
 
 class CatchWatch:
@@ -50,8 +50,18 @@ class CatchWatch:
         self.catch_time: float | None = None
         self.approaching = True
 
-    def observe(self, t: float, obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega,
-                parts: list, caught: bool) -> None:
+    def observe(
+        self,
+        t: float,
+        obj_pos,
+        obj_vel,
+        palm_pos,
+        palm_quat,
+        palm_vel,
+        palm_omega,
+        parts: list,
+        caught: bool,
+    ) -> None:
         """One step: the object's and the palm's state (world) and the parts touching now."""
         R = quaternion_matrix(palm_quat)
         centre = np.asarray(palm_pos, float) + R[:, 2] * self.palm_thickness
@@ -60,18 +70,27 @@ class CatchWatch:
         v_point = np.asarray(palm_vel, float) + np.cross(palm_omega, np.asarray(obj_pos) - palm_pos)
         rel = np.asarray(obj_vel, float) - v_point
         speed = float(np.linalg.norm(rel))
-        inward = -(R.T @ rel)[2]                 # towards the palm face, along its normal
+        inward = -(R.T @ rel)[2]  # towards the palm face, along its normal
         angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
-        sample = PalmSample(t, float(math.hypot(local[0], local[1])), float(local[2]), speed,
-                            angle, d)
+        sample = PalmSample(
+            t, float(math.hypot(local[0], local[1])), float(local[2]), speed, angle, d
+        )
         if self.closest is None or np.linalg.norm(d) < np.linalg.norm(self.closest.world_offset):
             self.closest = sample
-        self.approaching = self.closest is sample        # still closing in at the last step
+        self.approaching = self.closest is sample  # still closing in at the last step
         if parts and self.first_contact is None:
             before = self.last or sample
-            self.first_contact = (PalmSample(t, sample.offset, sample.height, before.rel_speed,
-                                             before.approach_angle, sample.world_offset),
-                                  sorted(parts))
+            self.first_contact = (
+                PalmSample(
+                    t,
+                    sample.offset,
+                    sample.height,
+                    before.rel_speed,
+                    before.approach_angle,
+                    sample.world_offset,
+                ),
+                sorted(parts),
+            )
         if caught and self.catch_time is None:
             self.catch_time = t
         self.last = sample
@@ -82,9 +101,13 @@ class CatchWatch:
         if self.first_contact is not None:
             c, parts = self.first_contact
             part = _first_part(parts)
-            out.update(first_contact_time=round(c.t, 6), contact_part=part,
-                       contact_speed=c.rel_speed, contact_offset=c.offset,
-                       approach_angle=c.approach_angle)
+            out.update(
+                first_contact_time=round(c.t, 6),
+                contact_part=part,
+                contact_speed=c.rel_speed,
+                contact_offset=c.offset,
+                approach_angle=c.approach_angle,
+            )
         if self.catch_time is not None:
             out["catch_time"] = round(self.catch_time, 6)
         if caught:
@@ -94,10 +117,12 @@ class CatchWatch:
         if self.first_contact is not None:
             c, parts = self.first_contact
             part = _first_part(parts)
-            if self.last is not None and self.last.t - c.t < 0.06 and \
-                    np.linalg.norm(self.last.world_offset) < 2 * self.palm_radius:
-                return {"success": False, "reason": f"{k} touched the hand but was not held",
-                        **out}
+            if (
+                self.last is not None
+                and self.last.t - c.t < 0.06
+                and np.linalg.norm(self.last.world_offset) < 2 * self.palm_radius
+            ):
+                return {"success": False, "reason": f"{k} touched the hand but was not held", **out}
             if part == "palm":
                 where = "rim" if c.offset > self.palm_radius else "face"
                 return {"success": False, "reason": f"{k} bounced off the palm {where}", **out}
@@ -107,11 +132,15 @@ class CatchWatch:
         if self.closest is None:
             return {"success": False, "reason": f"the run ended before the {k} reached the hand"}
         cl = self.closest
-        out.update(closest_distance=float(np.linalg.norm(cl.world_offset)),
-                   closest_time=round(cl.t, 6))
+        out.update(
+            closest_distance=float(np.linalg.norm(cl.world_offset)), closest_time=round(cl.t, 6)
+        )
         if self.approaching:
-            return {"success": False, "reason": f"the run ended before the {k} reached the hand",
-                    **out}
+            return {
+                "success": False,
+                "reason": f"the run ended before the {k} reached the hand",
+                **out,
+            }
         dy, dz = abs(cl.world_offset[1]), cl.world_offset[2]
         side = ("below" if dz < 0 else "above") if abs(dz) >= dy else "beside"
         return {"success": False, "reason": f"{k} passed {side} the hand", **out}
@@ -120,4 +149,3 @@ class CatchWatch:
 def _first_part(parts: list) -> str:
     """The part a first touch is attributed to: the palm if it is among them, else the first."""
     return "palm" if "palm" in parts else (parts[0] if parts else "arm")
-

@@ -47,7 +47,7 @@ class VelocityServos:
         v = np.asarray(qd, float).reshape(-1)
         if v.shape != self.command.shape:
             raise ValueError(f"velocity command needs {len(self.K)} values, got {v.shape[0]}")
-        self.command = np.where(np.isfinite(v), v, 0.0)   # a non-finite command: stop
+        self.command = np.where(np.isfinite(v), v, 0.0)  # a non-finite command: stop
 
     def torques(self, qd: np.ndarray) -> np.ndarray:
         """The motors' torques for joint velocities ``qd`` (before a physics step)."""
@@ -56,7 +56,7 @@ class VelocityServos:
         raw = self.K * (e + self.wi * integral)
         lim = self.limits
         sat = np.abs(raw) > lim
-        self.integral = np.where(sat, self.integral, integral)       # anti-windup
+        self.integral = np.where(sat, self.integral, integral)  # anti-windup
         self.torque = np.clip(raw, -lim, lim)
         self.saturated = sat
         return self.torque
@@ -88,9 +88,13 @@ class VelocityMotors:
         self.command = np.where(np.isfinite(v), v, 0.0)
 
     def actuate(self) -> None:
-        self.bc.setJointMotorControlArray(self.body, self.joints, p.VELOCITY_CONTROL,
-                                          targetVelocities=self.command.tolist(),
-                                          forces=self._forces)
+        self.bc.setJointMotorControlArray(
+            self.body,
+            self.joints,
+            p.VELOCITY_CONTROL,
+            targetVelocities=self.command.tolist(),
+            forces=self._forces,
+        )
 
     def read(self, states) -> None:
         """The motors' torques from this step's joint states (index 3)."""

@@ -16,8 +16,13 @@ import numpy as np
 
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.settings import resolve
-from replay.messages import (TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_STATE, TOPIC_HAND_JOINT_STATE,
-                             TOPIC_OBJECT_STATE, TOPIC_VISION_OBJECT)
+from replay.messages import (
+    TOPIC_ARM_JOINT_STATE,
+    TOPIC_EFFECTOR_STATE,
+    TOPIC_HAND_JOINT_STATE,
+    TOPIC_OBJECT_STATE,
+    TOPIC_VISION_OBJECT,
+)
 from replay.scenario import params_from_data
 from replay.spatial import rpy_to_wxyz, xyzw_to_wxyz
 from replay.viewer.data import RunData, Track
@@ -38,14 +43,16 @@ def plant_models_urdf(p: dict, params_cls: type = Params) -> Path:
 URDF_FOR: Callable[[dict], Path] | None = None
 
 
-def arm_urdf(p: dict, urdf_for: Callable[[dict], Path] | None = None,
-             params_cls: type = Params) -> Path:
+def arm_urdf(
+    p: dict, urdf_for: Callable[[dict], Path] | None = None, params_cls: type = Params
+) -> Path:
     fn = urdf_for or URDF_FOR or (lambda d: plant_models_urdf(d, params_cls))
     try:
         path = Path(fn(p))
     except Exception as exc:  # noqa: BLE001 - any failure is one line in the view
-        raise ViewerError(f"cannot build the arm's URDF ({exc.__class__.__name__}: {exc})") \
-            from None
+        raise ViewerError(
+            f"cannot build the arm's URDF ({exc.__class__.__name__}: {exc})"
+        ) from None
     if not path.is_file():
         raise ViewerError(f"arm URDF {path} not found")
     return path
@@ -54,12 +61,18 @@ def arm_urdf(p: dict, urdf_for: Callable[[dict], Path] | None = None,
 class ArmScene(RunScene):
     """Namiki & Ishikawa 2003 (catching), Namiki et al. 1999 (grasping): arm and hand from the
     plant's URDF, the free object (ball / hexahedron) and its path, cameras."""
+
     kind = "arm"
     view_direction = (0.3, -1.05, 0.4)
-    Params: type = Params       # the plant's params; a scene for a plant built on this one
-                                # (e.g. with Params(Params) subclassed) sets its own
+    Params: type = Params  # the plant's params; a scene for a plant built on this one
+    # (e.g. with Params(Params) subclassed) sets its own
     needs = (TOPIC_ARM_JOINT_STATE, TOPIC_OBJECT_STATE)
-    optional = (TOPIC_ARM_JOINT_STATE, TOPIC_HAND_JOINT_STATE, TOPIC_OBJECT_STATE, TOPIC_VISION_OBJECT)
+    optional = (
+        TOPIC_ARM_JOINT_STATE,
+        TOPIC_HAND_JOINT_STATE,
+        TOPIC_OBJECT_STATE,
+        TOPIC_VISION_OBJECT,
+    )
 
     def expected(self):
         p = self.params
@@ -74,6 +87,7 @@ class ArmScene(RunScene):
 
     def build(self) -> None:
         from viser.extras import ViserUrdf
+
         p = self.params = self.plant_params(self.Params)
         self.check_topics()
         self._path_thickness = 3.0
@@ -81,52 +95,90 @@ class ArmScene(RunScene):
         if self.k == 0:
             lo, hi = self.bounds()
             span = float(max(hi[0] - lo[0], hi[1] - lo[1], 2.0)) + 1.0
-            self._add(sc.add_grid("/floor", width=span, height=span, cell_size=0.25,
-                                  section_size=1.0, position=((lo[0] + hi[0]) / 2.0,
-                                                              (lo[1] + hi[1]) / 2.0, 0.0)))
+            self._add(
+                sc.add_grid(
+                    "/floor",
+                    width=span,
+                    height=span,
+                    cell_size=0.25,
+                    section_size=1.0,
+                    position=((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, 0.0),
+                )
+            )
         self.urdf = None
         self._names: tuple[str, ...] = ()
         self._maps: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-        self._add(sc.add_frame(                 # the base plate's pose; the URDF hangs here
-            f"{r}/arm", show_axes=False,
-            position=tuple(float(v) for v in p.base_position), wxyz=rpy_to_wxyz(p.base_rpy)))
+        self._add(
+            sc.add_frame(  # the base plate's pose; the URDF hangs here
+                f"{r}/arm",
+                show_axes=False,
+                position=tuple(float(v) for v in p.base_position),
+                wxyz=rpy_to_wxyz(p.base_rpy),
+            )
+        )
         if self.run.track(TOPIC_ARM_JOINT_STATE) is not None or self.run.plant_type:
             try:
                 path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
                 override = None if not self.ghost else (*(c / 255 for c in self.color), 0.45)
-                self.urdf = ViserUrdf(self.server, path, root_node_name=f"{r}/arm",
-                                      mesh_color_override=override)
+                self.urdf = ViserUrdf(
+                    self.server, path, root_node_name=f"{r}/arm", mesh_color_override=override
+                )
                 self._names = self.urdf.get_actuated_joint_names()
                 self._cfg = np.zeros(len(self._names))
             except ViewerError as exc:
                 self.notes.append(f"arm not drawn: {exc}")
             except Exception as exc:  # noqa: BLE001 - a URDF yourdfpy cannot read
-                self.notes.append(f"arm not drawn: URDF unreadable ({exc.__class__.__name__}: "
-                                  f"{exc})")
+                self.notes.append(
+                    f"arm not drawn: URDF unreadable ({exc.__class__.__name__}: {exc})"
+                )
         color = (240, 120, 30) if not self.ghost else self.color
         if p.object == "box":
-            self.body = self._add(sc.add_box(f"{r}/object", color=color,
-                                             dimensions=tuple(float(s) for s in p.object_size),
-                                             opacity=0.6 if self.ghost else None,
-                                             visible=False))
+            self.body = self._add(
+                sc.add_box(
+                    f"{r}/object",
+                    color=color,
+                    dimensions=tuple(float(s) for s in p.object_size),
+                    opacity=0.6 if self.ghost else None,
+                    visible=False,
+                )
+            )
         else:
-            self.body = self._add(sc.add_icosphere(f"{r}/object", radius=p.object_radius,
-                                                   color=color, subdivisions=3,
-                                                   opacity=0.6 if self.ghost else None,
-                                                   visible=False))
-        self.seen = self._add(sc.add_icosphere(f"{r}/vision", radius=0.008, color=(20, 170, 90),
-                                               visible=False))
-        self.target = self._add(sc.add_icosphere(f"{r}/effector_target", radius=0.012,
-                                                 color=(30, 120, 230), opacity=0.6,
-                                                 visible=False))
+            self.body = self._add(
+                sc.add_icosphere(
+                    f"{r}/object",
+                    radius=p.object_radius,
+                    color=color,
+                    subdivisions=3,
+                    opacity=0.6 if self.ghost else None,
+                    visible=False,
+                )
+            )
+        self.seen = self._add(
+            sc.add_icosphere(f"{r}/vision", radius=0.008, color=(20, 170, 90), visible=False)
+        )
+        self.target = self._add(
+            sc.add_icosphere(
+                f"{r}/effector_target",
+                radius=0.012,
+                color=(30, 120, 230),
+                opacity=0.6,
+                visible=False,
+            )
+        )
         self.markers = []
         for e in self.run.events:
             pos = (e.get("data") or {}).get("position")
             if isinstance(pos, list) and len(pos) == 3:
-                h = self._add(sc.add_icosphere(
-                    f"{r}/events/{len(self.markers)}", radius=0.012,
-                    color=(220, 30, 30) if e.get("kind") != "catch" else (30, 180, 60),
-                    opacity=0.7, position=tuple(float(v) for v in pos), visible=False))
+                h = self._add(
+                    sc.add_icosphere(
+                        f"{r}/events/{len(self.markers)}",
+                        radius=0.012,
+                        color=(220, 30, 30) if e.get("kind") != "catch" else (30, 180, 60),
+                        opacity=0.7,
+                        position=tuple(float(v) for v in pos),
+                        visible=False,
+                    )
+                )
                 self.markers.append((float(e["t"]), h))
         self._cameras(scale=0.12)
 
@@ -185,8 +237,11 @@ class ArmScene(RunScene):
             self.seen.position = tuple(float(v) for v in vo.fields["position"][j])
         ef = run.track(TOPIC_EFFECTOR_STATE)
         j = ef.index(t) if ef is not None and ef.has("desired_position") else -1
-        ok = j >= 0 and ef.fields["desired_position"].shape[1:] == (3,) and \
-            bool(np.all(np.isfinite(ef.fields["desired_position"][j])))
+        ok = (
+            j >= 0
+            and ef.fields["desired_position"].shape[1:] == (3,)
+            and bool(np.all(np.isfinite(ef.fields["desired_position"][j])))
+        )
         self.target.visible = ok
         if ok:
             self.target.position = tuple(float(v) for v in ef.fields["desired_position"][j])
@@ -200,17 +255,23 @@ class ArmScene(RunScene):
                 if tr is None or not tr.has(field) or tr.fields[field].shape[1] <= k:
                     return None
                 return tr.t, tr.fields[field][:, k]
+
             return signal
+
         tr = self.run.track(TOPIC_ARM_JOINT_STATE)
         if tr is None:
             return []
-        names = list(tr.labels.get("name") or
-                     [f"q{k + 1}" for k in range(tr.fields["position"].shape[1])])
+        names = list(
+            tr.labels.get("name") or [f"q{k + 1}" for k in range(tr.fields["position"].shape[1])]
+        )
         specs = []
-        for field, title in (("position", "joint angles (rad)"),
-                             ("velocity", "joint velocities (rad/s)"),
-                             ("effort", "joint torques (N·m)")):
+        for field, title in (
+            ("position", "joint angles (rad)"),
+            ("velocity", "joint velocities (rad/s)"),
+            ("effort", "joint torques (N·m)"),
+        ):
             if tr.has(field):
-                specs.append(PlotSpec(title, [PlotSeries(n, joint(field, k))
-                                              for k, n in enumerate(names)]))
+                specs.append(
+                    PlotSpec(title, [PlotSeries(n, joint(field, k)) for k, n in enumerate(names)])
+                )
         return specs

@@ -32,9 +32,9 @@ def fmt3(v) -> str:
 
 @dataclass
 class Geometry:
-    kind: str                       # box | cylinder | sphere
-    size: tuple                     # box (x, y, z); cylinder (radius, length); sphere (radius,)
-    origin: np.ndarray              # 4x4 in the link frame
+    kind: str  # box | cylinder | sphere
+    size: tuple  # box (x, y, z); cylinder (radius, length); sphere (radius,)
+    origin: np.ndarray  # 4x4 in the link frame
     rgba: tuple = (0.7, 0.7, 0.7, 1.0)
     material: str = "grey"
 
@@ -50,16 +50,20 @@ class Geometry:
             raise ValueError(self.kind)
         mat = ""
         if tag == "visual":
-            mat = (f'\n      <material name="{self.material}"><color rgba="{fmt3(self.rgba[:3])} '
-                   f'{fmt(self.rgba[3])}"/></material>')
-        return (f'    <{tag}>\n      <origin xyz="{fmt3(self.origin[:3, 3])}" rpy="{fmt3(rpy)}"/>\n'
-                f'      <geometry>{g}</geometry>{mat}\n    </{tag}>\n')
+            mat = (
+                f'\n      <material name="{self.material}"><color rgba="{fmt3(self.rgba[:3])} '
+                f'{fmt(self.rgba[3])}"/></material>'
+            )
+        return (
+            f'    <{tag}>\n      <origin xyz="{fmt3(self.origin[:3, 3])}" rpy="{fmt3(rpy)}"/>\n'
+            f"      <geometry>{g}</geometry>{mat}\n    </{tag}>\n"
+        )
 
 
 @dataclass
 class Link:
     name: str
-    body: RigidBody | None = None           # in the link frame; None = zero mass
+    body: RigidBody | None = None  # in the link frame; None = zero mass
     geometry: list[Geometry] = field(default_factory=list)
     collide: bool = True
 
@@ -72,7 +76,8 @@ class Link:
             f'      <mass value="{fmt(b.mass)}"/>\n'
             f'      <inertia ixx="{fmt(inertia[0, 0])}" ixy="{fmt(inertia[0, 1])}" '
             f'ixz="{fmt(inertia[0, 2])}" iyy="{fmt(inertia[1, 1])}" iyz="{fmt(inertia[1, 2])}" '
-            f'izz="{fmt(inertia[2, 2])}"/>\n    </inertial>\n')
+            f'izz="{fmt(inertia[2, 2])}"/>\n    </inertial>\n'
+        )
         for g in self.geometry:
             out.append(g.xml("visual"))
             if self.collide:
@@ -84,10 +89,10 @@ class Link:
 @dataclass
 class Joint:
     name: str
-    kind: str                 # revolute | fixed
+    kind: str  # revolute | fixed
     parent: str
     child: str
-    origin: np.ndarray        # 4x4, child frame at q = 0 in the parent frame
+    origin: np.ndarray  # 4x4, child frame at q = 0 in the parent frame
     axis: tuple = (0.0, 0.0, 1.0)
     lower: float = 0.0
     upper: float = 0.0
@@ -96,14 +101,18 @@ class Joint:
 
     def xml(self) -> str:
         rpy = matrix_to_rpy(self.origin[:3, :3])
-        s = (f'  <joint name="{self.name}" type="{self.kind}">\n'
-             f'    <parent link="{self.parent}"/>\n    <child link="{self.child}"/>\n'
-             f'    <origin xyz="{fmt3(self.origin[:3, 3])}" rpy="{fmt3(rpy)}"/>\n')
+        s = (
+            f'  <joint name="{self.name}" type="{self.kind}">\n'
+            f'    <parent link="{self.parent}"/>\n    <child link="{self.child}"/>\n'
+            f'    <origin xyz="{fmt3(self.origin[:3, 3])}" rpy="{fmt3(rpy)}"/>\n'
+        )
         if self.kind != "fixed":
-            s += (f'    <axis xyz="{fmt3(self.axis)}"/>\n'
-                  f'    <limit lower="{fmt(self.lower)}" upper="{fmt(self.upper)}" '
-                  f'effort="{fmt(self.effort)}" velocity="{fmt(self.velocity)}"/>\n'
-                  f'    <dynamics damping="0" friction="0"/>\n')
+            s += (
+                f'    <axis xyz="{fmt3(self.axis)}"/>\n'
+                f'    <limit lower="{fmt(self.lower)}" upper="{fmt(self.upper)}" '
+                f'effort="{fmt(self.effort)}" velocity="{fmt(self.velocity)}"/>\n'
+                f'    <dynamics damping="0" friction="0"/>\n'
+            )
         return s + "  </joint>\n"
 
 
@@ -111,8 +120,13 @@ def robot_xml(name: str, links: list[Link], joints: list[Joint], comment: str = 
     head = '<?xml version="1.0"?>\n'
     if comment:
         head += "<!-- " + comment.replace("--", "-") + " -->\n"
-    return (head + f'<robot name="{name}">\n' + "".join(l.xml() for l in links)
-            + "".join(j.xml() for j in joints) + "</robot>\n")
+    return (
+        head
+        + f'<robot name="{name}">\n'
+        + "".join(l.xml() for l in links)
+        + "".join(j.xml() for j in joints)
+        + "</robot>\n"
+    )
 
 
 def cache_dir() -> Path:

@@ -4,5 +4,12 @@ from replay.log.errors import LogError, NonFiniteValueError, NotALogError
 from replay.log.reader import LogMessage, LogReader
 from replay.log.writer import LogWriter, seconds_to_ns
 
-__all__ = ["LogError", "LogMessage", "LogReader", "LogWriter", "NonFiniteValueError",
-           "NotALogError", "seconds_to_ns"]
+__all__ = [
+    "LogError",
+    "LogMessage",
+    "LogReader",
+    "LogWriter",
+    "NonFiniteValueError",
+    "NotALogError",
+    "seconds_to_ns",
+]

@@ -22,6 +22,7 @@ class NonFiniteValueError(LogError):
 
 def _non_finite_paths(value, path=""):
     import math
+
     if isinstance(value, float):
         if not math.isfinite(value):
             yield path or "(value)"

@@ -25,7 +25,7 @@ from replay.log.errors import LogError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
 MAGIC = b"\x89MCAP0\r\n"
-_RECORD_LIMIT = 1 << 30          # no record of ours is near 1 GiB: a bigger length is damage
+_RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
 
 
 @dataclass(frozen=True)
@@ -79,8 +79,10 @@ class LogReader:
             if tail == MAGIC and self.size > 2 * len(MAGIC):
                 self._damage("its summary (index, statistics) cannot be read")
             else:
-                self.problems.append("truncated: the file ends mid-run (no summary): read up "
-                                     "to its last whole record")
+                self.problems.append(
+                    "truncated: the file ends mid-run (no summary): read up "
+                    "to its last whole record"
+                )
 
     def _damage(self, what: str) -> None:
         self.damaged = True
@@ -103,13 +105,16 @@ class LogReader:
         n = 0
         try:
             with open(self.path, "rb") as f:
-                for _ in StreamReader(f, validate_crcs=True,
-                                      record_size_limit=_RECORD_LIMIT).records:
+                for _ in StreamReader(
+                    f, validate_crcs=True, record_size_limit=_RECORD_LIMIT
+                ).records:
                     n += 1
         except Exception as exc:  # noqa: BLE001
             if not self.truncated or self._summary is not None:
-                self._damage(f"a record after {n} whole ones does not read "
-                             f"({type(exc).__name__}); what follows it is missing")
+                self._damage(
+                    f"a record after {n} whole ones does not read "
+                    f"({type(exc).__name__}); what follows it is missing"
+                )
             self._summary = None
             self.truncated = True
         return self
@@ -130,8 +135,10 @@ class LogReader:
                             yield item
                 return
             except Exception as exc:  # noqa: BLE001
-                self._damage(f"the index points at bad bytes ({type(exc).__name__}); "
-                             "read record by record instead")
+                self._damage(
+                    f"the index points at bad bytes ({type(exc).__name__}); "
+                    "read record by record instead"
+                )
                 self._summary = None
                 self.truncated = True
                 skip = done
@@ -180,8 +187,10 @@ class LogReader:
         if self._summary is not None and self._summary.statistics is not None:
             stats = self._summary.statistics.channel_message_counts
             channels = self._summary.channels
-            return {channels[cid].topic if cid in channels else f"(channel {cid})": n
-                    for cid, n in sorted(stats.items())}
+            return {
+                channels[cid].topic if cid in channels else f"(channel {cid})": n
+                for cid, n in sorted(stats.items())
+            }
         return dict(Counter(m.topic for m in self.messages()))
 
     def time_range(self) -> tuple[float, float]:
@@ -229,6 +238,8 @@ class LogReader:
             except LogError:
                 t_end, ended = 0.0, False
             if not ended:
-                notes.append(f"the run's end is missing: no outcome event; the log stops at "
-                             f"t = {t_end:.4f} s")
+                notes.append(
+                    f"the run's end is missing: no outcome event; the log stops at "
+                    f"t = {t_end:.4f} s"
+                )
         return notes

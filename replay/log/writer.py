@@ -33,9 +33,9 @@ from replay.messages import TOPICS, json_schema, to_dict
 
 PART_SUFFIX = ".part"
 MAGIC = b"\x89MCAP0\r\n"
-_ENCODER = json.JSONEncoder(allow_nan=False, separators=(",", ":"))   # built once: dumps() with
-                                                                       # options builds one a call
-_ORJSON = orjson.OPT_NON_STR_KEYS          # keys as the standard encoder writes them
+_ENCODER = json.JSONEncoder(allow_nan=False, separators=(",", ":"))  # built once: dumps() with
+# options builds one a call
+_ORJSON = orjson.OPT_NON_STR_KEYS  # keys as the standard encoder writes them
 
 
 def encode(topic: str, payload: Any) -> bytes:
@@ -102,8 +102,10 @@ class _HeldSigint:
             raise KeyboardInterrupt
 
     def install(self) -> None:
-        if (threading.current_thread() is threading.main_thread() and
-                signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+        if (
+            threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        ):
             signal.signal(signal.SIGINT, self._handler)
             self.installed = True
 
@@ -152,20 +154,23 @@ def check_output(path: Path, *, kind: str = "log", magic: bytes | None = MAGIC) 
     try:
         parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise LogError(f"cannot write {kind} {path}: cannot make folder {parent} "
-                       f"({exc.strerror})") from None
+        raise LogError(
+            f"cannot write {kind} {path}: cannot make folder {parent} ({exc.strerror})"
+        ) from None
     try:
-        tempfile.TemporaryFile(dir=parent).close()      # can a file be made there at all?
+        tempfile.TemporaryFile(dir=parent).close()  # can a file be made there at all?
     except OSError as exc:
-        raise LogError(f"cannot write {kind} {path}: folder {parent} takes no files "
-                       f"({exc.strerror})") from None
+        raise LogError(
+            f"cannot write {kind} {path}: folder {parent} takes no files ({exc.strerror})"
+        ) from None
 
 
 class LogWriter:
     """``with LogWriter(path) as log: log.write("/events", Event(...), t_ns)``."""
 
-    def __init__(self, path: str | os.PathLike, *, chunk_size: int = 256 * 1024,
-                 compression: str = "zstd") -> None:
+    def __init__(
+        self, path: str | os.PathLike, *, chunk_size: int = 256 * 1024, compression: str = "zstd"
+    ) -> None:
         self.path = Path(path)
         self.part_path = self.path.with_name(self.path.name + PART_SUFFIX)
         check_output(self.path)
@@ -175,8 +180,11 @@ class LogWriter:
             raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from exc
         self._held = _HeldSigint()
         self._held.install()
-        comp = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
-                "none": CompressionType.NONE}[compression]
+        comp = {
+            "zstd": CompressionType.ZSTD,
+            "lz4": CompressionType.LZ4,
+            "none": CompressionType.NONE,
+        }[compression]
         self._writer = Writer(self._file, chunk_size=chunk_size, compression=comp)
         self._writer.start(profile="", library=f"paper-replay {__version__}")
         self._channels: dict[str, int] = {}
@@ -189,10 +197,13 @@ class LogWriter:
             cls = TOPICS.get(topic) or (None if isinstance(payload, dict) else type(payload))
             schema = json_schema(cls) if cls is not None else {"title": topic, "type": "object"}
             schema_id = self._writer.register_schema(
-                name=schema["title"], encoding="jsonschema",
-                data=json.dumps(schema, separators=(",", ":")).encode())
+                name=schema["title"],
+                encoding="jsonschema",
+                data=json.dumps(schema, separators=(",", ":")).encode(),
+            )
             self._channels[topic] = self._writer.register_channel(
-                topic=topic, message_encoding="json", schema_id=schema_id)
+                topic=topic, message_encoding="json", schema_id=schema_id
+            )
             self._sequence[topic] = 0
         return self._channels[topic]
 
@@ -202,8 +213,13 @@ class LogWriter:
         with self._held:
             try:
                 channel = self._channel(topic, payload)
-                self._writer.add_message(channel_id=channel, log_time=t_ns, publish_time=t_ns,
-                                         data=data, sequence=self._sequence[topic])
+                self._writer.add_message(
+                    channel_id=channel,
+                    log_time=t_ns,
+                    publish_time=t_ns,
+                    data=data,
+                    sequence=self._sequence[topic],
+                )
             except OSError as exc:
                 raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
             self._sequence[topic] += 1
@@ -226,8 +242,7 @@ class LogWriter:
                     self._file.close()
                     os.replace(self.part_path, final)
                 except OSError as exc:
-                    raise LogError(f"cannot finish log {self.part_path}: "
-                                   f"{exc.strerror}") from None
+                    raise LogError(f"cannot finish log {self.part_path}: {exc.strerror}") from None
                 finally:
                     self._held.uninstall()
                 self.closed = True
@@ -238,5 +253,6 @@ class LogWriter:
         return self
 
     def __exit__(self, *exc) -> None:
-        self.close("" if exc[0] is None else
-                   "interrupted" if exc[0] is KeyboardInterrupt else "failed")
+        self.close(
+            "" if exc[0] is None else "interrupted" if exc[0] is KeyboardInterrupt else "failed"
+        )

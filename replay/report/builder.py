@@ -23,13 +23,25 @@ from replay.log import LogError, LogReader
 from replay.papers import PAPERS
 from replay.report.captions import CAPTIONS
 
-PACKAGES = ("numpy", "scipy", "pymunk", "pybullet", "opencv-python-headless", "mcap",
-            "matplotlib", "click", "pyyaml", "viser", "ray", "tqdm")
+PACKAGES = (
+    "numpy",
+    "scipy",
+    "pymunk",
+    "pybullet",
+    "opencv-python-headless",
+    "mcap",
+    "matplotlib",
+    "click",
+    "pyyaml",
+    "viser",
+    "ray",
+    "tqdm",
+)
 
 
 @dataclass
 class Figure:
-    png: str                    # path relative to the report
+    png: str  # path relative to the report
     svg: str
     caption: str
 
@@ -43,7 +55,7 @@ class Ablation:
     shows: str
     table: str
     sweep: str
-    source: str                 # "run here" | "stored"
+    source: str  # "run here" | "stored"
     command: str
 
 
@@ -52,7 +64,7 @@ class PaperSection:
     key: str
     title: str
     authors: str
-    runs: list = field(default_factory=list)        # (scenario name, seed, log path)
+    runs: list = field(default_factory=list)  # (scenario name, seed, log path)
     figures: list = field(default_factory=list)
     claims: list = field(default_factory=list)
     claims_md: str = ""
@@ -84,6 +96,7 @@ def _caption(paper: str, stem: str, name: str) -> str:
 def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/logs") -> Path:
     from replay.sweep import ablations
     from replay.sweep.variants import code_version
+
     out = Path(out)
     if out.exists():
         shutil.rmtree(out)
@@ -106,13 +119,18 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
             for png in (p for p in paths if p.suffix == ".png"):
                 svg = png.with_suffix(".svg")
                 run = next((n for n in readers if png.stem.startswith(n)), "")
-                sec.figures.append(Figure(png.relative_to(out).as_posix(),
-                                          svg.relative_to(out).as_posix() if svg.is_file()
-                                          else "", _caption(key, png.stem, run)))
+                sec.figures.append(
+                    Figure(
+                        png.relative_to(out).as_posix(),
+                        svg.relative_to(out).as_posix() if svg.is_file() else "",
+                        _caption(key, png.stem, run),
+                    )
+                )
             try:
                 evaluate = registry.load("claims", key)
                 sec.claims = evaluate(readers)
                 from analysis.claims import format_table
+
                 sec.claims_md = format_table(paper.title, sec.claims)
             except registry.UnknownPlugin:
                 sec.notes.append("No claims table defined yet.")
@@ -122,9 +140,11 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
                 continue
             sec.ablations.append(_ablation(sf, out, ablations))
         if key == "namiki1999" and not sec.ablations:
-            sec.notes.append("TODO: the grasping paper's ablations (grasp rate and tracking error "
-                             "against the loop period 1-33 ms and the object's speed) are still "
-                             "to be added as sweeps/grasp_*.yaml.")
+            sec.notes.append(
+                "TODO: the grasping paper's ablations (grasp rate and tracking error "
+                "against the loop period 1-33 ms and the object's speed) are still "
+                "to be added as sweeps/grasp_*.yaml."
+            )
         sections.append(sec)
     info = _provenance(code_version())
     commands = _commands(sections, logs)
@@ -136,6 +156,7 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
 def _ablation(sf, out: Path, ablations) -> Ablation:
     from replay.sweep.table import read_table
     from replay.sweep.worker import load_function
+
     (out / "ablations").mkdir(exist_ok=True)
     (out / "tables").mkdir(exist_ok=True)
     (out / "sweeps").mkdir(exist_ok=True)
@@ -143,22 +164,42 @@ def _ablation(sf, out: Path, ablations) -> Ablation:
     table, source = ablations.table_path(sf.name)
     command = f"replay ablate {sf.name}"
     if table is None or not read_table(table):
-        return Ablation(sf.name, "", "", sf.caption, f"Not run yet: `{command}`.", "",
-                        f"sweeps/{sf.path.name}", "not run", command)
+        return Ablation(
+            sf.name,
+            "",
+            "",
+            sf.caption,
+            f"Not run yet: `{command}`.",
+            "",
+            f"sweeps/{sf.path.name}",
+            "not run",
+            command,
+        )
     shutil.copy(table, out / "tables" / f"{sf.name}.csv")
     paths = ablations.plot(sf, table, out / "ablations")
     png = next(p for p in paths if p.suffix == ".png")
     svg = png.with_suffix(".svg")
     rows = read_table(table)
     shows = load_function(sf.summary)(rows) if sf.summary else ""
-    return Ablation(sf.name, png.relative_to(out).as_posix(),
-                    svg.relative_to(out).as_posix() if svg.is_file() else "", sf.caption, shows,
-                    f"tables/{sf.name}.csv", f"sweeps/{sf.path.name}", source, command)
+    return Ablation(
+        sf.name,
+        png.relative_to(out).as_posix(),
+        svg.relative_to(out).as_posix() if svg.is_file() else "",
+        sf.caption,
+        shows,
+        f"tables/{sf.name}.csv",
+        f"sweeps/{sf.path.name}",
+        source,
+        command,
+    )
 
 
 def _provenance(version: str) -> dict[str, str]:
-    info = {"paper-replay": version, "python": platform.python_version(),
-            "platform": platform.platform()}
+    info = {
+        "paper-replay": version,
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+    }
     for pkg in PACKAGES:
         try:
             info[pkg] = metadata.version(pkg)
@@ -173,8 +214,10 @@ def _commands(sections, logs) -> list[str]:
         for name, seed, _ in sec.runs:
             cmds.append(f"replay run scenarios/{name}.yaml --seed {seed} -o out/logs/{name}.mcap")
     if logs:
-        cmds += ["replay figures out/logs/*.mcap -o out/figures",
-                 "replay claims out/logs/*.mcap --markdown out/claims.md"]
+        cmds += [
+            "replay figures out/logs/*.mcap -o out/figures",
+            "replay claims out/logs/*.mcap --markdown out/claims.md",
+        ]
     for sec in sections:
         for a in sec.ablations:
             cmds.append(f"{a.command} --store   # table: {a.source}")
@@ -184,10 +227,15 @@ def _commands(sections, logs) -> list[str]:
 
 # -- Markdown --------------------------------------------------------------------------------
 
+
 def _markdown(sections, info, commands) -> str:
-    lines = ["# paper-replay: reproduction report", "",
-             "Every figure below is regenerated from a run's MCAP log; every ablation plot from "
-             "its sweep table.", ""]
+    lines = [
+        "# paper-replay: reproduction report",
+        "",
+        "Every figure below is regenerated from a run's MCAP log; every ablation plot from "
+        "its sweep table.",
+        "",
+    ]
     for sec in sections:
         lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
         if sec.runs:
@@ -207,8 +255,12 @@ def _markdown(sections, info, commands) -> str:
                 if a.png:
                     lines += [f"![{a.caption}]({a.png})", ""]
                 table = f"Table: [{a.table}]({a.table}) ({a.source}); " if a.table else ""
-                lines += [f"*{a.caption}* {a.shows}", "",
-                          f"{table}sweep: [{a.sweep}]({a.sweep}); `{a.command}`", ""]
+                lines += [
+                    f"*{a.caption}* {a.shows}",
+                    "",
+                    f"{table}sweep: [{a.sweep}]({a.sweep}); `{a.command}`",
+                    "",
+                ]
     lines += ["## Versions", "", "| package | version |", "|---|---|"]
     lines += [f"| {k} | {v} |" for k, v in info.items()]
     lines += ["", "## Commands", "", "```sh", *commands, "```", ""]
@@ -235,34 +287,56 @@ def _e(text) -> str:
 
 
 def _html(sections, info, commands) -> str:
-    h = ["<!doctype html>", "<html lang='en'><head><meta charset='utf-8'>",
-         "<title>paper-replay: reproduction report</title>", f"<style>{_STYLE}</style>",
-         "</head><body>", "<h1>paper-replay: reproduction report</h1>",
-         "<p>Every figure below is regenerated from a run's MCAP log; every ablation plot from "
-         "its sweep table. <a href='index.md'>Markdown version</a>.</p>", "<nav><ul>"]
+    h = [
+        "<!doctype html>",
+        "<html lang='en'><head><meta charset='utf-8'>",
+        "<title>paper-replay: reproduction report</title>",
+        f"<style>{_STYLE}</style>",
+        "</head><body>",
+        "<h1>paper-replay: reproduction report</h1>",
+        "<p>Every figure below is regenerated from a run's MCAP log; every ablation plot from "
+        "its sweep table. <a href='index.md'>Markdown version</a>.</p>",
+        "<nav><ul>",
+    ]
     h += [f"<li><a href='#{s.key}'>{_e(s.title)}</a></li>" for s in sections]
-    h += ["<li><a href='#versions'>Versions</a></li>", "<li><a href='#commands'>Commands</a></li>",
-          "</ul></nav>"]
+    h += [
+        "<li><a href='#versions'>Versions</a></li>",
+        "<li><a href='#commands'>Commands</a></li>",
+        "</ul></nav>",
+    ]
     for sec in sections:
-        h += [f"<section id='{sec.key}'>", f"<h2>{_e(sec.title)}</h2>",
-              f"<p><em>{_e(sec.authors)}</em> (<code>{sec.key}</code>)</p>"]
+        h += [
+            f"<section id='{sec.key}'>",
+            f"<h2>{_e(sec.title)}</h2>",
+            f"<p><em>{_e(sec.authors)}</em> (<code>{sec.key}</code>)</p>",
+        ]
         if sec.runs:
-            h.append("<p>Runs: " + ", ".join(f"<code>{_e(n)}</code> (seed {s})"
-                                             for n, s, _ in sec.runs) + "</p>")
+            h.append(
+                "<p>Runs: "
+                + ", ".join(f"<code>{_e(n)}</code> (seed {s})" for n, s, _ in sec.runs)
+                + "</p>"
+            )
         h += [f"<p class='note'>{_e(n)}</p>" for n in sec.notes]
         if sec.figures:
             h.append("<h3>Figures</h3>")
             for f in sec.figures:
                 svg = f" <a href='{f.svg}'>SVG</a>" if f.svg else ""
-                h.append(f"<figure><img src='{f.png}' alt='{_e(f.caption)}'>"
-                         f"<figcaption>{_e(f.caption)}{svg}</figcaption></figure>")
+                h.append(
+                    f"<figure><img src='{f.png}' alt='{_e(f.caption)}'>"
+                    f"<figcaption>{_e(f.caption)}{svg}</figcaption></figure>"
+                )
         if sec.claims:
-            h += ["<h3>Claims</h3>", "<table><tr><th>quantity</th><th>paper states</th>"
-                  "<th>this run</th><th>status</th><th>note</th></tr>"]
+            h += [
+                "<h3>Claims</h3>",
+                "<table><tr><th>quantity</th><th>paper states</th>"
+                "<th>this run</th><th>status</th><th>note</th></tr>",
+            ]
             for c in sec.claims:
-                h.append(f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.stated)}</td>"
-                         f"<td>{_e(c.measured)}</td><td class='{_e(c.status)}'><b>"
-                         f"{_e(c.status)}</b></td><td>{_e(c.note)}</td></tr>")
+                h.append(
+                    f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.stated)}</td>"
+                    f"<td>{_e(c.measured)}</td><td class='{_e(c.status)}'><b>"
+                    f"{_e(c.status)}</b></td><td>{_e(c.note)}</td></tr>"
+                )
             n_ok = sum(c.status == "reproduced" for c in sec.claims)
             h += ["</table>", f"<p>{n_ok} of {len(sec.claims)} reproduced.</p>"]
         if sec.ablations:
@@ -271,17 +345,25 @@ def _html(sections, info, commands) -> str:
                 h.append(f"<h4 id='ablation-{a.name}'>{_e(a.name)}</h4>")
                 if a.png:
                     svg = f" <a href='{a.svg}'>SVG</a>" if a.svg else ""
-                    h.append(f"<figure><img src='{a.png}' alt='{_e(a.caption)}'><figcaption>"
-                             f"{_e(a.caption)} <strong>{_e(a.shows)}</strong>{svg}</figcaption>"
-                             "</figure>")
+                    h.append(
+                        f"<figure><img src='{a.png}' alt='{_e(a.caption)}'><figcaption>"
+                        f"{_e(a.caption)} <strong>{_e(a.shows)}</strong>{svg}</figcaption>"
+                        "</figure>"
+                    )
                 else:
                     h.append(f"<p>{_e(a.caption)} {_e(a.shows)}</p>")
-                table = (f"<a href='{a.table}'>table</a> ({_e(a.source)}), " if a.table else "")
-                h.append(f"<p>{table}<a href='{a.sweep}'>sweep file</a>; "
-                         f"<code>{_e(a.command)}</code></p>")
+                table = f"<a href='{a.table}'>table</a> ({_e(a.source)}), " if a.table else ""
+                h.append(
+                    f"<p>{table}<a href='{a.sweep}'>sweep file</a>; "
+                    f"<code>{_e(a.command)}</code></p>"
+                )
         h.append("</section>")
     h += ["<h2 id='versions'>Versions</h2>", "<table><tr><th>package</th><th>version</th></tr>"]
     h += [f"<tr><td>{_e(k)}</td><td>{_e(v)}</td></tr>" for k, v in info.items()]
-    h += ["</table>", "<h2 id='commands'>Commands</h2>",
-          "<pre>" + _e("\n".join(commands)) + "</pre>", "</body></html>"]
+    h += [
+        "</table>",
+        "<h2 id='commands'>Commands</h2>",
+        "<pre>" + _e("\n".join(commands)) + "</pre>",
+        "</body></html>",
+    ]
     return "\n".join(h) + "\n"

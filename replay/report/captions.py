@@ -4,7 +4,7 @@ CAPTIONS = {
     "higashimori2007": {
         6: "A series of photos during the 3-step capturing strategy.",
         7: "Translational and rotational velocities with respect to time during the 3-step "
-           "capturing strategy.",
+        "capturing strategy.",
     },
     "namiki2003": {
         6: "Optimization of cost functions",

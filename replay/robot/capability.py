@@ -21,8 +21,9 @@ def _vertices(limits: Sequence[float]) -> np.ndarray:
     return np.array(list(itertools.product(*[(-float(l), float(l)) for l in limits])))
 
 
-def max_tool_speed(chain: SerialChain, q, velocity_limits: Sequence[float],
-                   active: Sequence[int] | None = None) -> float:
+def max_tool_speed(
+    chain: SerialChain, q, velocity_limits: Sequence[float], active: Sequence[int] | None = None
+) -> float:
     """max |J qd| over |qd_i| <= limit_i (m/s), the tool point, active joints only."""
     active = list(range(chain.n)) if active is None else list(active)
     J = chain.position_jacobian(q)[:, active]
@@ -34,7 +35,7 @@ def sphere_directions(n: int = 2000) -> np.ndarray:
     """Unit vectors spread evenly over the sphere (Fibonacci lattice), n x 3."""
     i = np.arange(n) + 0.5
     phi = np.arccos(1.0 - 2.0 * i / n)
-    th = math.pi * (1.0 + 5.0 ** 0.5) * i
+    th = math.pi * (1.0 + 5.0**0.5) * i
     return np.column_stack([np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)])
 
 
@@ -51,9 +52,13 @@ def _facet_normals(A: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-def tool_acceleration_from_rest(chain: SerialChain, q, torque_limits: Sequence[float],
-                                active: Sequence[int] | None = None,
-                                directions: np.ndarray | None = None) -> dict:
+def tool_acceleration_from_rest(
+    chain: SerialChain,
+    q,
+    torque_limits: Sequence[float],
+    active: Sequence[int] | None = None,
+    directions: np.ndarray | None = None,
+) -> dict:
     """Tool accelerations reachable from rest (qd = 0, gravity included), |tau_i| <= limit_i.
 
     Returns ``peak`` (m/s^2: the largest |a| in the best direction), ``peak_torque`` (the torque
@@ -75,5 +80,9 @@ def tool_acceleration_from_rest(chain: SerialChain, q, torque_limits: Sequence[f
     # minimum over those (or over given ``directions``) is exact
     u = _facet_normals(A) if directions is None else directions
     iso = float(np.min(u @ b + np.abs(u @ A) @ lim))
-    return {"peak": float(acc[k]), "peak_torque": V[k], "isotropic": iso,
-            "gravity_sag": float(np.linalg.norm(b))}
+    return {
+        "peak": float(acc[k]),
+        "peak_torque": V[k],
+        "isotropic": iso,
+        "gravity_sag": float(np.linalg.norm(b)),
+    }

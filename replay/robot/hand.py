@@ -31,33 +31,33 @@ from replay.spatial import rot_x, rot_y, rot_z, transform
 @dataclass(frozen=True)
 class HandJoint:
     name: str
-    kind: str            # "flex" (about y) or "abduct" (about x)
-    length: float        # m, link length along the link's z axis
-    width: float         # m, square cross-section of the link's box
-    mass: float          # kg, of the link (a uniform box)
-    lower: float         # rad
-    upper: float         # rad
-    open: float = 0.0    # rad, the "open" posture
+    kind: str  # "flex" (about y) or "abduct" (about x)
+    length: float  # m, link length along the link's z axis
+    width: float  # m, square cross-section of the link's box
+    mass: float  # kg, of the link (a uniform box)
+    lower: float  # rad
+    upper: float  # rad
+    open: float = 0.0  # rad, the "open" posture
     closed: float = 0.0  # rad, the "closed" posture
 
 
 @dataclass(frozen=True)
 class Finger:
     name: str
-    root: tuple[float, float, float]   # m, in the palm frame
-    yaw: float                         # rad, root frame about the palm normal
+    root: tuple[float, float, float]  # m, in the palm frame
+    yaw: float  # rad, root frame about the palm normal
     joints: tuple[HandJoint, ...]
 
 
 @dataclass(frozen=True)
 class HandTable:
     name: str
-    palm_shape: str                    # "cylinder" (size = (radius, radius, thickness)) or "box"
-    palm_size: tuple[float, float, float]   # m: box full extents x, y, z; cylinder (r, r, z)
-    palm_mass: float                   # kg, uniform solid
+    palm_shape: str  # "cylinder" (size = (radius, radius, thickness)) or "box"
+    palm_size: tuple[float, float, float]  # m: box full extents x, y, z; cylinder (r, r, z)
+    palm_mass: float  # kg, uniform solid
     fingers: tuple[Finger, ...]
-    closing_speed: float               # rad/s, the joints' speed limit
-    max_torque: float                  # N*m, each joint's actuator limit
+    closing_speed: float  # rad/s, the joints' speed limit
+    max_torque: float  # N*m, each joint's actuator limit
     note: str = ""
 
     @property
@@ -123,8 +123,9 @@ def link_body(j: HandJoint) -> RigidBody:
     if j.length <= 0.0:  # a knuckle without length: a small cube
         w = j.width
         return RigidBody(j.mass, (0.0, 0.0, 0.0), box_inertia(j.mass, (w, w, w)))
-    return RigidBody(j.mass, (0.0, 0.0, j.length / 2.0),
-                     box_inertia(j.mass, (j.width, j.width, j.length)))
+    return RigidBody(
+        j.mass, (0.0, 0.0, j.length / 2.0), box_inertia(j.mass, (j.width, j.width, j.length))
+    )
 
 
 def finger_frames(finger: Finger, q) -> list[np.ndarray]:
@@ -147,7 +148,7 @@ def hand_body(hand: HandTable, q=None) -> RigidBody:
     k = 0
     for f in hand.fingers:
         n = len(f.joints)
-        frames = finger_frames(f, q[k:k + n])
+        frames = finger_frames(f, q[k : k + n])
         for j, T in zip(f.joints, frames[:-1]):
             body = body.combined(link_body(j).transformed(T))
         k += n
@@ -164,26 +165,42 @@ def hand_mass(hand: HandTable) -> float:
 # Only the 3 fingers, 3 axes and 90 deg / 20 ms are from the paper; the dimensions and masses are
 # assumed (a light hand around a palm a bit wider than a ~4 cm ball): fingers at 120 deg on the
 # rim of a 45 mm-radius disc palm, open along the palm normal, closing 90 deg towards its centre.
-CATCH_CLOSING_SPEED = (math.pi / 2.0) / 0.020   # 90 deg in 20 ms = 78.54 rad/s
+CATCH_CLOSING_SPEED = (math.pi / 2.0) / 0.020  # 90 deg in 20 ms = 78.54 rad/s
 
 
 def _catch_finger(k: int) -> Finger:
-    phi = math.radians(90.0 + 120.0 * k)          # root direction from the palm centre
+    phi = math.radians(90.0 + 120.0 * k)  # root direction from the palm centre
     r = 0.040
     return Finger(
-        name=f"f{k + 1}", root=(r * math.cos(phi), r * math.sin(phi), 0.012),
-        yaw=phi + math.pi,                          # root x axis towards the palm centre
-        joints=(HandJoint(name=f"f{k + 1}_j1", kind="flex", length=0.070, width=0.014,
-                          mass=0.030, lower=-0.2, upper=math.pi / 2.0,
-                          open=0.0, closed=math.pi / 2.0),))
+        name=f"f{k + 1}",
+        root=(r * math.cos(phi), r * math.sin(phi), 0.012),
+        yaw=phi + math.pi,  # root x axis towards the palm centre
+        joints=(
+            HandJoint(
+                name=f"f{k + 1}_j1",
+                kind="flex",
+                length=0.070,
+                width=0.014,
+                mass=0.030,
+                lower=-0.2,
+                upper=math.pi / 2.0,
+                open=0.0,
+                closed=math.pi / 2.0,
+            ),
+        ),
+    )
 
 
 CATCH3 = HandTable(
-    name="catch3", palm_shape="cylinder", palm_size=(0.045, 0.045, 0.012), palm_mass=0.25,
+    name="catch3",
+    palm_shape="cylinder",
+    palm_size=(0.045, 0.045, 0.012),
+    palm_mass=0.25,
     fingers=tuple(_catch_finger(k) for k in range(3)),
     closing_speed=CATCH_CLOSING_SPEED,
-    max_torque=2.0,   # assumed: ~28 N at a 70 mm finger's tip
-    note="Namiki & Ishikawa Sec. IV-A: 3 fingers, 3 axes, 90 deg in 20 ms; sizes/masses assumed")
+    max_torque=2.0,  # assumed: ~28 N at a 70 mm finger's tip
+    note="Namiki & Ishikawa Sec. IV-A: 3 fingers, 3 axes, 90 deg in 20 ms; sizes/masses assumed",
+)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -191,32 +208,59 @@ CATCH3 = HandTable(
 # finger is installed opposite to the other three fingers". The split 4/3/4/3 and every size
 # are assumed (human-like proportions): index, middle and ring side by side, each a sideways
 # (abduct) knuckle then flexion joints; the thumb opposite them.
-def _grasp_finger(name: str, y: float, x: float, yaw: float, kinds: tuple[str, ...],
-                  lengths: tuple[float, ...]) -> Finger:
+def _grasp_finger(
+    name: str, y: float, x: float, yaw: float, kinds: tuple[str, ...], lengths: tuple[float, ...]
+) -> Finger:
     joints = []
     for i, (kind, length) in enumerate(zip(kinds, lengths)):
         lo, hi = (-0.35, 0.35) if kind == "abduct" else (-0.2, math.pi / 2.0)
-        joints.append(HandJoint(name=f"{name}_j{i + 1}", kind=kind, length=length, width=0.016,
-                                mass=0.010 if length == 0.0 else 0.025, lower=lo, upper=hi,
-                                open=0.0, closed=0.0 if kind == "abduct" else 1.2))
+        joints.append(
+            HandJoint(
+                name=f"{name}_j{i + 1}",
+                kind=kind,
+                length=length,
+                width=0.016,
+                mass=0.010 if length == 0.0 else 0.025,
+                lower=lo,
+                upper=hi,
+                open=0.0,
+                closed=0.0 if kind == "abduct" else 1.2,
+            )
+        )
     return Finger(name=name, root=(x, y, 0.015), yaw=yaw, joints=tuple(joints))
 
 
 GRASP4 = HandTable(
-    name="grasp4", palm_shape="box", palm_size=(0.10, 0.09, 0.015), palm_mass=0.40,
+    name="grasp4",
+    palm_shape="box",
+    palm_size=(0.10, 0.09, 0.015),
+    palm_mass=0.40,
     fingers=(
-        _grasp_finger("index", 0.030, 0.045, math.pi, ("abduct", "flex", "flex", "flex"),
-                      (0.0, 0.045, 0.030, 0.025)),
-        _grasp_finger("middle", 0.0, 0.045, math.pi, ("flex", "flex", "flex"),
-                      (0.050, 0.032, 0.025)),
-        _grasp_finger("ring", -0.030, 0.045, math.pi, ("abduct", "flex", "flex", "flex"),
-                      (0.0, 0.045, 0.030, 0.025)),
-        _grasp_finger("thumb", 0.0, -0.045, 0.0, ("flex", "flex", "flex"),
-                      (0.045, 0.032, 0.025)),
+        _grasp_finger(
+            "index",
+            0.030,
+            0.045,
+            math.pi,
+            ("abduct", "flex", "flex", "flex"),
+            (0.0, 0.045, 0.030, 0.025),
+        ),
+        _grasp_finger(
+            "middle", 0.0, 0.045, math.pi, ("flex", "flex", "flex"), (0.050, 0.032, 0.025)
+        ),
+        _grasp_finger(
+            "ring",
+            -0.030,
+            0.045,
+            math.pi,
+            ("abduct", "flex", "flex", "flex"),
+            (0.0, 0.045, 0.030, 0.025),
+        ),
+        _grasp_finger("thumb", 0.0, -0.045, 0.0, ("flex", "flex", "flex"), (0.045, 0.032, 0.025)),
     ),
-    closing_speed=CATCH_CLOSING_SPEED,   # assumed same drive as the catching hand
+    closing_speed=CATCH_CLOSING_SPEED,  # assumed same drive as the catching hand
     max_torque=2.0,
     note="Namiki et al. Sec. 3.3: 4 fingers, 14 joints, thumb opposite; split 4/3/4/3 and "
-         "all sizes assumed")
+    "all sizes assumed",
+)
 
 HANDS: dict[str, HandTable] = {h.name: h for h in (CATCH3, GRASP4)}

@@ -20,23 +20,24 @@ import numpy as np
 @dataclass(frozen=True)
 class StickSpec:
     """What the method may know of the object (paper Assumptions 7 and 10): not the friction."""
-    mass: float            # kg
-    inertia: float         # kg*m^2 about the centre of mass
-    length: float          # m
-    width: float           # m (the analysis takes it as ~0, Assumption 5)
-    restitution: float     # Newton's e, eq. 2
+
+    mass: float  # kg
+    inertia: float  # kg*m^2 about the centre of mass
+    length: float  # m
+    width: float  # m (the analysis takes it as ~0, Assumption 5)
+    restitution: float  # Newton's e, eq. 2
 
 
 @dataclass(frozen=True)
 class HandSpec:
     root_offsets: tuple[tuple[float, float], tuple[float, float]]  # m, from the base
-    link_lengths: tuple[float, float]                               # l1, l2 (m), both fingers
-    joint_limits: tuple[tuple[float, float], tuple[float, float]]   # (q1 lo, hi), (q2 lo, hi) rad
-    joint_speed: float        # rad/s, each joint
-    base_limits: tuple[tuple[float, float], tuple[float, float]]    # (x lo, hi), (y lo, hi) m
-    base_speed: float         # m/s, each slider axis
-    tip_radius: float         # m, fingertip disc radius
-    start_base: tuple[float, float] = (0.0, 0.0)    # m, where the hand is homed at t = 0
+    link_lengths: tuple[float, float]  # l1, l2 (m), both fingers
+    joint_limits: tuple[tuple[float, float], tuple[float, float]]  # (q1 lo, hi), (q2 lo, hi) rad
+    joint_speed: float  # rad/s, each joint
+    base_limits: tuple[tuple[float, float], tuple[float, float]]  # (x lo, hi), (y lo, hi) m
+    base_speed: float  # m/s, each slider axis
+    tip_radius: float  # m, fingertip disc radius
+    start_base: tuple[float, float] = (0.0, 0.0)  # m, where the hand is homed at t = 0
     start_joints: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
 
 
@@ -49,7 +50,8 @@ class AirTableSpec:
 @dataclass(frozen=True)
 class HandCommand:
     """Position targets; the plant moves toward them no faster than the spec's speed limits."""
-    base: tuple[float, float]                               # m
+
+    base: tuple[float, float]  # m
     joints: tuple[tuple[float, float], tuple[float, float]]  # rad, (q1, q2) per finger
 
 

@@ -21,14 +21,14 @@ import numpy as np
 
 @dataclass(frozen=True)
 class HeadSpec:
-    position: tuple[float, float, float]   # m, world: the pan/tilt axes' intersection
-    yaw: float                             # rad, base heading about world +z
-    camera_offset: float                   # m, camera ahead of the tilt axis
-    lower: tuple[float, float]             # rad, (pan, tilt) limits
+    position: tuple[float, float, float]  # m, world: the pan/tilt axes' intersection
+    yaw: float  # rad, base heading about world +z
+    camera_offset: float  # m, camera ahead of the tilt axis
+    lower: tuple[float, float]  # rad, (pan, tilt) limits
     upper: tuple[float, float]
-    inertia: tuple[float, float]           # kg m^2, about each axis
-    torque_limit: tuple[float, float]      # N m, each DC servo
-    velocity_limit: tuple[float, float]    # rad/s
+    inertia: tuple[float, float]  # kg m^2, about each axis
+    torque_limit: tuple[float, float]  # N m, each DC servo
+    velocity_limit: tuple[float, float]  # rad/s
 
 
 def camera_pose(head: HeadSpec, pan: float, tilt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -39,9 +39,7 @@ def camera_pose(head: HeadSpec, pan: float, tilt: float) -> tuple[np.ndarray, np
     # line of sight: the base x axis panned by a, tilted down by ``tilt``
     # line of sight fwd = (ca ct, sa ct, -st), tilt axis left = (-sa, ca, 0), image up =
     # fwd x left = (st ca, st sa, ct); camera x = -left (right), y = -up (down), z = fwd
-    R = np.array([[sa, -st * ca, ca * ct],
-                  [-ca, -st * sa, sa * ct],
-                  [0.0, -ct, -st]])
+    R = np.array([[sa, -st * ca, ca * ct], [-ca, -st * sa, sa * ct], [0.0, -ct, -st]])
     p, k = head.position, head.camera_offset
     return R, np.array([p[0] + k * ca * ct, p[1] + k * sa * ct, p[2] - k * st])
 

@@ -26,16 +26,21 @@ def dh_transform(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
     """Standard DH: Rz(theta) Tz(d) Tx(a) Rx(alpha)."""
     ct, st = np.cos(theta), np.sin(theta)
     ca, sa = np.cos(alpha), np.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, a * ct],
-                     [st, ct * ca, -ct * sa, a * st],
-                     [0.0, sa, ca, d],
-                     [0.0, 0.0, 0.0, 1.0]])
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
 
 
 @dataclass(frozen=True, eq=False)
 class RigidBody:
     """Mass properties: ``com`` (m) in the body frame, ``inertia`` (kg*m^2) about the centre of
     mass with axes aligned with the body frame."""
+
     mass: float
     com: np.ndarray = field(default_factory=lambda: np.zeros(3))
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
@@ -77,10 +82,16 @@ class SerialChain:
     held at a value by the caller; the matching rows/columns can be dropped with ``active``.
     """
 
-    def __init__(self, dh: Sequence[DHRow], links: Sequence[RigidBody], *,
-                 base: np.ndarray | None = None, tool: np.ndarray | None = None,
-                 gravity: Sequence[float] = (0.0, 0.0, -9.81),
-                 joint_names: Sequence[str] | None = None) -> None:
+    def __init__(
+        self,
+        dh: Sequence[DHRow],
+        links: Sequence[RigidBody],
+        *,
+        base: np.ndarray | None = None,
+        tool: np.ndarray | None = None,
+        gravity: Sequence[float] = (0.0, 0.0, -9.81),
+        joint_names: Sequence[str] | None = None,
+    ) -> None:
         if len(dh) != len(links):
             raise ValueError(f"{len(dh)} DH rows but {len(links)} links")
         self.dh = tuple(dh)
@@ -89,8 +100,9 @@ class SerialChain:
         self.base = np.eye(4) if base is None else np.asarray(base, dtype=float)
         self.tool = np.eye(4) if tool is None else np.asarray(tool, dtype=float)
         self.gravity = np.asarray(gravity, dtype=float)
-        self.joint_names = tuple(joint_names) if joint_names else tuple(
-            f"J{i + 1}" for i in range(self.n))
+        self.joint_names = (
+            tuple(joint_names) if joint_names else tuple(f"J{i + 1}" for i in range(self.n))
+        )
         self._masses = np.array([b.mass for b in self.links])
         self._coms = np.array([b.com for b in self.links])
         self._inertias = np.array([b.inertia for b in self.links])
@@ -99,8 +111,14 @@ class SerialChain:
     def with_payload(self, body: RigidBody) -> SerialChain:
         """The chain with ``body`` (given in the tool frame) rigidly added to the last link."""
         last = self.links[-1].combined(body.transformed(self.tool))
-        return SerialChain(self.dh, self.links[:-1] + (last,), base=self.base, tool=self.tool,
-                           gravity=self.gravity, joint_names=self.joint_names)
+        return SerialChain(
+            self.dh,
+            self.links[:-1] + (last,),
+            base=self.base,
+            tool=self.tool,
+            gravity=self.gravity,
+            joint_names=self.joint_names,
+        )
 
     # ------------------------------------------------------------------ kinematics
     def _q(self, q) -> np.ndarray:
@@ -146,7 +164,7 @@ class SerialChain:
         Ts = self.frames(q)
         w = np.zeros(3)
         dw = np.zeros(3)
-        v = np.zeros(3)   # of the origin o_{i-1}
+        v = np.zeros(3)  # of the origin o_{i-1}
         a = np.zeros(3)
         for i in range(self.n):
             z, o0, o1 = Ts[i][:3, 2], Ts[i][:3, 3], Ts[i + 1][:3, 3]
@@ -175,10 +193,14 @@ class SerialChain:
         qd_l, qdd_l = qd.tolist(), qdd.tolist()
         zs = [tuple(T[:3, 2].tolist()) for T in Ts]
         os_ = [tuple(T[:3, 3].tolist()) for T in Ts]
-        cs = [tuple((Ts[i + 1][:3, :3] @ self.links[i].com + Ts[i + 1][:3, 3]).tolist())
-              for i in range(n)]
-        Is = [(Ts[i + 1][:3, :3] @ self.links[i].inertia @ Ts[i + 1][:3, :3].T).tolist()
-              for i in range(n)]
+        cs = [
+            tuple((Ts[i + 1][:3, :3] @ self.links[i].com + Ts[i + 1][:3, 3]).tolist())
+            for i in range(n)
+        ]
+        Is = [
+            (Ts[i + 1][:3, :3] @ self.links[i].inertia @ Ts[i + 1][:3, :3].T).tolist()
+            for i in range(n)
+        ]
         w = (0.0, 0.0, 0.0)
         dw = (0.0, 0.0, 0.0)
         a_o = tuple((-g).tolist())
@@ -196,16 +218,18 @@ class SerialChain:
             a_o = _add3(a_o, _cross(dw, r), _cross(w, _cross(w, r)))
         tau = np.zeros(n)
         f_next = (0.0, 0.0, 0.0)
-        n_next = (0.0, 0.0, 0.0)       # moment about o_i exerted on link i+1
+        n_next = (0.0, 0.0, 0.0)  # moment about o_i exerted on link i+1
         for i in reversed(range(n)):
             m = self.links[i].mass
             o0, o1 = os_[i], os_[i + 1]
             ma = _scale(a_cs[i], m)
             f = _add(ma, f_next)
             Iw = _matvec(Is[i], ws[i])
-            nm = _add3(_add(_matvec(Is[i], dws[i]), _cross(ws[i], Iw)),
-                       _cross(_sub(cs[i], o0), ma),
-                       _add(n_next, _cross(_sub(o1, o0), f_next)))
+            nm = _add3(
+                _add(_matvec(Is[i], dws[i]), _cross(ws[i], Iw)),
+                _cross(_sub(cs[i], o0), ma),
+                _add(n_next, _cross(_sub(o1, o0), f_next)),
+            )
             z = zs[i]
             tau[i] = z[0] * nm[0] + z[1] * nm[1] + z[2] * nm[2]
             f_next, n_next = f, nm
@@ -215,11 +239,11 @@ class SerialChain:
         """Per link i: COM Jacobian Jv (n, n, 3), angular Jw (n, n, 3), world inertia (n, 3, 3)."""
         Ts = self.frames(q)
         n = self.n
-        z = np.array([T[:3, 2] for T in Ts[:-1]])                     # joint axes z_0..z_{n-1}
+        z = np.array([T[:3, 2] for T in Ts[:-1]])  # joint axes z_0..z_{n-1}
         o = np.array([T[:3, 3] for T in Ts[:-1]])
         R = np.array([T[:3, :3] for T in Ts[1:]])
         c = np.einsum("ijk,ik->ij", R, self._coms) + np.array([T[:3, 3] for T in Ts[1:]])
-        mask = np.tril(np.ones((n, n)))[:, :, None]                   # joint j moves link i>=j
+        mask = np.tril(np.ones((n, n)))[:, :, None]  # joint j moves link i>=j
         Jv = np.cross(np.broadcast_to(z, (n, n, 3)), c[:, None, :] - o[None, :, :]) * mask
         Jw = np.broadcast_to(z, (n, n, 3)) * mask
         Iw = np.einsum("iab,ibc,idc->iad", R, self._inertias, R)
@@ -229,8 +253,9 @@ class SerialChain:
         """M(q) = sum_i m_i Jv_i^T Jv_i + Jw_i^T I_i Jw_i (Spong eq. 7.50); an algorithm
         independent of :meth:`rnea`, so the two check each other."""
         Jv, Jw, Iw = self._link_jacobians(self._q(q))
-        M = (np.einsum("i,ijk,ilk->jl", self._masses, Jv, Jv)
-             + np.einsum("ijk,ikm,ilm->jl", Jw, Iw, Jw))
+        M = np.einsum("i,ijk,ilk->jl", self._masses, Jv, Jv) + np.einsum(
+            "ijk,ikm,ilm->jl", Jw, Iw, Jw
+        )
         return 0.5 * (M + M.T)
 
     def coriolis(self, q, qd) -> np.ndarray:
@@ -244,8 +269,9 @@ class SerialChain:
 
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
         """qdd = M^-1 (tau - H qd - g)."""
-        return np.linalg.solve(self.mass_matrix(q), np.asarray(tau, float) - self.rnea(
-            q, qd, np.zeros(self.n)))
+        return np.linalg.solve(
+            self.mass_matrix(q), np.asarray(tau, float) - self.rnea(q, qd, np.zeros(self.n))
+        )
 
     # ------------------------------------------------------------------ batched (leading axis)
     def frames_batch(self, Q) -> np.ndarray:
@@ -273,13 +299,13 @@ class SerialChain:
     def _link_jacobians_batch(self, Q):
         Ts = self.frames_batch(Q)
         n = self.n
-        z = Ts[:, :-1, :3, 2]                                   # (N, n, 3) axes z_0..z_{n-1}
+        z = Ts[:, :-1, :3, 2]  # (N, n, 3) axes z_0..z_{n-1}
         o = Ts[:, :-1, :3, 3]
-        R = Ts[:, 1:, :3, :3]                                   # (N, n, 3, 3)
+        R = Ts[:, 1:, :3, :3]  # (N, n, 3, 3)
         c = np.einsum("lijk,ik->lij", R, self._coms) + Ts[:, 1:, :3, 3]
         mask = np.tril(np.ones((n, n)))[None, :, :, None]
         zb = np.broadcast_to(z[:, None, :, :], (z.shape[0], n, n, 3))
-        Jv = np.cross(zb, c[:, :, None, :] - o[:, None, :, :]) * mask   # (N, link, joint, 3)
+        Jv = np.cross(zb, c[:, :, None, :] - o[:, None, :, :]) * mask  # (N, link, joint, 3)
         Jw = zb * mask
         Iw = np.einsum("liab,ibc,lidc->liad", R, self._inertias, R)
         return Jv, Jw, Iw
@@ -287,10 +313,11 @@ class SerialChain:
     def mass_matrix_batch(self, Q) -> np.ndarray:
         """M for many configurations: (N, n) -> (N, n, n)."""
         Jv, Jw, Iw = self._link_jacobians_batch(Q)
-        Jv_t = np.swapaxes(Jv, 2, 3)                            # (N, link, 3, joint)
+        Jv_t = np.swapaxes(Jv, 2, 3)  # (N, link, 3, joint)
         Jw_t = np.swapaxes(Jw, 2, 3)
-        M = (np.einsum("i,nikj,nikl->njl", self._masses, Jv_t, Jv_t, optimize=True)
-             + (np.swapaxes(Jw_t, 2, 3) @ (Iw @ Jw_t)).sum(axis=1))
+        M = np.einsum("i,nikj,nikl->njl", self._masses, Jv_t, Jv_t, optimize=True) + (
+            np.swapaxes(Jw_t, 2, 3) @ (Iw @ Jw_t)
+        ).sum(axis=1)
         return 0.5 * (M + np.swapaxes(M, 1, 2))
 
     def gravity_torque_batch(self, Q) -> np.ndarray:
@@ -314,8 +341,8 @@ class SerialChain:
         for i in range(n):
             z, o0, o1 = Ts[:, i, :3, 2], Ts[:, i, :3, 3], Ts[:, i + 1, :3, 3]
             R1 = Ts[:, i + 1, :3, :3]
-            zq = z * QD[:, i:i + 1]
-            dw = dw + z * QDD[:, i:i + 1] + np.cross(w, zq)
+            zq = z * QD[:, i : i + 1]
+            dw = dw + z * QDD[:, i : i + 1] + np.cross(w, zq)
             w = w + zq
             c = R1 @ self.links[i].com + o1
             rc = c - o0
@@ -331,9 +358,13 @@ class SerialChain:
             z, o0, o1, c, a_c, w_i, dw_i, Iw = keep[i]
             ma = self.links[i].mass * a_c
             f = ma + f_next
-            nm = (np.einsum("nab,nb->na", Iw, dw_i)
-                  + np.cross(w_i, np.einsum("nab,nb->na", Iw, w_i))
-                  + np.cross(c - o0, ma) + n_next + np.cross(o1 - o0, f_next))
+            nm = (
+                np.einsum("nab,nb->na", Iw, dw_i)
+                + np.cross(w_i, np.einsum("nab,nb->na", Iw, w_i))
+                + np.cross(c - o0, ma)
+                + n_next
+                + np.cross(o1 - o0, f_next)
+            )
             tau[:, i] = np.einsum("na,na->n", z, nm)
             f_next, n_next = f, nm
         return tau
@@ -370,9 +401,11 @@ def _scale(a, s):
 
 
 def _matvec(m, v):
-    return (m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-            m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-            m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2])
+    return (
+        m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
+        m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
+        m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
+    )
 
 
 def active_block(x: np.ndarray, active: Sequence[int]) -> np.ndarray:

@@ -17,7 +17,7 @@ def quadratic_roots(a: float, b: float, c: float) -> tuple[float, ...]:
     disc = b * b - 4.0 * a * c
     if disc < 0.0:
         return ()
-    q = -0.5 * (b + math.copysign(math.sqrt(disc), b))   # numerically stable pair
+    q = -0.5 * (b + math.copysign(math.sqrt(disc), b))  # numerically stable pair
     if q == 0.0:
         return (0.0,)
     return tuple(sorted((q / a, c / q)))
@@ -28,8 +28,9 @@ def quadratic_roots(a: float, b: float, c: float) -> tuple[float, ...]:
 # --------------------------------------------------------------------------------------------
 
 
-def spin_before_pure_rotation(m: float, inertia: float, e: float, speed: float,
-                              omega_1: float) -> list[tuple[float, float]]:
+def spin_before_pure_rotation(
+    m: float, inertia: float, e: float, speed: float, omega_1: float
+) -> list[tuple[float, float]]:
     """The initial spins omega_0 for which the 3-step first collision (v_1 = 0 at
     theta_1 = alpha(v_0), eq. 34) of a stick moving at ``speed`` leaves ``omega_1``.
 
@@ -38,7 +39,9 @@ def spin_before_pure_rotation(m: float, inertia: float, e: float, speed: float,
     (eq. 10) at the contact gives  e |v_0| m d^2 - (1 + e) I |omega_1| d + e |v_0| I = 0.
     """
     out = []
-    for d in quadratic_roots(e * speed * m, -(1.0 + e) * inertia * abs(omega_1), e * speed * inertia):
+    for d in quadratic_roots(
+        e * speed * m, -(1.0 + e) * inertia * abs(omega_1), e * speed * inertia
+    ):
         if d > 0.0:
             out.append((omega_1 - math.copysign(1.0, omega_1) * m * d * speed / inertia, d))
     return sorted(out, key=lambda p: p[1])

@@ -48,6 +48,7 @@ def _load(path: str) -> dict:
 def load_wam_table(path: str | Path | None = None) -> dict:
     """The parsed parameter table (a fresh copy)."""
     import copy
+
     return copy.deepcopy(_load(str(path or WAM_YAML)))
 
 
@@ -67,8 +68,10 @@ def wam_dh(dof: int = 4, table: dict | None = None) -> list[DHRow]:
 
 def wam_links(dof: int = 4, table: dict | None = None) -> list[RigidBody]:
     t = table or load_wam_table()
-    return [RigidBody(float(t["links"][k]["mass"]), t["links"][k]["com"], t["links"][k]["inertia"])
-            for k in _link_keys(dof)]
+    return [
+        RigidBody(float(t["links"][k]["mass"]), t["links"][k]["com"], t["links"][k]["inertia"])
+        for k in _link_keys(dof)
+    ]
 
 
 def wam_joint_names(dof: int = 4, table: dict | None = None) -> tuple[str, ...]:
@@ -93,24 +96,35 @@ def default_tool_d(dof: int, table: dict | None = None) -> float:
     return float(t["tool_4dof_d"]) if dof == 4 else 0.0
 
 
-def base_transform(position=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0),
-                   table: dict | None = None) -> np.ndarray:
+def base_transform(
+    position=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0), table: dict | None = None
+) -> np.ndarray:
     """World pose of DH frame 0: the base plate's pose, then ``base_height`` up to J1/J2's axes."""
     t = table or load_wam_table()
     plate = transform(rpy_to_matrix(rpy), position)
     return plate @ transform(translation=(0.0, 0.0, float(t["base_height"])))
 
 
-def wam_chain(dof: int = 4, *, tool_d: float | None = None, base_position=(0.0, 0.0, 0.0),
-              base_rpy=(0.0, 0.0, 0.0), gravity: float = 9.81,
-              payload: RigidBody | None = None, table: dict | None = None) -> SerialChain:
+def wam_chain(
+    dof: int = 4,
+    *,
+    tool_d: float | None = None,
+    base_position=(0.0, 0.0, 0.0),
+    base_rpy=(0.0, 0.0, 0.0),
+    gravity: float = 9.81,
+    payload: RigidBody | None = None,
+    table: dict | None = None,
+) -> SerialChain:
     """The WAM model. ``payload`` (mass properties in the tool frame, e.g. a hand) is added to the
     last link; ``gravity`` is the magnitude of g along world -z (m/s^2)."""
     t = table or load_wam_table()
     d = default_tool_d(dof, t) if tool_d is None else float(tool_d)
-    chain = SerialChain(wam_dh(dof, t), wam_links(dof, t),
-                        base=base_transform(base_position, base_rpy, t),
-                        tool=transform(translation=(0.0, 0.0, d)),
-                        gravity=(0.0, 0.0, -float(gravity)),
-                        joint_names=wam_joint_names(dof, t))
+    chain = SerialChain(
+        wam_dh(dof, t),
+        wam_links(dof, t),
+        base=base_transform(base_position, base_rpy, t),
+        tool=transform(translation=(0.0, 0.0, d)),
+        gravity=(0.0, 0.0, -float(gravity)),
+        joint_names=wam_joint_names(dof, t),
+    )
     return chain.with_payload(payload) if payload is not None else chain

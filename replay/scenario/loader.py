@@ -33,19 +33,28 @@ from replay.params import MAX_CHARS, MAX_FLOAT, MAX_INT, MAX_ITEMS, ParamError
 from replay.scenario.schema import Scenario
 from replay.scenario.yamlio import ScenarioError, compose, read_text, show
 
-__all__ = ["ScenarioError", "build", "build_dataclass", "load_scenario", "params_from_data",
-           "plugin_sections",
-           "resolved_yaml", "scenario_from_text", "to_plain"]
+__all__ = [
+    "ScenarioError",
+    "build",
+    "build_dataclass",
+    "load_scenario",
+    "params_from_data",
+    "plugin_sections",
+    "resolved_yaml",
+    "scenario_from_text",
+    "to_plain",
+]
 
 _SET_SOURCE = "<--set>"
-MAX_EXTENDS = 16                 # extends chains at most this long
+MAX_EXTENDS = 16  # extends chains at most this long
 MAX_SET_CHARS = 100_000
 _STR = "tag:yaml.org,2002:str"
 _MAP = "tag:yaml.org,2002:map"
-_PLAIN_FLOAT = re.compile(r"[-+]?(\d[\d_]*\.?\d*|\.\d+)[eE][-+]?\d+")   # 1e-3: YAML 1.1 says str
+_PLAIN_FLOAT = re.compile(r"[-+]?(\d[\d_]*\.?\d*|\.\d+)[eE][-+]?\d+")  # 1e-3: YAML 1.1 says str
 
 
 # -- reading YAML into node trees ----------------------------------------------------------------
+
 
 def _compose_root(text: str, name: str) -> yaml.MappingNode:
     node = compose(text, name)
@@ -56,8 +65,9 @@ def _compose_root(text: str, name: str) -> yaml.MappingNode:
     return node
 
 
-def _compose_file(path: Path, seen: tuple[Path, ...] = (), *, inputs: list[Path]
-                  ) -> yaml.MappingNode:
+def _compose_file(
+    path: Path, seen: tuple[Path, ...] = (), *, inputs: list[Path]
+) -> yaml.MappingNode:
     """The file's tree merged onto its ``extends`` chain; ``seen``: the files below it,
     ``inputs`` collects every file read."""
     inputs.append(path.resolve())
@@ -65,23 +75,26 @@ def _compose_file(path: Path, seen: tuple[Path, ...] = (), *, inputs: list[Path]
     base_node = _pop(node, "extends")
     if base_node is None:
         return node
-    if not (isinstance(base_node, yaml.ScalarNode) and base_node.tag == _STR and
-            base_node.value):
+    if not (isinstance(base_node, yaml.ScalarNode) and base_node.tag == _STR and base_node.value):
         raise ScenarioError("expected a file name", node=base_node, path="extends")
     try:
         base_path = (path.parent / base_node.value).resolve()
     except (OSError, RuntimeError, ValueError):
-        raise ScenarioError(f"bad file name {show(base_node.value)}", node=base_node,
-                            path="extends") from None
+        raise ScenarioError(
+            f"bad file name {show(base_node.value)}", node=base_node, path="extends"
+        ) from None
     if base_path in seen or base_path == path.resolve():
-        raise ScenarioError(f"extends loop through {show(base_path.name)}", node=base_node,
-                            path="extends")
+        raise ScenarioError(
+            f"extends loop through {show(base_path.name)}", node=base_node, path="extends"
+        )
     if len(seen) >= MAX_EXTENDS:
-        raise ScenarioError(f"extends chain longer than {MAX_EXTENDS} files", node=base_node,
-                            path="extends")
+        raise ScenarioError(
+            f"extends chain longer than {MAX_EXTENDS} files", node=base_node, path="extends"
+        )
     if not base_path.is_file():
-        raise ScenarioError(f"no such scenario file {show(base_node.value)}", node=base_node,
-                            path="extends")
+        raise ScenarioError(
+            f"no such scenario file {show(base_node.value)}", node=base_node, path="extends"
+        )
     return _merge(_compose_file(base_path, seen + (path.resolve(),), inputs=inputs), node)
 
 
@@ -122,17 +135,19 @@ def _merge(base: yaml.Node, over: yaml.Node) -> yaml.Node:
 
 def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
     if "=" not in assignment:
-        raise ScenarioError(f"--set expects key.path=value, got {show(assignment)}",
-                            file=_SET_SOURCE)
+        raise ScenarioError(
+            f"--set expects key.path=value, got {show(assignment)}", file=_SET_SOURCE
+        )
     key_path, text = assignment.split("=", 1)
     keys = [k.strip() for k in key_path.strip().split(".")]
     if not all(keys):
         raise ScenarioError(f"--set: bad key path {show(key_path)}", file=_SET_SOURCE)
     if len(text) > MAX_SET_CHARS:
-        raise ScenarioError(f"--set {key_path}: value longer than {MAX_SET_CHARS} characters",
-                            file=_SET_SOURCE)
+        raise ScenarioError(
+            f"--set {key_path}: value longer than {MAX_SET_CHARS} characters", file=_SET_SOURCE
+        )
     value = compose(text if text.strip() else "''", f"<--set {key_path}>", what="a value")
-    if value is None:      # "key=" followed by a comment only
+    if value is None:  # "key=" followed by a comment only
         value = compose("''", f"<--set {key_path}>")
     node = root
     for depth, key in enumerate(keys):
@@ -142,13 +157,13 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
             if found:
                 node.value[node.value.index(found)] = (found[0], value)
             else:
-                node.value.append((yaml.ScalarNode(_STR, key, value.start_mark,
-                                                   value.end_mark), value))
+                node.value.append(
+                    (yaml.ScalarNode(_STR, key, value.start_mark, value.end_mark), value)
+                )
             return
         if found is None:
             child = yaml.MappingNode(_MAP, [], value.start_mark, value.end_mark)
-            node.value.append((yaml.ScalarNode(_STR, key, value.start_mark, value.end_mark),
-                               child))
+            node.value.append((yaml.ScalarNode(_STR, key, value.start_mark, value.end_mark), child))
             node = child
         elif isinstance(found[1], yaml.MappingNode):
             node = found[1]
@@ -157,19 +172,23 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
             node.value[node.value.index(found)] = (found[0], child)
             node = child
         else:
-            raise ScenarioError(f"--set {key_path}: {'.'.join(keys[:depth + 1])} is not a "
-                                "mapping", file=_SET_SOURCE)
+            raise ScenarioError(
+                f"--set {key_path}: {'.'.join(keys[: depth + 1])} is not a mapping",
+                file=_SET_SOURCE,
+            )
 
 
 # -- node trees into typed values ------------------------------------------------------------
+
 
 def _scalar(node: yaml.ScalarNode, path: str) -> Any:
     try:
         return yaml.SafeLoader("").construct_object(node, deep=True)
     except (yaml.constructor.ConstructorError, ValueError, OverflowError) as exc:
         problem = getattr(exc, "problem", None) or str(exc)
-        raise ScenarioError(f"not allowed: {problem} (scenarios are data, not code)",
-                            node=node, path=path) from None
+        raise ScenarioError(
+            f"not allowed: {problem} (scenarios are data, not code)", node=node, path=path
+        ) from None
 
 
 def _describe(tp) -> str:
@@ -214,36 +233,41 @@ def _bounds(meta: dict, default: float | None = None) -> str:
 
 def _check_range(value: float, meta: dict, node, path, default: float) -> None:
     low, high = _limits(meta, default)
-    ok = ((value > low if meta.get("gt") is not None else value >= low) and
-          (value < high if meta.get("lt") is not None else value <= high))
+    ok = (value > low if meta.get("gt") is not None else value >= low) and (
+        value < high if meta.get("lt") is not None else value <= high
+    )
     if not ok:
         what = "a whole number" if isinstance(value, int) else "a number"
         got = show(value, 24) if isinstance(value, int) else f"{value:g}"
-        raise ScenarioError(f"expected {what} {_bounds(meta, default)}, got {got}", node=node,
-                            path=path)
+        raise ScenarioError(
+            f"expected {what} {_bounds(meta, default)}, got {got}", node=node, path=path
+        )
 
 
 def _number(node: yaml.ScalarNode, path: str, meta: dict) -> float:
     if node.tag == _STR and node.style is None and _PLAIN_FLOAT.fullmatch(node.value):
-        value: Any = float(node.value.replace("_", ""))      # 1e-3 (YAML 1.1 reads a string)
+        value: Any = float(node.value.replace("_", ""))  # 1e-3 (YAML 1.1 reads a string)
     else:
         value = _scalar(node, path)
     bounds = _bounds(meta, MAX_FLOAT)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ScenarioError(f"expected a number {bounds}, got {show(node.value)}", node=node,
-                            path=path)
+        raise ScenarioError(
+            f"expected a number {bounds}, got {show(node.value)}", node=node, path=path
+        )
     if isinstance(value, float) and math.isnan(value):
         raise ScenarioError(f"expected a number {bounds}, got NaN", node=node, path=path)
     if isinstance(value, float) and math.isinf(value):
         if not meta.get("allow_inf"):
-            raise ScenarioError(f"expected a finite number {bounds}, got {value}", node=node,
-                                path=path)
+            raise ScenarioError(
+                f"expected a finite number {bounds}, got {value}", node=node, path=path
+            )
         low, high = _limits(meta, math.inf)
         if not low <= value <= high:
-            raise ScenarioError(f"expected a number {_bounds(meta)}, got {value}", node=node,
-                                path=path)
+            raise ScenarioError(
+                f"expected a number {_bounds(meta)}, got {value}", node=node, path=path
+            )
         return value
-    _check_range(value, meta, node, path, MAX_FLOAT)     # exact for huge ints: no overflow
+    _check_range(value, meta, node, path, MAX_FLOAT)  # exact for huge ints: no overflow
     return float(value)
 
 
@@ -287,28 +311,33 @@ def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
         value = _scalar(node, path)
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ScenarioError(f"expected a whole number, got {show(node.value)}", node=node,
-                                path=path)
+            raise ScenarioError(
+                f"expected a whole number, got {show(node.value)}", node=node, path=path
+            )
         _check_range(value, meta, node, path, MAX_INT)
     elif tp is bool:
         if not isinstance(value, bool):
-            raise ScenarioError(f"expected true or false, got {show(node.value)}", node=node,
-                                path=path)
+            raise ScenarioError(
+                f"expected true or false, got {show(node.value)}", node=node, path=path
+            )
     elif tp is str:
         if not isinstance(value, str):
-            raise ScenarioError(f"expected a string, got {show(node.value)}", node=node,
-                                path=path)
+            raise ScenarioError(f"expected a string, got {show(node.value)}", node=node, path=path)
         _check_length(len(value), meta, node, path, "a string")
         pattern = meta.get("pattern")
         if pattern and not re.fullmatch(pattern, value):
-            raise ScenarioError(f"expected a name matching {pattern}, got {show(value)}",
-                                node=node, path=path)
+            raise ScenarioError(
+                f"expected a name matching {pattern}, got {show(value)}", node=node, path=path
+            )
     elif tp is Any or tp is object:
         if isinstance(value, float) and not math.isfinite(value):
             raise ScenarioError(f"expected a finite value, got {value}", node=node, path=path)
     if meta.get("choices") and value not in meta["choices"]:
-        raise ScenarioError(f"expected one of {', '.join(map(str, meta['choices']))}, got "
-                            f"{show(value)}", node=node, path=path)
+        raise ScenarioError(
+            f"expected one of {', '.join(map(str, meta['choices']))}, got {show(value)}",
+            node=node,
+            path=path,
+        )
     return value
 
 
@@ -323,15 +352,15 @@ def _build_list(node: yaml.Node, tp: Any, path: str, meta: dict) -> list | tuple
     else:
         item_types = [args[0]] * len(node.value)
     _check_length(len(node.value), meta, node, path, "a list")
-    item_meta = {k: v for k, v in meta.items()
-                 if k not in ("length", "min_length", "max_length")}
+    item_meta = {k: v for k, v in meta.items() if k not in ("length", "min_length", "max_length")}
     items = []
     for i, (v, t) in enumerate(zip(node.value, item_types)):
         sub = f"{path}[{i}]"
         if t is Any:
             if not isinstance(v, yaml.ScalarNode):
-                raise ScenarioError(f"expected a number, string or true/false, got {_kind(v)}",
-                                    node=v, path=sub)
+                raise ScenarioError(
+                    f"expected a number, string or true/false, got {_kind(v)}", node=v, path=sub
+                )
             t = object
         items.append(build(v, t, sub, item_meta))
     return tuple(items) if origin is tuple else items
@@ -346,13 +375,17 @@ def _build_dict(node: yaml.Node, tp: Any, path: str, meta: dict) -> Any:
     _, vt = typing.get_args(tp) or (str, Any)
     if vt is Any:
         return node
-    _check_length(len(node.value), {"max_length": meta.get("max_length") or 32}, node, path,
-                  "a mapping")
+    _check_length(
+        len(node.value), {"max_length": meta.get("max_length") or 32}, node, path, "a mapping"
+    )
     out = {}
     for k, v in node.value:
         if not _KEY.fullmatch(k.value):
-            raise ScenarioError(f"expected a name (letters, digits, _ and -), got "
-                                f"{show(k.value)}", node=k, path=f"{path}.{k.value}")
+            raise ScenarioError(
+                f"expected a name (letters, digits, _ and -), got {show(k.value)}",
+                node=k,
+                path=f"{path}.{k.value}",
+            )
         if k.value in out:
             raise ScenarioError("given twice", node=k, path=f"{path}.{k.value}")
         out[k.value] = build(v, vt, f"{path}.{k.value}")
@@ -371,10 +404,11 @@ def _kind(node: yaml.Node) -> str:
 
 def build_dataclass(node: yaml.Node, cls: type, path: str) -> Any:
     if isinstance(node, yaml.ScalarNode) and node.tag.endswith(":null"):
-        node = yaml.MappingNode(_MAP, [], node.start_mark, node.end_mark)   # "key:" = defaults
+        node = yaml.MappingNode(_MAP, [], node.start_mark, node.end_mark)  # "key:" = defaults
     if not isinstance(node, yaml.MappingNode):
-        raise ScenarioError(f"expected a mapping of {cls.__name__} fields, got {_kind(node)}",
-                            node=node, path=path)
+        raise ScenarioError(
+            f"expected a mapping of {cls.__name__} fields, got {_kind(node)}", node=node, path=path
+        )
     hints = typing.get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls) if not f.metadata.get("internal")}
     values: dict[str, Any] = {}
@@ -382,30 +416,34 @@ def build_dataclass(node: yaml.Node, cls: type, path: str) -> Any:
         key = k.value
         sub = f"{path}.{key}" if path else str(key)
         if key not in fields:
-            raise ScenarioError(f"unknown field {show(key)} (expected one of: "
-                                f"{', '.join(fields)})", node=k, path=sub)
+            raise ScenarioError(
+                f"unknown field {show(key)} (expected one of: {', '.join(fields)})",
+                node=k,
+                path=sub,
+            )
         if key in values:
             raise ScenarioError("field given twice", node=k, path=sub)
         values[key] = build(v, hints[key], sub, dict(fields[key].metadata))
     for name, f in fields.items():
-        required = (f.default is dataclasses.MISSING and
-                    f.default_factory is dataclasses.MISSING)  # type: ignore[misc]
+        required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING  # type: ignore[misc]
         if required and name not in values:
             unit = f.metadata.get("unit")
-            raise ScenarioError(f"missing field {name!r}"
-                                f"{' (' + unit + ')' if unit and unit != '1' else ''}",
-                                node=node, path=path or "(top level)")
+            raise ScenarioError(
+                f"missing field {name!r}{' (' + unit + ')' if unit and unit != '1' else ''}",
+                node=node,
+                path=path or "(top level)",
+            )
     try:
         return cls(**values)
-    except ParamError as exc:     # a Params __post_init__ check naming its field
+    except ParamError as exc:  # a Params __post_init__ check naming its field
         sub = f"{path}.{exc.field}" if path else exc.field
-        raise ScenarioError(exc.message, node=node_at(node, exc.field) or node,
-                            path=sub) from None
-    except (ValueError, TypeError, ArithmeticError) as exc:   # any other Params check
+        raise ScenarioError(exc.message, node=node_at(node, exc.field) or node, path=sub) from None
+    except (ValueError, TypeError, ArithmeticError) as exc:  # any other Params check
         raise ScenarioError(str(exc), node=node, path=path) from None
 
 
 # -- scenarios --------------------------------------------------------------------------------
+
 
 def node_at(root: yaml.Node, path: str) -> yaml.Node | None:
     """The node of a field path (``a.b[2].c``) under ``root``, or None when it is not given."""
@@ -450,14 +488,18 @@ def plugin_sections(sc: Scenario) -> Iterator[tuple[str, Any, str]]:
 def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
     """Replace each plug-in's raw ``params`` node by its validated ``Params`` instance."""
     if (sc.controller is None) == (not sc.tasks):
-        raise ScenarioError("give either controller: or tasks:, not "
-                            + ("both" if sc.tasks else "neither"), node=root, path="controller")
+        raise ScenarioError(
+            "give either controller: or tasks:, not " + ("both" if sc.tasks else "neither"),
+            node=root,
+            path="controller",
+        )
     for kind, spec, path in plugin_sections(sc):
         try:
             cls = registry.load(kind, spec.type)
         except registry.UnknownPlugin as exc:
-            raise ScenarioError(str(exc), node=_nearest(root, f"{path}.type"),
-                                path=f"{path}.type") from None
+            raise ScenarioError(
+                str(exc), node=_nearest(root, f"{path}.type"), path=f"{path}.type"
+            ) from None
         raw = spec.params
         if not isinstance(raw, yaml.Node):  # no params given: all defaults
             raw = yaml.MappingNode(_MAP, [], _nearest(root, path).start_mark, None)
@@ -476,30 +518,43 @@ def check_timing(sc: Scenario, root: yaml.Node) -> None:
     """Every task rate divides the physics rate; the run has at least one physics step."""
     rate = sc.timing.physics_rate
     if sc.timing.duration * rate < 1:
-        raise ScenarioError(f"expected at least one physics step (>= {1 / rate:g} s at "
-                            f"{rate} Hz), got {sc.timing.duration:g} s",
-                            node=_nearest(root, "timing.duration"), path="timing.duration")
-    tasks = [(f"{path}.rate", spec.rate) for kind, spec, path in plugin_sections(sc)
-             if kind in ("controller", "sensor")]
+        raise ScenarioError(
+            f"expected at least one physics step (>= {1 / rate:g} s at "
+            f"{rate} Hz), got {sc.timing.duration:g} s",
+            node=_nearest(root, "timing.duration"),
+            path="timing.duration",
+        )
+    tasks = [
+        (f"{path}.rate", spec.rate)
+        for kind, spec, path in plugin_sections(sc)
+        if kind in ("controller", "sensor")
+    ]
     if sc.timing.state_log_rate:
         tasks.append(("timing.state_log_rate", sc.timing.state_log_rate))
     for path, r in tasks:
         ratio = rate / r
         if abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio) or round(ratio) < 1:
-            raise ScenarioError(f"expected a rate that divides timing.physics_rate = {rate} Hz, "
-                                f"got {r:g} Hz", node=_nearest(root, path), path=path)
+            raise ScenarioError(
+                f"expected a rate that divides timing.physics_rate = {rate} Hz, got {r:g} Hz",
+                node=_nearest(root, path),
+                path=path,
+            )
 
 
 def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = None) -> Scenario:
     from replay.scenario.ports import check_ports
+
     for s in sets:
         _apply_set(root, s)
     sc = build_dataclass(root, Scenario, "")
     sc.source = source
     if seed is not None:
-        if not 0 <= seed <= 2 ** 63 - 1:
-            raise ScenarioError(f"expected a seed from 0 to 2^63 - 1, got {show(seed, 24)}",
-                                path="seed", file="--seed")
+        if not 0 <= seed <= 2**63 - 1:
+            raise ScenarioError(
+                f"expected a seed from 0 to 2^63 - 1, got {show(seed, 24)}",
+                path="seed",
+                file="--seed",
+            )
         sc.seed = seed
     check_timing(sc, root)
     _resolve_plugins(sc, root)
@@ -507,8 +562,9 @@ def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = 
     return sc
 
 
-def load_scenario(path: str | Path, sets: list[str] | tuple = (), seed: int | None = None
-                  ) -> Scenario:
+def load_scenario(
+    path: str | Path, sets: list[str] | tuple = (), seed: int | None = None
+) -> Scenario:
     """Read, merge, override and validate a scenario file."""
     path = Path(path)
     if not path.is_file():
@@ -520,8 +576,9 @@ def load_scenario(path: str | Path, sets: list[str] | tuple = (), seed: int | No
     return sc
 
 
-def scenario_from_text(text: str, name: str = "<log>", sets=(), seed: int | None = None
-                       ) -> Scenario:
+def scenario_from_text(
+    text: str, name: str = "<log>", sets=(), seed: int | None = None
+) -> Scenario:
     """A resolved scenario text (e.g. from a log's /scenario message) back into a Scenario."""
     root = _compose_root(text, name)
     _pop(root, "extends")
@@ -538,9 +595,12 @@ def params_from_data(cls: type, data: dict | None, path: str, source: str = "<lo
 def to_plain(value: Any) -> Any:
     """Dataclasses, tuples and lists as plain YAML-ready values, every default filled in."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: to_plain(getattr(value, f.name)) for f in dataclasses.fields(value)
-                if not f.metadata.get("internal")
-                and not (f.metadata.get("omit_empty") and not getattr(value, f.name))}
+        return {
+            f.name: to_plain(getattr(value, f.name))
+            for f in dataclasses.fields(value)
+            if not f.metadata.get("internal")
+            and not (f.metadata.get("omit_empty") and not getattr(value, f.name))
+        }
     if isinstance(value, (list, tuple)):
         return [to_plain(v) for v in value]
     if isinstance(value, dict):

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import yaml
 
-MAX_FILE_BYTES = 1 << 20        # a scenario is a page of text, not a megabyte
-MAX_DEPTH = 32                  # mappings and lists nested at most this deep
-MAX_NODES = 100_000             # YAML nodes, aliases expanded (an alias bomb stays small)
+MAX_FILE_BYTES = 1 << 20  # a scenario is a page of text, not a megabyte
+MAX_DEPTH = 32  # mappings and lists nested at most this deep
+MAX_NODES = 100_000  # YAML nodes, aliases expanded (an alias bomb stays small)
 _YAML_TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_YAML_TAG + t for t in ("str", "int", "float", "bool", "null", "timestamp")}
 _MAP, _SEQ = _YAML_TAG + "map", _YAML_TAG + "seq"
@@ -31,8 +31,15 @@ class ScenarioError(Exception):
     """Bad input: ``where`` is ``file:line:column`` (or the file, or ``<--set>``), ``path`` the
     field; ``str()`` is one line."""
 
-    def __init__(self, message: str, *, node: yaml.Node | None = None, path: str = "",
-                 file: str | None = None, mark: yaml.Mark | None = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        *,
+        node: yaml.Node | None = None,
+        path: str = "",
+        file: str | None = None,
+        mark: yaml.Mark | None = None,
+    ) -> None:
         self.message = one_line(message)
         self.path = one_line(path)
         mark = mark if mark is not None else (node.start_mark if node is not None else None)
@@ -56,11 +63,12 @@ def show(value, limit: int = 40) -> str:
     """A user's value for an error message: repr, shortened."""
     text = value if isinstance(value, str) else repr(value)
     if len(text) > limit:
-        text = f"{text[:limit // 2]}...({len(text)} characters)"
+        text = f"{text[: limit // 2]}...({len(text)} characters)"
     return repr(text) if isinstance(value, str) else text
 
 
 # -- text ------------------------------------------------------------------------------------
+
 
 def _tag(tag: str) -> str:
     return show(tag.replace(_YAML_TAG, "!!"), 60)
@@ -68,7 +76,7 @@ def _tag(tag: str) -> str:
 
 def _line_col(data: bytes | str, pos: int) -> tuple[int, int]:
     head = data[:pos]
-    text = head.decode("latin-1") if isinstance(head, bytes) else head   # 1 byte = 1 char
+    text = head.decode("latin-1") if isinstance(head, bytes) else head  # 1 byte = 1 char
     return text.count("\n") + 1, pos - (text.rfind("\n") + 1) + 1
 
 
@@ -78,8 +86,9 @@ def read_text(path: Path) -> str:
     try:
         size = path.stat().st_size
         if size > MAX_FILE_BYTES:
-            raise ScenarioError(f"file too big for a scenario ({size} bytes; at most "
-                                f"{MAX_FILE_BYTES})", file=name)
+            raise ScenarioError(
+                f"file too big for a scenario ({size} bytes; at most {MAX_FILE_BYTES})", file=name
+            )
         data = path.read_bytes()
     except OSError as exc:
         raise ScenarioError(f"cannot read scenario: {exc.strerror or exc}", file=name) from None
@@ -89,15 +98,19 @@ def read_text(path: Path) -> str:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line, col = _line_col(data, exc.start)
-        raise ScenarioError(f"not UTF-8 text (byte 0x{data[exc.start]:02x}); a scenario is "
-                            "UTF-8 YAML", file=f"{name}:{line}:{col}") from None
+        raise ScenarioError(
+            f"not UTF-8 text (byte 0x{data[exc.start]:02x}); a scenario is UTF-8 YAML",
+            file=f"{name}:{line}:{col}",
+        ) from None
     return text
 
 
 # -- composing ---------------------------------------------------------------------------------
 
+
 class _BoundedLoader(yaml.SafeLoader):
     """A SafeLoader whose composer refuses to nest deeper than ``MAX_DEPTH``."""
+
     source_name = "<string>"
 
     def __init__(self, stream) -> None:
@@ -109,8 +122,9 @@ class _BoundedLoader(yaml.SafeLoader):
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
-                raise ScenarioError(f"nested deeper than {MAX_DEPTH} levels",
-                                    mark=self.peek_event().start_mark)
+                raise ScenarioError(
+                    f"nested deeper than {MAX_DEPTH} levels", mark=self.peek_event().start_mark
+                )
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
@@ -130,8 +144,10 @@ def compose(text: str, name: str, *, what: str = "a scenario") -> yaml.Node | No
         raise ScenarioError(f"not valid YAML: {problem}", mark=mark, file=name) from None
     except yaml.reader.ReaderError as exc:
         line, col = _line_col(text, exc.position)
-        raise ScenarioError(f"not valid YAML: character {exc.character!r} is not allowed "
-                            f"in {what}", file=f"{name}:{line}:{col}") from None
+        raise ScenarioError(
+            f"not valid YAML: character {exc.character!r} is not allowed in {what}",
+            file=f"{name}:{line}:{col}",
+        ) from None
     except yaml.YAMLError as exc:
         raise ScenarioError(f"not valid YAML: {exc}", file=name) from None
     if node is not None:
@@ -151,21 +167,29 @@ def check_shape(root: yaml.Node) -> None:
             return size[key]
         if key in active or depth > 2 * MAX_DEPTH:
             raise ScenarioError("a recursive alias (a node that contains itself)", node=node)
-        allowed = ({_MAP} if isinstance(node, yaml.MappingNode) else
-                   {_SEQ} if isinstance(node, yaml.SequenceNode) else _SCALAR_TAGS)
+        allowed = (
+            {_MAP}
+            if isinstance(node, yaml.MappingNode)
+            else {_SEQ}
+            if isinstance(node, yaml.SequenceNode)
+            else _SCALAR_TAGS
+        )
         if node.tag not in allowed:
-            raise ScenarioError(f"tag {_tag(node.tag)} not allowed (scenarios are data, not "
-                                "code)", node=node)
+            raise ScenarioError(
+                f"tag {_tag(node.tag)} not allowed (scenarios are data, not code)", node=node
+            )
         active.add(key)
         n = 1
         if isinstance(node, yaml.MappingNode):
             for k, v in node.value:
                 if not isinstance(k, yaml.ScalarNode):
-                    raise ScenarioError("a key must be a plain name, not a list or a mapping",
-                                        node=k)
+                    raise ScenarioError(
+                        "a key must be a plain name, not a list or a mapping", node=k
+                    )
                 if k.tag == _YAML_TAG + "merge":
-                    raise ScenarioError("merge keys (<<) are not supported: use extends: FILE",
-                                        node=k)
+                    raise ScenarioError(
+                        "merge keys (<<) are not supported: use extends: FILE", node=k
+                    )
                 if k.tag not in _SCALAR_TAGS:
                     raise ScenarioError(f"tag {_tag(k.tag)} not allowed on a key", node=k)
                 n += 1 + count(v, depth + 1)
@@ -174,8 +198,10 @@ def check_shape(root: yaml.Node) -> None:
                 n += count(v, depth + 1)
         active.discard(key)
         if n > MAX_NODES:
-            raise ScenarioError(f"too many values ({n} with aliases expanded; at most "
-                                f"{MAX_NODES}): an alias bomb?", node=node)
+            raise ScenarioError(
+                f"too many values ({n} with aliases expanded; at most {MAX_NODES}): an alias bomb?",
+                node=node,
+            )
         size[key] = n
         return n
 

@@ -20,16 +20,20 @@ from replay.scene import Scene
 
 @dataclass
 class EncoderParams:
-    reading: str = param("arm", max_length=100,
-                        doc="which of the plant's readings (Scene.readings) to publish")
-    topic: str = param(TOPIC_ARM_ENCODERS, pattern=r"/[A-Za-z0-9_/]{1,99}",
-                       doc="log topic of the measurement")
-    resolution: float = param(0.0, unit="rad", ge=0, le=10,
-                              doc="angle per encoder count; 0 = exact")
+    reading: str = param(
+        "arm", max_length=100, doc="which of the plant's readings (Scene.readings) to publish"
+    )
+    topic: str = param(
+        TOPIC_ARM_ENCODERS, pattern=r"/[A-Za-z0-9_/]{1,99}", doc="log topic of the measurement"
+    )
+    resolution: float = param(
+        0.0, unit="rad", ge=0, le=10, doc="angle per encoder count; 0 = exact"
+    )
 
 
 class JointEncoders(Sensor):
     """Joint encoders: the plant's joint readings, quantised, on ``/arm/encoders``."""
+
     Params = EncoderParams
     topic = TOPIC_ARM_ENCODERS
 
@@ -44,5 +48,4 @@ class JointEncoders(Sensor):
         q = np.asarray(r["position"], dtype=float)
         if self.params.resolution > 0.0:
             q = np.round(q / self.params.resolution) * self.params.resolution
-        return JointState(t, list(r["name"]), q.tolist(), list(r["velocity"]),
-                          [0.0] * len(q))
+        return JointState(t, list(r["name"]), q.tolist(), list(r["velocity"]), [0.0] * len(q))

@@ -20,30 +20,29 @@ from replay.params import param
 from replay.scene import Scene
 
 
-
 @dataclass
 class WristWrench:
     t: float
-    force: list      # N, palm frame
-    torque: list     # N m, palm frame, about the flange-palm joint's origin
+    force: list  # N, palm frame
+    torque: list  # N m, palm frame, about the flange-palm joint's origin
 
 
 @dataclass
 class JointTorque:
     t: float
     name: list
-    torque: list     # N m
+    torque: list  # N m
 
 
 @dataclass
 class WristFTParams:
     force_noise: float = param(0.0, unit="N", ge=0.0, doc="standard deviation per force axis")
-    torque_noise: float = param(0.0, unit="N*m", ge=0.0,
-                                doc="standard deviation per torque axis")
+    torque_noise: float = param(0.0, unit="N*m", ge=0.0, doc="standard deviation per torque axis")
 
 
 class WristFTSensor(Sensor):
     """The wrist's 6-axis force/torque sensor: ``/wrist/wrench``."""
+
     Params = WristFTParams
     topic = TOPIC_WRIST_WRENCH
     spec_type = None
@@ -67,6 +66,7 @@ class HandTorqueParams:
 
 class HandTorqueSensor(Sensor):
     """The hand joints' strain gauges: ``/hand/joint_torque``."""
+
     Params = HandTorqueParams
     topic = TOPIC_HAND_TORQUE
     spec_type = None

@@ -22,6 +22,7 @@ import numpy as np
 @dataclass(frozen=True)
 class Intrinsics:
     """Focal lengths and principal point in pixels, image size in pixels."""
+
     fx: float
     fy: float
     cx: float
@@ -35,7 +36,9 @@ class Intrinsics:
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
 
     @classmethod
-    def from_fov(cls, width: int, height: int, fov_x: float, fov_y: float | None = None) -> Intrinsics:
+    def from_fov(
+        cls, width: int, height: int, fov_x: float, fov_y: float | None = None
+    ) -> Intrinsics:
         """Intrinsics from the full horizontal field of view ``fov_x`` (rad), edge to edge.
 
         ``fov_y`` defaults to square pixels (fy = fx). The principal point is the image centre.
@@ -49,8 +52,14 @@ class Intrinsics:
             if not 0.0 < fov_y < math.pi:
                 raise ValueError(f"fov_y must be in (0, pi) rad, got {fov_y}")
             fy = (height / 2.0) / math.tan(fov_y / 2.0)
-        return cls(fx=fx, fy=fy, cx=(width - 1) / 2.0, cy=(height - 1) / 2.0,
-                   width=int(width), height=int(height))
+        return cls(
+            fx=fx,
+            fy=fy,
+            cx=(width - 1) / 2.0,
+            cy=(height - 1) / 2.0,
+            width=int(width),
+            height=int(height),
+        )
 
 
 def look_at_rotation(eye, target, up=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -83,8 +92,11 @@ class PinholeCamera:
 
     def __init__(self, intrinsics: Intrinsics, rotation=None, position=(0.0, 0.0, 0.0)) -> None:
         R = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
-        if R.shape != (3, 3) or not np.allclose(R.T @ R, np.eye(3), atol=1e-9) \
-                or np.linalg.det(R) < 0.0:
+        if (
+            R.shape != (3, 3)
+            or not np.allclose(R.T @ R, np.eye(3), atol=1e-9)
+            or np.linalg.det(R) < 0.0
+        ):
             raise ValueError("rotation must be a proper 3x3 rotation matrix (camera-to-world)")
         self.intrinsics = intrinsics
         self.rotation = R
@@ -97,8 +109,16 @@ class PinholeCamera:
         return cls(intrinsics, look_at_rotation(eye, target, up), eye)
 
     @classmethod
-    def from_fov(cls, width: int, height: int, fov_x: float, eye, target,
-                 up=(0.0, 0.0, 1.0), fov_y: float | None = None) -> PinholeCamera:
+    def from_fov(
+        cls,
+        width: int,
+        height: int,
+        fov_x: float,
+        eye,
+        target,
+        up=(0.0, 0.0, 1.0),
+        fov_y: float | None = None,
+    ) -> PinholeCamera:
         """A look-at camera with intrinsics from the horizontal field of view (rad)."""
         return cls.look_at(Intrinsics.from_fov(width, height, fov_x, fov_y), eye, target, up)
 
@@ -135,21 +155,29 @@ class PinholeCamera:
         uv = np.asarray(pixels, dtype=float)
         w, h = self.intrinsics.width, self.intrinsics.height
         with np.errstate(invalid="ignore"):
-            return ((uv[..., 0] >= -0.5) & (uv[..., 0] < w - 0.5)
-                    & (uv[..., 1] >= -0.5) & (uv[..., 1] < h - 0.5))
+            return (
+                (uv[..., 0] >= -0.5)
+                & (uv[..., 0] < w - 0.5)
+                & (uv[..., 1] >= -0.5)
+                & (uv[..., 1] < h - 0.5)
+            )
 
     # --- backward --------------------------------------------------------------------------
     def ray(self, pixels) -> tuple[np.ndarray, np.ndarray]:
         """The viewing ray(s) of pixel(s): ``(origin (3,), unit directions (N, 3) or (3,))``."""
         uv = np.asarray(pixels, dtype=float)
         k = self.intrinsics
-        d_cam = np.stack([(uv[..., 0] - k.cx) / k.fx, (uv[..., 1] - k.cy) / k.fy,
-                          np.ones(uv.shape[:-1])], axis=-1)
+        d_cam = np.stack(
+            [(uv[..., 0] - k.cx) / k.fx, (uv[..., 1] - k.cy) / k.fy, np.ones(uv.shape[:-1])],
+            axis=-1,
+        )
         d = d_cam @ self.rotation.T
         d = d / np.linalg.norm(d, axis=-1, keepdims=True)
         return self.position.copy(), d
 
-    def backproject_to_plane(self, pixels, point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0)) -> np.ndarray:
+    def backproject_to_plane(
+        self, pixels, point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0)
+    ) -> np.ndarray:
         """World points (N, 3) or (3,) where the pixels' rays meet the plane through ``point``
         with ``normal``; NaN where a ray is parallel to the plane or meets it behind the camera."""
         o, d = self.ray(pixels)

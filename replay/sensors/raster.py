@@ -30,13 +30,13 @@ def _cut(a: np.ndarray, b: np.ndarray, limit):
     last = np.minimum(np.maximum(np.floor(np.maximum(a, b)), 0.0), limit)
     n = (np.maximum(last - first + 1.0, 0.0) * (d != 0.0)).astype(np.int64) + 2
     seg = np.arange(len(a)).repeat(n)
-    j = np.arange(seg.size) - (n.cumsum() - n).repeat(n)          # 0 .. n - 1 on each segment
+    j = np.arange(seg.size) - (n.cumsum() - n).repeat(n)  # 0 .. n - 1 on each segment
     ds, ns = d[seg], n[seg]
     k = np.where(ds > 0.0, first[seg] + (j - 1), last[seg] - (j - 1))
     s = np.minimum(np.maximum((k - a[seg]) / np.where(ds != 0.0, ds, 1.0), 0.0), 1.0)
     s[j == 0] = 0.0
     s[j == ns - 1] = 1.0
-    inner = np.flatnonzero(j < ns - 1)                              # piece from s[i] to s[i + 1]
+    inner = np.flatnonzero(j < ns - 1)  # piece from s[i] to s[i + 1]
     return seg[inner], s[inner], s[inner + 1]
 
 
@@ -47,8 +47,9 @@ def coverage_blocks(polygons, blocks) -> list[np.ndarray]:
     so the cost (a few dozen NumPy calls on short arrays) is shared by every polygon and block,
     e.g. the same ball seen by two cameras."""
     out = [np.zeros((int(b[3]), int(b[2]))) for b in blocks]
-    todo = [i for i, q in enumerate(polygons) if len(q) >= 3 and blocks[i][2] > 0
-            and blocks[i][3] > 0]
+    todo = [
+        i for i, q in enumerate(polygons) if len(q) >= 3 and blocks[i][2] > 0 and blocks[i][3] > 0
+    ]
     if not todo:
         return out
     # window coordinates: pixel (c, r) of a block spans [c, c + 1] x [r, r + 1]
@@ -65,9 +66,9 @@ def coverage_blocks(polygons, blocks) -> list[np.ndarray]:
     hs = np.array([blocks[i][3] for i in todo], dtype=np.int64)
     strides = ws + 1
     offsets = np.concatenate(([0], (hs * strides).cumsum()))
-    cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]      # twice each polygon's signed area
+    cross = P[:, 0] * Q[:, 1] - Q[:, 0] * P[:, 1]  # twice each polygon's signed area
     signs = np.where(np.add.reduceat(cross, size.cumsum() - size) >= 0.0, -1.0, 1.0)
-    owner = np.arange(len(todo)).repeat(size)          # edge -> polygon (in ``todo``)
+    owner = np.arange(len(todo)).repeat(size)  # edge -> polygon (in ``todo``)
     # edges cut into pieces within one pixel row, then within one pixel
     e, s0, s1 = _cut(P[:, 1], Q[:, 1], hs[owner])
     Pe, de = P[e], Q[e] - P[e]
@@ -84,9 +85,9 @@ def coverage_blocks(polygons, blocks) -> list[np.ndarray]:
     xm = xa[r] + 0.5 * (u0 + u1) * (xb[r] - xa[r])
     dy = (u1 - u0) * (yb[r] - ya[r]) * signs[o]
     col = np.floor(xm)
-    keep = np.flatnonzero(col < ws[o])                 # right of the block: no effect in it
+    keep = np.flatnonzero(col < ws[o])  # right of the block: no effect in it
     o, r, xm, dy, col = o[keep], r[keep], xm[keep], dy[keep], col[keep]
-    left = col < 0                                     # left of the block: at its left edge
+    left = col < 0  # left of the block: at its left edge
     f = xm - col
     f[left] = 0.0
     col[left] = 0.0
@@ -96,7 +97,7 @@ def coverage_blocks(polygons, blocks) -> list[np.ndarray]:
     acc[1:] += np.bincount(cell + 1, weights=dy * f, minlength=total + 1)[1:]
     for k, i in enumerate(todo):
         h, w, st = int(hs[k]), int(ws[k]), int(strides[k])
-        out[i] = acc[offsets[k]:offsets[k] + h * st].reshape(h, st).cumsum(axis=1)[:, :w]
+        out[i] = acc[offsets[k] : offsets[k] + h * st].reshape(h, st).cumsum(axis=1)[:, :w]
     return out
 
 

@@ -37,11 +37,12 @@ from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
 from replay.sensors.raster import coverage_blocks, paint
 
-ELLIPSE_VERTICES = 48   # vertices of the polygon standing in for an ellipse
-_NEAR = 1e-6            # m: nearest depth drawn
+ELLIPSE_VERTICES = 48  # vertices of the polygon standing in for an ellipse
+_NEAR = 1e-6  # m: nearest depth drawn
 # an N-gon inscribed at equal parameter steps has N/2 sin(2 pi/N) / pi of the ellipse's area
-_AREA_SCALE = math.sqrt(2.0 * math.pi
-                        / (ELLIPSE_VERTICES * math.sin(2.0 * math.pi / ELLIPSE_VERTICES)))
+_AREA_SCALE = math.sqrt(
+    2.0 * math.pi / (ELLIPSE_VERTICES * math.sin(2.0 * math.pi / ELLIPSE_VERTICES))
+)
 _COS = np.cos(2.0 * math.pi * np.arange(ELLIPSE_VERTICES) / ELLIPSE_VERTICES)
 _SIN = np.sin(2.0 * math.pi * np.arange(ELLIPSE_VERTICES) / ELLIPSE_VERTICES)
 
@@ -50,6 +51,7 @@ _SIN = np.sin(2.0 * math.pi * np.arange(ELLIPSE_VERTICES) / ELLIPSE_VERTICES)
 class Ellipse:
     """An image ellipse in pixels: centre, semi-axes ``a >= b`` and the angle (rad) of the
     ``a`` axis from the image u axis (towards +v); ``depth`` is the sphere's centre depth Z (m)."""
+
     u: float
     v: float
     a: float
@@ -78,7 +80,7 @@ def sphere_ellipse(camera: PinholeCamera, centre, radius: float) -> Ellipse | No
     front of the camera's plane (``Z <= r``: the outline is then unbounded or empty)."""
     R, o = camera.rotation, camera.position
     dx, dy, dz = float(centre[0]) - o[0], float(centre[1]) - o[1], float(centre[2]) - o[2]
-    X = R[0, 0] * dx + R[1, 0] * dy + R[2, 0] * dz        # p_cam = R^T (p - o)
+    X = R[0, 0] * dx + R[1, 0] * dy + R[2, 0] * dz  # p_cam = R^T (p - o)
     Y = R[0, 1] * dx + R[1, 1] * dy + R[2, 1] * dz
     Z = R[0, 2] * dx + R[1, 2] * dy + R[2, 2] * dz
     r2 = float(radius) ** 2
@@ -95,11 +97,16 @@ def sphere_ellipse(camera: PinholeCamera, centre, radius: float) -> Ellipse | No
     bh = -g * X * Y / (D * fx * fy)
     mean = 0.5 * (baa + bdd)
     rad = math.hypot(0.5 * (baa - bdd), bh)
-    lam_small, lam_big = mean - rad, mean + rad           # semi-axes 1/sqrt(lambda)
-    angle = 0.5 * math.atan2(2.0 * bh, baa - bdd) + 0.5 * math.pi   # axis of lam_small
-    return Ellipse(u=fx * X * Z / E + k.cx, v=fy * Y * Z / E + k.cy,
-                   a=1.0 / math.sqrt(lam_small), b=1.0 / math.sqrt(lam_big),
-                   angle=math.atan2(math.sin(angle), math.cos(angle)), depth=Z)
+    lam_small, lam_big = mean - rad, mean + rad  # semi-axes 1/sqrt(lambda)
+    angle = 0.5 * math.atan2(2.0 * bh, baa - bdd) + 0.5 * math.pi  # axis of lam_small
+    return Ellipse(
+        u=fx * X * Z / E + k.cx,
+        v=fy * Y * Z / E + k.cy,
+        a=1.0 / math.sqrt(lam_small),
+        b=1.0 / math.sqrt(lam_big),
+        angle=math.atan2(math.sin(angle), math.cos(angle)),
+        depth=Z,
+    )
 
 
 def sphere_centroid_bias(camera: PinholeCamera, centre, radius: float) -> np.ndarray:
@@ -122,8 +129,9 @@ def correct_sphere_centroid(camera: PinholeCamera, uv, depth: float, radius: flo
 # --- polygons of other primitives ---------------------------------------------------------
 
 _BOX = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
-_RIM = np.column_stack([np.cos(2 * np.pi * np.arange(32) / 32),
-                        np.sin(2 * np.pi * np.arange(32) / 32)])
+_RIM = np.column_stack(
+    [np.cos(2 * np.pi * np.arange(32) / 32), np.sin(2 * np.pi * np.arange(32) / 32)]
+)
 
 
 def _hull_points(prim) -> np.ndarray:
@@ -133,8 +141,12 @@ def _hull_points(prim) -> np.ndarray:
         body = _BOX * (0.5 * np.asarray(prim.size, float))
     else:
         ring = prim.radius * _RIM
-        body = np.vstack([np.column_stack([ring, np.full(len(ring), s * 0.5 * prim.length)])
-                          for s in (-1.0, 1.0)])
+        body = np.vstack(
+            [
+                np.column_stack([ring, np.full(len(ring), s * 0.5 * prim.length)])
+                for s in (-1.0, 1.0)
+            ]
+        )
     return body @ R.T + np.asarray(prim.position, float)
 
 
@@ -161,6 +173,7 @@ def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse
 
 # --- raster --------------------------------------------------------------------------------
 
+
 def _block(poly: np.ndarray, w: int, h: int):
     """The pixel block (x0, y0, w, h) of a polygon's bounding box plus a pixel, clipped to a
     w x h image, or None if it is off the image."""
@@ -174,7 +187,7 @@ def _block(poly: np.ndarray, w: int, h: int):
 def render_views(cameras, scene: Scene, *, background: float = 0.1) -> list[np.ndarray]:
     """:func:`render` for several cameras at once: the coverage of every silhouette in every
     view is computed in one pass (:func:`~replay.sensors.raster.coverage_blocks`)."""
-    images, jobs = [], []                                  # (view, polygon, grey, block)
+    images, jobs = [], []  # (view, polygon, grey, block)
     for view, camera in enumerate(cameras):
         k = camera.intrinsics
         images.append(np.full((k.height, k.width), 255.0 * background, np.float32))
@@ -183,15 +196,15 @@ def render_views(cameras, scene: Scene, *, background: float = 0.1) -> list[np.n
             s = silhouette(camera, prim)
             if s is not None:
                 items.append((-s[0], i, prim, s[1]))
-        items.sort(key=lambda it: (it[0], it[1]))          # far first
+        items.sort(key=lambda it: (it[0], it[1]))  # far first
         for _, _, prim, shape in items:
             poly = shape.polygon() if isinstance(shape, Ellipse) else shape
             block = _block(poly, k.width, k.height) if len(poly) >= 3 else None
             if block is not None:
                 jobs.append((view, poly, 255.0 * float(prim.albedo), block))
     covs = coverage_blocks([j[1] for j in jobs], [j[3] for j in jobs])
-    for (view, _, grey, (x0, y0, w, h)), cov in zip(jobs, covs):   # in each view far to near
-        paint(images[view][y0:y0 + h, x0:x0 + w], cov, grey)
+    for (view, _, grey, (x0, y0, w, h)), cov in zip(jobs, covs):  # in each view far to near
+        paint(images[view][y0 : y0 + h, x0 : x0 + w], cov, grey)
     return images
 
 

@@ -67,75 +67,131 @@ from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
 from replay.sensors.silhouette import correct_sphere_centroid, render_views
 
-_DILATE = np.ones((5, 5), np.uint8)   # the grey-moment region: the blob grown by 2 px
-_MARGIN = 4                           # px around the blob: region (2) + background ring (2)
+_DILATE = np.ones((5, 5), np.uint8)  # the grey-moment region: the blob grown by 2 px
+_MARGIN = 4  # px around the blob: region (2) + background ring (2)
 
 
 @dataclass
 class StereoBallCameraParams:
     cam0_position: list[float] = param(
-        [2.6, 0.4, 0.8], unit="m", length=3, ge=-100, le=100,
+        [2.6, 0.4, 0.8],
+        unit="m",
+        length=3,
+        ge=-100,
+        le=100,
         doc="optical centre of camera 0 (world). Default: 0.4 m to the +y side of the flight "
-            "path, 0.6 m in front of the release (the ball is thrown between the two cameras)")
+        "path, 0.6 m in front of the release (the ball is thrown between the two cameras)",
+    )
     cam0_target: list[float] = param(
-        [1.9, 0.0, 0.8], unit="m", length=3, ge=-100, le=100,
+        [1.9, 0.0, 0.8],
+        unit="m",
+        length=3,
+        ge=-100,
+        le=100,
         doc="world point on camera 0's optical axis. Default: on the flight path, chosen to "
-            "centre the ball's image from x = 2.2 m to the catch point (0.7, 0, 0.5) m")
+        "centre the ball's image from x = 2.2 m to the catch point (0.7, 0, 0.5) m",
+    )
     cam1_position: list[float] = param(
-        [2.6, -0.4, 0.8], unit="m", length=3, ge=-100, le=100,
+        [2.6, -0.4, 0.8],
+        unit="m",
+        length=3,
+        ge=-100,
+        le=100,
         doc="optical centre of camera 1 (world); default: the mirror image of camera 0, a "
-            "0.8 m stereo baseline")
-    cam1_target: list[float] = param([1.9, 0.0, 0.8], unit="m", length=3, ge=-100, le=100,
-                                     doc="world point on camera 1's optical axis")
-    up: list[float] = param([0.0, 0.0, 1.0], unit="1", length=3, ge=-1e3, le=1e3,
-                            doc="world direction shown as 'up' in both images")
-    fov: float = param(math.radians(60.0), unit="rad", gt=0.0, lt=math.pi,
-                       doc="vertical field of view, edge to edge (square pixels; 60 deg default: "
-                           "f = 110.9 px)")
+        "0.8 m stereo baseline",
+    )
+    cam1_target: list[float] = param(
+        [1.9, 0.0, 0.8],
+        unit="m",
+        length=3,
+        ge=-100,
+        le=100,
+        doc="world point on camera 1's optical axis",
+    )
+    up: list[float] = param(
+        [0.0, 0.0, 1.0],
+        unit="1",
+        length=3,
+        ge=-1e3,
+        le=1e3,
+        doc="world direction shown as 'up' in both images",
+    )
+    fov: float = param(
+        math.radians(60.0),
+        unit="rad",
+        gt=0.0,
+        lt=math.pi,
+        doc="vertical field of view, edge to edge (square pixels; 60 deg default: f = 110.9 px)",
+    )
     width: int = param(128, unit="px", ge=8, le=2048, doc="image width; paper: 128 (CPV)")
     height: int = param(128, unit="px", ge=8, le=2048, doc="image height; paper: 128 (CPV)")
-    noise_sigma: float = param(0.0, unit="grey level", ge=0.0, le=1000,
-                               doc="standard deviation of Gaussian pixel noise (0..255 scale)")
-    threshold: float = param(100.0, unit="grey level", ge=0.0, le=255.0,
-                             doc="pixels brighter than this are ball (ball 0.9 * 255 on "
-                                 "0.1 * 255): a pixel 37 % covered by the ball passes, so a "
-                                 "1.5 px ball is still seen")
-    min_pixels: int = param(1, unit="px", ge=1, le=2048 * 2048,
-                            doc="smallest blob (pixels above threshold) accepted")
-    moments: str = param("grey", choices=("grey", "binary"),
-                         doc="grey: moments of grey level above the local background in the blob "
-                             "grown by 2 px (sub-pixel); binary: moments of the segmented blob "
-                             "(a 1-bit vision chip's)")
-    bias_correction: bool = param(True, doc="correct the sphere-silhouette centroid bias (needs "
-                                            "the tracked primitive to be a Sphere: its radius)")
-    background: float = param(0.1, unit="1", ge=0.0, le=1.0,
-                              doc="albedo of the (uniform) background")
-    tracked: str = param("ball", max_length=100,
-                         doc="name of the scene primitive whose position is measured")
+    noise_sigma: float = param(
+        0.0,
+        unit="grey level",
+        ge=0.0,
+        le=1000,
+        doc="standard deviation of Gaussian pixel noise (0..255 scale)",
+    )
+    threshold: float = param(
+        100.0,
+        unit="grey level",
+        ge=0.0,
+        le=255.0,
+        doc="pixels brighter than this are ball (ball 0.9 * 255 on "
+        "0.1 * 255): a pixel 37 % covered by the ball passes, so a "
+        "1.5 px ball is still seen",
+    )
+    min_pixels: int = param(
+        1, unit="px", ge=1, le=2048 * 2048, doc="smallest blob (pixels above threshold) accepted"
+    )
+    moments: str = param(
+        "grey",
+        choices=("grey", "binary"),
+        doc="grey: moments of grey level above the local background in the blob "
+        "grown by 2 px (sub-pixel); binary: moments of the segmented blob "
+        "(a 1-bit vision chip's)",
+    )
+    bias_correction: bool = param(
+        True,
+        doc="correct the sphere-silhouette centroid bias (needs "
+        "the tracked primitive to be a Sphere: its radius)",
+    )
+    background: float = param(
+        0.1, unit="1", ge=0.0, le=1.0, doc="albedo of the (uniform) background"
+    )
+    tracked: str = param(
+        "ball", max_length=100, doc="name of the scene primitive whose position is measured"
+    )
 
     def __post_init__(self) -> None:
-        for i, (eye, target) in enumerate(((self.cam0_position, self.cam0_target),
-                                           (self.cam1_position, self.cam1_target))):
+        for i, (eye, target) in enumerate(
+            ((self.cam0_position, self.cam0_target), (self.cam1_position, self.cam1_target))
+        ):
             try:
                 look_at_rotation(eye, target, self.up)
             except ValueError as exc:
-                raise ParamError(f"cam{i}_target" if "coincide" in str(exc) else "up",
-                                 f"camera {i}: {exc}") from None
+                raise ParamError(
+                    f"cam{i}_target" if "coincide" in str(exc) else "up", f"camera {i}: {exc}"
+                ) from None
         if np.allclose(self.cam0_position, self.cam1_position):
-            raise ParamError("cam1_position", "the two cameras are at the same place: no stereo "
-                             "baseline")
-
+            raise ParamError(
+                "cam1_position", "the two cameras are at the same place: no stereo baseline"
+            )
 
 
 class StereoBallCamera(Sensor):
     """Two 128 x 128 cameras, blob moments and triangulation: ``/vision/object`` (``r_o``)."""
+
     Params = StereoBallCameraParams
     topic = TOPIC_VISION_OBJECT
-    description = ("two 128x128 pinhole cameras either side of the throw; threshold, image "
-                   "moments, cv2.triangulatePoints -> ball position r_o")
+    description = (
+        "two 128x128 pinhole cameras either side of the throw; threshold, image "
+        "moments, cv2.triangulatePoints -> ball position r_o"
+    )
 
-    def __init__(self, params: StereoBallCameraParams, *, rng: np.random.Generator,
-                 spec=None) -> None:
+    def __init__(
+        self, params: StereoBallCameraParams, *, rng: np.random.Generator, spec=None
+    ) -> None:
         super().__init__(params, rng=rng, spec=spec)
         self.cameras = self.make_cameras(params)
         self.projections = [c.projection_matrix() for c in self.cameras]
@@ -144,21 +200,32 @@ class StereoBallCamera(Sensor):
 
     # --- helpers usable without a sensor instance -------------------------------------------
     @staticmethod
-    def make_cameras(params: StereoBallCameraParams | None = None
-                     ) -> tuple[PinholeCamera, PinholeCamera]:
+    def make_cameras(
+        params: StereoBallCameraParams | None = None,
+    ) -> tuple[PinholeCamera, PinholeCamera]:
         """The two look-at pinhole cameras (square pixels, principal point at the centre)."""
         p = params if params is not None else StereoBallCameraParams()
         f = (p.height / 2.0) / math.tan(p.fov / 2.0)
-        k = Intrinsics(fx=f, fy=f, cx=(p.width - 1) / 2.0, cy=(p.height - 1) / 2.0,
-                       width=int(p.width), height=int(p.height))
-        return tuple(PinholeCamera.look_at(k, eye, target, p.up)        # type: ignore[return-value]
-                     for eye, target in ((p.cam0_position, p.cam0_target),
-                                         (p.cam1_position, p.cam1_target)))
+        k = Intrinsics(
+            fx=f,
+            fy=f,
+            cx=(p.width - 1) / 2.0,
+            cy=(p.height - 1) / 2.0,
+            width=int(p.width),
+            height=int(p.height),
+        )
+        return tuple(
+            PinholeCamera.look_at(k, eye, target, p.up)  # type: ignore[return-value]
+            for eye, target in ((p.cam0_position, p.cam0_target), (p.cam1_position, p.cam1_target))
+        )
 
     @staticmethod
-    def render(scene: Scene, params: StereoBallCameraParams | None = None,
-               rng: np.random.Generator | None = None,
-               cameras: tuple[PinholeCamera, PinholeCamera] | None = None) -> list[np.ndarray]:
+    def render(
+        scene: Scene,
+        params: StereoBallCameraParams | None = None,
+        rng: np.random.Generator | None = None,
+        cameras: tuple[PinholeCamera, PinholeCamera] | None = None,
+    ) -> list[np.ndarray]:
         """The two 8-bit images the cameras would see (noise only if ``rng`` is given)."""
         p = params if params is not None else StereoBallCameraParams()
         cams = cameras if cameras is not None else StereoBallCamera.make_cameras(p)
@@ -176,35 +243,40 @@ class StereoBallCamera(Sensor):
         None when there is no whole blob of ``min_pixels``."""
         p = params if params is not None else StereoBallCameraParams()
         h, w = image.shape
-        _, mask = cv2.threshold(image, p.threshold, 1, cv2.THRESH_BINARY)   # image > threshold
+        _, mask = cv2.threshold(image, p.threshold, 1, cv2.THRESH_BINARY)  # image > threshold
         ex, ey, ew, eh = cv2.boundingRect(mask)
         if ew == 0:
             return None
         # label only around the bright pixels (a full 128 x 128 labelling costs ~0.2 ms)
         ex0, ey0 = max(ex - _MARGIN, 0), max(ey - _MARGIN, 0)
         ex1, ey1 = min(ex + ew + _MARGIN, w), min(ey + eh + _MARGIN, h)
-        n, labels, stats, _ = cv2.connectedComponentsWithStats(mask[ey0:ey1, ex0:ex1],
-                                                                 connectivity=8)
+        n, labels, stats, _ = cv2.connectedComponentsWithStats(
+            mask[ey0:ey1, ex0:ex1], connectivity=8
+        )
         i = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
         bx, by, bw, bh, area = (int(v) for v in stats[i])
         bx, by = bx + ex0, by + ey0
         if area < p.min_pixels:
             return None
         if bx == 0 or by == 0 or bx + bw == w or by + bh == h:
-            return None                                        # cut by the image border
+            return None  # cut by the image border
         x0, y0 = max(bx - _MARGIN, 0), max(by - _MARGIN, 0)
         x1, y1 = min(bx + bw + _MARGIN, w), min(by + bh + _MARGIN, h)
-        labels = labels[y0 - ey0:y1 - ey0, x0 - ex0:x1 - ex0]
+        labels = labels[y0 - ey0 : y1 - ey0, x0 - ex0 : x1 - ex0]
         blob = (labels == i).astype(np.uint8)
         if p.moments == "binary":
             m = cv2.moments(blob, binaryImage=True)
-            return {"u": x0 + m["m10"] / m["m00"], "v": y0 + m["m01"] / m["m00"],
-                    "area": area, "background": None}
+            return {
+                "u": x0 + m["m10"] / m["m00"],
+                "v": y0 + m["m01"] / m["m00"],
+                "area": area,
+                "background": None,
+            }
         roi = image[y0:y1, x0:x1].astype(np.float32)
         free = labels == 0
         region = cv2.dilate(blob, _DILATE).astype(bool) & (free | blob.astype(bool))
         ring = roi[~region & free]
-        if ring.size:                                          # local background: the median
+        if ring.size:  # local background: the median
             background = float(np.partition(ring, ring.size // 2)[ring.size // 2])
         else:
             background = 255.0 * p.background
@@ -212,15 +284,22 @@ class StereoBallCamera(Sensor):
         weight = np.where(region, roi - np.float32(background), np.float32(0.0))
         m = cv2.moments(weight)
         if m["m00"] <= 0.0:
-            return None                                        # no signal above the background
-        return {"u": x0 + m["m10"] / m["m00"], "v": y0 + m["m01"] / m["m00"],
-                "area": area, "background": background}
+            return None  # no signal above the background
+        return {
+            "u": x0 + m["m10"] / m["m00"],
+            "v": y0 + m["m01"] / m["m00"],
+            "area": area,
+            "background": background,
+        }
 
     def triangulate(self, uv0, uv1) -> np.ndarray:
         """World point (3,) from a pixel in each image (``cv2.triangulatePoints``, linear)."""
-        X = cv2.triangulatePoints(self.projections[0], self.projections[1],
-                                  np.asarray(uv0, np.float64).reshape(2, 1),
-                                  np.asarray(uv1, np.float64).reshape(2, 1)).ravel()
+        X = cv2.triangulatePoints(
+            self.projections[0],
+            self.projections[1],
+            np.asarray(uv0, np.float64).reshape(2, 1),
+            np.asarray(uv1, np.float64).reshape(2, 1),
+        ).ravel()
         if X[3] == 0.0:
             return np.full(3, np.nan)
         return X[:3] / X[3]
@@ -260,7 +339,12 @@ class StereoBallCamera(Sensor):
         if not np.all(np.isfinite(X)):
             return None
         if any(float(cam.to_camera(X)[2]) <= 0.0 for cam in self.cameras):
-            return None                                        # a mismatch behind a camera
-        return VisionObject(t=t, position=[float(v) for v in X],
-                            features={"centroids": [[float(u), float(v)] for u, v in uv],
-                                      "areas": [int(b["area"]) for b in blobs]})
+            return None  # a mismatch behind a camera
+        return VisionObject(
+            t=t,
+            position=[float(v) for v in X],
+            features={
+                "centroids": [[float(u), float(v)] for u, v in uv],
+                "areas": [int(b["area"]) for b in blobs],
+            },
+        )

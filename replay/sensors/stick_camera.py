@@ -52,20 +52,26 @@ from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
 from replay.sensors.raster import composite
 
-_RIM = 48             # vertices of a polygon standing in for a circle
+_RIM = 48  # vertices of a polygon standing in for a circle
 
 
 # --- geometry of primitives ----------------------------------------------------------------
 
-_BOX_SIGNS = np.array([[sx, sy, sz] for sz in (-1.0, 1.0)
-                       for sx, sy in ((1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0))])
+_BOX_SIGNS = np.array(
+    [
+        [sx, sy, sz]
+        for sz in (-1.0, 1.0)
+        for sx, sy in ((1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0))
+    ]
+)
 
 
 def box_corners(box: Box) -> np.ndarray:
     """The 8 corners (8, 3) of a box in world coordinates; the last 4 are the body +z face."""
     half = np.array([0.5 * float(s) for s in box.size])
     return (_BOX_SIGNS * half) @ quaternion_matrix(box.orientation).T + np.asarray(
-        box.position, dtype=float)
+        box.position, dtype=float
+    )
 
 
 def _circle(n: int) -> np.ndarray:
@@ -100,7 +106,7 @@ def _outline_points(camera: PinholeCamera, prim) -> np.ndarray:
         b = np.cross(u, a)
         rho = prim.radius * math.sqrt(1.0 - (prim.radius / d) ** 2)
         ring = _CIRCLE
-        return c + prim.radius ** 2 / d * u + rho * (ring[:, :1] * a + ring[:, 1:] * b)
+        return c + prim.radius**2 / d * u + rho * (ring[:, :1] * a + ring[:, 1:] * b)
     raise TypeError(f"cannot render {type(prim).__name__}")
 
 
@@ -118,12 +124,13 @@ def _projected_items(camera: PinholeCamera, scene: Scene) -> list:
             outlines.append(pts)
     if not prims:
         return []
-    pc = camera.to_camera(np.concatenate(outlines))         # all outlines in one projection
+    pc = camera.to_camera(np.concatenate(outlines))  # all outlines in one projection
     k = camera.intrinsics
     z = pc[:, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        uv = np.column_stack([k.fx * pc[:, 0] / z + k.cx,
-                              k.fy * pc[:, 1] / z + k.cy]).astype(np.float32)
+        uv = np.column_stack([k.fx * pc[:, 0] / z + k.cx, k.fy * pc[:, 1] / z + k.cy]).astype(
+            np.float32
+        )
     items = []
     end = 0
     for prim, pts in zip(prims, outlines):
@@ -132,8 +139,9 @@ def _projected_items(camera: PinholeCamera, scene: Scene) -> list:
             continue
         hull = cv2.convexHull(uv[start:end]).reshape(-1, 2).astype(np.float64)
         if len(hull) >= 3:
-            distance = float(np.linalg.norm(np.asarray(prim.position, dtype=float)
-                                            - camera.position))
+            distance = float(
+                np.linalg.norm(np.asarray(prim.position, dtype=float) - camera.position)
+            )
             items.append((distance, float(prim.albedo), hull, prim.name))
     items.sort(key=lambda it: -it[0])
     return items
@@ -150,8 +158,9 @@ def hull_window(camera: PinholeCamera, hull: np.ndarray, margin: int = 8):
     return None if x1 <= x0 or y1 <= y0 else (x0, y0, x1, y1)
 
 
-def render_scene(camera: PinholeCamera, scene: Scene, *, background: float = 0.1,
-                 window=None, items=None) -> np.ndarray:
+def render_scene(
+    camera: PinholeCamera, scene: Scene, *, background: float = 0.1, window=None, items=None
+) -> np.ndarray:
     """A noiseless float32 grey image (0..255) of the scene; ``background`` is an albedo.
 
     Every primitive is drawn as its silhouette (the convex hull of its projected outline) with
@@ -163,10 +172,10 @@ def render_scene(camera: PinholeCamera, scene: Scene, *, background: float = 0.1
     x0, y0, x1, y1 = window if window is not None else (0, 0, k.width, k.height)
     img = np.full((y1 - y0, x1 - x0), 255.0 * background, np.float32)
     polys, greys = [], []
-    for _, albedo, hull, _ in (items if items is not None else _projected_items(camera, scene)):
+    for _, albedo, hull, _ in items if items is not None else _projected_items(camera, scene):
         lo, hi = hull.min(axis=0), hull.max(axis=0)
         if hi[0] < x0 - 1 or hi[1] < y0 - 1 or lo[0] > x1 or lo[1] > y1:
-            continue                                     # wholly outside the window
+            continue  # wholly outside the window
         polys.append(hull)
         greys.append(255.0 * albedo)
     composite(img, polys, greys, origin=(x0, y0))
@@ -198,7 +207,7 @@ def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> floa
     along = (np.column_stack([cols + origin[0], rows + origin[1]]) - c) @ e
     h, w = image.shape
     levels = []
-    for end in (along.max(), along.min()):             # the blob's extreme pixels on its axis
+    for end in (along.max(), along.min()):  # the blob's extreme pixels on its axis
         sign = 1.0 if end > 0 else -1.0
         pts = c + (end + sign * _END_SAMPLES[:, :1]) * e + _END_SAMPLES[:, 1:] * n
         ij = np.rint(pts).astype(int)
@@ -210,28 +219,72 @@ def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> floa
 
 # --- the sensor ----------------------------------------------------------------------------
 
+
 @dataclass
 class StickCameraParams:
     width: int = param(512, unit="px", ge=16, le=4096, doc="image width")
     height: int = param(512, unit="px", ge=16, le=4096, doc="image height")
-    position: list[float] = param([0.0, 0.0, 1.0], unit="m", length=3, ge=-100, le=100,
-                                  doc="optical centre (world); paper: 1 m above the table")
-    target: list[float] = param([0.0, 0.0, 0.0], unit="m", length=3, ge=-100, le=100,
-                                doc="world point on the optical axis; default: straight down "
-                                    "at the table centre")
-    up: list[float] = param([0.0, 1.0, 0.0], unit="1", length=3, ge=-1e3, le=1e3,
-                            doc="world direction shown as 'up' in the image (not along the axis)")
-    fov_x: float = param(0.62, unit="rad", gt=0, lt=math.pi,
-                         doc="horizontal field of view, edge to edge; 0.62 rad (35.5 deg) from "
-                             "1 m: 0.640 m of table across 512 px, 1.25 mm per pixel")
-    noise_sigma: float = param(0.0, unit="grey level", ge=0, le=1000,
-                               doc="standard deviation of Gaussian pixel noise (0..255 scale)")
-    position_offset: list[float] = param([0.0, 0.0], unit="m", length=2, ge=-10, le=10,
-                                         doc="constant bias added to the measured (x, y)")
-    threshold: float = param(192.0, unit="grey level", ge=0, le=255,
-                             doc="pixels brighter than this are marker (white 255 vs stick)")
-    min_pixels: int = param(20, unit="px", ge=1, le=4096 * 4096,
-                            doc="smallest marker blob (pixels above threshold) accepted")
+    position: list[float] = param(
+        [0.0, 0.0, 1.0],
+        unit="m",
+        length=3,
+        ge=-100,
+        le=100,
+        doc="optical centre (world); paper: 1 m above the table",
+    )
+    target: list[float] = param(
+        [0.0, 0.0, 0.0],
+        unit="m",
+        length=3,
+        ge=-100,
+        le=100,
+        doc="world point on the optical axis; default: straight down at the table centre",
+    )
+    up: list[float] = param(
+        [0.0, 1.0, 0.0],
+        unit="1",
+        length=3,
+        ge=-1e3,
+        le=1e3,
+        doc="world direction shown as 'up' in the image (not along the axis)",
+    )
+    fov_x: float = param(
+        0.62,
+        unit="rad",
+        gt=0,
+        lt=math.pi,
+        doc="horizontal field of view, edge to edge; 0.62 rad (35.5 deg) from "
+        "1 m: 0.640 m of table across 512 px, 1.25 mm per pixel",
+    )
+    noise_sigma: float = param(
+        0.0,
+        unit="grey level",
+        ge=0,
+        le=1000,
+        doc="standard deviation of Gaussian pixel noise (0..255 scale)",
+    )
+    position_offset: list[float] = param(
+        [0.0, 0.0],
+        unit="m",
+        length=2,
+        ge=-10,
+        le=10,
+        doc="constant bias added to the measured (x, y)",
+    )
+    threshold: float = param(
+        192.0,
+        unit="grey level",
+        ge=0,
+        le=255,
+        doc="pixels brighter than this are marker (white 255 vs stick)",
+    )
+    min_pixels: int = param(
+        20,
+        unit="px",
+        ge=1,
+        le=4096 * 4096,
+        doc="smallest marker blob (pixels above threshold) accepted",
+    )
     background: float = param(0.1, unit="1", ge=0, le=1, doc="albedo of the table (dark)")
     marker: str = param("marker", max_length=100, doc="name of the Box the camera tracks")
 
@@ -244,10 +297,13 @@ class StickCameraParams:
 
 class StickCamera(Sensor):
     """Overhead camera measuring the stick's marker: ``/vision/stick`` (x, y, theta)."""
+
     Params = StickCameraParams
     topic = TOPIC_VISION_STICK
-    description = ("overhead pinhole camera 1 m above the table; white-marker centroid and "
-                   "second moments -> stick x, y, theta (mod pi)")
+    description = (
+        "overhead pinhole camera 1 m above the table; white-marker centroid and "
+        "second moments -> stick x, y, theta (mod pi)"
+    )
 
     def __init__(self, params: StickCameraParams, *, rng: np.random.Generator, spec=None) -> None:
         super().__init__(params, rng=rng, spec=spec)
@@ -259,24 +315,36 @@ class StickCamera(Sensor):
     def make_camera(params: StickCameraParams) -> PinholeCamera:
         """The look-at pinhole of the params (square pixels, principal point at the centre);
         by default straight down from 1 m: image x = world x, image up = world +y."""
-        return PinholeCamera.from_fov(params.width, params.height, params.fov_x,
-                                      eye=params.position, target=params.target, up=params.up)
+        return PinholeCamera.from_fov(
+            params.width,
+            params.height,
+            params.fov_x,
+            eye=params.position,
+            target=params.target,
+            up=params.up,
+        )
 
     @staticmethod
-    def render(scene: Scene, params: StickCameraParams | None = None,
-               rng: np.random.Generator | None = None, window=None) -> np.ndarray:
+    def render(
+        scene: Scene,
+        params: StickCameraParams | None = None,
+        rng: np.random.Generator | None = None,
+        window=None,
+    ) -> np.ndarray:
         """The 8-bit image the camera would see (noise only if ``rng`` is given), or only its
         ``window`` (x0, y0, x1, y1)."""
         p = params if params is not None else StickCameraParams()
-        img = render_scene(StickCamera.make_camera(p), scene, background=p.background,
-                           window=window)
+        img = render_scene(
+            StickCamera.make_camera(p), scene, background=p.background, window=window
+        )
         if rng is not None and p.noise_sigma > 0.0:
             img = img + np.float32(p.noise_sigma) * rng.standard_normal(img.shape, dtype=np.float32)
         return np.clip(np.rint(img), 0, 255).astype(np.uint8)
 
     @staticmethod
-    def marker_moments(image: np.ndarray, params: StickCameraParams,
-                       origin: tuple[int, int] = (0, 0)) -> dict | None:
+    def marker_moments(
+        image: np.ndarray, params: StickCameraParams, origin: tuple[int, int] = (0, 0)
+    ) -> dict | None:
         """Segment the marker in an 8-bit image; its weighted ``cv2.moments`` (in full-image
         pixel coordinates: ``u``, ``v`` centroid, ``angle`` of the long axis in the image,
         ``pixels`` above threshold), or None when there is no whole blob of enough pixels.
@@ -287,9 +355,10 @@ class StickCamera(Sensor):
         bright = cv2.findNonZero(mask)
         if bright is None:
             return None
-        cx, cy, cw, ch = cv2.boundingRect(bright)              # label only where it is bright
+        cx, cy, cw, ch = cv2.boundingRect(bright)  # label only where it is bright
         n, labels, stats, _ = cv2.connectedComponentsWithStats(
-            mask[cy:cy + ch, cx:cx + cw], connectivity=8)
+            mask[cy : cy + ch, cx : cx + cw], connectivity=8
+        )
         if n <= 1:
             return None
         i = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
@@ -297,16 +366,21 @@ class StickCamera(Sensor):
         bx, by = bx + cx, by + cy
         if area < params.min_pixels:
             return None
-        if (bx + ox == 0 or by + oy == 0 or bx + ox + bw == params.width
-                or by + oy + bh == params.height):
-            return None                                        # cut by the image border
+        if (
+            bx + ox == 0
+            or by + oy == 0
+            or bx + ox + bw == params.width
+            or by + oy + bh == params.height
+        ):
+            return None  # cut by the image border
         x0, y0 = max(bx - 3, 0), max(by - 3, 0)
         x1, y1 = min(bx + bw + 3, w), min(by + bh + 3, h)
         roi = image[y0:y1, x0:x1].astype(np.float32)
         blob = np.zeros((y1 - y0, x1 - x0), np.uint8)
-        lx0, ly0 = bx - cx, by - cy                            # the blob's box in the crop
-        blob[by - y0:by - y0 + bh, bx - x0:bx - x0 + bw] = \
-            labels[ly0:ly0 + bh, lx0:lx0 + bw] == i
+        lx0, ly0 = bx - cx, by - cy  # the blob's box in the crop
+        blob[by - y0 : by - y0 + bh, bx - x0 : bx - x0 + bw] = (
+            labels[ly0 : ly0 + bh, lx0 : lx0 + bw] == i
+        )
         background = _background_beyond_ends(image, blob, (x0, y0))
         if background is None:
             return None
@@ -315,9 +389,14 @@ class StickCamera(Sensor):
         m = cv2.moments(weight.astype(np.float32))
         if m["m00"] <= 0.0:
             return None
-        return {"u": ox + x0 + m["m10"] / m["m00"], "v": oy + y0 + m["m01"] / m["m00"],
-                "angle": 0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"]),
-                "pixels": area, "background": background, "moments": m}
+        return {
+            "u": ox + x0 + m["m10"] / m["m00"],
+            "v": oy + y0 + m["m01"] / m["m00"],
+            "angle": 0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"]),
+            "pixels": area,
+            "background": background,
+            "moments": m,
+        }
 
     # --- the sensor ---------------------------------------------------------------------------
     @property
@@ -338,13 +417,13 @@ class StickCamera(Sensor):
         items = _projected_items(self.camera, scene)
         hull = next((h for _, _, h, name in items if name == p.marker), None)
         window = None if hull is None else hull_window(self.camera, hull)
-        if window is None:                       # no marker in view: the whole (rare) frame
+        if window is None:  # no marker in view: the whole (rare) frame
             window = (0, 0, p.width, p.height)
-        img = render_scene(self.camera, scene, background=p.background, window=window,
-                           items=items)
+        img = render_scene(self.camera, scene, background=p.background, window=window, items=items)
         if p.noise_sigma > 0.0:
-            img = img + np.float32(p.noise_sigma) * self.rng.standard_normal(img.shape,
-                                                                            dtype=np.float32)
+            img = img + np.float32(p.noise_sigma) * self.rng.standard_normal(
+                img.shape, dtype=np.float32
+            )
         img = np.clip(np.rint(img), 0, 255).astype(np.uint8)
         self._last = (img, window)
         try:
@@ -359,11 +438,16 @@ class StickCamera(Sensor):
         # the centroid is back-projected onto the horizontal plane through the marker's centre.
         z = float(marker.position[2])
         u, v, a = found["u"], found["v"], found["angle"]
-        step = 10.0                                            # px along the axis, for its angle
+        step = 10.0  # px along the axis, for its angle
         pts = self.camera.backproject_to_height(
-            np.array([[u, v], [u + step * math.cos(a), v + step * math.sin(a)]]), z)
+            np.array([[u, v], [u + step * math.cos(a), v + step * math.sin(a)]]), z
+        )
         if not np.all(np.isfinite(pts)):
             return None
         theta = wrap_half_pi(math.atan2(pts[1, 1] - pts[0, 1], pts[1, 0] - pts[0, 0]))
-        return VisionStick(t=t, x=float(pts[0, 0]) + float(p.position_offset[0]),
-                           y=float(pts[0, 1]) + float(p.position_offset[1]), theta=theta)
+        return VisionStick(
+            t=t,
+            x=float(pts[0, 0]) + float(p.position_offset[0]),
+            y=float(pts[0, 1]) + float(p.position_offset[1]),
+            theta=theta,
+        )

@@ -33,27 +33,38 @@ from replay.sensors.pinhole import Intrinsics, PinholeCamera
 from replay.sensors.silhouette import render
 
 
-
 @dataclass
 class VisionChipParams:
-    fov: float = param(math.radians(12.0), unit="rad", gt=0.0, lt=math.pi,
-                       doc="full horizontal field of view (square pixels); the paper gives none: "
-                           "12 deg assumed")
+    fov: float = param(
+        math.radians(12.0),
+        unit="rad",
+        gt=0.0,
+        lt=math.pi,
+        doc="full horizontal field of view (square pixels); the paper gives none: 12 deg assumed",
+    )
     width: int = param(16, unit="px", ge=2, doc="photodetectors per row; SPE-256: 16")
     height: int = param(16, unit="px", ge=2, doc="rows; SPE-256: 16")
-    threshold: float = param(0.5, unit="1", gt=0.0, lt=1.0,
-                             doc="a pixel is 1 when its grey level is above background + "
-                                 "threshold * (object - background): ~half covered")
-    object_albedo: float = param(0.9, unit="1", gt=0.0, le=1.0,
-                                 doc="albedo the threshold is set for (the object's)")
+    threshold: float = param(
+        0.5,
+        unit="1",
+        gt=0.0,
+        lt=1.0,
+        doc="a pixel is 1 when its grey level is above background + "
+        "threshold * (object - background): ~half covered",
+    )
+    object_albedo: float = param(
+        0.9, unit="1", gt=0.0, le=1.0, doc="albedo the threshold is set for (the object's)"
+    )
     background: float = param(0.1, unit="1", ge=0.0, lt=1.0, doc="albedo of the background")
-    noise_sigma: float = param(0.0, unit="grey level", ge=0.0,
-                               doc="Gaussian grey-level noise before thresholding (0..255)")
+    noise_sigma: float = param(
+        0.0, unit="grey level", ge=0.0, doc="Gaussian grey-level noise before thresholding (0..255)"
+    )
     reading: str = param("head", doc="the plant's reading with the camera pose")
 
 
 class VisionChipSensor(Sensor):
     """16 x 16 binary images from the head's camera: ``/vision/chip``."""
+
     Params = VisionChipParams
     topic = TOPIC_VISION_CHIP
     spec_type = None
@@ -80,12 +91,12 @@ class VisionChipSensor(Sensor):
         p = self.params
         img = render(self.camera(scene), scene, background=p.background)
         if p.noise_sigma > 0.0:
-            img += np.float32(p.noise_sigma) * self.rng.standard_normal(img.shape,
-                                                                        dtype=np.float32)
+            img += np.float32(p.noise_sigma) * self.rng.standard_normal(img.shape, dtype=np.float32)
         return img > self.level
 
     def measure(self, t: float, scene: Scene) -> VisionChip | None:
         bits = self.image(scene)
         self.last_image = bits
-        return VisionChip(t, int(bits.shape[1]), int(bits.shape[0]), pack_rows(bits),
-                          int(bits.sum()))
+        return VisionChip(
+            t, int(bits.shape[1]), int(bits.shape[0]), pack_rows(bits), int(bits.sum())
+        )

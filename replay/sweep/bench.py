@@ -33,12 +33,20 @@ def measure(n: int, workers: int, executor: str = "local") -> dict:
     with tempfile.TemporaryDirectory(prefix="sweep-bench-") as d:
         variants = _variants(n, f"{executor}{workers}-{time.time_ns()}")
         t0 = time.perf_counter()
-        s = run_sweep(variants, d, workers=workers, executor=executor, keep_logs=False,
-                      progress=False)
+        s = run_sweep(
+            variants, d, workers=workers, executor=executor, keep_logs=False, progress=False
+        )
         wall = time.perf_counter() - t0
     cpu = sum(as_float(r.get("cpu_time")) for r in s.rows)
-    return {"executor": executor, "workers": workers, "variants": s.ran, "wall": wall,
-            "rate": s.ran / wall, "cpu_per_variant": cpu / max(1, s.ran), "ok": s.ok}
+    return {
+        "executor": executor,
+        "workers": workers,
+        "variants": s.ran,
+        "wall": wall,
+        "rate": s.ran / wall,
+        "cpu_per_variant": cpu / max(1, s.ran),
+        "ok": s.ok,
+    }
 
 
 def main(argv=None) -> None:
@@ -49,16 +57,22 @@ def main(argv=None) -> None:
     runs = [measure(args.variants, 1), measure(args.variants, 2)]
     if ray_available() and not args.no_ray:
         from replay.sweep import executors
+
         runs.append(measure(args.variants, 2, "ray"))
         runs[-1]["note"] = f"ray.init {executors.last_ray_init:.1f} s included"
-    print(f"sweep throughput: {args.variants} variants of {SCENARIO} "
-          f"({' '.join(SETS)}, friction varied)")
+    print(
+        f"sweep throughput: {args.variants} variants of {SCENARIO} "
+        f"({' '.join(SETS)}, friction varied)"
+    )
     for r in runs:
-        print(f"  {r['executor']:<5} workers={r['workers']}: {r['rate']:.3f} variants/s "
-              f"({r['wall']:.1f} s wall, {r['cpu_per_variant']:.2f} s CPU per variant, "
-              f"{r['ok']}/{r['variants']} ok){'  ' + r['note'] if 'note' in r else ''}")
-    print(f"  speed-up 2 vs 1 local workers: {runs[1]['rate'] / runs[0]['rate']:.2f}x "
-          "(2.0 = linear)")
+        print(
+            f"  {r['executor']:<5} workers={r['workers']}: {r['rate']:.3f} variants/s "
+            f"({r['wall']:.1f} s wall, {r['cpu_per_variant']:.2f} s CPU per variant, "
+            f"{r['ok']}/{r['variants']} ok){'  ' + r['note'] if 'note' in r else ''}"
+        )
+    print(
+        f"  speed-up 2 vs 1 local workers: {runs[1]['rate'] / runs[0]['rate']:.2f}x (2.0 = linear)"
+    )
 
 
 if __name__ == "__main__":

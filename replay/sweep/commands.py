@@ -21,34 +21,79 @@ def _fail(message: str, code: int = 2) -> None:
 
 @click.command()
 @click.argument("scenario", type=click.Path(dir_okay=False))
-@click.option("--grid", "grids", multiple=True, metavar="KEY.PATH=A,B,C",
-              help="vary a field over these values (repeatable: the cartesian product); "
-                   "scenario=a.yaml,b.yaml varies the scenario file")
-@click.option("--random", "randoms", multiple=True, metavar="KEY.PATH=LO:HI",
-              help="draw the field uniformly from [LO, HI] (repeatable), --n times")
+@click.option(
+    "--grid",
+    "grids",
+    multiple=True,
+    metavar="KEY.PATH=A,B,C",
+    help="vary a field over these values (repeatable: the cartesian product); "
+    "scenario=a.yaml,b.yaml varies the scenario file",
+)
+@click.option(
+    "--random",
+    "randoms",
+    multiple=True,
+    metavar="KEY.PATH=LO:HI",
+    help="draw the field uniformly from [LO, HI] (repeatable), --n times",
+)
 @click.option("--n", "n", type=int, help="random draws (default 10 with --random)")
-@click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE",
-              help="fix a field for every variant (repeatable)")
-@click.option("--seed", type=int, default=0, show_default=True,
-              help="seed of every variant's run and of the random draws")
-@click.option("-o", "--out", type=click.Path(file_okay=False),
-              help="directory for table.csv and logs/ (default out/sweeps/NAME)")
-@click.option("--workers", type=click.IntRange(min=1),
-              help="parallel variants (default: this machine's cores)")
+@click.option(
+    "--set",
+    "sets",
+    multiple=True,
+    metavar="KEY.PATH=VALUE",
+    help="fix a field for every variant (repeatable)",
+)
+@click.option(
+    "--seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="seed of every variant's run and of the random draws",
+)
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(file_okay=False),
+    help="directory for table.csv and logs/ (default out/sweeps/NAME)",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    help="parallel variants (default: this machine's cores)",
+)
 @click.option("--executor", type=click.Choice(EXECUTORS), default="local", show_default=True)
-@click.option("--address", help="Ray cluster to join (auto or HOST:PORT); default: a private "
-                                "local Ray")
+@click.option(
+    "--address", help="Ray cluster to join (auto or HOST:PORT); default: a private local Ray"
+)
 @click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
-@click.option("--retry-failed", is_flag=True, help="re-run the variants whose row says they "
-                                                   "failed to run (error:/invalid:)")
+@click.option(
+    "--retry-failed",
+    is_flag=True,
+    help="re-run the variants whose row says they failed to run (error:/invalid:)",
+)
 @click.option("-q", "--quiet", is_flag=True, help="no progress bar")
-def sweep(scenario, grids, randoms, n, sets, seed, out, workers, executor, address, no_logs,
-          retry_failed, quiet):
+def sweep(
+    scenario,
+    grids,
+    randoms,
+    n,
+    sets,
+    seed,
+    out,
+    workers,
+    executor,
+    address,
+    no_logs,
+    retry_failed,
+    quiet,
+):
     """Run SCENARIO (a file, or a shipped scenario's name) over a grid and/or random draws of its fields: one table row per variant
     (outcome, metrics, wall time, log). Reruns skip the variants already in the table."""
     from replay.resources import find_scenario
     from replay.scenario import ScenarioError, load_scenario
     from replay.sweep.spec import from_options
+
     scenario = find_scenario(scenario)
     try:
         spec = from_options(grids, randoms, n)
@@ -63,17 +108,41 @@ def sweep(scenario, grids, randoms, n, sets, seed, out, workers, executor, addre
     except ScenarioError as exc:
         _fail(str(exc))
     out = Path(out) if out else DEFAULT_SWEEP_OUT / base.name
-    summary = _run(scenario, spec, seed, sets, out, workers, executor, address, not no_logs,
-                   not quiet, retry_failed=retry_failed)
+    summary = _run(
+        scenario,
+        spec,
+        seed,
+        sets,
+        out,
+        workers,
+        executor,
+        address,
+        not no_logs,
+        not quiet,
+        retry_failed=retry_failed,
+    )
     click.echo(summary.line())
     if summary.interrupted:
         sys.exit(130)
 
 
-def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs, progress,
-         metrics="", retry_failed=False):
+def _run(
+    scenario,
+    spec,
+    seed,
+    sets,
+    out,
+    workers,
+    executor,
+    address,
+    keep_logs,
+    progress,
+    metrics="",
+    retry_failed=False,
+):
     from replay.sweep.engine import run_sweep
     from replay.sweep.variants import check_keys, code_version, expand
+
     if executor != "ray" and address:
         _fail("--address is for --executor ray")
     try:
@@ -87,9 +156,17 @@ def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs,
     except SweepSpecError as exc:
         _fail(str(exc))
     try:
-        return run_sweep(variants, out, workers=workers, executor=executor, address=address,
-                         keep_logs=keep_logs, progress=progress, metrics=metrics,
-                         retry_failed=retry_failed)
+        return run_sweep(
+            variants,
+            out,
+            workers=workers,
+            executor=executor,
+            address=address,
+            keep_logs=keep_logs,
+            progress=progress,
+            metrics=metrics,
+            retry_failed=retry_failed,
+        )
     except ExecutorError as exc:
         _fail(str(exc))
 
@@ -100,17 +177,23 @@ def _run(scenario, spec, seed, sets, out, workers, executor, address, keep_logs,
 @click.option("--workers", type=click.IntRange(min=1), help="parallel variants")
 @click.option("--executor", type=click.Choice(EXECUTORS), default="local", show_default=True)
 @click.option("--address", help="Ray cluster to join (with --executor ray)")
-@click.option("--store", is_flag=True, help="also keep each table as data/ablations/NAME.csv "
-                                            "(what the report plots without a fresh run)")
+@click.option(
+    "--store",
+    is_flag=True,
+    help="also keep each table as data/ablations/NAME.csv "
+    "(what the report plots without a fresh run)",
+)
 @click.option("--plot-only", is_flag=True, help="no runs: redraw from the freshest table")
 @click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
 @click.option("--retry-failed", is_flag=True, help="re-run variants that failed to run")
 @click.option("-q", "--quiet", is_flag=True, help="no progress bar")
-def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, retry_failed,
-           quiet):
+def ablate(
+    names, list_, workers, executor, address, store, plot_only, no_logs, retry_failed, quiet
+):
     """Run the named ablations (sweeps/NAME.yaml; all with no NAME) and draw each plot from its
     table into out/ablations/NAME/."""
     from replay.sweep import ablations
+
     if list_:
         for name in ablations.names():
             sf = ablations.load(name)
@@ -127,9 +210,20 @@ def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, 
             if table is None:
                 _fail(f"{sf.name}: no table yet (run `replay ablate {sf.name}`)")
         else:
-            summary = _run(str(sf.scenario), sf.spec, sf.seed, sf.sets, out, workers, executor,
-                           address, not no_logs, not quiet, metrics=sf.metrics,
-                           retry_failed=retry_failed)
+            summary = _run(
+                str(sf.scenario),
+                sf.spec,
+                sf.seed,
+                sf.sets,
+                out,
+                workers,
+                executor,
+                address,
+                not no_logs,
+                not quiet,
+                metrics=sf.metrics,
+                retry_failed=retry_failed,
+            )
             click.echo(f"{sf.name}: {summary.line()}")
             if summary.interrupted:
                 sys.exit(130)
@@ -141,17 +235,25 @@ def ablate(names, list_, workers, executor, address, store, plot_only, no_logs, 
 
 
 @click.command()
-@click.option("-o", "--out", type=click.Path(file_okay=False), default="out/report",
-              show_default=True)
-@click.option("--logs", type=click.Path(file_okay=False), default="out/logs", show_default=True,
-              help="the runs whose figures and claims go in")
+@click.option(
+    "-o", "--out", type=click.Path(file_okay=False), default="out/report", show_default=True
+)
+@click.option(
+    "--logs",
+    type=click.Path(file_okay=False),
+    default="out/logs",
+    show_default=True,
+    help="the runs whose figures and claims go in",
+)
 def report(out, logs):
     """Write the reproduction report (index.html and index.md): per paper the regenerated
     figures, the claims table and the ablation plots; versions, seeds and commands."""
     from replay.report import build_report
+
     if not Path(logs).is_dir():
-        click.echo(f"note: no {logs}/: the report has no figures or claims (run `make run`)",
-                   err=True)
+        click.echo(
+            f"note: no {logs}/: the report has no figures or claims (run `make run`)", err=True
+        )
     path = build_report(out, logs)
     click.echo(f"report: {path} (and {path.with_suffix('.md')})")
 

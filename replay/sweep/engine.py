@@ -40,45 +40,77 @@ class SweepSummary:
         return self.ran / self.wall_time if self.wall_time > 0 else 0.0
 
     def line(self) -> str:
-        text = (f"sweep: {self.total} variants: {self.ran} ran, {self.skipped} skipped (done "
-                f"before); {self.ok} succeeded, {self.failed} failed; {self.wall_time:.1f} s "
-                f"({self.rate:.2f} variants/s); table: {self.table}")
+        text = (
+            f"sweep: {self.total} variants: {self.ran} ran, {self.skipped} skipped (done "
+            f"before); {self.ok} succeeded, {self.failed} failed; {self.wall_time:.1f} s "
+            f"({self.rate:.2f} variants/s); table: {self.table}"
+        )
         if self.stale:
-            text += (f" ({self.stale} rows of another code or scenario version moved to "
-                     "table.stale.csv)")
+            text += (
+                f" ({self.stale} rows of another code or scenario version moved to table.stale.csv)"
+            )
         return ("interrupted: " if self.interrupted else "") + text
 
 
 def _progress(total: int, enabled: bool):
     from tqdm import tqdm
-    return tqdm(total=total, unit="variant", dynamic_ncols=True, file=sys.stderr,
-                disable=(not enabled) or None, leave=False, desc="sweep",
-                bar_format="{desc}: {n_fmt}/{total_fmt} |{bar}| {rate_fmt} ETA {remaining}"
-                           "{postfix}")
+
+    return tqdm(
+        total=total,
+        unit="variant",
+        dynamic_ncols=True,
+        file=sys.stderr,
+        disable=(not enabled) or None,
+        leave=False,
+        desc="sweep",
+        bar_format="{desc}: {n_fmt}/{total_fmt} |{bar}| {rate_fmt} ETA {remaining}{postfix}",
+    )
 
 
-def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | None = None,
-              executor: str = "local", address: str | None = None, keep_logs: bool = True,
-              progress: bool = True, metrics: str = "", retry_failed: bool = False
-              ) -> SweepSummary:
+def run_sweep(
+    variants: list[Variant],
+    out_dir: str | Path,
+    *,
+    workers: int | None = None,
+    executor: str = "local",
+    address: str | None = None,
+    keep_logs: bool = True,
+    progress: bool = True,
+    metrics: str = "",
+    retry_failed: bool = False,
+) -> SweepSummary:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     table = out_dir / TABLE
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
     old = read_table(table)
-    rows: dict[str, dict] = {r["key"]: dict(r) for r in old if r.get("key") in by_key
-                             and not (retry_failed and is_error(r))}
-    for key, r in rows.items():        # the index follows this sweep's order
+    rows: dict[str, dict] = {
+        r["key"]: dict(r)
+        for r in old
+        if r.get("key") in by_key and not (retry_failed and is_error(r))
+    }
+    for key, r in rows.items():  # the index follows this sweep's order
         r["index"] = by_key[key].index
     stale = len(old) - len(rows)
-    if stale:                          # rows of another code or scenario version: kept aside
+    if stale:  # rows of another code or scenario version: kept aside
         table.replace(out_dir / "table.stale.csv")
     todo = [v for v in variants if v.key not in rows]
     workers = workers or default_workers()
-    tasks = [{"key": v.key, "index": v.index, "resolved": v.resolved, "error": v.error,
-              "log": str((out_dir / "logs" / f"{v.name or 'variant'}-{v.key}.mcap").resolve())
-              if keep_logs else "", "cwd": os.getcwd(), "metrics": metrics} for v in todo]
+    tasks = [
+        {
+            "key": v.key,
+            "index": v.index,
+            "resolved": v.resolved,
+            "error": v.error,
+            "log": str((out_dir / "logs" / f"{v.name or 'variant'}-{v.key}.mcap").resolve())
+            if keep_logs
+            else "",
+            "cwd": os.getcwd(),
+            "metrics": metrics,
+        }
+        for v in todo
+    ]
     t0 = time.perf_counter()
     ran = failed_now = 0
     interrupted = False
@@ -86,10 +118,11 @@ def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | No
     if stale or (old and not todo) or todo:
         write_table(table, _with_params(rows.values(), by_key), params)
     try:
-        stream = (run_local(tasks, workers) if executor == "local"
-                  else run_ray(tasks, workers, address))
+        stream = (
+            run_local(tasks, workers) if executor == "local" else run_ray(tasks, workers, address)
+        )
         for row in stream:
-            if row.get("reason") == INTERRUPTED:     # Ctrl-C reached the worker: not done
+            if row.get("reason") == INTERRUPTED:  # Ctrl-C reached the worker: not done
                 interrupted = True
                 continue
             rows[row["key"]] = row
@@ -105,10 +138,18 @@ def run_sweep(variants: list[Variant], out_dir: str | Path, *, workers: int | No
         bar.close()
     done = list(_with_params(rows.values(), by_key))
     ok = sum(as_bool(r.get("success")) for r in done)
-    return SweepSummary(total=len(variants), ran=ran, skipped=len(variants) - len(todo), ok=ok,
-                        failed=len(done) - ok, wall_time=time.perf_counter() - t0, table=table,
-                        rows=sorted(done, key=lambda r: int(r["index"])),
-                        interrupted=interrupted, stale=stale)
+    return SweepSummary(
+        total=len(variants),
+        ran=ran,
+        skipped=len(variants) - len(todo),
+        ok=ok,
+        failed=len(done) - ok,
+        wall_time=time.perf_counter() - t0,
+        table=table,
+        rows=sorted(done, key=lambda r: int(r["index"])),
+        interrupted=interrupted,
+        stale=stale,
+    )
 
 
 def is_error(row: dict) -> bool:

@@ -26,14 +26,22 @@ class ExecutorError(Exception):
 def crashed(task: dict, exc: BaseException) -> dict:
     """The row of a variant whose worker died under it."""
     text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-    return {"key": task["key"], "index": task["index"], "success": False,
-            "reason": f"error: worker died: {type(exc).__name__}{': ' + text if text else ''}",
-            "wall_time": "", "cpu_time": "", "log": ""}
+    return {
+        "key": task["key"],
+        "index": task["index"],
+        "success": False,
+        "reason": f"error: worker died: {type(exc).__name__}{': ' + text if text else ''}",
+        "wall_time": "",
+        "cpu_time": "",
+        "log": "",
+    }
 
 
 def default_workers() -> int:
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-               else (os.cpu_count() or 1))
+    return max(
+        1,
+        len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1),
+    )
 
 
 def run_local(tasks: list[dict], workers: int) -> Iterator[dict]:
@@ -50,9 +58,9 @@ def run_local(tasks: list[dict], workers: int) -> Iterator[dict]:
             for f in done:
                 try:
                     yield f.result()
-                except Exception as exc:   # noqa: BLE001 - a dead worker (a crash in C code)
+                except Exception as exc:  # noqa: BLE001 - a dead worker (a crash in C code)
                     yield crashed(of[f], exc)
-    except BaseException:              # Ctrl-C, or the consumer stopped: do not wait for them
+    except BaseException:  # Ctrl-C, or the consumer stopped: do not wait for them
         for proc in list(getattr(pool, "_processes", {}).values()):
             proc.terminate()
         pool.shutdown(wait=False, cancel_futures=True)
@@ -68,8 +76,8 @@ def ray_available() -> bool:
     return True
 
 
-last_ray_init = float("nan")   # s the last ray.init took (bench, tests)
-INIT_ATTEMPTS = 3      # Ray gives its raylet 30 s to register; on a loaded machine, try again
+last_ray_init = float("nan")  # s the last ray.init took (bench, tests)
+INIT_ATTEMPTS = 3  # Ray gives its raylet 30 s to register; on a loaded machine, try again
 
 
 def _init_ray(ray, workers: int, address: str | None) -> float:
@@ -84,12 +92,13 @@ def _init_ray(ray, workers: int, address: str | None) -> float:
         try:
             ray.init(address=address, **kw)
             return time.perf_counter() - t0
-        except Exception as exc:     # noqa: BLE001 - Ray raises bare Exception on timeouts
+        except Exception as exc:  # noqa: BLE001 - Ray raises bare Exception on timeouts
             ray.shutdown()
             if address or attempt == INIT_ATTEMPTS - 1:
                 text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-                raise ExecutorError(f"cannot start or join Ray"
-                                    f"{' at ' + address if address else ''}: {text}") from None
+                raise ExecutorError(
+                    f"cannot start or join Ray{' at ' + address if address else ''}: {text}"
+                ) from None
     return time.perf_counter() - t0
 
 
@@ -97,8 +106,9 @@ def run_ray(tasks: list[dict], workers: int, address: str | None = None) -> Iter
     try:
         import ray
     except ImportError:
-        raise ExecutorError("--executor ray needs Ray: pip install 'paper-replay[cluster]'") \
-            from None
+        raise ExecutorError(
+            "--executor ray needs Ray: pip install 'paper-replay[cluster]'"
+        ) from None
     global last_ray_init
     started = False
     if not ray.is_initialized():
@@ -113,7 +123,7 @@ def run_ray(tasks: list[dict], workers: int, address: str | None = None) -> Iter
             for ref in done:
                 try:
                     yield ray.get(ref)
-                except Exception as exc:   # noqa: BLE001 - a dead worker or a lost node
+                except Exception as exc:  # noqa: BLE001 - a dead worker or a lost node
                     yield crashed(of[ref], exc)
     finally:
         if started:

@@ -31,9 +31,9 @@ class SweepSpecError(Exception):
 
 @dataclass
 class Axis:
-    name: str                  # a key path, SCENARIO_AXIS, or a label for a linked axis
-    values: list               # plain values, or dicts {key.path: value} for a linked axis
-    labels: list = field(default_factory=list)   # what the table shows per value
+    name: str  # a key path, SCENARIO_AXIS, or a label for a linked axis
+    values: list  # plain values, or dicts {key.path: value} for a linked axis
+    labels: list = field(default_factory=list)  # what the table shows per value
 
     def __post_init__(self) -> None:
         if not self.labels:
@@ -105,8 +105,9 @@ def _key_path(text: str, option: str) -> str:
     key = text.strip()
     parts = key.split(".")
     if not key or not all(p and p.strip() == p and " " not in p for p in parts):
-        raise SweepSpecError(f"{option}: bad key path {text!r} (expected e.g. "
-                             "plant.params.stick.friction)")
+        raise SweepSpecError(
+            f"{option}: bad key path {text!r} (expected e.g. plant.params.stick.friction)"
+        )
     return key
 
 
@@ -170,8 +171,7 @@ def parse_random(text: str) -> RandomAxis:
 
 
 def from_options(grids: tuple | list, randoms: tuple | list, n: int | None) -> SweepSpec:
-    spec = SweepSpec(grid=[parse_grid(g) for g in grids],
-                     random=[parse_random(r) for r in randoms])
+    spec = SweepSpec(grid=[parse_grid(g) for g in grids], random=[parse_random(r) for r in randoms])
     if n is not None and n < 1:
         raise SweepSpecError(f"--n: expected at least 1 draw, got {n}")
     if spec.random:
@@ -184,8 +184,9 @@ def from_options(grids: tuple | list, randoms: tuple | list, n: int | None) -> S
 
 def _check_unique(spec: SweepSpec) -> None:
     seen: set[str] = set()
-    for name in spec.columns + [k for a in spec.grid if a.values and isinstance(a.values[0], dict)
-                                for k in a.values[0]]:
+    for name in spec.columns + [
+        k for a in spec.grid if a.values and isinstance(a.values[0], dict) for k in a.values[0]
+    ]:
         if name in seen:
             raise SweepSpecError(f"{name}: varied twice (one --grid/--random per key)")
         seen.add(name)
@@ -193,9 +194,11 @@ def _check_unique(spec: SweepSpec) -> None:
 
 # -- sweep files (sweeps/NAME.yaml) ---------------------------------------------------------------
 
+
 @dataclass
 class SweepFile:
     """A named, reproducible sweep: scenario, axes, seed, and how to plot its table."""
+
     name: str
     path: Path
     scenario: Path
@@ -203,11 +206,11 @@ class SweepFile:
     seed: int
     sets: list[str]
     description: str
-    plot: str                   # "module:function" drawing the table
-    caption: str                # what the plot shows, one sentence (the report's text)
+    plot: str  # "module:function" drawing the table
+    caption: str  # what the plot shows, one sentence (the report's text)
     paper: str
-    metrics: str = ""           # "module:function" LogReader -> extra columns, or ""
-    summary: str = ""           # "module:function" rows -> one sentence of what the plot shows
+    metrics: str = ""  # "module:function" LogReader -> extra columns, or ""
+    summary: str = ""  # "module:function" rows -> one sentence of what the plot shows
 
 
 def load_sweep_file(path: str | Path) -> SweepFile:
@@ -222,12 +225,26 @@ def load_sweep_file(path: str | Path) -> SweepFile:
         raise SweepSpecError(f"{where}: not valid YAML") from None
     if not isinstance(data, dict):
         raise SweepSpecError(f"{path}: a sweep file is a mapping")
-    known = {"name", "description", "paper", "scenario", "seed", "set", "grid", "random", "n",
-             "plot", "caption", "metrics", "summary"}
+    known = {
+        "name",
+        "description",
+        "paper",
+        "scenario",
+        "seed",
+        "set",
+        "grid",
+        "random",
+        "n",
+        "plot",
+        "caption",
+        "metrics",
+        "summary",
+    }
     unknown = sorted(set(data) - known)
     if unknown:
-        raise SweepSpecError(f"{path}: unknown field {unknown[0]!r} (expected one of: "
-                             f"{', '.join(sorted(known))})")
+        raise SweepSpecError(
+            f"{path}: unknown field {unknown[0]!r} (expected one of: {', '.join(sorted(known))})"
+        )
     for req in ("scenario", "plot"):
         if req not in data:
             raise SweepSpecError(f"{path}: missing field {req!r}")
@@ -245,22 +262,29 @@ def load_sweep_file(path: str | Path) -> SweepFile:
     if not isinstance(sets, dict):
         raise SweepSpecError(f"{path}: set: expected a mapping key.path -> value")
     return SweepFile(
-        name=str(data.get("name", path.stem)), path=path,
+        name=str(data.get("name", path.stem)),
+        path=path,
         scenario=(path.parent / str(data["scenario"])),
-        spec=spec, seed=int(data.get("seed", 0)),
+        spec=spec,
+        seed=int(data.get("seed", 0)),
         sets=[f"{k}={_yaml_text(v)}" for k, v in sets.items()],
-        description=str(data.get("description", "")), plot=str(data["plot"]),
-        caption=str(data.get("caption", "")).strip(), paper=str(data.get("paper", "")),
-        metrics=str(data.get("metrics", "")), summary=str(data.get("summary", "")))
+        description=str(data.get("description", "")),
+        plot=str(data["plot"]),
+        caption=str(data.get("caption", "")).strip(),
+        paper=str(data.get("paper", "")),
+        metrics=str(data.get("metrics", "")),
+        summary=str(data.get("summary", "")),
+    )
 
 
 def _file_axis(path: Path, name: str, values: Any) -> Axis:
-    if isinstance(values, dict):           # linked axis: {label: {key.path: value, ...}, ...}
+    if isinstance(values, dict):  # linked axis: {label: {key.path: value, ...}, ...}
         labels, vals = [], []
         for label, sets in values.items():
             if not isinstance(sets, dict) or not sets:
-                raise SweepSpecError(f"{path}: grid.{name}.{label}: expected a mapping "
-                                     "key.path -> value")
+                raise SweepSpecError(
+                    f"{path}: grid.{name}.{label}: expected a mapping key.path -> value"
+                )
             for k in sets:
                 _key_path(str(k), f"{path}: grid.{name}.{label}")
             labels.append(_label(label))
@@ -269,15 +293,19 @@ def _file_axis(path: Path, name: str, values: Any) -> Axis:
     if not isinstance(values, list) or not values:
         raise SweepSpecError(f"{path}: grid.{name}: expected a non-empty list of values")
     if name == SCENARIO_AXIS:
-        return Axis(name, [str((path.parent / str(v)).as_posix()) for v in values],
-                    [Path(str(v)).stem for v in values])
+        return Axis(
+            name,
+            [str((path.parent / str(v)).as_posix()) for v in values],
+            [Path(str(v)).stem for v in values],
+        )
     _key_path(name, f"{path}: grid")
     return Axis(name, values)
 
 
 def _yaml_text(v: Any) -> str:
-    return yaml.safe_dump(v, default_flow_style=True, width=10_000).strip().removesuffix("...") \
-        .strip()
+    return (
+        yaml.safe_dump(v, default_flow_style=True, width=10_000).strip().removesuffix("...").strip()
+    )
 
 
 SEED_AXIS = "seed"

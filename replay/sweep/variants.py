@@ -22,14 +22,14 @@ from replay.sweep.spec import SweepSpec, sets_for
 @dataclass
 class Variant:
     index: int
-    key: str                    # 16 hex digits
-    params: dict[str, str]      # axis -> the table's cell
+    key: str  # 16 hex digits
+    params: dict[str, str]  # axis -> the table's cell
     scenario_path: str
     sets: list[str]
     seed: int
-    resolved: str = ""          # the resolved YAML ("" when it failed to load)
-    error: str = ""             # why it failed to load
-    name: str = ""              # the scenario's name
+    resolved: str = ""  # the resolved YAML ("" when it failed to load)
+    error: str = ""  # why it failed to load
+    name: str = ""  # the scenario's name
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -37,10 +37,19 @@ def code_version() -> str:
     """Package version, git commit and a digest of uncommitted changes (so an edit re-runs)."""
     here = Path(__file__).resolve().parent
     try:
-        commit = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], capture_output=True,
-                                text=True, timeout=10, cwd=here)
-        diff = subprocess.run(["git", "diff", "HEAD", "--", ".", ":(exclude)*.csv"],
-                              capture_output=True, timeout=30, cwd=here.parent.parent)
+        commit = subprocess.run(
+            ["git", "rev-parse", "--short=12", "HEAD"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            cwd=here,
+        )
+        diff = subprocess.run(
+            ["git", "diff", "HEAD", "--", ".", ":(exclude)*.csv"],
+            capture_output=True,
+            timeout=30,
+            cwd=here.parent.parent,
+        )
     except (OSError, subprocess.SubprocessError):
         return __version__
     version = f"{__version__}+{commit.stdout.strip() or 'unknown'}"
@@ -57,8 +66,14 @@ def variant_key(resolved: str, seed: int, version: str) -> str:
     return h.hexdigest()[:16]
 
 
-def expand(scenario: str | Path, spec: SweepSpec, seed: int, *, sets: list[str] | tuple = (),
-           version: str | None = None) -> list[Variant]:
+def expand(
+    scenario: str | Path,
+    spec: SweepSpec,
+    seed: int,
+    *,
+    sets: list[str] | tuple = (),
+    version: str | None = None,
+) -> list[Variant]:
     """The sweep's variants, each loaded and validated (or carrying why it cannot be)."""
     version = code_version() if version is None else version
     out = []
@@ -86,6 +101,7 @@ def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] | tuple = 
     failure: raise SweepSpecError before anything runs."""
     from replay.scenario.loader import to_plain
     from replay.sweep.spec import SCENARIO_AXIS, SEED_AXIS, SweepSpecError
+
     try:
         base = to_plain(load_scenario(scenario, sets=list(sets)))
     except ScenarioError as exc:
@@ -101,6 +117,7 @@ def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] | tuple = 
             if not isinstance(node, dict) or part not in node:
                 where = ".".join(key.split(".")[:depth]) or "(top level)"
                 choices = ", ".join(node) if isinstance(node, dict) else "(not a mapping)"
-                raise SweepSpecError(f"{key}: no field {part!r} in {where} of {scenario} "
-                                     f"(fields: {choices})")
+                raise SweepSpecError(
+                    f"{key}: no field {part!r} in {where} of {scenario} (fields: {choices})"
+                )
             node = node[part]

@@ -36,10 +36,12 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         os.close(fd)
     cwd = task.get("cwd")
     if cwd and Path(cwd).is_dir() and os.getcwd() != cwd:
-        os.chdir(cwd)                     # relative data paths (alpha files) as in the scenario
+        os.chdir(cwd)  # relative data paths (alpha files) as in the scenario
     from replay.runner import RunInterrupted, Runner
+
     try:
         from replay.scenario.loader import scenario_from_text
+
         sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>")
         if log:
             Path(log).parent.mkdir(parents=True, exist_ok=True)
@@ -54,15 +56,17 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         row.update({f"m.{k}": _cell(v) for k, v in outcome.items()})
         row.update({f"e.{k}": n for k, n in sorted(result.events.items())})
         if task.get("metrics"):
-            row.update({f"x.{k}": _cell(v) for k, v in
-                        _extract(task["metrics"], log or tmp).items()})
+            row.update(
+                {f"x.{k}": _cell(v) for k, v in _extract(task["metrics"], log or tmp).items()}
+            )
     except (RunInterrupted, KeyboardInterrupt):
-        row.update(success=False, reason=INTERRUPTED)   # not a result: the engine drops it
-    except Exception as exc:                        # noqa: BLE001 - a failed variant is a row
+        row.update(success=False, reason=INTERRUPTED)  # not a result: the engine drops it
+    except Exception as exc:  # noqa: BLE001 - a failed variant is a row
         row["success"] = False
         last = traceback.extract_tb(exc.__traceback__)[-1]
-        row["reason"] = (f"error: {type(exc).__name__}: {exc} "
-                         f"({Path(last.filename).name}:{last.lineno})").replace("\n", " ")
+        row["reason"] = (
+            f"error: {type(exc).__name__}: {exc} ({Path(last.filename).name}:{last.lineno})"
+        ).replace("\n", " ")
     finally:
         if tmp:
             Path(tmp).unlink(missing_ok=True)
@@ -75,6 +79,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
 def load_function(ref: str):
     """``package.module:function`` -> the function."""
     import importlib
+
     module, _, name = ref.partition(":")
     return getattr(importlib.import_module(module), name)
 
@@ -82,12 +87,14 @@ def load_function(ref: str):
 def _extract(ref: str, log: str) -> dict:
     """Extra table columns read from the variant's log by the sweep's ``metrics`` function."""
     from replay.log import LogReader
+
     return dict(load_function(ref)(LogReader(log)) or {})
 
 
 def _cell(v: Any) -> Any:
     """A metric as a CSV cell: numbers and strings as they are, the rest as JSON."""
     import json
+
     if isinstance(v, bool) or v is None or isinstance(v, (int, str)):
         return v
     if isinstance(v, float):

@@ -14,12 +14,21 @@ from replay.viewer.data import RunData, Track, load_run
 from replay.viewer.errors import ViewerError
 from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
 
-__all__ = ["DEFAULT_SPEED", "LiveSession", "RunData", "SPEEDS", "Track", "Viewer", "ViewerError",
-           "load_run"]
+__all__ = [
+    "DEFAULT_SPEED",
+    "LiveSession",
+    "RunData",
+    "SPEEDS",
+    "Track",
+    "Viewer",
+    "ViewerError",
+    "load_run",
+]
 
 
-def __getattr__(name):        # Viewer/LiveSession import viser: only when asked for
+def __getattr__(name):  # Viewer/LiveSession import viser: only when asked for
     if name in ("Viewer", "LiveSession"):
         from replay.viewer import app
+
         return getattr(app, name)
     raise AttributeError(name)

@@ -26,7 +26,7 @@ from replay.viewer.timeline import DEFAULT_SPEED, Timeline
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8080
 PORT_TRIES = 50
-PLOT_PERIOD = 0.1             # s between plot-cursor updates while playing
+PLOT_PERIOD = 0.1  # s between plot-cursor updates while playing
 
 
 def _can_bind(host: str, port: int) -> OSError | None:
@@ -36,7 +36,7 @@ def _can_bind(host: str, port: int) -> OSError | None:
         return exc
     family, _, _, _, addr = infos[0]
     with socket.socket(family, socket.SOCK_STREAM) as s:
-        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)   # as asyncio's server does
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as asyncio's server does
         try:
             s.bind(addr)
         except OSError as exc:
@@ -58,15 +58,18 @@ def free_port(host: str, port: int) -> tuple[int, str]:
             return p, ("" if p == port else f"port {port} is in use; serving on port {p}")
         if err.errno not in (errno.EADDRINUSE, errno.EACCES):
             raise ViewerError(f"cannot listen on {host}:{p}: {err.strerror or err}")
-    raise ViewerError(f"ports {port}-{port + PORT_TRIES - 1} on {host} are all in use "
-                      "(choose another with --port)")
+    raise ViewerError(
+        f"ports {port}-{port + PORT_TRIES - 1} on {host} are all in use "
+        "(choose another with --port)"
+    )
 
 
 def start_server(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT):
     """A Viser server bound to ``host`` (127.0.0.1 unless told otherwise): (server, note)."""
     import viser
+
     port, note = free_port(host, port)
-    with contextlib.redirect_stdout(io.StringIO()):     # viser's banner: we print the URL
+    with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: we print the URL
         server = viser.ViserServer(host=host, port=port, label="paper-replay", verbose=False)
     return server, note
 
@@ -74,9 +77,15 @@ def start_server(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT):
 class Viewer:
     """A browser replay of one or more runs, overlaid and in step on one timeline."""
 
-    def __init__(self, runs: Iterable[RunData] = (), *, host: str = DEFAULT_HOST,
-                 port: int | None = None, speed: str = DEFAULT_SPEED,
-                 urdf_for: Callable[[dict], Path] | None = None) -> None:
+    def __init__(
+        self,
+        runs: Iterable[RunData] = (),
+        *,
+        host: str = DEFAULT_HOST,
+        port: int | None = None,
+        speed: str = DEFAULT_SPEED,
+        urdf_for: Callable[[dict], Path] | None = None,
+    ) -> None:
         self.server, self.port_note = start_server(host, DEFAULT_PORT if port is None else port)
         self.host = host
         self.speed = speed
@@ -102,7 +111,7 @@ class Viewer:
         """Load the logs (one-line :class:`ViewerError` if one cannot be shown), then serve."""
         runs = [load_run(p) for p in paths]
         for run in runs:
-            scene_class(run)              # fail before starting a server
+            scene_class(run)  # fail before starting a server
         return cls(runs, **kw)
 
     @property
@@ -118,7 +127,7 @@ class Viewer:
     def _clear(self) -> None:
         if self.timeline is not None:
             self.timeline.close()
-        self.server.scene.reset()          # every node, the runs' and the shared ones
+        self.server.scene.reset()  # every node, the runs' and the shared ones
         self.server.gui.reset()
         self.scenes, self.timeline, self.plots, self._status = [], None, None, None
 
@@ -155,28 +164,32 @@ class Viewer:
             t1 = max(r.time_range()[1] for r in self.runs)
             title = " vs ".join(f"**{r.label}**" for r in self.runs)
             papers = sorted({str(r.scenario.get("paper", "")) for r in self.runs} - {""})
-            gui.add_markdown(f"{title}  \n{', '.join(papers) or 'no scenario'} · "
-                             f"{t1 - t0:.3f} s simulated")
+            gui.add_markdown(
+                f"{title}  \n{', '.join(papers) or 'no scenario'} · {t1 - t0:.3f} s simulated"
+            )
             if len(self.runs) > 1:
                 legend = " · ".join(
                     f"<span style='color:rgb{run_color(k)}'>■</span> {r.label}"
                     + (" (natural colours)" if k == 0 else "")
-                    for k, r in enumerate(self.runs))
+                    for k, r in enumerate(self.runs)
+                )
                 gui.add_markdown(legend)
             if self.notes:
                 gui.add_markdown("\n".join(f"- ⚠ {n}" for n in self.notes))
             frames = np.unique(np.concatenate([s.frame_times() for s in self.scenes]))
             events = [(r.label, e) for r in self.runs for e in r.events if "t" in e]
             events.sort(key=lambda le: le[1]["t"])
-            self.timeline = Timeline(self.server, (t0, t1), frames, events, self.show,
-                                     speed=self.speed)
+            self.timeline = Timeline(
+                self.server, (t0, t1), frames, events, self.show, speed=self.speed
+            )
             self.run_toggles = []
             if len(self.runs) > 1:
                 with gui.add_folder("Runs"):
                     for s in self.scenes:
                         cb = gui.add_checkbox(f"show {s.run.label}", True)
-                        cb.on_update(lambda ev, s=s: setattr(s.root_frame, "visible",
-                                                             ev.target.value))
+                        cb.on_update(
+                            lambda ev, s=s: setattr(s.root_frame, "visible", ev.target.value)
+                        )
                         self.run_toggles.append(cb)
             specs = self.scenes[0].plots()
             if specs:
@@ -199,8 +212,9 @@ class Viewer:
                 self.plots.set_cursor(t)
             if tl is not None:
                 k = int(np.searchsorted(tl.frames, t + 1e-9, side="right"))
-                tl.status.content = (f"t = {t:.4f} s · frame {max(k, 1)}/{len(tl.frames)} · "
-                                     f"speed {tl.speed.value}")
+                tl.status.content = (
+                    f"t = {t:.4f} s · frame {max(k, 1)}/{len(tl.frames)} · speed {tl.speed.value}"
+                )
 
     def seek(self, t: float) -> None:
         if self.timeline is not None:
@@ -243,9 +257,15 @@ class LiveSession:
     """``Runner(..., observers=(session.observe,))``: the run drawn as it is computed (at most
     ``rate`` times per wall-clock second), then ``finish(log)`` replays the written log."""
 
-    def __init__(self, *, host: str = DEFAULT_HOST, port: int | None = None,
-                 speed: str = DEFAULT_SPEED, rate: float = 20.0,
-                 urdf_for: Callable[[dict], Path] | None = None) -> None:
+    def __init__(
+        self,
+        *,
+        host: str = DEFAULT_HOST,
+        port: int | None = None,
+        speed: str = DEFAULT_SPEED,
+        rate: float = 20.0,
+        urdf_for: Callable[[dict], Path] | None = None,
+    ) -> None:
         self.viewer = Viewer(host=host, port=port, speed=speed, urdf_for=urdf_for)
         self.acc = RunAccumulator()
         self.period = 1.0 / rate
@@ -276,7 +296,7 @@ class LiveSession:
                     try:
                         scene_class(run)
                     except ViewerError:
-                        return                         # nothing drawable yet
+                        return  # nothing drawable yet
                     v._build_scenes([run])
                     v._status = v.server.gui.add_markdown("")
                 with v.server.atomic():

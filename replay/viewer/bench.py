@@ -32,11 +32,14 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     from replay.log import LogReader
     from replay.viewer import Viewer, load_run
+
     with tempfile.TemporaryDirectory() as tmp:
-        logs = {"air table": write_stick_log(Path(tmp) / "stick.mcap", duration=args.duration,
-                                             rate=args.rate),
-                "arm": write_arm_log(Path(tmp) / "arm.mcap", duration=args.duration,
-                                     rate=args.rate)}
+        logs = {
+            "air table": write_stick_log(
+                Path(tmp) / "stick.mcap", duration=args.duration, rate=args.rate
+            ),
+            "arm": write_arm_log(Path(tmp) / "arm.mcap", duration=args.duration, rate=args.rate),
+        }
         for kind, path in logs.items():
             n = sum(LogReader(path).topic_counts().values())
             size = path.stat().st_size / 1024
@@ -44,6 +47,7 @@ def main(argv=None) -> None:
 
             def open_view(path=path):
                 Viewer.open([path], port=0).stop()
+
             whole = _best(open_view, args.repeat)
             print(f"{kind}: {args.duration:g} s at {args.rate} Hz, {n} messages, {size:.0f} KiB")
             print(f"  log -> arrays (load_run):             {load:.3f} s")

@@ -28,11 +28,12 @@ OBJECT_TOPICS = (TOPIC_SCENARIO, TOPIC_EVENTS)
 @dataclass
 class Track:
     """One topic's messages as columns: ``t`` (s, ascending) and ``fields[name]`` (n, ...)."""
+
     topic: str
     t: np.ndarray
     fields: dict[str, np.ndarray]
-    labels: dict[str, Any] = field(default_factory=dict)   # non-numeric fields, first message
-    ragged: tuple[str, ...] = ()                            # fields whose shape changed (NaN rows)
+    labels: dict[str, Any] = field(default_factory=dict)  # non-numeric fields, first message
+    ragged: tuple[str, ...] = ()  # fields whose shape changed (NaN rows)
 
     def __len__(self) -> int:
         return len(self.t)
@@ -63,8 +64,9 @@ def _shape_of(value) -> tuple | None:
             return (len(value),)
         if all(isinstance(v, list) and v for v in value):
             n = len(value[0])
-            if all(len(v) == n and all(isinstance(x, (bool, int, float)) for x in v)
-                   for v in value):
+            if all(
+                len(v) == n and all(isinstance(x, (bool, int, float)) for x in v) for v in value
+            ):
                 return (len(value), n)
     return None
 
@@ -93,11 +95,11 @@ class _TrackBuilder:
     def _grow(self) -> None:
         self.cap *= 2
         t = np.empty(self.cap)
-        t[:self.n] = self.t[:self.n]
+        t[: self.n] = self.t[: self.n]
         self.t = t
         for name, col in self.cols.items():
             new = np.full((self.cap, *col.shape[1:]), np.nan)
-            new[:self.n] = col[:self.n]
+            new[: self.n] = col[: self.n]
             self.cols[name] = new
 
     def add(self, t_ns: int, data: dict) -> None:
@@ -111,32 +113,41 @@ class _TrackBuilder:
             value = data.get(name)
             shape = col.shape[1:]
             try:
-                if shape and (not isinstance(value, list) or len(value) != shape[0] or
-                              (len(shape) > 1 and np.shape(value) != shape)):
-                    raise ValueError(name)      # no broadcasting of a shorter list
+                if shape and (
+                    not isinstance(value, list)
+                    or len(value) != shape[0]
+                    or (len(shape) > 1 and np.shape(value) != shape)
+                ):
+                    raise ValueError(name)  # no broadcasting of a shorter list
                 col[n] = value
-            except (TypeError, ValueError):     # missing, or its shape changed
+            except (TypeError, ValueError):  # missing, or its shape changed
                 col[n] = np.nan
                 self.ragged.add(name)
         self.n = n + 1
 
     def track(self) -> Track:
         n = self.n
-        return Track(self.topic, self.t[:n], {k: v[:n] for k, v in (self.cols or {}).items()},
-                     dict(self.labels), tuple(sorted(self.ragged)))
+        return Track(
+            self.topic,
+            self.t[:n],
+            {k: v[:n] for k, v in (self.cols or {}).items()},
+            dict(self.labels),
+            tuple(sorted(self.ragged)),
+        )
 
 
 @dataclass
 class RunData:
     """One run as the viewer sees it: its scenario, its tracks, its events."""
-    label: str                               # scenario name, or the file name
+
+    label: str  # scenario name, or the file name
     path: Path | None
-    scenario: dict                           # the /scenario message ({} if absent)
-    config: dict                             # the resolved scenario YAML, parsed ({} if absent)
+    scenario: dict  # the /scenario message ({} if absent)
+    config: dict  # the resolved scenario YAML, parsed ({} if absent)
     tracks: dict[str, Track]
     events: list[dict]
     truncated: bool = False
-    notes: list[str] = field(default_factory=list)   # what the viewer could not show, and why
+    notes: list[str] = field(default_factory=list)  # what the viewer could not show, and why
 
     def track(self, topic: str) -> Track | None:
         tr = self.tracks.get(topic)
@@ -201,17 +212,28 @@ class RunAccumulator:
             try:
                 config = yaml.safe_load(scenario["yaml"]) or {}
             except yaml.YAMLError as exc:
-                notes.append(f"scenario YAML unreadable ({exc.__class__.__name__}); "
-                             "default geometry used")
+                notes.append(
+                    f"scenario YAML unreadable ({exc.__class__.__name__}); default geometry used"
+                )
             if not isinstance(config, dict):
                 config = {}
         label = scenario.get("name") or (self.path.stem if self.path else "live run")
         for tr in tracks.values():
             for name in tr.ragged:
-                notes.append(f"{tr.topic}.{name} changes shape or is missing in some messages; "
-                             "those messages are left out")
-        return RunData(label=str(label), path=self.path, scenario=scenario, config=config,
-                       tracks=tracks, events=events, truncated=truncated, notes=notes)
+                notes.append(
+                    f"{tr.topic}.{name} changes shape or is missing in some messages; "
+                    "those messages are left out"
+                )
+        return RunData(
+            label=str(label),
+            path=self.path,
+            scenario=scenario,
+            config=config,
+            tracks=tracks,
+            events=events,
+            truncated=truncated,
+            notes=notes,
+        )
 
 
 def load_run(path: str | Path) -> RunData:
@@ -227,7 +249,7 @@ def load_run(path: str | Path) -> RunData:
         raise
     except LogError as exc:
         raise ViewerError(str(exc)) from None
-    except (ValueError, OSError) as exc:      # a corrupt message (bad JSON) or a read error
+    except (ValueError, OSError) as exc:  # a corrupt message (bad JSON) or a read error
         raise ViewerError(f"{path}: unreadable log ({exc})") from None
     run = acc.snapshot(truncated=reader.truncated)
     if not run.tracks and not run.events:

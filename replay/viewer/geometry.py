@@ -19,9 +19,9 @@ from replay.spatial import matrix_to_wxyz
 class CameraPose:
     name: str
     position: tuple[float, float, float]
-    wxyz: tuple[float, float, float, float]    # camera-to-world, OpenCV axes (z forward, y down)
-    fov_y: float                               # rad, vertical
-    aspect: float                              # width / height
+    wxyz: tuple[float, float, float, float]  # camera-to-world, OpenCV axes (z forward, y down)
+    fov_y: float  # rad, vertical
+    aspect: float  # width / height
 
 
 def _pose(name: str, cam) -> CameraPose:
@@ -50,7 +50,7 @@ def cameras(sensors: dict) -> tuple[list[CameraPose], list[str]]:
             missing.append(str(name))
             continue
         make = getattr(cls, "make_cameras", None) or getattr(cls, "make_camera", None)
-        if make is None:                       # not a camera (e.g. joint encoders)
+        if make is None:  # not a camera (e.g. joint encoders)
             continue
         try:
             params = params_from_data(cls.Params, spec.get("params"), f"sensors.{name}.params")
@@ -59,6 +59,7 @@ def cameras(sensors: dict) -> tuple[list[CameraPose], list[str]]:
             continue
         made = make(params)
         made = list(made) if isinstance(made, (list, tuple)) else [made]
-        found += [_pose(str(name) if len(made) == 1 else f"{name}/{i}", cam)
-                  for i, cam in enumerate(made)]
+        found += [
+            _pose(str(name) if len(made) == 1 else f"{name}/{i}", cam) for i, cam in enumerate(made)
+        ]
     return found, missing

@@ -15,9 +15,19 @@ from replay.viewer.data import RunData, resample
 from replay.viewer.scenes import PlotSpec
 
 GRID_POINTS = 500
-PALETTE = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2",
-           "#17becf", "#bcbd22", "#7f7f7f"]
-_OFF = -10.0          # cursor value off the chart (its scale is fixed to 0..1)
+PALETTE = [
+    "#1f77b4",
+    "#d62728",
+    "#2ca02c",
+    "#9467bd",
+    "#ff7f0e",
+    "#8c564b",
+    "#e377c2",
+    "#17becf",
+    "#bcbd22",
+    "#7f7f7f",
+]
+_OFF = -10.0  # cursor value off the chart (its scale is fixed to 0..1)
 
 
 class Plot:
@@ -34,25 +44,43 @@ class Plot:
                 t, y = got
                 self.ys.append(resample(t, y, grid))
                 label = f"{s.label} ({run.label})" if many else s.label
-                cfg = {"label": label, "stroke": PALETTE[(s_i if len(spec.series) > 1 else k)
-                                                          % len(PALETTE)],
-                       "width": 1.5, "scale": "y", "points": {"show": False}}
+                cfg = {
+                    "label": label,
+                    "stroke": PALETTE[(s_i if len(spec.series) > 1 else k) % len(PALETTE)],
+                    "width": 1.5,
+                    "scale": "y",
+                    "points": {"show": False},
+                }
                 if k > 0 and len(spec.series) > 1:
                     cfg["dash"] = [6, 4]
                 series.append(cfg)
         self.empty = not self.ys
-        series.append({"label": "now", "stroke": "#343a40", "width": 1.5, "scale": "cursor",
-                       "points": {"show": False}})
+        series.append(
+            {
+                "label": "now",
+                "stroke": "#343a40",
+                "width": 1.5,
+                "scale": "cursor",
+                "points": {"show": False},
+            }
+        )
         self.handle = None
         if self.empty:
             return
         self.handle = gui.add_uplot(
-            self._data(float(grid[0])), tuple(series), title=spec.title,
-            scales={"x": {"time": False, "auto": True}, "y": {"auto": True},
-                    "cursor": {"auto": False, "range": [0.0, 1.0]}},
+            self._data(float(grid[0])),
+            tuple(series),
+            title=spec.title,
+            scales={
+                "x": {"time": False, "auto": True},
+                "y": {"auto": True},
+                "cursor": {"auto": False, "range": [0.0, 1.0]},
+            },
             axes=({}, {"scale": "y", "size": 48}),
             legend={"show": True, "live": False},
-            cursor={"show": False}, aspect=1.6)
+            cursor={"show": False},
+            aspect=1.6,
+        )
 
     def _data(self, t: float) -> tuple[np.ndarray, ...]:
         x = self.grid
@@ -75,8 +103,13 @@ class Plot:
 class PlotPanel:
     """All plots of the shown runs, in the current GUI container."""
 
-    def __init__(self, server: viser.ViserServer, specs: list[PlotSpec], runs: list[RunData],
-                 t_range: tuple[float, float]) -> None:
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        specs: list[PlotSpec],
+        runs: list[RunData],
+        t_range: tuple[float, float],
+    ) -> None:
         t0, t1 = t_range
         n = GRID_POINTS if t1 > t0 else 2
         grid = np.linspace(t0, t1 if t1 > t0 else t0 + 1e-3, n)

@@ -25,7 +25,7 @@ from replay.viewer.errors import ViewerError
 from replay.viewer.geometry import cameras
 
 RUN_COLORS = [(225, 95, 30), (35, 110, 220), (40, 160, 70), (150, 60, 180), (200, 160, 20)]
-PATH_POINTS = 600          # a path so far is drawn with at most this many points
+PATH_POINTS = 600  # a path so far is drawn with at most this many points
 
 
 def run_color(k: int) -> tuple[int, int, int]:
@@ -35,7 +35,7 @@ def run_color(k: int) -> tuple[int, int, int]:
 @dataclass
 class PlotSeries:
     label: str
-    signal: Callable[[RunData], tuple[np.ndarray, np.ndarray] | None]   # run -> (t, y)
+    signal: Callable[[RunData], tuple[np.ndarray, np.ndarray] | None]  # run -> (t, y)
 
 
 @dataclass
@@ -46,8 +46,9 @@ class PlotSpec:
 
 class RunScene:
     """Base of the per-experiment builders."""
+
     kind = "?"
-    needs: tuple[str, ...] = ()         # any one of these topics makes the run drawable
+    needs: tuple[str, ...] = ()  # any one of these topics makes the run drawable
     optional: tuple[str, ...] = ()
     view_direction = (0.0, -0.62, 0.8)  # initial camera: centre + this * the scene's size
 
@@ -62,7 +63,7 @@ class RunScene:
         self.options = options
         self.notes: list[str] = []
         self.handles: list = []
-        self.dynamic: dict = {}         # nodes re-added as they change (lines), by role
+        self.dynamic: dict = {}  # nodes re-added as they change (lines), by role
         self._path: Any = None
         self._path_len = -1
         self._path_thickness = 2.0
@@ -119,22 +120,37 @@ class RunScene:
             return
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
         self._path = self.scene.add_line_segments(
-            f"{self.root}/path", segs, self.color, thickness=self._path_thickness,
-            thickness_units="screen")
+            f"{self.root}/path",
+            segs,
+            self.color,
+            thickness=self._path_thickness,
+            thickness_units="screen",
+        )
         self.dynamic["path"] = self._path
 
     def _cameras(self, scale: float) -> None:
         cams, missing = cameras(self.run.sensors)
         for i, c in enumerate(cams):
-            self._add(self.scene.add_camera_frustum(
-                f"{self.root}/cameras/{i}", fov=c.fov_y, aspect=c.aspect, scale=scale,
-                color=(60, 60, 60) if not self.ghost else self.color, wxyz=c.wxyz,
-                position=c.position, thickness=2.0, thickness_units="screen"))
-            self._add(self.scene.add_label(f"{self.root}/cameras/{i}/label", c.name,
-                                           position=(0.0, 0.0, 0.0)))
+            self._add(
+                self.scene.add_camera_frustum(
+                    f"{self.root}/cameras/{i}",
+                    fov=c.fov_y,
+                    aspect=c.aspect,
+                    scale=scale,
+                    color=(60, 60, 60) if not self.ghost else self.color,
+                    wxyz=c.wxyz,
+                    position=c.position,
+                    thickness=2.0,
+                    thickness_units="screen",
+                )
+            )
+            self._add(
+                self.scene.add_label(
+                    f"{self.root}/cameras/{i}/label", c.name, position=(0.0, 0.0, 0.0)
+                )
+            )
         for name in missing:
-            self.notes.append(f"camera '{name}': no pose in its scenario params; frustum not "
-                              "drawn")
+            self.notes.append(f"camera '{name}': no pose in its scenario params; frustum not drawn")
 
     # -- interface --------------------------------------------------------------------------
     def build(self) -> None:
@@ -158,8 +174,9 @@ class RunScene:
 
     def remove(self) -> None:
         import warnings
+
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")          # children of removed parents
+            warnings.simplefilter("ignore")  # children of removed parents
             for h in [*self.handles, *self.dynamic.values()]:
                 try:
                     h.remove()
@@ -190,5 +207,6 @@ def scene_class(run: RunData) -> type[RunScene]:
     where = run.path if run.path is not None else run.label
     need = " or ".join(t for c in scenes.values() for t in c.needs)
     have = ", ".join(sorted(run.tracks)) or "none"
-    raise ViewerError(f"{where}: nothing the viewer can draw: needs {need} "
-                      f"(topics in the log: {have})")
+    raise ViewerError(
+        f"{where}: nothing the viewer can draw: needs {need} (topics in the log: {have})"
+    )

@@ -35,12 +35,12 @@ from replay.control.catching.model import ArmModel
 
 @dataclass
 class ApproachTerm:
-    normal: np.ndarray     # (k, 3) palm normal at each catch sample
-    P: np.ndarray          # (k, 3, 3) I - n n^T
-    h0: np.ndarray         # (k, 3) r_e''(t_c) at alpha = 0
-    G: np.ndarray          # (k, 3, n_alpha) d r_e''(t_c) / d alpha
-    a0: float              # m/s^2, the normaliser
-    weight: float          # w_app * n_per_throw
+    normal: np.ndarray  # (k, 3) palm normal at each catch sample
+    P: np.ndarray  # (k, 3, 3) I - n n^T
+    h0: np.ndarray  # (k, 3) r_e''(t_c) at alpha = 0
+    G: np.ndarray  # (k, 3, n_alpha) d r_e''(t_c) / d alpha
+    a0: float  # m/s^2, the normaliser
+    weight: float  # w_app * n_per_throw
 
     def accel(self, alpha) -> np.ndarray:
         """r_e''(t_c) per catch sample, (k, 3)."""
@@ -51,8 +51,9 @@ class ApproachTerm:
         return (np.sqrt(self.weight) / self.a0 * lat).ravel()
 
     def jacobian(self) -> np.ndarray:
-        return (np.sqrt(self.weight) / self.a0 * np.einsum("kij,kjn->kin", self.P,
-                                                           self.G)).reshape(-1, self.G.shape[-1])
+        return (np.sqrt(self.weight) / self.a0 * np.einsum("kij,kjn->kin", self.P, self.G)).reshape(
+            -1, self.G.shape[-1]
+        )
 
     def cost(self, alpha) -> float:
         r = self.residuals(alpha)
@@ -65,8 +66,15 @@ class ApproachTerm:
         return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
 
 
-def approach_term(mapping: DirectMapping, model: ArmModel, feats: Features, catch_idx,
-                  gravity, alpha0, weight: float) -> ApproachTerm:
+def approach_term(
+    mapping: DirectMapping,
+    model: ArmModel,
+    feats: Features,
+    catch_idx,
+    gravity,
+    alpha0,
+    weight: float,
+) -> ApproachTerm:
     """The term over the catch samples ``catch_idx`` of ``feats`` (q4 = q_alpha there)."""
     idx = np.asarray(catch_idx, int)
     nm, m = mapping.poly.n_mono, mapping.poly.m
@@ -74,9 +82,9 @@ def approach_term(mapping: DirectMapping, model: ArmModel, feats: Features, catc
     normals, accs, grads = [], [], []
     for k in idx:
         p, pd, pdd = feats.p[k], feats.pd[k], feats.pdd[k]
-        acc, J = model.point_acceleration(p, pd, pdd)     # b = 0, q_d' = q_o' at t_c
+        acc, J = model.point_acceleration(p, pd, pdd)  # b = 0, q_d' = q_o' at t_c
         normals.append(model.tool_axis(p))
-        accs.append(acc - g)                               # r_o'' = g
+        accs.append(acc - g)  # r_o'' = g
         # d(J m2 A)/dA[j, c] = J[:, c] m2_j  ->  alpha index j * m + c (row-major A)
         grads.append(np.einsum("ic,j->ijc", J, feats.m2[k]).reshape(3, nm * m))
     normal, h0, G = np.array(normals), np.array(accs), np.array(grads)

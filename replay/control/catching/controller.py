@@ -32,86 +32,186 @@ import numpy as np
 
 from replay.control.catching.estimator import BallisticEstimator
 from replay.control.catching.model import ArmModel
-from replay.control.catching.optimise import (CostRecord, OptimResult, initial_alpha, load_alpha,
-                                              save_alpha)
+from replay.control.catching.optimise import (
+    CostRecord,
+    OptimResult,
+    initial_alpha,
+    load_alpha,
+    save_alpha,
+)
 from replay.control.catching.problem import ProblemConfig, build_problem
 from replay.interfaces import Controller, Occurrence
-from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE,
-                             TOPIC_CATCHING_STATE, TOPIC_EFFECTOR_STATE, TOPIC_OPTIMIZATION_COST,
-                             TOPIC_VISION_OBJECT, EffectorState, JointCommand, OptimizationCost)
+from replay.messages import (
+    TOPIC_ARM_ENCODERS,
+    TOPIC_ARM_JOINT_COMMAND,
+    TOPIC_ARM_JOINT_STATE,
+    TOPIC_CATCHING_STATE,
+    TOPIC_EFFECTOR_STATE,
+    TOPIC_OPTIMIZATION_COST,
+    TOPIC_VISION_OBJECT,
+    EffectorState,
+    JointCommand,
+    OptimizationCost,
+)
 from replay.params import ParamError, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
 
-_JOINTS = tuple(f"J{i}" for i in range(1, 8))     # an arm's joints as ArmSpec names them
+_JOINTS = tuple(f"J{i}" for i in range(1, 8))  # an arm's joints as ArmSpec names them
 
 
 @dataclass
 class Params:
-    mapping: str = param("optimised", choices=("optimised", "initial"),
-                         doc="b(q) parameters: 'optimised' (eq. 25 under eq. 13) or 'initial' "
-                             "(minimum-norm alpha meeting only the initial constraint, eq. 13)")
-    alpha_file: str = param("", max_length=1000,
-                            doc="JSON with precomputed alpha (write_alpha_file), relative to the "
-                                "scenario file; used when its key matches this "
-                                "configuration, else alpha is recomputed")
-    q_alpha: float = param(math.pi / 2, unit="rad", ge=-10, le=10,
-                           doc="catching angle of the selected joint (Sec. IV-A: pi/2)")
-    selected_joint: str = param("J4", choices=_JOINTS,
-                                doc="the joint i of eq. 6 (Sec. IV-A: axis 4)")
-    held_joints: list[str] = param(["J3"], choices=_JOINTS, max_length=7,
-                                   doc="joints held at their initial angle (Sec. IV-A: axis 3 "
-                                       "at 0); with them the arm must keep 3 active joints")
+    mapping: str = param(
+        "optimised",
+        choices=("optimised", "initial"),
+        doc="b(q) parameters: 'optimised' (eq. 25 under eq. 13) or 'initial' "
+        "(minimum-norm alpha meeting only the initial constraint, eq. 13)",
+    )
+    alpha_file: str = param(
+        "",
+        max_length=1000,
+        doc="JSON with precomputed alpha (write_alpha_file), relative to the "
+        "scenario file; used when its key matches this "
+        "configuration, else alpha is recomputed",
+    )
+    q_alpha: float = param(
+        math.pi / 2,
+        unit="rad",
+        ge=-10,
+        le=10,
+        doc="catching angle of the selected joint (Sec. IV-A: pi/2)",
+    )
+    selected_joint: str = param(
+        "J4", choices=_JOINTS, doc="the joint i of eq. 6 (Sec. IV-A: axis 4)"
+    )
+    held_joints: list[str] = param(
+        ["J3"],
+        choices=_JOINTS,
+        max_length=7,
+        doc="joints held at their initial angle (Sec. IV-A: axis 3 "
+        "at 0); with them the arm must keep 3 active joints",
+    )
     order: int = param(4, ge=2, le=8, doc="N of eq. 12 (Sec. IV-B: 4th order)")
-    catch_q: list[float] = param([0.0, math.pi / 4], unit="rad", length=2, ge=-10, le=10,
-                          doc="(q1, q2) of the nominal catching point l(q)|q4=q_alpha; also the "
-                              "branch l_c^-1 prefers")
-    catch_offset: float = param(-1.0, unit="m", ge=-1.0, le=1.0,
-                                doc="l(q) is this far along the tool z axis (the ball centre on "
-                                    "the palm); negative = palm thickness + ball radius from the "
-                                    "spec (0 without hand/ball)")
-    throw_start: list[float] = param([3.2, 0.0, 1.0], unit="m", length=3, ge=-100, le=100,
-                              doc="r_o(t0): where the ball is first seen in the nominal throw; "
-                                  "every throw of the optimisation set starts here")
-    throw_speeds: list[float] = param([8.0, 9.0, 10.0], unit="m/s", gt=0.0, le=100,
-                                      min_length=1, max_length=10,
-                               doc="launch speeds of the set (Sec. IV-B: 8 ~ 10 m/s); the middle "
-                                   "one is the nominal throw of eq. 13")
-    throw_spread: float = param(0.1, unit="m", ge=0.0, le=10,
-                                doc="half-width of the arrival grid around the catching point")
+    catch_q: list[float] = param(
+        [0.0, math.pi / 4],
+        unit="rad",
+        length=2,
+        ge=-10,
+        le=10,
+        doc="(q1, q2) of the nominal catching point l(q)|q4=q_alpha; also the "
+        "branch l_c^-1 prefers",
+    )
+    catch_offset: float = param(
+        -1.0,
+        unit="m",
+        ge=-1.0,
+        le=1.0,
+        doc="l(q) is this far along the tool z axis (the ball centre on "
+        "the palm); negative = palm thickness + ball radius from the "
+        "spec (0 without hand/ball)",
+    )
+    throw_start: list[float] = param(
+        [3.2, 0.0, 1.0],
+        unit="m",
+        length=3,
+        ge=-100,
+        le=100,
+        doc="r_o(t0): where the ball is first seen in the nominal throw; "
+        "every throw of the optimisation set starts here",
+    )
+    throw_speeds: list[float] = param(
+        [8.0, 9.0, 10.0],
+        unit="m/s",
+        gt=0.0,
+        le=100,
+        min_length=1,
+        max_length=10,
+        doc="launch speeds of the set (Sec. IV-B: 8 ~ 10 m/s); the middle "
+        "one is the nominal throw of eq. 13",
+    )
+    throw_spread: float = param(
+        0.1, unit="m", ge=0.0, le=10, doc="half-width of the arrival grid around the catching point"
+    )
     throw_grid: int = param(3, ge=1, le=10, doc="arrival grid points per axis (grid x grid)")
     samples_per_throw: int = param(15, ge=2, le=200, doc="samples of each throw from t0 to arrival")
-    opt_torque_limits: list[float] = param([], unit="N*m", gt=0.0, le=1e4, max_length=7,
-                                    doc="tau_max of eq. 22 for the active joints; [] = spec")
-    opt_velocity_limits: list[float] = param([], unit="rad/s", gt=0.0, le=1000, max_length=7,
-                                      doc="omega_max of eq. 24 for the active joints; [] = spec")
+    opt_torque_limits: list[float] = param(
+        [],
+        unit="N*m",
+        gt=0.0,
+        le=1e4,
+        max_length=7,
+        doc="tau_max of eq. 22 for the active joints; [] = spec",
+    )
+    opt_velocity_limits: list[float] = param(
+        [],
+        unit="rad/s",
+        gt=0.0,
+        le=1000,
+        max_length=7,
+        doc="omega_max of eq. 24 for the active joints; [] = spec",
+    )
     w_tau: float = param(1.0, unit="1", gt=0.0, le=1e6, doc="K_tau = w_tau diag(1/tau_max^2)")
-    w_omega: float = param(1.0, unit="1", gt=0.0, le=1e6,
-                           doc="K_omega = w_omega diag(1/omega_max^2)")
-    limit_penalty: float = param(100.0, unit="1", ge=0.0, le=1e9,
-                                 doc="weight of the hinge penalties for eqs. 22 and 24")
-    torque_limit_penalty: float = param(-1.0, unit="1", ge=-1.0, le=1e9,
-                                        doc="weight of eq. 22's hinge alone; < 0 = "
-                                            "limit_penalty")
-    approach_weight: float = param(0.0, unit="1", ge=0.0, le=1e9,
-                                   doc="weight of the approach-direction term (not in the paper, "
-                                       "approach.py): the ball down the palm axis; 0 = eq. 25 only")
+    w_omega: float = param(
+        1.0, unit="1", gt=0.0, le=1e6, doc="K_omega = w_omega diag(1/omega_max^2)"
+    )
+    limit_penalty: float = param(
+        100.0, unit="1", ge=0.0, le=1e9, doc="weight of the hinge penalties for eqs. 22 and 24"
+    )
+    torque_limit_penalty: float = param(
+        -1.0, unit="1", ge=-1.0, le=1e9, doc="weight of eq. 22's hinge alone; < 0 = limit_penalty"
+    )
+    approach_weight: float = param(
+        0.0,
+        unit="1",
+        ge=0.0,
+        le=1e9,
+        doc="weight of the approach-direction term (not in the paper, "
+        "approach.py): the ball down the palm axis; 0 = eq. 25 only",
+    )
     max_iterations: int = param(40, ge=0, le=1000, doc="Levenberg-Marquardt iterations at most")
-    kp: list[float] = param([900.0, 1500.0, 300.0, 150.0], unit="N*m/rad", ge=0.0, le=1e6,
-                            min_length=1, max_length=7, doc="PD stiffness per arm joint")
-    kd: list[float] = param([30.0, 45.0, 10.0, 4.0], unit="N*m*s/rad", ge=0.0, le=1e6,
-                            min_length=1, max_length=7, doc="PD damping per arm joint")
-    feedforward: str = param("dynamics", choices=("dynamics", "gravity", "none"),
-                             doc="tau_ff: eq. 17 at q_d ('dynamics'), g(q) or none")
-    latency_compensation: bool = param(True, doc="carry r_o forward over the measurement's age "
-                                                 "with the fitted velocity")
-    fit_window: float = param(0.1, unit="s", gt=0.0, le=10,
-                              doc="ballistic fit over this much history")
-    close_lead: float = param(0.0, unit="s", ge=-1, le=1,
-                              doc="start closing this much earlier than (arrival - closing time)")
-    after_catch: str = param("hold", choices=("hold", "track"),
-                             doc="at the catch surface: freeze q_d ('hold') or keep mapping")
-    scenario_dir: str = field(default="", metadata={"internal": True})   # set by the loader
+    kp: list[float] = param(
+        [900.0, 1500.0, 300.0, 150.0],
+        unit="N*m/rad",
+        ge=0.0,
+        le=1e6,
+        min_length=1,
+        max_length=7,
+        doc="PD stiffness per arm joint",
+    )
+    kd: list[float] = param(
+        [30.0, 45.0, 10.0, 4.0],
+        unit="N*m*s/rad",
+        ge=0.0,
+        le=1e6,
+        min_length=1,
+        max_length=7,
+        doc="PD damping per arm joint",
+    )
+    feedforward: str = param(
+        "dynamics",
+        choices=("dynamics", "gravity", "none"),
+        doc="tau_ff: eq. 17 at q_d ('dynamics'), g(q) or none",
+    )
+    latency_compensation: bool = param(
+        True, doc="carry r_o forward over the measurement's age with the fitted velocity"
+    )
+    fit_window: float = param(
+        0.1, unit="s", gt=0.0, le=10, doc="ballistic fit over this much history"
+    )
+    close_lead: float = param(
+        0.0,
+        unit="s",
+        ge=-1,
+        le=1,
+        doc="start closing this much earlier than (arrival - closing time)",
+    )
+    after_catch: str = param(
+        "hold",
+        choices=("hold", "track"),
+        doc="at the catch surface: freeze q_d ('hold') or keep mapping",
+    )
+    scenario_dir: str = field(default="", metadata={"internal": True})  # set by the loader
 
 
 def alpha_path(params: Params) -> Path | None:
@@ -119,28 +219,33 @@ def alpha_path(params: Params) -> Path | None:
     if not params.alpha_file:
         return None
     path = Path(params.alpha_file)
-    return path if path.is_absolute() or not params.scenario_dir else \
-        Path(params.scenario_dir) / path
+    return (
+        path if path.is_absolute() or not params.scenario_dir else Path(params.scenario_dir) / path
+    )
 
     def __post_init__(self) -> None:
         if self.selected_joint in self.held_joints:
-            raise ParamError("selected_joint", f"{self.selected_joint} is also held "
-                             "(held_joints): the selected joint must move")
+            raise ParamError(
+                "selected_joint",
+                f"{self.selected_joint} is also held (held_joints): the selected joint must move",
+            )
         if len(self.kp) != len(self.kd):
-            raise ParamError("kd", f"expected one value per joint as kp ({len(self.kp)}), "
-                             f"got {len(self.kd)}")
+            raise ParamError(
+                "kd", f"expected one value per joint as kp ({len(self.kp)}), got {len(self.kd)}"
+            )
 
 
 @dataclass
 class CatchingState:
     """``/catching/state``: the mapping's inner quantities at a control step."""
+
     t: float
-    r_o: list                 # used object position (m)
-    r_o_velocity: list        # estimated (m/s)
-    q_o: list                 # l_c^-1(r_o), active joints (rad)
-    velocity_desired: list    # qd_d (rad/s), all arm joints
+    r_o: list  # used object position (m)
+    r_o_velocity: list  # estimated (m/s)
+    q_o: list  # l_c^-1(r_o), active joints (rad)
+    velocity_desired: list  # qd_d (rad/s), all arm joints
     in_domain: bool
-    predicted_catch_time: float   # s, -1 if unknown
+    predicted_catch_time: float  # s, -1 if unknown
     hand_closing: bool
     holding: bool
 
@@ -149,9 +254,11 @@ class CatchingController(Controller):
     Params = Params
     spec_type = ArmSpec
     command_type = ArmCommand
-    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)   # the stereo ball, the joint encoders
-    description = ("Namiki & Ishikawa: direct mapping q_d = g o l_c^-1(r_o) from stereo "
-                   "positions to joint targets, PD + dynamics feed-forward, hand timed by TTC")
+    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)  # the stereo ball, the joint encoders
+    description = (
+        "Namiki & Ishikawa: direct mapping q_d = g o l_c^-1(r_o) from stereo "
+        "positions to joint targets, PD + dynamics feed-forward, hand timed by TTC"
+    )
 
     def __init__(self, params: Params, *, spec, model: ArmModel | None = None) -> None:
         super().__init__(params, spec=spec)
@@ -162,8 +269,10 @@ class CatchingController(Controller):
         held = [names.index(j) for j in P.held_joints]
         self.active = tuple(i for i in range(self.n) if i not in held)
         if len(self.active) != 3 or names.index(P.selected_joint) != self.active[-1]:
-            raise ValueError(f"the catching mapping needs 3 active joints ending with "
-                             f"{P.selected_joint}; got {[names[i] for i in self.active]}")
+            raise ValueError(
+                f"the catching mapping needs 3 active joints ending with "
+                f"{P.selected_joint}; got {[names[i] for i in self.active]}"
+            )
         self.q_init = np.asarray(spec.initial_q, float).copy()
         self.tau_limit = np.asarray(spec.torque_limits, float)
         self.gravity = np.array([0.0, 0.0, -float(getattr(spec, "gravity", 9.81))])
@@ -176,25 +285,41 @@ class CatchingController(Controller):
                 if getattr(spec, "object", None) is not None:
                     off += float(spec.object.radius)
             self.catch_offset = off
-            model = ArmModel.from_chain(spec.model, active=self.active, q_fixed=self.q_init,
-                                        point_in_tool=(0.0, 0.0, off))
+            model = ArmModel.from_chain(
+                spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)
+            )
         else:
             self.catch_offset = P.catch_offset
         self.model = model
         act = list(self.active)
-        tau_max = (np.asarray(P.opt_torque_limits, float) if P.opt_torque_limits
-                   else self.tau_limit[act])
-        om_max = (np.asarray(P.opt_velocity_limits, float) if P.opt_velocity_limits
-                  else np.asarray(spec.velocity_limits, float)[act])
+        tau_max = (
+            np.asarray(P.opt_torque_limits, float) if P.opt_torque_limits else self.tau_limit[act]
+        )
+        om_max = (
+            np.asarray(P.opt_velocity_limits, float)
+            if P.opt_velocity_limits
+            else np.asarray(spec.velocity_limits, float)[act]
+        )
         self.config = ProblemConfig(
-            q_alpha=P.q_alpha, order=P.order, q_start=tuple(self.q_init.tolist()),
-            catch_q=tuple(P.catch_q), throw_start=tuple(P.throw_start),
-            speeds=tuple(P.throw_speeds), spread=P.throw_spread, grid=P.throw_grid,
-            n_samples=P.samples_per_throw, gravity=-float(self.gravity[2]),
-            tau_max=tuple(tau_max.tolist()), omega_max=tuple(om_max.tolist()), w_tau=P.w_tau,
-            w_omega=P.w_omega, penalty=P.limit_penalty,
-            torque_penalty=P.torque_limit_penalty, approach_weight=P.approach_weight,
-            max_iter=P.max_iterations)
+            q_alpha=P.q_alpha,
+            order=P.order,
+            q_start=tuple(self.q_init.tolist()),
+            catch_q=tuple(P.catch_q),
+            throw_start=tuple(P.throw_start),
+            speeds=tuple(P.throw_speeds),
+            spread=P.throw_spread,
+            grid=P.throw_grid,
+            n_samples=P.samples_per_throw,
+            gravity=-float(self.gravity[2]),
+            tau_max=tuple(tau_max.tolist()),
+            omega_max=tuple(om_max.tolist()),
+            w_tau=P.w_tau,
+            w_omega=P.w_omega,
+            penalty=P.limit_penalty,
+            torque_penalty=P.torque_limit_penalty,
+            approach_weight=P.approach_weight,
+            max_iter=P.max_iterations,
+        )
         self.problem = build_problem(model, self.config)
         self.history: list[CostRecord] = []
         self.result = None
@@ -221,8 +346,9 @@ class CatchingController(Controller):
         if hand is not None:
             self.hand_open = np.asarray(hand.open_posture, float)
             self.hand_closed = np.asarray(hand.closed_posture, float)
-            self.close_time = float(np.max(np.abs(self.hand_closed - self.hand_open))
-                                    / hand.closing_speed)
+            self.close_time = float(
+                np.max(np.abs(self.hand_closed - self.hand_open)) / hand.closing_speed
+            )
         else:
             self.close_time = 0.0
         # run-time state
@@ -240,7 +366,7 @@ class CatchingController(Controller):
         self._q_o = None
         self._warned_state = False
         self._t = 0.0
-        self._costs_logged = False       # /optimization/cost goes out with the first telemetry
+        self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
     def _optimised_alpha(self) -> np.ndarray:
@@ -251,9 +377,15 @@ class CatchingController(Controller):
             if data.get("meta", {}).get("key") == key:
                 self.history = data["history"]
                 return data["alpha"]
-            self._events.append(Occurrence("warning", {
-                "reason": "alpha_file made for another configuration; recomputed",
-                "file": str(path)}))
+            self._events.append(
+                Occurrence(
+                    "warning",
+                    {
+                        "reason": "alpha_file made for another configuration; recomputed",
+                        "file": str(path),
+                    },
+                )
+            )
         res = self.problem.solve()
         self.history = res.history
         self.result = res
@@ -263,17 +395,28 @@ class CatchingController(Controller):
         """Store the optimised alpha (and alpha0, the cost history) for ``alpha_file``."""
         if self.alpha_opt is None:
             self.alpha_opt = self._optimised_alpha()
-        res = OptimResult(alpha=np.asarray(self.alpha_opt), alpha0=self.alpha0,
-                          history=self.history,
-                          constraint_residual=float(np.max(np.abs(
-                              self.problem.C @ self.alpha_opt - self.problem.rhs))))
-        save_alpha(path, res, {"key": self.config.key(self.model),
-                               "config": {k: v for k, v in vars(self.config).items()}})
+        res = OptimResult(
+            alpha=np.asarray(self.alpha_opt),
+            alpha0=self.alpha0,
+            history=self.history,
+            constraint_residual=float(
+                np.max(np.abs(self.problem.C @ self.alpha_opt - self.problem.rhs))
+            ),
+        )
+        save_alpha(
+            path,
+            res,
+            {
+                "key": self.config.key(self.model),
+                "config": {k: v for k, v in vars(self.config).items()},
+            },
+        )
 
     def optimization_costs(self) -> list[OptimizationCost]:
         """``/optimization/cost`` messages (t = 0: the optimisation precedes the run)."""
-        return [OptimizationCost(0.0, h.iteration, h.torque_cost, h.velocity_cost)
-                for h in self.history]
+        return [
+            OptimizationCost(0.0, h.iteration, h.torque_cost, h.velocity_cost) for h in self.history
+        ]
 
     # ------------------------------------------------------------------ control
     def update(self, t: float, measurements: list) -> ArmCommand:
@@ -286,33 +429,50 @@ class CatchingController(Controller):
         P = self.params
         qdd_d = np.zeros(self.n)
         if self.est.n and not self.holding:
-            r, v, a = self.est.state(t) if P.latency_compensation else self.est.state(
-                self.est.last[0])
-            q_a, qd_a, qdd_a, f = self.mapping.evaluate(r, v, a)     # eqs. 7, 23, 16
+            r, v, a = (
+                self.est.state(t) if P.latency_compensation else self.est.state(self.est.last[0])
+            )
+            q_a, qd_a, qdd_a, f = self.mapping.evaluate(r, v, a)  # eqs. 7, 23, 16
             in_dom = bool(f.in_domain[0])
             if in_dom != self._in_domain and not in_dom:
-                self._events.append(Occurrence("infeasible", {
-                    "reason": "r_o outside the domain of l_c^-1 (clamped)",
-                    "r_o": r.tolist(), "d_min": self.geo.d_min}))
+                self._events.append(
+                    Occurrence(
+                        "infeasible",
+                        {
+                            "reason": "r_o outside the domain of l_c^-1 (clamped)",
+                            "r_o": r.tolist(),
+                            "d_min": self.geo.d_min,
+                        },
+                    )
+                )
             self._in_domain = in_dom
             self._r, self._v, self._q_o = r, v, f.p[0]
             reached = float(np.linalg.norm(r - self.geo.origin)) <= self.geo.catch_radius
             if reached and P.after_catch == "hold":
                 self.holding = True
                 self.qd_d = np.zeros(self.n)
-                self._events.append(Occurrence("mapping_hold", {
-                    "q_d": self.q_d.tolist(), "r_o": r.tolist()}))
+                self._events.append(
+                    Occurrence("mapping_hold", {"q_d": self.q_d.tolist(), "r_o": r.tolist()})
+                )
             else:
                 self.q_d = self.model.full(q_a[0])
                 self.qd_d = self.model.full_rate(qd_a[0])
                 qdd_d = self.model.full_rate(qdd_a[0])
             if not self.holding:
                 self.t_catch = self.est.time_to_radius(t, self.geo.origin, self.geo.catch_radius)
-        if self.hand is not None and not self.closing and self.t_catch is not None \
-                and t >= self.t_catch - self.close_time - P.close_lead - 1e-9:
+        if (
+            self.hand is not None
+            and not self.closing
+            and self.t_catch is not None
+            and t >= self.t_catch - self.close_time - P.close_lead - 1e-9
+        ):
             self.closing = True
-            self._events.append(Occurrence("hand_close", {
-                "predicted_catch_time": self.t_catch, "closing_time": self.close_time}))
+            self._events.append(
+                Occurrence(
+                    "hand_close",
+                    {"predicted_catch_time": self.t_catch, "closing_time": self.close_time},
+                )
+            )
         self.tau = self._torque(qdd_d)
         hand = None
         if self.hand is not None:
@@ -331,7 +491,7 @@ class CatchingController(Controller):
     def _torque(self, qdd_d: np.ndarray) -> np.ndarray:
         P = self.params
         q_d, qd_d = self.q_d, self.qd_d
-        if P.feedforward == "dynamics":      # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
+        if P.feedforward == "dynamics":  # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
             ff = self.model.inverse_dynamics_full(q_d, qd_d, qdd_d)
         elif P.feedforward == "gravity":
             ff = self.model.gravity_full(self.q if self.q is not None else q_d)
@@ -340,8 +500,12 @@ class CatchingController(Controller):
         if self.q is None:
             if not self._warned_state:
                 self._warned_state = True
-                self._events.append(Occurrence("warning", {
-                    "reason": "no /arm/joint_state delivered: feed-forward torque only"}))
+                self._events.append(
+                    Occurrence(
+                        "warning",
+                        {"reason": "no /arm/joint_state delivered: feed-forward torque only"},
+                    )
+                )
             tau = ff
         else:
             tau = ff + self.kp * (q_d - self.q) + self.kd * (qd_d - self.qd)
@@ -349,8 +513,11 @@ class CatchingController(Controller):
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:
-        out = {"mapping": self.params.mapping, "hand_closing": self.closing,
-               "holding": self.holding}
+        out = {
+            "mapping": self.params.mapping,
+            "hand_closing": self.closing,
+            "holding": self.holding,
+        }
         if self.t_catch is not None:
             st = self.est.state(self.t_catch, from_fit=True)
             out["catch_time"] = self.t_catch
@@ -372,17 +539,29 @@ class CatchingController(Controller):
         return ev
 
     def telemetry(self, t: float) -> dict:
-        out = {TOPIC_ARM_JOINT_COMMAND: JointCommand(t, position=self.q_d.tolist(),
-                                                  torque=self.tau.tolist()),
-               TOPIC_EFFECTOR_STATE: EffectorState(
-                   t, position=self.model.fk(self.q).tolist() if self.q is not None else [],
-                   desired_position=self.model.fk(self.q_d).tolist())}
-        if not self._costs_logged:       # the offline optimisation's history, once (t = 0)
+        out = {
+            TOPIC_ARM_JOINT_COMMAND: JointCommand(
+                t, position=self.q_d.tolist(), torque=self.tau.tolist()
+            ),
+            TOPIC_EFFECTOR_STATE: EffectorState(
+                t,
+                position=self.model.fk(self.q).tolist() if self.q is not None else [],
+                desired_position=self.model.fk(self.q_d).tolist(),
+            ),
+        }
+        if not self._costs_logged:  # the offline optimisation's history, once (t = 0)
             self._costs_logged = True
             out[TOPIC_OPTIMIZATION_COST] = self.optimization_costs()
         if self._r is not None:
             out[TOPIC_CATCHING_STATE] = CatchingState(
-                t, self._r.tolist(), self._v.tolist(), self._q_o.tolist(), self.qd_d.tolist(),
-                self._in_domain, float(self.t_catch) if self.t_catch is not None else -1.0,
-                self.closing, self.holding)
+                t,
+                self._r.tolist(),
+                self._v.tolist(),
+                self._q_o.tolist(),
+                self.qd_d.tolist(),
+                self._in_domain,
+                float(self.t_catch) if self.t_catch is not None else -1.0,
+                self.closing,
+                self.holding,
+            )
         return out

@@ -37,7 +37,7 @@ class BallisticEstimator:
     def add(self, t: float, r) -> None:
         r = np.asarray(r, float)
         if self.buf and t <= self.buf[-1][0]:
-            return                                   # out of order or repeated frame
+            return  # out of order or repeated frame
         self.buf.append((float(t), r))
         while self.buf and self.buf[-1][0] - self.buf[0][0] > self.window + 1e-12:
             self.buf.popleft()

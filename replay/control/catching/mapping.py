@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-ACTIVE = (0, 1, 3)      # active joints of the 4-DOF arm (axes 1, 2, 4); axis 3 held at 0
+ACTIVE = (0, 1, 3)  # active joints of the 4-DOF arm (axes 1, 2, 4); axis 3 held at 0
 
 
 def full_q(p: np.ndarray) -> np.ndarray:
@@ -71,8 +71,8 @@ def _wrap_near(x, ref):
 
 @dataclass
 class InverseResult:
-    p: np.ndarray            # (n, 3) active joint angles q_o = l_c^-1(r_o)
-    in_domain: np.ndarray    # (n,) bool: False where the target was clamped (or q1 undetermined)
+    p: np.ndarray  # (n, 3) active joint angles q_o = l_c^-1(r_o)
+    in_domain: np.ndarray  # (n,) bool: False where the target was clamped (or q1 undetermined)
 
 
 class CatchGeometry:
@@ -85,12 +85,12 @@ class CatchGeometry:
         self.c = np.asarray(c, float)
         self.t = np.asarray(t, float)
         self.q_alpha = float(q_alpha)
-        self.p_ref = np.asarray(p_ref, float)    # (q1, q2) the inverse prefers (branch choice)
+        self.p_ref = np.asarray(p_ref, float)  # (q1, q2) the inverse prefers (branch choice)
         self.K1, self.K2 = _skew(self.w1), _skew(self.w2)
         a, b = self.t @ self.t, self.c @ self.t
         self._a, self._b = a, b
-        self._sigma = 1.0 if b >= 0.0 else -1.0          # branch with s = 0 at |r - O| = |c|
-        self.s_min_dist = -b / a                         # s at the line's closest point to O
+        self._sigma = 1.0 if b >= 0.0 else -1.0  # branch with s = 0 at |r - O| = |c|
+        self.s_min_dist = -b / a  # s at the line's closest point to O
         self.d_min = float(np.linalg.norm(self.c + self.t * self.s_min_dist))
         self.catch_radius = float(np.linalg.norm(self.c))
 
@@ -123,7 +123,7 @@ class CatchGeometry:
             raise ValueError("J1 and J2 axes do not intersect: closed-form l_c does not apply")
         origin = 0.5 * (o1 + o2)
         P = np.asarray(fk(np.array([0.0, 0.0, 0.0, q_alpha])), float)
-        t = np.cross(w4, P - c4)                        # dl/dq4 at the zero pose
+        t = np.cross(w4, P - c4)  # dl/dq4 at the zero pose
         geo = cls(origin, w1, w2, P - origin, t, q_alpha, p_ref)
         if check:
             geo.check_against_fk(fk)
@@ -151,8 +151,9 @@ class CatchGeometry:
 
     def check_against_fk(self, fk, tol: float = 1e-6) -> None:
         rng = np.random.default_rng(0)
-        P = np.column_stack([rng.uniform(-1, 1, 5), rng.uniform(-1, 1.5, 5),
-                             self.q_alpha + rng.uniform(-1, 1, 5)])
+        P = np.column_stack(
+            [rng.uniform(-1, 1, 5), rng.uniform(-1, 1.5, 5), self.q_alpha + rng.uniform(-1, 1, 5)]
+        )
         err = np.abs(self.lc(P) - self.lc_eq6(fk, P)).max()
         if err > tol:
             raise ValueError(f"closed-form l_c differs from eq. 6 by {err:.3g} m")
@@ -191,7 +192,7 @@ class CatchGeometry:
         disc = b * b - a * (self.c @ self.c - R2)
         ok = disc >= 0.0
         s = (-b + self._sigma * np.sqrt(np.maximum(disc, 0.0))) / a
-        u = self.c + self.t * s[:, None]                       # (n, 3), |u| = |v| where ok
+        u = self.c + self.t * s[:, None]  # (n, 3), |u| = |v| where ok
         nu = np.linalg.norm(u, axis=1)
         nv = np.linalg.norm(v, axis=1)
         v = np.where(ok[:, None], v, v * (nu / np.maximum(nv, 1e-300))[:, None])
@@ -206,7 +207,7 @@ class CatchGeometry:
         al = (w12 * (u @ w2) - v @ w1) / den
         be = (w12 * (v @ w1) - u @ w2) / den
         x = np.cross(w1, w2)
-        g2 = (np.einsum("ni,ni->n", u, u) - al ** 2 - be ** 2 - 2 * al * be * w12) / (x @ x)
+        g2 = (np.einsum("ni,ni->n", u, u) - al**2 - be**2 - 2 * al * be * w12) / (x @ x)
         ok = g2 > 1e-12 * np.maximum(np.einsum("ni,ni->n", v, v), 1e-300)
         g = np.sqrt(np.maximum(g2, 0.0))
         best = None
@@ -214,8 +215,8 @@ class CatchGeometry:
             z = al[:, None] * w1 + be[:, None] * w2 + (sign * g)[:, None] * x
             q2 = _wrap_near(_subproblem1(w2, u, z), self.p_ref[1])
             q1 = _wrap_near(_subproblem1(w1, z, v), self.p_ref[0])
-            q1 = np.where(ok, q1, self.p_ref[0])               # on the J1 axis: q1 undetermined
-            if not np.all(ok):                                   # re-solve q2 with that q1
+            q1 = np.where(ok, q1, self.p_ref[0])  # on the J1 axis: q1 undetermined
+            if not np.all(ok):  # re-solve q2 with that q1
                 zz = np.einsum("nij,nj->ni", _rot(self.K1, -q1), v)
                 q2 = np.where(ok, q2, _wrap_near(_subproblem1(w2, u, zz), self.p_ref[1]))
             dist = (q1 - self.p_ref[0]) ** 2 + (q2 - self.p_ref[1]) ** 2
@@ -243,17 +244,21 @@ class PolynomialB:
     so b and db/dq vanish at q4 = q_alpha (the terminal constraint, eq. 8).
     """
 
-    def __init__(self, order: int = 4, q_alpha: float = math.pi / 2, n_joints: int = 3,
-                 selected: int = 2) -> None:
+    def __init__(
+        self, order: int = 4, q_alpha: float = math.pi / 2, n_joints: int = 3, selected: int = 2
+    ) -> None:
         if order < 2:
             raise ValueError("eq. 12 needs N >= 2")
         self.order, self.q_alpha, self.m, self.i = order, float(q_alpha), n_joints, selected
-        exps = [e for deg in range(order - 1)
-                for e in sorted(itertools.product(range(deg + 1), repeat=n_joints), reverse=True)
-                if sum(e) == deg]
-        self.exponents = np.array(exps, dtype=int)                # j (without the +2)
+        exps = [
+            e
+            for deg in range(order - 1)
+            for e in sorted(itertools.product(range(deg + 1), repeat=n_joints), reverse=True)
+            if sum(e) == deg
+        ]
+        self.exponents = np.array(exps, dtype=int)  # j (without the +2)
         self.powers = self.exponents.copy()
-        self.powers[:, selected] += 2                             # actual powers of eq. 12
+        self.powers[:, selected] += 2  # actual powers of eq. 12
         self.n_mono = len(exps)
         self.n_alpha = self.n_mono * n_joints
 
@@ -312,14 +317,15 @@ class Features:
 
     q_d = p + m A,  qd_d = pd + m1 A,  qdd_d = pdd + m2 A  (eqs. 7, 8, 12, 16, 23).
     """
-    p: np.ndarray       # (n, 3) q_o = l_c^-1(r_o)
-    pd: np.ndarray      # (n, 3) d q_o / dt = J_c^-1 r_o'
-    pdd: np.ndarray     # (n, 3)
-    m: np.ndarray       # (n, nm)
-    m1: np.ndarray      # (n, nm)  dm . pd
-    m2: np.ndarray      # (n, nm)  dm . pdd + d2m[pd, pd]
-    dm: np.ndarray      # (n, nm, 3)
-    Jc: np.ndarray      # (n, 3, 3)
+
+    p: np.ndarray  # (n, 3) q_o = l_c^-1(r_o)
+    pd: np.ndarray  # (n, 3) d q_o / dt = J_c^-1 r_o'
+    pdd: np.ndarray  # (n, 3)
+    m: np.ndarray  # (n, nm)
+    m1: np.ndarray  # (n, nm)  dm . pd
+    m2: np.ndarray  # (n, nm)  dm . pdd + d2m[pd, pd]
+    dm: np.ndarray  # (n, nm, 3)
+    Jc: np.ndarray  # (n, 3, 3)
     in_domain: np.ndarray
 
 
@@ -388,6 +394,7 @@ class DirectMapping:
         """
         f = self.features(np.atleast_2d(r0), np.atleast_2d(rd0))
         C = np.vstack([self.poly.design(f.m[0]), self.poly.design(f.m1[0])])
-        rhs = np.concatenate([np.asarray(p_start, float) - f.p[0],
-                              np.asarray(pd_start, float) - f.pd[0]])
+        rhs = np.concatenate(
+            [np.asarray(p_start, float) - f.p[0], np.asarray(pd_start, float) - f.pd[0]]
+        )
         return C, rhs

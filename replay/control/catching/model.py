@@ -14,12 +14,22 @@ import numpy as np
 
 
 class ArmModel:
-    def __init__(self, fk: Callable, mass_matrix: Callable, bias: Callable, gravity: Callable, *,
-                 n: int = 4, active: Sequence[int] = (0, 1, 3), q_fixed=None,
-                 inverse_dynamics: Callable | None = None, axis: Callable | None = None) -> None:
+    def __init__(
+        self,
+        fk: Callable,
+        mass_matrix: Callable,
+        bias: Callable,
+        gravity: Callable,
+        *,
+        n: int = 4,
+        active: Sequence[int] = (0, 1, 3),
+        q_fixed=None,
+        inverse_dynamics: Callable | None = None,
+        axis: Callable | None = None,
+    ) -> None:
         self._fk, self._M, self._bias, self._g = fk, mass_matrix, bias, gravity
         self._id = inverse_dynamics
-        self._axis = axis            # q -> the tool z axis (the palm normal), world (3,)
+        self._axis = axis  # q -> the tool z axis (the palm normal), world (3,)
         self.n = n
         self.active = np.asarray(active, dtype=int)
         self.q_fixed = np.zeros(n) if q_fixed is None else np.asarray(q_fixed, float).copy()
@@ -35,10 +45,17 @@ class ArmModel:
         def axis(q):
             return (chain.frames(q)[-1] @ chain.tool)[:3, 2]
 
-        return cls(fk, chain.mass_matrix,
-                   lambda q, qd: chain.rnea(q, qd, np.zeros(chain.n)),
-                   chain.gravity_torque, n=chain.n, active=active, q_fixed=q_fixed,
-                   inverse_dynamics=chain.rnea, axis=axis)
+        return cls(
+            fk,
+            chain.mass_matrix,
+            lambda q, qd: chain.rnea(q, qd, np.zeros(chain.n)),
+            chain.gravity_torque,
+            n=chain.n,
+            active=active,
+            q_fixed=q_fixed,
+            inverse_dynamics=chain.rnea,
+            axis=axis,
+        )
 
     # ---- coordinates
     def full(self, p) -> np.ndarray:
@@ -88,8 +105,9 @@ class ArmModel:
 
     def tau(self, p, pd, pdd) -> np.ndarray:
         """Active joint torques of eq. 15 / 17 (the locked joint's holding torque dropped)."""
-        return self.inverse_dynamics_full(self.full(p), self.full_rate(pd),
-                                          self.full_rate(pdd))[self.active]
+        return self.inverse_dynamics_full(self.full(p), self.full_rate(pd), self.full_rate(pdd))[
+            self.active
+        ]
 
     def mass(self, p) -> np.ndarray:
         M = np.asarray(self._M(self.full(p)), float)

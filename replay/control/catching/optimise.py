@@ -32,13 +32,13 @@ from replay.control.catching.model import ArmModel
 @dataclass
 class CostRecord:
     iteration: int
-    torque_cost: float        # sum tau^T K_tau tau
-    velocity_cost: float      # sum omega^T K_omega omega
-    penalty: float            # limit hinge penalty (eqs. 22, 24)
-    objective: float          # torque_cost + velocity_cost + penalty
-    max_torque_ratio: float   # max_i,samples |tau_i| / tau_max_i
+    torque_cost: float  # sum tau^T K_tau tau
+    velocity_cost: float  # sum omega^T K_omega omega
+    penalty: float  # limit hinge penalty (eqs. 22, 24)
+    objective: float  # torque_cost + velocity_cost + penalty
+    max_torque_ratio: float  # max_i,samples |tau_i| / tau_max_i
     max_velocity_ratio: float
-    approach_cost: float = 0.0    # the optional approach-direction term (approach.py), in objective
+    approach_cost: float = 0.0  # the optional approach-direction term (approach.py), in objective
 
 
 @dataclass
@@ -66,24 +66,33 @@ class Objective:
     """E(alpha) of eq. 25 over fixed samples, with its residuals and Jacobian (plus, optionally, the
     approach-direction term of approach.py, which is not in the paper)."""
 
-    def __init__(self, mapping: DirectMapping, model: ArmModel, feats: Features,
-                 tau_max, omega_max, w_tau: float = 1.0, w_omega: float = 1.0,
-                 penalty: float = 100.0, approach=None, torque_penalty: float | None = None
-                 ) -> None:
+    def __init__(
+        self,
+        mapping: DirectMapping,
+        model: ArmModel,
+        feats: Features,
+        tau_max,
+        omega_max,
+        w_tau: float = 1.0,
+        w_omega: float = 1.0,
+        penalty: float = 100.0,
+        approach=None,
+        torque_penalty: float | None = None,
+    ) -> None:
         self.mp, self.model, self.f = mapping, model, feats
-        self.approach = approach                     # ApproachTerm or None (eq. 25 as stated)
+        self.approach = approach  # ApproachTerm or None (eq. 25 as stated)
         self.tau_max = np.asarray(tau_max, float)
         self.omega_max = np.asarray(omega_max, float)
-        self.kt = w_tau / self.tau_max ** 2          # K_tau = diag(w_tau / tau_max^2)
-        self.kw = w_omega / self.omega_max ** 2      # K_omega = diag(w_omega / omega_max^2)
-        self.wp = penalty                            # hinge weight of eq. 24 (omega)
-        self.wpt = penalty if torque_penalty is None else torque_penalty   # of eq. 22 (tau)
+        self.kt = w_tau / self.tau_max**2  # K_tau = diag(w_tau / tau_max^2)
+        self.kw = w_omega / self.omega_max**2  # K_omega = diag(w_omega / omega_max^2)
+        self.wp = penalty  # hinge weight of eq. 24 (omega)
+        self.wpt = penalty if torque_penalty is None else torque_penalty  # of eq. 22 (tau)
         self.nm, self.m = mapping.poly.n_mono, mapping.poly.m
 
     def trajectory(self, alpha):
         A = np.asarray(alpha).reshape(self.nm, self.m)
         f = self.f
-        return f.p + f.m @ A, f.pd + f.m1 @ A, f.pdd + f.m2 @ A   # eqs. 7, 23, 16
+        return f.p + f.m @ A, f.pd + f.m1 @ A, f.pdd + f.m2 @ A  # eqs. 7, 23, 16
 
     def torques(self, alpha) -> np.ndarray:
         q, qd, qdd = self.trajectory(alpha)
@@ -97,22 +106,33 @@ class Objective:
     def record(self, it: int, alpha, tau=None) -> CostRecord:
         tau = self.torques(alpha) if tau is None else tau
         _, omega, _ = self.trajectory(alpha)
-        tc = float(np.sum(self.kt * tau ** 2))
-        vc = float(np.sum(self.kw * omega ** 2))
+        tc = float(np.sum(self.kt * tau**2))
+        vc = float(np.sum(self.kw * omega**2))
         ht, hw = self._parts(tau, omega)
-        pen = float(self.wpt * np.sum(ht ** 2) + self.wp * np.sum(hw ** 2))
+        pen = float(self.wpt * np.sum(ht**2) + self.wp * np.sum(hw**2))
         ac = self.approach.cost(alpha) if self.approach is not None else 0.0
-        return CostRecord(it, tc, vc, pen, tc + vc + pen + ac,
-                          float(np.max(np.abs(tau) / self.tau_max)),
-                          float(np.max(np.abs(omega) / self.omega_max)), ac)
+        return CostRecord(
+            it,
+            tc,
+            vc,
+            pen,
+            tc + vc + pen + ac,
+            float(np.max(np.abs(tau) / self.tau_max)),
+            float(np.max(np.abs(omega) / self.omega_max)),
+            ac,
+        )
 
     def residuals(self, alpha, tau=None):
         tau = self.torques(alpha) if tau is None else tau
         _, omega, _ = self.trajectory(alpha)
         ht, hw = self._parts(tau, omega)
         sp, spt = np.sqrt(self.wp), np.sqrt(self.wpt)
-        parts = [(np.sqrt(self.kt) * tau).ravel(), (np.sqrt(self.kw) * omega).ravel(),
-                 spt * ht.ravel(), sp * hw.ravel()]
+        parts = [
+            (np.sqrt(self.kt) * tau).ravel(),
+            (np.sqrt(self.kw) * omega).ravel(),
+            spt * ht.ravel(),
+            sp * hw.ravel(),
+        ]
         if self.approach is not None:
             parts.append(self.approach.residuals(alpha))
         return np.concatenate(parts), tau
@@ -128,24 +148,40 @@ class Objective:
             tau[k], Tq[k], Tqd[k], M[k] = self.model.tau_and_partials(q[k], qd[k], qdd[k])
         f = self.f
         # d tau_i / d A[j, k] = Tq[i, k] m_j + Tqd[i, k] m1_j + M[i, k] m2_j
-        Jt = (np.einsum("nj,nik->nijk", f.m, Tq) + np.einsum("nj,nik->nijk", f.m1, Tqd)
-              + np.einsum("nj,nik->nijk", f.m2, M)).reshape(n, self.m, -1)
+        Jt = (
+            np.einsum("nj,nik->nijk", f.m, Tq)
+            + np.einsum("nj,nik->nijk", f.m1, Tqd)
+            + np.einsum("nj,nik->nijk", f.m2, M)
+        ).reshape(n, self.m, -1)
         Jw = np.einsum("nj,ik->nijk", f.m1, np.eye(self.m)).reshape(n, self.m, -1)
         omega = qd
         ht, hw = self._parts(tau, omega)
         sp, spt = np.sqrt(self.wp), np.sqrt(self.wpt)
         Jht = (ht > 0)[..., None] * (np.sign(tau) / self.tau_max)[..., None] * Jt
         Jhw = (hw > 0)[..., None] * (np.sign(omega) / self.omega_max)[..., None] * Jw
-        J = np.concatenate([(np.sqrt(self.kt)[:, None] * Jt).reshape(-1, Jt.shape[-1]),
-                            (np.sqrt(self.kw)[:, None] * Jw).reshape(-1, Jw.shape[-1]),
-                            spt * Jht.reshape(-1, Jt.shape[-1]), sp * Jhw.reshape(-1, Jw.shape[-1])]
-                           + ([self.approach.jacobian()] if self.approach is not None else []))
+        J = np.concatenate(
+            [
+                (np.sqrt(self.kt)[:, None] * Jt).reshape(-1, Jt.shape[-1]),
+                (np.sqrt(self.kw)[:, None] * Jw).reshape(-1, Jw.shape[-1]),
+                spt * Jht.reshape(-1, Jt.shape[-1]),
+                sp * Jhw.reshape(-1, Jw.shape[-1]),
+            ]
+            + ([self.approach.jacobian()] if self.approach is not None else [])
+        )
         r, _ = self.residuals(alpha, tau)
         return r, tau, J
 
 
-def optimise(objective: Objective, C: np.ndarray, rhs: np.ndarray, *, max_iter: int = 30,
-             rtol: float = 1e-5, lam0: float = 1e-3, progress=None) -> OptimResult:
+def optimise(
+    objective: Objective,
+    C: np.ndarray,
+    rhs: np.ndarray,
+    *,
+    max_iter: int = 30,
+    rtol: float = 1e-5,
+    lam0: float = 1e-3,
+    progress=None,
+) -> OptimResult:
     """Levenberg-Marquardt over beta, alpha = alpha0 + Z beta (see the module doc)."""
     t_start = time.perf_counter()
     alpha0 = initial_alpha(C, rhs)
@@ -184,17 +220,26 @@ def optimise(objective: Objective, C: np.ndarray, rhs: np.ndarray, *, max_iter: 
         if rel < rtol:
             break
         r, tau, Ja = objective.jacobian(alpha)
-    res = OptimResult(alpha=alpha, alpha0=alpha0, history=hist,
-                      constraint_residual=float(np.max(np.abs(C @ alpha - rhs))),
-                      wall_time=time.perf_counter() - t_start, n_samples=len(objective.f.p))
+    res = OptimResult(
+        alpha=alpha,
+        alpha0=alpha0,
+        history=hist,
+        constraint_residual=float(np.max(np.abs(C @ alpha - rhs))),
+        wall_time=time.perf_counter() - t_start,
+        n_samples=len(objective.f.p),
+    )
     return res
 
 
 def save_alpha(path, result: OptimResult, meta: dict) -> None:
     """A small JSON: alpha (optimised), alpha0 (initial), the cost history and what they are for."""
-    data = {"alpha": np.asarray(result.alpha).tolist(), "alpha0": result.alpha0.tolist(),
-            "history": [asdict(h) for h in result.history],
-            "constraint_residual": result.constraint_residual, "meta": meta}
+    data = {
+        "alpha": np.asarray(result.alpha).tolist(),
+        "alpha0": result.alpha0.tolist(),
+        "history": [asdict(h) for h in result.history],
+        "constraint_residual": result.constraint_residual,
+        "meta": meta,
+    }
     with open(path, "w", encoding="utf-8") as fh:
         json.dump(data, fh, indent=1, allow_nan=False)
 

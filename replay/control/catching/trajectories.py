@@ -30,7 +30,7 @@ def launch_velocity(start, end, speed: float, gravity) -> tuple[np.ndarray, floa
     if disc < 0.0 or b <= 0.0:
         raise ValueError(f"{speed} m/s cannot reach {end} from {start}")
     if gg == 0.0:
-        T2 = float(d @ d) / speed ** 2
+        T2 = float(d @ d) / speed**2
     else:
         T2 = (b - np.sqrt(disc)) / (0.5 * gg)
     T = float(np.sqrt(T2))
@@ -39,10 +39,10 @@ def launch_velocity(start, end, speed: float, gravity) -> tuple[np.ndarray, floa
 
 @dataclass
 class Throw:
-    t: np.ndarray      # (n,) s since t0
-    r: np.ndarray      # (n, 3)
-    rd: np.ndarray     # (n, 3)
-    rdd: np.ndarray    # (n, 3)
+    t: np.ndarray  # (n,) s since t0
+    r: np.ndarray  # (n, 3)
+    rd: np.ndarray  # (n, 3)
+    rdd: np.ndarray  # (n, 3)
     speed: float
     arrival: np.ndarray
 
@@ -58,17 +58,28 @@ def sample_throw(start, v0, T: float, n: int, gravity, speed: float = 0.0) -> Th
 @dataclass
 class ThrowSet:
     throws: list
-    nominal: int           # index of the nominal throw (centre arrival, middle speed)
+    nominal: int  # index of the nominal throw (centre arrival, middle speed)
 
     def stacked(self):
         """(r, rd, rdd) of every sample of every throw, (N, 3) each."""
-        return (np.vstack([th.r for th in self.throws]), np.vstack([th.rd for th in self.throws]),
-                np.vstack([th.rdd for th in self.throws]))
+        return (
+            np.vstack([th.r for th in self.throws]),
+            np.vstack([th.rd for th in self.throws]),
+            np.vstack([th.rdd for th in self.throws]),
+        )
 
 
-def throw_set(start, catch_point, origin, catch_radius: float, speeds=(8.0, 9.0, 10.0),
-              spread: float = 0.1, grid: int = 3, n_samples: int = 20,
-              gravity=(0.0, 0.0, -9.81)) -> ThrowSet:
+def throw_set(
+    start,
+    catch_point,
+    origin,
+    catch_radius: float,
+    speeds=(8.0, 9.0, 10.0),
+    spread: float = 0.1,
+    grid: int = 3,
+    n_samples: int = 20,
+    gravity=(0.0, 0.0, -9.81),
+) -> ThrowSet:
     start, cp, origin = (np.asarray(x, float) for x in (start, catch_point, origin))
     horiz = cp - start
     horiz[2] = 0.0
@@ -84,8 +95,11 @@ def throw_set(start, catch_point, origin, catch_radius: float, speeds=(8.0, 9.0,
                 a = cp + dy * lateral + np.array([0.0, 0.0, dz]) - origin
                 arrival = origin + catch_radius * a / np.linalg.norm(a)
                 v0, T = launch_velocity(start, arrival, v, gravity)
-                if dy == ticks[len(ticks) // 2] and dz == ticks[len(ticks) // 2] \
-                        and v == speeds[len(speeds) // 2]:
+                if (
+                    dy == ticks[len(ticks) // 2]
+                    and dz == ticks[len(ticks) // 2]
+                    and v == speeds[len(speeds) // 2]
+                ):
                     nominal = len(throws)
                 throws.append(sample_throw(start, v0, T, n_samples, gravity, v))
     return ThrowSet(throws, nominal)

@@ -12,5 +12,10 @@ from replay.control.grasping.head_tracking import HeadTrackingTask
 from replay.control.grasping.recognition import RecognitionTask
 from replay.control.grasping.schedule import ScheduleTask
 
-__all__ = ["ArmControlTask", "HandControlTask", "HeadTrackingTask", "RecognitionTask",
-           "ScheduleTask"]
+__all__ = [
+    "ArmControlTask",
+    "HandControlTask",
+    "HeadTrackingTask",
+    "RecognitionTask",
+    "ScheduleTask",
+]

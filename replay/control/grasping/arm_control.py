@@ -30,42 +30,73 @@ import numpy as np
 
 from replay.control.grasping.payloads import ArmLoop
 from replay.interfaces import Controller
-from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_GRASP_ARM, TOPIC_GRASP_OBJECT,
-                             TOPIC_GRASP_STATE, TOPIC_WRIST_WRENCH)
+from replay.messages import (
+    TOPIC_ARM_ENCODERS,
+    TOPIC_GRASP_ARM,
+    TOPIC_GRASP_OBJECT,
+    TOPIC_GRASP_STATE,
+    TOPIC_WRIST_WRENCH,
+)
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.hand import hand_body
 from replay.robot.serial_chain import dh_transform
 from replay.spatial import cross3, wrap_half_pi
 
-S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])        # eq. 3
+S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
 
 
 @dataclass
 class ArmParams:
     K_ap: float = param(1.0, unit="1", ge=0.0, doc="eq. 2's K^ap (a scalar times I)")
-    K_a1: list = param([0.0, 40.0, 40.0, 20.0, 0.0, 0.0], unit="1/s", length=6, ge=0.0,
-                       doc="eq. 2's K^a1 (tracking; only the S components act; assumed)")
-    K_a2: list = param([15.0, 0.0, 0.0, 0.0, 10.0, 10.0], unit="1/s", length=6, ge=0.0,
-                       doc="eq. 2's K^a2 (reaching; only the I - S components act; assumed)")
+    K_a1: list = param(
+        [0.0, 40.0, 40.0, 20.0, 0.0, 0.0],
+        unit="1/s",
+        length=6,
+        ge=0.0,
+        doc="eq. 2's K^a1 (tracking; only the S components act; assumed)",
+    )
+    K_a2: list = param(
+        [15.0, 0.0, 0.0, 0.0, 10.0, 10.0],
+        unit="1/s",
+        length=6,
+        ge=0.0,
+        doc="eq. 2's K^a2 (reaching; only the I - S components act; assumed)",
+    )
     K_av: float = param(0.05, unit="1", ge=0.0, doc="eq. 2's K^av (scalar times I)")
-    K_af: float = param(0.005, unit="rad/(s*N*m)", ge=0.0,
-                        doc="eq. 2's K^af (scalar times I): compliance to the wrist wrench")
-    grasp_point: float = param(0.045, unit="m", ge=0.0,
-                               doc="x^a: the hand's grasp point this far along the palm normal "
-                                   "from its back face (between the fingers)")
+    K_af: float = param(
+        0.005,
+        unit="rad/(s*N*m)",
+        ge=0.0,
+        doc="eq. 2's K^af (scalar times I): compliance to the wrist wrench",
+    )
+    grasp_point: float = param(
+        0.045,
+        unit="m",
+        ge=0.0,
+        doc="x^a: the hand's grasp point this far along the palm normal "
+        "from its back face (between the fingers)",
+    )
     damping: float = param(0.01, unit="m", gt=0.0, doc="lambda of the damped pseudo-inverse")
-    force_deadband: float = param(1.0, unit="N", ge=0.0,
-                                  doc="external forces below this are taken as zero (sensor "
-                                      "noise and the hand's inertia)")
-    force_filter: float = param(0.01, unit="s", ge=0.0,
-                                doc="time constant of the first-order low-pass on F^a: the "
-                                    "wrist also feels the hand's inertia (m a), and feeding that "
-                                    "back through the 1 ms loop unfiltered is unstable")
+    force_deadband: float = param(
+        1.0,
+        unit="N",
+        ge=0.0,
+        doc="external forces below this are taken as zero (sensor noise and the hand's inertia)",
+    )
+    force_filter: float = param(
+        0.01,
+        unit="s",
+        ge=0.0,
+        doc="time constant of the first-order low-pass on F^a: the "
+        "wrist also feels the hand's inertia (m a), and feeding that "
+        "back through the 1 ms loop unfiltered is unstable",
+    )
 
 
 class ArmControlTask(Controller):
     """Eqs. 2-3: arm tracking (S) and reaching (I - S) with wrist force feedback."""
+
     Params = ArmParams
     spec_type = GraspSpec
     command_type = ServoCommand
@@ -83,7 +114,7 @@ class ArmControlTask(Controller):
         self.hand = hand_body(spec.hand.table)
         self.g = np.array([0.0, 0.0, -spec.gravity])
         self.vlim = np.asarray(spec.velocity_limits, float)
-        self.dt = spec.dt                       # the task's period (from its update times)
+        self.dt = spec.dt  # the task's period (from its update times)
         self._t_last: float | None = None
         self.K_a1, self.K_a2 = np.asarray(params.K_a1, float), np.asarray(params.K_a2, float)
         self.q = np.asarray(spec.initial_q, float).copy()
@@ -119,7 +150,7 @@ class ArmControlTask(Controller):
         r = R @ np.asarray(self.hand.com, float)
         ext = np.concatenate([f - w_hand, m - cross3(r, w_hand)])
         if self.bias is None:
-            self.bias = ext.copy()              # tare at start: the sensor's offset
+            self.bias = ext.copy()  # tare at start: the sensor's offset
             self.filtered = np.zeros(6)
         ext = ext - self.bias
         a = self.dt / (self.params.force_filter + self.dt)
@@ -166,7 +197,7 @@ class ArmControlTask(Controller):
         e_reach = np.zeros(6)
         e_reach[:3] = xd[:3] - gp
         e_reach[3:] = cross3(n_palm, self.n_plane)
-        JJt = Jg @ Jg.T + (P.damping ** 2) * np.eye(6)
+        JJt = Jg @ Jg.T + (P.damping**2) * np.eye(6)
         Jpinv = Jg.T @ np.linalg.solve(JJt, np.eye(6))
         track = P.K_ap * Jpinv @ (S_DIAG * self.K_a1 * e_track)
         reach = P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach)
@@ -174,12 +205,21 @@ class ArmControlTask(Controller):
         F = self.external_wrench(R) if self.wrench_raw is not None else np.zeros(6)
         force = P.K_af * (J.T @ F)
         cmd = np.clip(track + reach + damp + force, -self.vlim, self.vlim)
-        self._out = ArmLoop(t, [*gp.tolist(), 0.0, 0.0, 0.0],
-                            (self.obj.x_o if self.obj is not None else []), xd.tolist(),
-                            [float(e_track[1]), float(e_track[2]), float(e_track[3])],
-                            F.tolist(), {"track": track.tolist(), "reach": reach.tolist(),
-                                         "damp": damp.tolist(), "force": force.tolist()},
-                            cmd.tolist())
+        self._out = ArmLoop(
+            t,
+            [*gp.tolist(), 0.0, 0.0, 0.0],
+            (self.obj.x_o if self.obj is not None else []),
+            xd.tolist(),
+            [float(e_track[1]), float(e_track[2]), float(e_track[3])],
+            F.tolist(),
+            {
+                "track": track.tolist(),
+                "reach": reach.tolist(),
+                "damp": damp.tolist(),
+                "force": force.tolist(),
+            },
+            cmd.tolist(),
+        )
         ph = self.state.phase
         acc = self.track_sq.setdefault(ph, [0.0, 0])
         acc[0] += float(e_track[1] ** 2 + e_track[2] ** 2)
@@ -190,5 +230,8 @@ class ArmControlTask(Controller):
         return {TOPIC_GRASP_ARM: self._out} if self._out is not None else {}
 
     def outcome(self, t: float) -> dict:
-        return {"tracking_error_rms_by_phase": {
-            ph: math.sqrt(s / n) for ph, (s, n) in sorted(self.track_sq.items()) if n}}
+        return {
+            "tracking_error_rms_by_phase": {
+                ph: math.sqrt(s / n) for ph, (s, n) in sorted(self.track_sq.items()) if n
+            }
+        }

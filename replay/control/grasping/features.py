@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 _ANGLES = np.radians(np.arange(0.0, 90.0, 5.0))
-_DIRS = np.stack([np.cos(_ANGLES), np.sin(_ANGLES)])             # (2, n)
+_DIRS = np.stack([np.cos(_ANGLES), np.sin(_ANGLES)])  # (2, n)
 _NORMALS = np.stack([-np.sin(_ANGLES), np.cos(_ANGLES)])
 # a unit pixel square's extent along direction (c, s): |c| + |s|
 _PIXEL_EXTENT = np.abs(_DIRS).sum(axis=0)
@@ -30,11 +30,11 @@ class Blob:
     area: int
     u: float
     v: float
-    phi: float              # rad, principal axis from +u towards +v
-    elongation: float       # sqrt(lambda_max / lambda_min) (>= 1)
-    length: float           # px, extent along the principal axis (pixel squares)
-    width: float            # px, extent across it
-    fill: float             # area / smallest bounding box area
+    phi: float  # rad, principal axis from +u towards +v
+    elongation: float  # sqrt(lambda_max / lambda_min) (>= 1)
+    length: float  # px, extent along the principal axis (pixel squares)
+    width: float  # px, extent across it
+    fill: float  # area / smallest bounding box area
     touches_border: bool
 
 
@@ -50,7 +50,7 @@ def blob(target: np.ndarray, fill: bool = True) -> Blob | None:
     mu20, mu02, mu11 = (du * du).mean(), (dv * dv).mean(), (du * dv).mean()
     phi = 0.5 * math.atan2(2.0 * mu11, mu20 - mu02)
     mean, rad = 0.5 * (mu20 + mu02), math.hypot(0.5 * (mu20 - mu02), mu11)
-    lam1, lam2 = mean + rad + 1.0 / 12.0, mean - rad + 1.0 / 12.0   # + a pixel square's own
+    lam1, lam2 = mean + rad + 1.0 / 12.0, mean - rad + 1.0 / 12.0  # + a pixel square's own
     c, s = math.cos(phi), math.sin(phi)
     along, across = du * c + dv * s, -du * s + dv * c
     ext = abs(c) + abs(s)
@@ -59,12 +59,19 @@ def blob(target: np.ndarray, fill: bool = True) -> Blob | None:
     fill_ratio = math.nan
     if fill:
         pts = np.stack([du, dv], axis=1)
-        pa, pn = pts @ _DIRS, pts @ _NORMALS                         # (n, angles)
-        boxes = ((pa.max(0) - pa.min(0) + _PIXEL_EXTENT) * (pn.max(0) - pn.min(0)
-                                                            + _PIXEL_EXTENT))
+        pa, pn = pts @ _DIRS, pts @ _NORMALS  # (n, angles)
+        boxes = (pa.max(0) - pa.min(0) + _PIXEL_EXTENT) * (pn.max(0) - pn.min(0) + _PIXEL_EXTENT)
         fill_ratio = float(n / boxes.min())
     h, w = target.shape
     border = bool(us.min() == 0 or vs.min() == 0 or us.max() == w - 1 or vs.max() == h - 1)
-    return Blob(area=n, u=float(u0), v=float(v0), phi=phi,
-                elongation=math.sqrt(lam1 / max(lam2, 1e-12)), length=length, width=width,
-                fill=fill_ratio, touches_border=border)
+    return Blob(
+        area=n,
+        u=float(u0),
+        v=float(v0),
+        phi=phi,
+        elongation=math.sqrt(lam1 / max(lam2, 1e-12)),
+        length=length,
+        width=width,
+        fill=fill_ratio,
+        touches_border=border,
+    )

@@ -24,8 +24,13 @@ import numpy as np
 
 from replay.control.grasping.payloads import HandLoop
 from replay.interfaces import Controller, Occurrence
-from replay.messages import (TOPIC_GRASP_HAND, TOPIC_GRASP_OBJECT, TOPIC_GRASP_STATE,
-                             TOPIC_HAND_ENCODERS, TOPIC_HAND_TORQUE)
+from replay.messages import (
+    TOPIC_GRASP_HAND,
+    TOPIC_GRASP_OBJECT,
+    TOPIC_GRASP_STATE,
+    TOPIC_HAND_ENCODERS,
+    TOPIC_HAND_TORQUE,
+)
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 
@@ -33,40 +38,74 @@ from replay.robot.arm_types import GraspSpec, ServoCommand
 # thumb (flex x3). Assumed postures (rad), none from the paper.
 _RECT_PRE = [0.0, 0.0, 0.05, 0.05, 0.0, 0.05, 0.05, 0.0, 0.0, 0.05, 0.05, 0.0, 0.05, 0.05]
 _RECT_GRIP = [0.0, 1.10, 0.80, 0.60, 1.10, 0.80, 0.60, 0.0, 1.10, 0.80, 0.60, 1.10, 0.80, 0.60]
-_CIRC_PRE = [-0.10, -0.15, 0.20, 0.20, -0.15, 0.20, 0.20, 0.10, -0.15, 0.20, 0.20, -0.15, 0.20,
-             0.20]
-_CIRC_GRIP = [-0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, 0.20, 1.20, 0.90, 0.80, 1.20, 0.90,
-              0.80]
+_CIRC_PRE = [
+    -0.10,
+    -0.15,
+    0.20,
+    0.20,
+    -0.15,
+    0.20,
+    0.20,
+    0.10,
+    -0.15,
+    0.20,
+    0.20,
+    -0.15,
+    0.20,
+    0.20,
+]
+_CIRC_GRIP = [-0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, 0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80]
 
 
 @dataclass
 class HandParams:
     K_hg: float = param(25.0, unit="1/s", ge=0.0, doc="eq. 4's K^hg (scalar times I, assumed)")
     K_hv: float = param(0.02, unit="1", ge=0.0, doc="eq. 4's K^hv (scalar times I)")
-    K_hf: float = param(40.0, unit="rad/(s*N*m)", ge=0.0,
-                        doc="eq. 4's K^hf (scalar times I): grip torque = K^hg/K^hf x overclosure")
-    rectangle_preshape: list = param(_RECT_PRE, unit="rad", length=14,
-                                     doc="theta_d^h before closing on a rectangle (assumed)")
-    rectangle_grip: list = param(_RECT_GRIP, unit="rad", length=14,
-                                 doc="theta_d^h fully closed on a rectangle (past the contact)")
-    circle_preshape: list = param(_CIRC_PRE, unit="rad", length=14,
-                                  doc="theta_d^h before closing on a circle: a cupped hand")
-    circle_grip: list = param(_CIRC_GRIP, unit="rad", length=14,
-                              doc="theta_d^h fully closed on a circle")
-    close_from: float = param(0.8, unit="1", ge=0.0, lt=1.0,
-                              doc="reach progress (x_d^a) from which theta_d^h closes")
-    load_filter: float = param(0.005, unit="s", ge=0.0,
-                               doc="time constant of the first-order low-pass on F^h: the gauge "
-                                   "reads the drive's own torque, so unfiltered feedback through "
-                                   "a stiff servo chatters")
-    free_closure: float = param(0.1, unit="rad", gt=0.0,
-                                doc="a hold phase in which every finger reaches its grip posture "
-                                    "within this closed on nothing (a missed grasp): an object "
-                                    "stops them ~0.4 rad short")
+    K_hf: float = param(
+        40.0,
+        unit="rad/(s*N*m)",
+        ge=0.0,
+        doc="eq. 4's K^hf (scalar times I): grip torque = K^hg/K^hf x overclosure",
+    )
+    rectangle_preshape: list = param(
+        _RECT_PRE, unit="rad", length=14, doc="theta_d^h before closing on a rectangle (assumed)"
+    )
+    rectangle_grip: list = param(
+        _RECT_GRIP,
+        unit="rad",
+        length=14,
+        doc="theta_d^h fully closed on a rectangle (past the contact)",
+    )
+    circle_preshape: list = param(
+        _CIRC_PRE, unit="rad", length=14, doc="theta_d^h before closing on a circle: a cupped hand"
+    )
+    circle_grip: list = param(
+        _CIRC_GRIP, unit="rad", length=14, doc="theta_d^h fully closed on a circle"
+    )
+    close_from: float = param(
+        0.8, unit="1", ge=0.0, lt=1.0, doc="reach progress (x_d^a) from which theta_d^h closes"
+    )
+    load_filter: float = param(
+        0.005,
+        unit="s",
+        ge=0.0,
+        doc="time constant of the first-order low-pass on F^h: the gauge "
+        "reads the drive's own torque, so unfiltered feedback through "
+        "a stiff servo chatters",
+    )
+    free_closure: float = param(
+        0.1,
+        unit="rad",
+        gt=0.0,
+        doc="a hold phase in which every finger reaches its grip posture "
+        "within this closed on nothing (a missed grasp): an object "
+        "stops them ~0.4 rad short",
+    )
 
 
 class HandControlTask(Controller):
     """Eq. 4: hand compliance control with joint-torque feedback, preshaped by the shape."""
+
     Params = HandParams
     spec_type = GraspSpec
     command_type = ServoCommand
@@ -81,10 +120,16 @@ class HandControlTask(Controller):
         n = hand.n
         if n != 14:
             raise ValueError(f"the grasping hand has 14 joints, this plant's has {n}")
-        self.postures = {"rectangle": (np.asarray(params.rectangle_preshape, float),
-                                       np.asarray(params.rectangle_grip, float)),
-                         "circle": (np.asarray(params.circle_preshape, float),
-                                    np.asarray(params.circle_grip, float))}
+        self.postures = {
+            "rectangle": (
+                np.asarray(params.rectangle_preshape, float),
+                np.asarray(params.rectangle_grip, float),
+            ),
+            "circle": (
+                np.asarray(params.circle_preshape, float),
+                np.asarray(params.circle_grip, float),
+            ),
+        }
         self.open = np.asarray(hand.open_posture, float)
         self.lo, self.hi = np.asarray(hand.lower, float), np.asarray(hand.upper, float)
         self.vmax = float(hand.closing_speed)
@@ -98,7 +143,7 @@ class HandControlTask(Controller):
         self.state: Any = None
         self._events: list[Occurrence] = []
         self._out: HandLoop | None = None
-        self._holds: dict[int, float] = {}       # cycle -> least closure deficit in its hold
+        self._holds: dict[int, float] = {}  # cycle -> least closure deficit in its hold
         self._shape_at_grasp: dict[int, str] = {}
 
     def update(self, t: float, measurements) -> ServoCommand | None:
@@ -107,8 +152,11 @@ class HandControlTask(Controller):
                 self.q, self.qd = np.asarray(m.position, float), np.asarray(m.velocity, float)
             elif topic == TOPIC_HAND_TORQUE:
                 # F^h: the load on the joints (minus the drive's torque), low-passed
-                a = 1.0 if self.params.load_filter <= 0.0 else min(
-                    1.0, self.dt / (self.params.load_filter + self.dt))
+                a = (
+                    1.0
+                    if self.params.load_filter <= 0.0
+                    else min(1.0, self.dt / (self.params.load_filter + self.dt))
+                )
                 self.load += a * (-np.asarray(m.torque, float) - self.load)
             elif topic == TOPIC_GRASP_OBJECT:
                 self.shape = m.shape
@@ -126,8 +174,9 @@ class HandControlTask(Controller):
             c = min(max((st.reach_progress - f) / (1.0 - f), 0.0), 1.0)
         elif st.phase == "hold":
             c = 1.0
-        if self.shape in self.postures and (st.phase in ("track", "release")
-                                            or self.preshape == "none"):
+        if self.shape in self.postures and (
+            st.phase in ("track", "release") or self.preshape == "none"
+        ):
             if self.preshape != self.shape:
                 self.preshape = self.shape
                 self._events.append(Occurrence("preshape", {"shape": self.shape}))
@@ -137,14 +186,15 @@ class HandControlTask(Controller):
         else:
             theta_d = self.open
         P = self.params
-        cmd = P.K_hg * (theta_d - self.q) - P.K_hv * self.qd + P.K_hf * self.load     # eq. 4
+        cmd = P.K_hg * (theta_d - self.q) - P.K_hv * self.qd + P.K_hf * self.load  # eq. 4
         cmd = np.clip(cmd, -self.vmax, self.vmax)
         if st.phase == "hold":
             self._shape_at_grasp.setdefault(st.cycle, self.preshape)
             deficit = float(np.max(np.abs(theta_d - self.q)))
             self._holds[st.cycle] = min(self._holds.get(st.cycle, np.inf), deficit)
-        self._out = HandLoop(t, self.preshape, c, theta_d.tolist(), self.load.tolist(),
-                             cmd.tolist())
+        self._out = HandLoop(
+            t, self.preshape, c, theta_d.tolist(), self.load.tolist(), cmd.tolist()
+        )
         return ServoCommand(hand=cmd)
 
     def telemetry(self, t: float) -> dict:
@@ -155,15 +205,24 @@ class HandControlTask(Controller):
         return ev
 
     def outcome(self, t: float) -> dict:
-        missed = [{"cycle": c, "why": f"the fingers closed on nothing (all within {v:.3f} rad "
-                   "of their grip posture)"}
-                  for c, v in sorted(self._holds.items()) if v < self.params.free_closure]
-        out: dict[str, Any] = {"preshape": self.preshape,
-               "preshape_at_grasp": [self._shape_at_grasp[c] for c in sorted(self._shape_at_grasp)],
-               "hold_closure_deficit": [self._holds[c] for c in sorted(self._holds)],
-               "missed": missed}
+        missed = [
+            {
+                "cycle": c,
+                "why": f"the fingers closed on nothing (all within {v:.3f} rad "
+                "of their grip posture)",
+            }
+            for c, v in sorted(self._holds.items())
+            if v < self.params.free_closure
+        ]
+        out: dict[str, Any] = {
+            "preshape": self.preshape,
+            "preshape_at_grasp": [self._shape_at_grasp[c] for c in sorted(self._shape_at_grasp)],
+            "hold_closure_deficit": [self._holds[c] for c in sorted(self._holds)],
+            "missed": missed,
+        }
         if missed:
-            out.update(success=False, reason=f"missed grasp in cycle {missed[0]['cycle']}: "
-                       f"{missed[0]['why']}")
+            out.update(
+                success=False,
+                reason=f"missed grasp in cycle {missed[0]['cycle']}: {missed[0]['why']}",
+            )
         return out
-

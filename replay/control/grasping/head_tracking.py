@@ -23,10 +23,20 @@ from replay.robot.arm_types import GraspSpec, ServoCommand
 
 @dataclass
 class HeadParams:
-    K_v: list = param([60.0, 60.0], unit="1/s", length=2, ge=0.0,
-                      doc="eq. 1's K^v (diagonal): image error to head rate (assumed)")
-    K_vv: list = param([0.02, 0.02], unit="1", length=2, ge=0.0,
-                       doc="eq. 1's K^vv (diagonal): damping of the head's rate (assumed)")
+    K_v: list = param(
+        [60.0, 60.0],
+        unit="1/s",
+        length=2,
+        ge=0.0,
+        doc="eq. 1's K^v (diagonal): image error to head rate (assumed)",
+    )
+    K_vv: list = param(
+        [0.02, 0.02],
+        unit="1",
+        length=2,
+        ge=0.0,
+        doc="eq. 1's K^vv (diagonal): damping of the head's rate (assumed)",
+    )
     xi_d: list = param([], unit="px", doc="objective image position; [] = the image centre")
     width: int = param(16, unit="px", ge=2, doc="chip width (for the default xi_d)")
     height: int = param(16, unit="px", ge=2, doc="chip height")
@@ -34,6 +44,7 @@ class HeadParams:
 
 class HeadTrackingTask(Controller):
     """Eq. 1: active-vision tracking with the head model's image Jacobian."""
+
     Params = HeadParams
     spec_type = GraspSpec
     command_type = ServoCommand
@@ -42,8 +53,11 @@ class HeadTrackingTask(Controller):
 
     def __init__(self, params: HeadParams, *, spec: GraspSpec) -> None:
         super().__init__(params, spec=spec)
-        self.xi_d = (np.asarray(params.xi_d, float) if params.xi_d else
-                     np.array([(params.width - 1) / 2.0, (params.height - 1) / 2.0]))
+        self.xi_d = (
+            np.asarray(params.xi_d, float)
+            if params.xi_d
+            else np.array([(params.width - 1) / 2.0, (params.height - 1) / 2.0])
+        )
         self.K_v, self.K_vv = np.asarray(params.K_v, float), np.asarray(params.K_vv, float)
         if spec.head is None:
             raise ValueError("head tracking needs a plant with a head")

@@ -23,8 +23,7 @@ from replay.control.grasping.features import blob
 from replay.control.grasping.payloads import GraspObject
 from replay.control.grasping.self_window import track
 from replay.interfaces import Controller, Occurrence
-from replay.messages import (TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP,
-                             unpack_rows)
+from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP, unpack_rows
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import HeadSpec, camera_pose
@@ -33,21 +32,36 @@ from replay.spatial import wrap_half_pi
 
 @dataclass
 class RecognitionParams:
-    fov: float = param(math.radians(12.0), unit="rad", gt=0.0, lt=math.pi,
-                       doc="the chip's calibrated horizontal field of view (= the sensor's)")
+    fov: float = param(
+        math.radians(12.0),
+        unit="rad",
+        gt=0.0,
+        lt=math.pi,
+        doc="the chip's calibrated horizontal field of view (= the sensor's)",
+    )
     width: int = param(16, unit="px", ge=2, doc="chip width (= the sensor's)")
     height: int = param(16, unit="px", ge=2, doc="chip height (= the sensor's)")
-    rectangle_fill: float = param(0.9, unit="1", gt=0.0, lt=1.0,
-                                  doc="fill of the smallest bounding box above which the shape "
-                                      "is a rectangle (an axis-aligned rectangle ~1, a disc "
-                                      "pi/4 = 0.79; a rolled one's jagged 16 x 16 edges ~0.75)")
-    rectangle_elongation: float = param(1.3, unit="1", ge=1.0,
-                                        doc="elongation above which the shape is a rectangle "
-                                            "(a disc's is 1; measured 1.01-1.11 on the chip)")
+    rectangle_fill: float = param(
+        0.9,
+        unit="1",
+        gt=0.0,
+        lt=1.0,
+        doc="fill of the smallest bounding box above which the shape "
+        "is a rectangle (an axis-aligned rectangle ~1, a disc "
+        "pi/4 = 0.79; a rolled one's jagged 16 x 16 edges ~0.75)",
+    )
+    rectangle_elongation: float = param(
+        1.3,
+        unit="1",
+        ge=1.0,
+        doc="elongation above which the shape is a rectangle "
+        "(a disc's is 1; measured 1.01-1.11 on the chip)",
+    )
     min_area: int = param(6, unit="px", ge=1, doc="smallest target used to judge the shape")
     shape_frames: int = param(20, ge=1, doc="whole views voted on before the shape is decided")
-    axis_elongation: float = param(1.25, unit="1", ge=1.0,
-                                   doc="elongation above which the target's axis (roll) is used")
+    axis_elongation: float = param(
+        1.25, unit="1", ge=1.0, doc="elongation above which the target's axis (roll) is used"
+    )
 
 
 def shape_of(b, params: RecognitionParams) -> str:
@@ -100,8 +114,9 @@ class Camera:
         a = self.head.yaw + angles[0]
         J = np.zeros((2, 2))
         for i, k in enumerate(((0.0, 0.0, 1.0), (-math.sin(a), math.cos(a), 0.0))):
-            kxr = np.array([k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2],
-                            k[0] * r[1] - k[1] * r[0]])
+            kxr = np.array(
+                [k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2], k[0] * r[1] - k[1] * r[0]]
+            )
             d = -(R.T @ kxr)
             J[:, i] = self.f * (d[:2] * pc[2] - pc[:2] * d[2]) / (pc[2] * pc[2])
         return J
@@ -117,6 +132,7 @@ def meet_plane(o, d, point, normal) -> np.ndarray | None:
 
 class RecognitionTask(Controller):
     """Self Windowing, moments, 3-D pose on the constraint plane, shape: ``/grasping/object``."""
+
     Params = RecognitionParams
     spec_type = GraspSpec
     command_type = ServoCommand
@@ -177,8 +193,23 @@ class RecognitionTask(Controller):
             if self._had_target:
                 self._events.append(Occurrence("lost", {"t_image": chip.t}))
                 self._had_target = False
-            return GraspObject(chip.t, False, [], 0.0, 0, window, [], None, [], [], self.shape,
-                               0.0, 0.0, [], list(angles))
+            return GraspObject(
+                chip.t,
+                False,
+                [],
+                0.0,
+                0,
+                window,
+                [],
+                None,
+                [],
+                [],
+                self.shape,
+                0.0,
+                0.0,
+                [],
+                list(angles),
+            )
         if reacquired and self.frames > 1:
             self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
         self._had_target = True
@@ -193,26 +224,45 @@ class RecognitionTask(Controller):
         if X2 is not None and b.elongation >= self.params.axis_elongation:
             e = X2 - X
             roll = wrap_half_pi(math.atan2(float(e @ self.pv), float(e @ self.pu)))
-        scale = float(np.linalg.norm(X - o)) / self.camera.f       # m per px at the object
+        scale = float(np.linalg.norm(X - o)) / self.camera.f  # m per px at the object
         if not b.touches_border and b.area >= self.params.min_area:
             self._vote(b)
         J = self.camera.jacobian(angles, X)
-        x_o = [float(X[0]), float(X[1]), float(X[2]), roll if roll is not None else 0.0,
-               0.0, 0.0]
-        return GraspObject(chip.t, True, [b.u, b.v], b.phi, b.area, window, X.tolist(), roll,
-                           x_o, [b.length * scale, b.width * scale], self.shape,
-                           b.fill if b.fill == b.fill else None,
-                           b.elongation, J.tolist(), list(angles))
+        x_o = [float(X[0]), float(X[1]), float(X[2]), roll if roll is not None else 0.0, 0.0, 0.0]
+        return GraspObject(
+            chip.t,
+            True,
+            [b.u, b.v],
+            b.phi,
+            b.area,
+            window,
+            X.tolist(),
+            roll,
+            x_o,
+            [b.length * scale, b.width * scale],
+            self.shape,
+            b.fill if b.fill == b.fill else None,
+            b.elongation,
+            J.tolist(),
+            list(angles),
+        )
 
     def _vote(self, b) -> None:
         kind = shape_of(b, self.params)
         self._votes[kind] += 1
         if self.shape == "unknown" and sum(self._votes.values()) >= self.params.shape_frames:
             self.shape = max(self._votes, key=lambda k: (self._votes[k], k))
-            self._events.append(Occurrence("shape", {"shape": self.shape,
-                                                     "votes": dict(self._votes),
-                                                     "fill": b.fill,
-                                                     "elongation": b.elongation}))
+            self._events.append(
+                Occurrence(
+                    "shape",
+                    {
+                        "shape": self.shape,
+                        "votes": dict(self._votes),
+                        "fill": b.fill,
+                        "elongation": b.elongation,
+                    },
+                )
+            )
 
     def telemetry(self, t: float) -> dict:
         return {TOPIC_GRASP_OBJECT: self._out} if self._out is not None else {}
@@ -222,10 +272,16 @@ class RecognitionTask(Controller):
         return ev
 
     def outcome(self, t: float) -> dict:
-        out = {"shape": self.shape, "vision_frames": self.frames,
-               "vision_lost_frames": self.lost_frames}
+        out = {
+            "shape": self.shape,
+            "vision_frames": self.frames,
+            "vision_lost_frames": self.lost_frames,
+        }
         if self.shape == "unknown":
-            out.update(success=False, reason="the object's shape was never recognised "
-                       f"({sum(self._votes.values())} whole views of "
-                       f"{self.params.shape_frames} needed)")
+            out.update(
+                success=False,
+                reason="the object's shape was never recognised "
+                f"({sum(self._votes.values())} whole views of "
+                f"{self.params.shape_frames} needed)",
+            )
         return out

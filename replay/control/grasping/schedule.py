@@ -30,11 +30,16 @@ class ScheduleParams:
     release_time: float = param(0.3, unit="s", gt=0.0, doc="release and retreat")
     track_time_next: float = param(0.7, unit="s", ge=0.0, doc="tracking between cycles")
     cycles: int = param(1, ge=1, doc="grasp/release cycles")
-    x_far: float = param(0.15, unit="m", gt=0.0,
-                         doc="x_d^a while tracking: the hand's grasp point this far before the "
-                             "plane (along its normal)")
-    x_grasp: float = param(0.0, unit="m",
-                           doc="x_d^a at the grasp: the grasp point this far before the plane")
+    x_far: float = param(
+        0.15,
+        unit="m",
+        gt=0.0,
+        doc="x_d^a while tracking: the hand's grasp point this far before the "
+        "plane (along its normal)",
+    )
+    x_grasp: float = param(
+        0.0, unit="m", doc="x_d^a at the grasp: the grasp point this far before the plane"
+    )
 
 
 def min_jerk(s: float) -> float:
@@ -44,6 +49,7 @@ def min_jerk(s: float) -> float:
 
 class ScheduleTask(Controller):
     """The grasp/release schedule and the reaching target x_d^a, given beforehand."""
+
     Params = ScheduleParams
     spec_type = GraspSpec
     command_type = ServoCommand
@@ -57,7 +63,7 @@ class ScheduleTask(Controller):
             raise ValueError("the schedule needs a plant with a constraint plane")
         self.point = [float(x) for x in spec.plane.point]
         self.normal = [float(x) for x in spec.plane.normal]
-        self.segments: list[tuple[float, float, str, int]] = []   # (start, end, phase, cycle)
+        self.segments: list[tuple[float, float, str, int]] = []  # (start, end, phase, cycle)
         t = 0.0
         for c in range(P.cycles):
             track = P.track_time if c == 0 else P.track_time_next
@@ -91,7 +97,7 @@ class ScheduleTask(Controller):
             s = 1.0
         elif phase == "release":
             s = 1.0 - min_jerk(tau / P.release_time)
-        dist = P.x_far + s * (P.x_grasp - P.x_far)             # before the plane, along -n
+        dist = P.x_far + s * (P.x_grasp - P.x_far)  # before the plane, along -n
         x = [self.point[i] - dist * self.normal[i] for i in range(3)]
         grasp = phase in ("reach", "hold")
         return GraspState(t, phase, cycle, [*x, 0.0, 0.0, 0.0], s, grasp, tau)

@@ -31,47 +31,81 @@ from replay.control.catching.model import ArmModel
 from replay.control.predictive.kalman import BallKalman, first_crossing
 from replay.control.predictive.trajectory import Quintic
 from replay.interfaces import Controller, Occurrence
-from replay.messages import (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_COMMAND, TOPIC_ARM_JOINT_STATE,
-                             TOPIC_EFFECTOR_STATE, TOPIC_VISION_OBJECT, EffectorState,
-                             JointCommand)
+from replay.messages import (
+    TOPIC_ARM_ENCODERS,
+    TOPIC_ARM_JOINT_COMMAND,
+    TOPIC_ARM_JOINT_STATE,
+    TOPIC_EFFECTOR_STATE,
+    TOPIC_VISION_OBJECT,
+    EffectorState,
+    JointCommand,
+)
 from replay.params import param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
 
 @dataclass
 class PredictiveParams:
-    q_alpha: float = param(math.pi / 2, unit="rad",
-                           doc="joint angle of the selected joint at the catch (the catch "
-                               "surface), as the direct mapping's")
+    q_alpha: float = param(
+        math.pi / 2,
+        unit="rad",
+        doc="joint angle of the selected joint at the catch (the catch "
+        "surface), as the direct mapping's",
+    )
     selected_joint: str = param("J4", doc="the joint at q_alpha on the catch surface")
     held_joints: list = param(["J3"], doc="joints held at their initial angle")
-    catch_q: list = param([0.0, math.pi / 4], unit="rad", length=2,
-                          doc="(q1, q2) the inverse kinematics prefers (branch choice)")
-    catch_offset: float = param(-1.0, unit="m",
-                                doc="catch point this far along the tool z axis; negative = "
-                                    "palm thickness + ball radius from the spec")
-    meas_sigma: float = param(0.002, unit="m", gt=0.0,
-                              doc="Kalman measurement noise (the stereo's ~1-2 mm, "
-                                  "sensors/stereo.py)")
-    accel_sigma: float = param(2.0, unit="m/s^2", gt=0.0,
-                               doc="Kalman process noise: unmodelled acceleration (drag, kicks)")
+    catch_q: list = param(
+        [0.0, math.pi / 4],
+        unit="rad",
+        length=2,
+        doc="(q1, q2) the inverse kinematics prefers (branch choice)",
+    )
+    catch_offset: float = param(
+        -1.0,
+        unit="m",
+        doc="catch point this far along the tool z axis; negative = "
+        "palm thickness + ball radius from the spec",
+    )
+    meas_sigma: float = param(
+        0.002,
+        unit="m",
+        gt=0.0,
+        doc="Kalman measurement noise (the stereo's ~1-2 mm, sensors/stereo.py)",
+    )
+    accel_sigma: float = param(
+        2.0, unit="m/s^2", gt=0.0, doc="Kalman process noise: unmodelled acceleration (drag, kicks)"
+    )
     min_measurements: int = param(3, ge=1, doc="frames before the first plan")
-    margin: float = param(0.02, unit="s", ge=0.0,
-                          doc="reach the catch posture this long before the predicted arrival")
-    min_duration: float = param(0.03, unit="s", gt=0.0,
-                                doc="a re-planned trajectory lasts at least this long")
-    replan_distance: float = param(0.005, unit="m", ge=0.0,
-                                   doc="re-plan when the predicted catch point moves this far")
-    replan_time: float = param(0.003, unit="s", ge=0.0,
-                               doc="re-plan when the predicted catch time moves this much")
-    freeze_time: float = param(0.01, unit="s", ge=0.0,
-                               doc="no re-planning this close to the predicted catch")
-    kp: list = param([900.0, 1500.0, 300.0, 150.0], unit="N*m/rad", ge=0.0,
-                     doc="PD stiffness per arm joint (as the direct controller's)")
-    kd: list = param([30.0, 45.0, 10.0, 4.0], unit="N*m*s/rad", ge=0.0,
-                     doc="PD damping per arm joint (as the direct controller's)")
-    close_lead: float = param(0.0, unit="s", doc="start closing this much earlier than "
-                                                 "(t_c - closing time)")
+    margin: float = param(
+        0.02, unit="s", ge=0.0, doc="reach the catch posture this long before the predicted arrival"
+    )
+    min_duration: float = param(
+        0.03, unit="s", gt=0.0, doc="a re-planned trajectory lasts at least this long"
+    )
+    replan_distance: float = param(
+        0.005, unit="m", ge=0.0, doc="re-plan when the predicted catch point moves this far"
+    )
+    replan_time: float = param(
+        0.003, unit="s", ge=0.0, doc="re-plan when the predicted catch time moves this much"
+    )
+    freeze_time: float = param(
+        0.01, unit="s", ge=0.0, doc="no re-planning this close to the predicted catch"
+    )
+    kp: list = param(
+        [900.0, 1500.0, 300.0, 150.0],
+        unit="N*m/rad",
+        ge=0.0,
+        doc="PD stiffness per arm joint (as the direct controller's)",
+    )
+    kd: list = param(
+        [30.0, 45.0, 10.0, 4.0],
+        unit="N*m*s/rad",
+        ge=0.0,
+        doc="PD damping per arm joint (as the direct controller's)",
+    )
+    close_lead: float = param(
+        0.0, unit="s", doc="start closing this much earlier than (t_c - closing time)"
+    )
 
 
 Params = PredictiveParams
@@ -82,8 +116,10 @@ class PredictiveController(Controller):
     spec_type = ArmSpec
     command_type = ArmCommand
     reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)
-    description = ("predict-then-intercept baseline: Kalman filter, ballistic catch point, IK, "
-                   "re-planned quintic joint trajectory, PD + dynamics")
+    description = (
+        "predict-then-intercept baseline: Kalman filter, ballistic catch point, IK, "
+        "re-planned quintic joint trajectory, PD + dynamics"
+    )
 
     def __init__(self, params: PredictiveParams, *, spec) -> None:
         super().__init__(params, spec=spec)
@@ -94,8 +130,10 @@ class PredictiveController(Controller):
         held = [names.index(j) for j in P.held_joints]
         self.active = tuple(i for i in range(self.n) if i not in held)
         if len(self.active) != 3 or names.index(P.selected_joint) != self.active[-1]:
-            raise ValueError(f"the predictive baseline needs 3 active joints ending with "
-                             f"{P.selected_joint}; got {[names[i] for i in self.active]}")
+            raise ValueError(
+                f"the predictive baseline needs 3 active joints ending with "
+                f"{P.selected_joint}; got {[names[i] for i in self.active]}"
+            )
         self.q_init = np.asarray(spec.initial_q, float).copy()
         self.tau_limit = np.asarray(spec.torque_limits, float)
         self.gravity = np.array([0.0, 0.0, -float(spec.gravity)])
@@ -106,8 +144,9 @@ class PredictiveController(Controller):
                 off += float(spec.hand.table.palm_thickness)
             if spec.object is not None:
                 off += float(spec.object.radius)
-        self.model = ArmModel.from_chain(spec.model, active=self.active, q_fixed=self.q_init,
-                                         point_in_tool=(0.0, 0.0, off))
+        self.model = ArmModel.from_chain(
+            spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)
+        )
         self.geo = CatchGeometry.from_fk(self.model.fk, P.q_alpha, p_ref=tuple(P.catch_q))
         self.kp = np.asarray(P.kp, dtype=float)
         self.kd = np.asarray(P.kd, dtype=float)
@@ -118,8 +157,9 @@ class PredictiveController(Controller):
         if self.hand is not None:
             self.hand_open = np.asarray(self.hand.open_posture, float)
             self.hand_closed = np.asarray(self.hand.closed_posture, float)
-            self.close_time = float(np.max(np.abs(self.hand_closed - self.hand_open))
-                                    / self.hand.closing_speed)
+            self.close_time = float(
+                np.max(np.abs(self.hand_closed - self.hand_open)) / self.hand.closing_speed
+            )
         else:
             self.close_time = 0.0
         self.q: np.ndarray | None = None
@@ -147,11 +187,19 @@ class PredictiveController(Controller):
             self._maybe_replan(t)
         if self.plan is not None:
             self.q_d, self.qd_d, self.qdd_d = self.plan(t)
-        if self.hand is not None and not self.closing and self.t_catch is not None \
-                and t >= self.t_catch - self.close_time - P.close_lead - 1e-9:
+        if (
+            self.hand is not None
+            and not self.closing
+            and self.t_catch is not None
+            and t >= self.t_catch - self.close_time - P.close_lead - 1e-9
+        ):
             self.closing = True
-            self._events.append(Occurrence("hand_close", {
-                "predicted_catch_time": self.t_catch, "closing_time": self.close_time}))
+            self._events.append(
+                Occurrence(
+                    "hand_close",
+                    {"predicted_catch_time": self.t_catch, "closing_time": self.close_time},
+                )
+            )
         self.tau = self._torque()
         hand = None
         if self.hand is not None:
@@ -168,9 +216,12 @@ class PredictiveController(Controller):
             return
         t_c = t + s
         p_c = r + v * s + 0.5 * self.gravity * s * s
-        if (self.plan is not None and self.t_catch is not None
-                and np.linalg.norm(p_c - self.p_catch) <= P.replan_distance
-                and abs(t_c - self.t_catch) <= P.replan_time):
+        if (
+            self.plan is not None
+            and self.t_catch is not None
+            and np.linalg.norm(p_c - self.p_catch) <= P.replan_distance
+            and abs(t_c - self.t_catch) <= P.replan_time
+        ):
             return
         inv = self.geo.inverse(p_c)
         q_goal = self.model.full(inv.p[0])
@@ -178,11 +229,21 @@ class PredictiveController(Controller):
         self.plan = Quintic(t, t_end, self.q_d, self.qd_d, self.qdd_d, q_goal)
         self.t_catch, self.p_catch = t_c, p_c
         self.replans += 1
-        self._events.append(Occurrence("plan", {
-            "catch_time": t_c, "catch_point": p_c.tolist(), "q_goal": q_goal.tolist(),
-            "arrive": t_end, "in_domain": bool(inv.in_domain[0]), "index": self.replans,
-            "position_sigma": self.kf.position_sigma(),
-            "velocity_sigma": self.kf.velocity_sigma()}))
+        self._events.append(
+            Occurrence(
+                "plan",
+                {
+                    "catch_time": t_c,
+                    "catch_point": p_c.tolist(),
+                    "q_goal": q_goal.tolist(),
+                    "arrive": t_end,
+                    "in_domain": bool(inv.in_domain[0]),
+                    "index": self.replans,
+                    "position_sigma": self.kf.position_sigma(),
+                    "velocity_sigma": self.kf.velocity_sigma(),
+                },
+            )
+        )
 
     def _joint_state(self, m) -> None:
         pos, vel = np.asarray(m.position, float), np.asarray(m.velocity, float)
@@ -214,13 +275,19 @@ class PredictiveController(Controller):
     def outcome(self, t: float) -> dict:
         out: dict = {"replans": self.replans}
         if self.t_catch is not None:
-            out.update(predicted_catch_time=self.t_catch,
-                       predicted_catch_point=self.p_catch.tolist())
+            out.update(
+                predicted_catch_time=self.t_catch, predicted_catch_point=self.p_catch.tolist()
+            )
         return out
 
     def telemetry(self, t: float) -> dict:
-        return {TOPIC_ARM_JOINT_COMMAND: JointCommand(t, position=self.q_d.tolist(),
-                                                   torque=self.tau.tolist()),
-                TOPIC_EFFECTOR_STATE: EffectorState(
-                    t, position=self.model.fk(self.q).tolist() if self.q is not None else [],
-                    desired_position=self.model.fk(self.q_d).tolist())}
+        return {
+            TOPIC_ARM_JOINT_COMMAND: JointCommand(
+                t, position=self.q_d.tolist(), torque=self.tau.tolist()
+            ),
+            TOPIC_EFFECTOR_STATE: EffectorState(
+                t,
+                position=self.model.fk(self.q).tolist() if self.q is not None else [],
+                desired_position=self.model.fk(self.q_d).tolist(),
+            ),
+        }

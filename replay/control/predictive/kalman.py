@@ -16,13 +16,19 @@ import numpy as np
 
 
 class BallKalman:
-    def __init__(self, gravity=(0.0, 0.0, -9.81), *, meas_sigma: float = 0.002,
-                 accel_sigma: float = 2.0, v_sigma0: float = 10.0) -> None:
+    def __init__(
+        self,
+        gravity=(0.0, 0.0, -9.81),
+        *,
+        meas_sigma: float = 0.002,
+        accel_sigma: float = 2.0,
+        v_sigma0: float = 10.0,
+    ) -> None:
         self.g = np.asarray(gravity, float)
-        self.R = np.eye(3) * meas_sigma ** 2
-        self.q = accel_sigma ** 2
+        self.R = np.eye(3) * meas_sigma**2
+        self.q = accel_sigma**2
         self.v_sigma0 = v_sigma0
-        self.x = np.zeros(6)                    # r, v (valid once n > 0)
+        self.x = np.zeros(6)  # r, v (valid once n > 0)
         self.P = np.eye(6)
         self.t = 0.0
         self.n = 0
@@ -34,19 +40,19 @@ class BallKalman:
         F[:3, 3:] = np.eye(3) * dt
         self.x = F @ self.x + np.concatenate([0.5 * self.g * dt * dt, self.g * dt])
         I3 = np.eye(3)
-        Q = self.q * np.block([[dt ** 3 / 3 * I3, dt ** 2 / 2 * I3], [dt ** 2 / 2 * I3, dt * I3]])
+        Q = self.q * np.block([[dt**3 / 3 * I3, dt**2 / 2 * I3], [dt**2 / 2 * I3, dt * I3]])
         self.P = F @ self.P @ F.T + Q
 
     def add(self, t: float, z) -> None:
         z = np.asarray(z, float)
         if self.n == 0:
             self.x = np.concatenate([z, np.zeros(3)])
-            self.P = np.diag([self.R[0, 0]] * 3 + [self.v_sigma0 ** 2] * 3)
+            self.P = np.diag([self.R[0, 0]] * 3 + [self.v_sigma0**2] * 3)
             self.t = float(t)
             self.n = 1
             return
         if t <= self.t:
-            return                                  # repeated or out-of-order frame
+            return  # repeated or out-of-order frame
         self._predict(t - self.t)
         self.t = float(t)
         H = np.hstack([np.eye(3), np.zeros((3, 3))])

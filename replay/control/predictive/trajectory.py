@@ -18,10 +18,11 @@ class Quintic:
         h = q1 - q0 - qd0 * T - 0.5 * qdd0 * T * T
         hd = -qd0 - qdd0 * T
         hdd = -qdd0
-        M = np.array([[T ** 3, T ** 4, T ** 5], [3 * T ** 2, 4 * T ** 3, 5 * T ** 4],
-                      [6 * T, 12 * T ** 2, 20 * T ** 3]])
+        M = np.array(
+            [[T**3, T**4, T**5], [3 * T**2, 4 * T**3, 5 * T**4], [6 * T, 12 * T**2, 20 * T**3]]
+        )
         c345 = np.linalg.solve(M, np.vstack([h, hd, hdd]))
-        self.c = np.vstack([q0, qd0, 0.5 * qdd0, c345])         # (6, n)
+        self.c = np.vstack([q0, qd0, 0.5 * qdd0, c345])  # (6, n)
 
     def __call__(self, t: float):
         """(q, qd, qdd) at t; before t0 the start, after t1 at rest at the goal."""
@@ -29,7 +30,7 @@ class Quintic:
             return self.goal.copy(), np.zeros_like(self.goal), np.zeros_like(self.goal)
         s = max(0.0, t - self.t0)
         k = np.arange(6)
-        pw = s ** k
+        pw = s**k
         q = pw @ self.c
         qd = (k[1:] * s ** (k[1:] - 1)) @ self.c[1:]
         qdd = (k[2:] * (k[2:] - 1) * s ** (k[2:] - 2)) @ self.c[2:]

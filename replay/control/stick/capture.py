@@ -110,67 +110,165 @@ from replay.messages import TOPIC_STICK_ESTIMATE, TOPIC_VISION_STICK
 
 @dataclass
 class StickCaptureParams:
-    window: int = param(30, unit="1", ge=2, le=1000,
-                        doc="samples in the sliding least-squares window (0.1 s at 300 fps)")
-    min_samples: int = param(6, unit="1", ge=2, le=1000,
-                             doc="samples since the last collision before the estimate is used")
-    pos_tol: float = param(0.002, unit="m", gt=0.0, le=0.1,
-                           doc="position deviation from the prediction that breaks the model")
-    theta_tol: float = param(0.03, unit="rad", gt=0.0, le=1.0,
-                             doc="orientation deviation from the prediction that breaks the model")
-    confirm: int = param(2, unit="1", ge=1, le=5,
-                         doc="consecutive deviating samples that confirm a collision")
-    horizon: float = param(1.0, unit="s", gt=0.0, le=10.0,
-                           doc="how far ahead a contact is searched")
-    arrive_margin: float = param(0.01, unit="s", ge=0.0, le=0.5,
-                                 doc="the fingertip must be at the spot this long before contact")
-    freeze: float = param(0.01, unit="s", ge=0.0, le=0.5,
-                          doc="the target is no longer refined this long before the contact")
-    detect_window: float = param(0.04, unit="s", gt=0.0, le=1.0,
-                                 doc="a model break this close to the planned time is the plan's")
-    min_spin: float = param(0.2, unit="rad/s", ge=0.0, le=100.0,
-                            doc="below this |omega| a spin-stopping step is skipped")
-    max_extra: int = param(2, unit="1", ge=0, le=10,
-                           doc="spin-stop collisions (eq. 30) added when a clamped contact left "
-                               "|omega| >= min_spin, before closing")
-    tip_margin: float = param(0.005, unit="m", ge=0.0, le=0.05,
-                              doc="fallback: |r_x| is clamped to L/2 - tip_margin")
-    sweep_margin: float = param(0.003, unit="m", ge=0.0, le=0.05,
-                                doc="clearance between an idle fingertip and the predicted sweep")
-    stage_margin: float = param(0.01, unit="m", ge=0.0, le=0.2,
-                                doc="a staged tip waits this far outside a spinning stick's reach")
-    post_horizon: float = param(0.1, unit="s", ge=0.0, le=2.0,
-                                doc="after a contact the idle finger stays clear this long")
-    grip_clearance: float = param(0.002, unit="m", ge=0.0, le=0.05,
-                                  doc="final fingertip gap = W + 2 tip_radius + grip_clearance")
-    follow_gap: float = param(0.01, unit="m", ge=0.0, le=0.1,
-                              doc="the rear fingertip follows this far behind the stick")
-    retry_interval: float = param(0.02, unit="s", ge=0.0, le=1.0,
-                                  doc="after a failed plan, wait this long before trying again")
-    close_retry: float = param(0.3, unit="s", gt=0.0, le=5.0,
-                               doc="the closing is re-planned when no capture this long after "
-                                   "the planned meeting")
-    capture_speed: float = param(0.02, unit="m/s", gt=0.0, le=1.0,
-                                 doc="capture: estimated speed below this")
-    capture_spin: float = param(0.5, unit="rad/s", gt=0.0, le=50.0,
-                                doc="capture: estimated |omega| below this")
-    capture_hold: float = param(0.05, unit="s", ge=0.0, le=5.0,
-                                doc="capture: conditions held this long")
-    respin: float = param(2.0, unit="rad/s", ge=0.0, le=100.0,
-                          doc="a closing to be (re)planned on a stick spinning faster than this "
-                              "gets a spin-stop collision (eq. 30) first, up to max_extra")
-    view: list = param([-0.40, 0.40, -0.20, 0.60], unit="m", length=4, ge=-10.0, le=10.0,
-                       doc="[x_min, x_max, y_min, y_max] of the stick's centre where the camera "
-                           "sees the whole stick (the scenarios' camera: a 0.9 m square about "
-                           "(0, 0.2), less L/2); contacts there are preferred (the method sees "
-                           "their result)")
-    keep_in_reach: float = param(0.3, unit="s", ge=0.0, le=5.0,
-                                 doc="a contact after which the stick's predicted centre is still "
-                                     "within reach_fraction of the fingers' reach this long is "
-                                     "preferred (the next steps need it there; our choice)")
-    reach_fraction: float = param(0.85, unit="1", gt=0.0, le=2.0,
-                                  doc="'within reach' for keep_in_reach: this fraction of l1 + l2 "
-                                      "from a finger root the slider can reach")
+    window: int = param(
+        30,
+        unit="1",
+        ge=2,
+        le=1000,
+        doc="samples in the sliding least-squares window (0.1 s at 300 fps)",
+    )
+    min_samples: int = param(
+        6,
+        unit="1",
+        ge=2,
+        le=1000,
+        doc="samples since the last collision before the estimate is used",
+    )
+    pos_tol: float = param(
+        0.002,
+        unit="m",
+        gt=0.0,
+        le=0.1,
+        doc="position deviation from the prediction that breaks the model",
+    )
+    theta_tol: float = param(
+        0.03,
+        unit="rad",
+        gt=0.0,
+        le=1.0,
+        doc="orientation deviation from the prediction that breaks the model",
+    )
+    confirm: int = param(
+        2, unit="1", ge=1, le=5, doc="consecutive deviating samples that confirm a collision"
+    )
+    horizon: float = param(
+        1.0, unit="s", gt=0.0, le=10.0, doc="how far ahead a contact is searched"
+    )
+    arrive_margin: float = param(
+        0.01,
+        unit="s",
+        ge=0.0,
+        le=0.5,
+        doc="the fingertip must be at the spot this long before contact",
+    )
+    freeze: float = param(
+        0.01,
+        unit="s",
+        ge=0.0,
+        le=0.5,
+        doc="the target is no longer refined this long before the contact",
+    )
+    detect_window: float = param(
+        0.04,
+        unit="s",
+        gt=0.0,
+        le=1.0,
+        doc="a model break this close to the planned time is the plan's",
+    )
+    min_spin: float = param(
+        0.2,
+        unit="rad/s",
+        ge=0.0,
+        le=100.0,
+        doc="below this |omega| a spin-stopping step is skipped",
+    )
+    max_extra: int = param(
+        2,
+        unit="1",
+        ge=0,
+        le=10,
+        doc="spin-stop collisions (eq. 30) added when a clamped contact left "
+        "|omega| >= min_spin, before closing",
+    )
+    tip_margin: float = param(
+        0.005, unit="m", ge=0.0, le=0.05, doc="fallback: |r_x| is clamped to L/2 - tip_margin"
+    )
+    sweep_margin: float = param(
+        0.003,
+        unit="m",
+        ge=0.0,
+        le=0.05,
+        doc="clearance between an idle fingertip and the predicted sweep",
+    )
+    stage_margin: float = param(
+        0.01,
+        unit="m",
+        ge=0.0,
+        le=0.2,
+        doc="a staged tip waits this far outside a spinning stick's reach",
+    )
+    post_horizon: float = param(
+        0.1, unit="s", ge=0.0, le=2.0, doc="after a contact the idle finger stays clear this long"
+    )
+    grip_clearance: float = param(
+        0.002,
+        unit="m",
+        ge=0.0,
+        le=0.05,
+        doc="final fingertip gap = W + 2 tip_radius + grip_clearance",
+    )
+    follow_gap: float = param(
+        0.01, unit="m", ge=0.0, le=0.1, doc="the rear fingertip follows this far behind the stick"
+    )
+    retry_interval: float = param(
+        0.02,
+        unit="s",
+        ge=0.0,
+        le=1.0,
+        doc="after a failed plan, wait this long before trying again",
+    )
+    close_retry: float = param(
+        0.3,
+        unit="s",
+        gt=0.0,
+        le=5.0,
+        doc="the closing is re-planned when no capture this long after the planned meeting",
+    )
+    capture_speed: float = param(
+        0.02, unit="m/s", gt=0.0, le=1.0, doc="capture: estimated speed below this"
+    )
+    capture_spin: float = param(
+        0.5, unit="rad/s", gt=0.0, le=50.0, doc="capture: estimated |omega| below this"
+    )
+    capture_hold: float = param(
+        0.05, unit="s", ge=0.0, le=5.0, doc="capture: conditions held this long"
+    )
+    respin: float = param(
+        2.0,
+        unit="rad/s",
+        ge=0.0,
+        le=100.0,
+        doc="a closing to be (re)planned on a stick spinning faster than this "
+        "gets a spin-stop collision (eq. 30) first, up to max_extra",
+    )
+    view: list = param(
+        [-0.40, 0.40, -0.20, 0.60],
+        unit="m",
+        length=4,
+        ge=-10.0,
+        le=10.0,
+        doc="[x_min, x_max, y_min, y_max] of the stick's centre where the camera "
+        "sees the whole stick (the scenarios' camera: a 0.9 m square about "
+        "(0, 0.2), less L/2); contacts there are preferred (the method sees "
+        "their result)",
+    )
+    keep_in_reach: float = param(
+        0.3,
+        unit="s",
+        ge=0.0,
+        le=5.0,
+        doc="a contact after which the stick's predicted centre is still "
+        "within reach_fraction of the fingers' reach this long is "
+        "preferred (the next steps need it there; our choice)",
+    )
+    reach_fraction: float = param(
+        0.85,
+        unit="1",
+        gt=0.0,
+        le=2.0,
+        doc="'within reach' for keep_in_reach: this fraction of l1 + l2 "
+        "from a finger root the slider can reach",
+    )
 
 
 def _finite_or_none(v) -> float | None:
@@ -198,13 +296,18 @@ class StickCaptureController(Controller):
         p = params
         self.hand: HandSpec = spec.hand
         self.stick = spec.stick
-        self.est = StickEstimator(window=p.window, min_samples=p.min_samples, pos_tol=p.pos_tol,
-                                  theta_tol=p.theta_tol, confirm=p.confirm)
+        self.est = StickEstimator(
+            window=p.window,
+            min_samples=p.min_samples,
+            pos_tol=p.pos_tol,
+            theta_tol=p.theta_tol,
+            confirm=p.confirm,
+        )
         self.model = HandModel(self.hand, self._home())
         self.planner = ContactPlanner(p, self.hand, self.stick, self.model)
         self.closing = ClosePlanner(self.planner)
         self.phase = "observe"
-        self.step = 1                       # index of the next collision
+        self.step = 1  # index of the next collision
         self.plan: ContactPlan | None = None
         self.close: ClosePlan | None = None
         self.last_finger: int | None = None
@@ -212,11 +315,11 @@ class StickCaptureController(Controller):
         self._capture_since: float | None = None
         self._events: list[Occurrence] = []
         self._reported: set = set()
-        self._next_try = -math.inf          # no new plan attempt before this time
-        self.extra = 0                      # spin-stop collisions added so far
-        self._lost: tuple | None = None     # (time of a contact chance not yet planned, numbers)
-        self._infeasible: list[dict] = []   # the ``infeasible`` reports, in order
-        self._missed = 0                    # ``missed`` reports
+        self._next_try = -math.inf  # no new plan attempt before this time
+        self.extra = 0  # spin-stop collisions added so far
+        self._lost: tuple | None = None  # (time of a contact chance not yet planned, numbers)
+        self._infeasible: list[dict] = []  # the ``infeasible`` reports, in order
+        self._missed = 0  # ``missed`` reports
         self._t_capture: float | None = None
 
     # -- Controller interface -----------------------------------------------------------------
@@ -250,11 +353,16 @@ class StickCaptureController(Controller):
     def outcome(self, t: float) -> dict:
         """The method's metrics and, when it has not captured the stick, why (the last thing that
         stopped it: out of reach, r_x beyond the stick, no feasible plan, or the run ended first)."""
-        out = {"method_captured": self.captured, "t_capture_method": self._t_capture,
-               "phase": self.phase, "collisions_done": self.step - 1,
-               "extra_spin_stops": self.extra, "missed": self._missed,
-               "infeasible": [d["reason"] + f"@{d['step']}" for d in self._infeasible],
-               "as_planned": not self._infeasible and not self._missed}
+        out = {
+            "method_captured": self.captured,
+            "t_capture_method": self._t_capture,
+            "phase": self.phase,
+            "collisions_done": self.step - 1,
+            "extra_spin_stops": self.extra,
+            "missed": self._missed,
+            "infeasible": [d["reason"] + f"@{d['step']}" for d in self._infeasible],
+            "as_planned": not self._infeasible and not self._missed,
+        }
         if self.captured:
             return out
         # the runner keeps the plant's reason when both fail: method_reason keeps this one too
@@ -265,44 +373,72 @@ class StickCaptureController(Controller):
     def _why_not(self, t: float) -> str:
         last = self._infeasible[-1] if self._infeasible else None
         where = f"phase {self.phase}, collision {self.step}"
-        if self._lost is not None and t > self._lost[0]:        # a chance passed, not reported
-            last = {"reason": "unreachable", "step": self.step, "t_contact": self._lost[0],
-                    "t_needed": _finite_or_none(self._lost[1].t_needed),
-                    "t_available": self._lost[1].t_available}
+        if self._lost is not None and t > self._lost[0]:  # a chance passed, not reported
+            last = {
+                "reason": "unreachable",
+                "step": self.step,
+                "t_contact": self._lost[0],
+                "t_needed": _finite_or_none(self._lost[1].t_needed),
+                "t_available": self._lost[1].t_available,
+            }
         if last is None:
             e = self.est.estimate()
             if e is None:
                 return f"timed out before capture: the stick was never seen ({where})"
             if t - e.t_ref > 0.1:
-                return (f"timed out before capture: the stick out of sight since t = "
-                        f"{e.t_ref:.3f} s ({where})")
+                return (
+                    f"timed out before capture: the stick out of sight since t = "
+                    f"{e.t_ref:.3f} s ({where})"
+                )
             return f"timed out before capture ({where})"
         step = last["step"]
         if last["reason"] == "unreachable":
             need = last.get("t_needed")
             if need is None:
                 return f"out of reach: no hand posture reaches contact {step} clear of the stick"
-            return (f"out of reach: the hand cannot get to contact {step} in time (needs "
-                    f"{need:.3f} s, had {last.get('t_available', 0.0):.3f} s)")
+            return (
+                f"out of reach: the hand cannot get to contact {step} in time (needs "
+                f"{need:.3f} s, had {last.get('t_available', 0.0):.3f} s)"
+            )
         if last["reason"] == "r_x_beyond_stick":
-            return (f"infeasible: r_x beyond the stick at collision {step} (|r_x| = "
-                    f"{abs(last['r_x']) * 1e3:.1f} mm > L/2 = {last['limit'] * 1e3:.1f} mm); "
-                    f"the clamped fallback did not capture ({where})")
+            return (
+                f"infeasible: r_x beyond the stick at collision {step} (|r_x| = "
+                f"{abs(last['r_x']) * 1e3:.1f} mm > L/2 = {last['limit'] * 1e3:.1f} mm); "
+                f"the clamped fallback did not capture ({where})"
+            )
         if last["reason"] in ("no_solution", "no_crossing"):
-            what = ("no root of eq. 25/28 passes eq. 26" if last["reason"] == "no_solution"
-                    else "the stick never turns to alpha(v)")
+            what = (
+                "no root of eq. 25/28 passes eq. 26"
+                if last["reason"] == "no_solution"
+                else "the stick never turns to alpha(v)"
+            )
             return f"infeasible: no feasible plan for collision {step} ({what}; {where})"
         return f"infeasible: {last['reason']} at collision {step} ({where})"
 
     def telemetry(self, t: float) -> dict:
         e = self.est.estimate()
-        msg = {"t": float(t), "phase": self.phase, "step": self.step,
-               "ready": bool(self.est.ready())}
+        msg = {
+            "t": float(t),
+            "phase": self.phase,
+            "step": self.step,
+            "ready": bool(self.est.ready()),
+        }
         if e is not None:
             x, y, th = e.at(t)
-            msg.update({"t_ref": e.t_ref, "x": x, "y": y, "theta": th, "vx": e.vx, "vy": e.vy,
-                        "omega": e.omega, "n": e.n, "rms_xy": e.rms_xy,
-                        "rms_theta": e.rms_theta})
+            msg.update(
+                {
+                    "t_ref": e.t_ref,
+                    "x": x,
+                    "y": y,
+                    "theta": th,
+                    "vx": e.vx,
+                    "vy": e.vy,
+                    "omega": e.omega,
+                    "n": e.n,
+                    "rms_xy": e.rms_xy,
+                    "rms_theta": e.rms_theta,
+                }
+            )
         return {TOPIC_STICK_ESTIMATE: msg}
 
     # -- strategy hooks -------------------------------------------------------------------------
@@ -334,8 +470,10 @@ class StickCaptureController(Controller):
         if key in self._reported:
             return
         self._reported.add(key)
-        clean = {k: (_finite_or_none(v) if isinstance(v, (float, np.floating)) else v)
-                 for k, v in data.items()}
+        clean = {
+            k: (_finite_or_none(v) if isinstance(v, (float, np.floating)) else v)
+            for k, v in data.items()
+        }
         self._events.append(Occurrence(kind=kind, data=clean))
         if kind == "infeasible":
             self._infeasible.append(clean)
@@ -361,14 +499,22 @@ class StickCaptureController(Controller):
             if self.step > self.n_steps:
                 spinning = abs(plan.sol.u_after[2]) >= self.params.min_spin
                 if spinning and self.extra < self.params.max_extra:
-                    self.extra += 1          # one more spin-stop collision (eq. 30)
+                    self.extra += 1  # one more spin-stop collision (eq. 30)
                 else:
                     self.phase = "close"
         else:
             self._missed += 1
-            self._events.append(Occurrence("missed", {
-                "index": plan.index, "reason": "early_contact", "t_planned": float(plan.t),
-                "t_break": float(t_break)}))
+            self._events.append(
+                Occurrence(
+                    "missed",
+                    {
+                        "index": plan.index,
+                        "reason": "early_contact",
+                        "t_planned": float(plan.t),
+                        "t_break": float(t_break),
+                    },
+                )
+            )
             self.plan = None
             self.phase = "observe"
 
@@ -378,9 +524,17 @@ class StickCaptureController(Controller):
         if self.phase in ("observe", "approach"):
             if self.plan is not None and est.t_ref > self.plan.t + p.detect_window:
                 self._missed += 1
-                self._events.append(Occurrence("missed", {
-                    "index": self.plan.index, "reason": "no_collision",
-                    "t_planned": float(self.plan.t), "t_now": float(t)}))
+                self._events.append(
+                    Occurrence(
+                        "missed",
+                        {
+                            "index": self.plan.index,
+                            "reason": "no_collision",
+                            "t_planned": float(self.plan.t),
+                            "t_now": float(t),
+                        },
+                    )
+                )
                 self.plan = None
                 self.phase = "observe"
             if self.plan is None:
@@ -393,12 +547,20 @@ class StickCaptureController(Controller):
                 # extrapolates a noisy velocity (e.g. 0.05 m/s from 6 samples: 2 cm in 0.4 s)
                 self._refine(t, est)
         elif self.phase == "close":
-            if self.close is not None and t > self.close.t_meet + p.close_retry \
-                    and self._capture_since is None and not self._between_tips(t, est):
-                self.close = None        # (a stick already between the tips is left to settle)
-            if self.close is None and abs(est.omega) >= p.respin \
-                    and self.extra < p.max_extra and self._capture_since is None:
-                self.extra += 1          # still spinning: one more spin-stop collision (eq. 30)
+            if (
+                self.close is not None
+                and t > self.close.t_meet + p.close_retry
+                and self._capture_since is None
+                and not self._between_tips(t, est)
+            ):
+                self.close = None  # (a stick already between the tips is left to settle)
+            if (
+                self.close is None
+                and abs(est.omega) >= p.respin
+                and self.extra < p.max_extra
+                and self._capture_since is None
+            ):
+                self.extra += 1  # still spinning: one more spin-stop collision (eq. 30)
                 self.step = max(self.step, self.n_steps + 1)
                 self.phase = "observe"
                 self._next_try = -math.inf
@@ -416,15 +578,23 @@ class StickCaptureController(Controller):
         p = self.params
         step = self.step
         if self._stops_spin(step) and abs(est.omega) < p.min_spin:
-            self._events.append(Occurrence("skip", {"index": step, "omega": float(est.omega),
-                                                    "reason": "no_spin"}))
+            self._events.append(
+                Occurrence("skip", {"index": step, "omega": float(est.omega), "reason": "no_spin"})
+            )
             self.step = self.n_steps + 1
             self.phase = "close"
             return
         options = self._contacts(est, step)
         if not options:
-            self._report("infeasible", (step, "no_solution"), step=step, reason="no_solution",
-                         vx=est.vx, vy=est.vy, omega=est.omega)
+            self._report(
+                "infeasible",
+                (step, "no_solution"),
+                step=step,
+                reason="no_solution",
+                vx=est.vx,
+                vy=est.vy,
+                omega=est.omega,
+            )
             self._to_close()
             return
         usable = [c for c in map(self._clamp, options) if c is not None]
@@ -443,8 +613,9 @@ class StickCaptureController(Controller):
                         continue
                     if keep == 2 and not self._stays_in_reach(est, sol, t_c):
                         continue
-                    plan = self.planner.reach(self.step, t, est, sol, raw, t_c, fingers,
-                                              strict, shortfall)
+                    plan = self.planner.reach(
+                        self.step, t, est, sol, raw, t_c, fingers, strict, shortfall
+                    )
                     if plan is not None:
                         self.plan = plan
                         self._lost = None
@@ -453,10 +624,16 @@ class StickCaptureController(Controller):
                         return
         if not crossings_any:
             if abs(est.omega) < 1e-6:
-                self._report("infeasible", (step, "no_crossing"), step=step,
-                             reason="no_crossing", omega=est.omega, theta=est.theta)
+                self._report(
+                    "infeasible",
+                    (step, "no_crossing"),
+                    step=step,
+                    reason="no_crossing",
+                    omega=est.omega,
+                    theta=est.theta,
+                )
                 self._to_close()
-            return                      # else the next crossing is beyond the horizon: wait
+            return  # else the next crossing is beyond the horizon: wait
         self._lost_chance(t, first, shortfall)
 
     def _in_view(self, est: StickEstimate, sol: sc.ContactSolution, t_c: float) -> bool:
@@ -481,12 +658,18 @@ class StickCaptureController(Controller):
         that fails now may still succeed later, from nearer): the numbers of the last attempt
         made for it. ``deadline`` = the opportunity's time."""
         lost = self._lost
-        if lost is not None and t > lost[0]:            # that chance passed unplanned
-            self._report("infeasible", (self.step, "unreachable"), step=self.step,
-                         reason="unreachable", t_contact=lost[0], t_needed=lost[1].t_needed,
-                         t_available=lost[1].t_available)
+        if lost is not None and t > lost[0]:  # that chance passed unplanned
+            self._report(
+                "infeasible",
+                (self.step, "unreachable"),
+                step=self.step,
+                reason="unreachable",
+                t_contact=lost[0],
+                t_needed=lost[1].t_needed,
+                t_available=lost[1].t_available,
+            )
             lost = None
-        if lost is None or deadline <= lost[0] + 0.05:   # the same (drifting) chance, or earlier
+        if lost is None or deadline <= lost[0] + 0.05:  # the same (drifting) chance, or earlier
             self._lost = (deadline, shortfall)
 
     def _clamp(self, sol: sc.ContactSolution):
@@ -498,17 +681,33 @@ class StickCaptureController(Controller):
         if sc.approach_speed(sol.theta, r, sol.side, sol.u_before) <= 0.0:
             return None
         st = self.stick
-        return sc.contact_at(st.mass, st.inertia, st.restitution, sol.theta, sol.side,
-                             sol.u_before, r, length=st.length, roots=sol.roots), sol.r_x
+        return sc.contact_at(
+            st.mass,
+            st.inertia,
+            st.restitution,
+            sol.theta,
+            sol.side,
+            sol.u_before,
+            r,
+            length=st.length,
+            roots=sol.roots,
+        ), sol.r_x
 
     def _report_clamp(self, plan: ContactPlan) -> None:
         """The ``infeasible`` event of a clamped contact, with the plan's final numbers."""
         if plan.clamped:
-            self._report("infeasible", (plan.index, "r_x_beyond_stick"), step=plan.index,
-                         reason="r_x_beyond_stick", theta=plan.sol.theta, r_x=plan.raw_r_x,
-                         limit=0.5 * self.stick.length, fallback_r_x=plan.sol.r_x,
-                         omega_after=plan.sol.u_after[2],
-                         v_after=[float(v) for v in plan.sol.u_after[:2]])
+            self._report(
+                "infeasible",
+                (plan.index, "r_x_beyond_stick"),
+                step=plan.index,
+                reason="r_x_beyond_stick",
+                theta=plan.sol.theta,
+                r_x=plan.raw_r_x,
+                limit=0.5 * self.stick.length,
+                fallback_r_x=plan.sol.r_x,
+                omega_after=plan.sol.u_after[2],
+                v_after=[float(v) for v in plan.sol.u_after[:2]],
+            )
 
     def _to_close(self) -> None:
         self.step = self.n_steps + 1
@@ -522,7 +721,7 @@ class StickCaptureController(Controller):
         n_old = sc.tangent_normal(old.sol.theta, old.sol.side)[1]
         for sol in options:
             if float(np.dot(sc.tangent_normal(sol.theta, sol.side)[1], n_old)) <= 0.0:
-                continue                # the other face (alpha may jump by pi: compare n)
+                continue  # the other face (alpha may jump by pi: compare n)
             clamped = self._clamp(sol)
             if clamped is None:
                 return
@@ -532,12 +731,23 @@ class StickCaptureController(Controller):
                 return
             t_c = min(crossings, key=lambda tc: abs(tc - old.t))
             if abs(est.omega) > 1e-6 and abs(t_c - old.t) > 0.5 * math.pi / abs(est.omega):
-                return                                  # not the same crossing any more
-            plan = self.planner.reach(self.step, t, est, sol, raw, t_c, (old.finger,), True,
-                                      Shortfall(), bases=[old.config.base])
-            if plan is None:       # the spot moved out of reach from the old base
-                plan = self.planner.reach(self.step, t, est, sol, raw, t_c, (old.finger,),
-                                          True, Shortfall())
+                return  # not the same crossing any more
+            plan = self.planner.reach(
+                self.step,
+                t,
+                est,
+                sol,
+                raw,
+                t_c,
+                (old.finger,),
+                True,
+                Shortfall(),
+                bases=[old.config.base],
+            )
+            if plan is None:  # the spot moved out of reach from the old base
+                plan = self.planner.reach(
+                    self.step, t, est, sol, raw, t_c, (old.finger,), True, Shortfall()
+                )
             if plan is not None:
                 self.plan = plan
             return
@@ -545,8 +755,9 @@ class StickCaptureController(Controller):
     # -- closing (eqs. 32, 33, 38) --------------------------------------------------------------
     def _plan_close(self, t: float, est: StickEstimate) -> None:
         shortfall = Shortfall()
-        close = self.closing.plan(t, est, self.last_finger, self.step, len(self.est.breaks),
-                                  shortfall)
+        close = self.closing.plan(
+            t, est, self.last_finger, self.step, len(self.est.breaks), shortfall
+        )
         if close is not None:
             self.close = close
             self._lost = None
@@ -554,8 +765,7 @@ class StickCaptureController(Controller):
             return
         # the closing has no discrete chances: report once it failed for close_retry
         p = self.params
-        self._lost_chance(t, t + p.close_retry if self._lost is None else self._lost[0],
-                          shortfall)
+        self._lost_chance(t, t + p.close_retry if self._lost is None else self._lost[0], shortfall)
 
     # -- commands and capture -------------------------------------------------------------------
     def _command(self, t: float) -> None:
@@ -576,8 +786,10 @@ class StickCaptureController(Controller):
         for k in (0, 1):
             d = self.model.config.tip(hand, k) - np.array([x, y])
             xb, yb = d[0] * cs + d[1] * sn, -d[0] * sn + d[1] * cs
-            at = abs(xb) <= 0.5 * st.length and \
-                abs(yb) <= 0.5 * st.width + hand.tip_radius + p.grip_clearance + 0.003
+            at = (
+                abs(xb) <= 0.5 * st.length
+                and abs(yb) <= 0.5 * st.width + hand.tip_radius + p.grip_clearance + 0.003
+            )
             sides.append(yb if at else 0.0)
         return sides[0] * sides[1] < 0.0
 
@@ -587,8 +799,11 @@ class StickCaptureController(Controller):
         p, hand = self.params, self.hand
         est = self.est.estimate()
         x, y, th = est.at(t)
-        ok = est.speed < p.capture_speed and abs(est.omega) < p.capture_spin \
+        ok = (
+            est.speed < p.capture_speed
+            and abs(est.omega) < p.capture_spin
             and self._between_tips(t, est)
+        )
         if not ok:
             self._capture_since = None
             return
@@ -598,10 +813,22 @@ class StickCaptureController(Controller):
             self.captured = True
             self._t_capture = float(self._capture_since)
             self.phase = "captured"
-            self._events.append(Occurrence("capture", {
-                "t_since": float(self._capture_since), "speed": float(est.speed),
-                "omega": float(est.omega), "x": float(x), "y": float(y), "theta": float(th),
-                "tips": [[float(v) for v in self.model.config.tip(hand, k)] for k in (0, 1)]}))
+            self._events.append(
+                Occurrence(
+                    "capture",
+                    {
+                        "t_since": float(self._capture_since),
+                        "speed": float(est.speed),
+                        "omega": float(est.omega),
+                        "x": float(x),
+                        "y": float(y),
+                        "theta": float(th),
+                        "tips": [
+                            [float(v) for v in self.model.config.tip(hand, k)] for k in (0, 1)
+                        ],
+                    },
+                )
+            )
 
     # -- set-up -----------------------------------------------------------------------------------
     def _home(self) -> Config:

@@ -45,29 +45,40 @@ class ClosePlan:
     front: int
     rear: int
     t_meet: float
-    d: np.ndarray            # unit direction of motion along the closing line
-    meet: np.ndarray         # stick centre at the meeting (m)
-    half_gap: float          # fingertip centre to the stick centre at the end (m)
-    config: Config           # base and front finger; rear finger updated while following
+    d: np.ndarray  # unit direction of motion along the closing line
+    meet: np.ndarray  # stick centre at the meeting (m)
+    half_gap: float  # fingertip centre to the stick centre at the end (m)
+    config: Config  # base and front finger; rear finger updated while following
     sol: sc.ContactSolution | None
     theta: float
-    n_breaks: int = 0        # the estimator's break count when planned
-    route: list = field(default_factory=list)   # [(t_start, Config)] for base and front finger
+    n_breaks: int = 0  # the estimator's break count when planned
+    route: list = field(default_factory=list)  # [(t_start, Config)] for base and front finger
 
     def target(self, t: float) -> Config:
         return route_target(self.route, t, self.config)
 
     def intent(self, width: float) -> dict:
-        out = {"index": self.index, "finger": self.front, "t": float(self.t_meet),
-               "theta": float(self.theta), "r_x": 0.0, "clamped": False,
-               "contact": [float(x) for x in self.meet + self.d * width / 2.0],
-               "tip": [float(x) for x in self.meet + self.d * self.half_gap]}
+        out = {
+            "index": self.index,
+            "finger": self.front,
+            "t": float(self.t_meet),
+            "theta": float(self.theta),
+            "r_x": 0.0,
+            "clamped": False,
+            "contact": [float(x) for x in self.meet + self.d * width / 2.0],
+            "tip": [float(x) for x in self.meet + self.d * self.half_gap],
+        }
         if self.sol is not None:
             k = round((self.theta - self.sol.theta) / math.pi)
             f = 1 if k % 2 == 0 else -1
-            out.update({"r_y": f * self.sol.side * width / 2.0, "side": f * self.sol.side,
-                        "v_after": [float(self.sol.u_after[0]), float(self.sol.u_after[1])],
-                        "omega_after": float(self.sol.u_after[2])})
+            out.update(
+                {
+                    "r_y": f * self.sol.side * width / 2.0,
+                    "side": f * self.sol.side,
+                    "v_after": [float(self.sol.u_after[0]), float(self.sol.u_after[1])],
+                    "omega_after": float(self.sol.u_after[2]),
+                }
+            )
         return out
 
 
@@ -82,8 +93,15 @@ class ClosePlanner:
         self.stick = planner.stick
         self.model = planner.model
 
-    def plan(self, t: float, est: StickEstimate, last_finger: int | None, index: int,
-             n_breaks: int, shortfall: Shortfall) -> ClosePlan | None:
+    def plan(
+        self,
+        t: float,
+        est: StickEstimate,
+        last_finger: int | None,
+        index: int,
+        n_breaks: int,
+        shortfall: Shortfall,
+    ) -> ClosePlan | None:
         """The closing plan (number ``index``; the estimator has seen ``n_breaks`` breaks), or
         None with the closest miss noted in ``shortfall``. ``last_finger`` made the last
         collision (None: none did)."""
@@ -144,14 +162,28 @@ class ClosePlanner:
                 if best is not None:
                     break
             if best is not None:
-                sol = sc.closing_contact(st.mass, st.inertia, st.restitution, est.u, st.length) \
-                    if moving else None
-                return ClosePlan(index, front, rear, t_m, d, meet, h, best[1], sol,
-                                 pre.pose(t_m)[1], n_breaks, best[2])
+                sol = (
+                    sc.closing_contact(st.mass, st.inertia, st.restitution, est.u, st.length)
+                    if moving
+                    else None
+                )
+                return ClosePlan(
+                    index,
+                    front,
+                    rear,
+                    t_m,
+                    d,
+                    meet,
+                    h,
+                    best[1],
+                    sol,
+                    pre.pose(t_m)[1],
+                    n_breaks,
+                    best[2],
+                )
         return None
 
-    def around(self, t: float, now: Config, cfg: Config, k: int, target,
-               motion: Motion) -> list:
+    def around(self, t: float, now: Config, cfg: Config, k: int, target, motion: Motion) -> list:
         """Routes taking finger k's tip around an end of a translating stick to ``target``:
         sideways beyond the end, along the stick's motion, then in (base already at cfg's)."""
         p, st, hand = self.params, self.stick, self.hand
@@ -163,20 +195,22 @@ class ClosePlanner:
         routes = []
         for sgn in (1.0, -1.0):
             a1 = c + sgn * w * s_hat + n_hat * float(np.dot(tip - c, n_hat))
-            a2 = np.asarray(target) + s_hat * (sgn * w - float(np.dot(np.asarray(target) - c,
-                                                                       s_hat)))
+            a2 = np.asarray(target) + s_hat * (
+                sgn * w - float(np.dot(np.asarray(target) - c, s_hat))
+            )
             q2 = hand2d.finger_ik(hand, cfg.base, k, a2, q_near=cfg.joints[k])
             if q2 is None:
                 continue
             c2 = cfg.with_finger(k, q2)
-            for base1 in (cfg.base, now.base):       # sideways first, the base moving or not
+            for base1 in (cfg.base, now.base):  # sideways first, the base moving or not
                 q1 = hand2d.finger_ik(hand, base1, k, a1, q_near=now.joints[k])
                 if q1 is not None:
                     break
             if q1 is None:
                 continue
-            c1 = (cfg if tuple(base1) == tuple(cfg.base) else
-                  Config(tuple(base1), now.joints)).with_finger(k, q1)
+            c1 = (
+                cfg if tuple(base1) == tuple(cfg.base) else Config(tuple(base1), now.joints)
+            ).with_finger(k, q1)
             t1 = t + travel(hand, now, c1)
             t2 = t1 + travel(hand, c1, c2)
             routes.append([(t, c1), (t1, c2), (t2, cfg)])
@@ -187,15 +221,23 @@ class ClosePlanner:
         meeting time) while the stick has not touched anything since the closing was planned
         (the estimator's break count is still ``n_breaks``)."""
         p = self.params
-        if n_breaks != c.n_breaks or est.speed < p.capture_speed \
-                or (c.route and t < c.route[-1][0]):      # still going around the stick
+        if (
+            n_breaks != c.n_breaks
+            or est.speed < p.capture_speed
+            or (c.route and t < c.route[-1][0])
+        ):  # still going around the stick
             return
         d = np.array([est.vx, est.vy]) / est.speed
         if float(np.dot(d, c.d)) < 0.9:
             return
         meet = Motion(est).pose(c.t_meet)[0]
-        q = hand2d.finger_ik(self.hand, c.config.base, c.front, meet + d * c.half_gap,
-                             q_near=c.config.joints[c.front])
+        q = hand2d.finger_ik(
+            self.hand,
+            c.config.base,
+            c.front,
+            meet + d * c.half_gap,
+            q_near=c.config.joints[c.front],
+        )
         if q is None:
             return
         cfg = c.config.with_finger(c.front, q)
@@ -206,23 +248,27 @@ class ClosePlanner:
         c.theta = Motion(est).pose(c.t_meet)[1]
         if c.sol is not None:
             st = self.stick
-            c.sol = sc.closing_contact(st.mass, st.inertia, st.restitution, est.u, st.length) \
-                or c.sol
+            c.sol = (
+                sc.closing_contact(st.mass, st.inertia, st.restitution, est.u, st.length) or c.sol
+            )
 
     def command(self, t: float, c: ClosePlan, estimator: StickEstimator) -> Config:
         """The hand target at ``t`` for the closing ``c``: its route's waypoint, with the rear
         fingertip following the stick along the line once the base has arrived."""
         cfg = c.target(t)
         if np.max(np.abs(np.subtract(self.model.config.base, c.config.base))) > 1e-9:
-            return cfg                   # the base is still moving: the rear finger is parked
+            return cfg  # the base is still moving: the rear finger is parked
         pred = estimator.predict(t)
         s_now = float(np.dot(c.d, np.array(pred[:2]) - c.meet))
-        s_rear = -c.half_gap if t >= c.t_meet else min(-c.half_gap,
-                                                      s_now - c.half_gap - self.params.follow_gap)
+        s_rear = (
+            -c.half_gap
+            if t >= c.t_meet
+            else min(-c.half_gap, s_now - c.half_gap - self.params.follow_gap)
+        )
         point = c.meet + c.d * s_rear
-        q = hand2d.finger_ik(self.hand, cfg.base, c.rear, point,
-                             q_near=self.model.target.joints[c.rear])
+        q = hand2d.finger_ik(
+            self.hand, cfg.base, c.rear, point, q_near=self.model.target.joints[c.rear]
+        )
         if q is None:
             return cfg.with_finger(c.rear, self.model.target.joints[c.rear])
         return cfg.with_finger(c.rear, q)
-

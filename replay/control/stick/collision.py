@@ -83,8 +83,9 @@ def _sign(side: int) -> float:
     return 1.0 if side > 0 else -1.0
 
 
-def f_omega(m: float, inertia: float, e: float, theta: float, side: int, u_prev,
-            omega_d: float) -> tuple[float, ...]:
+def f_omega(
+    m: float, inertia: float, e: float, theta: float, side: int, u_prev, omega_d: float
+) -> tuple[float, ...]:
     """F_omega,i(omega_d) of eq. 25: both r_x (ascending) giving omega_i = omega_d (eq. 24)."""
     u = np.asarray(u_prev, dtype=float)
     _, n = tangent_normal(theta, side)
@@ -94,8 +95,9 @@ def f_omega(m: float, inertia: float, e: float, theta: float, side: int, u_prev,
     return _roots(a1, b1, c1)
 
 
-def f_v(m: float, inertia: float, e: float, theta: float, side: int, u_prev,
-        speed_d: float) -> tuple[float, ...]:
+def f_v(
+    m: float, inertia: float, e: float, theta: float, side: int, u_prev, speed_d: float
+) -> tuple[float, ...]:
     """F_V,i(V_d) of eq. 28: both r_x (ascending) giving V_i = V_d (eq. 27).
 
     V_i is the speed along -v_{i-1}/|v_{i-1}| (V_d = 0 stops the translation); valid for a
@@ -117,8 +119,9 @@ def axis_map(m: float, inertia: float, e: float, theta: float, r_x: float, side:
     return collision_map(m, inertia, e, theta, (r_x, 0.0), side)
 
 
-def contact_condition(m: float, inertia: float, e: float, theta: float, r_x: float, side: int,
-                      u_prev) -> float:
+def contact_condition(
+    m: float, inertia: float, e: float, theta: float, r_x: float, side: int, u_prev
+) -> float:
     """C_i of eq. 26: n_i^T H_i J_i u_{i-1}, the normal velocity of the contact point after the
     collision; > 0 when it leaves the fingertip (then it approached before: C_i = -e n^T H u)."""
     u = np.asarray(u_prev, dtype=float)
@@ -137,13 +140,14 @@ def approach_speed(theta: float, r_x: float, side: int, u_prev) -> float:
 @dataclass(frozen=True)
 class ContactSolution:
     """One planned friction independent collision: where, from which side, and what it does."""
-    theta: float              # theta_B,i (rad), in (-pi/2, pi/2] as alpha() returns it
-    side: int                 # +1: ^B r_y = +W/2, -1: ^B r_y = -W/2
-    r_x: float                # ^B r_x,i (m)
-    u_before: tuple           # u_{i-1} = (vx, vy, omega)
-    u_after: tuple            # u_i = J_i u_{i-1} (eq. 22)
-    roots: tuple              # both roots of eq. 25 / 28 (m)
-    condition: float          # C_i (eq. 26) of the chosen root (m/s)
+
+    theta: float  # theta_B,i (rad), in (-pi/2, pi/2] as alpha() returns it
+    side: int  # +1: ^B r_y = +W/2, -1: ^B r_y = -W/2
+    r_x: float  # ^B r_x,i (m)
+    u_before: tuple  # u_{i-1} = (vx, vy, omega)
+    u_after: tuple  # u_i = J_i u_{i-1} (eq. 22)
+    roots: tuple  # both roots of eq. 25 / 28 (m)
+    condition: float  # C_i (eq. 26) of the chosen root (m/s)
     length: float | None = None
 
     @property
@@ -164,9 +168,18 @@ def _valid(m, inertia, e, theta, r_x, side, u) -> bool:
     return approach_speed(theta, r_x, side, u) > 1e-12
 
 
-def contact_options(m: float, inertia: float, e: float, theta: float, u_prev, *,
-                    omega: float | None = None, speed: float | None = None,
-                    length: float | None = None, sides=(1, -1)) -> list[ContactSolution]:
+def contact_options(
+    m: float,
+    inertia: float,
+    e: float,
+    theta: float,
+    u_prev,
+    *,
+    omega: float | None = None,
+    speed: float | None = None,
+    length: float | None = None,
+    sides=(1, -1),
+) -> list[ContactSolution]:
     """Every (side, root) giving omega_i = ``omega`` (eq. 25) or V_i = ``speed`` (eq. 28) that
     passes C_i > 0 (eq. 26), each with u_i = J_i u_{i-1}.
 
@@ -183,14 +196,26 @@ def contact_options(m: float, inertia: float, e: float, theta: float, u_prev, *,
             roots = f_omega(m, inertia, e, theta, side, u, omega)
         else:
             roots = f_v(m, inertia, e, theta, side, u, speed)
-        out += [contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
-                for r in roots if _valid(m, inertia, e, theta, r, side, u)]
+        out += [
+            contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
+            for r in roots
+            if _valid(m, inertia, e, theta, r, side, u)
+        ]
     return out
 
 
-def solve_contact(m: float, inertia: float, e: float, theta: float, side: int, u_prev, *,
-                  omega: float | None = None, speed: float | None = None,
-                  length: float | None = None) -> ContactSolution | None:
+def solve_contact(
+    m: float,
+    inertia: float,
+    e: float,
+    theta: float,
+    side: int,
+    u_prev,
+    *,
+    omega: float | None = None,
+    speed: float | None = None,
+    length: float | None = None,
+) -> ContactSolution | None:
     """The r_x on ``side`` giving omega_i = ``omega`` (eq. 25) or V_i = ``speed`` (eq. 28) with
     C_i > 0 (eq. 26), and the predicted u_i = J_i u_{i-1}; None when no root passes.
 
@@ -198,22 +223,37 @@ def solve_contact(m: float, inertia: float, e: float, theta: float, side: int, u
     A root beyond the stick (|r_x| > L/2 for the given ``length``) is still returned with
     ``within`` False: the caller reports it.
     """
-    opts = contact_options(m, inertia, e, theta, u_prev, omega=omega, speed=speed,
-                           length=length, sides=(side,))
+    opts = contact_options(
+        m, inertia, e, theta, u_prev, omega=omega, speed=speed, length=length, sides=(side,)
+    )
     return min(opts, key=lambda s: abs(s.r_x)) if opts else None
 
 
-def contact_at(m: float, inertia: float, e: float, theta: float, side: int, u_prev, r_x: float,
-               *, length: float | None = None, roots: tuple = ()) -> ContactSolution:
+def contact_at(
+    m: float,
+    inertia: float,
+    e: float,
+    theta: float,
+    side: int,
+    u_prev,
+    r_x: float,
+    *,
+    length: float | None = None,
+    roots: tuple = (),
+) -> ContactSolution:
     """The collision at a given r_x (e.g. a clamped one), predicted with J_i (eq. 22)."""
     u = np.asarray(u_prev, dtype=float)
     u_after = axis_map(m, inertia, e, theta, r_x, side) @ u
-    return ContactSolution(theta=theta, side=1 if side > 0 else -1, r_x=float(r_x),
-                           u_before=tuple(float(x) for x in u),
-                           u_after=tuple(float(x) for x in u_after),
-                           roots=tuple(float(r) for r in roots),
-                           condition=contact_condition(m, inertia, e, theta, r_x, side, u),
-                           length=length)
+    return ContactSolution(
+        theta=theta,
+        side=1 if side > 0 else -1,
+        r_x=float(r_x),
+        u_before=tuple(float(x) for x in u),
+        u_after=tuple(float(x) for x in u_after),
+        roots=tuple(float(r) for r in roots),
+        condition=contact_condition(m, inertia, e, theta, r_x, side, u),
+        length=length,
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -221,8 +261,9 @@ def contact_at(m: float, inertia: float, e: float, theta: float, side: int, u_pr
 # --------------------------------------------------------------------------------------------
 
 
-def two_step_first(m: float, inertia: float, e: float, u0, length: float | None = None
-                   ) -> ContactSolution | None:
+def two_step_first(
+    m: float, inertia: float, e: float, u0, length: float | None = None
+) -> ContactSolution | None:
     """Eq. 30: theta_1 = alpha(v_0), r_x = F_omega,1(0) with C_1 > 0, and the side giving p = -1
     in eq. 31 (v_1 against v_0). Preference: within the stick, then p = -1, then small |r_x|."""
     u = np.asarray(u0, dtype=float)
@@ -230,12 +271,14 @@ def two_step_first(m: float, inertia: float, e: float, u0, length: float | None 
     sols = contact_options(m, inertia, e, theta, u, omega=0.0, length=length)
     if not sols:
         return None
-    return min(sols, key=lambda s: (not s.within, float(np.dot(s.u_after[:2], u[:2])) >= 0.0,
-                                    abs(s.r_x)))
+    return min(
+        sols, key=lambda s: (not s.within, float(np.dot(s.u_after[:2], u[:2])) >= 0.0, abs(s.r_x))
+    )
 
 
-def three_step_first(m: float, inertia: float, e: float, u0, length: float | None = None
-                     ) -> ContactSolution | None:
+def three_step_first(
+    m: float, inertia: float, e: float, u0, length: float | None = None
+) -> ContactSolution | None:
     """Eq. 34: theta_1 = alpha(v_0), r_x = F_V,1(0) with C_1 > 0; the side satisfying eq. 35
     (omega_1 against omega_0) is preferred after being within the stick."""
     u = np.asarray(u0, dtype=float)
@@ -246,22 +289,27 @@ def three_step_first(m: float, inertia: float, e: float, u0, length: float | Non
     return min(sols, key=lambda s: (not s.within, s.u_after[2] * u[2] >= 0.0, abs(s.r_x)))
 
 
-def three_step_second(m: float, inertia: float, e: float, u1, lambda_2,
-                      length: float | None = None) -> ContactSolution | None:
+def three_step_second(
+    m: float, inertia: float, e: float, u1, lambda_2, length: float | None = None
+) -> ContactSolution | None:
     """Eq. 36: theta_2 = alpha(lambda_2), r_x = F_omega,2(0) with C_2 > 0, and the side for which
     v_2 / |v_2| = lambda_2 (eq. 37). None when no side sends the stick along lambda_2."""
     u = np.asarray(u1, dtype=float)
     lam = np.asarray(lambda_2, dtype=float)
     theta = alpha(lam)
-    sols = [s for s in contact_options(m, inertia, e, theta, u, omega=0.0, length=length)
-            if float(np.dot(s.u_after[:2], lam)) > 0.0]
+    sols = [
+        s
+        for s in contact_options(m, inertia, e, theta, u, omega=0.0, length=length)
+        if float(np.dot(s.u_after[:2], lam)) > 0.0
+    ]
     if not sols:
         return None
     return min(sols, key=lambda s: (not s.within, abs(s.r_x)))
 
 
-def closing_contact(m: float, inertia: float, e: float, u_prev, length: float | None = None
-                    ) -> ContactSolution | None:
+def closing_contact(
+    m: float, inertia: float, e: float, u_prev, length: float | None = None
+) -> ContactSolution | None:
     """Eqs. 32 / 38: ^B r_x = 0 on the side the stick moves into (n_i = -n_{i-1} alternately),
     so v_i = -e v_{i-1} (eq. 33) and no rotation. None when the stick does not translate."""
     u = np.asarray(u_prev, dtype=float)

@@ -32,15 +32,16 @@ import numpy as np
 @dataclass(frozen=True)
 class StickEstimate:
     """The constant-velocity fit, evaluated at ``t_ref`` (the latest sample's time)."""
-    t_ref: float      # s
-    x: float          # m
-    y: float          # m
-    theta: float      # rad, continuous (unwrapped)
-    vx: float         # m/s
-    vy: float         # m/s
-    omega: float      # rad/s
-    n: int            # samples in the fit
-    rms_xy: float     # m, residual rms of the position fit
+
+    t_ref: float  # s
+    x: float  # m
+    y: float  # m
+    theta: float  # rad, continuous (unwrapped)
+    vx: float  # m/s
+    vy: float  # m/s
+    omega: float  # rad/s
+    n: int  # samples in the fit
+    rms_xy: float  # m, residual rms of the position fit
     rms_theta: float  # rad, residual rms of the orientation fit
 
     @property
@@ -66,8 +67,15 @@ def unwrap_to(theta_mod_pi: float, near: float) -> float:
 class StickEstimator:
     """Sliding-window least-squares fit of x, y, theta linear in t, with collision detection."""
 
-    def __init__(self, *, window: int = 30, min_samples: int = 6, pos_tol: float = 0.002,
-                 theta_tol: float = 0.03, confirm: int = 2) -> None:
+    def __init__(
+        self,
+        *,
+        window: int = 30,
+        min_samples: int = 6,
+        pos_tol: float = 0.002,
+        theta_tol: float = 0.03,
+        confirm: int = 2,
+    ) -> None:
         if window < 2 or min_samples < 2 or min_samples > window or confirm < 1:
             raise ValueError("need 2 <= min_samples <= window and confirm >= 1")
         self.window = window
@@ -75,11 +83,11 @@ class StickEstimator:
         self.pos_tol = pos_tol
         self.theta_tol = theta_tol
         self.confirm = confirm
-        self._samples: list[tuple[float, float, float, float]] = []   # (t, x, y, theta unwrapped)
+        self._samples: list[tuple[float, float, float, float]] = []  # (t, x, y, theta unwrapped)
         self._pending: list[tuple[float, float, float, float]] = []
         self._fit: StickEstimate | None = None
-        self.breaks: list[float] = []            # time of the first sample after each break
-        self.before_break: StickEstimate | None = None   # the fit the last break ended
+        self.breaks: list[float] = []  # time of the first sample after each break
+        self.before_break: StickEstimate | None = None  # the fit the last break ended
 
     # -- input ------------------------------------------------------------------------------
     def add(self, t: float, x: float, y: float, theta: float) -> bool:
@@ -90,7 +98,7 @@ class StickEstimator:
         near = self._pending[-1][3] if self._pending else self._predict_theta(t)
         sample = (float(t), float(x), float(y), unwrap_to(float(theta), near))
         if not self.ready() or not self._deviates(sample):
-            self._pending.clear()           # isolated outliers are dropped
+            self._pending.clear()  # isolated outliers are dropped
             self._append(sample)
             return False
         self._pending.append(sample)
@@ -154,10 +162,19 @@ class StickEstimator:
             return
         tau = t - t_ref
         A = np.column_stack([np.ones(n), tau])
-        coef, *_ = np.linalg.lstsq(A, data[:, 1:], rcond=None)    # rows: value at t_ref, rate
+        coef, *_ = np.linalg.lstsq(A, data[:, 1:], rcond=None)  # rows: value at t_ref, rate
         res = data[:, 1:] - A @ coef
         rms_xy = float(math.sqrt(np.mean(res[:, 0] ** 2 + res[:, 1] ** 2)))
         rms_th = float(math.sqrt(np.mean(res[:, 2] ** 2)))
-        self._fit = StickEstimate(t_ref, float(coef[0, 0]), float(coef[0, 1]), float(coef[0, 2]),
-                                  float(coef[1, 0]), float(coef[1, 1]), float(coef[1, 2]),
-                                  n, rms_xy, rms_th)
+        self._fit = StickEstimate(
+            t_ref,
+            float(coef[0, 0]),
+            float(coef[0, 1]),
+            float(coef[0, 2]),
+            float(coef[1, 0]),
+            float(coef[1, 1]),
+            float(coef[1, 2]),
+            n,
+            rms_xy,
+            rms_th,
+        )

@@ -32,8 +32,8 @@ from replay.robot.hand2d import HandCommand, HandSpec
 
 @dataclass(frozen=True)
 class Config:
-    base: tuple           # (x, y) m
-    joints: tuple         # ((q1, q2), (q1, q2)) rad
+    base: tuple  # (x, y) m
+    joints: tuple  # ((q1, q2), (q1, q2)) rad
 
     def with_finger(self, k: int, q) -> "Config":
         j = [tuple(self.joints[0]), tuple(self.joints[1])]
@@ -44,8 +44,10 @@ class Config:
         return hand2d.finger_tip(hand, self.base, k, self.joints[k])
 
     def command(self) -> HandCommand:
-        return HandCommand(base=(float(self.base[0]), float(self.base[1])),
-                           joints=tuple((float(q[0]), float(q[1])) for q in self.joints))
+        return HandCommand(
+            base=(float(self.base[0]), float(self.base[1])),
+            joints=tuple((float(q[0]), float(q[1])) for q in self.joints),
+        )
 
 
 def travel(hand: HandSpec, a: Config, b: Config) -> float:
@@ -66,10 +68,14 @@ class HandModel:
             dt = t - self._t
             step_b = self.hand.base_speed * dt
             step_q = self.hand.joint_speed * dt
-            base = tuple(a + min(step_b, max(-step_b, b - a))
-                         for a, b in zip(self.config.base, self.target.base))
-            joints = tuple(tuple(a + min(step_q, max(-step_q, b - a)) for a, b in zip(qa, qb))
-                           for qa, qb in zip(self.config.joints, self.target.joints))
+            base = tuple(
+                a + min(step_b, max(-step_b, b - a))
+                for a, b in zip(self.config.base, self.target.base)
+            )
+            joints = tuple(
+                tuple(a + min(step_q, max(-step_q, b - a)) for a, b in zip(qa, qb))
+                for qa, qb in zip(self.config.joints, self.target.joints)
+            )
             self.config = Config(base, joints)
         self._t = t
 
@@ -114,8 +120,9 @@ def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
     l1, l2 = hand.link_lengths
     roots = np.array(hand.root_offsets)[None, :, :] + np.asarray(base)[:, None, :]
     q1, q12 = joints[..., 0], joints[..., 0] + joints[..., 1]
-    return roots + np.stack([l1 * np.cos(q1) + l2 * np.cos(q12),
-                             l1 * np.sin(q1) + l2 * np.sin(q12)], axis=-1)
+    return roots + np.stack(
+        [l1 * np.cos(q1) + l2 * np.cos(q12), l1 * np.sin(q1) + l2 * np.sin(q12)], axis=-1
+    )
 
 
 # ------------------------------------------------------------------------------------------
@@ -126,8 +133,9 @@ def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
 def posture_grid(hand: HandSpec) -> list[tuple]:
     """5 x 5 finger postures (q1, q2) spanning the joint limits (for an idle finger)."""
     (a0, a1), (b0, b1) = hand.joint_limits
-    return [(float(q1), float(q2)) for q1 in np.linspace(a0, a1, 5)
-            for q2 in np.linspace(b0, b1, 5)]
+    return [
+        (float(q1), float(q2)) for q1 in np.linspace(a0, a1, 5) for q2 in np.linspace(b0, b1, 5)
+    ]
 
 
 def base_candidates(hand: HandSpec, k: int, tip, here: tuple) -> list[tuple]:

@@ -38,12 +38,20 @@ from replay.robot.hand2d import HandSpec
 from replay.spatial import wrap_half_pi
 from replay.control.stick import collision as sc
 from replay.control.stick.estimator import StickEstimate
-from replay.control.stick.hand_model import (Config, HandModel, base_candidates, posture_grid,
-                                             route_configs, route_target, route_tips, travel)
+from replay.control.stick.hand_model import (
+    Config,
+    HandModel,
+    base_candidates,
+    posture_grid,
+    route_configs,
+    route_target,
+    route_tips,
+    travel,
+)
 from replay.control.stick.sweep import Motion, covered, covered_along, sample_times
 
 CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
-GO_DELAY = 0.003       # s, a staged tip moves in this long after the stick's last pass
+GO_DELAY = 0.003  # s, a staged tip moves in this long after the stick's last pass
 
 
 def _body_point(motion: Motion, t: float, point) -> tuple[float, float]:
@@ -61,18 +69,17 @@ def _body_point(motion: Motion, t: float, point) -> tuple[float, float]:
 
 @dataclass
 class ContactPlan:
-    index: int               # collision number i
+    index: int  # collision number i
     finger: int
-    t: float                 # planned contact time (s)
-    theta: float             # continuous orientation at the contact (estimator's frame)
+    t: float  # planned contact time (s)
+    theta: float  # continuous orientation at the contact (estimator's frame)
     sol: sc.ContactSolution  # in the frame theta* = sol.theta (mod pi)
-    raw_r_x: float | None    # the solved r_x when it was beyond the stick (sol is clamped)
-    contact: np.ndarray      # world contact point (m)
-    tip: np.ndarray          # world fingertip centre (m)
-    config: Config           # the hand at the contact
-    route: list = field(default_factory=list)   # [(t_start, Config)], the last one = config
-    exit: Config | None = None   # just after the contact: the tip out of the stick's sweep
-
+    raw_r_x: float | None  # the solved r_x when it was beyond the stick (sol is clamped)
+    contact: np.ndarray  # world contact point (m)
+    tip: np.ndarray  # world fingertip centre (m)
+    config: Config  # the hand at the contact
+    route: list = field(default_factory=list)  # [(t_start, Config)], the last one = config
+    exit: Config | None = None  # just after the contact: the tip out of the stick's sweep
 
     @property
     def clamped(self) -> bool:
@@ -91,19 +98,27 @@ class ContactPlan:
 
     def intent(self, width: float) -> dict:
         f = self.frame_flip()
-        return {"index": self.index, "finger": self.finger, "t": float(self.t),
-                "theta": float(self.theta), "r_x": f * self.sol.r_x,
-                "r_y": f * self.sol.side * width / 2.0, "side": f * self.sol.side,
-                "v_after": [float(self.sol.u_after[0]), float(self.sol.u_after[1])],
-                "omega_after": float(self.sol.u_after[2]),
-                "contact": [float(x) for x in self.contact], "tip": [float(x) for x in self.tip],
-                "clamped": self.clamped, "r_x_solved": f * (self.raw_r_x if self.clamped
-                                                             else self.sol.r_x)}
+        return {
+            "index": self.index,
+            "finger": self.finger,
+            "t": float(self.t),
+            "theta": float(self.theta),
+            "r_x": f * self.sol.r_x,
+            "r_y": f * self.sol.side * width / 2.0,
+            "side": f * self.sol.side,
+            "v_after": [float(self.sol.u_after[0]), float(self.sol.u_after[1])],
+            "omega_after": float(self.sol.u_after[2]),
+            "contact": [float(x) for x in self.contact],
+            "tip": [float(x) for x in self.tip],
+            "clamped": self.clamped,
+            "r_x_solved": f * (self.raw_r_x if self.clamped else self.sol.r_x),
+        }
 
 
 @dataclass
 class Shortfall:
     """The attempt that came closest: time needed vs time available (s)."""
+
     t_needed: float = math.inf
     t_available: float = 0.0
 
@@ -128,15 +143,16 @@ class ContactPlanner:
         self.model = model
         self._passive_grid = posture_grid(hand)
 
-    def crossings(self, t: float, est: StickEstimate, theta_star: float,
-                  keep_past: bool = False) -> list[float]:
+    def crossings(
+        self, t: float, est: StickEstimate, theta_star: float, keep_past: bool = False
+    ) -> list[float]:
         """Future times (<= t + horizon) at which theta(t) = theta* (mod pi)."""
         p = self.params
         t_min = t if keep_past else t + p.arrive_margin
         t_max = t + p.horizon
         if abs(est.omega) < 1e-6:
             if abs(wrap_half_pi(est.theta - theta_star)) < 0.02:
-                return [float(x) for x in np.arange(t_min, t_max, 0.01)]   # aligned: any time
+                return [float(x) for x in np.arange(t_min, t_max, 0.01)]  # aligned: any time
             return []
         w = est.omega
         delta = ((theta_star - est.theta) * math.copysign(1.0, w)) % math.pi
@@ -149,9 +165,19 @@ class ContactPlanner:
             tau += period
         return out
 
-    def reach(self, index: int, t: float, est: StickEstimate, sol: sc.ContactSolution,
-              raw: float | None, t_c: float, fingers, strict: bool, shortfall: Shortfall,
-              bases=None) -> ContactPlan | None:
+    def reach(
+        self,
+        index: int,
+        t: float,
+        est: StickEstimate,
+        sol: sc.ContactSolution,
+        raw: float | None,
+        t_c: float,
+        fingers,
+        strict: bool,
+        shortfall: Shortfall,
+        bases=None,
+    ) -> ContactPlan | None:
         """The quickest hand configuration that has finger k's tip at the contact spot for
         t_c with every check passed (the plan of collision ``index``), or None."""
         p, st, hand = self.params, self.stick, self.hand
@@ -167,8 +193,11 @@ class ContactPlanner:
         best: tuple | None = None
         for k in fingers:
             j = 1 - k
-            for base in (bases if bases is not None else base_candidates(
-                    hand, k, tip, tuple(self.model.target.base))):
+            for base in (
+                bases
+                if bases is not None
+                else base_candidates(hand, k, tip, tuple(self.model.target.base))
+            ):
                 q = hand2d.finger_ik(hand, base, k, tip, q_near=now.joints[k])
                 if q is None:
                     continue
@@ -187,15 +216,29 @@ class ContactPlanner:
                     continue
                 route, cost = found
                 if best is None or cost < best[0]:
-                    best = (cost, ContactPlan(index, k, t_c, th_c, sol, raw, contact,
-                                              tip, cfg, route,
-                                              self._exit_after(cfg, k, motion, t_c, tip, n)))
+                    best = (
+                        cost,
+                        ContactPlan(
+                            index,
+                            k,
+                            t_c,
+                            th_c,
+                            sol,
+                            raw,
+                            contact,
+                            tip,
+                            cfg,
+                            route,
+                            self._exit_after(cfg, k, motion, t_c, tip, n),
+                        ),
+                    )
             if best is not None and strict:
                 break
         return None if best is None else best[1]
 
-    def find_route(self, t: float, now: Config, cfg: Config, k: int, motion: Motion,
-                   t_c: float, tip, c_c) -> tuple[list, float] | None:
+    def find_route(
+        self, t: float, now: Config, cfg: Config, k: int, motion: Motion, t_c: float, tip, c_c
+    ) -> tuple[list, float] | None:
         """Waypoints [(t_start, Config)] that bring the hand from ``now`` to ``cfg`` (finger k's
         tip at the spot) before t_c with no fingertip hit by the predicted sweep on the way,
         and the arrival time. Tried in order: straight there; via a staging point outside a
@@ -222,7 +265,7 @@ class ContactPlanner:
             for tail in tails:
                 route = list(head)
                 t_free = t if not head else t + travel(hand, now, head[-1][1])
-                for t_start, c in (tail or [(None, cfg)]):
+                for t_start, c in tail or [(None, cfg)]:
                     route.append((t_free if t_start is None else t_start, c))
                 if not route or route[0][0] > t:
                     route.insert(0, (t, now))
@@ -231,8 +274,16 @@ class ContactPlanner:
                     return route, arrival
         return None
 
-    def route_clear(self, t: float, now: Config, route: list, k: int, motion: Motion,
-                    t_c: float, check_idle: bool = True) -> float | None:
+    def route_clear(
+        self,
+        t: float,
+        now: Config,
+        route: list,
+        k: int,
+        motion: Motion,
+        t_c: float,
+        check_idle: bool = True,
+    ) -> float | None:
         """The arrival time of ``route`` if every segment finishes before the next starts, the
         last before t_c - arrive_margin, and no fingertip is hit by the predicted sweep: on the
         way (both tips) and, once arrived, finger k's tip until just before t_c and the idle
@@ -253,12 +304,13 @@ class ContactPlanner:
             return None
         times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
         base, joints = route_configs(hand, starts, frm, to, times)
-        tips = route_tips(hand, base, joints)                             # (T, 2, 2)
+        tips = route_tips(hand, base, joints)  # (T, 2, 2)
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
         moving = times < arrival
         act = times <= t_c - CONTACT_GUARD
-        if covered_along(motion, times[act], tips[act, k], half_l, half_w,
-                         hand.tip_radius - 5e-4).any():
+        if covered_along(
+            motion, times[act], tips[act, k], half_l, half_w, hand.tip_radius - 5e-4
+        ).any():
             return None
         if check_idle:
             # on the way the idle tip keeps sweep_margin, or at least the clearance it has now
@@ -271,8 +323,7 @@ class ContactPlanner:
                 return None
         return arrival
 
-    def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip,
-                    n) -> Config | None:
+    def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip, n) -> Config | None:
         """Finger k's tip backed away along -n (the way it came, away from the face the contact
         pushes off) out of the stick's reach just after the contact when
         the predicted motion after it (J_i u, eq. 22: e.g. a stick left spinning in place)
@@ -282,9 +333,10 @@ class ContactPlanner:
         p, st, hand = self.params, self.stick, self.hand
         w = abs(motion.u_after[2])
         span = max(p.post_horizon, min(p.horizon, math.pi / w + 0.02 if w > 1e-6 else 0.0))
-        times = sample_times(t_c + 2.0 * GO_DELAY, t_c + span)       # up to half a turn
-        if not covered(motion, times, [tip], 0.5 * st.length, 0.5 * st.width,
-                       hand.tip_radius).any():
+        times = sample_times(t_c + 2.0 * GO_DELAY, t_c + span)  # up to half a turn
+        if not covered(
+            motion, times, [tip], 0.5 * st.length, 0.5 * st.width, hand.tip_radius
+        ).any():
             return None
         c, _ = motion.pose(t_c)
         d = np.asarray(tip) - c
@@ -292,8 +344,9 @@ class ContactPlanner:
         dn = float(np.dot(d, n))
         # |d - s n| = r_out, s > 0
         s = dn + math.sqrt(max(dn * dn + r_out * r_out - float(np.dot(d, d)), 0.0))
-        q = hand2d.finger_ik(hand, cfg.base, k, np.asarray(tip) - s * np.asarray(n),
-                             q_near=cfg.joints[k])
+        q = hand2d.finger_ik(
+            hand, cfg.base, k, np.asarray(tip) - s * np.asarray(n), q_near=cfg.joints[k]
+        )
         return None if q is None else cfg.with_finger(k, q)
 
     def _exit_config(self, t: float, now: Config, motion: Motion) -> Config | None:
@@ -321,14 +374,16 @@ class ContactPlanner:
         hand, st, p = self.hand, self.stick, self.params
         cands = [tuple(cfg.joints[j])] + self._passive_grid
         tips = np.array([hand2d.finger_tip(hand, cfg.base, j, q) for q in cands])
-        hit = covered(motion, times, tips, 0.5 * st.length, 0.5 * st.width,
-                      hand.tip_radius + p.sweep_margin).any(axis=0)
-        far = np.linalg.norm(tips - active_tip[None, :], axis=1) > 2.0 * hand.tip_radius \
-            + p.sweep_margin
+        hit = covered(
+            motion, times, tips, 0.5 * st.length, 0.5 * st.width, hand.tip_radius + p.sweep_margin
+        ).any(axis=0)
+        far = (
+            np.linalg.norm(tips - active_tip[None, :], axis=1)
+            > 2.0 * hand.tip_radius + p.sweep_margin
+        )
         ok = np.flatnonzero(~hit & far)
         if ok.size == 0:
             return None
         cur = np.array(cfg.joints[j])
         dist = [float(np.max(np.abs(np.array(cands[i]) - cur))) for i in ok]
         return cands[int(ok[int(np.argmin(dist))])]
-

@@ -26,8 +26,14 @@ from replay.control.stick.estimator import StickEstimate
 from replay.control.stick.hand_model import Config, HandModel
 
 # Config and HandModel are re-exported: callers (the tests) model the hand with them
-__all__ = ["TwoStepParams", "ThreeStepParams", "TwoStepController", "ThreeStepController",
-           "Config", "HandModel"]
+__all__ = [
+    "TwoStepParams",
+    "ThreeStepParams",
+    "TwoStepController",
+    "ThreeStepController",
+    "Config",
+    "HandModel",
+]
 
 
 # ------------------------------------------------------------------------------------------
@@ -42,13 +48,23 @@ class TwoStepParams(StickCaptureParams):
 
 @dataclass
 class ThreeStepParams(StickCaptureParams):
-    lambda_2: list[float] = param([1.0, 0.0], unit="1", length=2, ge=-1.0, le=1.0,
-                           doc="selection vector lambda_2 of eq. 36: the direction of v_2 "
-                               "(default: along world x, the stick perpendicular to the palm)")
-    lambda_2_auto_sign: bool = param(True, unit="1", choices=(True, False),
-                                     doc="use -lambda_2 when that sends the stick toward the "
-                                         "centre of the base range (tried first; the other "
-                                         "sign only if it cannot be reached)")
+    lambda_2: list[float] = param(
+        [1.0, 0.0],
+        unit="1",
+        length=2,
+        ge=-1.0,
+        le=1.0,
+        doc="selection vector lambda_2 of eq. 36: the direction of v_2 "
+        "(default: along world x, the stick perpendicular to the palm)",
+    )
+    lambda_2_auto_sign: bool = param(
+        True,
+        unit="1",
+        choices=(True, False),
+        doc="use -lambda_2 when that sends the stick toward the "
+        "centre of the base range (tried first; the other "
+        "sign only if it cannot be reached)",
+    )
 
     def __post_init__(self) -> None:
         if math.hypot(*self.lambda_2) < 1e-6:
@@ -118,5 +134,5 @@ class ThreeStepController(StickCaptureController):
             return (0, 1), False
         v2 = np.array(sol.u_after[:2])
         proj = [float(np.dot(self.hand.root_offsets[k], v2)) for k in (0, 1)]
-        rear = int(np.argmin(proj))     # the finger that pushes stays behind the stick
+        rear = int(np.argmin(proj))  # the finger that pushes stays behind the stick
         return (rear, 1 - rear), True

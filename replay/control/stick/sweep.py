@@ -18,12 +18,13 @@ import numpy as np
 
 from replay.control.stick.estimator import StickEstimate
 
-SAMPLE_DT = 0.001      # s, time step of the predicted-sweep checks
+SAMPLE_DT = 0.001  # s, time step of the predicted-sweep checks
 
 
 @dataclass(frozen=True)
 class Motion:
     """Constant velocities from ``est``; from ``t_switch`` on, ``u_after`` (a planned contact)."""
+
     est: StickEstimate
     t_switch: float = math.inf
     u_after: tuple = (0.0, 0.0, 0.0)
@@ -50,19 +51,22 @@ def _body(motion: Motion, times, points) -> tuple[np.ndarray, np.ndarray]:
     c, th = motion.poses(times)
     cs, sn = np.cos(th), np.sin(th)
     d = np.asarray(points, dtype=float)[None, :, :] - c[:, None, :]
-    return d[..., 0] * cs[:, None] + d[..., 1] * sn[:, None], \
-        -d[..., 0] * sn[:, None] + d[..., 1] * cs[:, None]
+    return d[..., 0] * cs[:, None] + d[..., 1] * sn[:, None], -d[..., 0] * sn[:, None] + d[
+        ..., 1
+    ] * cs[:, None]
 
 
-def covered(motion: Motion, times, points, half_length: float, half_width: float,
-            grow) -> np.ndarray:
+def covered(
+    motion: Motion, times, points, half_length: float, half_width: float, grow
+) -> np.ndarray:
     """(len(times), len(points)) booleans: point within ``grow`` of the stick rectangle."""
     xb, yb = _body(motion, times, np.asarray(points, dtype=float).reshape(-1, 2))
     return (np.abs(xb) <= half_length + grow) & (np.abs(yb) <= half_width + grow)
 
 
-def covered_along(motion: Motion, times, points, half_length: float, half_width: float,
-                  grow) -> np.ndarray:
+def covered_along(
+    motion: Motion, times, points, half_length: float, half_width: float, grow
+) -> np.ndarray:
     """(T,) booleans: points[i] (a moving point, (T, 2)) within ``grow`` of the stick at
     times[i]; ``grow`` a scalar or (T,)."""
     c, th = motion.poses(times)
