@@ -4,7 +4,7 @@ As scenarios/catch_optimised.yaml derives its nominal throw: the ball passes r_o
 (2.34, 0, 0.90) m (where both stereo images first see it whole) at t0 = 0.1 s with the launch
 velocity that reaches the catch point l([0, pi/4, 0, pi/2]) = (0.72090, 0, 0.46656) m (plus an
 ``offset``) at ``speed``; released 0.1 s earlier. The sweep files under sweeps/ carry the numbers
-(tests/test_sweep_files.py re-derives them).
+(tests/replay/sweep/test_sweep_files.py re-derives them).
 """
 
 from __future__ import annotations

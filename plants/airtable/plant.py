@@ -11,7 +11,7 @@
   the two shapes' values by product; the fingertip's are 1, so the pair gets exactly e and mu).
 
 Chipmunk2D facts this relies on (read in Munk2D's cpSpaceStep.c/cpArbiter.c, the engine of
-Pymunk 7, and checked by tests/test_airtable_plant.py):
+Pymunk 7, and checked by tests/plants/airtable/test_airtable_plant.py):
 positions are integrated at the start of a step, contacts are then detected at the new
 positions and velocities solved; restitution is a per-contact "bounce" target computed from the
 velocity before the solve; on later steps of a persisting contact the bounce target asks for an

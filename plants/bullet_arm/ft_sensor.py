@@ -3,7 +3,7 @@ flange-palm joint (``palm_joint``, kept as a joint: the URDF is loaded without m
 links).
 
 ``getJointState(...)[2]`` gives ``(Fx, Fy, Fz, Mx, My, Mz)`` in the joint frame (= the palm
-frame = the tool frame). Measured (tests/test_grasp_plant.py, the hand hanging from the flange,
+frame = the tool frame). Measured (tests/plants/bullet_arm/test_grasp_plant.py, the hand hanging from the flange,
 a known static load): it is the wrench the **parent (arm) exerts on the child (hand)**, the
 moment taken about the **child link's centre of mass** (the palm's inertial origin), not about
 the joint. Converted here to what a wrist sensor reports: the force and torque the hand side

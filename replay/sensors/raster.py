@@ -11,7 +11,7 @@ pixel (the integral of the winding number over the pixel: exact, for any simple 
 rounding). Pieces left of the window count at its left edge, pieces right of it or outside its
 rows are dropped, so a window of a large polygon is cut exactly. The cost grows with the
 polygon's perimeter in pixels, not with its area times its number of edges as the closed-form
-per-pixel coverage (kept as the reference in tests/test_raster.py) does.
+per-pixel coverage (kept as the reference in tests/replay/sensors/test_raster.py) does.
 """
 
 from __future__ import annotations

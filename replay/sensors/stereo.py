@@ -44,7 +44,7 @@ meet at ~88 deg at x = 2.2 m (0.57 m from each camera) and ~23 deg at the catch 
 The arm (not in the plant's scene today) is then background, not an occluder between the
 cameras and the ball. The 35 mm ball spans ~8 px at x = 2.2 m and ~2 px at the catch point.
 
-Accuracy (tests/test_stereo_vision.py; the paper states none): noise-free, over 432 points of
+Accuracy (tests/replay/sensors/test_stereo_vision.py; the paper states none): noise-free, over 432 points of
 the last 1.5 m of such throws, worst 1.25 mm, median 0.13 mm, the worst near the catch point,
 where the centroid of a 2-px blob carries the pixel grid's own sampling error (~0.03 px, the
 same for a real sensor) and the rays meet at 23 deg; with 1-bit moments, worst 24.5 mm, median

@@ -9,7 +9,7 @@ touches (4-neighbourhood) a pixel of its old one. Moving by s > 1 pixels a frame
 only the part of the new image within one pixel of the old target survives: the target loses
 s - 1 pixels a frame on its leading side... and the window then follows only what is left, so the
 target shrinks every frame and is lost after about ``width / (s - 1)`` frames (measured in
-tests/test_grasping_vision.py and stated in docs/grasping.md). At 1 kHz that bound is what
+tests/replay/control/grasping/test_grasping_vision.py and stated in docs/grasping.md). At 1 kHz that bound is what
 makes the algorithm work: 1 pixel a millisecond is fast (here ~13 mrad/ms, 10 m/s at 0.8 m).
 
 When the window holds nothing (the target lost, or the first frame), the whole image is the
