@@ -1,0 +1,59 @@
+"""The grasping ablation (sweeps/grasp_loops.yaml): grasp rate and tracking error against the loop
+period of every task and the vision chip, one line per speed of the human hand."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from analysis.ablation_table import grasped, mean_by, overall, pct, rate_by  # noqa: E402
+from analysis.figure_files import save  # noqa: E402
+
+PERIOD = "loop_period_ms"
+SPEED = "plant.params.human_speed"
+TRACKING = "m.tracking_error_rms"   # m: in-plane, grasp point to object centre, before the grasp
+
+
+def plot_loops(rows: list[dict], out: Path, stem: str) -> list[Path]:
+    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
+    errors = mean_by(rows, PERIOD, SPEED, TRACKING)
+    for speed, (xs, ys) in sorted(rate_by(rows, PERIOD, SPEED, grasped).items(),
+                                  key=lambda kv: float(kv[0])):
+        label = f"object {float(speed):g} m/s RMS"
+        ax.plot(xs, ys, "o-", label=label)
+        ex, ey = errors[speed]
+        ax2.plot(ex, np.asarray(ey) * 1e3, "o-", label=label)
+    for a in (ax, ax2):
+        a.axvline(1.0, color="0.5", lw=0.8, ls=":", label="paper: 1 ms" if a is ax else None)
+        a.set_xscale("log")
+        a.grid(True, alpha=0.3)
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_ylabel("grasp rate")
+    ax2.set_ylabel("RMS tracking error\nbefore the grasp [mm]", fontsize=8)
+    ax2.set_xlabel("loop period of every task and the vision chip [ms]")
+    ax.legend(fontsize=8)
+    ax.set_title("Grasping: grasp rate and tracking error vs loop period", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out, stem)
+
+
+def summary_loops(rows: list[dict]) -> str:
+    rates = rate_by(rows, PERIOD, SPEED, grasped)
+    errors = mean_by(rows, PERIOD, SPEED, TRACKING)
+    parts = []
+    for speed in sorted(rates, key=float):
+        xs, ys = rates[speed]
+        ok = [x for x, y in zip(xs, ys) if y > 0]
+        _, es = errors[speed]
+        err = ", ".join("n/a" if np.isnan(e) else f"{e * 1e3:.0f}" for e in es)
+        longest = f"grasps up to {max(ok):g} ms" if ok else "no grasp at any period"
+        parts.append(f"at {float(speed):g} m/s {longest} "
+                     f"({', '.join(f'{pct(y)} at {x:g}' for x, y in zip(xs, ys))} ms), "
+                     f"tracking error {err} mm")
+    return (f"Grasp rate against loop period ({overall(rows, grasped, 'grasped')}): "
+            + "; ".join(parts) + ".")
