@@ -48,12 +48,10 @@ def summary_loops(rows: list[dict]) -> str:
     parts = []
     for speed in sorted(rates, key=float):
         xs, ys = rates[speed]
-        ok = [x for x, y in zip(xs, ys) if y > 0]
         _, es = errors[speed]
+        ok = ", ".join(f"{x:g}" + ("" if y == 1 else f" ({pct(y)})") for x, y in zip(xs, ys) if y)
         err = ", ".join("n/a" if np.isnan(e) else f"{e * 1e3:.0f}" for e in es)
-        longest = f"grasps up to {max(ok):g} ms" if ok else "no grasp at any period"
-        parts.append(f"at {float(speed):g} m/s {longest} "
-                     f"({', '.join(f'{pct(y)} at {x:g}' for x, y in zip(xs, ys))} ms), "
-                     f"tracking error {err} mm")
+        parts.append(f"at {float(speed):g} m/s grasped with {ok or 'no'} ms loops, "
+                     f"RMS tracking error {err} mm at {', '.join(f'{x:g}' for x in xs)} ms")
     return (f"Grasp rate against loop period ({overall(rows, grasped, 'grasped')}): "
             + "; ".join(parts) + ".")
