@@ -22,15 +22,21 @@ TRACKING = "m.tracking_error_rms"   # m: in-plane, grasp point to object centre,
 def plot_loops(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     errors = mean_by(rows, PERIOD, SPEED, TRACKING)
-    for speed, (xs, ys) in sorted(rate_by(rows, PERIOD, SPEED, grasped).items(),
-                                  key=lambda kv: float(kv[0])):
-        label = f"object {float(speed):g} m/s RMS"
-        ax.plot(xs, ys, "o-", label=label)
+    periods: set = set()
+    curves = sorted(rate_by(rows, PERIOD, SPEED, grasped).items(), key=lambda kv: float(kv[0]))
+    for i, (speed, (xs, ys)) in enumerate(curves):
+        # markers shrink line by line so that coinciding curves stay visible
+        style = {"marker": "osD^v"[i % 5], "markersize": 9 - 2 * (i % 4), "lw": 2.4 - 0.6 * (i % 4),
+                 "label": f"object {float(speed):g} m/s RMS"}
+        ax.plot(xs, ys, **style)
         ex, ey = errors[speed]
-        ax2.plot(ex, np.asarray(ey) * 1e3, "o-", label=label)
+        ax2.plot(ex, np.asarray(ey) * 1e3, **style)
+        periods.update(xs)
     for a in (ax, ax2):
         a.axvline(1.0, color="0.5", lw=0.8, ls=":", label="paper: 1 ms" if a is ax else None)
         a.set_xscale("log")
+        a.set_xticks(sorted(periods), [f"{x:g}" for x in sorted(periods)])
+        a.minorticks_off()
         a.grid(True, alpha=0.3)
     ax.set_ylim(-0.05, 1.05)
     ax.set_ylabel("grasp rate")
