@@ -25,6 +25,13 @@ def captured(row: dict) -> bool:
     return as_bool(row.get("success")) and count(row, "capture") > 0
 
 
+def grasped(row: dict) -> bool:
+    """The object was grasped and held (the outcome a success: at least one grasp held long enough
+    while the human kept moving it)."""
+    n = as_float(row.get("m.grasps"))
+    return as_bool(row.get("success")) and not np.isnan(n) and n > 0
+
+
 def rate_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[list, list]]:
     """{line value: (sorted x values, success rate at each)} over the rows."""
     groups: dict = defaultdict(lambda: defaultdict(list))

@@ -139,12 +139,6 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
             if sf.paper != key:
                 continue
             sec.ablations.append(_ablation(sf, out, ablations))
-        if key == "namiki1999" and not sec.ablations:
-            sec.notes.append(
-                "TODO: the grasping paper's ablations (grasp rate and tracking error "
-                "against the loop period 1-33 ms and the object's speed) are still "
-                "to be added as sweeps/grasp_*.yaml."
-            )
         sections.append(sec)
     info = _provenance(code_version())
     commands = _commands(sections, logs)

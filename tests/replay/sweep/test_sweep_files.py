@@ -15,7 +15,7 @@ from replay.sweep.worker import load_function
 NAMES = ablations.names()
 
 
-def test_there_are_catching_and_stick_ablations():
+def test_there_are_catching_stick_and_grasping_ablations():
     assert {
         "catch_vision",
         "catch_throw_speed",
@@ -23,7 +23,30 @@ def test_there_are_catching_and_stick_ablations():
         "catch_direct_vs_predictive",
         "stick_friction",
         "stick_vision",
+        "grasp_loops",
     } <= set(NAMES)
+
+
+def test_grasp_loops_slows_every_loop_together(project_root):
+    """Each loop period sets every task and the vision chip to the same rate (latency one frame),
+    each rate a whole number of 1 kHz physics steps, periods 1 to 33 ms."""
+    from replay.scenario.loader import load_scenario
+
+    sf = ablations.load("grasp_loops")
+    sc = load_scenario(sf.scenario)
+    (axis,) = [a for a in sf.spec.grid if a.name == "loop_period_ms"]
+    periods = [float(label) for label in axis.labels]
+    assert min(periods) == 1.0 and max(periods) == 33.0
+    for period, sets in zip(periods, axis.values):
+        assert {k for k in sets if k.startswith("tasks.")} == {f"tasks.{t}.rate" for t in sc.tasks}
+        rates = [v for k, v in sets.items() if k.endswith(".rate")]
+        np.testing.assert_allclose(rates, 1e3 / period, rtol=1e-9)
+        assert sets["sensors.chip.rate"] == pytest.approx(1e3 / period, rel=1e-9)
+        assert sets["sensors.chip.latency"] == pytest.approx(period * 1e-3, rel=1e-9)
+        steps = sc.timing.physics_rate * period * 1e-3
+        assert steps == pytest.approx(round(steps), abs=1e-6)
+    (speeds,) = [a for a in sf.spec.grid if a.name == "plant.params.human_speed"]
+    assert len(speeds.values) >= 2
 
 
 @pytest.mark.parametrize("name", NAMES)

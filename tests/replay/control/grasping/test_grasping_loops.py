@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
-from test_grasp_plant import rig  # noqa: E402
+from grasp_rig import rig  # noqa: E402
 
 from replay.control.grasping.arm_control import ArmControlTask, ArmParams  # noqa: E402
 from replay.control.grasping.hand_control import HandControlTask, HandParams  # noqa: E402

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
-from test_grasp_plant import rig  # noqa: E402
+from grasp_rig import rig  # noqa: E402
 
 from plants.bullet_arm.head import HeadServo  # noqa: E402
 from replay.control.grasping.features import blob  # noqa: E402

@@ -1,0 +1,72 @@
+"""The grasping ablation (sweeps/grasp_loops.yaml): grasp rate and tracking error against the loop
+period of every task and the vision chip, one line per speed of the human hand."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from analysis.ablation_table import grasped, mean_by, overall, pct, rate_by  # noqa: E402
+from analysis.figure_files import save  # noqa: E402
+
+PERIOD = "loop_period_ms"
+SPEED = "plant.params.human_speed"
+TRACKING = "m.tracking_error_rms"  # m: in-plane, grasp point to object centre, before the grasp
+
+
+def plot_loops(rows: list[dict], out: Path, stem: str) -> list[Path]:
+    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
+    errors = mean_by(rows, PERIOD, SPEED, TRACKING)
+    periods: set = set()
+    curves = sorted(rate_by(rows, PERIOD, SPEED, grasped).items(), key=lambda kv: float(kv[0]))
+    for i, (speed, (xs, ys)) in enumerate(curves):
+        # markers shrink line by line so that coinciding curves stay visible
+        style = {
+            "marker": "osD^v"[i % 5],
+            "markersize": 9 - 2 * (i % 4),
+            "lw": 2.4 - 0.6 * (i % 4),
+            "label": f"object {float(speed):g} m/s RMS",
+        }
+        ax.plot(xs, ys, **style)
+        ex, ey = errors[speed]
+        ax2.plot(ex, np.asarray(ey) * 1e3, **style)
+        periods.update(xs)
+    for a in (ax, ax2):
+        a.axvline(1.0, color="0.5", lw=0.8, ls=":", label="paper: 1 ms" if a is ax else None)
+        a.set_xscale("log")
+        a.set_xticks(sorted(periods), [f"{x:g}" for x in sorted(periods)])
+        a.minorticks_off()
+        a.grid(True, alpha=0.3)
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_ylabel("grasp rate")
+    ax2.set_ylabel("RMS tracking error\nbefore the grasp [mm]", fontsize=8)
+    ax2.set_xlabel("loop period of every task and the vision chip [ms]")
+    ax.legend(fontsize=8)
+    ax.set_title("Grasping: grasp rate and tracking error vs loop period", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out, stem)
+
+
+def summary_loops(rows: list[dict]) -> str:
+    rates = rate_by(rows, PERIOD, SPEED, grasped)
+    errors = mean_by(rows, PERIOD, SPEED, TRACKING)
+    parts = []
+    for speed in sorted(rates, key=float):
+        xs, ys = rates[speed]
+        _, es = errors[speed]
+        ok = ", ".join(f"{x:g}" + ("" if y == 1 else f" ({pct(y)})") for x, y in zip(xs, ys) if y)
+        err = ", ".join("n/a" if np.isnan(e) else f"{e * 1e3:.0f}" for e in es)
+        parts.append(
+            f"at {float(speed):g} m/s grasped with {ok or 'no'} ms loops, "
+            f"RMS tracking error {err} mm at {', '.join(f'{x:g}' for x in xs)} ms"
+        )
+    return (
+        f"Grasp rate against loop period ({overall(rows, grasped, 'grasped')}): "
+        + "; ".join(parts)
+        + "."
+    )
