@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from replay.control.catching.estimator import BallisticEstimator
-from replay.control.catching.model import ArmModel
+from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
 from replay.control.catching.optimise import (
     CostRecord,
     OptimResult,
@@ -266,24 +266,12 @@ class CatchingController(Controller):
         names = tuple(spec.joint_names)
         self.names = names
         self.n = len(names)
-        held = [names.index(j) for j in P.held_joints]
-        self.active = tuple(i for i in range(self.n) if i not in held)
-        if len(self.active) != 3 or names.index(P.selected_joint) != self.active[-1]:
-            raise ValueError(
-                f"the catching mapping needs 3 active joints ending with "
-                f"{P.selected_joint}; got {[names[i] for i in self.active]}"
-            )
+        self.active = active_joints(names, P.held_joints, P.selected_joint, "the catching mapping")
         self.q_init = np.asarray(spec.initial_q, float).copy()
         self.tau_limit = np.asarray(spec.torque_limits, float)
         self.gravity = np.array([0.0, 0.0, -float(getattr(spec, "gravity", 9.81))])
         if model is None:
-            off = P.catch_offset
-            if off < 0:
-                off = 0.0
-                if getattr(spec, "hand", None) is not None:
-                    off += float(spec.hand.table.palm_thickness)
-                if getattr(spec, "object", None) is not None:
-                    off += float(spec.object.radius)
+            off = catch_point_offset(spec, P.catch_offset)
             self.catch_offset = off
             model = ArmModel.from_chain(
                 spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)

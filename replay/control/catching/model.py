@@ -127,3 +127,27 @@ class ArmModel:
             Tq[:, k] = (self.tau(p + e, pd, pdd) - tau) / h
             Tqd[:, k] = (self.tau(p, pd + e, pdd) - tau) / h
         return tau, Tq, Tqd, self.mass(p)
+
+
+def active_joints(names: tuple[str, ...], held, selected: str, who: str) -> tuple[int, ...]:
+    """Indices of the three moving joints (Sec. IV-A: axes 1, 2, 4), the last being ``selected``."""
+    held_i = [names.index(j) for j in held]
+    active = tuple(i for i in range(len(names)) if i not in held_i)
+    if len(active) != 3 or names.index(selected) != active[-1]:
+        raise ValueError(
+            f"{who} needs 3 active joints ending with {selected}; got {[names[i] for i in active]}"
+        )
+    return active
+
+
+def catch_point_offset(spec, catch_offset: float) -> float:
+    """The catch point along the tool z axis: ``catch_offset``, or (< 0) the palm's thickness
+    plus the ball's radius, so that the ball centre rests on the palm."""
+    if catch_offset >= 0:
+        return catch_offset
+    off = 0.0
+    if getattr(spec, "hand", None) is not None:
+        off += float(spec.hand.table.palm_thickness)
+    if getattr(spec, "object", None) is not None:
+        off += float(spec.object.radius)
+    return off

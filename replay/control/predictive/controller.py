@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from replay.control.catching.mapping import CatchGeometry
-from replay.control.catching.model import ArmModel
+from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
 from replay.control.predictive.kalman import BallKalman, first_crossing
 from replay.control.predictive.trajectory import Quintic
 from replay.interfaces import Controller, Occurrence
@@ -127,23 +127,13 @@ class PredictiveController(Controller):
         names = tuple(spec.joint_names)
         self.names = names
         self.n = len(names)
-        held = [names.index(j) for j in P.held_joints]
-        self.active = tuple(i for i in range(self.n) if i not in held)
-        if len(self.active) != 3 or names.index(P.selected_joint) != self.active[-1]:
-            raise ValueError(
-                f"the predictive baseline needs 3 active joints ending with "
-                f"{P.selected_joint}; got {[names[i] for i in self.active]}"
-            )
+        self.active = active_joints(
+            names, P.held_joints, P.selected_joint, "the predictive baseline"
+        )
         self.q_init = np.asarray(spec.initial_q, float).copy()
         self.tau_limit = np.asarray(spec.torque_limits, float)
         self.gravity = np.array([0.0, 0.0, -float(spec.gravity)])
-        off = P.catch_offset
-        if off < 0:
-            off = 0.0
-            if spec.hand is not None:
-                off += float(spec.hand.table.palm_thickness)
-            if spec.object is not None:
-                off += float(spec.object.radius)
+        off = catch_point_offset(spec, P.catch_offset)
         self.model = ArmModel.from_chain(
             spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)
         )
