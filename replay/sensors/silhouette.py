@@ -35,7 +35,7 @@ import numpy as np
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
-from replay.sensors.raster import coverage_blocks, paint
+from replay.sensors.raster import composite
 
 ELLIPSE_VERTICES = 48  # vertices of the polygon standing in for an ellipse
 _NEAR = 1e-6  # m: nearest depth drawn
@@ -174,41 +174,36 @@ def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse
 # --- raster --------------------------------------------------------------------------------
 
 
-def _block(poly: np.ndarray, w: int, h: int):
-    """The pixel block (x0, y0, w, h) of a polygon's bounding box plus a pixel, clipped to a
-    w x h image, or None if it is off the image."""
-    x0 = max(int(math.floor(poly[:, 0].min())) - 1, 0)
-    y0 = max(int(math.floor(poly[:, 1].min())) - 1, 0)
-    x1 = min(int(math.ceil(poly[:, 0].max())) + 2, w)
-    y1 = min(int(math.ceil(poly[:, 1].max())) + 2, h)
-    return (x0, y0, x1 - x0, y1 - y0) if x1 > x0 and y1 > y0 else None
+def _drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float]]:
+    """(convex polygon in pixels, grey level) of each primitive drawn by ``camera``, far first."""
+    items = []
+    for i, prim in enumerate(scene.primitives):
+        s = silhouette(camera, prim)
+        if s is not None:
+            items.append((-s[0], i, prim, s[1]))
+    items.sort(key=lambda it: (it[0], it[1]))  # far first
+    out = []
+    for _, _, prim, shape in items:
+        poly = shape.polygon() if isinstance(shape, Ellipse) else shape
+        if len(poly) >= 3:
+            out.append((poly, 255.0 * float(prim.albedo)))
+    return out
 
 
 def render_views(cameras, scene: Scene, *, background: float = 0.1) -> list[np.ndarray]:
-    """:func:`render` for several cameras at once: the coverage of every silhouette in every
-    view is computed in one pass (:func:`~replay.sensors.raster.coverage_blocks`)."""
-    images, jobs = [], []  # (view, polygon, grey, block)
-    for view, camera in enumerate(cameras):
-        k = camera.intrinsics
-        images.append(np.full((k.height, k.width), 255.0 * background, np.float32))
-        items = []
-        for i, prim in enumerate(scene.primitives):
-            s = silhouette(camera, prim)
-            if s is not None:
-                items.append((-s[0], i, prim, s[1]))
-        items.sort(key=lambda it: (it[0], it[1]))  # far first
-        for _, _, prim, shape in items:
-            poly = shape.polygon() if isinstance(shape, Ellipse) else shape
-            block = _block(poly, k.width, k.height) if len(poly) >= 3 else None
-            if block is not None:
-                jobs.append((view, poly, 255.0 * float(prim.albedo), block))
-    covs = coverage_blocks([j[1] for j in jobs], [j[3] for j in jobs])
-    for (view, _, grey, (x0, y0, w, h)), cov in zip(jobs, covs):  # in each view far to near
-        paint(images[view][y0 : y0 + h, x0 : x0 + w], cov, grey)
-    return images
+    """:func:`render` for several cameras."""
+    return [render(camera, scene, background=background) for camera in cameras]
 
 
-def render(camera: PinholeCamera, scene: Scene, *, background: float = 0.1) -> np.ndarray:
+def render(
+    camera: PinholeCamera, scene: Scene, *, background: float = 0.1, window=None
+) -> np.ndarray:
     """A noiseless float32 grey image (0..255) of the scene's silhouettes, each at grey level
-    ``255 * albedo``, on a uniform background of albedo ``background``."""
-    return render_views([camera], scene, background=background)[0]
+    ``255 * albedo``, on a uniform background of albedo ``background``; with ``window = (x0,
+    y0, x1, y1)`` only that part of the image (pixel (x0, y0) is pixel (0, 0) of the result)."""
+    k = camera.intrinsics
+    x0, y0, x1, y1 = window if window is not None else (0, 0, k.width, k.height)
+    img = np.full((y1 - y0, x1 - x0), 255.0 * background, np.float32)
+    drawn = _drawables(camera, scene)
+    composite(img, [d[0] for d in drawn], [d[1] for d in drawn], origin=(x0, y0))
+    return img
