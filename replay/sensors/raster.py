@@ -13,7 +13,7 @@ rows are dropped, so a window of a large polygon is cut exactly. The cost grows 
 polygon's perimeter in pixels, not with its area times its number of edges as the closed-form
 per-pixel coverage (kept as the reference in tests/replay/sensors/test_raster.py) does.
 
-The accumulation runs compiled (:mod:`replay.sensors.kernels`): it was a few dozen NumPy calls
+The accumulation runs compiled (``replay/sensors/_pixels.c``): it was a few dozen NumPy calls
 on short arrays per frame, whose overhead, not their arithmetic, was the cost. It is exact:
 equal to the reference to 1e-12 over random polygons and windows (test_raster.py).
 """
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from replay.sensors import kernels
+from replay.sensors import _pixels
 
 
 def _pack(polygons) -> tuple[np.ndarray, np.ndarray]:
@@ -42,7 +42,7 @@ def coverage(polygons, x0: int, y0: int, w: int, h: int) -> np.ndarray:
     P, starts = _pack(polygons)
     for i in range(len(polygons)):
         if starts[i + 1] - starts[i] >= 3 and w > 0 and h > 0:
-            kernels.coverage_into(P, starts[i], starts[i + 1], x0, y0, out[i])
+            _pixels.coverage(P[starts[i] : starts[i + 1]], x0, y0, out[i], w, h)
     return out
 
 
@@ -54,4 +54,6 @@ def composite(img: np.ndarray, polygons, greys, origin=(0, 0)) -> None:
     if not len(polygons) or img.size == 0:
         return
     P, starts = _pack(polygons)
-    kernels.composite(P, starts, np.asarray(greys, np.float64), int(origin[0]), int(origin[1]), img)
+    h, w = img.shape
+    g = np.asarray(greys, np.float64)
+    _pixels.composite(P, starts, g, int(origin[0]), int(origin[1]), img, w, h)
