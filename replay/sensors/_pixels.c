@@ -154,29 +154,27 @@ done:
     return ret;
 }
 
-/* composite(xy, starts, greys, ox, oy, img, w, h): alpha-composite polygons
- * xy[starts[i]:starts[i+1]] (int64 starts, vertex indices) of grey levels greys (float64) onto
- * the float32 image img (h x w, whose first pixel is (ox, oy) of the full image) in place, far
- * first: img += alpha (grey - img), alpha each pixel's exact covered area clipped to [0, 1], in
- * float32 (as NumPy's compositing did). */
+/* composite(polygons, greys, ox, oy, img, w, h): alpha-composite polygons (a sequence of
+ * C-contiguous float64 (n, 2) vertex arrays, pixels of the full image) of grey levels greys (a
+ * sequence of floats) onto the float32 image img (h x w, whose first pixel is (ox, oy) of the
+ * full image) in place, far first: img += alpha (grey - img), alpha each pixel's exact covered
+ * area clipped to [0, 1], in float32 (as NumPy's compositing did). */
 static PyObject *py_composite(PyObject *self, PyObject *args) {
-    Py_buffer P, S, G, I;
+    PyObject *polys, *greys;
+    Py_buffer I;
     int ox, oy, w, h;
-    if (!PyArg_ParseTuple(args, "y*y*y*iiw*ii", &P, &S, &G, &ox, &oy, &I, &w, &h)) return NULL;
-    PyObject *ret = NULL;
-    Py_ssize_t npoly = S.len / (Py_ssize_t)sizeof(int64_t) - 1;
-    Py_ssize_t nv = P.len / (2 * (Py_ssize_t)sizeof(double));
-    const int64_t *starts = S.buf;
-    const double *greys = G.buf;
+    if (!PyArg_ParseTuple(args, "OOiiw*ii", &polys, &greys, &ox, &oy, &I, &w, &h)) return NULL;
+    PyObject *ret = NULL, *pseq = NULL, *gseq = NULL;
     double *acc = NULL;
-    if (w < 0 || h < 0 || npoly < 0 || !check(&I, sizeof(float), (Py_ssize_t)w * h, "img") ||
-        !check(&G, sizeof(double), npoly, "greys"))
+    if (w < 0 || h < 0 || !check(&I, sizeof(float), (Py_ssize_t)w * h, "img")) goto done;
+    pseq = PySequence_Fast(polys, "polygons: not a sequence");
+    gseq = pseq ? PySequence_Fast(greys, "greys: not a sequence") : NULL;
+    if (!gseq) goto done;
+    Py_ssize_t npoly = PySequence_Fast_GET_SIZE(pseq);
+    if (PySequence_Fast_GET_SIZE(gseq) != npoly) {
+        PyErr_SetString(PyExc_ValueError, "one grey level per polygon");
         goto done;
-    for (Py_ssize_t i = 0; i <= npoly; i++)
-        if (starts[i] < 0 || starts[i] > nv || (i && starts[i] < starts[i - 1])) {
-            PyErr_SetString(PyExc_ValueError, "starts: not increasing vertex indices");
-            goto done;
-        }
+    }
     acc = calloc((size_t)h * (w + 1) + 1, sizeof(double));
     if (!acc) {
         PyErr_NoMemory();
@@ -184,34 +182,464 @@ static PyObject *py_composite(PyObject *self, PyObject *args) {
     }
     float *img = I.buf;
     for (Py_ssize_t i = 0; i < npoly; i++) {
-        Py_ssize_t n = starts[i + 1] - starts[i];
-        if (n < 3) continue;
-        int r0, r1, c0, c1;
-        accumulate((const double *)P.buf + 2 * starts[i], n, ox, oy, acc, w, h, &r0, &r1, &c0,
-                   &c1);
-        const float grey = (float)greys[i];
-        for (int r = r0; r < r1; r++) {
-            double *row = acc + (size_t)r * (w + 1);
-            float *px = img + (size_t)r * w;
-            double s = 0.0;
-            for (int c = c0; c < c1; c++) {
-                s += row[c];
-                row[c] = 0.0;
-                if (s > 0.0) {
-                    float a = (float)(s < 1.0 ? s : 1.0);
-                    px[c] += a * (grey - px[c]);
-                }
-            }
-            row[c1] = 0.0; /* the last column accumulate writes */
+        Py_buffer P;
+        if (PyObject_GetBuffer(PySequence_Fast_GET_ITEM(pseq, i), &P, PyBUF_C_CONTIGUOUS) < 0)
+            goto done;
+        double greyd = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(gseq, i));
+        if (greyd == -1.0 && PyErr_Occurred()) {
+            PyBuffer_Release(&P);
+            goto done;
         }
+        if (P.itemsize != sizeof(double) || P.len % (2 * sizeof(double))) {
+            PyBuffer_Release(&P);
+            PyErr_SetString(PyExc_ValueError, "polygons: float64 (n, 2) arrays");
+            goto done;
+        }
+        Py_ssize_t n = P.len / (2 * (Py_ssize_t)sizeof(double));
+        if (n >= 3) {
+            int r0, r1, c0, c1;
+            accumulate(P.buf, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1);
+            const float grey = (float)greyd;
+            for (int r = r0; r < r1; r++) {
+                double *row = acc + (size_t)r * (w + 1);
+                float *px = img + (size_t)r * w;
+                double s = 0.0;
+                for (int c = c0; c < c1; c++) {
+                    s += row[c];
+                    row[c] = 0.0;
+                    if (s > 0.0) {
+                        float a = (float)(s < 1.0 ? s : 1.0);
+                        px[c] += a * (grey - px[c]);
+                    }
+                }
+                row[c1] = 0.0; /* the last column accumulate writes */
+            }
+        }
+        PyBuffer_Release(&P);
     }
     Py_INCREF(Py_None);
     ret = Py_None;
 done:
     free(acc);
-    PyBuffer_Release(&P);
-    PyBuffer_Release(&S);
-    PyBuffer_Release(&G);
+    Py_XDECREF(pseq);
+    Py_XDECREF(gseq);
+    PyBuffer_Release(&I);
+    return ret;
+}
+
+/* quantise(img, out): out = clip(rint(img), 0, 255) as uint8 (img float32, out uint8, same
+ * number of pixels); rint rounds half to even, as np.rint. */
+static PyObject *py_quantise(PyObject *self, PyObject *args) {
+    Py_buffer I, O;
+    if (!PyArg_ParseTuple(args, "y*w*", &I, &O)) return NULL;
+    PyObject *ret = NULL;
+    Py_ssize_t n = O.len;
+    if (!check(&I, sizeof(float), n, "img")) goto done;
+    const float *in = I.buf;
+    uint8_t *out = O.buf;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        float v = rintf(in[i]);
+        out[i] = v <= 0.0f ? 0 : (v >= 255.0f ? 255 : (uint8_t)v); /* NaN -> 255 */
+    }
+    Py_INCREF(Py_None);
+    ret = Py_None;
+done:
+    PyBuffer_Release(&I);
+    PyBuffer_Release(&O);
+    return ret;
+}
+
+/* project_hull(body, q, p, R, o, fx, fy, cx, cy, out): the convex hull in pixels of body points
+ * (float64 (n, 3), body frame) of a rigid body at position p, orientation quaternion q = (x, y,
+ * z, w), seen by a pinhole at o with camera-to-world rotation R (float64 3 x 3, row-major); the
+ * projected points are rounded to float32 first (as cv2.convexHull of float32 points took
+ * them). The hull (counter-clockwise in image axes, no collinear vertices) is written to out
+ * (float64 (n, 2)); returns (count, umin, vmin, umax, vmax), or None if a point is not in front
+ * of the camera (depth <= 1e-6 m). */
+static int cmp_pt(const void *a, const void *b) {
+    const double *p = a, *q = b;
+    if (p[0] != q[0]) return (p[0] > q[0]) - (p[0] < q[0]);
+    return (p[1] > q[1]) - (p[1] < q[1]);
+}
+
+static double cross3(const double *o, const double *a, const double *b) {
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+static PyObject *py_project_hull(PyObject *self, PyObject *args) {
+    Py_buffer B, RB, O;
+    double qx, qy, qz, qw, px, py, pz, ox, oy, oz, fx, fy, cx, cy;
+    if (!PyArg_ParseTuple(args, "y*(dddd)(ddd)y*(ddd)ddddw*", &B, &qx, &qy, &qz, &qw, &px, &py,
+                          &pz, &RB, &ox, &oy, &oz, &fx, &fy, &cx, &cy, &O))
+        return NULL;
+    PyObject *ret = NULL;
+    double *pts = NULL;
+    Py_ssize_t n = B.len / (3 * (Py_ssize_t)sizeof(double));
+    if (B.len != n * 3 * (Py_ssize_t)sizeof(double) || !check(&RB, sizeof(double), 9, "R") ||
+        !check(&O, sizeof(double), 2 * n, "out"))
+        goto done;
+    double nq = qx * qx + qy * qy + qz * qz + qw * qw;
+    if (nq == 0.0) {
+        PyErr_SetString(PyExc_ValueError, "zero quaternion");
+        goto done;
+    }
+    double s = 2.0 / nq; /* replay.spatial.quaternion_matrix */
+    double q[9] = {1 - s * (qy * qy + qz * qz), s * (qx * qy - qz * qw), s * (qx * qz + qy * qw),
+                   s * (qx * qy + qz * qw),     1 - s * (qx * qx + qz * qz), s * (qy * qz - qx * qw),
+                   s * (qx * qz - qy * qw),     s * (qy * qz + qx * qw),     1 - s * (qx * qx + qy * qy)};
+    const double *R = RB.buf, *b = B.buf;
+    pts = malloc((size_t)(n ? n : 1) * 2 * sizeof(double));
+    if (!pts) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const double *v = b + 3 * i;
+        double d[3];
+        for (int k = 0; k < 3; k++) /* world point minus the optical centre */
+            d[k] = q[3 * k] * v[0] + q[3 * k + 1] * v[1] + q[3 * k + 2] * v[2] +
+                   (k == 0 ? px - ox : k == 1 ? py - oy : pz - oz);
+        double X = d[0] * R[0] + d[1] * R[3] + d[2] * R[6]; /* p_cam = R^T d */
+        double Y = d[0] * R[1] + d[1] * R[4] + d[2] * R[7];
+        double Z = d[0] * R[2] + d[1] * R[5] + d[2] * R[8];
+        if (!(Z > 1e-6)) {
+            Py_INCREF(Py_None);
+            ret = Py_None;
+            goto done;
+        }
+        pts[2 * i] = (float)(fx * X / Z + cx);
+        pts[2 * i + 1] = (float)(fy * Y / Z + cy);
+    }
+    /* Andrew's monotone chain */
+    qsort(pts, n, 2 * sizeof(double), cmp_pt);
+    double *hull = O.buf;
+    Py_ssize_t k = 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        while (k >= 2 && cross3(hull + 2 * (k - 2), hull + 2 * (k - 1), pts + 2 * i) <= 0.0) k--;
+        hull[2 * k] = pts[2 * i], hull[2 * k + 1] = pts[2 * i + 1], k++;
+    }
+    for (Py_ssize_t i = n - 2, t = k + 1; i >= 0; i--) {
+        while (k >= t && cross3(hull + 2 * (k - 2), hull + 2 * (k - 1), pts + 2 * i) <= 0.0) k--;
+        hull[2 * k] = pts[2 * i], hull[2 * k + 1] = pts[2 * i + 1], k++;
+    }
+    if (k > 1) k--; /* the first point is repeated at the end */
+    double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
+    for (Py_ssize_t i = 0; i < k; i++) {
+        if (hull[2 * i] < umin) umin = hull[2 * i];
+        if (hull[2 * i] > umax) umax = hull[2 * i];
+        if (hull[2 * i + 1] < vmin) vmin = hull[2 * i + 1];
+        if (hull[2 * i + 1] > vmax) vmax = hull[2 * i + 1];
+    }
+    ret = Py_BuildValue("(ndddd)", k, umin, vmin, umax, vmax);
+done:
+    free(pts);
+    PyBuffer_Release(&B);
+    PyBuffer_Release(&RB);
+    PyBuffer_Release(&O);
+    return ret;
+}
+
+/* --- blobs ------------------------------------------------------------------------------ */
+
+typedef struct {
+    int label, area, x, y, w, h; /* the largest component: its label, pixels and bounding box */
+} Blob;
+
+/* Bounding box [x0, x1) x [y0, y1) of the pixels brighter than thr; 0 if there are none. */
+static int bright_box(const uint8_t *img, int w, int h, double thr, int *x0, int *y0, int *x1,
+                      int *y1) {
+    int xa = w, ya = h, xb = -1, yb = -1;
+    for (int r = 0; r < h; r++)
+        for (int c = 0; c < w; c++)
+            if (img[(size_t)r * w + c] > thr) {
+                if (c < xa) xa = c;
+                if (c > xb) xb = c;
+                if (r < ya) ya = r;
+                yb = r;
+            }
+    if (xb < 0) return 0;
+    *x0 = xa, *y0 = ya, *x1 = xb + 1, *y1 = yb + 1;
+    return 1;
+}
+
+/* 8-connected components of the pixels brighter than thr in the box [x0, x1) x [y0, y1),
+ * labelled 1, 2, ... in raster order of their first pixel into lab (w x h, zero outside the
+ * components); the largest (the first of equal ones), as cv2.connectedComponentsWithStats and
+ * argmax over its areas give it. stack: w * h ints of scratch. */
+static Blob largest_component(const uint8_t *img, int w, int h, double thr, int x0, int y0,
+                              int x1, int y1, int32_t *lab, int32_t *stack) {
+    Blob best = {0, 0, 0, 0, 0, 0};
+    int next = 0;
+    for (int r = y0; r < y1; r++)
+        for (int c = x0; c < x1; c++) {
+            size_t i = (size_t)r * w + c;
+            if (lab[i] || !(img[i] > thr)) continue;
+            int L = ++next, top = 0, area = 0, bx0 = c, bx1 = c, by0 = r, by1 = r;
+            lab[i] = L;
+            stack[top++] = (int32_t)i;
+            while (top) {
+                int32_t k = stack[--top];
+                int kr = k / w, kc = k % w;
+                area++;
+                if (kc < bx0) bx0 = kc;
+                if (kc > bx1) bx1 = kc;
+                if (kr < by0) by0 = kr;
+                if (kr > by1) by1 = kr;
+                for (int dr = -1; dr <= 1; dr++) {
+                    int nr = kr + dr;
+                    if (nr < y0 || nr >= y1) continue;
+                    for (int dc = -1; dc <= 1; dc++) {
+                        int nc = kc + dc;
+                        if (nc < x0 || nc >= x1) continue;
+                        size_t j = (size_t)nr * w + nc;
+                        if (!lab[j] && img[j] > thr) {
+                            lab[j] = L;
+                            stack[top++] = (int32_t)j;
+                        }
+                    }
+                }
+            }
+            if (area > best.area) {
+                best.label = L, best.area = area;
+                best.x = bx0, best.y = by0, best.w = bx1 - bx0 + 1, best.h = by1 - by0 + 1;
+            }
+        }
+    return best;
+}
+
+/* near[(r - y0) * bw + c - x0] = whether pixel (c, r) of the box [x0, x1) x [y0, y1) is within
+ * 2 px (Chebyshev) of the blob L in it: the blob dilated by a 5 x 5 square, as cv2.dilate of the
+ * box draws it (separably: rows, then columns). tmp: bw * bh bytes of scratch. */
+static void dilate_blob(const int32_t *lab, int w, int L, int x0, int y0, int x1, int y1,
+                        uint8_t *near, uint8_t *tmp) {
+    int bw = x1 - x0, bh = y1 - y0;
+    for (int r = 0; r < bh; r++) {
+        const int32_t *row = lab + (size_t)(r + y0) * w + x0;
+        for (int c = 0; c < bw; c++) {
+            int any = 0;
+            for (int cc = c - 2; cc <= c + 2 && !any; cc++)
+                any = cc >= 0 && cc < bw && row[cc] == L;
+            tmp[(size_t)r * bw + c] = (uint8_t)any;
+        }
+    }
+    for (int r = 0; r < bh; r++)
+        for (int c = 0; c < bw; c++) {
+            int any = 0;
+            for (int rr = r - 2; rr <= r + 2 && !any; rr++)
+                any = rr >= 0 && rr < bh && tmp[(size_t)rr * bw + c];
+            near[(size_t)r * bw + c] = (uint8_t)any;
+        }
+}
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+typedef struct {
+    double m00, m10, m01, mu20, mu11, mu02; /* moments; central ones about the centroid */
+} Moments;
+
+/* Moments of the weights wt (n_w x n_h box, row-major) with pixel (c, r) at (c, r). */
+static Moments moments_of(const double *wt, int bw, int bh) {
+    Moments m = {0, 0, 0, 0, 0, 0};
+    for (int r = 0; r < bh; r++)
+        for (int c = 0; c < bw; c++) {
+            double v = wt[(size_t)r * bw + c];
+            m.m00 += v, m.m10 += v * c, m.m01 += v * r;
+        }
+    if (m.m00 == 0.0) return m;
+    double cx = m.m10 / m.m00, cy = m.m01 / m.m00;
+    for (int r = 0; r < bh; r++)
+        for (int c = 0; c < bw; c++) {
+            double v = wt[(size_t)r * bw + c], dx = c - cx, dy = r - cy;
+            m.mu20 += v * dx * dx, m.mu11 += v * dx * dy, m.mu02 += v * dy * dy;
+        }
+    return m;
+}
+
+/* marker_moments(img, w, h, threshold, min_pixels, ox, oy, full_w, full_h): the stick
+ * camera's marker measurement (replay/sensors/stick_camera.py StickCamera.marker_moments says
+ * what and why) on the uint8 image img (h x w, a window of the full_w x full_h image whose
+ * first pixel is (ox, oy)). None, or (u, v, angle, pixels, background, m00, m10, m01, mu20,
+ * mu11, mu02) with u, v in full-image pixels and the moments in those of the blob's box. */
+static PyObject *py_marker_moments(PyObject *self, PyObject *args) {
+    Py_buffer I;
+    int w, h, min_pixels, ox, oy, fw, fh;
+    double thr;
+    if (!PyArg_ParseTuple(args, "y*iidiiiii", &I, &w, &h, &thr, &min_pixels, &ox, &oy, &fw, &fh))
+        return NULL;
+    PyObject *ret = NULL;
+    int32_t *lab = NULL, *stack = NULL;
+    double *wt = NULL;
+    if (w <= 0 || h <= 0 || !check(&I, 1, (Py_ssize_t)w * h, "img")) goto done;
+    const uint8_t *img = I.buf;
+    int ex0, ey0, ex1, ey1;
+    if (!bright_box(img, w, h, thr, &ex0, &ey0, &ex1, &ey1)) goto none;
+    lab = calloc((size_t)w * h, sizeof(int32_t));
+    stack = malloc((size_t)w * h * sizeof(int32_t));
+    if (!lab || !stack) goto nomem;
+    Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1, ey1, lab, stack);
+    if (b.area < min_pixels) goto none;
+    if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
+        goto none; /* cut by the image border */
+    int x0 = b.x - 3 > 0 ? b.x - 3 : 0, y0 = b.y - 3 > 0 ? b.y - 3 : 0;
+    int x1 = b.x + b.w + 3 < w ? b.x + b.w + 3 : w, y1 = b.y + b.h + 3 < h ? b.y + b.h + 3 : h;
+    int bw = x1 - x0, bh = y1 - y0;
+    wt = malloc((size_t)bw * bh * sizeof(double) + 2 * (size_t)bw * bh);
+    if (!wt) goto nomem;
+    uint8_t *near = (uint8_t *)(wt + (size_t)bw * bh), *tmp = near + (size_t)bw * bh;
+    dilate_blob(lab, w, b.label, x0, y0, x1, y1, near, tmp);
+    /* the blob's binary moments: its centroid and axis */
+    for (int r = 0; r < bh; r++)
+        for (int c = 0; c < bw; c++)
+            wt[(size_t)r * bw + c] = lab[(size_t)(r + y0) * w + c + x0] == b.label;
+    Moments mb = moments_of(wt, bw, bh);
+    double a = 0.5 * atan2(2.0 * mb.mu11, mb.mu20 - mb.mu02);
+    double ex = cos(a), ey = sin(a), nx = -ey, ny = ex;
+    double cx = x0 + mb.m10 / mb.m00, cy = y0 + mb.m01 / mb.m00;
+    double amax = -INFINITY, amin = INFINITY;
+    for (int r = y0; r < y1; r++)
+        for (int c = x0; c < x1; c++)
+            if (lab[(size_t)r * w + c] == b.label) {
+                double al = (c - cx) * ex + (r - cy) * ey;
+                if (al > amax) amax = al;
+                if (al < amin) amin = al;
+            }
+    /* the background: the median of 9 pixels 2-4 px beyond each end along the axis, the
+     * brighter end winning */
+    double background = -INFINITY;
+    int have = 0;
+    double ends[2] = {amax, amin};
+    for (int e = 0; e < 2; e++) {
+        double sgn = ends[e] > 0 ? 1.0 : -1.0, vals[9];
+        int nv = 0;
+        for (int si = 0; si < 3; si++)
+            for (int oi = 0; oi < 3; oi++) {
+                double s = 2.0 + si, o = -1.0 + oi;
+                double px = cx + (ends[e] + sgn * s) * ex + o * nx;
+                double py = cy + (ends[e] + sgn * s) * ey + o * ny;
+                double ix = rint(px), iy = rint(py);
+                if (ix >= 0 && ix < w && iy >= 0 && iy < h)
+                    vals[nv++] = img[(size_t)iy * w + (size_t)ix];
+            }
+        if (!nv) continue;
+        qsort(vals, nv, sizeof(double), cmp_double);
+        double med = nv % 2 ? vals[nv / 2] : 0.5 * (vals[nv / 2 - 1] + vals[nv / 2]);
+        if (!have || med > background) background = med;
+        have = 1;
+    }
+    if (!have) goto none;
+    /* moments of the grey level above the background within the blob dilated by 2 px */
+    const float bg = (float)background;
+    for (int r = 0; r < bh; r++)
+        for (int c = 0; c < bw; c++) {
+            double v = 0.0;
+            if (near[(size_t)r * bw + c]) {
+                float d = (float)img[(size_t)(r + y0) * w + c + x0] - bg;
+                v = d > 0.0f ? d : 0.0f;
+            }
+            wt[(size_t)r * bw + c] = v;
+        }
+    Moments m = moments_of(wt, bw, bh);
+    if (m.m00 <= 0.0) goto none;
+    ret = Py_BuildValue("(dddidddddd)", ox + x0 + m.m10 / m.m00, oy + y0 + m.m01 / m.m00,
+                        0.5 * atan2(2.0 * m.mu11, m.mu20 - m.mu02), b.area, background, m.m00,
+                        m.m10, m.m01, m.mu20, m.mu11, m.mu02);
+    goto done;
+nomem:
+    PyErr_NoMemory();
+    goto done;
+none:
+    Py_INCREF(Py_None);
+    ret = Py_None;
+done:
+    free(lab);
+    free(stack);
+    free(wt);
+    PyBuffer_Release(&I);
+    return ret;
+}
+
+/* ball_blob(img, w, h, threshold, min_pixels, binary, default_background, ox, oy, full_w,
+ * full_h): the stereo camera's blob measurement (replay/sensors/stereo.py StereoBallCamera.blob
+ * says what and why) on the uint8 image img (h x w, a window of the full_w x full_h image whose
+ * first pixel is (ox, oy)). None, or (u, v, area, background) in full-image pixels, background
+ * NaN for binary moments. */
+static PyObject *py_ball_blob(PyObject *self, PyObject *args) {
+    Py_buffer I;
+    int w, h, min_pixels, binary, ox, oy, fw, fh;
+    double thr, default_bg;
+    if (!PyArg_ParseTuple(args, "y*iididiiii", &I, &w, &h, &thr, &min_pixels, &binary,
+                          &default_bg, &ox, &oy, &fw, &fh))
+        return NULL;
+    PyObject *ret = NULL;
+    int32_t *lab = NULL, *stack = NULL;
+    double *wt = NULL;
+    if (w <= 0 || h <= 0 || !check(&I, 1, (Py_ssize_t)w * h, "img")) goto done;
+    const uint8_t *img = I.buf;
+    int ex0, ey0, ex1, ey1;
+    if (!bright_box(img, w, h, thr, &ex0, &ey0, &ex1, &ey1)) goto none;
+    lab = calloc((size_t)w * h, sizeof(int32_t));
+    stack = malloc((size_t)w * h * sizeof(int32_t));
+    if (!lab || !stack) goto nomem;
+    Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1, ey1, lab, stack);
+    if (b.area < min_pixels) goto none;
+    if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
+        goto none; /* cut by the image border */
+    int x0 = b.x - 4 > 0 ? b.x - 4 : 0, y0 = b.y - 4 > 0 ? b.y - 4 : 0;
+    int x1 = b.x + b.w + 4 < w ? b.x + b.w + 4 : w, y1 = b.y + b.h + 4 < h ? b.y + b.h + 4 : h;
+    int bw = x1 - x0, bh = y1 - y0;
+    wt = malloc((size_t)bw * bh * 2 * sizeof(double) + 2 * (size_t)bw * bh);
+    if (!wt) goto nomem;
+    uint8_t *near = (uint8_t *)(wt + 2 * (size_t)bw * bh), *tmp = near + (size_t)bw * bh;
+    dilate_blob(lab, w, b.label, x0, y0, x1, y1, near, tmp);
+    double background = NAN;
+    if (binary) {
+        for (int r = 0; r < bh; r++)
+            for (int c = 0; c < bw; c++)
+                wt[(size_t)r * bw + c] = lab[(size_t)(r + y0) * w + c + x0] == b.label;
+    } else {
+        /* the local background: the (upper) median of the free pixels around the grown blob */
+        double *ring = wt + (size_t)bw * bh;
+        int nr = 0;
+        for (int r = y0; r < y1; r++)
+            for (int c = x0; c < x1; c++) {
+                int32_t L = lab[(size_t)r * w + c];
+                int region = L == b.label ||
+                             (L == 0 && near[(size_t)(r - y0) * bw + c - x0]);
+                if (!region && L == 0) ring[nr++] = img[(size_t)r * w + c];
+                wt[(size_t)(r - y0) * bw + c - x0] = region ? 1.0 : 0.0;
+            }
+        if (nr) {
+            qsort(ring, nr, sizeof(double), cmp_double);
+            background = ring[nr / 2];
+        } else {
+            background = default_bg;
+        }
+        /* signed weights: zero-mean noise around the blob leaves the centroid unbiased */
+        const float bg = (float)background;
+        for (int r = 0; r < bh; r++)
+            for (int c = 0; c < bw; c++) {
+                size_t k = (size_t)r * bw + c;
+                wt[k] = wt[k] != 0.0 ? (float)img[(size_t)(r + y0) * w + c + x0] - bg : 0.0f;
+            }
+    }
+    Moments m = moments_of(wt, bw, bh);
+    if (m.m00 <= 0.0) goto none;
+    ret = Py_BuildValue("(ddid)", ox + x0 + m.m10 / m.m00, oy + y0 + m.m01 / m.m00, b.area,
+                        background);
+    goto done;
+nomem:
+    PyErr_NoMemory();
+    goto done;
+none:
+    Py_INCREF(Py_None);
+    ret = Py_None;
+done:
+    free(lab);
+    free(stack);
+    free(wt);
     PyBuffer_Release(&I);
     return ret;
 }
@@ -219,6 +647,10 @@ done:
 static PyMethodDef methods[] = {
     {"coverage", py_coverage, METH_VARARGS, "exact coverage of one polygon in a block"},
     {"composite", py_composite, METH_VARARGS, "exact-coverage alpha compositing of polygons"},
+    {"quantise", py_quantise, METH_VARARGS, "float32 grey levels to uint8 (rint, clip)"},
+    {"project_hull", py_project_hull, METH_VARARGS, "convex hull of a body's projected points"},
+    {"marker_moments", py_marker_moments, METH_VARARGS, "the stick camera's marker moments"},
+    {"ball_blob", py_ball_blob, METH_VARARGS, "the stereo camera's ball blob moments"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -25,24 +25,13 @@ import numpy as np
 from replay.sensors import _pixels
 
 
-def _pack(polygons) -> tuple[np.ndarray, np.ndarray]:
-    """Polygons as one (N, 2) float64 array of vertices and the start of each (n + 1,)."""
-    sizes = [len(q) for q in polygons]
-    starts = np.zeros(len(sizes) + 1, np.int64)
-    starts[1:] = np.cumsum(sizes)
-    if not sizes or starts[-1] == 0:
-        return np.zeros((0, 2)), starts
-    return np.ascontiguousarray(np.concatenate(polygons), dtype=np.float64), starts
-
-
 def coverage(polygons, x0: int, y0: int, w: int, h: int) -> np.ndarray:
     """Exact covered area (0..1) of each polygon ((N, 2) vertices in pixels, either orientation)
     in each pixel of the ``h x w`` block whose first pixel is ``(x0, y0)``: shape (n, h, w)."""
     out = np.zeros((len(polygons), h, w))
-    P, starts = _pack(polygons)
-    for i in range(len(polygons)):
-        if starts[i + 1] - starts[i] >= 3 and w > 0 and h > 0:
-            _pixels.coverage(P[starts[i] : starts[i + 1]], x0, y0, out[i], w, h)
+    for i, q in enumerate(polygons):
+        if len(q) >= 3 and w > 0 and h > 0:
+            _pixels.coverage(np.ascontiguousarray(q, dtype=np.float64), x0, y0, out[i], w, h)
     return out
 
 
@@ -53,7 +42,13 @@ def composite(img: np.ndarray, polygons, greys, origin=(0, 0)) -> None:
     ``img`` may be a window of the full image whose first pixel is ``origin``."""
     if not len(polygons) or img.size == 0:
         return
-    P, starts = _pack(polygons)
     h, w = img.shape
-    g = np.asarray(greys, np.float64)
-    _pixels.composite(P, starts, g, int(origin[0]), int(origin[1]), img, w, h)
+    polys = [np.ascontiguousarray(q, dtype=np.float64) for q in polygons]
+    _pixels.composite(polys, [float(g) for g in greys], int(origin[0]), int(origin[1]), img, w, h)
+
+
+def quantise(img: np.ndarray) -> np.ndarray:
+    """An 8-bit image of a float32 one: ``clip(rint(img), 0, 255)``."""
+    out = np.empty(img.shape, np.uint8)
+    _pixels.quantise(np.ascontiguousarray(img, dtype=np.float32), out)
+    return out
