@@ -570,7 +570,7 @@ static PyObject *py_ball_blob(PyObject *self, PyObject *args) {
     Py_buffer I;
     int w, h, min_pixels, binary, ox, oy, fw, fh;
     double thr, default_bg;
-    if (!PyArg_ParseTuple(args, "y*iididiiii", &I, &w, &h, &thr, &min_pixels, &binary,
+    if (!PyArg_ParseTuple(args, "y*iidiidiiii", &I, &w, &h, &thr, &min_pixels, &binary,
                           &default_bg, &ox, &oy, &fw, &fh))
         return NULL;
     PyObject *ret = NULL;
@@ -644,11 +644,117 @@ done:
     return ret;
 }
 
+/* --- geometry --------------------------------------------------------------------------- */
+
+/* ellipse_polygon(cos, sin, u, v, a, b, c, s, out): out[k] = (u + a c cos_k - b s sin_k,
+ * v + a s cos_k + b c sin_k) for the tables cos, sin (float64, n each) into out (float64 (n, 2))
+ * (replay/sensors/silhouette.py Ellipse.polygon, the same operations in the same order);
+ * returns its box (umin, vmin, umax, vmax). */
+static PyObject *py_ellipse_polygon(PyObject *self, PyObject *args) {
+    Py_buffer C, S, O;
+    double u, v, a, b, c, s;
+    if (!PyArg_ParseTuple(args, "y*y*ddddddw*", &C, &S, &u, &v, &a, &b, &c, &s, &O)) return NULL;
+    PyObject *ret = NULL;
+    Py_ssize_t n = C.len / (Py_ssize_t)sizeof(double);
+    if (!check(&S, sizeof(double), n, "sin") || !check(&O, sizeof(double), 2 * n, "out"))
+        goto done;
+    const double *ct = C.buf, *st = S.buf;
+    double *out = O.buf, ac = a * c, bs = b * s, as = a * s, bc = b * c;
+    double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double pu = u + ac * ct[k] - bs * st[k], pv = v + as * ct[k] + bc * st[k];
+        out[2 * k] = pu, out[2 * k + 1] = pv;
+        if (pu < umin) umin = pu;
+        if (pu > umax) umax = pu;
+        if (pv < vmin) vmin = pv;
+        if (pv > vmax) vmax = pv;
+    }
+    ret = Py_BuildValue("(dddd)", umin, vmin, umax, vmax);
+done:
+    PyBuffer_Release(&C);
+    PyBuffer_Release(&S);
+    PyBuffer_Release(&O);
+    return ret;
+}
+
+/* triangulate(P0, P1, u0, v0, u1, v1): the linear (DLT) triangulation of cv2.triangulatePoints
+ * from pixels (u0, v0), (u1, v1) of two cameras with 3 x 4 projection matrices P0, P1 (float64,
+ * row-major): the homogeneous X minimising |A X| (|X| = 1), A = [u0 P0[2] - P0[0]; v0 P0[2] -
+ * P0[1]; u1 P1[2] - P1[0]; v1 P1[2] - P1[1]], i.e. the eigenvector of the smallest eigenvalue of
+ * A^T A (cyclic Jacobi). Returns (x, y, z), or None if X is at infinity. */
+static PyObject *py_triangulate(PyObject *self, PyObject *args) {
+    Py_buffer B0, B1;
+    double u0, v0, u1, v1;
+    if (!PyArg_ParseTuple(args, "y*y*dddd", &B0, &B1, &u0, &v0, &u1, &v1)) return NULL;
+    PyObject *ret = NULL;
+    if (!check(&B0, sizeof(double), 12, "P0") || !check(&B1, sizeof(double), 12, "P1")) goto done;
+    const double *P0 = B0.buf, *P1 = B1.buf;
+    double A[4][4], M[4][4], V[4][4];
+    for (int j = 0; j < 4; j++) {
+        A[0][j] = u0 * P0[8 + j] - P0[j];
+        A[1][j] = v0 * P0[8 + j] - P0[4 + j];
+        A[2][j] = u1 * P1[8 + j] - P1[j];
+        A[3][j] = v1 * P1[8 + j] - P1[4 + j];
+    }
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double t = 0.0;
+            for (int k = 0; k < 4; k++) t += A[k][i] * A[k][j];
+            M[i][j] = t;
+            V[i][j] = i == j;
+        }
+    for (int sweep = 0; sweep < 60; sweep++) {
+        double off = 0.0, diag = 0.0;
+        for (int i = 0; i < 4; i++) {
+            diag += M[i][i] * M[i][i];
+            for (int j = i + 1; j < 4; j++) off += M[i][j] * M[i][j];
+        }
+        if (off <= 1e-34 * diag) break;
+        for (int p = 0; p < 3; p++)
+            for (int q = p + 1; q < 4; q++) {
+                if (M[p][q] == 0.0) continue;
+                double theta = (M[q][q] - M[p][p]) / (2.0 * M[p][q]);
+                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 4; k++) { /* M <- J^T M J, V <- V J */
+                    double mkp = M[k][p], mkq = M[k][q];
+                    M[k][p] = c * mkp - s * mkq;
+                    M[k][q] = s * mkp + c * mkq;
+                }
+                for (int k = 0; k < 4; k++) {
+                    double mpk = M[p][k], mqk = M[q][k];
+                    M[p][k] = c * mpk - s * mqk;
+                    M[q][k] = s * mpk + c * mqk;
+                }
+                for (int k = 0; k < 4; k++) {
+                    double vkp = V[k][p], vkq = V[k][q];
+                    V[k][p] = c * vkp - s * vkq;
+                    V[k][q] = s * vkp + c * vkq;
+                }
+            }
+    }
+    int m = 0;
+    for (int i = 1; i < 4; i++)
+        if (M[i][i] < M[m][m]) m = i;
+    if (V[3][m] == 0.0) {
+        Py_INCREF(Py_None);
+        ret = Py_None;
+    } else {
+        ret = Py_BuildValue("(ddd)", V[0][m] / V[3][m], V[1][m] / V[3][m], V[2][m] / V[3][m]);
+    }
+done:
+    PyBuffer_Release(&B0);
+    PyBuffer_Release(&B1);
+    return ret;
+}
+
 static PyMethodDef methods[] = {
     {"coverage", py_coverage, METH_VARARGS, "exact coverage of one polygon in a block"},
     {"composite", py_composite, METH_VARARGS, "exact-coverage alpha compositing of polygons"},
     {"quantise", py_quantise, METH_VARARGS, "float32 grey levels to uint8 (rint, clip)"},
     {"project_hull", py_project_hull, METH_VARARGS, "convex hull of a body's projected points"},
+    {"ellipse_polygon", py_ellipse_polygon, METH_VARARGS, "an ellipse's polygon and box"},
+    {"triangulate", py_triangulate, METH_VARARGS, "linear two-view triangulation (DLT)"},
     {"marker_moments", py_marker_moments, METH_VARARGS, "the stick camera's marker moments"},
     {"ball_blob", py_ball_blob, METH_VARARGS, "the stereo camera's ball blob moments"},
     {NULL, NULL, 0, NULL},

@@ -35,6 +35,7 @@ import numpy as np
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
+from replay.sensors import _pixels
 from replay.sensors.raster import composite
 
 ELLIPSE_VERTICES = 48  # vertices of the polygon standing in for an ellipse
@@ -66,23 +67,29 @@ class Ellipse:
     def polygon(self, inset: float = 0.0, area_exact: bool = True) -> np.ndarray:
         """(N, 2) vertices on the ellipse with both semi-axes reduced by ``inset`` px; scaled so
         that the polygon's area is the (reduced) ellipse's if ``area_exact``."""
+        return self.polygon_and_box(inset, area_exact)[0]
+
+    def polygon_and_box(self, inset: float = 0.0, area_exact: bool = True):
+        """:meth:`polygon` and its box (umin, vmin, umax, vmax), in one compiled call."""
         k = _AREA_SCALE if area_exact else 1.0
         a = max(self.a - inset, 0.05 * self.a) * k
         b = max(self.b - inset, 0.05 * self.b) * k
-        c, s = math.cos(self.angle), math.sin(self.angle)
-        pu = self.u + a * c * _COS - b * s * _SIN
-        pv = self.v + a * s * _COS + b * c * _SIN
-        return np.column_stack([pu, pv])
+        out = np.empty((ELLIPSE_VERTICES, 2))
+        box = _pixels.ellipse_polygon(
+            _COS, _SIN, self.u, self.v, a, b, math.cos(self.angle), math.sin(self.angle), out
+        )
+        return out, box
 
 
 def sphere_ellipse(camera: PinholeCamera, centre, radius: float) -> Ellipse | None:
     """The exact outline of a sphere in the image, or None if the sphere is not entirely in
     front of the camera's plane (``Z <= r``: the outline is then unbounded or empty)."""
-    R, o = camera.rotation, camera.position
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = camera.rotation.tolist()
+    o = camera.position.tolist()
     dx, dy, dz = float(centre[0]) - o[0], float(centre[1]) - o[1], float(centre[2]) - o[2]
-    X = R[0, 0] * dx + R[1, 0] * dy + R[2, 0] * dz  # p_cam = R^T (p - o)
-    Y = R[0, 1] * dx + R[1, 1] * dy + R[2, 1] * dz
-    Z = R[0, 2] * dx + R[1, 2] * dy + R[2, 2] * dz
+    X = r00 * dx + r10 * dy + r20 * dz  # p_cam = R^T (p - o)
+    Y = r01 * dx + r11 * dy + r21 * dz
+    Z = r02 * dx + r12 * dy + r22 * dz
     r2 = float(radius) ** 2
     E = Z * Z - r2
     if radius <= 0.0 or Z <= float(radius) * (1.0 + 1e-9) or E <= 0.0:
@@ -153,7 +160,7 @@ def _hull_points(prim) -> np.ndarray:
 def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse] | None:
     """(distance (m) from the optical centre to the primitive's centre, convex polygon (N, 2) in
     pixels) of a primitive, or None if it reaches behind the camera. Spheres give their ellipse."""
-    distance = float(np.linalg.norm(np.asarray(prim.position, float) - camera.position))
+    distance = math.dist(prim.position, camera.position.tolist())
     if isinstance(prim, Sphere):
         e = sphere_ellipse(camera, prim.position, prim.radius)
         if e is None:
@@ -174,8 +181,9 @@ def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse
 # --- raster --------------------------------------------------------------------------------
 
 
-def _drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float]]:
-    """(convex polygon in pixels, grey level) of each primitive drawn by ``camera``, far first."""
+def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float, tuple]]:
+    """(convex polygon in pixels, grey level, its box (umin, vmin, umax, vmax)) of each
+    primitive drawn by ``camera``, far first."""
     items = []
     for i, prim in enumerate(scene.primitives):
         s = silhouette(camera, prim)
@@ -184,9 +192,15 @@ def _drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, fl
     items.sort(key=lambda it: (it[0], it[1]))  # far first
     out = []
     for _, _, prim, shape in items:
-        poly = shape.polygon() if isinstance(shape, Ellipse) else shape
-        if len(poly) >= 3:
-            out.append((poly, 255.0 * float(prim.albedo)))
+        if isinstance(shape, Ellipse):
+            poly, box = shape.polygon_and_box()
+        elif len(shape) >= 3:
+            poly = shape
+            lo, hi = shape.min(axis=0), shape.max(axis=0)
+            box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+        else:
+            continue
+        out.append((poly, 255.0 * float(prim.albedo), box))
     return out
 
 
@@ -204,6 +218,6 @@ def render(
     k = camera.intrinsics
     x0, y0, x1, y1 = window if window is not None else (0, 0, k.width, k.height)
     img = np.full((y1 - y0, x1 - x0), 255.0 * background, np.float32)
-    drawn = _drawables(camera, scene)
+    drawn = drawables(camera, scene)
     composite(img, [d[0] for d in drawn], [d[1] for d in drawn], origin=(x0, y0))
     return img
