@@ -15,7 +15,9 @@ setup(
     packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
     package_dir=SHIPPED,
     ext_modules=[
-        Extension("replay.sensors._pixels", ["replay/sensors/_pixels.c"], extra_compile_args=["-O2"])
+        Extension(
+            "replay.sensors._pixels", ["replay/sensors/_pixels.c"], extra_compile_args=["-O2"]
+        )
     ],
     package_data={
         "replay._shipped.data": ["**/*"],

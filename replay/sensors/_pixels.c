@@ -644,6 +644,37 @@ done:
     return ret;
 }
 
+/* pack_rows(bits, w, h): a 0/1 byte image (h x w, bool or uint8, w <= 64) as (h ints, bit u of
+ * row v = bits[v, u], as replay.messages.pack_rows packs them; pixels set). */
+static PyObject *py_pack_rows(PyObject *self, PyObject *args) {
+    Py_buffer B;
+    int w, h;
+    if (!PyArg_ParseTuple(args, "y*ii", &B, &w, &h)) return NULL;
+    PyObject *ret = NULL, *rows = NULL;
+    if (w < 0 || w > 64 || h < 0) {
+        PyErr_SetString(PyExc_ValueError, "pack_rows: 0 <= w <= 64");
+        goto done;
+    }
+    if (!check(&B, 1, (Py_ssize_t)w * h, "bits")) goto done;
+    rows = PyList_New(h);
+    if (!rows) goto done;
+    const uint8_t *b = B.buf;
+    long count = 0;
+    for (int r = 0; r < h; r++) {
+        unsigned long long x = 0;
+        for (int c = 0; c < w; c++)
+            if (b[(size_t)r * w + c]) x |= 1ULL << c, count++;
+        PyObject *v = PyLong_FromUnsignedLongLong(x);
+        if (!v) goto done;
+        PyList_SET_ITEM(rows, r, v);
+    }
+    ret = Py_BuildValue("(Ol)", rows, count);
+done:
+    Py_XDECREF(rows);
+    PyBuffer_Release(&B);
+    return ret;
+}
+
 /* --- geometry --------------------------------------------------------------------------- */
 
 /* ellipse_polygon(cos, sin, u, v, a, b, c, s, out): out[k] = (u + a c cos_k - b s sin_k,
@@ -753,6 +784,7 @@ static PyMethodDef methods[] = {
     {"composite", py_composite, METH_VARARGS, "exact-coverage alpha compositing of polygons"},
     {"quantise", py_quantise, METH_VARARGS, "float32 grey levels to uint8 (rint, clip)"},
     {"project_hull", py_project_hull, METH_VARARGS, "convex hull of a body's projected points"},
+    {"pack_rows", py_pack_rows, METH_VARARGS, "a binary image as one int a row"},
     {"ellipse_polygon", py_ellipse_polygon, METH_VARARGS, "an ellipse's polygon and box"},
     {"triangulate", py_triangulate, METH_VARARGS, "linear two-view triangulation (DLT)"},
     {"marker_moments", py_marker_moments, METH_VARARGS, "the stick camera's marker moments"},

@@ -29,11 +29,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from replay.scene import Box, Cylinder, Scene, Sphere
-from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
 from replay.sensors import _pixels
 from replay.sensors.raster import composite
@@ -141,40 +139,69 @@ _RIM = np.column_stack(
 )
 
 
-def _hull_points(prim) -> np.ndarray:
-    """World points whose projections' convex hull is a box's or cylinder's silhouette."""
-    R = quaternion_matrix(prim.orientation)
-    if isinstance(prim, Box):
-        body = _BOX * (0.5 * np.asarray(prim.size, float))
-    else:
-        ring = prim.radius * _RIM
-        body = np.vstack(
-            [
-                np.column_stack([ring, np.full(len(ring), s * 0.5 * prim.length)])
-                for s in (-1.0, 1.0)
-            ]
-        )
-    return body @ R.T + np.asarray(prim.position, float)
+_BODY: dict = {}  # body-frame outline points by shape (sizes do not change during a run)
 
 
-def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse] | None:
+def _body_points(prim: Box | Cylinder) -> np.ndarray:
+    """Body-frame points whose projections' convex hull is a box's or cylinder's silhouette."""
+    key = ("box", *prim.size) if isinstance(prim, Box) else ("cyl", prim.radius, prim.length)
+    body = _BODY.get(key)
+    if body is None:
+        if isinstance(prim, Box):
+            body = _BOX * (0.5 * np.asarray(prim.size, float))
+        else:
+            ring = prim.radius * _RIM
+            body = np.vstack(
+                [
+                    np.column_stack([ring, np.full(len(ring), s * 0.5 * prim.length)])
+                    for s in (-1.0, 1.0)
+                ]
+            )
+        if len(_BODY) < 1024:
+            _BODY[key] = body
+    return body
+
+
+def project_hull(camera: PinholeCamera, body: np.ndarray, orientation, position):
+    """(convex hull (N, 2) in pixels, its box (umin, vmin, umax, vmax)) of body-frame points
+    (n, 3) of a rigid body at ``position`` with quaternion ``orientation``, or None if a point
+    is not in front of the camera (depth <= 1 um). One compiled call
+    (``_pixels.project_hull``): the projections are rounded to float32, as ``cv2.convexHull``
+    of float32 points took them, and the hull is Andrew's monotone chain."""
+    k = camera.intrinsics
+    hull = np.empty((len(body), 2))
+    found = _pixels.project_hull(
+        body,
+        orientation,
+        position,
+        np.ascontiguousarray(camera.rotation, dtype=np.float64),
+        camera.position,
+        k.fx,
+        k.fy,
+        k.cx,
+        k.cy,
+        hull,
+    )
+    if found is None:
+        return None
+    return hull[: found[0]], found[1:]
+
+
+def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse, tuple] | None:
     """(distance (m) from the optical centre to the primitive's centre, convex polygon (N, 2) in
-    pixels) of a primitive, or None if it reaches behind the camera. Spheres give their ellipse."""
+    pixels, its box (umin, vmin, umax, vmax) or None for an ellipse) of a primitive, or None if
+    it reaches behind the camera. Spheres give their ellipse."""
     distance = math.dist(prim.position, camera.position.tolist())
     if isinstance(prim, Sphere):
         e = sphere_ellipse(camera, prim.position, prim.radius)
         if e is None:
             return None
-        return distance, e
+        return distance, e, None
     if isinstance(prim, (Box, Cylinder)):
-        pts = _hull_points(prim)
-        pc = camera.to_camera(pts)
-        if np.any(pc[:, 2] <= _NEAR):
+        found = project_hull(camera, _body_points(prim), prim.orientation, prim.position)
+        if found is None:
             return None
-        k = camera.intrinsics
-        uv = np.column_stack([k.fx * pc[:, 0] / pc[:, 2] + k.cx, k.fy * pc[:, 1] / pc[:, 2] + k.cy])
-        hull = cv2.convexHull(uv.astype(np.float32)).reshape(-1, 2).astype(np.float64)
-        return distance, hull
+        return distance, found[0], found[1]
     raise TypeError(f"cannot render {type(prim).__name__}")
 
 
@@ -188,16 +215,14 @@ def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, flo
     for i, prim in enumerate(scene.primitives):
         s = silhouette(camera, prim)
         if s is not None:
-            items.append((-s[0], i, prim, s[1]))
+            items.append((-s[0], i, prim, s[1], s[2]))
     items.sort(key=lambda it: (it[0], it[1]))  # far first
     out = []
-    for _, _, prim, shape in items:
+    for _, _, prim, shape, box in items:
         if isinstance(shape, Ellipse):
             poly, box = shape.polygon_and_box()
         elif len(shape) >= 3:
             poly = shape
-            lo, hi = shape.min(axis=0), shape.max(axis=0)
-            box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
         else:
             continue
         out.append((poly, 255.0 * float(prim.albedo), box))

@@ -69,7 +69,6 @@ from replay.sensors.raster import composite, quantise
 from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
 
 
-
 @dataclass
 class StereoBallCameraParams:
     cam0_position: list[float] = param(
@@ -344,7 +343,10 @@ class StereoBallCamera(Sensor):
             x0, y0, x1, y1 = min(x0, b[0]), min(y0, b[1]), max(x1, b[2]), max(y1, b[3])
         m = 6  # the polygon's pixels reach 1 px beyond its box, the moments 4 px beyond them
         wx0, wy0 = max(int(math.floor(x0)) - m, 0), max(int(math.floor(y0)) - m, 0)
-        wx1, wy1 = min(int(math.ceil(x1)) + m + 1, k.width), min(int(math.ceil(y1)) + m + 1, k.height)
+        wx1, wy1 = (
+            min(int(math.ceil(x1)) + m + 1, k.width),
+            min(int(math.ceil(y1)) + m + 1, k.height),
+        )
         if wx1 <= wx0 or wy1 <= wy0:
             return (0, 0, 0, 0)
         return (wx0, wy0, wx1, wy1)

@@ -41,7 +41,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from replay.interfaces import Sensor
@@ -51,6 +50,7 @@ from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
 from replay.sensors import _pixels
+from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
 
 _RIM = 48  # vertices of a polygon standing in for a circle
@@ -130,28 +130,18 @@ def _outline_points(camera: PinholeCamera, prim) -> np.ndarray:
 def _silhouette(camera: PinholeCamera, prim):
     """(distance of its centre from the camera, albedo, convex hull in pixels, name, pixel box
     (umin, vmin, umax, vmax)) of a primitive, or None if it reaches behind the camera (or has
-    no area). The outline's projection and hull are one compiled call (``_pixels.project_hull``:
-    the points rounded to float32, as cv2.convexHull took them)."""
+    no area). The outline's projection and hull: :func:`~replay.sensors.silhouette.project_hull`."""
     if isinstance(prim, (Box, Cylinder)):
         body, q, pos = _body_points(prim), prim.orientation, prim.position
     else:
         body, q, pos = _outline_points(camera, prim), (0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0)
         if not len(body):
             return None
-    k = camera.intrinsics
-    hull = np.empty((len(body), 2))
-    found = _pixels.project_hull(
-        body, q, pos, camera.rotation, camera.position, k.fx, k.fy, k.cx, k.cy, hull
-    )
-    if found is None or found[0] < 3:
+    found = project_hull(camera, body, q, pos)
+    if found is None or len(found[0]) < 3:
         return None
-    return (
-        math.dist(prim.position, camera.position),
-        float(prim.albedo),
-        hull[: found[0]],
-        prim.name,
-        found[1:],
-    )
+    distance = math.dist(prim.position, camera.position.tolist())
+    return (distance, float(prim.albedo), found[0], prim.name, found[1])
 
 
 def _misses(camera: PinholeCamera, prim, window, R=None) -> bool:
@@ -192,7 +182,9 @@ def _by_distance(items: list) -> list:
 def _projected_items(camera: PinholeCamera, scene: Scene) -> list:
     """:func:`_silhouette` of each drawable primitive, far ones first (:func:`_by_distance`).
     Primitives reaching behind the camera are not drawn."""
-    return _by_distance([it for it in map(lambda q: _silhouette(camera, q), scene.primitives) if it])
+    return _by_distance(
+        [it for it in map(lambda q: _silhouette(camera, q), scene.primitives) if it]
+    )
 
 
 def hull_window(camera: PinholeCamera, box, margin: int = 8):
