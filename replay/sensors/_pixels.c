@@ -288,7 +288,8 @@ static PyObject *py_project_hull(PyObject *self, PyObject *args) {
                    s * (qx * qy + qz * qw),     1 - s * (qx * qx + qz * qz), s * (qy * qz - qx * qw),
                    s * (qx * qz - qy * qw),     s * (qy * qz + qx * qw),     1 - s * (qx * qx + qy * qy)};
     const double *R = RB.buf, *b = B.buf;
-    pts = malloc((size_t)(n ? n : 1) * 2 * sizeof(double));
+    /* the points, then the chain (up to 2 n - 1 points before the repeated first is dropped) */
+    pts = malloc((size_t)(n ? n : 1) * 6 * sizeof(double));
     if (!pts) {
         PyErr_NoMemory();
         goto done;
@@ -312,7 +313,7 @@ static PyObject *py_project_hull(PyObject *self, PyObject *args) {
     }
     /* Andrew's monotone chain */
     qsort(pts, n, 2 * sizeof(double), cmp_pt);
-    double *hull = O.buf;
+    double *hull = pts + 2 * n;
     Py_ssize_t k = 0;
     for (Py_ssize_t i = 0; i < n; i++) {
         while (k >= 2 && cross3(hull + 2 * (k - 2), hull + 2 * (k - 1), pts + 2 * i) <= 0.0) k--;
@@ -323,6 +324,7 @@ static PyObject *py_project_hull(PyObject *self, PyObject *args) {
         hull[2 * k] = pts[2 * i], hull[2 * k + 1] = pts[2 * i + 1], k++;
     }
     if (k > 1) k--; /* the first point is repeated at the end */
+    memcpy(O.buf, hull, (size_t)k * 2 * sizeof(double));
     double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
     for (Py_ssize_t i = 0; i < k; i++) {
         if (hull[2 * i] < umin) umin = hull[2 * i];
