@@ -646,15 +646,15 @@ done:
     return ret;
 }
 
-/* pack_rows(bits, w, h): a 0/1 byte image (h x w, bool or uint8, w <= 64) as (h ints, bit u of
+/* pack_rows(bits, w, h): a 0/1 byte image (h x w, bool or uint8, w <= 63) as (h ints, bit u of
  * row v = bits[v, u], as replay.messages.pack_rows packs them; pixels set). */
 static PyObject *py_pack_rows(PyObject *self, PyObject *args) {
     Py_buffer B;
     int w, h;
     if (!PyArg_ParseTuple(args, "y*ii", &B, &w, &h)) return NULL;
     PyObject *ret = NULL, *rows = NULL;
-    if (w < 0 || w > 64 || h < 0) {
-        PyErr_SetString(PyExc_ValueError, "pack_rows: 0 <= w <= 64");
+    if (w < 0 || w > 63 || h < 0) { /* replay.messages.pack_rows packs into int64 */
+        PyErr_SetString(PyExc_ValueError, "pack_rows: 0 <= w <= 63");
         goto done;
     }
     if (!check(&B, 1, (Py_ssize_t)w * h, "bits")) goto done;

@@ -99,7 +99,7 @@ class VisionChipSensor(Sensor):
         bits = self.image(scene)
         self.last_image = bits
         h, w = bits.shape
-        if w <= 64:  # pack_rows, compiled
+        if w <= 63:  # pack_rows, compiled
             rows, count = _pixels.pack_rows(bits, w, h)
         else:
             rows, count = pack_rows(bits), int(bits.sum())
