@@ -238,8 +238,16 @@ static PyObject *py_quantise(PyObject *self, PyObject *args) {
     const float *in = I.buf;
     uint8_t *out = O.buf;
     for (Py_ssize_t i = 0; i < n; i++) {
-        float v = rintf(in[i]);
-        out[i] = v <= 0.0f ? 0 : (v >= 255.0f ? 255 : (uint8_t)v); /* NaN -> 255 */
+        float v = in[i];
+        /* clip, then round half to even by the float32 magic number (exact below 2^22) */
+        if (!(v > 0.0f)) /* NaN too */
+            out[i] = 0;
+        else if (v >= 255.0f)
+            out[i] = 255;
+        else {
+            float t = v + 12582912.0f; /* 1.5 * 2^23 */
+            out[i] = (uint8_t)(t - 12582912.0f);
+        }
     }
     Py_INCREF(Py_None);
     ret = Py_None;
@@ -251,7 +259,8 @@ done:
 
 /* project_hull(body, q, p, R, o, fx, fy, cx, cy, out): the convex hull in pixels of body points
  * (float64 (n, 3), body frame) of a rigid body at position p, orientation quaternion q = (x, y,
- * z, w), seen by a pinhole at o with camera-to-world rotation R (float64 3 x 3, row-major); the
+ * z, w), seen by a pinhole at o (float64 (3,)) with camera-to-world rotation R (float64 3 x 3,
+ * row-major); the
  * projected points are rounded to float32 first (as cv2.convexHull of float32 points took
  * them). The hull (counter-clockwise in image axes, no collinear vertices) is written to out
  * (float64 (n, 2)); returns (count, umin, vmin, umax, vmax), or None if a point is not in front
@@ -267,17 +276,19 @@ static double cross3(const double *o, const double *a, const double *b) {
 }
 
 static PyObject *py_project_hull(PyObject *self, PyObject *args) {
-    Py_buffer B, RB, O;
-    double qx, qy, qz, qw, px, py, pz, ox, oy, oz, fx, fy, cx, cy;
-    if (!PyArg_ParseTuple(args, "y*(dddd)(ddd)y*(ddd)ddddw*", &B, &qx, &qy, &qz, &qw, &px, &py,
-                          &pz, &RB, &ox, &oy, &oz, &fx, &fy, &cx, &cy, &O))
+    Py_buffer B, RB, OB, O;
+    double qx, qy, qz, qw, px, py, pz, fx, fy, cx, cy;
+    if (!PyArg_ParseTuple(args, "y*(dddd)(ddd)y*y*ddddw*", &B, &qx, &qy, &qz, &qw, &px, &py, &pz,
+                          &RB, &OB, &fx, &fy, &cx, &cy, &O))
         return NULL;
     PyObject *ret = NULL;
     double *pts = NULL;
     Py_ssize_t n = B.len / (3 * (Py_ssize_t)sizeof(double));
     if (B.len != n * 3 * (Py_ssize_t)sizeof(double) || !check(&RB, sizeof(double), 9, "R") ||
-        !check(&O, sizeof(double), 2 * n, "out"))
+        !check(&OB, sizeof(double), 3, "o") || !check(&O, sizeof(double), 2 * n, "out"))
         goto done;
+    const double ox = ((const double *)OB.buf)[0], oy = ((const double *)OB.buf)[1],
+                 oz = ((const double *)OB.buf)[2];
     double nq = qx * qx + qy * qy + qz * qz + qw * qw;
     if (nq == 0.0) {
         PyErr_SetString(PyExc_ValueError, "zero quaternion");
@@ -337,6 +348,7 @@ done:
     free(pts);
     PyBuffer_Release(&B);
     PyBuffer_Release(&RB);
+    PyBuffer_Release(&OB);
     PyBuffer_Release(&O);
     return ret;
 }
@@ -415,22 +427,26 @@ static Blob largest_component(const uint8_t *img, int w, int h, double thr, int 
 static void dilate_blob(const int32_t *lab, int w, int L, int x0, int y0, int x1, int y1,
                         uint8_t *near, uint8_t *tmp) {
     int bw = x1 - x0, bh = y1 - y0;
-    for (int r = 0; r < bh; r++) {
+    for (int r = 0; r < bh; r++) { /* rows: a running count of blob pixels in [c - 2, c + 2] */
         const int32_t *row = lab + (size_t)(r + y0) * w + x0;
+        uint8_t *t = tmp + (size_t)r * bw;
+        int n = 0;
+        for (int c = 0; c < 2 && c < bw; c++) n += row[c] == L;
         for (int c = 0; c < bw; c++) {
-            int any = 0;
-            for (int cc = c - 2; cc <= c + 2 && !any; cc++)
-                any = cc >= 0 && cc < bw && row[cc] == L;
-            tmp[(size_t)r * bw + c] = (uint8_t)any;
+            if (c + 2 < bw) n += row[c + 2] == L;
+            if (c - 3 >= 0) n -= row[c - 3] == L;
+            t[c] = n > 0;
         }
     }
-    for (int r = 0; r < bh; r++)
-        for (int c = 0; c < bw; c++) {
-            int any = 0;
-            for (int rr = r - 2; rr <= r + 2 && !any; rr++)
-                any = rr >= 0 && rr < bh && tmp[(size_t)rr * bw + c];
-            near[(size_t)r * bw + c] = (uint8_t)any;
+    for (int c = 0; c < bw; c++) { /* columns, the same on the rows' result */
+        int n = 0;
+        for (int r = 0; r < 2 && r < bh; r++) n += tmp[(size_t)r * bw + c];
+        for (int r = 0; r < bh; r++) {
+            if (r + 2 < bh) n += tmp[(size_t)(r + 2) * bw + c];
+            if (r - 3 >= 0) n -= tmp[(size_t)(r - 3) * bw + c];
+            near[(size_t)r * bw + c] = n > 0;
         }
+    }
 }
 
 static int cmp_double(const void *a, const void *b) {

@@ -175,7 +175,7 @@ def project_hull(camera: PinholeCamera, body: np.ndarray, orientation, position)
         orientation,
         position,
         np.ascontiguousarray(camera.rotation, dtype=np.float64),
-        camera.position,
+        np.ascontiguousarray(camera.position, dtype=np.float64),
         k.fx,
         k.fy,
         k.cx,

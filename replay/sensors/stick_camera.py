@@ -141,23 +141,25 @@ def _silhouette(camera: PinholeCamera, prim):
     if found is None or len(found[0]) < 3:
         return None
     distance = math.dist(prim.position, camera.position.tolist())
-    return (distance, float(prim.albedo), found[0], prim.name, found[1])
+    return (distance, prim.albedo, found[0], prim.name, found[1])
 
 
-def _misses(camera: PinholeCamera, prim, window, R=None) -> bool:
+def _misses(camera: PinholeCamera, prim, window, R, o) -> bool:
     """Whether a primitive certainly draws nothing in ``window`` (x0, y0, x1, y1): the image of
     its bounding sphere (centre c, radius rb) lies within ``f rb (Z + |X|) / ((Z - rb) Z)`` px
     of c's projection along each image axis (|x/z - X/Z| for |x - X|, |z - Z| <= rb), plus a
-    pixel, and that box misses the window. ``R``: ``camera.rotation.tolist()``, if at hand."""
+    pixel, and that box misses the window. ``R``, ``o``: the camera's rotation and position as
+    nested tuples of floats."""
     if isinstance(prim, Box):
-        rb = 0.5 * math.sqrt(sum(float(v) * float(v) for v in prim.size))
+        sx, sy, sz = prim.size
+        rb = 0.5 * math.sqrt(sx * sx + sy * sy + sz * sz)
     elif isinstance(prim, Cylinder):
         rb = math.hypot(prim.radius, 0.5 * prim.length)
     else:
         rb = float(prim.radius)
-    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = camera.rotation.tolist() if R is None else R
-    o = camera.position
-    dx, dy, dz = (float(prim.position[i]) - float(o[i]) for i in range(3))
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
+    px, py, pz = prim.position
+    dx, dy, dz = px - o[0], py - o[1], pz - o[2]
     X = r00 * dx + r10 * dy + r20 * dz  # R^T d
     Y = r01 * dx + r11 * dy + r21 * dz
     Z = r02 * dx + r12 * dy + r22 * dz
@@ -425,7 +427,7 @@ class StickCamera(Sensor):
             for prim in scene.primitives:
                 if prim is marker:
                     items.append(seen)
-                elif not _misses(cam, prim, window, self._R):
+                elif not _misses(cam, prim, window, self._R, self._o):
                     it = _silhouette(cam, prim)
                     if it is not None:
                         items.append(it)
