@@ -4,7 +4,7 @@ The paper's high-speed vision sits 1 m above the air table and measures the stic
 orientation at 300 fps from a white rectangular marker on the stick. This sensor does the same
 with images: it renders the scene through a :class:`~replay.sensors.pinhole.PinholeCamera` looking
 straight down at the table, adds pixel noise, segments the marker by a grey-level threshold and
-takes image moments (``cv2.moments``):
+takes image moments:
 
 - the centroid, back-projected onto the horizontal plane through the marker's centre (its known
   height), gives (x, y);
@@ -27,6 +27,21 @@ it left 0.03 px periodic centroid errors, visible as a 0.2 mm step measured as 0
 Moments are taken on the segmented blob dilated by two pixels, weighted by grey level above the
 local background (the stick, sampled just beyond the marker's ends), so partly covered edge
 pixels count by their coverage.
+
+Cost: a frame renders only the window around the marker's silhouette (plus 8 px; the rest of
+the image is exactly the dark table, which never passes the threshold, and is filled in only
+when the whole image is asked for, :attr:`StickCamera.last_image`), draws only the primitives
+whose bounding sphere's image meets that window, and does the per-pixel work in compiled
+kernels (``_pixels.c``: outline projection and hull, exact-coverage compositing, 8-bit
+quantising, segmentation and moments in one pass) with the same algorithms the NumPy/OpenCV
+code used (kept as references in tests/replay/sensors/test_fast_cameras.py and test_raster.py):
+~0.1 ms a frame of stick_3step instead of ~1.9 ms, measurements equal to 1e-9 m on the same
+silhouettes.
+
+Accuracy (test_fast_cameras.py, noise-free, 200 random poses of the stick_3step geometry, 1.8 mm
+per pixel, no fingertips), the same before and after the kernels: bias (mean error) x -0.17,
+y +0.39 um, theta +0.0017 deg; scatter (std) x 7.6, y 8.7 um, theta 0.012 deg; worst 43 um
+(1/40 px), 0.097 deg.
 
 Defaults: 512 x 512 pixels, 1 m above the table centre looking straight down, 0.62 rad field of
 view: 0.64 m of table across the image, 1.25 mm per pixel at the table. That keeps +-0.32 m in
