@@ -115,6 +115,14 @@ static void accumulate(const double *xy, Py_ssize_t n, double ox, double oy, dou
     *c1 = ch;
 }
 
+static int sizes_ok(int w, int h) {
+    if (w < 0 || h < 0) {
+        PyErr_Format(PyExc_ValueError, "negative image size %d x %d", w, h);
+        return 0;
+    }
+    return 1;
+}
+
 static int check(Py_buffer *b, Py_ssize_t itemsize, Py_ssize_t count, const char *what) {
     if (b->len != itemsize * count) {
         PyErr_Format(PyExc_ValueError, "%s: %zd bytes, expected %zd", what, b->len,
@@ -132,7 +140,7 @@ static PyObject *py_coverage(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "y*iiw*ii", &P, &ox, &oy, &O, &w, &h)) return NULL;
     PyObject *ret = NULL;
     Py_ssize_t n = P.len / (2 * (Py_ssize_t)sizeof(double));
-    if (w < 0 || h < 0 || !check(&O, sizeof(double), (Py_ssize_t)w * h, "out")) goto done;
+    if (!sizes_ok(w, h) || !check(&O, sizeof(double), (Py_ssize_t)w * h, "out")) goto done;
     double *acc = calloc((size_t)h * (w + 1) + 1, sizeof(double));
     if (!acc) {
         PyErr_NoMemory();
@@ -166,7 +174,7 @@ static PyObject *py_composite(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "OOiiw*ii", &polys, &greys, &ox, &oy, &I, &w, &h)) return NULL;
     PyObject *ret = NULL, *pseq = NULL, *gseq = NULL;
     double *acc = NULL;
-    if (w < 0 || h < 0 || !check(&I, sizeof(float), (Py_ssize_t)w * h, "img")) goto done;
+    if (!sizes_ok(w, h) || !check(&I, sizeof(float), (Py_ssize_t)w * h, "img")) goto done;
     pseq = PySequence_Fast(polys, "polygons: not a sequence");
     gseq = pseq ? PySequence_Fast(greys, "greys: not a sequence") : NULL;
     if (!gseq) goto done;
@@ -284,7 +292,7 @@ static PyObject *py_project_hull(PyObject *self, PyObject *args) {
     PyObject *ret = NULL;
     double *pts = NULL;
     Py_ssize_t n = B.len / (3 * (Py_ssize_t)sizeof(double));
-    if (B.len != n * 3 * (Py_ssize_t)sizeof(double) || !check(&RB, sizeof(double), 9, "R") ||
+    if (!check(&B, sizeof(double), 3 * n, "body") || !check(&RB, sizeof(double), 9, "R") ||
         !check(&OB, sizeof(double), 3, "o") || !check(&O, sizeof(double), 2 * n, "out"))
         goto done;
     const double ox = ((const double *)OB.buf)[0], oy = ((const double *)OB.buf)[1],
@@ -490,7 +498,8 @@ static PyObject *py_marker_moments(PyObject *self, PyObject *args) {
     PyObject *ret = NULL;
     int32_t *lab = NULL, *stack = NULL;
     double *wt = NULL;
-    if (w <= 0 || h <= 0 || !check(&I, 1, (Py_ssize_t)w * h, "img")) goto done;
+    if (!sizes_ok(w, h) || !check(&I, 1, (Py_ssize_t)w * h, "img")) goto done;
+    if (w == 0 || h == 0) goto none; /* an empty window: nothing seen */
     const uint8_t *img = I.buf;
     int ex0, ey0, ex1, ey1;
     if (!bright_box(img, w, h, thr, &ex0, &ey0, &ex1, &ey1)) goto none;
@@ -594,7 +603,8 @@ static PyObject *py_ball_blob(PyObject *self, PyObject *args) {
     PyObject *ret = NULL;
     int32_t *lab = NULL, *stack = NULL;
     double *wt = NULL;
-    if (w <= 0 || h <= 0 || !check(&I, 1, (Py_ssize_t)w * h, "img")) goto done;
+    if (!sizes_ok(w, h) || !check(&I, 1, (Py_ssize_t)w * h, "img")) goto done;
+    if (w == 0 || h == 0) goto none; /* an empty window: nothing seen */
     const uint8_t *img = I.buf;
     int ex0, ey0, ex1, ey1;
     if (!bright_box(img, w, h, thr, &ex0, &ey0, &ex1, &ey1)) goto none;

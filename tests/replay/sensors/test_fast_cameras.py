@@ -400,3 +400,25 @@ def test_window_of_a_box_on_the_stick_camera_is_clipped_to_the_image():
     cam = StickCamera.make_camera(StickCameraParams(**STICK_3STEP))
     assert hull_window(cam, (-20.0, 5.0, 3.0, 9.5)) == (0, 0, 12, 19)  # + 8 px, clipped
     assert hull_window(cam, (600.0, 5.0, 700.0, 9.5)) is None
+
+
+def test_kernels_refuse_bad_buffers_and_see_nothing_in_empty_images():
+    assert StereoBallCamera.blob(np.zeros((0, 0), np.uint8)) is None
+    assert StickCamera.marker_moments(np.zeros((0, 5), np.uint8), StickCameraParams()) is None
+    with pytest.raises(ValueError, match="negative image size"):
+        _pixels.coverage(np.zeros((3, 2)), 0, 0, np.zeros(4), -2, -2)
+    with pytest.raises(ValueError, match="img"):  # a float64 image where float32 is meant
+        _pixels.composite([np.zeros((3, 2))], [1.0], 0, 0, np.zeros((4, 4)), 4, 4)
+    with pytest.raises(ValueError, match="body"):
+        _pixels.project_hull(
+            np.zeros(7),
+            (0, 0, 0, 1.0),
+            (0, 0, 0.0),
+            np.eye(3),
+            np.zeros(3),
+            1,
+            1,
+            0,
+            0,
+            np.zeros(4),
+        )
