@@ -187,7 +187,9 @@ def project_hull(camera: PinholeCamera, body: np.ndarray, orientation, position)
     return hull[: found[0]], found[1:]
 
 
-def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse, tuple] | None:
+def silhouette(
+    camera: PinholeCamera, prim
+) -> tuple[float, np.ndarray | Ellipse, tuple | None] | None:
     """(distance (m) from the optical centre to the primitive's centre, convex polygon (N, 2) in
     pixels, its box (umin, vmin, umax, vmax) or None for an ellipse) of a primitive, or None if
     it reaches behind the camera. Spheres give their ellipse."""
@@ -221,11 +223,11 @@ def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, flo
     for _, _, prim, shape, box in items:
         if isinstance(shape, Ellipse):
             poly, box = shape.polygon_and_box()
-        elif len(shape) >= 3:
+        elif len(shape) >= 3 and box is not None:
             poly = shape
         else:
             continue
-        out.append((poly, 255.0 * float(prim.albedo), box))
+        out.append((poly, 255.0 * float(prim.albedo), tuple(box)))
     return out
 
 
