@@ -56,6 +56,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from replay.interfaces import Sensor
@@ -65,7 +66,6 @@ from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
 from replay.sensors import _pixels
-from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
 
 _RIM = 48  # vertices of a polygon standing in for a circle
@@ -145,18 +145,28 @@ def _outline_points(camera: PinholeCamera, prim) -> np.ndarray:
 def _silhouette(camera: PinholeCamera, prim):
     """(distance of its centre from the camera, albedo, convex hull in pixels, name, pixel box
     (umin, vmin, umax, vmax)) of a primitive, or None if it reaches behind the camera (or has
-    no area). The outline's projection and hull: :func:`~replay.sensors.silhouette.project_hull`."""
-    if isinstance(prim, (Box, Cylinder)):
-        body, q, pos = _body_points(prim), prim.orientation, prim.position
-    else:
-        body, q, pos = _outline_points(camera, prim), (0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0)
-        if not len(body):
-            return None
-    found = project_hull(camera, body, q, pos)
-    if found is None or len(found[0]) < 3:
+    no area). Projected with NumPy and hulled by ``cv2.convexHull`` of the float32 pixels, as
+    before the compiled kernels: ``_pixels.project_hull`` (the other cameras') agrees to a
+    float32 ulp, which is enough to move a pixel across a uint8 rounding boundary now and then
+    and, through the closed loop, a stick_3step run (an extra collision); this keeps the stick
+    camera's measurements equal to what they were."""
+    pts = _outline_points(camera, prim)
+    if not len(pts):
         return None
+    pc = camera.to_camera(pts)
+    z = pc[:, 2]
+    if z.min() <= 1e-6:
+        return None
+    k = camera.intrinsics
+    uv = np.column_stack([k.fx * pc[:, 0] / z + k.cx, k.fy * pc[:, 1] / z + k.cy]).astype(
+        np.float32
+    )
+    hull = cv2.convexHull(uv).reshape(-1, 2).astype(np.float64)
+    if len(hull) < 3:
+        return None
+    box = (*hull.min(axis=0).tolist(), *hull.max(axis=0).tolist())
     distance = math.dist(prim.position, camera.position.tolist())
-    return (distance, prim.albedo, found[0], prim.name, found[1])
+    return (distance, prim.albedo, hull, prim.name, box)
 
 
 def _misses(camera: PinholeCamera, prim, window, R, o) -> bool:
