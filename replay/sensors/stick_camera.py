@@ -32,11 +32,12 @@ Cost: a frame renders only the window around the marker's silhouette (plus 8 px;
 the image is exactly the dark table, which never passes the threshold, and is filled in only
 when the whole image is asked for, :attr:`StickCamera.last_image`), draws only the primitives
 whose bounding sphere's image meets that window, and does the per-pixel work in compiled
-kernels (``_pixels.c``: outline projection and hull, exact-coverage compositing, 8-bit
-quantising, segmentation and moments in one pass) with the same algorithms the NumPy/OpenCV
-code used (kept as references in tests/replay/sensors/test_fast_cameras.py and test_raster.py):
-~0.1 ms a frame of stick_3step instead of ~1.9 ms, measurements equal to 1e-9 m on the same
-silhouettes.
+kernels (``_pixels.c``: exact-coverage compositing, 8-bit quantising, segmentation and moments
+in one pass) with the same algorithms the NumPy/OpenCV code used (kept as references in
+tests/replay/sensors/test_fast_cameras.py and test_raster.py): ~0.1 ms a frame of stick_3step
+instead of ~1.9 ms (tools/bench_cameras.py), measurements equal to 1e-14 m, and a stick_3step
+run equal to what it was (the outlines are still projected with NumPy and hulled by OpenCV:
+see :func:`_silhouette`).
 
 Accuracy (test_fast_cameras.py, noise-free, 200 random poses of the stick_3step geometry, 1.8 mm
 per pixel, no fingertips), the same before and after the kernels: bias (mean error) x -0.17,
