@@ -16,7 +16,9 @@ setup(
     package_dir=SHIPPED,
     ext_modules=[
         Extension(
-            "replay.sensors._pixels", ["replay/sensors/_pixels.c"], extra_compile_args=["-O2"]
+            "replay.sensors._pixels",
+            ["replay/sensors/_pixels.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
         )
     ],
     package_data={

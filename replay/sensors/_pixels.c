@@ -313,22 +313,30 @@ static PyObject *py_project_hull(PyObject *self, PyObject *args) {
         PyErr_NoMemory();
         goto done;
     }
+    /* The products of 3-vectors as NumPy's matmul (OpenBLAS) computes them here, fused
+     * multiply-adds in ascending order, and in the order NumPy did it before (world = body R^T +
+     * p, then (world - o) R), so that the pixels are the same to the bit (a float32 ulp moved
+     * the stick camera's uint8 pixels now and then and, through the closed loop, a run). */
+    const double pos[3] = {px, py, pz}, org[3] = {ox, oy, oz};
     for (Py_ssize_t i = 0; i < n; i++) {
         const double *v = b + 3 * i;
         double d[3];
         for (int k = 0; k < 3; k++) /* world point minus the optical centre */
-            d[k] = q[3 * k] * v[0] + q[3 * k + 1] * v[1] + q[3 * k + 2] * v[2] +
-                   (k == 0 ? px - ox : k == 1 ? py - oy : pz - oz);
-        double X = d[0] * R[0] + d[1] * R[3] + d[2] * R[6]; /* p_cam = R^T d */
-        double Y = d[0] * R[1] + d[1] * R[4] + d[2] * R[7];
-        double Z = d[0] * R[2] + d[1] * R[5] + d[2] * R[8];
+            d[k] = (fma(v[2], q[3 * k + 2], fma(v[1], q[3 * k + 1], v[0] * q[3 * k])) + pos[k]) -
+                   org[k];
+        double X = fma(d[2], R[6], fma(d[1], R[3], d[0] * R[0])); /* p_cam = R^T d */
+        double Y = fma(d[2], R[7], fma(d[1], R[4], d[0] * R[1]));
+        double Z = fma(d[2], R[8], fma(d[1], R[5], d[0] * R[2]));
         if (!(Z > 1e-6)) {
             Py_INCREF(Py_None);
             ret = Py_None;
             goto done;
         }
-        pts[2 * i] = (float)(fx * X / Z + cx);
-        pts[2 * i + 1] = (float)(fy * Y / Z + cy);
+        /* rounded to float32 for real (a plain cast may be elided: GCC's default
+         * -fexcess-precision=fast) */
+        volatile float fu = (float)(fx * X / Z + cx), fv = (float)(fy * Y / Z + cy);
+        pts[2 * i] = fu;
+        pts[2 * i + 1] = fv;
     }
     /* Andrew's monotone chain */
     qsort(pts, n, 2 * sizeof(double), cmp_pt);

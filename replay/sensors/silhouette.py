@@ -166,8 +166,10 @@ def project_hull(camera: PinholeCamera, body: np.ndarray, orientation, position)
     """(convex hull (N, 2) in pixels, its box (umin, vmin, umax, vmax)) of body-frame points
     (n, 3) of a rigid body at ``position`` with quaternion ``orientation``, or None if a point
     is not in front of the camera (depth <= 1 um). One compiled call
-    (``_pixels.project_hull``): the projections are rounded to float32, as ``cv2.convexHull``
-    of float32 points took them, and the hull is Andrew's monotone chain."""
+    (``_pixels.project_hull``): the products as NumPy's matmul computes them (fused
+    multiply-adds in ascending order: the same pixels to the bit, test_fast_cameras.py), the
+    projections rounded to float32, as ``cv2.convexHull`` of float32 points took them, and the
+    hull is Andrew's monotone chain."""
     k = camera.intrinsics
     hull = np.empty((len(body), 2))
     found = _pixels.project_hull(

@@ -32,12 +32,11 @@ Cost: a frame renders only the window around the marker's silhouette (plus 8 px;
 the image is exactly the dark table, which never passes the threshold, and is filled in only
 when the whole image is asked for, :attr:`StickCamera.last_image`), draws only the primitives
 whose bounding sphere's image meets that window, and does the per-pixel work in compiled
-kernels (``_pixels.c``: exact-coverage compositing, 8-bit quantising, segmentation and moments
-in one pass) with the same algorithms the NumPy/OpenCV code used (kept as references in
+kernels (``_pixels.c``: outline projection and hull, exact-coverage compositing, 8-bit
+quantising, segmentation and moments in one pass) with the same algorithms the NumPy/OpenCV code used (kept as references in
 tests/replay/sensors/test_fast_cameras.py and test_raster.py): ~0.1 ms a frame of stick_3step
-instead of ~1.9 ms (tools/bench_cameras.py), measurements equal to 1e-14 m, and a stick_3step
-run equal to what it was (the outlines are still projected with NumPy and hulled by OpenCV:
-see :func:`_silhouette`).
+instead of ~1.9 ms (tools/bench_cameras.py), measurements equal to 1e-14 m and a stick_3step
+run equal to what it was (the outlines' pixels are NumPy's to the bit: ``project_hull``).
 
 Accuracy (test_fast_cameras.py, noise-free, 200 random poses of the stick_3step geometry, 1.8 mm
 per pixel, no fingertips), the same before and after the kernels: bias (mean error) x -0.17,
@@ -57,7 +56,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from replay.interfaces import Sensor
@@ -67,6 +65,7 @@ from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
 from replay.sensors import _pixels
+from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
 
 _RIM = 48  # vertices of a polygon standing in for a circle
@@ -146,28 +145,19 @@ def _outline_points(camera: PinholeCamera, prim) -> np.ndarray:
 def _silhouette(camera: PinholeCamera, prim):
     """(distance of its centre from the camera, albedo, convex hull in pixels, name, pixel box
     (umin, vmin, umax, vmax)) of a primitive, or None if it reaches behind the camera (or has
-    no area). Projected with NumPy and hulled by ``cv2.convexHull`` of the float32 pixels, as
-    before the compiled kernels: ``_pixels.project_hull`` (the other cameras') agrees to a
-    float32 ulp, which is enough to move a pixel across a uint8 rounding boundary now and then
-    and, through the closed loop, a stick_3step run (an extra collision); this keeps the stick
-    camera's measurements equal to what they were."""
-    pts = _outline_points(camera, prim)
-    if not len(pts):
+    no area). The outline's projection and hull: :func:`~replay.sensors.silhouette.project_hull`
+    (the same float32 pixels as NumPy's projection and ``cv2.convexHull`` gave)."""
+    if isinstance(prim, (Box, Cylinder)):
+        body, q, pos = _body_points(prim), prim.orientation, prim.position
+    else:
+        body, q, pos = _outline_points(camera, prim), (0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0)
+        if not len(body):
+            return None
+    found = project_hull(camera, body, q, pos)
+    if found is None or len(found[0]) < 3:
         return None
-    pc = camera.to_camera(pts)
-    z = pc[:, 2]
-    if z.min() <= 1e-6:
-        return None
-    k = camera.intrinsics
-    uv = np.column_stack([k.fx * pc[:, 0] / z + k.cx, k.fy * pc[:, 1] / z + k.cy]).astype(
-        np.float32
-    )
-    hull = cv2.convexHull(uv).reshape(-1, 2).astype(np.float64)
-    if len(hull) < 3:
-        return None
-    box = (*hull.min(axis=0).tolist(), *hull.max(axis=0).tolist())
     distance = math.dist(prim.position, camera.position.tolist())
-    return (distance, prim.albedo, hull, prim.name, box)
+    return (distance, prim.albedo, found[0], prim.name, found[1])
 
 
 def _misses(camera: PinholeCamera, prim, window, R, o) -> bool:
