@@ -21,10 +21,10 @@ from mcap.reader import make_reader
 from mcap.records import Channel, Message
 from mcap.stream_reader import StreamReader
 
+from replay.log.chunks import MAGIC
 from replay.log.errors import LogError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
-MAGIC = b"\x89MCAP0\r\n"
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
 
 

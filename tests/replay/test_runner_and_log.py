@@ -219,18 +219,18 @@ def test_sigint_mid_record_is_held_until_the_record_is_whole(tmp_path):
     """Ctrl-C while a record is written is raised only once the write is done, so the log never
     holds a torn record; after close the default handler is back."""
     w = LogWriter(tmp_path / "x.mcap", chunk_size=100)
+    add, reached = w._mcap.message, []
+
+    def interrupted_mid_record(*args):  # Ctrl-C arrives while the record is being written
+        os.kill(os.getpid(), signal.SIGINT)
+        add(*args)
+        reached.append(True)
+
+    w._mcap.message = interrupted_mid_record
     with pytest.raises(KeyboardInterrupt):
-        with w._held:  # what write() does around a record
-            os.kill(os.getpid(), signal.SIGINT)
-            w._writer.add_message(
-                channel_id=w._channel("/events", Event(0.0, "a")),
-                log_time=0,
-                publish_time=0,
-                data=b'{"t":0,"kind":"a"}',
-                sequence=0,
-            )
-            reached = True
+        w.write("/events", Event(0.0, "a"), 0)
     assert reached
+    w._mcap.message = add
     w.write("/events", Event(0.001, "interrupted"), 1_000_000)
     assert w.close("interrupted") == tmp_path / "x.interrupted.mcap"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
