@@ -11,6 +11,7 @@ logged at its end, collisions with the controller's intent attached. The run sto
 
 from __future__ import annotations
 
+import functools
 import heapq
 import platform
 import subprocess
@@ -57,6 +58,7 @@ class RunResult:
 COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 
+@functools.cache  # once a process: the code a process runs is the code it loaded
 def _git_commit() -> str:
     try:
         out = subprocess.run(
@@ -71,6 +73,17 @@ def _git_commit() -> str:
         return ""
 
 
+@functools.cache  # once a process (~3 ms of package metadata reads)
+def _versions() -> tuple[tuple[str, str], ...]:
+    found = []
+    for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
+        try:
+            found.append((pkg, importlib_metadata.version(pkg)))
+        except importlib_metadata.PackageNotFoundError:
+            pass
+    return tuple(found)
+
+
 def provenance(sc: Scenario, commit: str) -> dict[str, str]:
     info = {
         "scenario": sc.name,
@@ -80,11 +93,7 @@ def provenance(sc: Scenario, commit: str) -> dict[str, str]:
         "python": platform.python_version(),
         "git_commit": commit,
     }
-    for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
-        try:
-            info[pkg] = importlib_metadata.version(pkg)
-        except importlib_metadata.PackageNotFoundError:
-            pass
+    info.update(_versions())
     return info
 
 

@@ -72,7 +72,8 @@ class McapFile:
         self._counts: list[int] = [0]  # messages per channel id (id 0 unused)
         self._order: list[int] = []  # channel ids in the order of their first message
         self._chunk = bytearray()  # the records of the chunk being built
-        self._chunk_index: dict[int, list[int]] = {}  # channel id -> [t, offset, t, offset, ...]
+        # per channel id, its messages in the chunk being built: [t, offset, t, offset, ...]
+        self._indexes: list[list[int]] = [[]]
         self._chunk_indexes: list[ChunkIndex] = []
         self._metadata_indexes: list[MetadataIndex] = []
 
@@ -104,6 +105,7 @@ class McapFile:
         )
         self._channels.append(channel)
         self._counts.append(0)
+        self._indexes.append([])
         self._chunk += _record(channel)
         self._maybe_finish_chunk()
         return channel.id
@@ -113,13 +115,8 @@ class McapFile:
         counts = self._counts
         sequence = counts[channel_id]
         counts[channel_id] = sequence + 1
-        if not sequence:
-            self._order.append(channel_id)
         chunk = self._chunk
-        index = self._chunk_index.get(channel_id)
-        if index is None:
-            index = self._chunk_index[channel_id] = []
-        index += (log_time, len(chunk))
+        self._indexes[channel_id] += (log_time, len(chunk))
         chunk += _MESSAGE.pack(
             Opcode.MESSAGE,
             _MESSAGE_FIXED + len(data),
@@ -149,11 +146,15 @@ class McapFile:
             self._finish_chunk()
 
     def _finish_chunk(self) -> None:
-        if not self._chunk_index:
+        # the chunk's channels in the order of their first message in it
+        present = sorted((entries[1], c) for c, entries in enumerate(self._indexes) if entries)
+        if not present:
             return  # (schemas and channels alone wait for the first message, as mcap's do)
-        # the chunk's time range from its index, once a chunk (entries: t, offset, t, ...)
-        start = min(min(entries[::2]) for entries in self._chunk_index.values())
-        end = max(0, max(max(entries[::2]) for entries in self._chunk_index.values()))
+        for _, c in present:
+            if self._counts[c] == len(self._indexes[c]) // 2:  # its first chunk
+                self._order.append(c)
+        start = min(min(self._indexes[c][::2]) for _, c in present)
+        end = max(0, max(max(self._indexes[c][::2]) for _, c in present))
         raw = bytes(self._chunk)
         data = self._compressor.compress(raw) if self._compressor else raw
         comp = self._compression.encode()
@@ -175,7 +176,8 @@ class McapFile:
         offsets = {}
         parts = [head, data]
         position = index_start
-        for channel_id, entries in self._chunk_index.items():
+        for _, channel_id in present:
+            entries = self._indexes[channel_id]
             n = len(entries)
             part = _INDEX_HEAD.pack(
                 Opcode.MESSAGE_INDEX, 2 + 4 + 8 * n, channel_id, 8 * n
@@ -198,7 +200,8 @@ class McapFile:
             )
         )
         self._chunk = bytearray()
-        self._chunk_index = {}
+        for _, c in present:
+            self._indexes[c] = []
 
     def finish(self) -> None:
         """The last chunk, the data end, the summary (schemas, channels, statistics, chunk and

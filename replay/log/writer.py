@@ -39,7 +39,8 @@ PART_SUFFIX = ".part"
 ZSTD_LEVEL = 1
 _ENCODER = json.JSONEncoder(allow_nan=False, separators=(",", ":"))  # built once: dumps() with
 # options builds one a call
-_ORJSON = orjson.OPT_NON_STR_KEYS  # keys as the standard encoder writes them
+_ORJSON = orjson.OPT_NON_STR_KEYS  # int keys as the standard encoder writes them
+_dumps = orjson.dumps
 
 
 def encode(topic: str, payload: Any) -> bytes:
@@ -51,13 +52,16 @@ def encode(topic: str, payload: Any) -> bytes:
     encoder takes (e.g. ``numpy.float64``) is encoded by it, which refuses non-finite numbers.
     """
     try:
-        data = orjson.dumps(payload, option=_ORJSON)
+        data = _dumps(payload)
     except TypeError:
-        body = to_dict(payload)
         try:
-            return _ENCODER.encode(body).encode()
-        except ValueError:
-            raise NonFiniteValueError(topic, body) from None
+            data = _dumps(payload, option=_ORJSON)  # (slower than without: only when needed)
+        except TypeError:
+            body = to_dict(payload)
+            try:
+                return _ENCODER.encode(body).encode()
+            except ValueError:
+                raise NonFiniteValueError(topic, body) from None
     if b"null" in data and not _finite(payload):
         raise NonFiniteValueError(topic, to_dict(payload))
     return data
@@ -281,9 +285,7 @@ class LogWriter:
     def write(self, topic: str, payload: Any, t_ns: int) -> None:
         """Write one message; ``t_ns`` (simulated time) is both log and publish time."""
         data = encode(topic, payload)  # NonFiniteValueError before anything is written
-        channel = self._json_channels.get(topic)
-        if channel is None:
-            channel = self._json_channel(topic, payload)
+        channel = self._json_channels.get(topic) or self._json_channel(topic, payload)  # ids > 0
         self.write_raw(channel, data, t_ns)
 
     def write_raw(self, channel_id: int, data: bytes, t_ns: int) -> None:
