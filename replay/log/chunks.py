@@ -1,9 +1,9 @@
 """An indexed, chunked, zstd-compressed MCAP file written with little Python per message.
 
 The ``mcap`` library's ``Writer`` builds a ``Message`` dataclass and makes ~10 small writes to a
-``BytesIO`` per message (~10 us); here a message is one ``struct.pack`` of its 31-byte header and
-two ``bytearray`` appends (~1 us), and the per-channel message index of a chunk is a flat list of
-(log time, offset) packed once per chunk. Every other record (header, schemas, channels,
+``BytesIO`` per message; here a message is one ``struct.pack`` of its 31-byte header and two
+``bytearray`` appends, and the per-channel message index of a chunk is a flat list of (log time,
+offset) packed once per chunk. Every other record (header, schemas, channels,
 metadata, statistics, indexes, footer) is written by the ``mcap`` library's own record classes,
 in the order its ``Writer`` writes them, so that a file written here is byte for byte the file
 ``mcap.writer.Writer(compression=ZSTD)`` writes for the same calls (a test checks it), readable by
