@@ -249,10 +249,11 @@ class Runner:
                     telemetry = telemetry_of(t)
                     c0 = clock()
                     t_controller += c0 - c1
-                    for occ in occurrences:
-                        stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
-                    if telemetry:
+                    if occurrences:
+                        for occ in occurrences:
+                            stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
                         c0 = clock()
+                    if telemetry:
                         for topic, payload in telemetry.items():
                             if isinstance(payload, list):
                                 for item in payload:
