@@ -54,8 +54,10 @@ class RunResult:
     timings: dict = field(default_factory=dict)
 
 
-# The parts of a run timed by the runner itself (perf_counter around each call: ~0.1 us a call),
-# so `make bench` shows where the time goes without a profiler.
+# The parts of a run timed by the runner itself (perf_counter, one reading a part), so `make
+# bench` shows where the time goes without a profiler: sensors (measure); controller (update,
+# pop_events, telemetry, intent); plant (scene, apply, truth, step, pop_events); logging (log
+# writes and observers); runner (the rest: the loop itself, delivery, set-up, closing the log).
 COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 
