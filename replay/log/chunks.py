@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import struct
 import zlib
-from typing import BinaryIO
+from typing import Any, Protocol
 
 import zstandard
 from mcap.data_stream import RecordBuilder
@@ -40,6 +40,12 @@ _OP_MESSAGE = int(Opcode.MESSAGE)  # (an enum member's lookup costs ~10x a plain
 _INDEX_HEAD = struct.Struct("<BQHI")  # opcode, length, channel id, byte length of the entries
 
 
+class Sink(Protocol):
+    """Where the file goes: anything with ``write(bytes)`` (a binary file, ``io.BytesIO``)."""
+
+    def write(self, data: bytes, /) -> Any: ...
+
+
 def _record(record) -> bytes:
     """One record (an ``mcap.records`` instance) as bytes, written by the library itself."""
     builder = RecordBuilder()
@@ -53,7 +59,7 @@ class McapFile:
 
     def __init__(
         self,
-        stream: BinaryIO,
+        stream: Sink,
         *,
         chunk_size: int = 1024 * 1024,
         compression: str = "zstd",
