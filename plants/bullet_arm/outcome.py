@@ -49,6 +49,7 @@ class CatchWatch:
         self.closest: PalmSample | None = None
         self.catch_time: float | None = None
         self.approaching = True
+        self._closest_d2 = math.inf  # |world_offset|^2 of ``closest``
 
     def observe(
         self,
@@ -62,21 +63,33 @@ class CatchWatch:
         parts: list,
         caught: bool,
     ) -> None:
-        """One step: the object's and the palm's state (world) and the parts touching now."""
-        R = quaternion_matrix(palm_quat)
-        centre = np.asarray(palm_pos, float) + R[:, 2] * self.palm_thickness
-        d = np.asarray(obj_pos, float) - centre
-        local = R.T @ d
-        v_point = np.asarray(palm_vel, float) + np.cross(palm_omega, np.asarray(obj_pos) - palm_pos)
-        rel = np.asarray(obj_vel, float) - v_point
-        speed = float(np.linalg.norm(rel))
-        inward = -(R.T @ rel)[2]  # towards the palm face, along its normal
-        angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
-        sample = PalmSample(
-            t, float(math.hypot(local[0], local[1])), float(local[2]), speed, angle, d
+        """One step: the object's and the palm's state (world) and the parts touching now.
+        Written in floats (3-vectors as tuples): it runs at every physics step."""
+        R = quaternion_matrix(palm_quat).tolist()
+        X = (R[0][0], R[1][0], R[2][0])  # the palm frame's axes (world)
+        Y = (R[0][1], R[1][1], R[2][1])
+        Z = (R[0][2], R[1][2], R[2][2])
+        (ox, oy, oz), (px, py, pz) = [float(x) for x in obj_pos], [float(x) for x in palm_pos]
+        th = self.palm_thickness
+        d = (ox - px - Z[0] * th, oy - py - Z[1] * th, oz - pz - Z[2] * th)
+        lx, ly = _dot(X, d), _dot(Y, d)
+        lz = _dot(Z, d)
+        w = [float(x) for x in palm_omega]
+        arm = (ox - px, oy - py, oz - pz)
+        vp = [float(x) for x in palm_vel]
+        vo = [float(x) for x in obj_vel]
+        rel = (
+            vo[0] - vp[0] - (w[1] * arm[2] - w[2] * arm[1]),
+            vo[1] - vp[1] - (w[2] * arm[0] - w[0] * arm[2]),
+            vo[2] - vp[2] - (w[0] * arm[1] - w[1] * arm[0]),
         )
-        if self.closest is None or np.linalg.norm(d) < np.linalg.norm(self.closest.world_offset):
-            self.closest = sample
+        speed = math.sqrt(_dot(rel, rel))
+        inward = -_dot(Z, rel)  # towards the palm face, along its normal
+        angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
+        sample = PalmSample(t, math.hypot(lx, ly), lz, speed, angle, np.array(d))
+        dist2 = _dot(d, d)
+        if self.closest is None or dist2 < self._closest_d2:
+            self.closest, self._closest_d2 = sample, dist2
         self.approaching = self.closest is sample  # still closing in at the last step
         if parts and self.first_contact is None:
             before = self.last or sample
@@ -144,6 +157,10 @@ class CatchWatch:
         dy, dz = abs(cl.world_offset[1]), cl.world_offset[2]
         side = ("below" if dz < 0 else "above") if abs(dz) >= dy else "beside"
         return {"success": False, "reason": f"{k} passed {side} the hand", **out}
+
+
+def _dot(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 def _first_part(parts: list) -> str:

@@ -70,6 +70,7 @@ class BulletArmPlant(Plant):
         self.urdf_path = self.model.write()
         self.joint_names = names
         self.lower, self.upper = S.lower, S.upper
+        self._lower_in, self._upper_in = self.lower + 1e-3, self.upper - 1e-3  # "at the limit"
 
         # ---- the world
         with quiet_c_output():  # connect prints "argv[0]="
@@ -126,6 +127,21 @@ class BulletArmPlant(Plant):
         for j, v in zip(self._hand_j, h0):
             bc.resetJointState(self.robot, j, float(v), 0.0)
         self._hand_target = h0.copy()
+        # one getJointStates a step for the arm and the hand; q of the locked joints preset
+        self._read_j = self._arm_j + self._hand_j
+        self._act_idx = np.array(self.active, dtype=int)
+        self._q_locked = np.zeros(dof)
+        for n, v in self.locked.items():
+            self._q_locked[names.index(n)] = v
+        self._locked_idx = np.array([names.index(n) for n in self.locked], dtype=int)
+        # BulletClient makes a new functools.partial on every attribute access: bind the calls
+        # made every step once (stepSimulation stays an attribute: the bench times it there)
+        self._get_joint_states = bc.getJointStates
+        self._get_base_pose = bc.getBasePositionAndOrientation
+        self._get_base_velocity = bc.getBaseVelocity
+        self._get_link_state = bc.getLinkState
+        self._get_contact_points = bc.getContactPoints
+        self._set_motors = bc.setJointMotorControlArray
         if ht is not None:
             self._hand_lo = np.array([j.lower for j in ht.joints])
             self._hand_hi = np.array([j.upper for j in ht.joints])
@@ -183,6 +199,7 @@ class BulletArmPlant(Plant):
         self._contacts: list = []
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
         self._cache = None
+        self._effector = None  # (step, the tool link's state): read at most once a step
         self._spec = self._make_spec(q0)
         ht = self.hand_table  # the catch verdict (outcome.py): a free object and a hand
         self._watch = (
@@ -255,28 +272,28 @@ class BulletArmPlant(Plant):
     # ------------------------------------------------------------------ state
     def _state(self) -> tuple:
         """((q, qd), hand (q, qd, effort), object (pos, orn, v, w) or None), read from PyBullet
-        once after each step and kept until the next one (``invalidate_state`` after changing
-        the simulation other than by stepping it)."""
+        once after each step (one getJointStates for arm and hand) and kept until the next one
+        (``invalidate_state`` after changing the simulation other than by stepping it)."""
         if self._cache is None:
-            q = np.zeros(self.dof)
+            st = self._get_joint_states(self.robot, self._read_j)
+            na = len(self._arm_j)
+            q = self._q_locked.copy()
             qd = np.zeros(self.dof)
-            for n, v in self.locked.items():
-                q[self.joint_names.index(n)] = v
-            for k, st in enumerate(self.bc.getJointStates(self.robot, self._arm_j)):
-                q[self.active[k]], qd[self.active[k]] = st[0], st[1]
-            if self._hand_j:
-                st = self.bc.getJointStates(self.robot, self._hand_j)
+            q[self._act_idx] = [s[0] for s in st[:na]]
+            qd[self._act_idx] = [s[1] for s in st[:na]]
+            if na < len(st):
+                hs = st[na:]
                 hand = (
-                    np.array([s[0] for s in st]),
-                    np.array([s[1] for s in st]),
-                    np.array([s[3] for s in st]),
+                    np.array([s[0] for s in hs]),
+                    np.array([s[1] for s in hs]),
+                    np.array([s[3] for s in hs]),
                 )
             else:
                 hand = (np.zeros(0), np.zeros(0), np.zeros(0))
             obj = None
             if self.obj is not None:
-                pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
-                v, w = self.bc.getBaseVelocity(self.obj)
+                pos, orn = self._get_base_pose(self.obj)
+                v, w = self._get_base_velocity(self.obj)
                 obj = (np.array(pos), np.array(orn), np.array(v), np.array(w))
             self._cache = ((q, qd), hand, obj)
         return self._cache
@@ -284,6 +301,7 @@ class BulletArmPlant(Plant):
     def invalidate_state(self) -> None:
         """Forget the state read from PyBullet (after a reset* call: the next read is fresh)."""
         self._cache = None
+        self._effector = None
 
     def arm_state(self) -> tuple[np.ndarray, np.ndarray]:
         """(q, qd) of every arm joint (locked ones at their lock value, zero speed)."""
@@ -297,11 +315,14 @@ class BulletArmPlant(Plant):
         return tuple(a.copy() for a in self._state()[2])
 
     def effector_state(self):
-        """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity."""
-        ls = self.bc.getLinkState(
-            self.robot, self._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
-        )
-        return np.array(ls[4]), np.array(ls[5]), np.array(ls[6]), np.array(ls[7])
+        """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity (read
+        once a step, like the joint state)."""
+        if self._effector is None or self._effector[0] != self._steps:
+            ls = self._get_link_state(
+                self.robot, self._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+            self._effector = (self._steps, (ls[4], ls[5], ls[6], ls[7]))
+        return tuple(np.array(x) for x in self._effector[1])
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ArmCommand) -> None:
@@ -317,20 +338,21 @@ class BulletArmPlant(Plant):
 
     def _limit_torque(self, qd: np.ndarray) -> None:
         finite = np.isfinite(self._tau_cmd)
-        tau = np.where(finite, self._tau_cmd, 0.0)  # a non-finite command gives no torque
-        lim = self.torque_limits
-        applied = np.clip(tau, -lim, lim)
-        clamped = (applied != tau) | ~finite
+        all_finite = bool(finite.all())
+        tau = self._tau_cmd if all_finite else np.where(finite, self._tau_cmd, 0.0)
+        lim = self.torque_limits  # (a non-finite command gives no torque)
+        applied = np.minimum(np.maximum(tau, -lim), lim)
+        clamped = applied != tau
+        if not all_finite:
+            clamped |= ~finite
         if self.params.enforce_velocity_limits:
             over = (np.abs(qd) >= self.velocity_limits) & (np.sign(applied) == np.sign(qd))
             over &= applied != 0.0
             applied = np.where(over, 0.0, applied)
             clamped |= over
-        for n in self.locked:
-            i = self.joint_names.index(n)
-            applied[i] = 0.0
-            clamped[i] = False
-        for i in np.flatnonzero(clamped & ~self._torque_episode):
+        applied[self._locked_idx] = 0.0
+        clamped[self._locked_idx] = False
+        for i in np.flatnonzero(clamped & ~self._torque_episode) if clamped.any() else ():
             self._events.append(
                 Occurrence(
                     "torque_limit",
@@ -348,21 +370,20 @@ class BulletArmPlant(Plant):
 
     def step(self) -> None:
         bc = self.bc
-        q, qd = self.arm_state()
-        self._limit_torque(qd)
-        bc.setJointMotorControlArray(
+        self._limit_torque(self._state()[0][1])
+        self._set_motors(
             self.robot,
             self._arm_j,
             p.TORQUE_CONTROL,
-            forces=[float(self._tau_applied[i]) for i in self.active],
+            forces=self._tau_applied[self._act_idx].tolist(),
         )
         if self._hand_j:
-            hq, _, _ = self.hand_state()
+            hq = self._state()[1][0]
             speed = self.params.hand_closing_speed
             # rate-limited position servo: reach the target at most at the closing speed, the
             # last step landing on it (PyBullet's velocity motor is implicit, so this is stable)
-            v = np.clip((self._hand_target - hq) / self.dt, -speed, speed)
-            bc.setJointMotorControlArray(
+            v = np.minimum(np.maximum((self._hand_target - hq) / self.dt, -speed), speed)
+            self._set_motors(
                 self.robot,
                 self._hand_j,
                 p.VELOCITY_CONTROL,
@@ -370,7 +391,7 @@ class BulletArmPlant(Plant):
                 forces=[self.params.hand_max_torque] * len(v),
             )
         if self.obj is not None:
-            pos, _, v, _ = self.object_state()
+            pos, _, v, _ = self._state()[2]
             J = self._impulses.pop(self._steps) if self._impulses else None
             if J is not None:  # a scenario-set kick (impulse.py)
                 v = v + J / self.params.object_mass
@@ -397,31 +418,34 @@ class BulletArmPlant(Plant):
     # ------------------------------------------------------------------ events
     def _robot_contacts(self):
         """Contact points object-robot that touch (normal force > 0 or no gap)."""
-        pts = self.bc.getContactPoints(bodyA=self.obj, bodyB=self.robot)
+        pts = self._get_contact_points(bodyA=self.obj, bodyB=self.robot)
         return [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
 
     def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
         if link < 0:
             return np.zeros(3)
-        ls = self.bc.getLinkState(
+        ls = self._get_link_state(
             self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
         )
-        return np.array(ls[6]) + np.cross(np.array(ls[7]), point - np.array(ls[0]))
+        (vx, vy, vz), (wx, wy, wz), (cx, cy, cz) = ls[6], ls[7], ls[0]
+        rx, ry, rz = (float(x) for x in point)
+        rx, ry, rz = rx - cx, ry - cy, rz - cz  # v + w x (point - link COM)
+        return np.array([vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx])
 
     def _check_events(self) -> None:
         P = self.params
         q, qd = self.arm_state()
-        finite = bool(np.all(np.isfinite(q)) and np.all(np.isfinite(qd)))
+        finite = bool(np.isfinite(q).all() and np.isfinite(qd).all())
         if self.obj is not None:
             pos, orn, v, w = self.object_state()
-            finite = finite and bool(np.all(np.isfinite(pos)) and np.all(np.isfinite(v)))
+            finite = finite and bool(np.isfinite(pos).all() and np.isfinite(v).all())
         if not finite:
             if not self.diverged:
                 self.diverged = True
                 self._events.append(Occurrence("nan", {"step": self._steps}))
             return
         over = np.abs(qd) > self.velocity_limits
-        for i in np.flatnonzero(over & ~self._vel_over):
+        for i in np.flatnonzero(over & ~self._vel_over) if over.any() else ():
             self._events.append(
                 Occurrence(
                     "velocity_limit",
@@ -433,8 +457,8 @@ class BulletArmPlant(Plant):
                 )
             )
         self._vel_over = over
-        at = (q <= self.lower + 1e-3) | (q >= self.upper - 1e-3)
-        for i in np.flatnonzero(at & ~self._at_limit):
+        at = (q <= self._lower_in) | (q >= self._upper_in)
+        for i in np.flatnonzero(at & ~self._at_limit) if at.any() else ():
             if self.joint_names[i] in self.locked:
                 continue
             self._events.append(
@@ -480,7 +504,7 @@ class BulletArmPlant(Plant):
         held = False
         if self._palm_link is not None and len(hand_parts) >= P.catch_min_parts:
             rel = v - self._link_point_velocity(self._palm_link, pos)
-            held = float(np.linalg.norm(rel)) < P.catch_relative_speed
+            held = math.sqrt(float(rel @ rel)) < P.catch_relative_speed
         if held:
             self._hold += self.dt
             self._unhold = 0.0
@@ -547,7 +571,7 @@ class BulletArmPlant(Plant):
         # the tool frame's motion; /effector/state (actual and desired point) is the controller's
         pe, oe, ve, we = self.effector_state()
         out[TOPIC_EFFECTOR_MOTION] = EffectorMotion(
-            t, pe.tolist(), oe.tolist(), ve.tolist(), we.tolist(), float(np.linalg.norm(ve))
+            t, pe.tolist(), oe.tolist(), ve.tolist(), we.tolist(), math.sqrt(float(ve @ ve))
         )
         if self.obj is not None:
             pos, orn, v, w = self.object_state()
