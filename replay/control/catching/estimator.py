@@ -126,10 +126,43 @@ class BallisticEstimator:
         if d @ d <= radius * radius:
             return t
         coeffs = [0.25 * (g @ g), v @ g, v @ v + d @ g, 2.0 * (d @ v), d @ d - radius * radius]
+        s = _first_root_newton([float(c) for c in coeffs])
+        if s is not None:
+            return t + s
         roots = _roots(coeffs)
         real = roots[np.abs(roots.imag) < 1e-9].real
         real = real[real >= 0.0]
         return t + float(real.min()) if real.size else None
+
+
+def _first_root_newton(c):
+    """The smallest root s >= 0 of the quartic c[0] s^4 + ... + c[4] (c[4] > 0: outside the
+    sphere) when Newton's method from s = 0 provably finds it, else None (then the caller takes
+    the companion matrix's eigenvalues). Proof: where h'' > 0 on [0, s*] and h'(0) < 0, Newton's
+    iterates from 0 rise monotonically to the first root. A ball flying at the arm makes h
+    convex (h'' = 2 |v + g s|^2 + 2 (d + v s + g s^2 / 2) . g, the first term dominating)."""
+    c4, c3, c2, c1, c0 = c
+    s = 0.0
+    for _ in range(60):
+        f = (((c4 * s + c3) * s + c2) * s + c1) * s + c0
+        fp = ((4.0 * c4 * s + 3.0 * c3) * s + 2.0 * c2) * s + c1
+        if not fp < 0.0:
+            return None
+        step = f / fp
+        s -= step
+        if abs(step) <= 1e-15 * max(s, 1e-3):
+            break
+    else:
+        return None
+    if not s >= 0.0:
+        return None
+    # h'' = 12 c4 s^2 + 6 c3 s + 2 c2 must stay positive on [0, s]: check its minimum there
+    cand = [0.0, s]
+    if c4 > 0.0 and 0.0 < -c3 / (4.0 * c4) < s:
+        cand.append(-c3 / (4.0 * c4))
+    if min((12.0 * c4 * x + 6.0 * c3) * x + 2.0 * c2 for x in cand) <= 0.0:
+        return None
+    return s
 
 
 def _roots(coeffs) -> np.ndarray:

@@ -129,3 +129,45 @@ def test_roots_equal_numpy_roots():
         np.testing.assert_allclose(np.sort_complex(_roots(c)), np.sort_complex(np.roots(c)))
     # an end coefficient of zero: np.roots's own handling
     np.testing.assert_allclose(np.sort_complex(_roots([0.0, 1.0, -3.0, 2.0, 0.0])), [0, 1, 2])
+
+
+def _ttr_eigvals(est, t, origin, R):
+    """time_to_radius by the companion matrix only (the path Newton's method stands in for)."""
+    r, v, g = est.state(t, from_fit=True)
+    d = r - origin
+    c = [0.25 * (g @ g), v @ g, v @ v + d @ g, 2.0 * (d @ v), d @ d - R * R]
+    roots = _roots(c)
+    real = roots[np.abs(roots.imag) < 1e-9].real
+    real = real[real >= 0.0]
+    return t + float(real.min()) if real.size else None
+
+
+def test_time_to_radius_newton_equals_the_eigenvalue_roots():
+    """Seeded throws at, past, away from and over the catch sphere: the same first arrival (or
+    none) as the companion matrix's roots; the share Newton's method settles itself is printed."""
+    from replay.control.catching import estimator as E
+
+    rng = np.random.default_rng(15)
+    origin, R = np.array([0.0, 0.0, 0.346]), 0.48
+    settled = n = 0
+    for k in range(300):
+        r0 = np.array([rng.uniform(1.0, 3.5), rng.uniform(-0.5, 0.5), rng.uniform(0.0, 1.5)])
+        aim = origin + rng.normal(scale=0.4, size=3)
+        speed = rng.uniform(3.0, 12.0) * (1 if k % 4 else -1)  # a quarter thrown away
+        v0 = (aim - r0) / np.linalg.norm(aim - r0) * speed
+        est = BallisticEstimator(G, window=0.05)
+        for i in range(20):
+            est.add(i * 1e-3, r0 + v0 * i * 1e-3 + 0.5 * G * (i * 1e-3) ** 2)
+        t = 0.019
+        got, ref = est.time_to_radius(t, origin, R), _ttr_eigvals(est, t, origin, R)
+        st = est.state(t, from_fit=True)
+        d = st[0] - origin
+        if d @ d > R * R and ref is not None:  # outside, arriving: Newton's case
+            n += 1
+            c = [0.25 * G @ G, st[1] @ G, st[1] @ st[1] + d @ G, 2 * d @ st[1], d @ d - R * R]
+            settled += E._first_root_newton([float(x) for x in c]) is not None
+        assert (got is None) == (ref is None)
+        if got is not None:
+            assert got == pytest.approx(ref, abs=1e-9)
+    print(f"time_to_radius: Newton settled {settled}/{n} arrivals, the rest by eigenvalues")
+    assert n >= 60 and settled >= 0.9 * n
