@@ -26,7 +26,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.spatial import quaternion_matrix
 
 
 @dataclass
@@ -36,7 +35,7 @@ class PalmSample:
     height: float  # m: object centre above the palm face (palm z)
     rel_speed: float  # m/s: object velocity relative to the palm point under it
     approach_angle: float  # deg: relative velocity vs the palm's inward normal (-z)
-    world_offset: np.ndarray  # object centre - palm face centre (world, m)
+    world_offset: tuple  # object centre - palm face centre (world, m)
 
 
 class CatchWatch:
@@ -65,29 +64,35 @@ class CatchWatch:
     ) -> None:
         """One step: the object's and the palm's state (world) and the parts touching now.
         Written in floats (3-vectors as tuples): it runs at every physics step."""
-        R = quaternion_matrix(palm_quat).tolist()
-        X = (R[0][0], R[1][0], R[2][0])  # the palm frame's axes (world)
-        Y = (R[0][1], R[1][1], R[2][1])
-        Z = (R[0][2], R[1][2], R[2][2])
-        (ox, oy, oz), (px, py, pz) = [float(x) for x in obj_pos], [float(x) for x in palm_pos]
+        qx, qy, qz, qw = palm_quat  # the palm frame's z axis and in-plane axes (world)
+        n = qx * qx + qy * qy + qz * qz + qw * qw
+        k = 2.0 / n  # (quaternion_matrix's columns, normalised there too)
+        X = (1 - k * (qy * qy + qz * qz), k * (qx * qy + qz * qw), k * (qx * qz - qy * qw))
+        Y = (k * (qx * qy - qz * qw), 1 - k * (qx * qx + qz * qz), k * (qy * qz + qx * qw))
+        Z = (k * (qx * qz + qy * qw), k * (qy * qz - qx * qw), 1 - k * (qx * qx + qy * qy))
+        ox, oy, oz = obj_pos
+        px, py, pz = palm_pos
         th = self.palm_thickness
         d = (ox - px - Z[0] * th, oy - py - Z[1] * th, oz - pz - Z[2] * th)
-        lx, ly = _dot(X, d), _dot(Y, d)
-        lz = _dot(Z, d)
-        w = [float(x) for x in palm_omega]
-        arm = (ox - px, oy - py, oz - pz)
-        vp = [float(x) for x in palm_vel]
-        vo = [float(x) for x in obj_vel]
+        lx = X[0] * d[0] + X[1] * d[1] + X[2] * d[2]
+        ly = Y[0] * d[0] + Y[1] * d[1] + Y[2] * d[2]
+        lz = Z[0] * d[0] + Z[1] * d[1] + Z[2] * d[2]
+        wx, wy, wz = palm_omega
+        ax, ay, az = ox - px, oy - py, oz - pz
+        vx, vy, vz = palm_vel
+        ux, uy, uz = obj_vel
         rel = (
-            vo[0] - vp[0] - (w[1] * arm[2] - w[2] * arm[1]),
-            vo[1] - vp[1] - (w[2] * arm[0] - w[0] * arm[2]),
-            vo[2] - vp[2] - (w[0] * arm[1] - w[1] * arm[0]),
+            ux - vx - (wy * az - wz * ay),
+            uy - vy - (wz * ax - wx * az),
+            uz - vz - (wx * ay - wy * ax),
         )
-        speed = math.sqrt(_dot(rel, rel))
-        inward = -_dot(Z, rel)  # towards the palm face, along its normal
+        speed = math.sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2])
+        inward = -(Z[0] * rel[0] + Z[1] * rel[1] + Z[2] * rel[2])  # towards the palm face
         angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
-        sample = PalmSample(t, math.hypot(lx, ly), lz, speed, angle, np.array(d))
-        dist2 = _dot(d, d)
+        dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+        sample = PalmSample(
+            t, math.hypot(lx, ly), lz, speed, angle, tuple(float(x) for x in d)
+        )
         if self.closest is None or dist2 < self._closest_d2:
             self.closest, self._closest_d2 = sample, dist2
         self.approaching = self.closest is sample  # still closing in at the last step
@@ -157,10 +162,6 @@ class CatchWatch:
         dy, dz = abs(cl.world_offset[1]), cl.world_offset[2]
         side = ("below" if dz < 0 else "above") if abs(dz) >= dy else "beside"
         return {"success": False, "reason": f"{k} passed {side} the hand", **out}
-
-
-def _dot(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 def _first_part(parts: list) -> str:

@@ -190,8 +190,13 @@ class BulletArmPlant(Plant):
         self._ever_caught = False
         self._fallen = False
         self.diverged = False
-        self._vel_over = np.zeros(dof, dtype=bool)
-        self._at_limit = np.zeros(dof, dtype=bool)
+        self._vel_over = [False] * dof  # per joint: over its speed limit / at a joint limit
+        self._at_limit = [False] * dof
+        self._vlim_l = self.velocity_limits.tolist()
+        self._tlim_l = self.torque_limits.tolist()
+        self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
+        self._locked_l = [n in self.locked for n in self.joint_names]
+        self._contact_summary = (None, [], [], 0.0)  # (contacts list it is of, parts, links, N)
         self._torque_episode = np.zeros(dof, dtype=bool)
         self._obj_vel_before = (
             np.asarray(P.object_velocity, float) if self.obj is not None else np.zeros(3)
@@ -317,12 +322,16 @@ class BulletArmPlant(Plant):
     def effector_state(self):
         """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity (read
         once a step, like the joint state)."""
+        return tuple(np.array(x) for x in self._effector_now())
+
+    def _effector_now(self) -> tuple:
+        """effector_state as PyBullet's tuples, read once a step."""
         if self._effector is None or self._effector[0] != self._steps:
             ls = self._get_link_state(
                 self.robot, self._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
             )
             self._effector = (self._steps, (ls[4], ls[5], ls[6], ls[7]))
-        return tuple(np.array(x) for x in self._effector[1])
+        return self._effector[1]
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ArmCommand) -> None:
@@ -337,36 +346,43 @@ class BulletArmPlant(Plant):
             self._hand_target = np.clip(h, self._hand_lo, self._hand_hi)
 
     def _limit_torque(self, qd: np.ndarray) -> None:
-        finite = np.isfinite(self._tau_cmd)
-        all_finite = bool(finite.all())
-        tau = self._tau_cmd if all_finite else np.where(finite, self._tau_cmd, 0.0)
-        lim = self.torque_limits  # (a non-finite command gives no torque)
-        applied = np.minimum(np.maximum(tau, -lim), lim)
-        clamped = applied != tau
-        if not all_finite:
-            clamped |= ~finite
-        if self.params.enforce_velocity_limits:
-            over = (np.abs(qd) >= self.velocity_limits) & (np.sign(applied) == np.sign(qd))
-            over &= applied != 0.0
-            applied = np.where(over, 0.0, applied)
-            clamped |= over
-        applied[self._locked_idx] = 0.0
-        clamped[self._locked_idx] = False
-        for i in np.flatnonzero(clamped & ~self._torque_episode) if clamped.any() else ():
-            self._events.append(
-                Occurrence(
-                    "torque_limit",
-                    {
-                        "joint": self.joint_names[i],
-                        "commanded": float(tau[i]) if finite[i] else None,
-                        "applied": float(applied[i]),
-                        "limit": float(lim[i]),
-                    },
-                )
-            )
-        self._torque_episode = clamped
-        self.clamp_count += int(clamped.sum())
-        self._tau_applied, self._clamped = applied, clamped
+        """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
+        locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
+        its speed limit further. Per joint in plain Python (4-7 floats)."""
+        enforce = self.params.enforce_velocity_limits
+        cmd = self._tau_cmd.tolist()
+        qdl = qd.tolist()
+        applied, clamped = [0.0] * self.dof, [False] * self.dof
+        sign = lambda x: (x > 0.0) - (x < 0.0)  # noqa: E731  (np.sign)
+        for i, (x, lim) in enumerate(zip(cmd, self._tlim_l)):
+            if self._locked_l[i]:
+                continue
+            if not math.isfinite(x):
+                clamped[i] = True  # a non-finite command gives no torque
+                continue
+            a = min(max(x, -lim), lim)
+            c = a != x
+            if enforce and abs(qdl[i]) >= self._vlim_l[i] and sign(a) == sign(qdl[i]) and a != 0:
+                a, c = 0.0, True
+            applied[i], clamped[i] = a, c
+        if any(clamped):
+            for i, c in enumerate(clamped):
+                if c and not self._torque_episode[i]:
+                    x = cmd[i]
+                    self._events.append(
+                        Occurrence(
+                            "torque_limit",
+                            {
+                                "joint": self.joint_names[i],
+                                "commanded": x if math.isfinite(x) else None,
+                                "applied": applied[i],
+                                "limit": self._tlim_l[i],
+                            },
+                        )
+                    )
+            self.clamp_count += sum(clamped)
+        self._tau_applied = np.array(applied)
+        self._clamped = self._torque_episode = np.array(clamped, dtype=bool)
 
     def step(self) -> None:
         bc = self.bc
@@ -435,50 +451,51 @@ class BulletArmPlant(Plant):
     def _check_events(self) -> None:
         P = self.params
         q, qd = self.arm_state()
-        finite = bool(np.isfinite(q).all() and np.isfinite(qd).all())
+        ql, qdl = q.tolist(), qd.tolist()  # per-joint checks on 4-7 floats: plain Python
+        isfinite = math.isfinite
+        finite = all(map(isfinite, ql)) and all(map(isfinite, qdl))
         if self.obj is not None:
             pos, orn, v, w = self.object_state()
-            finite = finite and bool(np.isfinite(pos).all() and np.isfinite(v).all())
+            finite = finite and all(map(isfinite, pos.tolist())) and all(map(isfinite, v.tolist()))
         if not finite:
             if not self.diverged:
                 self.diverged = True
                 self._events.append(Occurrence("nan", {"step": self._steps}))
             return
-        over = np.abs(qd) > self.velocity_limits
-        for i in np.flatnonzero(over & ~self._vel_over) if over.any() else ():
-            self._events.append(
-                Occurrence(
-                    "velocity_limit",
-                    {
-                        "joint": self.joint_names[i],
-                        "velocity": float(qd[i]),
-                        "limit": float(self.velocity_limits[i]),
-                    },
+        over = [abs(x) > lim for x, lim in zip(qdl, self._vlim_l)]
+        for i in range(self.dof) if over != self._vel_over else ():
+            if over[i] and not self._vel_over[i]:
+                self._events.append(
+                    Occurrence(
+                        "velocity_limit",
+                        {
+                            "joint": self.joint_names[i],
+                            "velocity": qdl[i],
+                            "limit": self._vlim_l[i],
+                        },
+                    )
                 )
-            )
         self._vel_over = over
-        at = (q <= self._lower_in) | (q >= self._upper_in)
-        for i in np.flatnonzero(at & ~self._at_limit) if at.any() else ():
-            if self.joint_names[i] in self.locked:
-                continue
-            self._events.append(
-                Occurrence(
-                    "joint_limit",
-                    {
-                        "joint": self.joint_names[i],
-                        "position": float(q[i]),
-                        "lower": float(self.lower[i]),
-                        "upper": float(self.upper[i]),
-                    },
+        at = [x <= lo or x >= hi for x, lo, hi in zip(ql, self._lower_l, self._upper_l)]
+        for i in range(self.dof) if at != self._at_limit else ():
+            if at[i] and not self._at_limit[i] and not self._locked_l[i]:
+                self._events.append(
+                    Occurrence(
+                        "joint_limit",
+                        {
+                            "joint": self.joint_names[i],
+                            "position": ql[i],
+                            "lower": float(self.lower[i]),
+                            "upper": float(self.upper[i]),
+                        },
+                    )
                 )
-            )
         self._at_limit = at
         if self.obj is None:
             return
         contacts = self._robot_contacts()
         self._contacts = contacts
-        links = sorted({self._link_name[c[4]] for c in contacts})
-        parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
+        _, parts, links, _ = self._contact_summary_now()
         if contacts and not self._in_contact:
             c = max(contacts, key=lambda c: c[9])
             point = np.array(c[6])
@@ -535,8 +552,10 @@ class BulletArmPlant(Plant):
                 Occurrence(kind, {"position": pos.tolist(), "velocity": v.tolist()})
             )
         if self._watch is not None:
-            pe, oe, ve, we = self.effector_state()
-            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
+            pe, oe, ve, we = self._effector_now()  # floats: faster than arrays here
+            self._watch.observe(
+                self._t, pos.tolist(), v.tolist(), pe, oe, ve, we, parts, self.caught
+            )
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
@@ -560,7 +579,7 @@ class BulletArmPlant(Plant):
                 list(self.joint_names),
                 [float(x) if math.isfinite(x) else None for x in self._tau_cmd.tolist()],
                 self._tau_applied.tolist(),
-                [bool(c) for c in self._clamped],
+                [bool(c) for c in self._clamped.tolist()],
             ),
         }
         if self._hand_j:
@@ -578,14 +597,19 @@ class BulletArmPlant(Plant):
             out[TOPIC_OBJECT_STATE] = ObjectState(
                 t, pos.tolist(), orn.tolist(), v.tolist(), w.tolist()
             )
-            links = sorted({self._link_name[c[4]] for c in self._contacts})
-            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(
-                t,
-                sorted({self.model.part_of_link.get(l, "arm") for l in links}),
-                links,
-                float(sum(c[9] for c in self._contacts)),
-            )
+            _, parts, links, force = self._contact_summary_now()
+            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(t, parts, links, force)
         return out
+
+    def _contact_summary_now(self):
+        """(contacts, parts, links, total normal force) of ``_contacts``, summed once per list."""
+        if self._contact_summary[0] is not self._contacts:
+            links = sorted({self._link_name[c[4]] for c in self._contacts})
+            parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
+            force = float(sum(c[9] for c in self._contacts))
+            self._contact_summary = (self._contacts, parts, links, force)
+        _, parts, links, force = self._contact_summary
+        return self._contact_summary[0], list(parts), list(links), force
 
     def scene(self) -> Scene:
         prims = []
