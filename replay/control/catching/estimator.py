@@ -121,12 +121,16 @@ class BallisticEstimator:
         st = self.state(t, from_fit=True)
         if st is None or self.n < 2:
             return None
-        r, v, g = st
-        d = r - np.asarray(origin, float)
-        if d @ d <= radius * radius:
+        (rx, ry, rz), v, g = st[0].tolist(), st[1].tolist(), self._g
+        ox, oy, oz = (float(x) for x in origin)
+        d = (rx - ox, ry - oy, rz - oz)
+        dot = lambda a, b: a[0] * b[0] + a[1] * b[1] + a[2] * b[2]  # noqa: E731
+        dd = dot(d, d)
+        if dd <= radius * radius:
             return t
-        coeffs = [0.25 * (g @ g), v @ g, v @ v + d @ g, 2.0 * (d @ v), d @ d - radius * radius]
-        s = _first_root_newton([float(c) for c in coeffs])
+        coeffs = [0.25 * dot(g, g), dot(v, g), dot(v, v) + dot(d, g), 2.0 * dot(d, v)]
+        coeffs.append(dd - radius * radius)
+        s = _first_root_newton(coeffs)
         if s is not None:
             return t + s
         roots = _roots(coeffs)

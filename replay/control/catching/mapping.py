@@ -88,7 +88,7 @@ class CatchGeometry:
         self.p_ref = np.asarray(p_ref, float)  # (q1, q2) the inverse prefers (branch choice)
         self.K1, self.K2 = _skew(self.w1), _skew(self.w2)
         a, b = self.t @ self.t, self.c @ self.t
-        self._a, self._b = a, b
+        self._a, self._b = float(a), float(b)
         self._sigma = 1.0 if b >= 0.0 else -1.0  # branch with s = 0 at |r - O| = |c|
         self.s_min_dist = -b / a  # s at the line's closest point to O
         self.d_min = float(np.linalg.norm(self.c + self.t * self.s_min_dist))
@@ -489,7 +489,6 @@ class DirectMapping:
     @A.setter
     def A(self, value) -> None:
         self._A = np.array(value, dtype=float).reshape(self.poly.n_mono, self.poly.m)
-        self._A_rows = tuple(tuple(row) for row in self._A.tolist())  # for evaluate_one
 
     @property
     def alpha(self) -> np.ndarray:
@@ -527,22 +526,16 @@ class DirectMapping:
         pd = _solve3(J, rd)
         a, b, c = pd
         H00, H01, H02, H11, H12 = H
-        quad = tuple(
-            H00[i] * a * a + 2 * H01[i] * a * b + 2 * H02[i] * a * c + H11[i] * b * b
-            + 2 * H12[i] * b * c
-            for i in range(3)
+        aa, ab2, ac2, bb, bc2 = a * a, 2 * a * b, 2 * a * c, b * b, 2 * b * c
+        pdd = _solve3(
+            J,
+            [
+                rdd[i]
+                - (H00[i] * aa + H01[i] * ab2 + H02[i] * ac2 + H11[i] * bb + H12[i] * bc2)
+                for i in range(3)
+            ],
         )
-        pdd = _solve3(J, (rdd[0] - quad[0], rdd[1] - quad[1], rdd[2] - quad[2]))
-        m, m1, m2 = self.poly.coefficients_one(p, pd, pdd)
-        A = self._A_rows
-        out = []
-        for base, coef in ((p, m), (pd, m1), (pdd, m2)):
-            v = list(base)
-            for cj, Aj in zip(coef, A):
-                v[0] += cj * Aj[0]
-                v[1] += cj * Aj[1]
-                v[2] += cj * Aj[2]
-            out.append(np.array(v))
+        out = np.array((p, pd, pdd)) + np.array(self.poly.coefficients_one(p, pd, pdd)) @ self._A
         return out[0], out[1], out[2], np.array(p), ok
 
     def __call__(self, r) -> np.ndarray:
