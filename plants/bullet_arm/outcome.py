@@ -27,7 +27,6 @@ from dataclasses import dataclass
 import numpy as np
 
 
-
 @dataclass
 class PalmSample:
     t: float
@@ -90,9 +89,7 @@ class CatchWatch:
         inward = -(Z[0] * rel[0] + Z[1] * rel[1] + Z[2] * rel[2])  # towards the palm face
         angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
         dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-        sample = PalmSample(
-            t, math.hypot(lx, ly), lz, speed, angle, tuple(float(x) for x in d)
-        )
+        sample = PalmSample(t, math.hypot(lx, ly), lz, speed, angle, tuple(float(x) for x in d))
         if self.closest is None or dist2 < self._closest_d2:
             self.closest, self._closest_d2 = sample, dist2
         self.approaching = self.closest is sample  # still closing in at the last step

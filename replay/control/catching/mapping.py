@@ -230,7 +230,6 @@ class CatchGeometry:
                 best = (np.where(take, q1, best[0]), np.where(take, q2, best[1]), None)
         return best[0], best[1], ok
 
-
     # --- one sample in Python floats (the 1 kHz loop): the formulas above, per component ------
     def inverse_one(self, r) -> tuple[tuple, bool]:
         """:meth:`inverse` of one point r (3,): (q1, q2, q4) and in_domain."""
@@ -530,8 +529,7 @@ class DirectMapping:
         pdd = _solve3(
             J,
             [
-                rdd[i]
-                - (H00[i] * aa + H01[i] * ab2 + H02[i] * ac2 + H11[i] * bb + H12[i] * bc2)
+                rdd[i] - (H00[i] * aa + H01[i] * ab2 + H02[i] * ac2 + H11[i] * bb + H12[i] * bc2)
                 for i in range(3)
             ],
         )
