@@ -140,6 +140,7 @@ class BulletArmPlant(Plant):
         self._get_base_pose = bc.getBasePositionAndOrientation
         self._get_base_velocity = bc.getBaseVelocity
         self._get_link_state = bc.getLinkState
+        self._get_link_states = bc.getLinkStates
         self._get_contact_points = bc.getContactPoints
         self._set_motors = bc.setJointMotorControlArray
         if ht is not None:
@@ -326,11 +327,23 @@ class BulletArmPlant(Plant):
 
     def _effector_now(self) -> tuple:
         """effector_state as PyBullet's tuples, read once a step."""
+        return self._frames_now()[0]
+
+    def _frames_now(self) -> tuple:
+        """(tool (pos, orn, v, w), palm link state or None): one getLinkStates a step for the
+        tool frame and the palm (the catch check's point velocity)."""
         if self._effector is None or self._effector[0] != self._steps:
-            ls = self._get_link_state(
-                self.robot, self._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
+            links = (
+                [self._tool_link] if self._palm_link is None else [self._tool_link, self._palm_link]
             )
-            self._effector = (self._steps, (ls[4], ls[5], ls[6], ls[7]))
+            st = self._get_link_states(
+                self.robot, links, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+            ls = st[0]
+            self._effector = (
+                self._steps,
+                ((ls[4], ls[5], ls[6], ls[7]), st[1] if len(st) > 1 else None),
+            )
         return self._effector[1]
 
     # ------------------------------------------------------------------ command
@@ -440,9 +453,11 @@ class BulletArmPlant(Plant):
     def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
         if link < 0:
             return np.zeros(3)
-        ls = self._get_link_state(
-            self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
-        )
+        ls = self._frames_now()[1] if link == self._palm_link else None
+        if ls is None:
+            ls = self._get_link_state(
+                self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
+            )
         (vx, vy, vz), (wx, wy, wz), (cx, cy, cz) = ls[6], ls[7], ls[0]
         rx, ry, rz = (float(x) for x in point)
         rx, ry, rz = rx - cx, ry - cy, rz - cz  # v + w x (point - link COM)
