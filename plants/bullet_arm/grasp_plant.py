@@ -12,8 +12,9 @@ What it adds to :class:`BulletArmPlant` (same URDF builder, same object, same co
 - events ``grasp`` (the base's hold event under this name), ``release`` (with how long it was
   held), ``slip``, and the run's outcome: grasped, held while the human kept moving the object.
 
-One ``getJointStates`` per step reads the arm, the hand and the palm joint together; the base's
-state readers use that cache.
+One ``getJointStates`` per step reads the arm, the hand and the palm joint together, and one
+``getLinkStates`` the tool and palm frames (pose and twist); the base's state readers, the
+effector's motion and the palm's point velocities use that cache.
 """
 
 from __future__ import annotations
@@ -62,6 +63,8 @@ class BulletGraspPlant(BulletArmPlant):
         assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
+        self._act = np.array(self.active, dtype=int)
+        self._frame_links = [self._tool_link, self._palm_link]
         # the servos: every arm and hand joint's own inertia at the initial posture
         bc.setJointMotorControlArray(
             self.robot, self._hand_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._hand_j)
@@ -153,6 +156,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._track_sq = 0.0
         self._track_n = 0
         self._last_pos: np.ndarray | None = None
+        self._head_pose: tuple | None = None
         self._read()
         self._spec = self._grasp_spec(self._spec)
 
@@ -167,30 +171,37 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ state (one read a step)
     def _read(self) -> None:
-        st = self.bc.getJointStates(self.robot, self._all_j)
+        bc = self.bc
+        st = bc.getJointStates(self.robot, self._all_j)
         na, nh = len(self._arm_j), len(self._hand_j)
+        pos, vel = [s[0] for s in st], [s[1] for s in st]
         q = np.zeros(self.dof)
         qd = np.zeros(self.dof)
         for n, val in self.locked.items():
             q[self.joint_names.index(n)] = val
-        act = list(self.active)
-        q[act] = [s[0] for s in st[:na]]
-        qd[act] = [s[1] for s in st[:na]]
+        act = self._act
+        q[act] = pos[:na]
+        qd[act] = vel[:na]
         self._q, self._qd = q, qd
         tau = np.zeros(self.dof)
         tau[act] = self.arm_servos.torque
         self._tau_applied = self._tau_cmd = tau
         self._clamped = np.zeros(self.dof, dtype=bool)
         self._clamped[act] = self.arm_servos.saturated
-        hs = st[na : na + nh]
-        self._hq = np.array([s[0] for s in hs])
-        self._hqd = np.array([s[1] for s in hs])
-        self.hand_servos.read(hs)
+        self._hq = np.array(pos[na : na + nh])
+        self._hqd = np.array(vel[na : na + nh])
+        self.hand_servos.read(st[na : na + nh])
         self._htau = self.hand_servos.torque
         self._wrench = self.ft.convert(st[-1][2])
-        pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
-        v, w = self.bc.getBaseVelocity(self.obj)
-        self._obj = (np.array(pos), np.array(orn), np.array(v), np.array(w))
+        opos, orn = bc.getBasePositionAndOrientation(self.obj)
+        v, w = bc.getBaseVelocity(self.obj)
+        self._obj = (np.array(opos), np.array(orn), np.array(v), np.array(w))
+        # the tool and palm frames (world pose, COM twist), read once: the effector's motion,
+        # the grasp point and the palm's point velocity of every check this step
+        self._links = bc.getLinkStates(
+            self.robot, self._frame_links, computeLinkVelocity=1, computeForwardKinematics=1
+        )
+        self._head_pose = None
 
     def arm_state(self):
         return self._q, self._qd
@@ -200,6 +211,16 @@ class BulletGraspPlant(BulletArmPlant):
 
     def object_state(self):
         return self._obj
+
+    def effector_state(self):
+        ls = self._links[0]
+        return np.array(ls[4]), np.array(ls[5]), np.array(ls[6]), np.array(ls[7])
+
+    def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
+        if link != self._palm_link:
+            return super()._link_point_velocity(link, point)
+        ls = self._links[1]  # the same call as the base's, read once this step
+        return np.array(ls[6]) + np.cross(np.array(ls[7]), point - np.array(ls[0]))
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ServoCommand) -> None:  # type: ignore[override]
@@ -217,8 +238,9 @@ class BulletGraspPlant(BulletArmPlant):
 
     def step(self) -> None:
         self.human.drive(self._t)
-        act = list(self.active)
-        apply_torques(self.bc, self.robot, self._servo_j, self.arm_servos.torques(self._qd[act]))
+        apply_torques(
+            self.bc, self.robot, self._servo_j, self.arm_servos.torques(self._qd[self._act])
+        )
         self.hand_servos.actuate()
         self.head_servo.step()
         self._obj_vel_before = self._obj[2]
@@ -279,9 +301,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._last_pos = pos
 
     def _tool_position(self) -> np.ndarray:
-        return np.array(
-            self.bc.getLinkState(self.robot, self._tool_link, computeForwardKinematics=1)[4]
-        )
+        return np.array(self._links[0][4])
 
     # ------------------------------------------------------------------ verdict
     def outcome(self, t: float) -> dict:
@@ -327,8 +347,10 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ log and scene
     def _head_reading(self):
-        R, c = camera_pose(self.head, *self.head_servo.q)
-        return R, c
+        """(R, c) of the head camera now (computed once a step: the log and the scene)."""
+        if self._head_pose is None:
+            self._head_pose = camera_pose(self.head, *self.head_servo.q)
+        return self._head_pose
 
     def truth(self, t: float) -> dict:
         out = super().truth(t)
