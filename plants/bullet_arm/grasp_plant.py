@@ -64,6 +64,7 @@ class BulletGraspPlant(BulletArmPlant):
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
         self._act = np.array(self.active, dtype=int)
+        self._all_active = len(self.active) == self.dof  # no locked joint: no index mapping
         self._frame_links = [self._tool_link, self._palm_link]
         # the servos: every arm and hand joint's own inertia at the initial posture
         bc.setJointMotorControlArray(
@@ -175,19 +176,24 @@ class BulletGraspPlant(BulletArmPlant):
         st = bc.getJointStates(self.robot, self._all_j)
         na, nh = len(self._arm_j), len(self._hand_j)
         pos, vel = [s[0] for s in st], [s[1] for s in st]
-        q = np.zeros(self.dof)
-        qd = np.zeros(self.dof)
-        for n, val in self.locked.items():
-            q[self.joint_names.index(n)] = val
-        act = self._act
-        q[act] = pos[:na]
-        qd[act] = vel[:na]
-        self._q, self._qd = q, qd
-        tau = np.zeros(self.dof)
-        tau[act] = self.arm_servos.torque
-        self._tau_applied = self._tau_cmd = tau
-        self._clamped = np.zeros(self.dof, dtype=bool)
-        self._clamped[act] = self.arm_servos.saturated
+        if self._all_active:
+            self._q, self._qd = np.array(pos[:na]), np.array(vel[:na])
+            self._tau_applied = self._tau_cmd = self.arm_servos.torque.copy()
+            self._clamped = self.arm_servos.saturated.copy()
+        else:
+            q = np.zeros(self.dof)
+            qd = np.zeros(self.dof)
+            for n, val in self.locked.items():
+                q[self.joint_names.index(n)] = val
+            act = self._act
+            q[act] = pos[:na]
+            qd[act] = vel[:na]
+            self._q, self._qd = q, qd
+            tau = np.zeros(self.dof)
+            tau[act] = self.arm_servos.torque
+            self._tau_applied = self._tau_cmd = tau
+            self._clamped = np.zeros(self.dof, dtype=bool)
+            self._clamped[act] = self.arm_servos.saturated
         self._hq = np.array(pos[na : na + nh])
         self._hqd = np.array(vel[na : na + nh])
         self.hand_servos.read(st[na : na + nh])
@@ -219,8 +225,13 @@ class BulletGraspPlant(BulletArmPlant):
     def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
         if link != self._palm_link:
             return super()._link_point_velocity(link, point)
-        ls = self._links[1]  # the same call as the base's, read once this step
-        return np.array(ls[6]) + np.cross(np.array(ls[7]), point - np.array(ls[0]))
+        # the base's v + w x (point - com) of the same link state, read once this step, in floats
+        # (the same products and sums as np.cross, without its ~10 us of axis handling)
+        (cx, cy, cz), _, _, _, _, _, (vx, vy, vz), (wx, wy, wz) = self._links[1]
+        rx, ry, rz = float(point[0]) - cx, float(point[1]) - cy, float(point[2]) - cz
+        return np.array(
+            [vx + (wy * rz - wz * ry), vy + (wz * rx - wx * rz), vz + (wx * ry - wy * rx)]
+        )
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ServoCommand) -> None:  # type: ignore[override]
