@@ -40,7 +40,6 @@ from replay.messages import (
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.hand import hand_body
-from replay.robot.serial_chain import dh_transform
 from replay.spatial import cross3, wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
@@ -107,6 +106,16 @@ class ArmControlTask(Controller):
         super().__init__(params, spec=spec)
         self.chain = spec.model
         self.dh = [(r.alpha, r.a, r.d, r.theta_offset) for r in self.chain.dh]
+        # dh_transform's constant entries (alpha, a, d) per joint, filled once: a step only
+        # writes the cos/sin of theta (the same products as dh_transform's, so the same floats)
+        alpha = np.array([r[0] for r in self.dh])
+        self._a = np.array([r[1] for r in self.dh])
+        self._off = np.array([r[3] for r in self.dh])
+        self._ca, self._sa = np.cos(alpha), np.sin(alpha)
+        self._M = np.zeros((len(self.dh), 4, 4))
+        self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
+        self._M[:, 2, 3] = [r[2] for r in self.dh]
+        self._M[:, 3, 3] = 1.0
         self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
             raise ValueError("arm control needs a plant with a hand and a constraint plane")
@@ -129,16 +138,30 @@ class ArmControlTask(Controller):
 
     def kinematics(self, q):
         """(tool transform, 6 x n geometric Jacobian at the tool origin)."""
+        n = len(self.dh)
+        theta = np.asarray(q, float)[:n] + self._off
+        ct, st = np.cos(theta), np.sin(theta)
+        M = self._M  # every joint's dh_transform(alpha, a, d, q + offset)
+        M[:, 0, 0], M[:, 0, 1], M[:, 0, 2], M[:, 0, 3] = (
+            ct,
+            -st * self._ca,
+            st * self._sa,
+            self._a * ct,
+        )
+        M[:, 1, 0], M[:, 1, 1], M[:, 1, 2], M[:, 1, 3] = (
+            st,
+            ct * self._ca,
+            -ct * self._sa,
+            self._a * st,
+        )
         T = self.chain.base
-        axes, origins = [], []
-        for (alpha, a, d, off), qi in zip(self.dh, q):
-            axes.append(T[:3, 2])
-            origins.append(T[:3, 3])
-            T = T @ dh_transform(alpha, a, d, qi + off)
+        Z, O = np.empty((3, n)), np.empty((3, n))
+        for i in range(n):
+            Z[:, i] = T[:3, 2]
+            O[:, i] = T[:3, 3]
+            T = T @ M[i]
         T = T @ self.tool
         p = T[:3, 3]
-        Z = np.array(axes).T
-        O = np.array(origins).T
         J = np.vstack([cross3(Z, p[:, None] - O), Z])
         return T, J
 
