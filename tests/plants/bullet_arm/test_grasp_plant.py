@@ -214,3 +214,63 @@ def test_the_rig_refuses_a_torque_command():
             plant.apply(ArmCommand(torque=[0.0] * 7))
     finally:
         plant.close()
+
+
+def test_frames_read_once_a_step_equal_pybullets_own_reads_while_moving():
+    """The tool/palm link states read once a step (effector motion, grasp point, the palm's point
+    velocity) are what PyBullet's getLinkState gives at that moment, at seeded random commands."""
+    plant = rig(human_speed=0.1)
+    rng = np.random.default_rng(3)
+    try:
+        bc = plant.bc
+        for k in range(60):
+            plant.apply(
+                ServoCommand(
+                    arm=rng.uniform(-0.5, 0.5, 7).tolist(),
+                    hand=rng.uniform(-1.0, 1.0, 14).tolist(),
+                    head=[0.0, 0.0],
+                )
+            )
+            plant.step()
+            if k % 10:
+                continue
+            tool = bc.getLinkState(
+                plant.robot, plant._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+            pe, oe, ve, we = plant.effector_state()
+            for got, want in zip((pe, oe, ve, we), (tool[4], tool[5], tool[6], tool[7])):
+                np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
+            assert np.linalg.norm(ve) > 1e-3  # it moves: a stale cache would differ
+            palm = bc.getLinkState(
+                plant.robot, plant._palm_link, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+            point = plant.object_state()[0]
+            want = np.array(palm[6]) + np.cross(np.array(palm[7]), point - np.array(palm[0]))
+            got = plant._link_point_velocity(plant._palm_link, point)
+            np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
+            np.testing.assert_allclose(plant._tool_position(), tool[4], rtol=0.0, atol=1e-12)
+    finally:
+        plant.close()
+
+
+def test_the_robot_never_collides_with_itself():
+    """Self-collision is off (the URDF is loaded without URDF_USE_SELF_COLLISION): the closing
+    fingers, the palm and the arm links never make contact points with each other, so filtering
+    their pairs cannot change (or speed up) the physics."""
+    plant = rig()
+    try:
+        closed = np.asarray(GRASP4.closed_posture)
+        for _ in range(300):
+            hq = plant.hand_state()[0]
+            plant.apply(
+                ServoCommand(arm=[0.0, 0.5, 0.0, 0.5, 0.0, 0.5, 0.0], hand=(closed - hq) * 20)
+            )
+            plant.step()
+            assert plant.bc.getContactPoints(bodyA=plant.robot, bodyB=plant.robot) == ()
+        # the fingers did close onto each other's space: the hand moved towards its grip
+        assert (
+            np.abs(plant.hand_state()[0] - closed).max()
+            < 0.5 * np.abs(np.asarray(GRASP4.open_posture) - closed).max()
+        )
+    finally:
+        plant.close()
