@@ -131,6 +131,40 @@ def test_head_servo_reaches_its_rate_within_its_torque_limit():
     assert servo.qd[0] == pytest.approx(2.0 + DT * 0.5 / 2e-3, rel=1e-9)
 
 
+def _head_step_reference(servo, q, qd, cmd):
+    """The head servo's step on 2-vectors (module docstring of plants/bullet_arm/head.py)."""
+    dt, J, K = servo.dt, servo.J, servo.K
+    qd_new = (J * qd + dt * K * cmd) / (J + dt * K)
+    tau = K * (cmd - qd_new)
+    over = np.abs(tau) > servo.tau_max
+    if over.any():
+        tau = np.clip(K * (cmd - qd), -servo.tau_max, servo.tau_max)
+        qd_new = np.where(over, qd + dt * tau / J, qd_new)
+    q_new = q + dt * qd_new
+    stop = (q_new < servo.lower) | (q_new > servo.upper)
+    return np.clip(q_new, servo.lower, servo.upper), np.where(stop, 0.0, qd_new), tau
+
+
+def test_head_servo_step_equals_the_vector_form_over_random_commands():
+    """Seeded random commands within and beyond the torque limit, into the hard stops: the
+    per-axis float step gives exactly the 2-vector form's angles, rates and torques."""
+    head = HeadSpec(
+        (0.0, 0.0, 1.0), 0.0, 0.03, (-0.2, -0.1), (0.2, 0.1), (2e-3, 1e-3), (0.5, 0.5), (10.0, 10.0)
+    )
+    servo = HeadServo(head, 300.0, DT, [0.0, 0.0])
+    rng = np.random.default_rng(7)
+    n, same, saturated, stopped = 400, 0, 0, 0
+    for k in range(n):
+        servo.set_command(rng.normal(0.0, 3.0 if k % 50 else 400.0, 2))
+        want = _head_step_reference(servo, servo.q, servo.qd, servo.command)
+        servo.step()
+        same += all(np.array_equal(a, b) for a, b in zip((servo.q, servo.qd, servo.torque), want))
+        saturated += bool(np.any(np.abs(want[2]) >= servo.tau_max - 1e-12))
+        stopped += bool(np.any((want[0] == servo.lower) | (want[0] == servo.upper)))
+    print(f"head step: {same}/{n} equal; {saturated} at the torque limit, {stopped} at a stop")
+    assert same == n and saturated > 0 and stopped > 0
+
+
 def test_camera_pose_looks_where_look_angles_says():
     head = HeadSpec((0.0, 0.15, 0.7), 0.2, 0.0, (-2, -2), (2, 2), (1, 1), (1, 1), (1, 1))
     target = np.array([0.75, -0.05, 0.5])
