@@ -366,12 +366,11 @@ class BulletGraspPlant(BulletArmPlant):
     def truth(self, t: float) -> dict:
         out = super().truth(t)
         del out["/arm/applied_torque"]
-        act = list(self.active)
         out["/arm/servo"] = ServoState(
             t,
             list(self.joint_names),
-            _full(self.dof, act, self.arm_servos.command),
-            _full(self.dof, act, self.arm_servos.integral),
+            self._full(self.arm_servos.command),
+            self._full(self.arm_servos.integral),
             self._tau_applied.tolist(),
             [bool(c) for c in self._clamped],
         )
@@ -399,6 +398,14 @@ class BulletGraspPlant(BulletArmPlant):
         out["/wrist/wrench_truth"] = Wrench(t, w[:3].tolist(), w[3:].tolist())
         return out
 
+    def _full(self, values) -> list:
+        """Per-active-joint values as a list over every arm joint (zero where locked)."""
+        if self._all_active:
+            return np.asarray(values, float).tolist()
+        out = np.zeros(self.dof)
+        out[self._act] = values
+        return out.tolist()
+
     def scene(self) -> Scene:
         sc = super().scene()
         hs = self.head_servo
@@ -418,9 +425,3 @@ class BulletGraspPlant(BulletArmPlant):
         }
         sc.readings["wrist"] = {"wrench": self._wrench}
         return sc
-
-
-def _full(n: int, idx: list, values) -> list:
-    out = np.zeros(n)
-    out[idx] = values
-    return out.tolist()
