@@ -116,6 +116,7 @@ class ArmControlTask(Controller):
         self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
         self._M[:, 2, 3] = [r[2] for r in self.dh]
         self._M[:, 3, 3] = 1.0
+        self._eye6 = np.eye(6)
         self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
             raise ValueError("arm control needs a plant with a hand and a constraint plane")
@@ -220,8 +221,8 @@ class ArmControlTask(Controller):
         e_reach = np.zeros(6)
         e_reach[:3] = xd[:3] - gp
         e_reach[3:] = cross3(n_palm, self.n_plane)
-        JJt = Jg @ Jg.T + (P.damping**2) * np.eye(6)
-        Jpinv = Jg.T @ np.linalg.solve(JJt, np.eye(6))
+        JJt = Jg @ Jg.T + P.damping**2 * self._eye6
+        Jpinv = Jg.T @ np.linalg.solve(JJt, self._eye6)
         track = P.K_ap * Jpinv @ (S_DIAG * self.K_a1 * e_track)
         reach = P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach)
         damp = -P.K_av * self.qd
