@@ -241,7 +241,7 @@ class BulletGraspPlant(BulletArmPlant):
             qd = np.asarray(command.arm, float).reshape(-1)
             if qd.shape != (self.dof,):
                 raise ValueError(f"ServoCommand.arm needs {self.dof} values, got {qd.shape[0]}")
-            self.arm_servos.set_command(qd[list(self.active)])
+            self.arm_servos.set_command(qd if self._all_active else qd[self._act])
         if command.hand is not None:
             self.hand_servos.set_command(command.hand)
         if command.head is not None:
