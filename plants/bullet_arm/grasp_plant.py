@@ -40,6 +40,20 @@ from replay.scene import Scene
 from replay.spatial import matrix_to_quaternion
 
 HEAD_JOINTS = ("pan", "tilt")
+# the PyBullet calls of every step: BulletClient builds a new functools.partial (client id bound)
+# at each attribute access; the rig keeps one per name on its client (the same call)
+PER_STEP_CALLS = (
+    "stepSimulation",
+    "getJointStates",
+    "getLinkStates",
+    "getLinkState",
+    "getBasePositionAndOrientation",
+    "getBaseVelocity",
+    "getContactPoints",
+    "setJointMotorControlArray",
+    "changeConstraint",
+    "getConstraintState",
+)
 
 
 class BulletGraspPlant(BulletArmPlant):
@@ -59,6 +73,8 @@ class BulletGraspPlant(BulletArmPlant):
         self._watch = None  # the catch verdict's watcher: this rig's is outcome()
         P = params
         bc = self.bc
+        for name in PER_STEP_CALLS:
+            setattr(bc, name, getattr(bc, name))
         self._palm_j = self._jidx["palm_joint"]
         assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)

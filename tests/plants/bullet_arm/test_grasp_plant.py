@@ -308,3 +308,25 @@ def test_the_robot_never_collides_with_itself():
         )
     finally:
         plant.close()
+
+
+def test_kept_pybullet_calls_stay_bound_to_each_rigs_own_client():
+    """Two rigs at once: the per-step calls kept on each client carry that client's id, so
+    stepping one moves only its own world."""
+    from plants.bullet_arm.grasp_plant import PER_STEP_CALLS
+
+    a, b = rig(human_speed=0.1), rig(human_speed=0.1)
+    try:
+        assert a.bc._client != b.bc._client
+        for plant in (a, b):
+            for name in PER_STEP_CALLS:
+                assert getattr(plant.bc, name).keywords["physicsClientId"] == plant.bc._client
+        before = b.object_state()[0].copy()
+        for _ in range(200):
+            a.step()
+        assert np.linalg.norm(a.object_state()[0] - before) > 1e-3  # a's human moved its box
+        b._read()
+        np.testing.assert_array_equal(b.object_state()[0], before)
+    finally:
+        a.close()
+        b.close()
