@@ -12,9 +12,9 @@ What it adds to :class:`BulletArmPlant` (same URDF builder, same object, same co
 - events ``grasp`` (the base's hold event under this name), ``release`` (with how long it was
   held), ``slip``, and the run's outcome: grasped, held while the human kept moving the object.
 
-One ``getJointStates`` per step reads the arm, the hand and the palm joint together, and one
-``getLinkStates`` the tool and palm frames (pose and twist); the base's state readers, the
-effector's motion and the palm's point velocities use that cache.
+One ``getJointStates`` per step reads the arm, the hand and the palm joint together; the base's
+state readers use that cache, and its one ``getLinkStates`` a step (tool and palm frames) gives the
+effector's motion, the grasp point and the palm's point velocity.
 """
 
 from __future__ import annotations
@@ -40,16 +40,11 @@ from replay.scene import Scene
 from replay.spatial import matrix_to_quaternion
 
 HEAD_JOINTS = ("pan", "tilt")
-# the PyBullet calls of every step: BulletClient builds a new functools.partial (client id bound)
-# at each attribute access; the rig keeps one per name on its client (the same call)
+# the PyBullet calls the rig's helpers (servos, human hand) and the runner make every step through
+# the client: BulletClient builds a new functools.partial (client id bound) at each attribute
+# access, so the rig keeps one per name on its client (the same call; the base binds its reads)
 PER_STEP_CALLS = (
     "stepSimulation",
-    "getJointStates",
-    "getLinkStates",
-    "getLinkState",
-    "getBasePositionAndOrientation",
-    "getBaseVelocity",
-    "getContactPoints",
     "setJointMotorControlArray",
     "changeConstraint",
     "getConstraintState",
@@ -81,7 +76,6 @@ class BulletGraspPlant(BulletArmPlant):
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
         self._act = np.array(self.active, dtype=int)
         self._all_active = len(self.active) == self.dof  # no locked joint: no index mapping
-        self._frame_links = [self._tool_link, self._palm_link]
         # the servos: every arm and hand joint's own inertia at the initial posture
         bc.setJointMotorControlArray(
             self.robot, self._hand_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._hand_j)
@@ -188,8 +182,7 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ state (one read a step)
     def _read(self) -> None:
-        bc = self.bc
-        st = bc.getJointStates(self.robot, self._all_j)
+        st = self._get_joint_states(self.robot, self._all_j)
         na, nh = len(self._arm_j), len(self._hand_j)
         pos, vel = [s[0] for s in st], [s[1] for s in st]
         if self._all_active:
@@ -215,14 +208,9 @@ class BulletGraspPlant(BulletArmPlant):
         self.hand_servos.read(st[na : na + nh])
         self._htau = self.hand_servos.torque
         self._wrench = self.ft.convert(st[-1][2])
-        opos, orn = bc.getBasePositionAndOrientation(self.obj)
-        v, w = bc.getBaseVelocity(self.obj)
+        opos, orn = self._get_base_pose(self.obj)
+        v, w = self._get_base_velocity(self.obj)
         self._obj = (np.array(opos), np.array(orn), np.array(v), np.array(w))
-        # the tool and palm frames (world pose, COM twist), read once: the effector's motion,
-        # the grasp point and the palm's point velocity of every check this step
-        self._links = bc.getLinkStates(
-            self.robot, self._frame_links, computeLinkVelocity=1, computeForwardKinematics=1
-        )
         self._head_pose = None
 
     def arm_state(self):
@@ -234,16 +222,13 @@ class BulletGraspPlant(BulletArmPlant):
     def object_state(self):
         return self._obj
 
-    def effector_state(self):
-        ls = self._links[0]
-        return np.array(ls[4]), np.array(ls[5]), np.array(ls[6]), np.array(ls[7])
-
     def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
         if link != self._palm_link:
             return super()._link_point_velocity(link, point)
-        # the base's v + w x (point - com) of the same link state, read once this step, in floats
-        # (the same products and sums as np.cross, without its ~10 us of axis handling)
-        (cx, cy, cz), _, _, _, _, _, (vx, vy, vz), (wx, wy, wz) = self._links[1]
+        # v + (w x (point - com)) of the palm's state read once this step (the base's
+        # _frames_now), summed as np.cross's v + cross: the rig's grasp/slip checks and log
+        # stay bit-identical to the array form
+        (cx, cy, cz), _, _, _, _, _, (vx, vy, vz), (wx, wy, wz) = self._frames_now()[1]
         rx, ry, rz = float(point[0]) - cx, float(point[1]) - cy, float(point[2]) - cz
         return np.array(
             [vx + (wy * rz - wz * ry), vy + (wz * rx - wx * rz), vz + (wx * ry - wy * rx)]
@@ -328,7 +313,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._last_pos = pos
 
     def _tool_position(self) -> np.ndarray:
-        return np.array(self._links[0][4])
+        return np.array(self._frames_now()[0][0])
 
     # ------------------------------------------------------------------ verdict
     def outcome(self, t: float) -> dict:
