@@ -152,29 +152,38 @@ class StickEstimator:
         self._refit()
 
     def _refit(self) -> None:
-        data = np.array(self._samples)
-        t = data[:, 0]
-        t_ref = float(t[-1])
-        n = len(t)
+        """Least squares of (x, y, theta) = value at t_ref + rate (t - t_ref), in closed form
+        (centred sums: rate = S_tv / S_tt, value = mean_v - rate mean_tau)."""
+        samples = self._samples
+        n = len(samples)
+        t_ref = samples[-1][0]
         if n == 1:
-            _, x, y, th = self._samples[0]
+            _, x, y, th = samples[0]
             self._fit = StickEstimate(t_ref, x, y, th, 0.0, 0.0, 0.0, 1, 0.0, 0.0)
             return
-        tau = t - t_ref
-        A = np.column_stack([np.ones(n), tau])
-        coef, *_ = np.linalg.lstsq(A, data[:, 1:], rcond=None)  # rows: value at t_ref, rate
-        res = data[:, 1:] - A @ coef
-        rms_xy = float(math.sqrt(np.mean(res[:, 0] ** 2 + res[:, 1] ** 2)))
-        rms_th = float(math.sqrt(np.mean(res[:, 2] ** 2)))
+        ts, xs, ys, ths = zip(*samples)
+        tau = [t - t_ref for t in ts]
+        tm = sum(tau) / n
+        dt = [v - tm for v in tau]
+        s_tt = sum(d * d for d in dt)
+        out = []
+        res2 = []
+        for vals in (xs, ys, ths):
+            vm = sum(vals) / n
+            dv = [v - vm for v in vals]
+            rate = sum(d * w for d, w in zip(dt, dv)) / s_tt if s_tt > 0.0 else 0.0
+            out.append((vm - rate * tm, rate))
+            res2.append(sum((w - rate * d) ** 2 for d, w in zip(dt, dv)))
+        (x, vx), (y, vy), (th, w) = out
         self._fit = StickEstimate(
             t_ref,
-            float(coef[0, 0]),
-            float(coef[0, 1]),
-            float(coef[0, 2]),
-            float(coef[1, 0]),
-            float(coef[1, 1]),
-            float(coef[1, 2]),
+            x,
+            y,
+            th,
+            vx,
+            vy,
+            w,
             n,
-            rms_xy,
-            rms_th,
+            math.sqrt((res2[0] + res2[1]) / n),
+            math.sqrt(res2[2] / n),
         )
