@@ -158,6 +158,29 @@ class StickCaptureParams:
         le=0.5,
         doc="the target is no longer refined this long before the contact",
     )
+    replan_tol: float = param(
+        1e-4,
+        unit="m",
+        ge=0.0,
+        le=0.01,
+        doc="a new estimate re-plans a committed contact only when it moves the fingertip "
+        "spot by more than this (our choice: ~0.05 px of the 512 px camera) ...",
+    )
+    replan_theta: float = param(
+        2e-3,
+        unit="rad",
+        ge=0.0,
+        le=0.5,
+        doc="... or when, at the committed time, the stick would be this far from the "
+        "contact orientation (|omega| |t_c' - t_c|; our choice, 1/15 of theta_tol) ...",
+    )
+    replan_dt: float = param(
+        1e-3,
+        unit="s",
+        ge=0.0,
+        le=0.1,
+        doc="... or the contact time moves by more than this (a tenth of arrive_margin)",
+    )
     detect_window: float = param(
         0.04,
         unit="s",
@@ -732,6 +755,8 @@ class StickCaptureController(Controller):
             t_c = min(crossings, key=lambda tc: abs(tc - old.t))
             if abs(est.omega) > 1e-6 and abs(t_c - old.t) > 0.5 * math.pi / abs(est.omega):
                 return  # not the same crossing any more
+            if self._plan_holds(old, est, sol, t_c):
+                return  # the new measurement does not change the plan
             plan = self.planner.reach(
                 self.step,
                 t,
@@ -751,6 +776,19 @@ class StickCaptureController(Controller):
             if plan is not None:
                 self.plan = plan
             return
+
+    def _plan_holds(
+        self, old: ContactPlan, est: StickEstimate, sol: sc.ContactSolution, t_c: float
+    ) -> bool:
+        """The refined contact (``sol`` at ``t_c``) is the committed one within the tolerances:
+        fingertip spot within ``replan_tol``, the stick's orientation at the committed time within
+        ``replan_theta`` of the contact's, the time within ``replan_dt``."""
+        p = self.params
+        dt = abs(t_c - old.t)
+        if dt > p.replan_dt or abs(est.omega) * dt > p.replan_theta:
+            return False
+        _, tip, _ = self.planner.spot(est, sol, t_c)
+        return math.hypot(tip[0] - old.tip[0], tip[1] - old.tip[1]) <= p.replan_tol
 
     # -- closing (eqs. 32, 33, 38) --------------------------------------------------------------
     def _plan_close(self, t: float, est: StickEstimate) -> None:

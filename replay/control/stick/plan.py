@@ -165,6 +165,18 @@ class ContactPlanner:
             tau += period
         return out
 
+    def spot(
+        self, est: StickEstimate, sol: sc.ContactSolution, t_c: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(contact point R(theta*) r + c, fingertip centre contact - tip_radius n, n) in the
+        world for the contact ``sol`` at t_c, the stick moving as ``est`` predicts."""
+        x, y, _ = est.at(t_c)
+        c, s = math.cos(sol.theta), math.sin(sol.theta)
+        r_x, r_y = sol.r_x, 0.5 * self.stick.width * sol.side
+        contact = np.array([x + c * r_x - s * r_y, y + s * r_x + c * r_y])
+        n = np.array([s, -c]) if sol.side > 0 else np.array([-s, c])  # eq. 4
+        return contact, contact - self.hand.tip_radius * n, n
+
     def reach(
         self,
         index: int,
@@ -181,12 +193,8 @@ class ContactPlanner:
         """The quickest hand configuration that has finger k's tip at the contact spot for
         t_c with every check passed (the plan of collision ``index``), or None."""
         p, st, hand = self.params, self.stick, self.hand
-        pre = Motion(est)
-        c_c, th_c = pre.pose(t_c)
-        R = sc.rotation(sol.theta)
-        contact = c_c + R @ sol.r_b(st.width)
-        _, n = sc.tangent_normal(sol.theta, sol.side)
-        tip = contact - hand.tip_radius * n
+        c_c, th_c = Motion(est).pose(t_c)
+        contact, tip, n = self.spot(est, sol, t_c)
         motion = Motion(est, t_c, sol.u_after)
         now = self.model.config
         times_all = sample_times(t, t_c + p.post_horizon)
