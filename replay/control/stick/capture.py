@@ -624,18 +624,22 @@ class StickCaptureController(Controller):
         shortfall = Shortfall()
         crossings_any = False
         first = math.inf
+        tried = set()  # (option, crossing) already without a plan: the same inputs again fail
         # first the contacts in view that leave the stick within reach, then those in view, then any
         for keep in (2, 1, 0):
-            for sol, raw in usable:
+            for i, (sol, raw) in enumerate(usable):
                 crossings = self.planner.crossings(t, est, sol.theta)
                 crossings_any |= bool(crossings)
                 first = min([first, *crossings])
                 fingers, strict = self._finger_order(sol, step)
                 for t_c in crossings:
+                    if (i, t_c) in tried:
+                        continue
                     if keep and not self._in_view(est, sol, t_c):
                         continue
                     if keep == 2 and not self._stays_in_reach(est, sol, t_c):
                         continue
+                    tried.add((i, t_c))
                     plan = self.planner.reach(
                         self.step, t, est, sol, raw, t_c, fingers, strict, shortfall
                     )
