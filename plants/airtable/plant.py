@@ -126,6 +126,7 @@ class AirTablePlant(Plant):
         self._events: list[Occurrence] = []
         self._pending: list[dict] = []
         self._last_command: tuple | None = None
+        self._last_object: HandCommand | None = None
         self._rest_since: float | None = None
         self._rest_reported = False
         self._nan_reported = False
@@ -145,6 +146,9 @@ class AirTablePlant(Plant):
         return self._steps * self.dt
 
     def apply(self, command: HandCommand) -> None:
+        if command is self._last_object:
+            return  # the same (frozen) command object again
+        self._last_object = command
         key = (tuple(map(float, command.base)), tuple(tuple(map(float, q)) for q in command.joints))
         if key == self._last_command:
             return  # the same target again: nothing new to clamp or report

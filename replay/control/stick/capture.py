@@ -360,7 +360,7 @@ class StickCaptureController(Controller):
             self._on_estimate(t)
         self._command(t)
         self._check_capture(t)
-        return self.model.target.command()
+        return self.model.target.command
 
     def intent(self) -> dict:
         if self.plan is not None:

@@ -16,6 +16,7 @@ Pure NumPy.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -43,7 +44,9 @@ class Config:
     def tip(self, hand: HandSpec, k: int) -> np.ndarray:
         return hand2d.finger_tip(hand, self.base, k, self.joints[k])
 
+    @functools.cached_property
     def command(self) -> HandCommand:
+        """This configuration as the plant's command (made once per configuration)."""
         return HandCommand(
             base=(float(self.base[0]), float(self.base[1])),
             joints=tuple((float(q[0]), float(q[1])) for q in self.joints),
@@ -64,7 +67,7 @@ class HandModel:
         self._t: float | None = None
 
     def advance(self, t: float) -> None:
-        if self._t is not None and t > self._t:
+        if self._t is not None and t > self._t and self.config != self.target:
             dt = t - self._t
             step_b = self.hand.base_speed * dt
             step_q = self.hand.joint_speed * dt
