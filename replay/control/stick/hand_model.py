@@ -111,9 +111,11 @@ def route_configs(hand: HandSpec, starts, frm, to, times):
             continue
         tau = np.maximum(times[sel] - s0, 0.0)[:, None]
         a_b, b_b = np.array(a.base), np.array(b.base)
-        base[sel] = a_b + np.clip(b_b - a_b, -hand.base_speed * tau, hand.base_speed * tau)
+        step = hand.base_speed * tau
+        base[sel] = a_b + np.minimum(np.maximum(b_b - a_b, -step), step)  # clip
         a_q, b_q = np.array(a.joints).reshape(4), np.array(b.joints).reshape(4)
-        q = a_q + np.clip(b_q - a_q, -hand.joint_speed * tau, hand.joint_speed * tau)
+        step = hand.joint_speed * tau
+        q = a_q + np.minimum(np.maximum(b_q - a_q, -step), step)
         joints[sel] = q.reshape(-1, 2, 2)
     return base, joints
 
@@ -121,11 +123,12 @@ def route_configs(hand: HandSpec, starts, frm, to, times):
 def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
     """Fingertip centres (T, 2 fingers, 2) for bases (T, 2) and joints (T, 2, 2)."""
     l1, l2 = hand.link_lengths
-    roots = np.array(hand.root_offsets)[None, :, :] + np.asarray(base)[:, None, :]
+    out = np.empty(np.shape(joints))
     q1, q12 = joints[..., 0], joints[..., 0] + joints[..., 1]
-    return roots + np.stack(
-        [l1 * np.cos(q1) + l2 * np.cos(q12), l1 * np.sin(q1) + l2 * np.sin(q12)], axis=-1
-    )
+    out[..., 0] = l1 * np.cos(q1) + l2 * np.cos(q12)
+    out[..., 1] = l1 * np.sin(q1) + l2 * np.sin(q12)
+    out += np.array(hand.root_offsets)[None, :, :] + np.asarray(base)[:, None, :]  # the roots
+    return out
 
 
 # ------------------------------------------------------------------------------------------

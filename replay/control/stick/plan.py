@@ -341,8 +341,15 @@ class ContactPlanner:
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
         moving = times < arrival
         act = times <= t_c - CONTACT_GUARD
+        c, th = poses = motion.poses(times)
         if covered_along(
-            motion, times[act], tips[act, k], half_l, half_w, hand.tip_radius - 5e-4
+            motion,
+            times[act],
+            tips[act, k],
+            half_l,
+            half_w,
+            hand.tip_radius - 5e-4,
+            poses=(c[act], th[act]),
         ).any():
             return None
         if check_idle:
@@ -352,7 +359,7 @@ class ContactPlanner:
             gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
             on_way = max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
             grow = np.where(moving, on_way, hand.tip_radius + p.sweep_margin)
-            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow).any():
+            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow, poses).any():
                 return None
         return arrival
 

@@ -33,17 +33,26 @@ class Motion:
         t = np.asarray(times, dtype=float)
         e = self.est
         t1 = np.minimum(t, self.t_switch) - e.t_ref
-        c = np.column_stack([e.x + e.vx * t1, e.y + e.vy * t1])
+        c = np.empty(t.shape + (2,))
+        c[..., 0] = e.x + e.vx * t1
+        c[..., 1] = e.y + e.vy * t1
         th = e.theta + e.omega * t1
         if math.isfinite(self.t_switch):
             t2 = np.maximum(t - self.t_switch, 0.0)
-            c = c + np.column_stack([self.u_after[0] * t2, self.u_after[1] * t2])
+            c[..., 0] += self.u_after[0] * t2
+            c[..., 1] += self.u_after[1] * t2
             th = th + self.u_after[2] * t2
         return c, th
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
-        c, th = self.poses([t])
-        return c[0], float(th[0])
+        e, ts = self.est, self.t_switch
+        t1 = min(t, ts) - e.t_ref
+        x, y, th = e.x + e.vx * t1, e.y + e.vy * t1, e.theta + e.omega * t1
+        if math.isfinite(ts):
+            t2 = max(t - ts, 0.0)
+            u = self.u_after
+            x, y, th = x + u[0] * t2, y + u[1] * t2, th + u[2] * t2
+        return np.array([x, y]), float(th)
 
 
 def _body(motion: Motion, times, points) -> tuple[np.ndarray, np.ndarray]:
@@ -65,11 +74,11 @@ def covered(
 
 
 def covered_along(
-    motion: Motion, times, points, half_length: float, half_width: float, grow
+    motion: Motion, times, points, half_length: float, half_width: float, grow, poses=None
 ) -> np.ndarray:
     """(T,) booleans: points[i] (a moving point, (T, 2)) within ``grow`` of the stick at
-    times[i]; ``grow`` a scalar or (T,)."""
-    c, th = motion.poses(times)
+    times[i]; ``grow`` a scalar or (T,); ``poses``: ``motion.poses(times)`` if already made."""
+    c, th = motion.poses(times) if poses is None else poses
     d = np.asarray(points, dtype=float) - c
     cs, sn = np.cos(th), np.sin(th)
     xb = d[:, 0] * cs + d[:, 1] * sn
