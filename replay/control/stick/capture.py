@@ -745,9 +745,10 @@ class StickCaptureController(Controller):
         when the refined one does not work."""
         old = self.plan
         options = self._contacts(est, old.index)
-        n_old = sc.tangent_normal(old.sol.theta, old.sol.side)[1]
+        ox, oy = sc.normal(old.sol.theta, old.sol.side)
         for sol in options:
-            if float(np.dot(sc.tangent_normal(sol.theta, sol.side)[1], n_old)) <= 0.0:
+            nx, ny = sc.normal(sol.theta, sol.side)
+            if nx * ox + ny * oy <= 0.0:
                 continue  # the other face (alpha may jump by pi: compare n)
             clamped = self._clamp(sol)
             if clamped is None:

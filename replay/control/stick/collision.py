@@ -22,7 +22,7 @@ def rotation(theta: float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
-def _normal(theta: float, side: int) -> tuple[float, float]:
+def normal(theta: float, side: int) -> tuple[float, float]:
     """n_i in Sigma_R (eq. 4) as floats: R_B(theta) [0, -side]."""
     c, s = math.cos(theta), math.sin(theta)
     return (s, -c) if side > 0 else (-s, c)
@@ -89,7 +89,7 @@ def alpha(a) -> float:
 
 def friction_independent(theta: float, v, side: int = 1, tol: float = 1e-9) -> bool:
     """Eq. 12: s_i^T v_{B,i-1} = 0 (within ``tol`` of |v|)."""
-    nx, ny = _normal(theta, side)
+    nx, ny = normal(theta, side)
     vx, vy = float(v[0]), float(v[1])
     return abs(-ny * vx + nx * vy) <= tol * max(1.0, math.hypot(vx, vy))  # s = (-n_y, n_x)
 
@@ -118,7 +118,7 @@ def f_omega(
 ) -> tuple[float, ...]:
     """F_omega,i(omega_d) of eq. 25: both r_x (ascending) giving omega_i = omega_d (eq. 24)."""
     vx, vy, w = _u3(u_prev)
-    nx, ny = _normal(theta, side)
+    nx, ny = normal(theta, side)
     a1 = m * (omega_d + e * w)
     b1 = -(1.0 + e) * m * _sign(side) * (nx * vx + ny * vy)
     c1 = inertia * (omega_d - w)
@@ -137,7 +137,7 @@ def f_v(
     speed = math.hypot(vx, vy)
     if speed == 0.0:
         return ()
-    nx, ny = _normal(theta, side)
+    nx, ny = normal(theta, side)
     a2 = m * (speed_d + speed)
     b2 = (1.0 + e) * inertia * w * _sign(side) * (nx * vx + ny * vy) / speed
     c2 = inertia * (speed_d - e * speed)
@@ -162,7 +162,7 @@ def contact_condition(
 def approach_speed(theta: float, r_x: float, side: int, u_prev) -> float:
     """-n_i^T H_i u_{i-1}: how fast the contact point moves into the fingertip before (m/s)."""
     vx, vy, w = _u3(u_prev)
-    nx, ny = _normal(theta, side)
+    nx, ny = normal(theta, side)
     ax, ay = math.cos(theta) * r_x, math.sin(theta) * r_x  # R_B(theta) [r_x, 0]
     return -(nx * vx + ny * vy + (-ay * nx + ax * ny) * w)
 
