@@ -337,7 +337,14 @@ class ContactPlanner:
             return None
         times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
         base, joints = route_configs(hand, starts, frm, to, times)
-        tips = route_tips(hand, base, joints)  # (T, 2, 2)
+        # once every axis is on its target the configuration no longer changes: the tips of
+        # that (bit-identical) tail are those of its first sample
+        flat = np.concatenate([base, joints.reshape(len(times), 4)], axis=1)
+        changing = np.flatnonzero(np.any(flat != flat[-1], axis=1))
+        i0 = int(changing[-1]) + 1 if changing.size else 0
+        tips = np.empty((len(times), 2, 2))
+        tips[: i0 + 1] = route_tips(hand, base[: i0 + 1], joints[: i0 + 1])
+        tips[i0 + 1 :] = tips[i0]
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
         moving = times < arrival
         act = times <= t_c - CONTACT_GUARD
