@@ -21,15 +21,16 @@ except ImportError:  # pragma: no cover - another Pymunk layout
 def pose_reader(body: pymunk.Body) -> Callable[[], tuple[float, float, float, float, float, float]]:
     """A callable returning ``(x, y, vx, vy, angle, angular_velocity)`` of ``body`` now."""
     if _cp is None or not hasattr(body, "_body"):  # pragma: no cover
-        def read():
+
+        def public() -> tuple[float, float, float, float, float, float]:
             (x, y), (vx, vy) = body.position, body.velocity
             return x, y, vx, vy, body.angle, body.angular_velocity
 
-        return read
+        return public
     ptr, pos, vel = body._body, _cp.cpBodyGetPosition, _cp.cpBodyGetVelocity
     angle, omega = _cp.cpBodyGetAngle, _cp.cpBodyGetAngularVelocity
 
-    def read():
+    def read() -> tuple[float, float, float, float, float, float]:
         p, v = pos(ptr), vel(ptr)
         return p.x, p.y, v.x, v.y, angle(ptr), omega(ptr)
 
@@ -39,10 +40,15 @@ def pose_reader(body: pymunk.Body) -> Callable[[], tuple[float, float, float, fl
 def position_reader(body: pymunk.Body) -> Callable[[], tuple[float, float]]:
     """A callable returning ``(x, y)`` of ``body`` now."""
     if _cp is None or not hasattr(body, "_body"):  # pragma: no cover
-        return lambda: tuple(body.position)
+
+        def public() -> tuple[float, float]:
+            x, y = body.position
+            return x, y
+
+        return public
     ptr, pos = body._body, _cp.cpBodyGetPosition
 
-    def read():
+    def read() -> tuple[float, float]:
         p = pos(ptr)
         return p.x, p.y
 
@@ -52,9 +58,10 @@ def position_reader(body: pymunk.Body) -> Callable[[], tuple[float, float]]:
 def velocity_setter(body: pymunk.Body) -> Callable[[float, float], None]:
     """A callable setting ``body.velocity = (vx, vy)``."""
     if _cp is None or not hasattr(body, "_body"):  # pragma: no cover
-        def put(vx, vy):
+
+        def public(vx: float, vy: float) -> None:
             body.velocity = (vx, vy)
 
-        return put
+        return public
     ptr, setv = body._body, _cp.cpBodySetVelocity
     return lambda vx, vy: setv(ptr, (vx, vy))

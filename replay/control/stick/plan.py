@@ -201,7 +201,7 @@ class ContactPlanner:
     ) -> ContactPlan | None:
         """The quickest hand configuration that has finger k's tip at the contact spot for
         t_c with every check passed (the plan of collision ``index``), or None."""
-        p, st, hand = self.params, self.stick, self.hand
+        p, hand = self.params, self.hand
         c_c, th_c = Motion(est).pose(t_c)
         contact, tip, n = self.spot(est, sol, t_c)
         motion = Motion(est, t_c, sol.u_after)

@@ -39,7 +39,9 @@ def test_closed_form_collision_map_is_eq_22():
         theta, side = rng.uniform(-math.pi, math.pi), int(rng.choice([1, -1]))
         r_b, u = rng.uniform(-0.06, 0.06, 2), rng.normal(size=3) * [1.0, 1.0, 10.0]
         J_ref = j_reference(m, inertia, e, theta, r_b, side)
-        worst = max(worst, float(np.abs(sc.collision_map(m, inertia, e, theta, r_b, side) - J_ref).max()))
+        worst = max(
+            worst, float(np.abs(sc.collision_map(m, inertia, e, theta, r_b, side) - J_ref).max())
+        )
         # C_i (eq. 26) and the approach speed with the contact on the axis
         J_ax = j_reference(m, inertia, e, theta, (r_b[0], 0.0), side)
         n = np.array(sc.normal(theta, side))
@@ -96,8 +98,16 @@ def test_sweep_prefilter_answers_as_sampling_every_time():
     rng = np.random.default_rng(12)
     agree = hits = 0
     for _ in range(200):
-        e = StickEstimate(0.0, *rng.uniform(-0.1, 0.1, 2), rng.uniform(-3, 3),
-                          *rng.normal(size=2), rng.normal() * 8.0, 30, 0.0, 0.0)
+        e = StickEstimate(
+            0.0,
+            *rng.uniform(-0.1, 0.1, 2),
+            rng.uniform(-3, 3),
+            *rng.normal(size=2),
+            rng.normal() * 8.0,
+            30,
+            0.0,
+            0.0,
+        )
         motion = Motion(e, rng.uniform(0.0, 0.3), tuple(rng.normal(size=3) * [0.3, 0.3, 4.0]))
         times = sample_times(0.0, rng.uniform(0.05, 0.6))
         sweep = Sweep(motion, times)
