@@ -99,25 +99,23 @@ def route_target(route: list, t: float, default: Config) -> Config:
 
 def route_configs(hand: HandSpec, starts, frm, to, times):
     """Base (T, 2) and joints (T, 2, 2) along waypoint segments, each axis moving toward its
-    target at its speed limit (the plant's motion model)."""
+    target at its speed limit (the plant's motion model). ``times`` ascending; segment i covers
+    starts[i] <= t < starts[i + 1] (the first one also what comes before its start)."""
     times = np.asarray(times, dtype=float)
-    base = np.empty((len(times), 2))
-    joints = np.empty((len(times), 2, 2))
+    out = np.empty((len(times), 6))  # base x, y, then the four joints
+    speed = np.array([hand.base_speed] * 2 + [hand.joint_speed] * 4)
+    edges = np.searchsorted(times, starts, side="left")  # first sample at or after each start
     for i, (s0, a, b) in enumerate(zip(starts, frm, to)):
-        t_end = starts[i + 1] if i + 1 < len(starts) else math.inf
-        sel = (times >= s0) | (i == 0)
-        sel &= times < t_end
-        if not sel.any():
+        lo = 0 if i == 0 else int(edges[i])
+        hi = int(edges[i + 1]) if i + 1 < len(starts) else len(times)
+        if hi <= lo:
             continue
-        tau = np.maximum(times[sel] - s0, 0.0)[:, None]
-        a_b, b_b = np.array(a.base), np.array(b.base)
-        step = hand.base_speed * tau
-        base[sel] = a_b + np.minimum(np.maximum(b_b - a_b, -step), step)  # clip
-        a_q, b_q = np.array(a.joints).reshape(4), np.array(b.joints).reshape(4)
-        step = hand.joint_speed * tau
-        q = a_q + np.minimum(np.maximum(b_q - a_q, -step), step)
-        joints[sel] = q.reshape(-1, 2, 2)
-    return base, joints
+        tau = np.maximum(times[lo:hi] - s0, 0.0)[:, None]
+        va = np.array([*a.base, *a.joints[0], *a.joints[1]], dtype=float)
+        vb = np.array([*b.base, *b.joints[0], *b.joints[1]], dtype=float)
+        step = tau * speed
+        out[lo:hi] = va + np.minimum(np.maximum(vb - va, -step), step)  # clip
+    return out[:, :2], out[:, 2:].reshape(-1, 2, 2)
 
 
 def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
