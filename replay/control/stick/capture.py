@@ -166,9 +166,10 @@ class StickCaptureParams:
         ge=0.0,
         le=0.01,
         doc="a new estimate re-plans a committed contact only when it moves the fingertip "
-        "spot by more than this (our choice, ~0.03 px of the 512 px camera: on the seeded "
-        "20-throw audit 0 and 3e-5-5e-5 m capture 19/20 3-step throws, 1e-4 and 2e-4 "
-        "18/20, a closing timing flip on one throw) ...",
+        "spot by more than this (our choice, ~0.03 px of the 512 px camera; on the seeded "
+        "20-throw audit, analysis.stick_throws, 3e-5 and 5e-5 m keep the 3-step's 19/20 of "
+        "re-planning on every estimate, 1e-4 gives 18/20: one throw's closing meets the "
+        "stick 20 ms later and its front tip is hit) ...",
     )
     replan_theta: float = param(
         2e-3,
