@@ -36,11 +36,6 @@ def tangent_normal(theta: float, side: int) -> tuple[np.ndarray, np.ndarray]:
     return np.array([-c, -s]), np.array([-s, c])
 
 
-def mass_matrix(m: float, inertia: float) -> np.ndarray:
-    """M of eq. 5."""
-    return np.diag([m, m, inertia])
-
-
 def contact_jacobian(theta: float, r_b) -> np.ndarray:
     """H_i of eq. 5: v_C = H_i u (eqs. 6, 7), with [a x] = [-a_y, a_x]."""
     a = rotation(theta) @ np.asarray(r_b, dtype=float)
@@ -51,7 +46,8 @@ def _impulse_terms(
     m: float, inertia: float, theta: float, r_x: float, r_y: float, side: int
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """(g, h) with J_i = E_3 - (1 + e) g h^T (eq. 22), in closed form: h = H_i^T n_i and
-    g = M^-1 H_i^T K_i^-1 n_i, K_i = H_i M^-1 H_i^T (eq. 9) inverted as a 2 x 2."""
+    g = M^-1 H_i^T K_i^-1 n_i, M = diag(m, m, I) and K_i = H_i M^-1 H_i^T (eqs. 5, 9), K_i
+    inverted as a 2 x 2 (the matrix form is the reference in tests/.../test_stick_fast_paths)."""
     c, s = math.cos(theta), math.sin(theta)
     ax, ay = c * r_x - s * r_y, s * r_x + c * r_y  # a = R_B(theta) ^B r
     nx, ny = (s, -c) if side > 0 else (-s, c)
