@@ -186,12 +186,13 @@ class ContactSolution:
         return np.array([self.r_x, 0.5 * width * self.side])
 
 
-def _valid(m, inertia, e, theta, r_x, side, u) -> bool:
-    """Eq. 26 (C_i > 0); for e = 0 C_i vanishes, so test the approach before instead."""
+def _valid(sol: "ContactSolution", e: float, u) -> bool:
+    """Eq. 26 (C_i > 0, ``sol.condition``); for e = 0 C_i vanishes, so test the approach before
+    instead."""
     if e > 0.0:
         tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
-        return contact_condition(m, inertia, e, theta, r_x, side, u) > tol
-    return approach_speed(theta, r_x, side, u) > 1e-12
+        return sol.condition > tol
+    return approach_speed(sol.theta, sol.r_x, sol.side, u) > 1e-12
 
 
 def contact_options(
@@ -222,11 +223,10 @@ def contact_options(
             roots = f_omega(m, inertia, e, theta, side, u, omega)
         else:
             roots = f_v(m, inertia, e, theta, side, u, speed)
-        out += [
-            contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
-            for r in roots
-            if _valid(m, inertia, e, theta, r, side, u)
-        ]
+        for r in roots:
+            sol = contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
+            if _valid(sol, e, u):
+                out.append(sol)
     return out
 
 
