@@ -52,6 +52,7 @@ from replay.messages import (
     EffectorState,
     JointCommand,
     OptimizationCost,
+    Vec3,
 )
 from replay.params import ParamError, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
@@ -240,10 +241,10 @@ class CatchingState:
     """``/catching/state``: the mapping's inner quantities at a control step."""
 
     t: float
-    r_o: list  # used object position (m)
-    r_o_velocity: list  # estimated (m/s)
-    q_o: list  # l_c^-1(r_o), active joints (rad)
-    velocity_desired: list  # qd_d (rad/s), all arm joints
+    r_o: Vec3  # used object position (m)
+    r_o_velocity: Vec3  # estimated (m/s)
+    q_o: list[float]  # l_c^-1(r_o), active joints (rad)
+    velocity_desired: list[float]  # qd_d (rad/s), all arm joints
     in_domain: bool
     predicted_catch_time: float  # s, -1 if unknown
     hand_closing: bool
