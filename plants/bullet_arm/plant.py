@@ -249,6 +249,10 @@ class BulletArmPlant(Plant):
             },
         )
 
+    def urdf(self) -> str:
+        """The arm and hand as loaded into PyBullet (plants/models/arm.py)."""
+        return self.model.urdf
+
     def spec(self) -> ArmSpec:
         return self._spec
 

@@ -358,7 +358,7 @@ class CatchingController(Controller):
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
-    def _optimised_alpha(self) -> np.ndarray:
+    def _optimised_alpha(self, progress=None) -> np.ndarray:
         key = self.config.key(self.model)
         path = alpha_path(self.params)
         if path is not None and path.is_file():
@@ -375,15 +375,16 @@ class CatchingController(Controller):
                     },
                 )
             )
-        res = self.problem.solve()
+        res = self.problem.solve(progress)
         self.history = res.history
         self.result = res
         return res.alpha
 
-    def write_alpha_file(self, path) -> None:
-        """Store the optimised alpha (and alpha0, the cost history) for ``alpha_file``."""
+    def write_alpha_file(self, path, progress=None) -> None:
+        """Store the optimised alpha (and alpha0, the cost history) for ``alpha_file``;
+        ``progress(CostRecord)`` is called at each iteration when it is optimised here."""
         if self.alpha_opt is None:
-            self.alpha_opt = self._optimised_alpha()
+            self.alpha_opt = self._optimised_alpha(progress)
         res = OptimResult(
             alpha=np.asarray(self.alpha_opt),
             alpha0=self.alpha0,
