@@ -303,7 +303,9 @@ def optimise(scenario, out, quiet):
         fail(str(exc))
     # built without its mapping (mapping: initial) so that the optimisation runs here, from
     # scratch, under a progress bar of its iterations
-    fresh = ["controller.params.alpha_file=''", "controller.params.mapping=initial"]
+    fresh = ["controller.params.alpha_file=''"]
+    if hasattr(sc.controller.params, "mapping"):
+        fresh.append("controller.params.mapping=initial")
     runner = _runner(scenario, _load(scenario, fresh), Runner)
     iterations = int(getattr(sc.controller.params, "max_iterations", 0) or 0) or None
     with bar(iterations, "optimise", unit="it", enabled=bars_on(quiet)) as progress:
