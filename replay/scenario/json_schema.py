@@ -94,16 +94,16 @@ class _Generator:
     def _plugin_section(self, out: dict[str, Any], kind: str, required: bool) -> None:
         """``type:`` as the enum of installed plug-ins; ``params:`` by that plug-in's Params."""
         names = registry.names(kind)
-        out["properties"]["type"] = {
-            **out["properties"]["type"],
-            "enum": names,
-        }
-        rules = []
+        rules, docs = [], []
         for name in names:
             try:
-                params_cls = registry.load(kind, name).Params
+                cls = registry.load(kind, name)
+                params_cls = cls.Params
             except Exception:  # noqa: BLE001 - a broken plug-in: its params stay unchecked here
+                docs.append("")
                 continue
+            first = ((cls.__doc__ or "").strip().splitlines() or [""])[0]
+            docs.append(getattr(cls, "description", "") or first)
             key = f"{kind}.{name}"
             if key not in self.definitions:
                 self.definitions[key] = self.dataclass(params_cls, required=True)
@@ -118,6 +118,12 @@ class _Generator:
                     "then": {"properties": {"params": {"$ref": f"#/definitions/{key}"}}},
                 }
             )
+        # enumDescriptions: shown by VS Code's YAML extension next to each completion
+        out["properties"]["type"] = {
+            **out["properties"]["type"],
+            "enum": names,
+            "enumDescriptions": docs,
+        }
         if rules:
             out["allOf"] = rules
 
