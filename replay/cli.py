@@ -11,6 +11,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from replay import completion as complete
 from replay import registry
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
@@ -66,23 +67,6 @@ def main() -> None:
     """paper-replay: re-run landmark high-speed robotics experiments from YAML scenarios."""
 
 
-def _complete_scenario(ctx, param, incomplete: str):
-    """Shell completion of a SCENARIO: the shipped scenarios' names, then files."""
-    from click.shell_completion import CompletionItem
-
-    names = sorted(p.stem for p in scenario_dir().glob("*.yaml") if p.stem.startswith(incomplete))
-    return [CompletionItem(n) for n in names] + [CompletionItem(incomplete, type="file")]
-
-
-def _complete_golden(ctx, param, incomplete: str):
-    from replay.golden import ManifestError, load_manifest
-
-    try:
-        return [n for n in load_manifest() if n.startswith(incomplete)]
-    except (OSError, ManifestError):
-        return []
-
-
 def _load(path: str, sets=(), seed=None):
     try:
         return load_scenario(find_scenario(path), sets=list(sets), seed=seed)
@@ -91,7 +75,7 @@ def _load(path: str, sets=(), seed=None):
 
 
 @main.command()
-@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=_complete_scenario)
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
 @click.option("-o", "--out", type=click.Path(), help="log path (default out/logs/NAME.mcap)")
 @click.option(
     "--set",
@@ -272,7 +256,7 @@ def _replay_live(live, log: Path) -> None:
 
 
 @main.command()
-@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=_complete_scenario)
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
 @click.option(
     "-o",
     "--out",
@@ -327,7 +311,7 @@ def optimise(scenario, out, quiet):
 
 @main.command()
 @click.argument(
-    "scenarios", nargs=-1, type=click.Path(dir_okay=False), shell_complete=_complete_scenario
+    "scenarios", nargs=-1, type=click.Path(dir_okay=False), shell_complete=complete.scenario
 )
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
 @click.option(
@@ -693,7 +677,7 @@ def _goldens(names):
 
 
 @golden.command("check")
-@click.argument("names", nargs=-1, shell_complete=_complete_golden)
+@click.argument("names", nargs=-1, shell_complete=complete.golden)
 @click.option("-q", "--quiet", is_flag=True, help="no progress bars")
 def golden_check(names, quiet):
     """Re-run each golden scenario and compare it with its stored log."""
@@ -728,7 +712,7 @@ def golden_check(names, quiet):
 
 
 @golden.command("update")
-@click.argument("names", nargs=-1, required=True, shell_complete=_complete_golden)
+@click.argument("names", nargs=-1, required=True, shell_complete=complete.golden)
 @click.option("-q", "--quiet", is_flag=True, help="no progress bars")
 def golden_update(names, quiet):
     """Rewrite golden logs; commit them with the reason in the message."""
@@ -791,7 +775,7 @@ def schema(out):
 
 
 @main.command()
-@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=_complete_scenario)
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
 @click.option(
     "-o", "--out", type=click.Path(dir_okay=False), required=True, help="the URDF file to write"
 )

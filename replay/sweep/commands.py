@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from replay import completion as complete
 from replay.console import fail, note
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.spec import SweepSpecError
@@ -16,7 +17,7 @@ DEFAULT_SWEEP_OUT = Path("out/sweeps")
 
 
 @click.command()
-@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
 @click.option(
     "--grid",
     "grids",
@@ -168,7 +169,7 @@ def _run(
 
 
 @click.command()
-@click.argument("names", nargs=-1)
+@click.argument("names", nargs=-1, shell_complete=complete.ablation)
 @click.option("--list", "list_", is_flag=True, help="list the ablations (sweeps/*.yaml)")
 @click.option("--workers", type=click.IntRange(min=1), help="parallel variants")
 @click.option("--executor", type=click.Choice(EXECUTORS), default="local", show_default=True)

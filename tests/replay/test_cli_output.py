@@ -140,6 +140,13 @@ def test_shell_completion_offers_shipped_scenarios_and_goldens():
         "COMP_CWORD": "3",
     }
     assert "plain,catch_optimised" in invoke(env=env).stdout.split()
+    env = {
+        "_REPLAY_COMPLETE": "bash_complete",
+        "COMP_WORDS": "replay ablate catch_",
+        "COMP_CWORD": "2",
+    }
+    items = invoke(env=env).stdout.split()
+    assert items and all(i.startswith("plain,catch_") for i in items)
     r = invoke(env={"_REPLAY_COMPLETE": "bash_source"})
     assert "_replay_completion" in r.stdout and "complete " in r.stdout
 
