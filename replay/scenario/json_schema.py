@@ -28,7 +28,7 @@ from replay.scenario.schema import ControllerSpec, PlantSpec, Scenario, SensorSp
 DRAFT = "http://json-schema.org/draft-07/schema#"
 SCHEMA_ID = "https://paper-replay.invalid/scenario.schema.json"  # a name, not fetched
 MAX_MAPPING = 32  # names in a mapping such as sensors: (the loader's limit)
-_SCALAR = {"type": ["number", "string", "boolean"]}  # an item of a bare ``list``
+_SCALAR = {"type": ["number", "string", "boolean", "null"]}  # an item of a bare ``list``
 _PLUGIN_KIND = {PlantSpec: "plant", SensorSpec: "sensor", ControllerSpec: "controller"}
 _PLUGIN_KIND[TaskSpec] = "controller"  # a task is a controller plug-in
 
@@ -154,7 +154,9 @@ class _Generator:
                 return {"anyOf": [schema, {"type": "null"}]}
             return schema
         if dataclasses.is_dataclass(tp):
-            return self.dataclass(tp, required=required)  # type: ignore[arg-type]
+            out = self.dataclass(tp, required=required)  # type: ignore[arg-type]
+            out["type"] = ["object", "null"]  # "timing:" alone = every default
+            return out
         if origin in (list, tuple):
             return self._list(tp, meta, required)
         if origin is dict:

@@ -116,6 +116,14 @@ def test_bad_scenarios_fail_both_schema_and_loader(validator, change, where):
         load_scenario_text(yaml.safe_dump(data))
 
 
+def test_what_the_loader_takes_as_defaults_validates(validator):
+    data = read(BASE)
+    data["stop"] = None  # "stop:" alone: every default
+    data["plant"]["params"]["stick"] = None
+    assert errors(validator, data) == []
+    load_scenario_text(yaml.safe_dump(data))
+
+
 def test_a_bad_arm_scenario_fails(validator):
     data = read((ROOT / "scenarios/catch_optimised.yaml").read_text())
     assert errors(validator, data) == []
