@@ -13,6 +13,7 @@ import numpy as np
 
 from replay import completion as complete
 from replay import registry
+from replay.console import RunProgress, bar, bars_on, fail, note, warn
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
 from replay.log.writer import check_output
@@ -20,7 +21,6 @@ from replay.papers import PAPERS
 from replay.resources import find_scenario, scenario_dir
 from replay.scenario import ScenarioError, load_scenario
 from replay.scenario.yamlio import one_line
-from replay.console import RunProgress, bar, bars_on, fail, note, warn
 from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
 
 DEFAULT_LOG_DIR = Path("out/logs")
