@@ -72,8 +72,10 @@ def test_every_message_of_a_run_validates_and_no_schema_is_loose(logs, paper_run
     with open(logs[paper_run], "rb") as f:
         for schema, channel, message in make_reader(f).iter_messages():
             topic = channel.topic
+            if channel.message_encoding != "json":
+                continue  # well-known schemas (e.g. Foxglove's, as Protobuf) decode themselves
             if topic not in validators:
-                assert schema.encoding == "jsonschema"
+                assert schema.encoding == "jsonschema", topic
                 doc = json.loads(schema.data)
                 jsonschema.Draft202012Validator.check_schema(doc)
                 assert doc.get("properties"), f"{topic}: empty schema {doc}"
