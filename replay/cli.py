@@ -785,14 +785,15 @@ def urdf(scenario, out, sets):
     Foxglove, RViz or yourdfpy."""
     sc = _load(scenario, sets)
     cls = registry.load("plant", sc.plant.type)
-    if cls.urdf is Plant.urdf:
+    describe = getattr(cls, "robot_description", None)  # the URDF text, or None
+    if describe is None or describe is getattr(Plant, "robot_description", None):
         fail(f"{scenario}: plant {sc.plant.type!r} has no URDF (its robot is not a URDF model)")
     try:
         plant = cls(sc.plant.params, dt=1.0 / sc.timing.physics_rate, rng=np.random.default_rng(0))
     except _REFUSED as exc:
         fail(_refusal(scenario, exc))
     try:
-        text = plant.urdf()
+        text = plant.robot_description()
     finally:
         plant.close()
     if not text:

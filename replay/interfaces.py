@@ -89,10 +89,6 @@ class Plant(ABC):
         None when this plant has no notion of success."""
         return None
 
-    def urdf(self) -> str | None:
-        """The robot's URDF text (``replay urdf``), or None when this plant has no URDF."""
-        return None
-
     def close(self) -> None:
         pass
 

@@ -249,10 +249,6 @@ class BulletArmPlant(Plant):
             },
         )
 
-    def urdf(self) -> str:
-        """The arm and hand as loaded into PyBullet (plants/models/arm.py)."""
-        return self.model.urdf
-
     def spec(self) -> ArmSpec:
         return self._spec
 
@@ -566,6 +562,9 @@ class BulletArmPlant(Plant):
                 float(sum(c[9] for c in self._contacts)),
             )
         return out
+
+    def robot_description(self) -> str:
+        return self.model.urdf
 
     def scene(self) -> Scene:
         prims = []
