@@ -25,7 +25,6 @@ from replay.scenario.yamlio import ScenarioError, compose, read_text, show
 GOLDEN_DIR = Path("data/golden")  # under replay.resources.shipped_root()
 MANIFEST = "manifest.yaml"
 IGNORED_FIELDS = {TOPIC_SCENARIO: {"version"}}  # the code version differs by design
-Progress = Callable[[float, float], None]  # the runner's progress(t, duration) hook
 
 
 @dataclass
@@ -120,6 +119,9 @@ def load_manifest(root: Path | None = None) -> dict[str, Golden]:
             ),
         )
     return out
+
+
+Progress = Callable[[float, float], None]  # the runner's progress(t, duration) hook
 
 
 def run_golden(g: Golden, out: Path, progress: Progress | None = None) -> Path:
