@@ -21,10 +21,10 @@ from mcap.reader import make_reader
 from mcap.records import Channel, Message
 from mcap.stream_reader import StreamReader
 
+from replay.log.chunks import MAGIC
 from replay.log.errors import LogError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
-MAGIC = b"\x89MCAP0\r\n"
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
 
 
@@ -122,13 +122,16 @@ class LogReader:
     # -- messages -------------------------------------------------------------------------
     def messages(self, topics: Iterable[str] | str | None = None) -> Iterator[LogMessage]:
         """Messages in log-time order (file order for a truncated log), optionally by topic.
-        Messages that are not JSON objects are skipped (and counted in ``problems``)."""
+        Only channels of JSON messages are read (others, e.g. protobuf, are for other tools);
+        messages on them that are not JSON objects are skipped (and counted in ``problems``)."""
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
         if self._summary is not None:
             done = 0
             try:
                 with open(self.path, "rb") as f:
                     for _, channel, msg in make_reader(f).iter_messages(topics=wanted):
+                        if channel.message_encoding != "json":
+                            continue  # e.g. Foxglove's protobuf channels: not JSON payloads
                         item = self._message(channel.topic, msg.log_time, msg.data)
                         if item is not None:
                             done += 1
@@ -159,7 +162,7 @@ class LogReader:
         return LogMessage(topic, t_ns, value)
 
     def _stream(self, wanted) -> Iterator[LogMessage]:
-        channels: dict[int, str] = {}
+        channels: dict[int, str] = {}  # the JSON channels' topics
         with open(self.path, "rb") as f:
             records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
             while True:
@@ -170,7 +173,8 @@ class LogReader:
                 except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
                     return
                 if isinstance(record, Channel):
-                    channels[record.id] = record.topic
+                    if record.message_encoding == "json":
+                        channels[record.id] = record.topic
                 elif isinstance(record, Message):
                     topic = channels.get(record.channel_id)
                     if topic is not None and (wanted is None or topic in wanted):
