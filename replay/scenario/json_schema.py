@@ -154,9 +154,9 @@ class _Generator:
                 return {"anyOf": [schema, {"type": "null"}]}
             return schema
         if dataclasses.is_dataclass(tp):
-            out = self.dataclass(tp, required=required)  # type: ignore[arg-type]
-            out["type"] = ["object", "null"]  # "timing:" alone = every default
-            return out
+            section = self.dataclass(tp, required=required)  # type: ignore[arg-type]
+            section["type"] = ["object", "null"]  # "timing:" alone = every default
+            return section
         if origin in (list, tuple):
             return self._list(tp, meta, required)
         if origin is dict:
