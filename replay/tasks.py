@@ -26,10 +26,10 @@ from replay.interfaces import Controller, Occurrence
 @dataclass
 class TaskLoops:
     t: float
-    names: list
-    ticked: list  # bool per task: ran this step
-    latency: list  # s per task (None before its inputs first arrived)
-    oldest: list  # per task: the input topic that latency is of
+    names: list[str]
+    ticked: list[bool]  # bool per task: ran this step
+    latency: list[float | None]  # s per task (None before its inputs first arrived)
+    oldest: list[str | None]  # per task: the input topic that latency is of
 
 
 @dataclass
