@@ -616,6 +616,9 @@ class BulletArmPlant(Plant):
             out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(t, parts, links, force)
         return out
 
+    def robot_description(self) -> str:
+        return self.model.urdf
+
     def _contact_summary_now(self):
         """(contacts, parts, links, total normal force) of ``_contacts``, summed once per list."""
         if self._contact_summary[0] is not self._contacts:
