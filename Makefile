@@ -11,7 +11,7 @@ SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml scenarios/
 
 .PHONY: install run lint test bench ablations golden-check clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py replay/sensors/_pixels.c
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test]'

@@ -1,7 +1,9 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
-folders ship in the wheel as package data under replay._shipped (found by replay.resources)."""
+folders ship in the wheel as package data under replay._shipped (found by replay.resources);
+the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
+the buffer protocol, no NumPy headers)."""
 
-from setuptools import find_namespace_packages, setup
+from setuptools import Extension, find_namespace_packages, setup
 
 SHIPPED = {
     "replay._shipped.data": "data",
@@ -12,6 +14,13 @@ SHIPPED = {
 setup(
     packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
     package_dir=SHIPPED,
+    ext_modules=[
+        Extension(
+            "replay.sensors._pixels",
+            ["replay/sensors/_pixels.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        )
+    ],
     package_data={
         "replay._shipped.data": ["**/*"],
         "replay._shipped.scenarios": ["*.yaml"],

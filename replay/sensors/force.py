@@ -48,15 +48,20 @@ class WristFTSensor(Sensor):
     spec_type = None
     description = "6-axis force/torque sensor between flange and palm (palm frame)"
 
+    def __init__(self, params: WristFTParams, *, rng: np.random.Generator, spec=None) -> None:
+        super().__init__(params, rng=rng, spec=spec)
+        self._sigma = np.repeat([params.force_noise, params.torque_noise], 3)
+        self._noisy = params.force_noise > 0.0 or params.torque_noise > 0.0
+
     def measure(self, t: float, scene: Scene) -> WristWrench | None:
         r = scene.readings.get("wrist")
         if r is None:
             return None
-        w = np.array(r["wrench"], dtype=float)
-        p = self.params
-        if p.force_noise > 0.0 or p.torque_noise > 0.0:
-            w += np.repeat([p.force_noise, p.torque_noise], 3) * self.rng.standard_normal(6)
-        return WristWrench(t, w[:3].tolist(), w[3:].tolist())
+        w = np.asarray(r["wrench"], dtype=float)
+        if self._noisy:
+            w = w + self._sigma * self.rng.standard_normal(6)
+        v = w.tolist()
+        return WristWrench(t, v[:3], v[3:])
 
 
 @dataclass

@@ -29,13 +29,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from replay.scene import Box, Cylinder, Scene, Sphere
-from replay.spatial import quaternion_matrix
 from replay.sensors.pinhole import PinholeCamera
-from replay.sensors.raster import coverage_blocks, paint
+from replay.sensors import _pixels
+from replay.sensors.raster import composite
 
 ELLIPSE_VERTICES = 48  # vertices of the polygon standing in for an ellipse
 _NEAR = 1e-6  # m: nearest depth drawn
@@ -66,23 +65,29 @@ class Ellipse:
     def polygon(self, inset: float = 0.0, area_exact: bool = True) -> np.ndarray:
         """(N, 2) vertices on the ellipse with both semi-axes reduced by ``inset`` px; scaled so
         that the polygon's area is the (reduced) ellipse's if ``area_exact``."""
+        return self.polygon_and_box(inset, area_exact)[0]
+
+    def polygon_and_box(self, inset: float = 0.0, area_exact: bool = True):
+        """:meth:`polygon` and its box (umin, vmin, umax, vmax), in one compiled call."""
         k = _AREA_SCALE if area_exact else 1.0
         a = max(self.a - inset, 0.05 * self.a) * k
         b = max(self.b - inset, 0.05 * self.b) * k
-        c, s = math.cos(self.angle), math.sin(self.angle)
-        pu = self.u + a * c * _COS - b * s * _SIN
-        pv = self.v + a * s * _COS + b * c * _SIN
-        return np.column_stack([pu, pv])
+        out = np.empty((ELLIPSE_VERTICES, 2))
+        box = _pixels.ellipse_polygon(
+            _COS, _SIN, self.u, self.v, a, b, math.cos(self.angle), math.sin(self.angle), out
+        )
+        return out, box
 
 
 def sphere_ellipse(camera: PinholeCamera, centre, radius: float) -> Ellipse | None:
     """The exact outline of a sphere in the image, or None if the sphere is not entirely in
     front of the camera's plane (``Z <= r``: the outline is then unbounded or empty)."""
-    R, o = camera.rotation, camera.position
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = camera.rotation.tolist()
+    o = camera.position.tolist()
     dx, dy, dz = float(centre[0]) - o[0], float(centre[1]) - o[1], float(centre[2]) - o[2]
-    X = R[0, 0] * dx + R[1, 0] * dy + R[2, 0] * dz  # p_cam = R^T (p - o)
-    Y = R[0, 1] * dx + R[1, 1] * dy + R[2, 1] * dz
-    Z = R[0, 2] * dx + R[1, 2] * dy + R[2, 2] * dz
+    X = r00 * dx + r10 * dy + r20 * dz  # p_cam = R^T (p - o)
+    Y = r01 * dx + r11 * dy + r21 * dz
+    Z = r02 * dx + r12 * dy + r22 * dz
     r2 = float(radius) ** 2
     E = Z * Z - r2
     if radius <= 0.0 or Z <= float(radius) * (1.0 + 1e-9) or E <= 0.0:
@@ -134,81 +139,114 @@ _RIM = np.column_stack(
 )
 
 
-def _hull_points(prim) -> np.ndarray:
-    """World points whose projections' convex hull is a box's or cylinder's silhouette."""
-    R = quaternion_matrix(prim.orientation)
-    if isinstance(prim, Box):
-        body = _BOX * (0.5 * np.asarray(prim.size, float))
-    else:
-        ring = prim.radius * _RIM
-        body = np.vstack(
-            [
-                np.column_stack([ring, np.full(len(ring), s * 0.5 * prim.length)])
-                for s in (-1.0, 1.0)
-            ]
-        )
-    return body @ R.T + np.asarray(prim.position, float)
+_BODY: dict = {}  # body-frame outline points by shape (sizes do not change during a run)
 
 
-def silhouette(camera: PinholeCamera, prim) -> tuple[float, np.ndarray | Ellipse] | None:
+def _body_points(prim: Box | Cylinder) -> np.ndarray:
+    """Body-frame points whose projections' convex hull is a box's or cylinder's silhouette."""
+    key = ("box", *prim.size) if isinstance(prim, Box) else ("cyl", prim.radius, prim.length)
+    body = _BODY.get(key)
+    if body is None:
+        if isinstance(prim, Box):
+            body = _BOX * (0.5 * np.asarray(prim.size, float))
+        else:
+            ring = prim.radius * _RIM
+            body = np.vstack(
+                [
+                    np.column_stack([ring, np.full(len(ring), s * 0.5 * prim.length)])
+                    for s in (-1.0, 1.0)
+                ]
+            )
+        if len(_BODY) < 1024:
+            _BODY[key] = body
+    return body
+
+
+def project_hull(camera: PinholeCamera, body: np.ndarray, orientation, position):
+    """(convex hull (N, 2) in pixels, its box (umin, vmin, umax, vmax)) of body-frame points
+    (n, 3) of a rigid body at ``position`` with quaternion ``orientation``, or None if a point
+    is not in front of the camera (depth <= 1 um). One compiled call
+    (``_pixels.project_hull``): the products as NumPy's matmul computes them (fused
+    multiply-adds in ascending order: the same pixels to the bit, test_fast_cameras.py), the
+    projections rounded to float32, as ``cv2.convexHull`` of float32 points took them, and the
+    hull is Andrew's monotone chain."""
+    k = camera.intrinsics
+    hull = np.empty((len(body), 2))
+    found = _pixels.project_hull(
+        body,
+        orientation,
+        position,
+        np.ascontiguousarray(camera.rotation, dtype=np.float64),
+        np.ascontiguousarray(camera.position, dtype=np.float64),
+        k.fx,
+        k.fy,
+        k.cx,
+        k.cy,
+        hull,
+    )
+    if found is None:
+        return None
+    return hull[: found[0]], found[1:]
+
+
+def silhouette(
+    camera: PinholeCamera, prim
+) -> tuple[float, np.ndarray | Ellipse, tuple | None] | None:
     """(distance (m) from the optical centre to the primitive's centre, convex polygon (N, 2) in
-    pixels) of a primitive, or None if it reaches behind the camera. Spheres give their ellipse."""
-    distance = float(np.linalg.norm(np.asarray(prim.position, float) - camera.position))
+    pixels, its box (umin, vmin, umax, vmax) or None for an ellipse) of a primitive, or None if
+    it reaches behind the camera. Spheres give their ellipse."""
+    distance = math.dist(prim.position, camera.position.tolist())
     if isinstance(prim, Sphere):
         e = sphere_ellipse(camera, prim.position, prim.radius)
         if e is None:
             return None
-        return distance, e
+        return distance, e, None
     if isinstance(prim, (Box, Cylinder)):
-        pts = _hull_points(prim)
-        pc = camera.to_camera(pts)
-        if np.any(pc[:, 2] <= _NEAR):
+        found = project_hull(camera, _body_points(prim), prim.orientation, prim.position)
+        if found is None:
             return None
-        k = camera.intrinsics
-        uv = np.column_stack([k.fx * pc[:, 0] / pc[:, 2] + k.cx, k.fy * pc[:, 1] / pc[:, 2] + k.cy])
-        hull = cv2.convexHull(uv.astype(np.float32)).reshape(-1, 2).astype(np.float64)
-        return distance, hull
+        return distance, found[0], found[1]
     raise TypeError(f"cannot render {type(prim).__name__}")
 
 
 # --- raster --------------------------------------------------------------------------------
 
 
-def _block(poly: np.ndarray, w: int, h: int):
-    """The pixel block (x0, y0, w, h) of a polygon's bounding box plus a pixel, clipped to a
-    w x h image, or None if it is off the image."""
-    x0 = max(int(math.floor(poly[:, 0].min())) - 1, 0)
-    y0 = max(int(math.floor(poly[:, 1].min())) - 1, 0)
-    x1 = min(int(math.ceil(poly[:, 0].max())) + 2, w)
-    y1 = min(int(math.ceil(poly[:, 1].max())) + 2, h)
-    return (x0, y0, x1 - x0, y1 - y0) if x1 > x0 and y1 > y0 else None
+def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float, tuple]]:
+    """(convex polygon in pixels, grey level, its box (umin, vmin, umax, vmax)) of each
+    primitive drawn by ``camera``, far first."""
+    items = []
+    for i, prim in enumerate(scene.primitives):
+        s = silhouette(camera, prim)
+        if s is not None:
+            items.append((-s[0], i, prim, s[1], s[2]))
+    items.sort(key=lambda it: (it[0], it[1]))  # far first
+    out = []
+    for _, _, prim, shape, box in items:
+        if isinstance(shape, Ellipse):
+            poly, box = shape.polygon_and_box()
+        elif len(shape) >= 3 and box is not None:
+            poly = shape
+        else:
+            continue
+        out.append((poly, 255.0 * float(prim.albedo), tuple(box)))
+    return out
 
 
 def render_views(cameras, scene: Scene, *, background: float = 0.1) -> list[np.ndarray]:
-    """:func:`render` for several cameras at once: the coverage of every silhouette in every
-    view is computed in one pass (:func:`~replay.sensors.raster.coverage_blocks`)."""
-    images, jobs = [], []  # (view, polygon, grey, block)
-    for view, camera in enumerate(cameras):
-        k = camera.intrinsics
-        images.append(np.full((k.height, k.width), 255.0 * background, np.float32))
-        items = []
-        for i, prim in enumerate(scene.primitives):
-            s = silhouette(camera, prim)
-            if s is not None:
-                items.append((-s[0], i, prim, s[1]))
-        items.sort(key=lambda it: (it[0], it[1]))  # far first
-        for _, _, prim, shape in items:
-            poly = shape.polygon() if isinstance(shape, Ellipse) else shape
-            block = _block(poly, k.width, k.height) if len(poly) >= 3 else None
-            if block is not None:
-                jobs.append((view, poly, 255.0 * float(prim.albedo), block))
-    covs = coverage_blocks([j[1] for j in jobs], [j[3] for j in jobs])
-    for (view, _, grey, (x0, y0, w, h)), cov in zip(jobs, covs):  # in each view far to near
-        paint(images[view][y0 : y0 + h, x0 : x0 + w], cov, grey)
-    return images
+    """:func:`render` for several cameras."""
+    return [render(camera, scene, background=background) for camera in cameras]
 
 
-def render(camera: PinholeCamera, scene: Scene, *, background: float = 0.1) -> np.ndarray:
+def render(
+    camera: PinholeCamera, scene: Scene, *, background: float = 0.1, window=None
+) -> np.ndarray:
     """A noiseless float32 grey image (0..255) of the scene's silhouettes, each at grey level
-    ``255 * albedo``, on a uniform background of albedo ``background``."""
-    return render_views([camera], scene, background=background)[0]
+    ``255 * albedo``, on a uniform background of albedo ``background``; with ``window = (x0,
+    y0, x1, y1)`` only that part of the image (pixel (x0, y0) is pixel (0, 0) of the result)."""
+    k = camera.intrinsics
+    x0, y0, x1, y1 = window if window is not None else (0, 0, k.width, k.height)
+    img = np.full((y1 - y0, x1 - x0), 255.0 * background, np.float32)
+    drawn = drawables(camera, scene)
+    composite(img, [d[0] for d in drawn], [d[1] for d in drawn], origin=(x0, y0))
+    return img

@@ -3,16 +3,16 @@ array of photodetectors, each with its own processing element, read as a **binar
 1 kHz.
 
 Each frame: the camera's pose comes from the head's joint angles (``Scene.readings["head"]``,
-the plant's ``replay.robot.head.camera_pose``); the scene's silhouettes are rendered with
-OpenCV through that pinhole camera (:func:`replay.sensors.silhouette.render`: exact projected
-outlines, each pixel's exact coverage), Gaussian grey-level noise is
+the plant's ``replay.robot.head.camera_pose``); the scene's silhouettes are rendered through that
+pinhole camera (:func:`replay.sensors.silhouette.render`: exact projected outlines, each pixel's
+exact coverage, compiled), Gaussian grey-level noise is
 added, and each pixel is thresholded into one bit. What happens to the bits (Self Windowing,
 moments) is the method's (``replay.control.grasping``): the chip's PEs run the paper's
 algorithm, so it is not part of this sensor.
 
 Published on ``/vision/chip``: ``VisionChip(t, width, height, rows, count)``, ``rows[v]`` an
 int whose bit ``u`` is pixel (u, v) (u right, v down, OpenCV's image axes), ``t`` the capture
-time. Cost: ~40 us per frame.
+time. Cost: ~30 us a frame (was ~0.5-0.7 ms), the frames bit-equal.
 
 The field of view is not in the paper: 12 deg (a scenario's assumption) makes the 16 pixels span
 ~0.17 m at 0.8 m, so a 10 cm box covers ~9 x 5 pixels and a 7 cm ball ~7 pixels.
@@ -30,6 +30,7 @@ from replay.interfaces import Sensor
 from replay.params import param
 from replay.scene import Scene
 from replay.sensors.pinhole import Intrinsics, PinholeCamera
+from replay.sensors import _pixels
 from replay.sensors.silhouette import render
 
 
@@ -82,7 +83,7 @@ class VisionChipSensor(Sensor):
         """The chip's camera at this frame's pose (one object, its pose replaced each frame: the
         head model's rotation is orthonormal by construction, so it is not re-validated)."""
         r = scene.readings[self.params.reading]
-        self._camera.rotation = np.asarray(r["camera_rotation"], float)
+        self._camera.rotation = np.ascontiguousarray(r["camera_rotation"], float)
         self._camera.position = np.asarray(r["camera_position"], float)
         return self._camera
 
@@ -97,6 +98,9 @@ class VisionChipSensor(Sensor):
     def measure(self, t: float, scene: Scene) -> VisionChip | None:
         bits = self.image(scene)
         self.last_image = bits
-        return VisionChip(
-            t, int(bits.shape[1]), int(bits.shape[0]), pack_rows(bits), int(bits.sum())
-        )
+        h, w = bits.shape
+        if w <= 63:  # pack_rows, compiled
+            rows, count = _pixels.pack_rows(bits, w, h)
+        else:
+            rows, count = pack_rows(bits), int(bits.sum())
+        return VisionChip(t, int(w), int(h), rows, int(count))

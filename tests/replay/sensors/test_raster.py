@@ -4,7 +4,7 @@ it replaced, kept here as the reference."""
 import numpy as np
 import pytest
 
-from replay.sensors.raster import composite, coverage
+from replay.sensors.raster import composite, coverage, quantise
 
 
 def _positive_part_integral(g0, g1, length):
@@ -120,3 +120,11 @@ def test_composite_paints_far_to_near_by_coverage():
     assert img[5, 8] == pytest.approx(100.0)
     assert img[4, 4] == pytest.approx(250.0)  # wholly inside the front square
     assert img[3, 3] == pytest.approx(100.0 + 0.25 * 150.0)  # a quarter of it
+
+
+def test_quantise_is_clip_of_rint():
+    rng = np.random.default_rng(0)
+    img = np.concatenate(
+        [rng.uniform(-20, 280, 5000), np.arange(-2, 258, 0.5), [0.0, -0.0, 255.0, 1e30, -1e30]]
+    ).astype(np.float32)
+    np.testing.assert_array_equal(quantise(img), np.clip(np.rint(img), 0, 255).astype(np.uint8))
