@@ -23,6 +23,7 @@ from typing import Callable
 import numpy as np
 
 from replay import __version__, registry
+from replay.foxglove.run import RunTopics
 from replay.log import LogWriter, NonFiniteValueError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
 from replay.scenario import Scenario, resolved_yaml
@@ -142,6 +143,9 @@ class Runner:
         self.log_div = (
             _divider(rate, scenario.timing.state_log_rate) if scenario.timing.state_log_rate else 1
         )
+        fr = scenario.timing.frame_rate  # the 3-D viewer topics (replay/foxglove)
+        self.frame_div = _divider(rate, fr) if fr else 0
+        self.viz: RunTopics | None = None
         self._t_log = 0.0  # seconds in log writes (and observers) this run
 
     def t_ns(self, k: int) -> int:
@@ -162,6 +166,8 @@ class Runner:
         self._write(
             log, TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0
         )
+        viz = self.viz = RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
+        viz.start(0)
         # (deliver at step, sequence, topic, payload): a heap, so readings reach the controller in
         # time order whatever the sensors' order and latencies
         pending: list = []
@@ -187,6 +193,10 @@ class Runner:
                             c0 = c1
                         m = sensor.measure(t, scene)
                         t_sensors += clock() - c0
+                        if name in viz.imaging:
+                            c0 = clock()
+                            viz.sensor(name, sensor, t_ns)
+                            self._t_log += clock() - c0
                         if m is not None:
                             self._write(log, sensor.topic, m, t_ns)
                             heapq.heappush(pending, (k + latency, seq, sensor.topic, m))
@@ -223,6 +233,9 @@ class Runner:
                     for topic, payload in truth.items():
                         self._write(log, topic, payload, t_ns)
                     c0 = clock()
+                if self.frame_div and k % self.frame_div == 0:
+                    self._frame(scene, t_ns)
+                    c0 = clock()
                 self.plant.step()
                 t_plant += clock() - c0
                 k += 1
@@ -242,6 +255,8 @@ class Runner:
             t_end = k / rate
             for topic, payload in self.plant.truth(t_end).items():
                 self._write(log, topic, payload, self.t_ns(k))
+            if self.frame_div:
+                self._frame(None, self.t_ns(k))
             self._outcome(log, result, k, self._verdict(k / rate))
         except NonFiniteValueError as exc:
             result.stopped_by = "error"
@@ -313,9 +328,18 @@ class Runner:
         )
         result.wall_time = time.perf_counter() - wall0
 
+    def _frame(self, scene, t_ns: int) -> None:
+        """The 3-D viewer topics now (``scene``: this step's, if a camera already asked)."""
+        c0 = time.perf_counter()
+        assert self.viz is not None
+        self.viz.frame(scene if scene is not None else self.plant.scene(), t_ns)
+        self._t_log += time.perf_counter() - c0
+
     def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:
         c0 = time.perf_counter()
         log.write(topic, payload, t_ns)
+        if topic == TOPIC_EVENTS and self.viz is not None:
+            self.viz.event(payload, t_ns)
         for observe in self.observers:
             observe(topic, payload, t_ns)
         self._t_log += time.perf_counter() - c0

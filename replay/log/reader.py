@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from mcap.reader import make_reader
-from mcap.records import Channel, Message
+from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 
 from replay.log.errors import LogError, NotALogError
@@ -33,6 +33,21 @@ class LogMessage:
     topic: str
     t_ns: int
     data: dict
+
+    @property
+    def t(self) -> float:
+        return self.t_ns * 1e-9
+
+
+@dataclass(frozen=True)
+class RawMessage:
+    """A message as stored: for channels that are not JSON (Foxglove's protobuf topics)."""
+
+    topic: str
+    t_ns: int
+    schema: str  # the schema's name, e.g. foxglove.FrameTransforms
+    encoding: str  # the channel's message encoding, e.g. protobuf
+    data: bytes
 
     @property
     def t(self) -> float:
@@ -122,13 +137,16 @@ class LogReader:
     # -- messages -------------------------------------------------------------------------
     def messages(self, topics: Iterable[str] | str | None = None) -> Iterator[LogMessage]:
         """Messages in log-time order (file order for a truncated log), optionally by topic.
-        Messages that are not JSON objects are skipped (and counted in ``problems``)."""
+        Messages that are not JSON objects are skipped (and counted in ``problems``); channels
+        that are not JSON at all (Foxglove's protobuf topics) are left out: :meth:`raw`."""
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
         if self._summary is not None:
             done = 0
             try:
                 with open(self.path, "rb") as f:
                     for _, channel, msg in make_reader(f).iter_messages(topics=wanted):
+                        if channel.message_encoding != "json":
+                            continue
                         item = self._message(channel.topic, msg.log_time, msg.data)
                         if item is not None:
                             done += 1
@@ -145,7 +163,31 @@ class LogReader:
         else:
             skip = 0
         for i, item in enumerate(self._stream(wanted)):
-            if i >= skip:
+            if i >= skip and isinstance(item, LogMessage):
+                yield item
+
+    def raw(self, topics: Iterable[str] | str | None = None) -> Iterator[RawMessage]:
+        """The messages of the channels that are not JSON (protobuf: ``replay.foxglove``
+        decodes them), undecoded, in log-time order (file order for a truncated log)."""
+        wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
+        if self._summary is not None:
+            try:
+                with open(self.path, "rb") as f:
+                    for schema, channel, msg in make_reader(f).iter_messages(topics=wanted):
+                        if channel.message_encoding != "json":
+                            yield RawMessage(
+                                channel.topic,
+                                msg.log_time,
+                                schema.name if schema is not None else "",
+                                channel.message_encoding,
+                                msg.data,
+                            )
+                return
+            except Exception as exc:  # noqa: BLE001
+                self._damage(f"the index points at bad bytes ({type(exc).__name__})")
+                return
+        for item in self._stream(wanted, raw=True):
+            if isinstance(item, RawMessage):
                 yield item
 
     def _message(self, topic: str, t_ns: int, data: bytes) -> LogMessage | None:
@@ -158,8 +200,9 @@ class LogReader:
             return None
         return LogMessage(topic, t_ns, value)
 
-    def _stream(self, wanted) -> Iterator[LogMessage]:
-        channels: dict[int, str] = {}
+    def _stream(self, wanted, raw: bool = False) -> Iterator[LogMessage | RawMessage]:
+        channels: dict[int, tuple[str, str, int]] = {}  # id -> topic, encoding, schema id
+        schemas: dict[int, str] = {}
         with open(self.path, "rb") as f:
             records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
             while True:
@@ -169,14 +212,29 @@ class LogReader:
                     return
                 except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
                     return
-                if isinstance(record, Channel):
-                    channels[record.id] = record.topic
+                if isinstance(record, Schema):
+                    schemas[record.id] = record.name
+                elif isinstance(record, Channel):
+                    channels[record.id] = (record.topic, record.message_encoding, record.schema_id)
                 elif isinstance(record, Message):
-                    topic = channels.get(record.channel_id)
-                    if topic is not None and (wanted is None or topic in wanted):
-                        item = self._message(topic, record.log_time, record.data)
-                        if item is not None:
-                            yield item
+                    topic, encoding, schema_id = channels.get(record.channel_id, (None, "", 0))
+                    if topic is None or (wanted is not None and topic not in wanted):
+                        continue
+                    if encoding != "json":
+                        if raw:
+                            yield RawMessage(
+                                topic,
+                                record.log_time,
+                                schemas.get(schema_id, ""),
+                                encoding,
+                                record.data,
+                            )
+                        continue
+                    if raw:
+                        continue
+                    item = self._message(topic, record.log_time, record.data)
+                    if item is not None:
+                        yield item
 
     def series(self, topic: str) -> list[dict]:
         """All payloads of one topic, in order."""

@@ -189,6 +189,7 @@ class LogWriter:
         self._writer.start(profile="", library=f"paper-replay {__version__}")
         self._channels: dict[str, int] = {}
         self._sequence: dict[str, int] = {}
+        self._schemas: dict[tuple[str, str], int] = {}  # (name, encoding) -> id, for raw channels
         self.count = 0
         self.closed = False
 
@@ -215,6 +216,47 @@ class LogWriter:
                 channel = self._channel(topic, payload)
                 self._writer.add_message(
                     channel_id=channel,
+                    log_time=t_ns,
+                    publish_time=t_ns,
+                    data=data,
+                    sequence=self._sequence[topic],
+                )
+            except OSError as exc:
+                raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+            self._sequence[topic] += 1
+            self.count += 1
+
+    def register_channel(
+        self,
+        topic: str,
+        *,
+        schema_name: str,
+        schema_encoding: str,
+        schema_data: bytes,
+        message_encoding: str,
+    ) -> None:
+        """Declare a channel whose messages are not our JSON payloads (e.g. Foxglove's
+        protobuf schemas); then :meth:`write_raw` writes its messages. A schema is stored
+        once however many channels use it. Registering a topic twice is a no-op."""
+        if topic in self._channels:
+            return
+        with self._held:
+            key = (schema_name, schema_encoding)
+            if key not in self._schemas:
+                self._schemas[key] = self._writer.register_schema(
+                    name=schema_name, encoding=schema_encoding, data=schema_data
+                )
+            self._channels[topic] = self._writer.register_channel(
+                topic=topic, message_encoding=message_encoding, schema_id=self._schemas[key]
+            )
+            self._sequence[topic] = 0
+
+    def write_raw(self, topic: str, data: bytes, t_ns: int) -> None:
+        """Write one already-encoded message on a channel of :meth:`register_channel`."""
+        with self._held:
+            try:
+                self._writer.add_message(
+                    channel_id=self._channels[topic],
                     log_time=t_ns,
                     publish_time=t_ns,
                     data=data,
