@@ -186,7 +186,9 @@ def compare_logs(
         tol_text = f"abs {tol.get('abs', 0):g}, rel {tol.get('rel', 0):g}"
         g_msgs = _decoded(golden, topic)
         r_msgs = _decoded(run, topic)
-        ignored = IGNORED_FIELDS.get(topic, IMAGE_IGNORED if topic.startswith(IMAGE_PREFIX) else set())
+        ignored = IGNORED_FIELDS.get(
+            topic, IMAGE_IGNORED if topic.startswith(IMAGE_PREFIX) else set()
+        )
         for i, (gm, rm) in enumerate(zip(g_msgs, r_msgs)):
             if gm.t_ns != rm.t_ns:
                 diffs.append(Difference(topic, i, gm.t, "(log time)", gm.t, rm.t))

@@ -8,6 +8,7 @@ it imports (Rerun decodes the Foxglove schemas only in this encoding).
 
 from __future__ import annotations
 
+import struct
 from functools import cache
 
 from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
@@ -21,10 +22,15 @@ from google.protobuf.message import DecodeError, Message
 
 SCHEMA_ENCODING = "protobuf"
 MESSAGE_ENCODING = "protobuf"
+# the URDF's topic: ROS 2 std_msgs/msg/String in CDR (little endian), what Foxglove's URDF layer
+# and Rerun's MCAP importer read
+STRING_SCHEMA = "std_msgs/msg/String"
+_CDR_HEADER = b"\x00\x01\x00\x00"  # CDR_LE, no options
 
 # the classes our logs use, by schema name
 CLASSES: dict[str, type[Message]] = {
-    cls.DESCRIPTOR.full_name: cls for cls in (FrameTransforms, SceneUpdate, JointStates, Log, CompressedImage)
+    cls.DESCRIPTOR.full_name: cls
+    for cls in (FrameTransforms, SceneUpdate, JointStates, Log, CompressedImage)
 }
 
 
@@ -60,7 +66,24 @@ def decode(schema_name: str, data: bytes) -> Message:
     return msg
 
 
+def encode_string(text: str) -> bytes:
+    """A ``std_msgs/msg/String`` in CDR: header, uint32 length (with the NUL), UTF-8, NUL."""
+    b = text.encode() + b"\x00"
+    return _CDR_HEADER + struct.pack("<I", len(b)) + b
+
+
+def decode_string(data: bytes) -> str:
+    if data[:4] != _CDR_HEADER or len(data) < 8:
+        raise ValueError(f"{STRING_SCHEMA}: not little-endian CDR")
+    (n,) = struct.unpack_from("<I", data, 4)
+    if n < 1 or len(data) < 8 + n:
+        raise ValueError(f"{STRING_SCHEMA}: string length {n} beyond the message")
+    return data[8 : 8 + n - 1].decode()
+
+
 def message_dict(schema_name: str, data: bytes) -> dict:
     """A message of one of our schemas as a dict (protobuf's JSON mapping, field names as in
     the schema; bytes as base64)."""
+    if schema_name == STRING_SCHEMA:
+        return {"data": decode_string(data)}
     return json_format.MessageToDict(decode(schema_name, data), preserving_proto_field_name=True)

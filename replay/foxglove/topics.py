@@ -6,8 +6,9 @@
 - ``/scene`` (``foxglove.SceneUpdate``): the scene's primitives (boxes, spheres, cylinders) at
   their world poses, grey by albedo;
 - ``/joint_states`` (``foxglove.JointStates``): every joint of the robot (arm, hand, head);
-- ``/robot_description``: the robot's URDF, once at t = 0, as ``std_msgs/String`` (JSON
-  ``{"data": URDF}``), the one shape Foxglove's URDF layer reads from a topic;
+- ``/robot_description``: the robot's URDF, once at t = 0, as ROS 2 ``std_msgs/msg/String``
+  (CDR): the one schema Foxglove's URDF layer reads from a topic, and the one Rerun's MCAP
+  importer turns into the robot's geometry;
 - ``/log`` (``foxglove.Log``): each ``/events`` message as a log line;
 - ``/camera/SENSOR/VIEW`` (``foxglove.CompressedImage``, PNG): each camera frame.
 
@@ -17,7 +18,6 @@ deterministically, so the same run gives the same bytes.
 
 from __future__ import annotations
 
-import json
 from typing import Iterable, Sequence
 
 import numpy as np
@@ -40,7 +40,13 @@ from google.protobuf.message import Message
 from google.protobuf.timestamp_pb2 import Timestamp
 
 from replay.foxglove.png import encode_png
-from replay.foxglove.schemas import MESSAGE_ENCODING, SCHEMA_ENCODING, schema_data
+from replay.foxglove.schemas import (
+    MESSAGE_ENCODING,
+    SCHEMA_ENCODING,
+    STRING_SCHEMA,
+    encode_string,
+    schema_data,
+)
 from replay.messages import (
     TOPIC_JOINT_STATES,
     TOPIC_LOG,
@@ -51,16 +57,6 @@ from replay.messages import (
 from replay.scene import Box, Cylinder, Frame, Sphere
 
 WORLD = "world"  # the fixed frame every pose hangs from
-STRING_SCHEMA = "std_msgs/String"  # the schema name Foxglove's URDF layer reads from a topic
-_STRING_JSON_SCHEMA = json.dumps(
-    {
-        "title": STRING_SCHEMA,
-        "type": "object",
-        "properties": {"data": {"type": "string"}},
-        "required": ["data"],
-    },
-    separators=(",", ":"),
-).encode()
 
 
 def camera_topic(sensor: str, view: str) -> str:
@@ -76,9 +72,7 @@ def _stamp(t_ns: int) -> Timestamp:
 def _pose(position, orientation=(0.0, 0.0, 0.0, 1.0)) -> Pose:
     x, y, z = position
     qx, qy, qz, qw = orientation
-    return Pose(
-        position=Vector3(x=x, y=y, z=z), orientation=Quaternion(x=qx, y=qy, z=qz, w=qw)
-    )
+    return Pose(position=Vector3(x=x, y=y, z=z), orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))
 
 
 def _grey(albedo: float) -> Color:
@@ -89,8 +83,20 @@ def _grey(albedo: float) -> Color:
 
 # the /events kinds that are shown as warnings / errors in the Log panel
 _WARNING_KINDS = frozenset(
-    {"infeasible", "missed", "miss", "drop", "torque_limit", "velocity_limit", "joint_limit",
-     "limit", "lost", "slip", "warning", "interrupted"}
+    {
+        "infeasible",
+        "missed",
+        "miss",
+        "drop",
+        "torque_limit",
+        "velocity_limit",
+        "joint_limit",
+        "limit",
+        "lost",
+        "slip",
+        "warning",
+        "interrupted",
+    }
 )
 _ERROR_KINDS = frozenset({"error", "nan"})
 
@@ -128,13 +134,12 @@ class FoxgloveTopics:
             self.log.register_channel(
                 TOPIC_ROBOT_DESCRIPTION,
                 schema_name=STRING_SCHEMA,
-                schema_encoding="jsonschema",
-                schema_data=_STRING_JSON_SCHEMA,
-                message_encoding="json",
+                schema_encoding="ros2msg",
+                schema_data=b"string data",
+                message_encoding="cdr",
             )
             self._registered.add(TOPIC_ROBOT_DESCRIPTION)
-        data = json.dumps({"data": urdf}, separators=(",", ":")).encode()
-        self.log.write_raw(TOPIC_ROBOT_DESCRIPTION, data, t_ns)
+        self.log.write_raw(TOPIC_ROBOT_DESCRIPTION, encode_string(urdf), t_ns)
 
     def transforms(self, frames: Iterable[Frame], t_ns: int) -> None:
         stamp = _stamp(t_ns)
@@ -146,7 +151,9 @@ class FoxgloveTopics:
                     child_frame_id=f.child,
                     translation=Vector3(x=f.position[0], y=f.position[1], z=f.position[2]),
                     rotation=Quaternion(
-                        x=f.orientation[0], y=f.orientation[1], z=f.orientation[2],
+                        x=f.orientation[0],
+                        y=f.orientation[1],
+                        z=f.orientation[2],
                         w=f.orientation[3],
                     ),
                 )
