@@ -381,8 +381,9 @@ class BulletGraspPlant(BulletArmPlant):
         """The robot's links and the head's camera (``head_camera``: x right, y down, z the
         optical axis) in ``world``."""
         R, c = self._head_reading()
-        orn = tuple(float(x) for x in matrix_to_quaternion(R))
-        return super().frames() + [Frame("world", "head_camera", tuple(c.tolist()), orn)]
+        qx, qy, qz, qw = (float(x) for x in matrix_to_quaternion(R))
+        x, y, z = (float(v) for v in c)
+        return super().frames() + [Frame("world", "head_camera", (x, y, z), (qx, qy, qz, qw))]
 
     def scene(self) -> Scene:
         sc = super().scene()

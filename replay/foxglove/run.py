@@ -43,7 +43,8 @@ class RunTopics:
         self.out.scene(scene.primitives, t_ns)
         joints = self.plant.joints()
         if joints is not None:
-            self.out.joint_states(*joints, t_ns)
+            names, position, velocity, effort = joints
+            self.out.joint_states(names, position, velocity, effort, t_ns)
 
     def sensor(self, name: str, sensor, t_ns: int) -> None:
         if name in self.imaging:

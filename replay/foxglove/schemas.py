@@ -9,7 +9,6 @@ it imports (Rerun decodes the Foxglove schemas only in this encoding).
 from __future__ import annotations
 
 import struct
-from functools import cache
 
 from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
@@ -34,9 +33,18 @@ CLASSES: dict[str, type[Message]] = {
 }
 
 
-@cache
+_SCHEMA_DATA: dict[str, bytes] = {}
+
+
 def schema_data(cls: type[Message]) -> bytes:
     """The ``FileDescriptorSet`` (bytes) of ``cls``'s file and its imports, imports first."""
+    name = cls.DESCRIPTOR.full_name
+    if name not in _SCHEMA_DATA:
+        _SCHEMA_DATA[name] = _file_descriptor_set(cls)
+    return _SCHEMA_DATA[name]
+
+
+def _file_descriptor_set(cls: type[Message]) -> bytes:
     fds = FileDescriptorSet()
     seen: set[str] = set()
 

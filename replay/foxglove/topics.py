@@ -101,7 +101,7 @@ _WARNING_KINDS = frozenset(
 _ERROR_KINDS = frozenset({"error", "nan"})
 
 
-def log_level(kind: str, data: dict) -> int:
+def log_level(kind: str, data: dict) -> Log.Level.ValueType:
     """``foxglove.Log`` level of an event: errors, warnings, a failed outcome a warning."""
     if kind in _ERROR_KINDS:
         return Log.ERROR

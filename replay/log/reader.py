@@ -162,9 +162,9 @@ class LogReader:
                 skip = done
         else:
             skip = 0
-        for i, item in enumerate(self._stream(wanted)):
-            if i >= skip and isinstance(item, LogMessage):
-                yield item
+        for i, streamed in enumerate(self._stream(wanted)):
+            if i >= skip and isinstance(streamed, LogMessage):
+                yield streamed
 
     def raw(self, topics: Iterable[str] | str | None = None) -> Iterator[RawMessage]:
         """The messages of the channels that are not JSON (protobuf: ``replay.foxglove``

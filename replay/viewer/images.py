@@ -43,6 +43,8 @@ class ImageTrack:
     def frame(self, k: int) -> np.ndarray:
         """Image ``k`` as RGB, scaled to :data:`SIZE` px wide, its centroid marked."""
         grey = cv2.imdecode(np.frombuffer(self.png[k], np.uint8), cv2.IMREAD_GRAYSCALE)
+        if grey is None:
+            raise ValueError(f"{self.topic}: image {k} is not a readable PNG")
         h, w = grey.shape
         s = SIZE / w
         interp = cv2.INTER_NEAREST if s >= 1 else cv2.INTER_AREA

@@ -244,3 +244,18 @@ def test_a_truncated_log_still_gives_its_protobuf_messages(catch_log, tmp_path):
     list(r.messages())  # JSON topics read as before, the protobuf ones not counted as damage
     assert not r.damaged, r.problems
     shutil.rmtree(tmp_path, ignore_errors=True)
+
+
+def test_golden_compare_reads_the_protobuf_topics(tmp_path):
+    from replay.golden import compare_logs
+
+    sets = ["timing.duration=0.03"]
+    a = run(tmp_path, "catch_optimised", sets, "a.mcap")
+    moved = sets + ["plant.params.object_position=[3.22772, 0.001, 0.99913]"]
+    b = run(tmp_path, "catch_optimised", moved, "b.mcap")
+    tol = {"abs": 1e-6, "rel": 0.0}
+    assert not compare_logs(a, a, {}, tol)
+    found = {d.topic: d for d in compare_logs(a, b, {}, tol)}
+    assert {TOPIC_TF, TOPIC_SCENE, TOPIC_OBJECT_STATE} <= set(found)
+    assert "translation" in found[TOPIC_TF].field  # the ball's frame moved by 1 mm in y
+    assert "/camera/stereo/cam0" not in found  # PNG bytes are not compared
