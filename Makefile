@@ -41,6 +41,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m replay.bench
+	$(PY) -m replay.log.bench
 	$(PY) -m replay.viewer.bench
 	$(PY) -m replay.sweep.bench
 

@@ -11,6 +11,8 @@ logged at its end, collisions with the controller's intent attached. The run sto
 
 from __future__ import annotations
 
+import collections
+import functools
 import heapq
 import platform
 import subprocess
@@ -18,7 +20,7 @@ import time
 from dataclasses import dataclass, field
 from importlib import metadata as importlib_metadata
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -53,11 +55,14 @@ class RunResult:
     timings: dict = field(default_factory=dict)
 
 
-# The parts of a run timed by the runner itself (perf_counter around each call: ~0.1 us a call),
-# so `make bench` shows where the time goes without a profiler.
+# The parts of a run timed by the runner itself (perf_counter, one reading a part), so `make
+# bench` shows where the time goes without a profiler: sensors (measure); controller (update,
+# pop_events, telemetry, intent); plant (scene, apply, truth, step, pop_events); logging (log
+# writes and observers); runner (the rest: the loop itself, delivery, set-up, closing the log).
 COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 
+@functools.cache  # once a process: the code a process runs is the code it loaded
 def _git_commit() -> str:
     try:
         out = subprocess.run(
@@ -72,6 +77,17 @@ def _git_commit() -> str:
         return ""
 
 
+@functools.cache  # once a process (~3 ms of package metadata reads)
+def _versions() -> tuple[tuple[str, str], ...]:
+    found = []
+    for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
+        try:
+            found.append((pkg, importlib_metadata.version(pkg)))
+        except importlib_metadata.PackageNotFoundError:
+            pass
+    return tuple(found)
+
+
 def provenance(sc: Scenario, commit: str) -> dict[str, str]:
     info = {
         "scenario": sc.name,
@@ -81,11 +97,7 @@ def provenance(sc: Scenario, commit: str) -> dict[str, str]:
         "python": platform.python_version(),
         "git_commit": commit,
     }
-    for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
-        try:
-            info[pkg] = importlib_metadata.version(pkg)
-        except importlib_metadata.PackageNotFoundError:
-            pass
+    info.update(_versions())
     return info
 
 
@@ -168,95 +180,140 @@ class Runner:
         )
         viz = self.viz = RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
         viz.start(0)
-        # (deliver at step, sequence, topic, payload): a heap, so readings reach the controller in
-        # time order whatever the sensors' order and latencies
-        pending: list = []
         seq = 0
         stop_at: int | None = None
         collisions = 0
         k = 0
+        # The loop is the hot path (1-3 k steps and 4-22 k messages per simulated second): the
+        # plug-ins' methods are bound once, and each part is timed by one clock reading at its
+        # end (the start is the previous part's end), so timing a message costs one perf_counter.
         clock = time.perf_counter
+        plant, controller = self.plant, self.controller
+        scene_of, apply, truth_of, step = plant.scene, plant.apply, plant.truth, plant.step
+        plant_events = plant.pop_events
+        update, telemetry_of, controller_events = (
+            controller.update,
+            controller.telemetry,
+            controller.pop_events,
+        )
+        write = self._emitter(log)
+        sensors = [
+            (s.measure, s.topic, div, latency, (name, s) if name in viz.imaging else None)
+            for name, s, div, latency in self.sensors
+        ]
+        ctrl_div, log_div, n_ns = self.ctrl_div, self.log_div, 1_000_000_000
+        frame_div = self.frame_div
+        progress, progress_div = self.progress, max(1, rate // 20)
+        # (deliver at step, sequence, topic, payload), delivered in that order whatever the
+        # sensors' order and latencies: a heap; with one latency for all, readings are made in
+        # delivery order, so a FIFO (half the cost of a heap's push and pop) is that order
+        pending: Any
+        if len({latency for *_, latency in sensors}) <= 1:
+            pending = collections.deque()
+            push, pop = pending.append, pending.popleft
+        else:
+            pending = []
+            push = functools.partial(heapq.heappush, pending)
+            pop = functools.partial(heapq.heappop, pending)
         t_sensors = t_controller = t_plant = 0.0
         self._t_log = 0.0
+        t_log = 0.0
         try:
             while k < n_steps and (stop_at is None or k < stop_at):
                 t = k / rate
-                t_ns = self.t_ns(k)
+                t_ns = k * n_ns // rate
                 scene = None
-                for name, sensor, div, latency in self.sensors:
+                for measure, topic, div, latency, imaging in sensors:
                     if k % div == 0:
                         c0 = clock()
                         if scene is None:
-                            scene = self.plant.scene()
+                            scene = scene_of()
                             c1 = clock()
                             t_plant += c1 - c0
                             c0 = c1
-                        m = sensor.measure(t, scene)
-                        t_sensors += clock() - c0
-                        if name in viz.imaging:
+                        m = measure(t, scene)
+                        c1 = clock()
+                        t_sensors += c1 - c0
+                        if imaging is not None:  # its frame, for Foxglove / Rerun
+                            viz.sensor(imaging[0], imaging[1], t_ns)
                             c0 = clock()
-                            viz.sensor(name, sensor, t_ns)
-                            self._t_log += clock() - c0
+                            t_log += c0 - c1
+                            c1 = c0
                         if m is not None:
-                            self._write(log, sensor.topic, m, t_ns)
-                            heapq.heappush(pending, (k + latency, seq, sensor.topic, m))
+                            write(topic, m, t_ns)
+                            t_log += clock() - c1
+                            push((k + latency, seq, topic, m))
                             seq += 1
-                if k % self.ctrl_div == 0:
+                if k % ctrl_div == 0:
                     delivered = []
                     while pending and pending[0][0] <= k:
-                        _, _, topic, m = heapq.heappop(pending)
+                        _, _, topic, m = pop()
                         delivered.append((topic, m))
                     c0 = clock()
-                    command = self.controller.update(t, delivered)
+                    command = update(t, delivered)
                     c1 = clock()
                     t_controller += c1 - c0
-                    if isinstance(command, list):  # parallel tasks' partial commands
-                        for c in command:
-                            self.plant.apply(c)
-                        t_plant += clock() - c1
-                    elif command is not None:
-                        self.plant.apply(command)
-                        t_plant += clock() - c1
-                    for occ in self.controller.pop_events():
-                        stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
+                    if command is not None:
+                        if isinstance(command, list):  # parallel tasks' partial commands
+                            for c in command:
+                                apply(c)
+                        else:
+                            apply(command)
+                        c0 = clock()
+                        t_plant += c0 - c1
+                        c1 = c0
+                    occurrences = controller_events()
+                    telemetry = telemetry_of(t)
                     c0 = clock()
-                    telemetry = self.controller.telemetry(t)
-                    t_controller += clock() - c0
-                    for topic, payload in telemetry.items():
-                        for item in payload if isinstance(payload, list) else [payload]:
-                            self._write(log, topic, item, t_ns)
+                    t_controller += c0 - c1
+                    if occurrences:
+                        for occ in occurrences:
+                            stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
+                        c0 = clock()
+                    if telemetry:
+                        for topic, payload in telemetry.items():
+                            if isinstance(payload, list):
+                                for item in payload:
+                                    write(topic, item, t_ns)
+                            else:
+                                write(topic, payload, t_ns)
+                        t_log += clock() - c0
                 c0 = clock()
-                if k % self.log_div == 0:
-                    truth = self.plant.truth(t)
+                if k % log_div == 0:
+                    truth = truth_of(t)
                     c1 = clock()
                     t_plant += c1 - c0
                     for topic, payload in truth.items():
-                        self._write(log, topic, payload, t_ns)
+                        write(topic, payload, t_ns)
                     c0 = clock()
-                if self.frame_div and k % self.frame_div == 0:
-                    self._frame(scene, t_ns)
+                    t_log += c0 - c1
+                if frame_div and k % frame_div == 0:  # the 3-D topics (replay/foxglove)
+                    c1 = clock()
+                    viz.frame(scene if scene is not None else scene_of(), t_ns)
                     c0 = clock()
-                self.plant.step()
-                t_plant += clock() - c0
+                    t_log += c0 - c1
+                step()
                 k += 1
-                t1, t1_ns = k / rate, self.t_ns(k)
-                for occ in self.plant.pop_events():
-                    if occ.kind == "collision":
-                        collisions += 1
-                        occ.data = {
-                            "index": collisions,
-                            **occ.data,
-                            "planned": self.controller.intent(),
-                        }
-                    stop_at = self._event(log, occ, t1, t1_ns, result, stop_at, k)
-                if self.progress and k % max(1, rate // 20) == 0:
-                    self.progress(t1, sc.timing.duration)
+                occurrences = plant_events()
+                t_plant += clock() - c0
+                if occurrences:
+                    t1, t1_ns = k / rate, k * n_ns // rate
+                    for occ in occurrences:
+                        if occ.kind == "collision":
+                            collisions += 1
+                            c0 = clock()
+                            planned = controller.intent()
+                            t_controller += clock() - c0
+                            occ.data = {"index": collisions, **occ.data, "planned": planned}
+                        stop_at = self._event(log, occ, t1, t1_ns, result, stop_at, k)
+                if progress and k % progress_div == 0:
+                    progress(k / rate, sc.timing.duration)
             # the final state, so the log ends where the run ended
             t_end = k / rate
             for topic, payload in self.plant.truth(t_end).items():
                 self._write(log, topic, payload, self.t_ns(k))
-            if self.frame_div:
-                self._frame(None, self.t_ns(k))
+            if frame_div:
+                viz.frame(self.plant.scene(), self.t_ns(k))
             self._outcome(log, result, k, self._verdict(k / rate))
         except NonFiniteValueError as exc:
             result.stopped_by = "error"
@@ -284,6 +341,7 @@ class Runner:
             self._finish(log, result, k, wall0)
             raise RunInterrupted(result) from None
         finally:
+            self._t_log += t_log
             self.plant.close()
         self._finish(log, result, k, wall0)
         result.timings = {
@@ -328,20 +386,25 @@ class Runner:
         )
         result.wall_time = time.perf_counter() - wall0
 
-    def _frame(self, scene, t_ns: int) -> None:
-        """The 3-D viewer topics now (``scene``: this step's, if a camera already asked)."""
-        c0 = time.perf_counter()
-        assert self.viz is not None
-        self.viz.frame(scene if scene is not None else self.plant.scene(), t_ns)
-        self._t_log += time.perf_counter() - c0
+    def _emitter(self, log: LogWriter) -> Callable[[str, object, int], None]:
+        """``write(topic, payload, t_ns)``: the log's own write, and the observers' after it."""
+        if not self.observers:
+            return log.write
+        observers = self.observers
+
+        def write(topic: str, payload, t_ns: int) -> None:
+            log.write(topic, payload, t_ns)
+            for observe in observers:
+                observe(topic, payload, t_ns)
+
+        return write
 
     def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:
+        """A message outside the loop's hot path (scenario, events, outcome), timed as logging."""
         c0 = time.perf_counter()
-        log.write(topic, payload, t_ns)
+        self._emitter(log)(topic, payload, t_ns)
         if topic == TOPIC_EVENTS and self.viz is not None:
-            self.viz.event(payload, t_ns)
-        for observe in self.observers:
-            observe(topic, payload, t_ns)
+            self.viz.event(payload, t_ns)  # its /log line
         self._t_log += time.perf_counter() - c0
 
     def _event(self, log, occ, t, t_ns, result, stop_at, k):

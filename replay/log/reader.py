@@ -21,10 +21,10 @@ from mcap.reader import make_reader
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 
+from replay.log.chunks import MAGIC
 from replay.log.errors import LogError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
-MAGIC = b"\x89MCAP0\r\n"
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
 
 
@@ -41,12 +41,13 @@ class LogMessage:
 
 @dataclass(frozen=True)
 class RawMessage:
-    """A message as stored: for channels that are not JSON (Foxglove's protobuf topics)."""
+    """A message as stored, for the channels that are not JSON (Foxglove's protobuf topics,
+    the URDF's CDR string: ``replay.foxglove.schemas`` decodes them)."""
 
     topic: str
     t_ns: int
     schema: str  # the schema's name, e.g. foxglove.FrameTransforms
-    encoding: str  # the channel's message encoding, e.g. protobuf
+    encoding: str  # the channel's message encoding: protobuf, cdr
     data: bytes
 
     @property
@@ -137,8 +138,8 @@ class LogReader:
     # -- messages -------------------------------------------------------------------------
     def messages(self, topics: Iterable[str] | str | None = None) -> Iterator[LogMessage]:
         """Messages in log-time order (file order for a truncated log), optionally by topic.
-        Messages that are not JSON objects are skipped (and counted in ``problems``); channels
-        that are not JSON at all (Foxglove's protobuf topics) are left out: :meth:`raw`."""
+        Only channels of JSON messages are read (others, e.g. protobuf, are for other tools);
+        messages on them that are not JSON objects are skipped (and counted in ``problems``)."""
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
         if self._summary is not None:
             done = 0
@@ -146,7 +147,7 @@ class LogReader:
                 with open(self.path, "rb") as f:
                     for _, channel, msg in make_reader(f).iter_messages(topics=wanted):
                         if channel.message_encoding != "json":
-                            continue
+                            continue  # e.g. Foxglove's protobuf channels: not JSON payloads
                         item = self._message(channel.topic, msg.log_time, msg.data)
                         if item is not None:
                             done += 1
@@ -162,32 +163,8 @@ class LogReader:
                 skip = done
         else:
             skip = 0
-        for i, streamed in enumerate(self._stream(wanted)):
-            if i >= skip and isinstance(streamed, LogMessage):
-                yield streamed
-
-    def raw(self, topics: Iterable[str] | str | None = None) -> Iterator[RawMessage]:
-        """The messages of the channels that are not JSON (protobuf: ``replay.foxglove``
-        decodes them), undecoded, in log-time order (file order for a truncated log)."""
-        wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
-        if self._summary is not None:
-            try:
-                with open(self.path, "rb") as f:
-                    for schema, channel, msg in make_reader(f).iter_messages(topics=wanted):
-                        if channel.message_encoding != "json":
-                            yield RawMessage(
-                                channel.topic,
-                                msg.log_time,
-                                schema.name if schema is not None else "",
-                                channel.message_encoding,
-                                msg.data,
-                            )
-                return
-            except Exception as exc:  # noqa: BLE001
-                self._damage(f"the index points at bad bytes ({type(exc).__name__})")
-                return
-        for item in self._stream(wanted, raw=True):
-            if isinstance(item, RawMessage):
+        for i, item in enumerate(self._stream(wanted)):
+            if i >= skip:
                 yield item
 
     def _message(self, topic: str, t_ns: int, data: bytes) -> LogMessage | None:
@@ -200,9 +177,55 @@ class LogReader:
             return None
         return LogMessage(topic, t_ns, value)
 
-    def _stream(self, wanted, raw: bool = False) -> Iterator[LogMessage | RawMessage]:
-        channels: dict[int, tuple[str, str, int]] = {}  # id -> topic, encoding, schema id
+    def _stream(self, wanted) -> Iterator[LogMessage]:
+        channels: dict[int, str] = {}  # the JSON channels' topics
+        with open(self.path, "rb") as f:
+            records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
+            while True:
+                try:
+                    record = next(records)
+                except StopIteration:
+                    return
+                except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
+                    return
+                if isinstance(record, Channel):
+                    if record.message_encoding == "json":
+                        channels[record.id] = record.topic
+                elif isinstance(record, Message):
+                    topic = channels.get(record.channel_id)
+                    if topic is not None and (wanted is None or topic in wanted):
+                        item = self._message(topic, record.log_time, record.data)
+                        if item is not None:
+                            yield item
+
+    def raw(self, topics: Iterable[str] | str | None = None) -> Iterator[RawMessage]:
+        """The messages of the channels that are not JSON, undecoded, in log-time order (file
+        order for a truncated log), optionally by topic."""
+        wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
+        if self._summary is not None:
+            try:
+                with open(self.path, "rb") as f:
+                    for schema, channel, msg in make_reader(f).iter_messages(topics=wanted):
+                        if channel.message_encoding != "json":
+                            name = schema.name if schema is not None else ""
+                            yield RawMessage(
+                                channel.topic,
+                                msg.log_time,
+                                name,
+                                channel.message_encoding,
+                                msg.data,
+                            )
+                return
+            except Exception as exc:  # noqa: BLE001
+                self._damage(f"the index points at bad bytes ({type(exc).__name__})")
+                return
+        yield from self._stream_raw(wanted)
+
+    def _stream_raw(self, wanted) -> Iterator[RawMessage]:
         schemas: dict[int, str] = {}
+        channels: dict[
+            int, tuple[str, str, int]
+        ] = {}  # the other channels: topic, encoding, schema
         with open(self.path, "rb") as f:
             records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
             while True:
@@ -215,26 +238,22 @@ class LogReader:
                 if isinstance(record, Schema):
                     schemas[record.id] = record.name
                 elif isinstance(record, Channel):
-                    channels[record.id] = (record.topic, record.message_encoding, record.schema_id)
-                elif isinstance(record, Message):
-                    topic, encoding, schema_id = channels.get(record.channel_id, (None, "", 0))
-                    if topic is None or (wanted is not None and topic not in wanted):
-                        continue
-                    if encoding != "json":
-                        if raw:
-                            yield RawMessage(
-                                topic,
-                                record.log_time,
-                                schemas.get(schema_id, ""),
-                                encoding,
-                                record.data,
-                            )
-                        continue
-                    if raw:
-                        continue
-                    item = self._message(topic, record.log_time, record.data)
-                    if item is not None:
-                        yield item
+                    if record.message_encoding != "json":
+                        channels[record.id] = (
+                            record.topic,
+                            record.message_encoding,
+                            record.schema_id,
+                        )
+                elif isinstance(record, Message) and record.channel_id in channels:
+                    topic, encoding, schema_id = channels[record.channel_id]
+                    if wanted is None or topic in wanted:
+                        yield RawMessage(
+                            topic,
+                            record.log_time,
+                            schemas.get(schema_id, ""),
+                            encoding,
+                            record.data,
+                        )
 
     def series(self, topic: str) -> list[dict]:
         """All payloads of one topic, in order."""

@@ -46,3 +46,17 @@ def test_non_finite_values_are_refused_with_their_field(bad):
     assert err.value.fields == ["y"]
     with pytest.raises(NonFiniteValueError):
         encode("/events", Event(0.0, "x", {"deep": [1.0, {"v": bad}]}))
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_non_finite_values_beside_nulls_and_in_nested_payloads_are_refused(bad):
+    """orjson writes NaN as null: a message that holds real nulls too is still checked."""
+    inner = StickState(0.0, 1.0, 2.0, 0.0, 0.0, 0.0, bad)
+    for payload in (
+        {"t": 0.0, "none": None, "inner": inner},
+        Event(0.0, "x", {"none": None, "v": (1.0, [None, bad])}),
+    ):
+        with pytest.raises(NonFiniteValueError):
+            encode("/x", payload)
+    fine = Event(0.0, "x", {"none": None, "v": (1.0, [None, 2.0]), "s": "null"})
+    assert json.loads(encode("/x", fine))["data"]["none"] is None
