@@ -208,7 +208,7 @@ class Runner:
         # sensors' order and latencies: a heap; with one latency for all, readings are made in
         # delivery order, so a FIFO (half the cost of a heap's push and pop) is that order
         pending: Any
-        if len({latency for *_, latency in sensors}) <= 1:
+        if len({latency for _, _, _, latency, _ in sensors}) <= 1:
             pending = collections.deque()
             push, pop = pending.append, pending.popleft
         else:
