@@ -9,20 +9,28 @@ from __future__ import annotations
 
 import numpy as np
 
-from replay.robot.hand2d import HandSpec, finger_tip
+from replay.robot.hand2d import HandSpec, finger_tip_xy
 
 
-def _toward(current: np.ndarray, target: np.ndarray, max_delta: float) -> np.ndarray:
-    """Move each entry toward its target by at most ``max_delta``; land exactly when in reach."""
-    diff = target - current
-    out = current + np.clip(diff, -max_delta, max_delta)
-    reached = np.abs(diff) <= max_delta
-    out[reached] = target[reached]
-    return out
+def _toward(current: list, target: list, max_delta: float) -> bool:
+    """Move each entry of ``current`` (in place) toward its target by at most ``max_delta``;
+    land exactly when in reach. True when every entry is on its target."""
+    done = True
+    for i, (c, g) in enumerate(zip(current, target)):
+        d = g - c
+        if abs(d) <= max_delta:
+            current[i] = g
+        else:
+            current[i] = c + max_delta if d > 0.0 else c - max_delta
+            done = False
+    return done
 
 
 class HandServo:
-    """Base position and joint angles of the two fingers, and their (clamped) targets."""
+    """Base position and joint angles of the two fingers, and their (clamped) targets.
+
+    The state is kept as Python floats (one step is six scalar moves); ``base``, ``joints``,
+    ``base_target`` and ``joint_targets`` give it as arrays."""
 
     def __init__(self, spec: HandSpec, base, joints) -> None:
         self.spec = spec
@@ -32,12 +40,32 @@ class HandServo:
         self._q_hi = np.array([spec.joint_limits[0][1], spec.joint_limits[1][1]])
         base = np.asarray(base, dtype=float)
         joints = np.asarray(joints, dtype=float).reshape(2, 2)
-        self.base, _ = self.clamp_base(base)
-        self.joints, _ = self.clamp_joints(joints)
-        self.base_target = self.base.copy()
-        self.joint_targets = self.joints.copy()
+        self._b = self.clamp_base(base)[0].tolist()  # [x, y]
+        self._q = self.clamp_joints(joints)[0].ravel().tolist()  # [q1, q2, q1, q2]
+        self._b_target, self._q_target = list(self._b), list(self._q)
         self._settled = True  # at the targets: advance() has nothing to do
-        self._tips: np.ndarray | None = None  # tips() of the current base and joints, once computed
+        self._tips: tuple | None = None  # tip_list() of the current base and joints, once computed
+
+    @property
+    def base(self) -> np.ndarray:
+        return np.array(self._b)
+
+    @property
+    def joints(self) -> np.ndarray:
+        return np.array(self._q).reshape(2, 2)
+
+    @property
+    def base_target(self) -> np.ndarray:
+        return np.array(self._b_target)
+
+    @property
+    def joint_targets(self) -> np.ndarray:
+        return np.array(self._q_target).reshape(2, 2)
+
+    def state_lists(self) -> tuple[list, list, list, list]:
+        """(base, joints, base_target, joint_targets) as nested lists (for the state log)."""
+        q, qt = self._q, self._q_target
+        return list(self._b), [q[0:2], q[2:4]], list(self._b_target), [qt[0:2], qt[2:4]]
 
     def clamp_base(self, base: np.ndarray) -> tuple[np.ndarray, bool]:
         c = np.clip(base, self._base_lo, self._base_hi)
@@ -53,8 +81,8 @@ class HandServo:
         joints = np.asarray(joints, dtype=float).reshape(2, 2)
         base_c, base_clamped = self.clamp_base(base)
         joints_c, joints_clamped = self.clamp_joints(joints)
-        self.base_target = base_c
-        self.joint_targets = joints_c
+        self._b_target = base_c.tolist()
+        self._q_target = joints_c.ravel().tolist()
         self._settled = False
         if not (base_clamped or joints_clamped):
             return None
@@ -71,18 +99,23 @@ class HandServo:
         """One step toward the targets at the speed limits (nothing to do once on them)."""
         if self._settled:
             return
-        self.base = _toward(self.base, self.base_target, self.spec.base_speed * dt)
-        self.joints = _toward(self.joints, self.joint_targets, self.spec.joint_speed * dt)
+        at_b = _toward(self._b, self._b_target, self.spec.base_speed * dt)
+        at_q = _toward(self._q, self._q_target, self.spec.joint_speed * dt)
         self._tips = None
-        self._settled = np.array_equal(self.base, self.base_target) and np.array_equal(
-            self.joints, self.joint_targets
-        )
+        self._settled = at_b and at_q
+
+    def tip_list(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Fingertip centres ((x, y), (x, y)) (world, m) for the current base and joints (cached
+        until the hand moves)."""
+        tips = self._tips
+        if tips is None:
+            b, q = self._b, self._q
+            tips = self._tips = (
+                finger_tip_xy(self.spec, b, 0, q[0:2]),
+                finger_tip_xy(self.spec, b, 1, q[2:4]),
+            )
+        return tips
 
     def tips(self) -> np.ndarray:
         """Fingertip centres (2 x 2, world, m) for the current base and joints (a copy)."""
-        tips = self._tips
-        if tips is None:
-            tips = self._tips = np.array(
-                [finger_tip(self.spec, self.base, k, self.joints[k]) for k in (0, 1)]
-            )
-        return tips.copy()
+        return np.array(self.tip_list())

@@ -41,7 +41,7 @@ from replay.messages import (
 from replay.scene import Box, Cylinder, Scene
 from replay.spatial import yaw_quaternion
 
-from plants.airtable import settings
+from plants.airtable import body_state, settings
 from plants.airtable.hand import HandServo
 from plants.airtable.params import Params
 
@@ -125,13 +125,17 @@ class AirTablePlant(Plant):
         self._steps = 0
         self._events: list[Occurrence] = []
         self._pending: list[dict] = []
-        self._before: tuple = ([0.0, 0.0], 0.0)
         self._last_command: tuple | None = None
+        self._last_object: HandCommand | None = None
         self._rest_since: float | None = None
         self._rest_reported = False
         self._nan_reported = False
         self._collisions = 0
         self._held_since: float | None = None  # the stick held between the tips since
+        self._read_stick = body_state.pose_reader(self.stick_body)
+        self._read_tips = [body_state.position_reader(tb) for tb in self.tip_bodies]
+        self._set_tip_v = [body_state.velocity_setter(tb) for tb in self.tip_bodies]
+        self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
 
     # -- Plant interface ------------------------------------------------------------------
@@ -142,6 +146,9 @@ class AirTablePlant(Plant):
         return self._steps * self.dt
 
     def apply(self, command: HandCommand) -> None:
+        if command is self._last_object:
+            return  # the same (frozen) command object again
+        self._last_object = command
         key = (tuple(map(float, command.base)), tuple(tuple(map(float, q)) for q in command.joints))
         if key == self._last_command:
             return  # the same target again: nothing new to clamp or report
@@ -154,24 +161,26 @@ class AirTablePlant(Plant):
         dt = self.dt
         # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
         self.hand.advance(dt)
-        for tb, tip in zip(self.tip_bodies, self.hand.tips().tolist()):
-            x, y = tb.position
-            tb.velocity = ((tip[0] - x) / dt, (tip[1] - y) / dt)
-        b = self.stick_body
-        vx, vy = b.velocity
-        self._before = ([vx, vy], b.angular_velocity)
-        self._pending = []
-        self.space.step(dt)
+        for put, (tx, ty), (x, y) in zip(self._set_tip_v, self.hand.tip_list(), self._tip_pos):
+            put((tx - x) / dt, (ty - y) / dt)
+        self.space.step(dt)  # (a collision's velocity before is read in _on_begin)
         self._steps += 1
+        self._read_state()
         if self._pending:
-            v_after, w_after = _vec(b.velocity), float(b.angular_velocity)
+            _, (vx, vy), _, w_after = self._state
             for c in self._pending:
-                c["v_after"], c["omega_after"] = v_after, w_after
+                c["v_after"], c["omega_after"] = [vx, vy], w_after
                 self._events.append(Occurrence("collision", c))
             self._collisions += len(self._pending)
             self._pending = []
         self._check_state()
         self._check_held()
+
+    def _read_state(self) -> None:
+        """The stick's and the tips' state, read from Pymunk once a step (after it)."""
+        x, y, vx, vy, angle, omega = self._read_stick()
+        self._state = ((x, y), (vx, vy), angle, omega)
+        self._tip_pos = [read() for read in self._read_tips]
 
     def _on_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         """A fingertip started touching the stick (called after position integration, before
@@ -195,7 +204,10 @@ class AirTablePlant(Plant):
         c, s = math.cos(theta), math.sin(theta)
         d = contact - np.array(b.position, dtype=float)
         r_x, r_y = c * d[0] + s * d[1], -s * d[0] + c * d[1]  # R_B(theta)^T d
-        v_before, w_before = self._before
+        # before the velocity solve (and Chipmunk's velocity integration, which with no gravity,
+        # damping 1 and no forces changes nothing): the velocity the stick came in with
+        vx, vy = b.velocity
+        v_before, w_before = [vx, vy], b.angular_velocity
         self._pending.append(
             {
                 "finger": finger,
@@ -212,20 +224,18 @@ class AirTablePlant(Plant):
         )
 
     def _check_state(self) -> None:
-        b = self.stick_body
-        (x, y), (vx, vy), angle, omega = b.position, b.velocity, b.angle, b.angular_velocity
-        tips = [tb.position for tb in self.tip_bodies]
-        if not all(
-            map(math.isfinite, (x, y, angle, vx, vy, omega, *(c for tip in tips for c in tip)))
-        ):
+        (x, y), (vx, vy), angle, omega = self._state
+        (t0x, t0y), (t1x, t1y) = self._tip_pos
+        if not math.isfinite(x + y + angle + vx + vy + omega + t0x + t0y + t1x + t1y):
             values = {"x": x, "y": y, "theta": angle, "vx": vx, "vy": vy, "omega": omega}
-            for k, (tx, ty) in enumerate(tips):
+            for k, (tx, ty) in enumerate(self._tip_pos):
                 values[f"tip{k}_x"], values[f"tip{k}_y"] = tx, ty
             bad = sorted(k for k, v in values.items() if not math.isfinite(v))
-            if not self._nan_reported:
-                self._nan_reported = True
-                self._events.append(Occurrence("nan", {"fields": bad, "step": self._steps}))
-            return
+            if bad:  # (else a finite sum overflowed)
+                if not self._nan_reported:
+                    self._nan_reported = True
+                    self._events.append(Occurrence("nan", {"fields": bad, "step": self._steps}))
+                return
         t = self.time
         slow = math.hypot(vx, vy) < self.params.rest_speed and abs(omega) < self.params.rest_omega
         if not slow:
@@ -253,24 +263,22 @@ class AirTablePlant(Plant):
     def _in_reach(self) -> bool:
         """The stick's centre within finger reach (l1 + l2, joint limits ignored) plus L/2 of a
         finger root anywhere on the slider's range: a loose, purely geometric bound."""
-        h, b = self._hand_spec, self.stick_body
+        h = self._hand_spec
         reach = sum(h.link_lengths) + h.tip_radius + 0.5 * self.params.stick.length
-        return root_distance(h, (b.position.x, b.position.y)) <= reach
+        return root_distance(h, self._state[0]) <= reach
 
     def _held(self) -> bool:
         """Slow (``hold_speed``, ``hold_omega``) with a fingertip at each face: between the
         stick's ends and within W/2 + tip_radius + ``hold_gap`` of its axis, on opposite sides."""
-        p, b = self.params, self.stick_body
-        if (
-            math.hypot(b.velocity.x, b.velocity.y) >= p.hold_speed
-            or abs(b.angular_velocity) >= p.hold_omega
-        ):
+        p = self.params
+        (x, y), (vx, vy), angle, omega = self._state
+        if math.hypot(vx, vy) >= p.hold_speed or abs(omega) >= p.hold_omega:
             return False
-        c, s = math.cos(b.angle), math.sin(b.angle)
+        c, s = math.cos(angle), math.sin(angle)
         reach_y = 0.5 * p.stick.collision_width + p.hand.tip_radius + p.hold_gap
         sides = []
-        for tb in self.tip_bodies:
-            dx, dy = tb.position.x - b.position.x, tb.position.y - b.position.y
+        for tx, ty in self._tip_pos:
+            dx, dy = tx - x, ty - y
             xb, yb = c * dx + s * dy, -s * dx + c * dy
             if abs(xb) > 0.5 * p.stick.length or abs(yb) > reach_y:
                 return False
@@ -329,28 +337,23 @@ class AirTablePlant(Plant):
         return out
 
     def truth(self, t: float) -> dict[str, Any]:
-        b = self.stick_body
-        (x, y), (vx, vy) = b.position, b.velocity
+        (x, y), (vx, vy), angle, omega = self._state
+        base, joints, base_target, joint_targets = self.hand.state_lists()
         return {
-            TOPIC_STICK_STATE: StickState(
-                t=t, x=x, y=y, theta=b.angle, vx=vx, vy=vy, omega=b.angular_velocity
-            ),
-            TOPIC_FINGERS_STATE: FingersState(
-                t=t, tips=[_vec(tb.position) for tb in self.tip_bodies]
-            ),
+            TOPIC_STICK_STATE: StickState(t=t, x=x, y=y, theta=angle, vx=vx, vy=vy, omega=omega),
+            TOPIC_FINGERS_STATE: FingersState(t=t, tips=[[tx, ty] for tx, ty in self._tip_pos]),
             TOPIC_HAND_STATE: {
                 "t": t,
-                "base": self.hand.base.tolist(),
-                "joints": self.hand.joints.tolist(),
-                "base_target": self.hand.base_target.tolist(),
-                "joint_targets": self.hand.joint_targets.tolist(),
+                "base": base,
+                "joints": joints,
+                "base_target": base_target,
+                "joint_targets": joint_targets,
             },
         }
 
     def scene(self) -> Scene:
         st = self.params.stick
-        b = self.stick_body
-        x, y, th = b.position.x, b.position.y, b.angle
+        (x, y), _, th, _ = self._state
         q = yaw_quaternion(th)
         marker_h = 0.0005
         prims: list = [
@@ -370,11 +373,11 @@ class AirTablePlant(Plant):
             ),
         ]
         h = self.params.hand
-        for k, tb in enumerate(self.tip_bodies):
+        for k, (tx, ty) in enumerate(self._tip_pos):
             prims.append(
                 Cylinder(
                     f"tip{k}",
-                    (tb.position.x, tb.position.y, h.tip_height / 2.0),
+                    (tx, ty, h.tip_height / 2.0),
                     (0.0, 0.0, 0.0, 1.0),
                     h.tip_radius,
                     h.tip_height,

@@ -26,8 +26,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.spatial import quaternion_matrix
-
 
 @dataclass
 class PalmSample:
@@ -36,7 +34,7 @@ class PalmSample:
     height: float  # m: object centre above the palm face (palm z)
     rel_speed: float  # m/s: object velocity relative to the palm point under it
     approach_angle: float  # deg: relative velocity vs the palm's inward normal (-z)
-    world_offset: np.ndarray  # object centre - palm face centre (world, m)
+    world_offset: tuple  # object centre - palm face centre (world, m)
 
 
 class CatchWatch:
@@ -49,6 +47,7 @@ class CatchWatch:
         self.closest: PalmSample | None = None
         self.catch_time: float | None = None
         self.approaching = True
+        self._closest_d2 = math.inf  # |world_offset|^2 of ``closest``
 
     def observe(
         self,
@@ -62,21 +61,37 @@ class CatchWatch:
         parts: list,
         caught: bool,
     ) -> None:
-        """One step: the object's and the palm's state (world) and the parts touching now."""
-        R = quaternion_matrix(palm_quat)
-        centre = np.asarray(palm_pos, float) + R[:, 2] * self.palm_thickness
-        d = np.asarray(obj_pos, float) - centre
-        local = R.T @ d
-        v_point = np.asarray(palm_vel, float) + np.cross(palm_omega, np.asarray(obj_pos) - palm_pos)
-        rel = np.asarray(obj_vel, float) - v_point
-        speed = float(np.linalg.norm(rel))
-        inward = -(R.T @ rel)[2]  # towards the palm face, along its normal
-        angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
-        sample = PalmSample(
-            t, float(math.hypot(local[0], local[1])), float(local[2]), speed, angle, d
+        """One step: the object's and the palm's state (world) and the parts touching now.
+        Written in floats (3-vectors as tuples): it runs at every physics step."""
+        qx, qy, qz, qw = palm_quat  # the palm frame's z axis and in-plane axes (world)
+        n = qx * qx + qy * qy + qz * qz + qw * qw
+        k = 2.0 / n  # (quaternion_matrix's columns, normalised there too)
+        X = (1 - k * (qy * qy + qz * qz), k * (qx * qy + qz * qw), k * (qx * qz - qy * qw))
+        Y = (k * (qx * qy - qz * qw), 1 - k * (qx * qx + qz * qz), k * (qy * qz + qx * qw))
+        Z = (k * (qx * qz + qy * qw), k * (qy * qz - qx * qw), 1 - k * (qx * qx + qy * qy))
+        ox, oy, oz = obj_pos
+        px, py, pz = palm_pos
+        th = self.palm_thickness
+        d = (ox - px - Z[0] * th, oy - py - Z[1] * th, oz - pz - Z[2] * th)
+        lx = X[0] * d[0] + X[1] * d[1] + X[2] * d[2]
+        ly = Y[0] * d[0] + Y[1] * d[1] + Y[2] * d[2]
+        lz = Z[0] * d[0] + Z[1] * d[1] + Z[2] * d[2]
+        wx, wy, wz = palm_omega
+        ax, ay, az = ox - px, oy - py, oz - pz
+        vx, vy, vz = palm_vel
+        ux, uy, uz = obj_vel
+        rel = (
+            ux - vx - (wy * az - wz * ay),
+            uy - vy - (wz * ax - wx * az),
+            uz - vz - (wx * ay - wy * ax),
         )
-        if self.closest is None or np.linalg.norm(d) < np.linalg.norm(self.closest.world_offset):
-            self.closest = sample
+        speed = math.sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2])
+        inward = -(Z[0] * rel[0] + Z[1] * rel[1] + Z[2] * rel[2])  # towards the palm face
+        angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
+        dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+        sample = PalmSample(t, math.hypot(lx, ly), lz, speed, angle, tuple(float(x) for x in d))
+        if self.closest is None or dist2 < self._closest_d2:
+            self.closest, self._closest_d2 = sample, dist2
         self.approaching = self.closest is sample  # still closing in at the last step
         if parts and self.first_contact is None:
             before = self.last or sample

@@ -70,6 +70,7 @@ class BulletArmPlant(Plant):
         self.urdf_path = self.model.write()
         self.joint_names = names
         self.lower, self.upper = S.lower, S.upper
+        self._lower_in, self._upper_in = self.lower + 1e-3, self.upper - 1e-3  # "at the limit"
 
         # ---- the world
         with quiet_c_output():  # connect prints "argv[0]="
@@ -131,6 +132,22 @@ class BulletArmPlant(Plant):
         for j, v in zip(self._hand_j, h0):
             bc.resetJointState(self.robot, j, float(v), 0.0)
         self._hand_target = h0.copy()
+        # one getJointStates a step for the arm and the hand; q of the locked joints preset
+        self._read_j = self._arm_j + self._hand_j
+        self._act_idx = np.array(self.active, dtype=int)
+        self._q_locked = np.zeros(dof)
+        for n, v in self.locked.items():
+            self._q_locked[names.index(n)] = v
+        self._locked_idx = np.array([names.index(n) for n in self.locked], dtype=int)
+        # BulletClient makes a new functools.partial on every attribute access: bind the calls
+        # made every step once (stepSimulation stays an attribute: the bench times it there)
+        self._get_joint_states = bc.getJointStates
+        self._get_base_pose = bc.getBasePositionAndOrientation
+        self._get_base_velocity = bc.getBaseVelocity
+        self._get_link_state = bc.getLinkState
+        self._get_link_states = bc.getLinkStates
+        self._get_contact_points = bc.getContactPoints
+        self._set_motors = bc.setJointMotorControlArray
         if ht is not None:
             self._hand_lo = np.array([j.lower for j in ht.joints])
             self._hand_hi = np.array([j.upper for j in ht.joints])
@@ -179,8 +196,13 @@ class BulletArmPlant(Plant):
         self._ever_caught = False
         self._fallen = False
         self.diverged = False
-        self._vel_over = np.zeros(dof, dtype=bool)
-        self._at_limit = np.zeros(dof, dtype=bool)
+        self._vel_over = [False] * dof  # per joint: over its speed limit / at a joint limit
+        self._at_limit = [False] * dof
+        self._vlim_l = self.velocity_limits.tolist()
+        self._tlim_l = self.torque_limits.tolist()
+        self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
+        self._locked_l = [n in self.locked for n in self.joint_names]
+        self._contact_summary = (None, [], [], 0.0)  # (contacts list it is of, parts, links, N)
         self._torque_episode = np.zeros(dof, dtype=bool)
         self._obj_vel_before = (
             np.asarray(P.object_velocity, float) if self.obj is not None else np.zeros(3)
@@ -188,6 +210,7 @@ class BulletArmPlant(Plant):
         self._contacts: list = []
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
         self._cache = None
+        self._effector = None  # (step, the tool link's state): read at most once a step
         self._spec = self._make_spec(q0)
         ht = self.hand_table  # the catch verdict (outcome.py): a free object and a hand
         self._watch = (
@@ -260,28 +283,28 @@ class BulletArmPlant(Plant):
     # ------------------------------------------------------------------ state
     def _state(self) -> tuple:
         """((q, qd), hand (q, qd, effort), object (pos, orn, v, w) or None), read from PyBullet
-        once after each step and kept until the next one (``invalidate_state`` after changing
-        the simulation other than by stepping it)."""
+        once after each step (one getJointStates for arm and hand) and kept until the next one
+        (``invalidate_state`` after changing the simulation other than by stepping it)."""
         if self._cache is None:
-            q = np.zeros(self.dof)
+            st = self._get_joint_states(self.robot, self._read_j)
+            na = len(self._arm_j)
+            q = self._q_locked.copy()
             qd = np.zeros(self.dof)
-            for n, v in self.locked.items():
-                q[self.joint_names.index(n)] = v
-            for k, st in enumerate(self.bc.getJointStates(self.robot, self._arm_j)):
-                q[self.active[k]], qd[self.active[k]] = st[0], st[1]
-            if self._hand_j:
-                st = self.bc.getJointStates(self.robot, self._hand_j)
+            q[self._act_idx] = [s[0] for s in st[:na]]
+            qd[self._act_idx] = [s[1] for s in st[:na]]
+            if na < len(st):
+                hs = st[na:]
                 hand = (
-                    np.array([s[0] for s in st]),
-                    np.array([s[1] for s in st]),
-                    np.array([s[3] for s in st]),
+                    np.array([s[0] for s in hs]),
+                    np.array([s[1] for s in hs]),
+                    np.array([s[3] for s in hs]),
                 )
             else:
                 hand = (np.zeros(0), np.zeros(0), np.zeros(0))
             obj = None
             if self.obj is not None:
-                pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
-                v, w = self.bc.getBaseVelocity(self.obj)
+                pos, orn = self._get_base_pose(self.obj)
+                v, w = self._get_base_velocity(self.obj)
                 obj = (np.array(pos), np.array(orn), np.array(v), np.array(w))
             self._cache = ((q, qd), hand, obj)
         return self._cache
@@ -289,6 +312,7 @@ class BulletArmPlant(Plant):
     def invalidate_state(self) -> None:
         """Forget the state read from PyBullet (after a reset* call: the next read is fresh)."""
         self._cache = None
+        self._effector = None
 
     def arm_state(self) -> tuple[np.ndarray, np.ndarray]:
         """(q, qd) of every arm joint (locked ones at their lock value, zero speed)."""
@@ -302,11 +326,30 @@ class BulletArmPlant(Plant):
         return tuple(a.copy() for a in self._state()[2])
 
     def effector_state(self):
-        """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity."""
-        ls = self.bc.getLinkState(
-            self.robot, self._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
-        )
-        return np.array(ls[4]), np.array(ls[5]), np.array(ls[6]), np.array(ls[7])
+        """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity (read
+        once a step, like the joint state)."""
+        return tuple(np.array(x) for x in self._effector_now())
+
+    def _effector_now(self) -> tuple:
+        """effector_state as PyBullet's tuples, read once a step."""
+        return self._frames_now()[0]
+
+    def _frames_now(self) -> tuple:
+        """(tool (pos, orn, v, w), palm link state or None): one getLinkStates a step for the
+        tool frame and the palm (the catch check's point velocity)."""
+        if self._effector is None or self._effector[0] != self._steps:
+            links = (
+                [self._tool_link] if self._palm_link is None else [self._tool_link, self._palm_link]
+            )
+            st = self._get_link_states(
+                self.robot, links, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+            ls = st[0]
+            self._effector = (
+                self._steps,
+                ((ls[4], ls[5], ls[6], ls[7]), st[1] if len(st) > 1 else None),
+            )
+        return self._effector[1]
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ArmCommand) -> None:
@@ -321,53 +364,60 @@ class BulletArmPlant(Plant):
             self._hand_target = np.clip(h, self._hand_lo, self._hand_hi)
 
     def _limit_torque(self, qd: np.ndarray) -> None:
-        finite = np.isfinite(self._tau_cmd)
-        tau = np.where(finite, self._tau_cmd, 0.0)  # a non-finite command gives no torque
-        lim = self.torque_limits
-        applied = np.clip(tau, -lim, lim)
-        clamped = (applied != tau) | ~finite
-        if self.params.enforce_velocity_limits:
-            over = (np.abs(qd) >= self.velocity_limits) & (np.sign(applied) == np.sign(qd))
-            over &= applied != 0.0
-            applied = np.where(over, 0.0, applied)
-            clamped |= over
-        for n in self.locked:
-            i = self.joint_names.index(n)
-            applied[i] = 0.0
-            clamped[i] = False
-        for i in np.flatnonzero(clamped & ~self._torque_episode):
-            self._events.append(
-                Occurrence(
-                    "torque_limit",
-                    {
-                        "joint": self.joint_names[i],
-                        "commanded": float(tau[i]) if finite[i] else None,
-                        "applied": float(applied[i]),
-                        "limit": float(lim[i]),
-                    },
-                )
-            )
-        self._torque_episode = clamped
-        self.clamp_count += int(clamped.sum())
-        self._tau_applied, self._clamped = applied, clamped
+        """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
+        locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
+        its speed limit further. Per joint in plain Python (4-7 floats)."""
+        enforce = self.params.enforce_velocity_limits
+        cmd = self._tau_cmd.tolist()
+        qdl = qd.tolist()
+        applied, clamped = [0.0] * self.dof, [False] * self.dof
+        sign = lambda x: (x > 0.0) - (x < 0.0)  # noqa: E731  (np.sign)
+        for i, (x, lim) in enumerate(zip(cmd, self._tlim_l)):
+            if self._locked_l[i]:
+                continue
+            if not math.isfinite(x):
+                clamped[i] = True  # a non-finite command gives no torque
+                continue
+            a = min(max(x, -lim), lim)
+            c = a != x
+            if enforce and abs(qdl[i]) >= self._vlim_l[i] and sign(a) == sign(qdl[i]) and a != 0:
+                a, c = 0.0, True
+            applied[i], clamped[i] = a, c
+        if any(clamped):
+            for i, c in enumerate(clamped):
+                if c and not self._torque_episode[i]:
+                    x = cmd[i]
+                    self._events.append(
+                        Occurrence(
+                            "torque_limit",
+                            {
+                                "joint": self.joint_names[i],
+                                "commanded": x if math.isfinite(x) else None,
+                                "applied": applied[i],
+                                "limit": self._tlim_l[i],
+                            },
+                        )
+                    )
+            self.clamp_count += sum(clamped)
+        self._tau_applied = np.array(applied)
+        self._clamped = self._torque_episode = np.array(clamped, dtype=bool)
 
     def step(self) -> None:
         bc = self.bc
-        q, qd = self.arm_state()
-        self._limit_torque(qd)
-        bc.setJointMotorControlArray(
+        self._limit_torque(self._state()[0][1])
+        self._set_motors(
             self.robot,
             self._arm_j,
             p.TORQUE_CONTROL,
-            forces=[float(self._tau_applied[i]) for i in self.active],
+            forces=self._tau_applied[self._act_idx].tolist(),
         )
         if self._hand_j:
-            hq, _, _ = self.hand_state()
+            hq = self._state()[1][0]
             speed = self.params.hand_closing_speed
             # rate-limited position servo: reach the target at most at the closing speed, the
             # last step landing on it (PyBullet's velocity motor is implicit, so this is stable)
-            v = np.clip((self._hand_target - hq) / self.dt, -speed, speed)
-            bc.setJointMotorControlArray(
+            v = np.minimum(np.maximum((self._hand_target - hq) / self.dt, -speed), speed)
+            self._set_motors(
                 self.robot,
                 self._hand_j,
                 p.VELOCITY_CONTROL,
@@ -375,7 +425,7 @@ class BulletArmPlant(Plant):
                 forces=[self.params.hand_max_torque] * len(v),
             )
         if self.obj is not None:
-            pos, _, v, _ = self.object_state()
+            pos, _, v, _ = self._state()[2]
             J = self._impulses.pop(self._steps) if self._impulses else None
             if J is not None:  # a scenario-set kick (impulse.py)
                 v = v + J / self.params.object_mass
@@ -402,64 +452,70 @@ class BulletArmPlant(Plant):
     # ------------------------------------------------------------------ events
     def _robot_contacts(self):
         """Contact points object-robot that touch (normal force > 0 or no gap)."""
-        pts = self.bc.getContactPoints(bodyA=self.obj, bodyB=self.robot)
+        pts = self._get_contact_points(bodyA=self.obj, bodyB=self.robot)
         return [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
 
     def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
         if link < 0:
             return np.zeros(3)
-        ls = self.bc.getLinkState(
-            self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
-        )
-        return np.array(ls[6]) + np.cross(np.array(ls[7]), point - np.array(ls[0]))
+        ls = self._frames_now()[1] if link == self._palm_link else None
+        if ls is None:
+            ls = self._get_link_state(
+                self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+        (vx, vy, vz), (wx, wy, wz), (cx, cy, cz) = ls[6], ls[7], ls[0]
+        rx, ry, rz = (float(x) for x in point)
+        rx, ry, rz = rx - cx, ry - cy, rz - cz  # v + w x (point - link COM)
+        return np.array([vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx])
 
     def _check_events(self) -> None:
         P = self.params
         q, qd = self.arm_state()
-        finite = bool(np.all(np.isfinite(q)) and np.all(np.isfinite(qd)))
+        ql, qdl = q.tolist(), qd.tolist()  # per-joint checks on 4-7 floats: plain Python
+        isfinite = math.isfinite
+        finite = all(map(isfinite, ql)) and all(map(isfinite, qdl))
         if self.obj is not None:
             pos, orn, v, w = self.object_state()
-            finite = finite and bool(np.all(np.isfinite(pos)) and np.all(np.isfinite(v)))
+            finite = finite and all(map(isfinite, pos.tolist())) and all(map(isfinite, v.tolist()))
         if not finite:
             if not self.diverged:
                 self.diverged = True
                 self._events.append(Occurrence("nan", {"step": self._steps}))
             return
-        over = np.abs(qd) > self.velocity_limits
-        for i in np.flatnonzero(over & ~self._vel_over):
-            self._events.append(
-                Occurrence(
-                    "velocity_limit",
-                    {
-                        "joint": self.joint_names[i],
-                        "velocity": float(qd[i]),
-                        "limit": float(self.velocity_limits[i]),
-                    },
+        over = [abs(x) > lim for x, lim in zip(qdl, self._vlim_l)]
+        for i in range(self.dof) if over != self._vel_over else ():
+            if over[i] and not self._vel_over[i]:
+                self._events.append(
+                    Occurrence(
+                        "velocity_limit",
+                        {
+                            "joint": self.joint_names[i],
+                            "velocity": qdl[i],
+                            "limit": self._vlim_l[i],
+                        },
+                    )
                 )
-            )
         self._vel_over = over
-        at = (q <= self.lower + 1e-3) | (q >= self.upper - 1e-3)
-        for i in np.flatnonzero(at & ~self._at_limit):
-            if self.joint_names[i] in self.locked:
-                continue
-            self._events.append(
-                Occurrence(
-                    "joint_limit",
-                    {
-                        "joint": self.joint_names[i],
-                        "position": float(q[i]),
-                        "lower": float(self.lower[i]),
-                        "upper": float(self.upper[i]),
-                    },
+        at = [x <= lo or x >= hi for x, lo, hi in zip(ql, self._lower_l, self._upper_l)]
+        for i in range(self.dof) if at != self._at_limit else ():
+            if at[i] and not self._at_limit[i] and not self._locked_l[i]:
+                self._events.append(
+                    Occurrence(
+                        "joint_limit",
+                        {
+                            "joint": self.joint_names[i],
+                            "position": ql[i],
+                            "lower": float(self.lower[i]),
+                            "upper": float(self.upper[i]),
+                        },
+                    )
                 )
-            )
         self._at_limit = at
         if self.obj is None:
             return
         contacts = self._robot_contacts()
         self._contacts = contacts
-        links = sorted({self._link_name[c[4]] for c in contacts})
-        parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
+        _, parts, links, _ = self._contact_summary_now()
         if contacts and not self._in_contact:
             c = max(contacts, key=lambda c: c[9])
             point = np.array(c[6])
@@ -485,7 +541,7 @@ class BulletArmPlant(Plant):
         held = False
         if self._palm_link is not None and len(hand_parts) >= P.catch_min_parts:
             rel = v - self._link_point_velocity(self._palm_link, pos)
-            held = float(np.linalg.norm(rel)) < P.catch_relative_speed
+            held = math.sqrt(float(rel @ rel)) < P.catch_relative_speed
         if held:
             self._hold += self.dt
             self._unhold = 0.0
@@ -516,8 +572,10 @@ class BulletArmPlant(Plant):
                 Occurrence(kind, {"position": pos.tolist(), "velocity": v.tolist()})
             )
         if self._watch is not None:
-            pe, oe, ve, we = self.effector_state()
-            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
+            pe, oe, ve, we = self._effector_now()  # floats: faster than arrays here
+            self._watch.observe(
+                self._t, pos.tolist(), v.tolist(), pe, oe, ve, we, parts, self.caught
+            )
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
@@ -541,7 +599,7 @@ class BulletArmPlant(Plant):
                 list(self.joint_names),
                 [float(x) if math.isfinite(x) else None for x in self._tau_cmd.tolist()],
                 self._tau_applied.tolist(),
-                [bool(c) for c in self._clamped],
+                [bool(c) for c in self._clamped.tolist()],
             ),
         }
         if self._hand_j:
@@ -552,20 +610,15 @@ class BulletArmPlant(Plant):
         # the tool frame's motion; /effector/state (actual and desired point) is the controller's
         pe, oe, ve, we = self.effector_state()
         out[TOPIC_EFFECTOR_MOTION] = EffectorMotion(
-            t, pe.tolist(), oe.tolist(), ve.tolist(), we.tolist(), float(np.linalg.norm(ve))
+            t, pe.tolist(), oe.tolist(), ve.tolist(), we.tolist(), math.sqrt(float(ve @ ve))
         )
         if self.obj is not None:
             pos, orn, v, w = self.object_state()
             out[TOPIC_OBJECT_STATE] = ObjectState(
                 t, pos.tolist(), orn.tolist(), v.tolist(), w.tolist()
             )
-            links = sorted({self._link_name[c[4]] for c in self._contacts})
-            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(
-                t,
-                sorted({self.model.part_of_link.get(l, "arm") for l in links}),
-                links,
-                float(sum(c[9] for c in self._contacts)),
-            )
+            _, parts, links, force = self._contact_summary_now()
+            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(t, parts, links, force)
         return out
 
     def robot_description(self) -> str:
@@ -597,6 +650,16 @@ class BulletArmPlant(Plant):
             qd.tolist() + hqd.tolist(),
             self._tau_applied.tolist() + heff.tolist(),
         )
+
+    def _contact_summary_now(self):
+        """(contacts, parts, links, total normal force) of ``_contacts``, summed once per list."""
+        if self._contact_summary[0] is not self._contacts:
+            links = sorted({self._link_name[c[4]] for c in self._contacts})
+            parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
+            force = float(sum(c[9] for c in self._contacts))
+            self._contact_summary = (self._contacts, parts, links, force)
+        _, parts, links, force = self._contact_summary
+        return self._contact_summary[0], list(parts), list(links), force
 
     def scene(self) -> Scene:
         prims = []

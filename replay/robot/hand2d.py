@@ -55,18 +55,27 @@ class HandCommand:
     joints: tuple[tuple[float, float], tuple[float, float]]  # rad, (q1, q2) per finger
 
 
-def finger_chain(base, root_offset, link_lengths, q) -> np.ndarray:
-    """Root, elbow and tip centre (3 x 2, world, m) of a finger with joints ``q = (q1, q2)``."""
+def _chain(base, root_offset, link_lengths, q) -> tuple[tuple[float, float], ...]:
     l1, l2 = link_lengths
     root = (base[0] + root_offset[0], base[1] + root_offset[1])
     elbow = (root[0] + l1 * math.cos(q[0]), root[1] + l1 * math.sin(q[0]))
     tip = (elbow[0] + l2 * math.cos(q[0] + q[1]), elbow[1] + l2 * math.sin(q[0] + q[1]))
-    return np.array([root, elbow, tip])
+    return root, elbow, tip
+
+
+def finger_chain(base, root_offset, link_lengths, q) -> np.ndarray:
+    """Root, elbow and tip centre (3 x 2, world, m) of a finger with joints ``q = (q1, q2)``."""
+    return np.array(_chain(base, root_offset, link_lengths, q))
+
+
+def finger_tip_xy(hand: HandSpec, base, k: int, q) -> tuple[float, float]:
+    """:func:`finger_tip` as a tuple of floats (no array: for per-step use)."""
+    return _chain(base, hand.root_offsets[k], hand.link_lengths, q)[2]
 
 
 def finger_tip(hand: HandSpec, base, k: int, q) -> np.ndarray:
     """Tip centre of finger ``k`` (world, m) for base position and joints ``q = (q1, q2)``."""
-    return finger_chain(base, hand.root_offsets[k], hand.link_lengths, q)[2]
+    return np.array(finger_tip_xy(hand, base, k, q))
 
 
 def finger_ik(hand: HandSpec, base, k: int, tip, q_near=None):

@@ -106,6 +106,29 @@ class SerialChain:
         self._masses = np.array([b.mass for b in self.links])
         self._coms = np.array([b.com for b in self.links])
         self._inertias = np.array([b.inertia for b in self.links])
+        # the single-configuration path in Python floats (see _frames_f): per joint
+        # (cos alpha, sin alpha, a, d, theta offset, mass, com, inertia rows)
+        self._rows_f = tuple(
+            (
+                math.cos(r.alpha),
+                math.sin(r.alpha),
+                float(r.a),
+                float(r.d),
+                float(r.theta_offset),
+                float(b.mass),
+                tuple(b.com.tolist()),
+                tuple(tuple(row) for row in b.inertia.tolist()),
+            )
+            for r, b in zip(self.dh, self.links)
+        )
+        B = self.base
+        self._base_f = (
+            tuple(B[:3, 0].tolist()),
+            tuple(B[:3, 1].tolist()),
+            tuple(B[:3, 2].tolist()),
+            tuple(B[:3, 3].tolist()),
+        )
+        self._memo: dict = {}  # q (tuple) -> _frames_f(q), the last few configurations
 
     # ------------------------------------------------------------------ variants
     def with_payload(self, body: RigidBody) -> SerialChain:
@@ -134,6 +157,56 @@ class SerialChain:
         for row, qi in zip(self.dh, q):
             T.append(T[-1] @ dh_transform(row.alpha, row.a, row.d, qi + row.theta_offset))
         return T
+
+    def _frames_f(self, q) -> list[tuple]:
+        """Frames 0..n as (X, Y, Z, o): the world axes and origin of each, 3-tuples of floats.
+
+        The same products as :meth:`frames` (T_i = T_{i-1} Rz(q_i + offset) Tz(d) Tx(a) Rx(alpha),
+        Spong Sec. 3.2) written per column, for one configuration: ~10x less time than 4x4
+        NumPy products. The last few configurations are remembered (a controller asks for the
+        kinematics and the dynamics at the same q in one step)."""
+        key = tuple(q)
+        hit = self._memo.get(key)
+        if hit is not None:
+            return hit
+        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._base_f
+        out = [self._base_f]
+        cos, sin = math.cos, math.sin
+        for qi, (ca, sa, a, d, off, _, _, _) in zip(key, self._rows_f):
+            th = qi + off
+            ct, st = cos(th), sin(th)
+            x1x, x1y, x1z = ct * xx + st * yx, ct * xy + st * yy, ct * xz + st * yz
+            y1x, y1y, y1z = ct * yx - st * xx, ct * yy - st * xy, ct * yz - st * xz
+            px, py, pz = px + d * zx + a * x1x, py + d * zy + a * x1y, pz + d * zz + a * x1z
+            yx, yy, yz, zx, zy, zz = (
+                ca * y1x + sa * zx,
+                ca * y1y + sa * zy,
+                ca * y1z + sa * zz,
+                ca * zx - sa * y1x,
+                ca * zy - sa * y1y,
+                ca * zz - sa * y1z,
+            )
+            xx, xy, xz = x1x, x1y, x1z
+            out.append(((xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz)))
+        if len(self._memo) >= 4:
+            self._memo.pop(next(iter(self._memo)))
+        self._memo[key] = out
+        return out
+
+    def point(self, q, point_in_last=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """World position of a point given in the last DH frame (for a tool point: ``tool`` @
+        the point), one configuration, from :meth:`_frames_f`."""
+        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._frames_f(
+            self._q(q).tolist()
+        )[-1]
+        u, v, w = point_in_last
+        return np.array(
+            [
+                px + u * xx + v * yx + w * zx,
+                py + u * xy + v * yy + w * zy,
+                pz + u * xz + v * yz + w * zz,
+            ]
+        )
 
     def fk(self, q) -> np.ndarray:
         """World transform of the tool frame."""
@@ -184,56 +257,86 @@ class SerialChain:
         Forward pass: angular velocity/acceleration of link i and linear acceleration of o_{i-1}
         (on joint i's axis, fixed in links i-1 and i); gravity enters as a base acceleration -g.
         Backward pass: force and moment (about o_{i-1}) that link i-1 exerts on link i.
-        Written with 3-tuples of floats: for n <= 7 this is ~10x faster than small NumPy arrays.
+        One configuration in Python floats on the frames of :meth:`_frames_f` (inertia applied
+        as R I R^T v without forming R I R^T); :meth:`rnea_batch` is the same recursion in NumPy
+        over many states, and the tests hold the two together.
         """
         q, qd, qdd = self._q(q), self._q(qd), self._q(qdd)
         g = self.gravity if gravity is None else np.asarray(gravity, dtype=float)
-        Ts = self.frames(q)
+        F = self._frames_f(q.tolist())
+        gx, gy, gz = g.tolist()
+        wx = wy = wz = dwx = dwy = dwz = 0.0
+        ax, ay, az = -gx, -gy, -gz  # acceleration of o_{i-1}
+        fwd = []
+        for i, (qdi, qddi) in enumerate(zip(qd.tolist(), qdd.tolist())):
+            (zx, zy, zz), (ox, oy, oz) = F[i][2], F[i][3]
+            X, Y, Z, (o1x, o1y, o1z) = F[i + 1]
+            row = self._rows_f[i]
+            c0, c1, c2 = row[6]
+            cx = o1x + c0 * X[0] + c1 * Y[0] + c2 * Z[0]
+            cy = o1y + c0 * X[1] + c1 * Y[1] + c2 * Z[1]
+            cz = o1z + c0 * X[2] + c1 * Y[2] + c2 * Z[2]
+            zqx, zqy, zqz = zx * qdi, zy * qdi, zz * qdi
+            dwx += zx * qddi + wy * zqz - wz * zqy
+            dwy += zy * qddi + wz * zqx - wx * zqz
+            dwz += zz * qddi + wx * zqy - wy * zqx
+            wx, wy, wz = wx + zqx, wy + zqy, wz + zqz
+            # a_c = a_o + dw x rc + w x (w x rc)
+            rx, ry, rz = cx - ox, cy - oy, cz - oz
+            ux, uy, uz = wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx
+            acx = ax + dwy * rz - dwz * ry + wy * uz - wz * uy
+            acy = ay + dwz * rx - dwx * rz + wz * ux - wx * uz
+            acz = az + dwx * ry - dwy * rx + wx * uy - wy * ux
+            rx, ry, rz = o1x - ox, o1y - oy, o1z - oz
+            ux, uy, uz = wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx
+            ax += dwy * rz - dwz * ry + wy * uz - wz * uy
+            ay += dwz * rx - dwx * rz + wz * ux - wx * uz
+            az += dwx * ry - dwy * rx + wx * uy - wy * ux
+            fwd.append((cx, cy, cz, acx, acy, acz, wx, wy, wz, dwx, dwy, dwz))
         n = self.n
-        qd_l, qdd_l = qd.tolist(), qdd.tolist()
-        zs = [tuple(T[:3, 2].tolist()) for T in Ts]
-        os_ = [tuple(T[:3, 3].tolist()) for T in Ts]
-        cs = [
-            tuple((Ts[i + 1][:3, :3] @ self.links[i].com + Ts[i + 1][:3, 3]).tolist())
-            for i in range(n)
-        ]
-        Is = [
-            (Ts[i + 1][:3, :3] @ self.links[i].inertia @ Ts[i + 1][:3, :3].T).tolist()
-            for i in range(n)
-        ]
-        w = (0.0, 0.0, 0.0)
-        dw = (0.0, 0.0, 0.0)
-        a_o = tuple((-g).tolist())
-        a_cs, ws, dws = [], [], []
-        for i in range(n):
-            z, o0, o1 = zs[i], os_[i], os_[i + 1]
-            zq = _scale(z, qd_l[i])
-            dw = _add3(dw, _scale(z, qdd_l[i]), _cross(w, zq))
-            w = _add(w, zq)
-            rc = _sub(cs[i], o0)
-            a_cs.append(_add3(a_o, _cross(dw, rc), _cross(w, _cross(w, rc))))
-            ws.append(w)
-            dws.append(dw)
-            r = _sub(o1, o0)
-            a_o = _add3(a_o, _cross(dw, r), _cross(w, _cross(w, r)))
-        tau = np.zeros(n)
-        f_next = (0.0, 0.0, 0.0)
-        n_next = (0.0, 0.0, 0.0)  # moment about o_i exerted on link i+1
-        for i in reversed(range(n)):
-            m = self.links[i].mass
-            o0, o1 = os_[i], os_[i + 1]
-            ma = _scale(a_cs[i], m)
-            f = _add(ma, f_next)
-            Iw = _matvec(Is[i], ws[i])
-            nm = _add3(
-                _add(_matvec(Is[i], dws[i]), _cross(ws[i], Iw)),
-                _cross(_sub(cs[i], o0), ma),
-                _add(n_next, _cross(_sub(o1, o0), f_next)),
+        tau = [0.0] * n
+        fx = fy = fz = nx = ny = nz = 0.0  # force on link i+1, moment about o_i
+        for i in range(n - 1, -1, -1):
+            cx, cy, cz, acx, acy, acz, wx, wy, wz, dwx, dwy, dwz = fwd[i]
+            (zx, zy, zz), (ox, oy, oz) = F[i][2], F[i][3]
+            X, Y, Z, (o1x, o1y, o1z) = F[i + 1]
+            row = self._rows_f[i]
+            m, I = row[5], row[7]
+            # I_w w and I_w dw with I_w = R I R^T (R = [X Y Z] of frame i+1)
+            lw0 = X[0] * wx + X[1] * wy + X[2] * wz
+            lw1 = Y[0] * wx + Y[1] * wy + Y[2] * wz
+            lw2 = Z[0] * wx + Z[1] * wy + Z[2] * wz
+            ld0 = X[0] * dwx + X[1] * dwy + X[2] * dwz
+            ld1 = Y[0] * dwx + Y[1] * dwy + Y[2] * dwz
+            ld2 = Z[0] * dwx + Z[1] * dwy + Z[2] * dwz
+            (i00, i01, i02), (i10, i11, i12), (i20, i21, i22) = I
+            u0 = i00 * lw0 + i01 * lw1 + i02 * lw2
+            u1 = i10 * lw0 + i11 * lw1 + i12 * lw2
+            u2 = i20 * lw0 + i21 * lw1 + i22 * lw2
+            e0 = i00 * ld0 + i01 * ld1 + i02 * ld2
+            e1 = i10 * ld0 + i11 * ld1 + i12 * ld2
+            e2 = i20 * ld0 + i21 * ld1 + i22 * ld2
+            Iwx, Iwy, Iwz = (
+                u0 * X[0] + u1 * Y[0] + u2 * Z[0],
+                u0 * X[1] + u1 * Y[1] + u2 * Z[1],
+                u0 * X[2] + u1 * Y[2] + u2 * Z[2],
             )
-            z = zs[i]
-            tau[i] = z[0] * nm[0] + z[1] * nm[1] + z[2] * nm[2]
-            f_next, n_next = f, nm
-        return tau
+            Idx, Idy, Idz = (
+                e0 * X[0] + e1 * Y[0] + e2 * Z[0],
+                e0 * X[1] + e1 * Y[1] + e2 * Z[1],
+                e0 * X[2] + e1 * Y[2] + e2 * Z[2],
+            )
+            max_, may, maz = m * acx, m * acy, m * acz
+            rcx, rcy, rcz = cx - ox, cy - oy, cz - oz
+            rx, ry, rz = o1x - ox, o1y - oy, o1z - oz
+            nx, ny, nz = (
+                Idx + wy * Iwz - wz * Iwy + rcy * maz - rcz * may + nx + ry * fz - rz * fy,
+                Idy + wz * Iwx - wx * Iwz + rcz * max_ - rcx * maz + ny + rz * fx - rx * fz,
+                Idz + wx * Iwy - wy * Iwx + rcx * may - rcy * max_ + nz + rx * fy - ry * fx,
+            )
+            fx, fy, fz = max_ + fx, may + fy, maz + fz
+            tau[i] = zx * nx + zy * ny + zz * nz
+        return np.array(tau)
 
     def _link_jacobians(self, q):
         """Per link i: COM Jacobian Jv (n, n, 3), angular Jw (n, n, 3), world inertia (n, 3, 3)."""
@@ -378,34 +481,6 @@ class SerialChain:
         """Each link's mass properties in world coordinates (for checks and drawing)."""
         Ts = self.frames(q)
         return [b.transformed(Ts[i + 1]) for i, b in enumerate(self.links)]
-
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _add3(a, b, c):
-    return (a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _scale(a, s):
-    return (a[0] * s, a[1] * s, a[2] * s)
-
-
-def _matvec(m, v):
-    return (
-        m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-        m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-        m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
-    )
 
 
 def active_block(x: np.ndarray, active: Sequence[int]) -> np.ndarray:

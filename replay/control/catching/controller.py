@@ -354,6 +354,11 @@ class CatchingController(Controller):
         self._q_o = None
         self._warned_state = False
         self._t = 0.0
+        self._names_seen = None  # joint-name layout of the last joint state message
+        self._idx = None
+        self._identity = list(range(self.n))
+        self._ff_key = None  # (q_d, qd_d, qdd_d) of the last feed-forward, and its torque
+        self._ff = None
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
@@ -420,8 +425,7 @@ class CatchingController(Controller):
             r, v, a = (
                 self.est.state(t) if P.latency_compensation else self.est.state(self.est.last[0])
             )
-            q_a, qd_a, qdd_a, f = self.mapping.evaluate(r, v, a)  # eqs. 7, 23, 16
-            in_dom = bool(f.in_domain[0])
+            q_a, qd_a, qdd_a, q_o, in_dom = self.mapping.evaluate_one(r, v, a)  # eqs. 7, 23, 16
             if in_dom != self._in_domain and not in_dom:
                 self._events.append(
                     Occurrence(
@@ -434,8 +438,9 @@ class CatchingController(Controller):
                     )
                 )
             self._in_domain = in_dom
-            self._r, self._v, self._q_o = r, v, f.p[0]
-            reached = float(np.linalg.norm(r - self.geo.origin)) <= self.geo.catch_radius
+            self._r, self._v, self._q_o = r, v, q_o
+            d = r - self.geo.origin
+            reached = math.sqrt(float(d @ d)) <= self.geo.catch_radius
             if reached and P.after_catch == "hold":
                 self.holding = True
                 self.qd_d = np.zeros(self.n)
@@ -443,9 +448,9 @@ class CatchingController(Controller):
                     Occurrence("mapping_hold", {"q_d": self.q_d.tolist(), "r_o": r.tolist()})
                 )
             else:
-                self.q_d = self.model.full(q_a[0])
-                self.qd_d = self.model.full_rate(qd_a[0])
-                qdd_d = self.model.full_rate(qdd_a[0])
+                self.q_d = self.model.full(q_a)
+                self.qd_d = self.model.full_rate(qd_a)
+                qdd_d = self.model.full_rate(qdd_a)
             if not self.holding:
                 self.t_catch = self.est.time_to_radius(t, self.geo.origin, self.geo.catch_radius)
         if (
@@ -469,10 +474,16 @@ class CatchingController(Controller):
 
     def _joint_state(self, m) -> None:
         pos, vel = np.asarray(m.position, float), np.asarray(m.velocity, float)
-        names = list(getattr(m, "name", []) or [])
-        if names and set(self.names) <= set(names):
-            idx = [names.index(n) for n in self.names]
-            pos, vel = pos[idx], vel[idx]
+        names = tuple(getattr(m, "name", ()) or ())
+        if names != self._names_seen:  # where our joints sit in the message (once per layout)
+            self._names_seen = names
+            self._idx = (
+                [names.index(n) for n in self.names]
+                if names and set(self.names) <= set(names)
+                else None
+            )
+        if self._idx is not None and self._idx != self._identity:
+            pos, vel = pos[self._idx], vel[self._idx]
         if pos.shape == (self.n,):
             self.q, self.qd = pos, (vel if vel.shape == (self.n,) else np.zeros(self.n))
 
@@ -480,7 +491,10 @@ class CatchingController(Controller):
         P = self.params
         q_d, qd_d = self.q_d, self.qd_d
         if P.feedforward == "dynamics":  # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
-            ff = self.model.inverse_dynamics_full(q_d, qd_d, qdd_d)
+            key = (q_d.tobytes(), qd_d.tobytes(), qdd_d.tobytes())
+            if key != self._ff_key:  # the same desired state (holding, not yet seen): same ff
+                self._ff_key, self._ff = key, self.model.inverse_dynamics_full(q_d, qd_d, qdd_d)
+            ff = self._ff
         elif P.feedforward == "gravity":
             ff = self.model.gravity_full(self.q if self.q is not None else q_d)
         else:
@@ -497,7 +511,7 @@ class CatchingController(Controller):
             tau = ff
         else:
             tau = ff + self.kp * (q_d - self.q) + self.kd * (qd_d - self.qd)
-        return np.clip(tau, -self.tau_limit, self.tau_limit)
+        return np.minimum(np.maximum(tau, -self.tau_limit), self.tau_limit)
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:

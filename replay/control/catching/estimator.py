@@ -16,15 +16,24 @@ import numpy as np
 
 
 class BallisticEstimator:
+    """The fit is solved from running sums (the 2 x 2 normal equations per axis) kept as
+    measurements enter and leave the window: with time measured from a reference t_ref the
+    model r = a + b (t - t_ref) + g (t - t_ref)^2 / 2 spans the same arcs as the one about
+    t_last, so the least-squares solution is the same; t_ref is moved (the sums rebuilt) once
+    per window so that the sums stay well conditioned."""
+
     def __init__(self, gravity=(0.0, 0.0, -9.81), window: float = 0.1, max_samples: int = 400):
         self.g = np.asarray(gravity, float)
+        self._g = tuple(self.g.tolist())
         self.window = float(window)
         self.buf: deque = deque(maxlen=max_samples)
         self._fit = None
+        self._rebuild(None)
 
     def reset(self) -> None:
         self.buf.clear()
         self._fit = None
+        self._rebuild(None)
 
     @property
     def n(self) -> int:
@@ -34,13 +43,41 @@ class BallisticEstimator:
     def last(self):
         return self.buf[-1] if self.buf else None
 
+    # ---- running sums: n, sum tau, sum tau^2, sum y, sum tau y (y = r - g tau^2 / 2, per axis)
+    def _rebuild(self, t_ref) -> None:
+        self._t_ref = t_ref
+        self._S = [0.0, 0.0, 0.0]
+        self._Sy = [0.0, 0.0, 0.0]
+        self._Sty = [0.0, 0.0, 0.0]
+        for t, r in self.buf:
+            self._account(t, r, 1.0)
+
+    def _account(self, t: float, r, sign: float) -> None:
+        tau = t - self._t_ref
+        S, Sy, Sty, g = self._S, self._Sy, self._Sty, self._g
+        S[0] += sign
+        S[1] += sign * tau
+        S[2] += sign * tau * tau
+        h = 0.5 * tau * tau
+        for k in range(3):
+            y = float(r[k]) - g[k] * h
+            Sy[k] += sign * y
+            Sty[k] += sign * tau * y
+
     def add(self, t: float, r) -> None:
         r = np.asarray(r, float)
         if self.buf and t <= self.buf[-1][0]:
             return  # out of order or repeated frame
+        if self._t_ref is None:
+            self._t_ref = float(t)
+        if len(self.buf) == self.buf.maxlen:  # the deque drops its oldest: so do the sums
+            self._account(*self.buf[0], -1.0)
         self.buf.append((float(t), r))
+        self._account(float(t), r, 1.0)
         while self.buf and self.buf[-1][0] - self.buf[0][0] > self.window + 1e-12:
-            self.buf.popleft()
+            self._account(*self.buf.popleft(), -1.0)
+        if self.buf[0][0] - self._t_ref > self.window:  # re-centre: sums of the window only
+            self._rebuild(self.buf[0][0])
         self._fit = None
 
     def fit(self):
@@ -52,11 +89,16 @@ class BallisticEstimator:
             if len(self.buf) == 1:
                 self._fit = (t_last, r_last, None)
             else:
-                s = np.array([b[0] for b in self.buf]) - t_last
-                Y = np.array([b[1] for b in self.buf]) - 0.5 * np.outer(s * s, self.g)
-                A = np.column_stack([np.ones_like(s), s])
-                sol, *_ = np.linalg.lstsq(A, Y, rcond=None)
-                self._fit = (t_last, sol[0], sol[1])
+                n, s1, s2 = self._S
+                n = float(len(self.buf))  # exact, not a running sum
+                det = n * s2 - s1 * s1
+                tl = t_last - self._t_ref
+                g = self._g
+                b = [(n * self._Sty[k] - s1 * self._Sy[k]) / det for k in range(3)]
+                a = [(self._Sy[k] - b[k] * s1) / n for k in range(3)]
+                r0 = np.array([a[k] + b[k] * tl + 0.5 * g[k] * tl * tl for k in range(3)])
+                v = np.array([b[k] + g[k] * tl for k in range(3)])
+                self._fit = (t_last, r0, v)
         return self._fit
 
     def state(self, t: float, *, from_fit: bool = False):
@@ -79,12 +121,60 @@ class BallisticEstimator:
         st = self.state(t, from_fit=True)
         if st is None or self.n < 2:
             return None
-        r, v, g = st
-        d = r - np.asarray(origin, float)
-        if d @ d <= radius * radius:
+        (rx, ry, rz), v, g = st[0].tolist(), st[1].tolist(), self._g
+        ox, oy, oz = (float(x) for x in origin)
+        d = (rx - ox, ry - oy, rz - oz)
+        dot = lambda a, b: a[0] * b[0] + a[1] * b[1] + a[2] * b[2]  # noqa: E731
+        dd = dot(d, d)
+        if dd <= radius * radius:
             return t
-        coeffs = [0.25 * (g @ g), v @ g, v @ v + d @ g, 2.0 * (d @ v), d @ d - radius * radius]
-        roots = np.roots(coeffs)
+        coeffs = [0.25 * dot(g, g), dot(v, g), dot(v, v) + dot(d, g), 2.0 * dot(d, v)]
+        coeffs.append(dd - radius * radius)
+        s = _first_root_newton(coeffs)
+        if s is not None:
+            return t + s
+        roots = _roots(coeffs)
         real = roots[np.abs(roots.imag) < 1e-9].real
         real = real[real >= 0.0]
         return t + float(real.min()) if real.size else None
+
+
+def _first_root_newton(c):
+    """The smallest root s >= 0 of the quartic c[0] s^4 + ... + c[4] (c[4] > 0: outside the
+    sphere) when Newton's method from s = 0 provably finds it, else None (then the caller takes
+    the companion matrix's eigenvalues). Proof: where h'' > 0 on [0, s*] and h'(0) < 0, Newton's
+    iterates from 0 rise monotonically to the first root. A ball flying at the arm makes h
+    convex (h'' = 2 |v + g s|^2 + 2 (d + v s + g s^2 / 2) . g, the first term dominating)."""
+    c4, c3, c2, c1, c0 = c
+    s = 0.0
+    for _ in range(60):
+        f = (((c4 * s + c3) * s + c2) * s + c1) * s + c0
+        fp = ((4.0 * c4 * s + 3.0 * c3) * s + 2.0 * c2) * s + c1
+        if not fp < 0.0:
+            return None
+        step = f / fp
+        s -= step
+        if abs(step) <= 1e-15 * max(s, 1e-3):
+            break
+    else:
+        return None
+    if not s >= 0.0:
+        return None
+    # h'' = 12 c4 s^2 + 6 c3 s + 2 c2 must stay positive on [0, s]: check its minimum there
+    cand = [0.0, s]
+    if c4 > 0.0 and 0.0 < -c3 / (4.0 * c4) < s:
+        cand.append(-c3 / (4.0 * c4))
+    if min((12.0 * c4 * x + 6.0 * c3) * x + 2.0 * c2 for x in cand) <= 0.0:
+        return None
+    return s
+
+
+def _roots(coeffs) -> np.ndarray:
+    """np.roots of a polynomial (highest power first): the eigenvalues of the same companion
+    matrix, built directly when neither end coefficient is zero (np.roots strips those)."""
+    if coeffs[0] == 0.0 or coeffs[-1] == 0.0:
+        return np.roots(coeffs)
+    n = len(coeffs) - 1
+    A = np.eye(n, k=-1)
+    A[0, :] = [-c / coeffs[0] for c in coeffs[1:]]
+    return np.linalg.eigvals(A)

@@ -38,9 +38,10 @@ class ArmModel:
     def from_chain(cls, chain, *, active=(0, 1, 3), q_fixed=None, point_in_tool=(0.0, 0.0, 0.0)):
         """A ``replay.robot.SerialChain``; l(q) is the point ``point_in_tool`` of its tool frame."""
         pt = np.array([*point_in_tool, 1.0])
+        pt_last = tuple((chain.tool @ pt)[:3].tolist())  # the point in the last DH frame
 
         def fk(q):
-            return (chain.frames(q)[-1] @ chain.tool @ pt)[:3]
+            return chain.point(q, pt_last)
 
         def axis(q):
             return (chain.frames(q)[-1] @ chain.tool)[:3, 2]

@@ -256,10 +256,11 @@ class ClosePlanner:
         """The hand target at ``t`` for the closing ``c``: its route's waypoint, with the rear
         fingertip following the stick along the line once the base has arrived."""
         cfg = c.target(t)
-        if np.max(np.abs(np.subtract(self.model.config.base, c.config.base))) > 1e-9:
+        (bx, by), (cx, cy) = self.model.config.base, c.config.base
+        if max(abs(bx - cx), abs(by - cy)) > 1e-9:
             return cfg  # the base is still moving: the rear finger is parked
-        pred = estimator.predict(t)
-        s_now = float(np.dot(c.d, np.array(pred[:2]) - c.meet))
+        px, py, _ = estimator.predict(t)
+        s_now = float(c.d[0] * (px - c.meet[0]) + c.d[1] * (py - c.meet[1]))
         s_rear = (
             -c.half_gap
             if t >= c.t_meet

@@ -22,17 +22,18 @@ def rotation(theta: float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
+def normal(theta: float, side: int) -> tuple[float, float]:
+    """n_i in Sigma_R (eq. 4) as floats: R_B(theta) [0, -side]."""
+    c, s = math.cos(theta), math.sin(theta)
+    return (s, -c) if side > 0 else (-s, c)
+
+
 def tangent_normal(theta: float, side: int) -> tuple[np.ndarray, np.ndarray]:
     """s_i and n_i in Sigma_R (eqs. 3, 4): n_i points from the fingertip into the stick."""
-    s_b = np.array([1.0, 0.0]) if side > 0 else np.array([-1.0, 0.0])
-    n_b = np.array([0.0, -1.0]) if side > 0 else np.array([0.0, 1.0])
-    R = rotation(theta)
-    return R @ s_b, R @ n_b
-
-
-def mass_matrix(m: float, inertia: float) -> np.ndarray:
-    """M of eq. 5."""
-    return np.diag([m, m, inertia])
+    c, s = math.cos(theta), math.sin(theta)
+    if side > 0:
+        return np.array([c, s]), np.array([s, -c])
+    return np.array([-c, -s]), np.array([-s, c])
 
 
 def contact_jacobian(theta: float, r_b) -> np.ndarray:
@@ -41,16 +42,37 @@ def contact_jacobian(theta: float, r_b) -> np.ndarray:
     return np.array([[1.0, 0.0, -a[1]], [0.0, 1.0, a[0]]])
 
 
+def _impulse_terms(
+    m: float, inertia: float, theta: float, r_x: float, r_y: float, side: int
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """(g, h) with J_i = E_3 - (1 + e) g h^T (eq. 22), in closed form: h = H_i^T n_i and
+    g = M^-1 H_i^T K_i^-1 n_i, M = diag(m, m, I) and K_i = H_i M^-1 H_i^T (eqs. 5, 9), K_i
+    inverted as a 2 x 2 (the matrix form is the reference in tests/.../test_stick_fast_paths)."""
+    c, s = math.cos(theta), math.sin(theta)
+    ax, ay = c * r_x - s * r_y, s * r_x + c * r_y  # a = R_B(theta) ^B r
+    nx, ny = (s, -c) if side > 0 else (-s, c)
+    k11, k12, k22 = 1.0 / m + ay * ay / inertia, -ax * ay / inertia, 1.0 / m + ax * ax / inertia
+    det = k11 * k22 - k12 * k12
+    wx, wy = (k22 * nx - k12 * ny) / det, (k11 * ny - k12 * nx) / det  # K^-1 n
+    g = (wx / m, wy / m, (-ay * wx + ax * wy) / inertia)
+    h = (nx, ny, -ay * nx + ax * ny)
+    return g, h
+
+
+def _after(g, h, e: float, u) -> tuple[float, float, float]:
+    """u_i = J_i u_{i-1} = u - (1 + e) g (h . u) (eq. 22)."""
+    k = (1.0 + e) * (h[0] * u[0] + h[1] * u[1] + h[2] * u[2])
+    return (u[0] - k * g[0], u[1] - k * g[1], u[2] - k * g[2])
+
+
 def collision_map(m: float, inertia: float, e: float, theta: float, r_b, side: int) -> np.ndarray:
     """J_i of eq. 22: u_i = J_i u_{i-1}, valid under the friction independent condition (eq. 12).
 
-    J_i = E_3 - (1 + e) M^-1 H_i^T K_i^-1 n_i n_i^T H_i, with K_i = H_i M^-1 H_i^T (eq. 9).
+    J_i = E_3 - (1 + e) M^-1 H_i^T K_i^-1 n_i n_i^T H_i, with K_i = H_i M^-1 H_i^T (eq. 9)
+    (closed form: :func:`_impulse_terms`).
     """
-    M_inv = np.linalg.inv(mass_matrix(m, inertia))
-    H = contact_jacobian(theta, r_b)
-    K = H @ M_inv @ H.T
-    _, n = tangent_normal(theta, side)
-    return np.eye(3) - (1.0 + e) * M_inv @ H.T @ np.linalg.solve(K, np.outer(n, n) @ H)
+    g, h = _impulse_terms(m, inertia, theta, float(r_b[0]), float(r_b[1]), side)
+    return np.eye(3) - (1.0 + e) * np.outer(g, h)
 
 
 def alpha(a) -> float:
@@ -63,9 +85,9 @@ def alpha(a) -> float:
 
 def friction_independent(theta: float, v, side: int = 1, tol: float = 1e-9) -> bool:
     """Eq. 12: s_i^T v_{B,i-1} = 0 (within ``tol`` of |v|)."""
-    s, _ = tangent_normal(theta, side)
-    v = np.asarray(v, dtype=float)
-    return abs(float(s @ v)) <= tol * max(1.0, float(np.linalg.norm(v)))
+    nx, ny = normal(theta, side)
+    vx, vy = float(v[0]), float(v[1])
+    return abs(-ny * vx + nx * vy) <= tol * max(1.0, math.hypot(vx, vy))  # s = (-n_y, n_x)
 
 
 # --------------------------------------------------------------------------------------------
@@ -83,15 +105,19 @@ def _sign(side: int) -> float:
     return 1.0 if side > 0 else -1.0
 
 
+def _u3(u) -> tuple[float, float, float]:
+    return float(u[0]), float(u[1]), float(u[2])
+
+
 def f_omega(
     m: float, inertia: float, e: float, theta: float, side: int, u_prev, omega_d: float
 ) -> tuple[float, ...]:
     """F_omega,i(omega_d) of eq. 25: both r_x (ascending) giving omega_i = omega_d (eq. 24)."""
-    u = np.asarray(u_prev, dtype=float)
-    _, n = tangent_normal(theta, side)
-    a1 = m * (omega_d + e * u[2])
-    b1 = -(1.0 + e) * m * _sign(side) * float(n @ u[:2])
-    c1 = inertia * (omega_d - u[2])
+    vx, vy, w = _u3(u_prev)
+    nx, ny = normal(theta, side)
+    a1 = m * (omega_d + e * w)
+    b1 = -(1.0 + e) * m * _sign(side) * (nx * vx + ny * vy)
+    c1 = inertia * (omega_d - w)
     return _roots(a1, b1, c1)
 
 
@@ -103,13 +129,13 @@ def f_v(
     V_i is the speed along -v_{i-1}/|v_{i-1}| (V_d = 0 stops the translation); valid for a
     friction independent collision, theta = alpha(v_{i-1}), and v_{i-1} != 0.
     """
-    u = np.asarray(u_prev, dtype=float)
-    speed = float(np.linalg.norm(u[:2]))
+    vx, vy, w = _u3(u_prev)
+    speed = math.hypot(vx, vy)
     if speed == 0.0:
         return ()
-    _, n = tangent_normal(theta, side)
+    nx, ny = normal(theta, side)
     a2 = m * (speed_d + speed)
-    b2 = (1.0 + e) * inertia * u[2] * _sign(side) * float(n @ u[:2]) / speed
+    b2 = (1.0 + e) * inertia * w * _sign(side) * (nx * vx + ny * vy) / speed
     c2 = inertia * (speed_d - e * speed)
     return _roots(a2, b2, c2)
 
@@ -124,17 +150,17 @@ def contact_condition(
 ) -> float:
     """C_i of eq. 26: n_i^T H_i J_i u_{i-1}, the normal velocity of the contact point after the
     collision; > 0 when it leaves the fingertip (then it approached before: C_i = -e n^T H u)."""
-    u = np.asarray(u_prev, dtype=float)
-    _, n = tangent_normal(theta, side)
-    H = contact_jacobian(theta, (r_x, 0.0))
-    return float(n @ H @ axis_map(m, inertia, e, theta, r_x, side) @ u)
+    g, h = _impulse_terms(m, inertia, theta, r_x, 0.0, side)
+    after = _after(g, h, e, _u3(u_prev))
+    return h[0] * after[0] + h[1] * after[1] + h[2] * after[2]
 
 
 def approach_speed(theta: float, r_x: float, side: int, u_prev) -> float:
     """-n_i^T H_i u_{i-1}: how fast the contact point moves into the fingertip before (m/s)."""
-    u = np.asarray(u_prev, dtype=float)
-    _, n = tangent_normal(theta, side)
-    return -float(n @ contact_jacobian(theta, (r_x, 0.0)) @ u)
+    vx, vy, w = _u3(u_prev)
+    nx, ny = normal(theta, side)
+    ax, ay = math.cos(theta) * r_x, math.sin(theta) * r_x  # R_B(theta) [r_x, 0]
+    return -(nx * vx + ny * vy + (-ay * nx + ax * ny) * w)
 
 
 @dataclass(frozen=True)
@@ -160,12 +186,13 @@ class ContactSolution:
         return np.array([self.r_x, 0.5 * width * self.side])
 
 
-def _valid(m, inertia, e, theta, r_x, side, u) -> bool:
-    """Eq. 26 (C_i > 0); for e = 0 C_i vanishes, so test the approach before instead."""
+def _valid(sol: "ContactSolution", e: float, u) -> bool:
+    """Eq. 26 (C_i > 0, ``sol.condition``); for e = 0 C_i vanishes, so test the approach before
+    instead."""
     if e > 0.0:
-        tol = 1e-12 * max(1.0, float(np.linalg.norm(u)))
-        return contact_condition(m, inertia, e, theta, r_x, side, u) > tol
-    return approach_speed(theta, r_x, side, u) > 1e-12
+        tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
+        return sol.condition > tol
+    return approach_speed(sol.theta, sol.r_x, sol.side, u) > 1e-12
 
 
 def contact_options(
@@ -189,18 +216,17 @@ def contact_options(
     """
     if (omega is None) == (speed is None):
         raise ValueError("give exactly one of omega, speed")
-    u = np.asarray(u_prev, dtype=float)
+    u = _u3(u_prev)
     out = []
     for side in sides:
         if omega is not None:
             roots = f_omega(m, inertia, e, theta, side, u, omega)
         else:
             roots = f_v(m, inertia, e, theta, side, u, speed)
-        out += [
-            contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
-            for r in roots
-            if _valid(m, inertia, e, theta, r, side, u)
-        ]
+        for r in roots:
+            sol = contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
+            if _valid(sol, e, u):
+                out.append(sol)
     return out
 
 
@@ -242,16 +268,18 @@ def contact_at(
     roots: tuple = (),
 ) -> ContactSolution:
     """The collision at a given r_x (e.g. a clamped one), predicted with J_i (eq. 22)."""
-    u = np.asarray(u_prev, dtype=float)
-    u_after = axis_map(m, inertia, e, theta, r_x, side) @ u
+    u = _u3(u_prev)
+    r_x = float(r_x)
+    g, h = _impulse_terms(m, inertia, theta, r_x, 0.0, side)
+    u_after = _after(g, h, e, u)
     return ContactSolution(
         theta=theta,
         side=1 if side > 0 else -1,
-        r_x=float(r_x),
-        u_before=tuple(float(x) for x in u),
-        u_after=tuple(float(x) for x in u_after),
+        r_x=r_x,
+        u_before=u,
+        u_after=u_after,
         roots=tuple(float(r) for r in roots),
-        condition=contact_condition(m, inertia, e, theta, r_x, side, u),
+        condition=h[0] * u_after[0] + h[1] * u_after[1] + h[2] * u_after[2],  # C_i (eq. 26)
         length=length,
     )
 
@@ -266,13 +294,18 @@ def two_step_first(
 ) -> ContactSolution | None:
     """Eq. 30: theta_1 = alpha(v_0), r_x = F_omega,1(0) with C_1 > 0, and the side giving p = -1
     in eq. 31 (v_1 against v_0). Preference: within the stick, then p = -1, then small |r_x|."""
-    u = np.asarray(u0, dtype=float)
+    u = _u3(u0)
     theta = alpha(u[:2])
     sols = contact_options(m, inertia, e, theta, u, omega=0.0, length=length)
     if not sols:
         return None
     return min(
-        sols, key=lambda s: (not s.within, float(np.dot(s.u_after[:2], u[:2])) >= 0.0, abs(s.r_x))
+        sols,
+        key=lambda s: (
+            not s.within,
+            s.u_after[0] * u[0] + s.u_after[1] * u[1] >= 0.0,
+            abs(s.r_x),
+        ),
     )
 
 
@@ -281,7 +314,7 @@ def three_step_first(
 ) -> ContactSolution | None:
     """Eq. 34: theta_1 = alpha(v_0), r_x = F_V,1(0) with C_1 > 0; the side satisfying eq. 35
     (omega_1 against omega_0) is preferred after being within the stick."""
-    u = np.asarray(u0, dtype=float)
+    u = _u3(u0)
     theta = alpha(u[:2])
     sols = contact_options(m, inertia, e, theta, u, speed=0.0, length=length)
     if not sols:
@@ -294,13 +327,13 @@ def three_step_second(
 ) -> ContactSolution | None:
     """Eq. 36: theta_2 = alpha(lambda_2), r_x = F_omega,2(0) with C_2 > 0, and the side for which
     v_2 / |v_2| = lambda_2 (eq. 37). None when no side sends the stick along lambda_2."""
-    u = np.asarray(u1, dtype=float)
-    lam = np.asarray(lambda_2, dtype=float)
-    theta = alpha(lam)
+    u = _u3(u1)
+    lx, ly = float(lambda_2[0]), float(lambda_2[1])
+    theta = alpha((lx, ly))
     sols = [
         s
         for s in contact_options(m, inertia, e, theta, u, omega=0.0, length=length)
-        if float(np.dot(s.u_after[:2], lam)) > 0.0
+        if s.u_after[0] * lx + s.u_after[1] * ly > 0.0
     ]
     if not sols:
         return None
@@ -312,8 +345,8 @@ def closing_contact(
 ) -> ContactSolution | None:
     """Eqs. 32 / 38: ^B r_x = 0 on the side the stick moves into (n_i = -n_{i-1} alternately),
     so v_i = -e v_{i-1} (eq. 33) and no rotation. None when the stick does not translate."""
-    u = np.asarray(u_prev, dtype=float)
-    if float(np.linalg.norm(u[:2])) == 0.0:
+    u = _u3(u_prev)
+    if u[0] == 0.0 and u[1] == 0.0:
         return None
     theta = alpha(u[:2])
     for side in (1, -1):

@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+REANCHOR = 1.0  # s, the running sums are rebuilt from the window once their anchor is this old
+
 
 @dataclass(frozen=True)
 class StickEstimate:
@@ -88,6 +90,7 @@ class StickEstimator:
         self._fit: StickEstimate | None = None
         self.breaks: list[float] = []  # time of the first sample after each break
         self.before_break: StickEstimate | None = None  # the fit the last break ended
+        self._rebuild()
 
     # -- input ------------------------------------------------------------------------------
     def add(self, t: float, x: float, y: float, theta: float) -> bool:
@@ -108,6 +111,7 @@ class StickEstimator:
         self.breaks.append(self._pending[0][0])
         self._samples = list(self._pending)
         self._pending.clear()
+        self._rebuild()
         self._refit()
         return True
 
@@ -115,6 +119,7 @@ class StickEstimator:
         """Forget everything (e.g. the stick was lost)."""
         self._samples.clear()
         self._pending.clear()
+        self._rebuild()
         self._fit = None
 
     # -- output -----------------------------------------------------------------------------
@@ -147,34 +152,59 @@ class StickEstimator:
 
     def _append(self, sample) -> None:
         self._samples.append(sample)
+        self._sum(sample, 1.0)
         if len(self._samples) > self.window:
+            for old in self._samples[: len(self._samples) - self.window]:
+                self._sum(old, -1.0)
             del self._samples[: len(self._samples) - self.window]
+            if sample[0] - self._anchor[0] > REANCHOR:
+                self._rebuild()
         self._refit()
 
+    # The fit is kept as running sums over the window (O(1) a sample), of the samples relative
+    # to an anchor sample (small numbers: little cancellation); rebuilt from the window at each
+    # restart and once the anchor is REANCHOR old (rounding never accumulates for long).
+    def _rebuild(self) -> None:
+        self._anchor = self._samples[0] if self._samples else (0.0, 0.0, 0.0, 0.0)
+        self._sums = [0.0] * 12
+        for sample in self._samples:
+            self._sum(sample, 1.0)
+
+    def _sum(self, sample, sign: float) -> None:
+        t0, x0, y0, th0 = self._anchor
+        t = sample[0] - t0
+        s = self._sums
+        s[0] += sign
+        s[1] += sign * t
+        s[2] += sign * t * t
+        for i, v in ((3, sample[1] - x0), (6, sample[2] - y0), (9, sample[3] - th0)):
+            s[i] += sign * v
+            s[i + 1] += sign * t * v
+            s[i + 2] += sign * v * v
+
     def _refit(self) -> None:
-        data = np.array(self._samples)
-        t = data[:, 0]
-        t_ref = float(t[-1])
-        n = len(t)
+        """Least squares of (x, y, theta) = value at t_ref + rate (t - t_ref), in closed form
+        from the running sums (rate = S_tv / S_tt of the centred sums)."""
+        samples = self._samples
+        n = len(samples)
+        t_ref = samples[-1][0]
         if n == 1:
-            _, x, y, th = self._samples[0]
+            _, x, y, th = samples[0]
             self._fit = StickEstimate(t_ref, x, y, th, 0.0, 0.0, 0.0, 1, 0.0, 0.0)
             return
-        tau = t - t_ref
-        A = np.column_stack([np.ones(n), tau])
-        coef, *_ = np.linalg.lstsq(A, data[:, 1:], rcond=None)  # rows: value at t_ref, rate
-        res = data[:, 1:] - A @ coef
-        rms_xy = float(math.sqrt(np.mean(res[:, 0] ** 2 + res[:, 1] ** 2)))
-        rms_th = float(math.sqrt(np.mean(res[:, 2] ** 2)))
+        s = self._sums
+        t0 = self._anchor[0]
+        tm = s[1] / n
+        s_tt = s[2] - s[1] * tm
+        dt_ref = (t_ref - t0) - tm
+        out = []
+        for i, v0 in ((3, self._anchor[1]), (6, self._anchor[2]), (9, self._anchor[3])):
+            vm = s[i] / n
+            s_tv = s[i + 1] - s[1] * vm
+            rate = s_tv / s_tt if s_tt > 0.0 else 0.0
+            rss = max(s[i + 2] - s[i] * vm - rate * s_tv, 0.0)
+            out.append((v0 + vm + rate * dt_ref, rate, rss))
+        (x, vx, rx), (y, vy, ry), (th, w, rth) = out
         self._fit = StickEstimate(
-            t_ref,
-            float(coef[0, 0]),
-            float(coef[0, 1]),
-            float(coef[0, 2]),
-            float(coef[1, 0]),
-            float(coef[1, 1]),
-            float(coef[1, 2]),
-            n,
-            rms_xy,
-            rms_th,
+            t_ref, x, y, th, vx, vy, w, n, math.sqrt((rx + ry) / n), math.sqrt(rth / n)
         )

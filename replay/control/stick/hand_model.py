@@ -16,6 +16,7 @@ Pure NumPy.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -43,7 +44,9 @@ class Config:
     def tip(self, hand: HandSpec, k: int) -> np.ndarray:
         return hand2d.finger_tip(hand, self.base, k, self.joints[k])
 
+    @functools.cached_property
     def command(self) -> HandCommand:
+        """This configuration as the plant's command (made once per configuration)."""
         return HandCommand(
             base=(float(self.base[0]), float(self.base[1])),
             joints=tuple((float(q[0]), float(q[1])) for q in self.joints),
@@ -64,7 +67,7 @@ class HandModel:
         self._t: float | None = None
 
     def advance(self, t: float) -> None:
-        if self._t is not None and t > self._t:
+        if self._t is not None and t > self._t and self.config != self.target:
             dt = t - self._t
             step_b = self.hand.base_speed * dt
             step_q = self.hand.joint_speed * dt
@@ -96,33 +99,34 @@ def route_target(route: list, t: float, default: Config) -> Config:
 
 def route_configs(hand: HandSpec, starts, frm, to, times):
     """Base (T, 2) and joints (T, 2, 2) along waypoint segments, each axis moving toward its
-    target at its speed limit (the plant's motion model)."""
+    target at its speed limit (the plant's motion model). ``times`` ascending; segment i covers
+    starts[i] <= t < starts[i + 1] (the first one also what comes before its start)."""
     times = np.asarray(times, dtype=float)
-    base = np.empty((len(times), 2))
-    joints = np.empty((len(times), 2, 2))
+    out = np.empty((len(times), 6))  # base x, y, then the four joints
+    speed = np.array([hand.base_speed] * 2 + [hand.joint_speed] * 4)
+    edges = np.searchsorted(times, starts, side="left")  # first sample at or after each start
     for i, (s0, a, b) in enumerate(zip(starts, frm, to)):
-        t_end = starts[i + 1] if i + 1 < len(starts) else math.inf
-        sel = (times >= s0) | (i == 0)
-        sel &= times < t_end
-        if not sel.any():
+        lo = 0 if i == 0 else int(edges[i])
+        hi = int(edges[i + 1]) if i + 1 < len(starts) else len(times)
+        if hi <= lo:
             continue
-        tau = np.maximum(times[sel] - s0, 0.0)[:, None]
-        a_b, b_b = np.array(a.base), np.array(b.base)
-        base[sel] = a_b + np.clip(b_b - a_b, -hand.base_speed * tau, hand.base_speed * tau)
-        a_q, b_q = np.array(a.joints).reshape(4), np.array(b.joints).reshape(4)
-        q = a_q + np.clip(b_q - a_q, -hand.joint_speed * tau, hand.joint_speed * tau)
-        joints[sel] = q.reshape(-1, 2, 2)
-    return base, joints
+        tau = np.maximum(times[lo:hi] - s0, 0.0)[:, None]
+        va = np.array([*a.base, *a.joints[0], *a.joints[1]], dtype=float)
+        vb = np.array([*b.base, *b.joints[0], *b.joints[1]], dtype=float)
+        step = tau * speed
+        out[lo:hi] = va + np.minimum(np.maximum(vb - va, -step), step)  # clip
+    return out[:, :2], out[:, 2:].reshape(-1, 2, 2)
 
 
 def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
     """Fingertip centres (T, 2 fingers, 2) for bases (T, 2) and joints (T, 2, 2)."""
     l1, l2 = hand.link_lengths
-    roots = np.array(hand.root_offsets)[None, :, :] + np.asarray(base)[:, None, :]
+    out = np.empty(np.shape(joints))
     q1, q12 = joints[..., 0], joints[..., 0] + joints[..., 1]
-    return roots + np.stack(
-        [l1 * np.cos(q1) + l2 * np.cos(q12), l1 * np.sin(q1) + l2 * np.sin(q12)], axis=-1
-    )
+    out[..., 0] = l1 * np.cos(q1) + l2 * np.cos(q12)
+    out[..., 1] = l1 * np.sin(q1) + l2 * np.sin(q12)
+    out += np.array(hand.root_offsets)[None, :, :] + np.asarray(base)[:, None, :]  # the roots
+    return out
 
 
 # ------------------------------------------------------------------------------------------

@@ -48,7 +48,7 @@ from replay.control.stick.hand_model import (
     route_tips,
     travel,
 )
-from replay.control.stick.sweep import Motion, covered, covered_along, sample_times
+from replay.control.stick.sweep import Motion, Sweep, covered, covered_along, sample_times
 
 CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
 GO_DELAY = 0.003  # s, a staged tip moves in this long after the stick's last pass
@@ -142,6 +142,15 @@ class ContactPlanner:
         self.stick = stick
         self.model = model
         self._passive_grid = posture_grid(hand)
+        q = np.array(self._passive_grid)
+        self._grid_q = q
+        l1, l2 = hand.link_lengths
+        self._grid_reach = (
+            l1 * np.cos(q[:, 0]),
+            l1 * np.sin(q[:, 0]),
+            l2 * np.cos(q[:, 0] + q[:, 1]),
+            l2 * np.sin(q[:, 0] + q[:, 1]),
+        )
 
     def crossings(
         self, t: float, est: StickEstimate, theta_star: float, keep_past: bool = False
@@ -165,6 +174,18 @@ class ContactPlanner:
             tau += period
         return out
 
+    def spot(
+        self, est: StickEstimate, sol: sc.ContactSolution, t_c: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(contact point R(theta*) r + c, fingertip centre contact - tip_radius n, n) in the
+        world for the contact ``sol`` at t_c, the stick moving as ``est`` predicts."""
+        x, y, _ = est.at(t_c)
+        c, s = math.cos(sol.theta), math.sin(sol.theta)
+        r_x, r_y = sol.r_x, 0.5 * self.stick.width * sol.side
+        contact = np.array([x + c * r_x - s * r_y, y + s * r_x + c * r_y])
+        n = np.array([s, -c]) if sol.side > 0 else np.array([-s, c])  # eq. 4
+        return contact, contact - self.hand.tip_radius * n, n
+
     def reach(
         self,
         index: int,
@@ -180,20 +201,22 @@ class ContactPlanner:
     ) -> ContactPlan | None:
         """The quickest hand configuration that has finger k's tip at the contact spot for
         t_c with every check passed (the plan of collision ``index``), or None."""
-        p, st, hand = self.params, self.stick, self.hand
-        pre = Motion(est)
-        c_c, th_c = pre.pose(t_c)
-        R = sc.rotation(sol.theta)
-        contact = c_c + R @ sol.r_b(st.width)
-        _, n = sc.tangent_normal(sol.theta, sol.side)
-        tip = contact - hand.tip_radius * n
+        p, hand = self.params, self.hand
+        c_c, th_c = Motion(est).pose(t_c)
+        contact, tip, n = self.spot(est, sol, t_c)
         motion = Motion(est, t_c, sol.u_after)
         now = self.model.config
-        times_all = sample_times(t, t_c + p.post_horizon)
-        best: tuple | None = None
-        for k in fingers:
+        sweep_all = Sweep(motion, sample_times(t, t_c + p.post_horizon))
+        # Every base is tried and the quickest arrival wins (ties: the earlier finger, then the
+        # earlier base). A route arrives no sooner than t + the travel time to the contact
+        # posture with the idle finger unmoved (``need``: travel times obey the triangle
+        # inequality and the idle finger's move only adds), so bases are tried in order of that
+        # bound and the search stops once it exceeds the best arrival found.
+        best: tuple | None = None  # (arrival, finger rank, base rank, k, cfg, route)
+        for rank, k in enumerate(fingers):
             j = 1 - k
-            for base in (
+            cands = []
+            for i, base in enumerate(
                 bases
                 if bases is not None
                 else base_candidates(hand, k, tip, tuple(self.model.target.base))
@@ -202,39 +225,49 @@ class ContactPlanner:
                 if q is None:
                     continue
                 cfg = Config(tuple(base), now.joints).with_finger(k, q)
-                passive = self._passive(cfg, j, motion, times_all, tip)
+                cands.append((travel(hand, now, cfg), i, cfg))
+            cands.sort(key=lambda c: (c[0], c[1]))
+            for need, i, cfg in cands:
+                if best is not None and t + need > best[0]:
+                    break  # no later base can arrive sooner
+                if (
+                    t + need > t_c - p.arrive_margin
+                    and need + p.arrive_margin - (t_c - t)
+                    >= shortfall.t_needed - shortfall.t_available
+                ):
+                    continue  # too late, and no nearer miss than the shortfall's best
+                passive = self._passive(cfg, j, sweep_all, tip)
                 if passive is None:
                     continue
                 cfg = cfg.with_finger(j, passive)
                 need = travel(hand, now, cfg)
-                t_arr = t + need
-                if t_arr > t_c - p.arrive_margin:
+                if t + need > t_c - p.arrive_margin:
                     shortfall.note(need + p.arrive_margin, t_c - t)
                     continue
                 found = self.find_route(t, now, cfg, k, motion, t_c, tip, c_c)
                 if found is None:
                     continue
                 route, cost = found
-                if best is None or cost < best[0]:
-                    best = (
-                        cost,
-                        ContactPlan(
-                            index,
-                            k,
-                            t_c,
-                            th_c,
-                            sol,
-                            raw,
-                            contact,
-                            tip,
-                            cfg,
-                            route,
-                            self._exit_after(cfg, k, motion, t_c, tip, n),
-                        ),
-                    )
+                if best is None or (cost, rank, i) < best[:3]:
+                    best = (cost, rank, i, k, cfg, route)
             if best is not None and strict:
                 break
-        return None if best is None else best[1]
+        if best is None:
+            return None
+        _, _, _, k, cfg, route = best
+        return ContactPlan(
+            index,
+            k,
+            t_c,
+            th_c,
+            sol,
+            raw,
+            contact,
+            tip,
+            cfg,
+            route,
+            self._exit_after(cfg, k, motion, t_c, tip, n),
+        )
 
     def find_route(
         self, t: float, now: Config, cfg: Config, k: int, motion: Motion, t_c: float, tip, c_c
@@ -304,12 +337,26 @@ class ContactPlanner:
             return None
         times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
         base, joints = route_configs(hand, starts, frm, to, times)
-        tips = route_tips(hand, base, joints)  # (T, 2, 2)
+        # once every axis is on its target the configuration no longer changes: the tips of
+        # that (bit-identical) tail are those of its first sample
+        flat = np.concatenate([base, joints.reshape(len(times), 4)], axis=1)
+        changing = np.flatnonzero(np.any(flat != flat[-1], axis=1))
+        i0 = int(changing[-1]) + 1 if changing.size else 0
+        tips = np.empty((len(times), 2, 2))
+        tips[: i0 + 1] = route_tips(hand, base[: i0 + 1], joints[: i0 + 1])
+        tips[i0 + 1 :] = tips[i0]
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
         moving = times < arrival
         act = times <= t_c - CONTACT_GUARD
+        c, th = poses = motion.poses(times)
         if covered_along(
-            motion, times[act], tips[act, k], half_l, half_w, hand.tip_radius - 5e-4
+            motion,
+            times[act],
+            tips[act, k],
+            half_l,
+            half_w,
+            hand.tip_radius - 5e-4,
+            poses=(c[act], th[act]),
         ).any():
             return None
         if check_idle:
@@ -319,7 +366,7 @@ class ContactPlanner:
             gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
             on_way = max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
             grow = np.where(moving, on_way, hand.tip_radius + p.sweep_margin)
-            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow).any():
+            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow, poses).any():
                 return None
         return arrival
 
@@ -368,22 +415,26 @@ class ContactPlanner:
             cfg, moved = cfg.with_finger(k, q), True
         return cfg if moved else None
 
-    def _passive(self, cfg: Config, j: int, motion: Motion, times, active_tip):
+    def _passive(self, cfg: Config, j: int, sweep: Sweep, active_tip):
         """The idle finger's joints nearest its current ones whose tip stays clear of the
-        predicted sweep (and of the active tip); None when no posture is clear."""
+        predicted sweep (and of the active tip); None when no posture is clear. Postures are
+        checked nearest first (ties: current, then grid order), the first clear one wins."""
         hand, st, p = self.hand, self.stick, self.params
-        cands = [tuple(cfg.joints[j])] + self._passive_grid
-        tips = np.array([hand2d.finger_tip(hand, cfg.base, j, q) for q in cands])
-        hit = covered(
-            motion, times, tips, 0.5 * st.length, 0.5 * st.width, hand.tip_radius + p.sweep_margin
-        ).any(axis=0)
-        far = (
-            np.linalg.norm(tips - active_tip[None, :], axis=1)
-            > 2.0 * hand.tip_radius + p.sweep_margin
-        )
-        ok = np.flatnonzero(~hit & far)
-        if ok.size == 0:
-            return None
-        cur = np.array(cfg.joints[j])
-        dist = [float(np.max(np.abs(np.array(cands[i]) - cur))) for i in ok]
-        return cands[int(ok[int(np.argmin(dist))])]
+        cur = cfg.joints[j]
+        g = self._grid_reach  # (l1 cos q1, l1 sin q1, l2 cos q12, l2 sin q12) of the grid
+        rx, ry = cfg.base[0] + hand.root_offsets[j][0], cfg.base[1] + hand.root_offsets[j][1]
+        tips = np.empty((1 + len(g[0]), 2))
+        tips[0] = hand2d.finger_tip(hand, cfg.base, j, cur)
+        tips[1:, 0] = (rx + g[0]) + g[2]
+        tips[1:, 1] = (ry + g[1]) + g[3]
+        d = tips - np.asarray(active_tip)[None, :]
+        far = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2) > 2.0 * hand.tip_radius + p.sweep_margin
+        grid = self._grid_q
+        dist = np.empty(len(tips))
+        dist[0] = 0.0
+        dist[1:] = np.maximum(np.abs(grid[:, 0] - cur[0]), np.abs(grid[:, 1] - cur[1]))
+        half_l, half_w, grow = 0.5 * st.length, 0.5 * st.width, hand.tip_radius + p.sweep_margin
+        for i in np.lexsort((np.arange(len(tips)), dist)):
+            if far[i] and not sweep.hits(tips[i], half_l, half_w, grow):
+                return tuple(cur) if i == 0 else self._passive_grid[i - 1]
+        return None

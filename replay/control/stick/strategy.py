@@ -100,18 +100,21 @@ class ThreeStepController(StickCaptureController):
     Params: ClassVar[type] = ThreeStepParams
     description = "Higashimori et al. 2007: 3-step friction independent stick capture"
     n_steps: ClassVar[int] = 2
+    _lam: tuple | None = None  # lambda_2 (unit), -lambda_2 and the centre of the base range
 
     def lambdas(self, est: StickEstimate) -> list[np.ndarray]:
         """lambda_2 (unit), and -lambda_2 first when auto-sign prefers it."""
-        lam = np.asarray(self.params.lambda_2, dtype=float)
-        lam = lam / np.linalg.norm(lam)
+        if self._lam is None:  # (from the params and the spec only)
+            lam = np.asarray(self.params.lambda_2, dtype=float)
+            lam = lam / np.linalg.norm(lam)
+            centre = [0.5 * (lo + hi) for lo, hi in self.hand.base_limits]
+            self._lam = (lam, -lam, centre)
+        lam, neg, centre = self._lam
         if not self.params.lambda_2_auto_sign:
             return [lam]
-        centre = np.array([0.5 * (lo + hi) for lo, hi in self.hand.base_limits])
-        x, y, _ = est.at(est.t_ref)
-        if float(np.dot(lam, centre - np.array([x, y]))) < 0.0:
-            return [-lam, lam]
-        return [lam, -lam]
+        if lam[0] * (centre[0] - est.x) + lam[1] * (centre[1] - est.y) < 0.0:
+            return [neg, lam]
+        return [lam, neg]
 
     def _options(self, est, step):
         st = self.stick

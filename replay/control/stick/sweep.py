@@ -33,17 +33,26 @@ class Motion:
         t = np.asarray(times, dtype=float)
         e = self.est
         t1 = np.minimum(t, self.t_switch) - e.t_ref
-        c = np.column_stack([e.x + e.vx * t1, e.y + e.vy * t1])
+        c = np.empty(t.shape + (2,))
+        c[..., 0] = e.x + e.vx * t1
+        c[..., 1] = e.y + e.vy * t1
         th = e.theta + e.omega * t1
         if math.isfinite(self.t_switch):
             t2 = np.maximum(t - self.t_switch, 0.0)
-            c = c + np.column_stack([self.u_after[0] * t2, self.u_after[1] * t2])
+            c[..., 0] += self.u_after[0] * t2
+            c[..., 1] += self.u_after[1] * t2
             th = th + self.u_after[2] * t2
         return c, th
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
-        c, th = self.poses([t])
-        return c[0], float(th[0])
+        e, ts = self.est, self.t_switch
+        t1 = min(t, ts) - e.t_ref
+        x, y, th = e.x + e.vx * t1, e.y + e.vy * t1, e.theta + e.omega * t1
+        if math.isfinite(ts):
+            t2 = max(t - ts, 0.0)
+            u = self.u_after
+            x, y, th = x + u[0] * t2, y + u[1] * t2, th + u[2] * t2
+        return np.array([x, y]), float(th)
 
 
 def _body(motion: Motion, times, points) -> tuple[np.ndarray, np.ndarray]:
@@ -65,11 +74,11 @@ def covered(
 
 
 def covered_along(
-    motion: Motion, times, points, half_length: float, half_width: float, grow
+    motion: Motion, times, points, half_length: float, half_width: float, grow, poses=None
 ) -> np.ndarray:
     """(T,) booleans: points[i] (a moving point, (T, 2)) within ``grow`` of the stick at
-    times[i]; ``grow`` a scalar or (T,)."""
-    c, th = motion.poses(times)
+    times[i]; ``grow`` a scalar or (T,); ``poses``: ``motion.poses(times)`` if already made."""
+    c, th = motion.poses(times) if poses is None else poses
     d = np.asarray(points, dtype=float) - c
     cs, sn = np.cos(th), np.sin(th)
     xb = d[:, 0] * cs + d[:, 1] * sn
@@ -82,3 +91,48 @@ def sample_times(t0: float, t1: float) -> np.ndarray:
     if t1 <= t0:
         return np.array([t0])
     return np.linspace(t0, t1, max(2, int(math.ceil((t1 - t0) / SAMPLE_DT)) + 1))
+
+
+class Sweep:
+    """The stick's poses at fixed sample times, for many "is this fixed point ever covered"
+    questions (the same answer as :func:`covered`, asked one point at a time).
+
+    A point farther from the centre's whole path (two straight segments: before and after the
+    switch) than the rectangle's corner reach cannot be covered at any sample, so it is answered
+    without sampling; the others are tested at every sample time."""
+
+    def __init__(self, motion: Motion, times) -> None:
+        self.motion = motion
+        self.times = np.asarray(times, dtype=float)
+        self._poses: tuple | None = None
+        e, t0, t1 = motion.est, float(self.times[0]), float(self.times[-1])
+        ts = min(max(motion.t_switch, t0), t1)
+        a = np.array([e.x + e.vx * (t0 - e.t_ref), e.y + e.vy * (t0 - e.t_ref)])
+        b = np.array([e.x + e.vx * (ts - e.t_ref), e.y + e.vy * (ts - e.t_ref)])
+        c = b + np.array(motion.u_after[:2]) * (t1 - ts) if t1 > motion.t_switch else b
+        self._segments = ((a, b), (b, c))
+
+    def _near_path(self, point, reach: float) -> bool:
+        p = np.asarray(point, dtype=float)
+        for a, b in self._segments:
+            ab = b - a
+            ll = float(ab @ ab)
+            s = 0.0 if ll == 0.0 else min(1.0, max(0.0, float((p - a) @ ab) / ll))
+            d = p - (a + s * ab)
+            if float(d @ d) <= reach * reach:
+                return True
+        return False
+
+    def hits(self, point, half_length: float, half_width: float, grow: float) -> bool:
+        """``point`` within ``grow`` of the stick rectangle at some sample time."""
+        hl, hw = half_length + grow, half_width + grow
+        if not self._near_path(point, math.hypot(hl, hw) * (1.0 + 1e-9) + 1e-12):
+            return False
+        if self._poses is None:
+            c, th = self.motion.poses(self.times)
+            self._poses = (c, np.cos(th), np.sin(th))
+        c, cs, sn = self._poses
+        d0, d1 = point[0] - c[:, 0], point[1] - c[:, 1]
+        xb = d0 * cs + d1 * sn
+        yb = -d0 * sn + d1 * cs
+        return bool(((np.abs(xb) <= hl) & (np.abs(yb) <= hw)).any())

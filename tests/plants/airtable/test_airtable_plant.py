@@ -378,3 +378,28 @@ def test_outcome_stopped_elsewhere_or_never_in_reach():
     run(plant, 300)
     o = plant.outcome(plant.time)
     assert o["reason"] == "not captured: the stick never came within the hand's reach"
+
+
+def test_state_reads_equal_pymunks_own_properties():
+    """The plant reads body state through Chipmunk's calls (no Vec2d): the same numbers as
+    Pymunk's properties, and the logged state is the bodies' after each step."""
+    import pymunk
+
+    from plants.airtable import body_state
+
+    b = pymunk.Body(0.0225, 3.2e-5)
+    b.position, b.velocity, b.angle, b.angular_velocity = (0.1, -0.2), (0.3, 0.4), 0.5, -6.0
+    assert body_state.pose_reader(b)() == (*b.position, *b.velocity, b.angle, b.angular_velocity)
+    assert body_state.position_reader(b)() == tuple(b.position)
+    body_state.velocity_setter(b)(-1.5, 2.5)
+    assert tuple(b.velocity) == (-1.5, 2.5)
+
+    plant = AirTablePlant(far_stick_params(vx=0.7, omega=3.0), dt=DT)
+    plant.apply(HandCommand((0.05, 0.02), ((1.8, -0.8), (1.2, 0.9))))  # the hand moving
+    for _ in range(30):
+        plant.step()
+        s, f = plant.truth(plant.time)["/stick/state"], plant.truth(plant.time)["/fingers/state"]
+        sb = plant.stick_body
+        assert (s.x, s.y, s.vx, s.vy) == (*sb.position, *sb.velocity)
+        assert (s.theta, s.omega) == (sb.angle, sb.angular_velocity)
+        assert f.tips == [list(tb.position) for tb in plant.tip_bodies]

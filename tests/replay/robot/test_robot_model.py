@@ -235,3 +235,24 @@ def test_batched_functions_equal_the_single_ones(dof):
         np.testing.assert_allclose(tau[k], c.rnea(Q[k], QD[k], QDD[k]), atol=1e-11)
         np.testing.assert_allclose(h[k], c.coriolis(Q[k], QD[k]), atol=1e-11)
         np.testing.assert_allclose(P[k], c.tool_position(Q[k]), atol=1e-14)
+
+
+@pytest.mark.parametrize("dof", [4, 7])
+def test_float_kinematics_and_rnea_equal_the_matrix_forms(dof):
+    """The one-configuration path (frames per column in floats, remembered for the last few q)
+    against 4x4 products and the batched RNEA, with configurations revisited in another order
+    so that a remembered frame set can never stand in for another q."""
+    rng = np.random.default_rng(9)
+    c = wam_chain(dof).with_payload(hand_body(CATCH3))
+    Q = random_q(rng, dof, 12)
+    QD, QDD = rng.uniform(-3, 3, Q.shape), rng.uniform(-20, 20, Q.shape)
+    tau_ref = c.rnea_batch(Q, QD, QDD)
+    pt = np.array([0.01, -0.02, 0.05, 1.0])
+    pt_last = tuple((c.tool @ pt)[:3].tolist())
+    order = list(range(len(Q))) + list(rng.permutation(len(Q))) + [0, 0, 1, 0]
+    for k in order:
+        np.testing.assert_allclose(c.rnea(Q[k], QD[k], QDD[k]), tau_ref[k], rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(
+            c.point(Q[k], pt_last), (c.frames(Q[k])[-1] @ c.tool @ pt)[:3], atol=1e-12
+        )
+    assert len(c._memo) <= 4
