@@ -9,8 +9,12 @@ from collections import defaultdict
 from pathlib import Path
 
 import click
+import numpy as np
 
+from replay import completion as complete
 from replay import registry
+from replay.console import RunProgress, bar, bars_on, fail, note, warn
+from replay.interfaces import Plant
 from replay.log import LogError, LogReader
 from replay.log.writer import check_output
 from replay.papers import PAPERS
@@ -23,37 +27,13 @@ DEFAULT_LOG_DIR = Path("out/logs")
 DEFAULT_FIGURE_DIR = Path("out/figures")
 
 
-def _fail(message: str, code: int = 2) -> None:
-    click.echo(f"error: {one_line(message)}", err=True)
-    sys.exit(code)
-
-
-def _warn(message: str) -> None:
-    click.echo(f"warning: {one_line(message)}", err=True)
-
-
-class _Progress:
-    """A one-line progress display on a terminal; silent elsewhere or with --quiet."""
-
-    def __init__(self, label: str, enabled: bool) -> None:
-        self.label = label
-        self.enabled = enabled and sys.stderr.isatty()
-
-    def __call__(self, t: float, duration: float) -> None:
-        if self.enabled:
-            frac = min(1.0, t / duration) if duration > 0 else 1.0
-            bar = "#" * int(frac * 30)
-            sys.stderr.write(f"\r{self.label} [{bar:<30}] t = {t:6.3f} / {duration:.3f} s")
-            sys.stderr.flush()
-
-    def done(self) -> None:
-        if self.enabled:
-            sys.stderr.write("\r\x1b[2K")
-            sys.stderr.flush()
+_NoArgsIsHelp = getattr(click.exceptions, "NoArgsIsHelpError", ())  # click >= 8.2
 
 
 class _Group(click.Group):
-    """Ctrl-C outside a run (loading, reading logs, figures) exits 130 quietly, not "Aborted!"."""
+    """Ctrl-C outside a run (loading, reading logs, figures) exits 130 quietly, not "Aborted!";
+    a usage error (a missing argument, an unknown option, a bad option value) is one line with
+    the same ``error:`` prefix as every other user error, exit code 2."""
 
     def invoke(self, ctx):
         try:
@@ -61,6 +41,24 @@ class _Group(click.Group):
         except KeyboardInterrupt:
             click.echo("interrupted", err=True)
             sys.exit(130)
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except _NoArgsIsHelp as exc:  # `replay` or `replay golden` alone: the help
+            exc.show()
+            sys.exit(exc.exit_code)
+        except click.UsageError as exc:
+            where = exc.ctx.command_path if exc.ctx else "replay"
+            fail(f"{exc.format_message()} (see `{where} --help`)", code=exc.exit_code)
+        except click.ClickException as exc:
+            fail(exc.format_message(), code=exc.exit_code)
+        except click.Abort:
+            click.echo("interrupted", err=True)
+            sys.exit(130)
+        sys.exit(code if isinstance(code, int) else 0)
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -73,11 +71,11 @@ def _load(path: str, sets=(), seed=None):
     try:
         return load_scenario(find_scenario(path), sets=list(sets), seed=seed)
     except ScenarioError as exc:
-        _fail(str(exc))
+        fail(str(exc))
 
 
 @main.command()
-@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
 @click.option("-o", "--out", type=click.Path(), help="log path (default out/logs/NAME.mcap)")
 @click.option(
     "--set",
@@ -87,7 +85,7 @@ def _load(path: str, sets=(), seed=None):
     help="override a scenario field (repeatable)",
 )
 @click.option("--seed", type=int, help="override the scenario's seed")
-@click.option("-q", "--quiet", is_flag=True, help="no progress, only errors")
+@click.option("-q", "--quiet", is_flag=True, help="no progress bar and no summary, only errors")
 @click.option(
     "--view",
     is_flag=True,
@@ -101,7 +99,7 @@ def run(scenario, out, sets, seed, quiet, view):
     sc = _load(scenario, sets, seed)
     out = Path(out) if out else DEFAULT_LOG_DIR / f"{sc.name}.mcap"
     _check_log_path(out, sc)
-    progress = _Progress(sc.name, not quiet)
+    progress = RunProgress(sc.name, bars_on(quiet))
     runner = _runner(scenario, sc, Runner, progress=progress)
     live = _live_viewer() if view else None
     if live:
@@ -121,20 +119,21 @@ def run(scenario, out, sets, seed, quiet, view):
         progress.done()
         if live:
             live.stop()
-        _fail(str(exc))
+        fail(str(exc))
     except Exception as exc:  # noqa: BLE001 - a plug-in failed mid-run: one line, the .part kept
         progress.done()
         if live:
             live.stop()
         part = out.with_name(out.name + ".part")
-        _fail(f"the run failed: {type(exc).__name__}: {exc}; partial log: {part}", code=1)
+        fail(f"the run failed: {type(exc).__name__}: {exc}; partial log: {part}", code=1)
     progress.done()
     failed = result.stopped_by == "error"
     if failed and not live:
-        _fail(f"{result.error} at t = {result.t_end:.4f} s; log kept: {result.path}", code=1)
+        fail(f"{result.error} at t = {result.t_end:.4f} s; log kept: {result.path}", code=1)
     if failed:
         click.echo(
-            f"error: {result.error} at t = {result.t_end:.4f} s; log kept: {result.path}", err=True
+            f"error: {one_line(result.error)} at t = {result.t_end:.4f} s; log kept: {result.path}",
+            err=True,
         )
     if not quiet and not failed:
         events = ", ".join(f"{k} x{n}" for k, n in sorted(result.events.items())) or "none"
@@ -154,13 +153,13 @@ def _check_log_path(out: Path, sc) -> None:
     try:
         target = out.resolve()
     except (OSError, RuntimeError) as exc:
-        _fail(f"bad log path {out}: {exc}")
+        fail(f"bad log path {out}: {exc}")
     if target in set(getattr(sc, "inputs", ())):
-        _fail(f"will not write the log over the scenario file {out} (give another -o)")
+        fail(f"will not write the log over the scenario file {out} (give another -o)")
     try:
         check_output(out)
     except LogError as exc:
-        _fail(str(exc))
+        fail(str(exc))
 
 
 _REFUSED = (ValueError, TypeError, KeyError, IndexError, ArithmeticError, OSError, LogError)
@@ -191,7 +190,7 @@ def _runner(scenario: str, sc, Runner, **kw):
     try:
         return Runner(sc, **kw)
     except _REFUSED as exc:
-        _fail(_refusal(scenario, exc))
+        fail(_refusal(scenario, exc))
 
 
 def _quiet_websockets() -> None:
@@ -219,7 +218,7 @@ def _warn_if_exposed(host: str) -> None:
     except ValueError:
         local = host == "localhost"
     if not local:
-        _warn(
+        warn(
             f"serving on {host}: anyone who can reach this machine on the network can see "
             "the viewer (use --host 127.0.0.1 to keep it local)"
         )
@@ -233,9 +232,9 @@ def _live_viewer():
     try:
         live = LiveSession()
     except ViewerError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     if live.viewer.port_note:
-        click.echo(f"note: {live.viewer.port_note}", err=True)
+        note(live.viewer.port_note)
     click.echo(f"viewer: {live.url}  (live while the run computes)", err=True)
     return live
 
@@ -244,27 +243,28 @@ def _replay_live(live, log: Path) -> None:
     from replay.viewer import ViewerError
 
     if live.error:
-        click.echo(f"warning: {live.error}", err=True)
+        warn(live.error)
     try:
         live.finish(log)
     except ViewerError as exc:
         live.stop()
-        _fail(str(exc))
-    for note in live.viewer.notes:
-        click.echo(f"warning: {note}", err=True)
+        fail(str(exc))
+    for text in live.viewer.notes:
+        warn(text)
     click.echo(f"viewer: {live.url}  (replaying {log}; Ctrl-C to stop)", err=True)
     live.wait()
 
 
 @main.command()
-@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
 @click.option(
     "-o",
     "--out",
     type=click.Path(dir_okay=False),
     help="where to write (default: the controller's alpha_file)",
 )
-def optimise(scenario, out):
+@click.option("-q", "--quiet", is_flag=True, help="no progress bar")
+def optimise(scenario, out, quiet):
     """Run a controller's offline optimisation from scratch and store its result where the
     scenario reads it (the catching mapping's alpha, eq. 25)."""
     from replay.runner import Runner
@@ -272,32 +272,47 @@ def optimise(scenario, out):
     sc = _load(scenario)
     stored = getattr(sc.controller.params, "alpha_file", None)
     if stored is None:
-        _fail(f"controller {sc.controller.type!r} has no offline optimisation to store")
+        fail(f"controller {sc.controller.type!r} has no offline optimisation to store")
     if not (out or stored):
-        _fail("the scenario sets no controller.params.alpha_file: give -o FILE")
+        fail("the scenario sets no controller.params.alpha_file: give -o FILE")
     base = getattr(sc.controller.params, "scenario_dir", "")  # files resolve from the scenario
     path = Path(out) if out else Path(base, stored).resolve() if base else Path(stored)
     if path.resolve() in set(sc.inputs) or path.suffix in (".yaml", ".yml", ".mcap"):
-        _fail(
+        fail(
             f"will not write the optimisation over {path} (a scenario or a log): give -o FILE.json"
         )
     try:
         check_output(path, kind="optimisation result", magic=b"{")
     except LogError as exc:
-        _fail(str(exc))
-    runner = _runner(scenario, _load(scenario, ["controller.params.alpha_file=''"]), Runner)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        runner.controller.write_alpha_file(path)
-    except OSError as exc:
-        _fail(f"cannot write {path}: {exc.strerror or exc}")
-    finally:
-        runner.plant.close()
+        fail(str(exc))
+    # built without its mapping (mapping: initial) so that the optimisation runs here, from
+    # scratch, under a progress bar of its iterations
+    fresh = ["controller.params.alpha_file=''"]
+    if hasattr(sc.controller.params, "mapping"):
+        fresh.append("controller.params.mapping=initial")
+    runner = _runner(scenario, _load(scenario, fresh), Runner)
+    iterations = int(getattr(sc.controller.params, "max_iterations", 0) or 0) or None
+    with bar(iterations, "optimise", unit="it", enabled=bars_on(quiet)) as progress:
+
+        def step(record) -> None:
+            if record.iteration:
+                progress.update(1)
+            progress.set_postfix(cost=f"{record.objective:.4g}", refresh=False)
+
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            runner.controller.write_alpha_file(path, progress=step)
+        except OSError as exc:
+            fail(f"cannot write {path}: {exc.strerror or exc}")
+        finally:
+            runner.plant.close()
     click.echo(f"wrote {path}")
 
 
 @main.command()
-@click.argument("scenarios", nargs=-1, type=click.Path(dir_okay=False))
+@click.argument(
+    "scenarios", nargs=-1, type=click.Path(dir_okay=False), shell_complete=complete.scenario
+)
 @click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
 @click.option(
     "--static",
@@ -317,7 +332,7 @@ def validate(scenarios, sets, static):
         try:
             sc = load_scenario(find_scenario(p), sets=list(sets))
         except ScenarioError as exc:
-            click.echo(f"error: {exc}", err=True)
+            click.echo(f"error: {one_line(str(exc))}", err=True)
             bad += 1
             continue
         if not static:
@@ -414,7 +429,7 @@ def _reader(path: str) -> LogReader:
     try:
         return LogReader(path).check()
     except LogError as exc:
-        _fail(str(exc))
+        fail(str(exc))
 
 
 def _log_notes(name: str, r: LogReader) -> list[str]:
@@ -465,8 +480,8 @@ def info(log):
         t = e.get("t")
         t = f"{t:8.4f}" if isinstance(t, (int, float)) else f"{'?':>8}"
         click.echo(one_line(f"  t = {t} s  {e['kind']:<12} {brief}"))
-    for note in _log_notes(log, r):
-        _warn(note)
+    for text in _log_notes(log, r):
+        warn(text)
 
 
 @main.command()
@@ -509,13 +524,13 @@ def view(logs, host, port, speed, timeout):
     try:
         viewer = Viewer.open(logs, host=host, port=port, speed=speed)
     except ViewerError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     if named:
         _warn_if_exposed(host)  # a name: once it resolved (a bad one stays one line)
     if viewer.port_note:
-        click.echo(f"note: {viewer.port_note}", err=True)
-    for note in viewer.notes:
-        click.echo(f"warning: {note}", err=True)
+        note(viewer.port_note)
+    for text in viewer.notes:
+        warn(text)
     click.echo(f"viewer: {viewer.url}  (Ctrl-C to stop)")
     viewer.wait(timeout)
 
@@ -533,17 +548,17 @@ def _short(v) -> str:
 def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
     paths = logs or sorted(str(p) for p in DEFAULT_LOG_DIR.glob("*.mcap"))
     if not paths:
-        _fail(f"no logs given and none in {DEFAULT_LOG_DIR}/ (run `replay run SCENARIO` first)")
+        fail(f"no logs given and none in {DEFAULT_LOG_DIR}/ (run `replay run SCENARIO` first)")
     by_paper: dict[str, dict[str, LogReader]] = defaultdict(dict)
     for p in paths:
         r = _reader(p)
         try:
             sc = r.scenario()
         except LogError as exc:
-            _fail(str(exc))
+            fail(str(exc))
         paper, name = sc.get("paper"), sc.get("name")
         if not (isinstance(paper, str) and paper and isinstance(name, str) and name):
-            _fail(f"{p}: its /scenario message names no paper or scenario (not a run log?)")
+            fail(f"{p}: its /scenario message names no paper or scenario (not a run log?)")
         by_paper[paper][name] = r
     return by_paper
 
@@ -561,7 +576,7 @@ def _partial(readers: dict[str, LogReader]) -> dict[str, list[str]]:
 def _analysis_failed(what: str, paper: str, readers, exc: Exception) -> None:
     partial = _partial(readers)
     why = f" (partial logs: {', '.join(partial)})" if partial else ""
-    _fail(
+    fail(
         f"{what} for {paper} could not be made from {', '.join(readers)}{why}: "
         f"{type(exc).__name__}: {exc}",
         code=1,
@@ -583,25 +598,25 @@ def figures(logs, out):
     try:
         Path(out).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        _fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+        fail(f"cannot write figures to {out}: {exc.strerror or exc}")
     for paper, readers in by_paper.items():
         try:
             make = registry.load("figures", paper)
         except registry.UnknownPlugin:
-            click.echo(f"{paper}: no figures defined yet ({', '.join(readers)})", err=True)
+            warn(f"{paper}: no figures defined yet ({', '.join(readers)})")
             continue
         try:
             paths = make(readers, Path(out))
         except OSError as exc:
-            _fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+            fail(f"cannot write figures to {out}: {exc.strerror or exc}")
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("figures", paper, readers, exc)
         for path in paths:
             click.echo(f"figure: {path}")
         for name, notes in _partial(readers).items():
-            for note in notes:
-                _warn(
-                    f"{name} is not a finished run ({note}): its figures show only what was logged"
+            for text in notes:
+                warn(
+                    f"{name} is not a finished run ({text}): its figures show only what was logged"
                 )
 
 
@@ -618,12 +633,12 @@ def claims(logs, markdown):
     if markdown and (
         Path(markdown).resolve() in inputs or Path(markdown).suffix in (".mcap", ".yaml", ".yml")
     ):
-        _fail(f"will not write the claims table over {markdown} (a log or a scenario)")
+        fail(f"will not write the claims table over {markdown} (a log or a scenario)")
     for paper, readers in by_paper.items():
         try:
             evaluate = registry.load("claims", paper)
         except registry.UnknownPlugin:
-            click.echo(f"{paper}: no claims defined yet", err=True)
+            warn(f"{paper}: no claims defined yet")
             continue
         try:
             rows = evaluate(readers)
@@ -638,7 +653,7 @@ def claims(logs, markdown):
             Path(markdown).parent.mkdir(parents=True, exist_ok=True)
             Path(markdown).write_text(text + "\n")
         except OSError as exc:
-            _fail(f"cannot write {markdown}: {exc.strerror or exc}")
+            fail(f"cannot write {markdown}: {exc.strerror or exc}")
 
 
 @main.group()
@@ -652,18 +667,19 @@ def _goldens(names):
     try:
         table = load_manifest()
     except FileNotFoundError:
-        _fail("no golden manifest shipped (data/golden/manifest.yaml is missing)")
+        fail("no golden manifest shipped (data/golden/manifest.yaml is missing)")
     except ManifestError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     unknown = [n for n in names if n not in table]
     if unknown:
-        _fail(f"unknown golden log {unknown[0]!r} (known: {', '.join(table)})")
+        fail(f"unknown golden log {unknown[0]!r} (known: {', '.join(table)})")
     return [table[n] for n in (names or table)]
 
 
 @golden.command("check")
-@click.argument("names", nargs=-1)
-def golden_check(names):
+@click.argument("names", nargs=-1, shell_complete=complete.golden)
+@click.option("-q", "--quiet", is_flag=True, help="no progress bars")
+def golden_check(names, quiet):
     """Re-run each golden scenario and compare it with its stored log."""
     from replay.golden import check
 
@@ -675,12 +691,15 @@ def golden_check(names):
             )
             failed += 1
             continue
+        progress = RunProgress(g.name, bars_on(quiet))
         try:
-            diffs = check(g)
+            diffs = check(g, progress=progress)
         except (LogError, ScenarioError) as exc:
             failed += 1
             click.echo(one_line(f"FAIL {g.name}: {exc}"))
             continue
+        finally:
+            progress.done()
         if diffs:
             failed += 1
             click.echo(f"FAIL {g.name}: first difference: {diffs[0]}")
@@ -693,18 +712,94 @@ def golden_check(names):
 
 
 @golden.command("update")
-@click.argument("names", nargs=-1, required=True)
-def golden_update(names):
+@click.argument("names", nargs=-1, required=True, shell_complete=complete.golden)
+@click.option("-q", "--quiet", is_flag=True, help="no progress bars")
+def golden_update(names, quiet):
     """Rewrite golden logs; commit them with the reason in the message."""
     from replay.golden import update
 
     for g in _goldens(names):
+        progress = RunProgress(g.name, bars_on(quiet))
         try:
-            path = update(g)
+            path = update(g, progress=progress)
         except (LogError, ScenarioError) as exc:
-            _fail(f"{g.name}: {exc}")
+            fail(f"{g.name}: {exc}")
+        finally:
+            progress.done()
         click.echo(f"updated {path} ({path.stat().st_size / 1024:.0f} KiB)")
-    click.echo("commit the golden logs with the reason for the change in the commit message")
+    note("commit the golden logs with the reason for the change in the commit message")
+
+
+def _write_output(path: Path, text: str, *, kind: str, magic: bytes) -> None:
+    """Write ``text`` to ``path`` (mode 0644, atomically); never over a scenario, a log or a
+    file that is not an earlier output of this kind (one that starts with ``magic``)."""
+    import os
+    import tempfile
+
+    if path.suffix in (".yaml", ".yml", ".mcap"):
+        fail(f"will not write the {kind} over {path} (a scenario or a log): give another -o")
+    try:
+        check_output(path, kind=kind, magic=magic)
+    except LogError as exc:
+        fail(str(exc))
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except OSError as exc:
+        fail(f"cannot write {path}: {exc.strerror or exc}")
+
+
+@main.command()
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(dir_okay=False),
+    help="write it to this file (default: stdout); docs/cli.md says how to hook it to an editor",
+)
+def schema(out):
+    """The scenario format as a JSON Schema (every field with its unit, range and default;
+    plug-in types as enums, each plug-in's params), for editors that complete and check YAML."""
+    import json
+
+    from replay.scenario.json_schema import scenario_schema
+
+    text = json.dumps(scenario_schema(), indent=1) + "\n"
+    if not out:
+        click.echo(text, nl=False)
+        return
+    _write_output(Path(out), text, kind="JSON Schema", magic=b"{")
+    click.echo(f"wrote {out}")
+
+
+@main.command()
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
+@click.option(
+    "-o", "--out", type=click.Path(dir_okay=False), required=True, help="the URDF file to write"
+)
+@click.option("--set", "sets", multiple=True, metavar="KEY.PATH=VALUE")
+def urdf(scenario, out, sets):
+    """Write the robot of SCENARIO's plant as URDF (what the simulator loads), e.g. for
+    Foxglove, RViz or yourdfpy."""
+    sc = _load(scenario, sets)
+    cls = registry.load("plant", sc.plant.type)
+    describe = getattr(cls, "robot_description", None)  # the URDF text, or None
+    if describe is None or describe is getattr(Plant, "robot_description", None):
+        fail(f"{scenario}: plant {sc.plant.type!r} has no URDF (its robot is not a URDF model)")
+    try:
+        plant = cls(sc.plant.params, dt=1.0 / sc.timing.physics_rate, rng=np.random.default_rng(0))
+    except _REFUSED as exc:
+        fail(_refusal(scenario, exc))
+    try:
+        text = plant.robot_description()
+    finally:
+        plant.close()
+    if not text:
+        fail(f"{scenario}: plant {sc.plant.type!r} has no URDF")
+    _write_output(Path(out), text, kind="URDF", magic=b"<?xml")
+    click.echo(f"wrote {out}")
 
 
 from replay.sweep.commands import register  # noqa: E402  (replay sweep, ablate, report)

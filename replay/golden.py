@@ -11,6 +11,7 @@ import math
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import yaml
 
@@ -135,9 +136,13 @@ def load_manifest(root: Path | None = None) -> dict[str, Golden]:
     return out
 
 
-def run_golden(g: Golden, out: Path) -> Path:
+Progress = Callable[[float, float], None]  # the runner's progress(t, duration) hook
+
+
+def run_golden(g: Golden, out: Path, progress: Progress | None = None) -> Path:
+    """Run ``g``'s scenario into ``out``; ``progress(t, duration)`` as the runner's hook."""
     sc = load_scenario(g.scenario, sets=g.sets)
-    Runner(sc).run(out)
+    Runner(sc, progress=progress).run(out)
     return out
 
 
@@ -211,17 +216,17 @@ def compare_logs(
     return diffs
 
 
-def check(g: Golden) -> list[Difference]:
+def check(g: Golden, progress: Progress | None = None) -> list[Difference]:
     """The differences of a fresh run from the stored log. Raises :class:`LogError` when the
     stored log cannot be read at all, ``ScenarioError`` when its scenario is bad."""
     with tempfile.TemporaryDirectory() as tmp:
-        out = run_golden(g, Path(tmp) / f"{g.name}.mcap")
+        out = run_golden(g, Path(tmp) / f"{g.name}.mcap", progress)
         try:
             return compare_logs(g.log, out, g.tolerances, g.default_tolerance)
         except LogError as exc:
             raise LogError(f"stored golden log: {exc}") from None
 
 
-def update(g: Golden) -> Path:
+def update(g: Golden, progress: Progress | None = None) -> Path:
     g.log.parent.mkdir(parents=True, exist_ok=True)
-    return run_golden(g, g.log)
+    return run_golden(g, g.log, progress)

@@ -8,9 +8,11 @@ Foxglove. Topic names and field names are a contract: add topics and fields, ren
 from __future__ import annotations
 
 import dataclasses
+import enum
+import types
 import typing
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 
@@ -57,6 +59,32 @@ TOPIC_ROBOT_DESCRIPTION = "/robot_description"  # the URDF, once at t = 0
 TOPIC_LOG = "/log"  # foxglove.Log: the /events as log lines
 
 
+@dataclass(frozen=True)
+class Length:
+    """``Annotated[list[float], Length(3)]``: a list of exactly ``n`` items in the schema;
+    ``empty=True``: or ``[]`` (nothing measured yet)."""
+
+    n: int
+    empty: bool = False
+
+
+@dataclass(frozen=True)
+class OneOf:
+    """``Annotated[str, OneOf("a", "b")]``: an enum in the schema, a plain ``str`` to mypy (a
+    ``Literal`` would make every assignment from a ``str`` variable a type error)."""
+
+    values: tuple
+
+    def __init__(self, *values: Any) -> None:
+        object.__setattr__(self, "values", values)
+
+
+Vec2 = Annotated[list[float], Length(2)]  # [x, y] or [u, v]
+Vec3 = Annotated[list[float], Length(3)]  # [x, y, z] (m, m/s, rad/s, N, N*m)
+Quat = Annotated[list[float], Length(4)]  # [qx, qy, qz, qw]
+Pose6 = Annotated[list[float], Length(6)]  # [x, y, z, roll, pitch, yaw]
+
+
 @dataclass
 class ScenarioInfo:
     t: float
@@ -71,7 +99,7 @@ class ScenarioInfo:
 class Event:
     t: float
     kind: str  # collision, catch, grasp, release, infeasible, rest, ...
-    data: dict = field(default_factory=dict)
+    data: dict[str, Any] = field(default_factory=dict)  # per kind (docs/DESIGN.md)
 
 
 @dataclass
@@ -88,7 +116,7 @@ class StickState:
 @dataclass
 class FingersState:
     t: float
-    tips: list  # [[x, y], [x, y]] fingertip centres (m)
+    tips: list[Vec2]  # [[x, y], [x, y]] fingertip centres (m)
 
 
 @dataclass
@@ -102,40 +130,40 @@ class VisionStick:
 @dataclass
 class JointState:
     t: float
-    name: list
-    position: list
-    velocity: list
-    effort: list
+    name: list[str]
+    position: list[float]
+    velocity: list[float]
+    effort: list[float]
 
 
 @dataclass
 class JointCommand:
     t: float
-    position: list  # q_d (rad)
-    torque: list  # (N*m)
+    position: list[float]  # q_d (rad)
+    torque: list[float]  # (N*m)
 
 
 @dataclass
 class ObjectState:
     t: float
-    position: list
-    orientation: list  # [qx, qy, qz, qw]
-    velocity: list
-    angular_velocity: list
+    position: Vec3
+    orientation: Quat
+    velocity: Vec3
+    angular_velocity: Vec3
 
 
 @dataclass
 class EffectorState:
     t: float
-    position: list
-    desired_position: list
+    position: Vec3
+    desired_position: Vec3
 
 
 @dataclass
 class VisionObject:
     t: float
-    position: list  # measured [x, y, z] (m)
-    features: dict = field(default_factory=dict)
+    position: Vec3  # measured [x, y, z] (m)
+    features: dict[str, Any] = field(default_factory=dict)  # the sensor's own (centroids, ...)
 
 
 @dataclass
@@ -146,12 +174,48 @@ class OptimizationCost:
     velocity_cost: float
 
 
+@dataclass
+class HandState:
+    """``/hand/state``: the air table's hand (Higashimori et al. 2007, Sec. IV-A): XY base (m)
+    and the two fingers' joint angles [[q1, q2], [q1, q2]] (rad), actual and target."""
+
+    t: float
+    base: Vec2
+    joints: Annotated[list[Vec2], Length(2)]
+    base_target: Vec2
+    joint_targets: Annotated[list[Vec2], Length(2)]
+
+
+@dataclass
+class StickEstimateMessage:
+    """``/control/stick_estimate``: the stick controllers' phase and, once the estimator has a
+    fit, the stick's state at ``t`` from the fit made at ``t_ref`` over ``n`` images, with the
+    fit's residuals (m, rad)."""
+
+    t: float
+    phase: Annotated[str, OneOf("observe", "approach", "close", "captured")]
+    step: int  # index of the next collision
+    ready: bool
+    t_ref: float | None = None
+    x: float | None = None
+    y: float | None = None
+    theta: float | None = None
+    vx: float | None = None
+    vy: float | None = None
+    omega: float | None = None
+    n: int | None = None
+    rms_xy: float | None = None
+    rms_theta: float | None = None
+
+
 # topic -> payload type, for the contract topics
 TOPICS: dict[str, type] = {
     TOPIC_SCENARIO: ScenarioInfo,
     TOPIC_EVENTS: Event,
     TOPIC_STICK_STATE: StickState,
     TOPIC_FINGERS_STATE: FingersState,
+    TOPIC_HAND_STATE: HandState,
+    TOPIC_STICK_ESTIMATE: StickEstimateMessage,
     TOPIC_VISION_STICK: VisionStick,
     TOPIC_ARM_JOINT_STATE: JointState,
     TOPIC_HAND_JOINT_STATE: JointState,
@@ -162,28 +226,75 @@ TOPICS: dict[str, type] = {
     TOPIC_OPTIMIZATION_COST: OptimizationCost,
 }
 
-_JSON_TYPES = {
-    float: "number",
-    int: "integer",
-    str: "string",
-    bool: "boolean",
-    list: "array",
-    dict: "object",
-}
+_SCALARS = {float: "number", int: "integer", str: "string", bool: "boolean"}
+
+
+def type_schema(tp: Any) -> dict[str, Any]:
+    """The JSON schema of one annotated type: scalars, ``list[X]`` (``items``), ``tuple``
+    (fixed or ``...``), ``Annotated[..., Length(n)]``, ``Annotated[str, OneOf(...)]``, ``dict[str, X]``, ``X | None``,
+    ``Literal``, ``Enum`` and nested dataclasses. ``Any`` is any JSON value. A bare ``list`` or
+    ``dict`` gives a loose schema (no ``items``): annotate what it holds."""
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if origin is Annotated:
+        out = type_schema(args[0])
+        for meta in args[1:]:
+            if isinstance(meta, Length) and meta.empty:
+                out["anyOf"] = [{"maxItems": 0}, {"minItems": meta.n, "maxItems": meta.n}]
+            elif isinstance(meta, Length):
+                out.update(minItems=meta.n, maxItems=meta.n)
+            elif isinstance(meta, OneOf):
+                out = {"enum": list(meta.values)}
+        return out
+    if tp is Any:
+        return {}
+    if tp in _SCALARS:
+        return {"type": _SCALARS[tp]}
+    if tp is type(None):
+        return {"type": "null"}
+    if origin in (typing.Union, types.UnionType):
+        return {"anyOf": [type_schema(a) for a in args]}
+    if origin is typing.Literal:
+        return {"enum": list(args)}
+    if isinstance(tp, type) and issubclass(tp, enum.Enum):
+        return {"enum": [m.value for m in tp]}
+    if dataclasses.is_dataclass(tp):
+        return json_schema(tp)  # type: ignore[arg-type]
+    if origin in (list, tuple) and args:
+        if origin is tuple and args[-1] is not Ellipsis:
+            n = len(args)
+            return {
+                "type": "array",
+                "prefixItems": [type_schema(a) for a in args],
+                "items": False,
+                "minItems": n,
+                "maxItems": n,
+            }
+        return {"type": "array", "items": type_schema(args[0])}
+    if origin is dict and args:
+        values = type_schema(args[1])
+        return {"type": "object", "additionalProperties": values if values else True}
+    if tp in (list, tuple) or origin in (list, tuple):
+        return {"type": "array"}  # loose: a plug-in's bare ``list`` (tests keep ours precise)
+    if tp is dict or origin is dict:
+        return {"type": "object"}
+    return {}  # any other type: any JSON value
 
 
 def json_schema(cls: type) -> dict[str, Any]:
-    """A JSON schema (draft 2020-12 subset) of a payload dataclass."""
-    hints = typing.get_type_hints(cls)
-    props = {}
-    for f in dataclasses.fields(cls):
-        tp = typing.get_origin(hints[f.name]) or hints[f.name]
-        props[f.name] = {"type": _JSON_TYPES.get(tp, "object")}
+    """The JSON schema (draft 2020-12) of a payload dataclass: each field from its annotation
+    (:func:`type_schema`); a field with a default may be left out of a message."""
+    hints = typing.get_type_hints(cls, include_extras=True)
+    fields = dataclasses.fields(cls)
     return {
         "title": cls.__name__,
         "type": "object",
-        "properties": props,
-        "required": [f.name for f in dataclasses.fields(cls)],
+        "properties": {f.name: type_schema(hints[f.name]) for f in fields},
+        "required": [
+            f.name
+            for f in fields
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        ],
     }
 
 
@@ -206,7 +317,7 @@ class VisionChip:
     t: float  # capture time
     width: int
     height: int
-    rows: list  # rows[v]: bit u set = pixel (u, v) is 1
+    rows: list[int]  # rows[v]: bit u set = pixel (u, v) is 1
     count: int  # pixels set
 
 

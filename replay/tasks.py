@@ -26,10 +26,10 @@ from replay.interfaces import Controller, Occurrence
 @dataclass
 class TaskLoops:
     t: float
-    names: list
-    ticked: list  # bool per task: ran this step
-    latency: list  # s per task (None before its inputs first arrived)
-    oldest: list  # per task: the input topic that latency is of
+    names: list[str]
+    ticked: list[bool]  # bool per task: ran this step
+    latency: list[float | None]  # s per task (None before its inputs first arrived)
+    oldest: list[str | None]  # per task: the input topic that latency is of
 
 
 @dataclass
@@ -64,9 +64,13 @@ class TaskSet(Controller):
         self._fields: dict[type, tuple[str, ...]] = {}
 
     def _route(self, topic: str, payload: Any) -> None:
+        readers = self._readers.get(topic)
+        if not readers:
+            return
         stamp = payload.get("t") if isinstance(payload, dict) else getattr(payload, "t", None)
-        for task in self._readers.get(topic, ()):
-            self._inbox[task.name].append((topic, payload))
+        item = (topic, payload)
+        for task in readers:
+            self._inbox[task.name].append(item)
             if stamp is not None:
                 self._newest[task.name][topic] = stamp
 
@@ -101,8 +105,8 @@ class TaskSet(Controller):
             command = task.controller.update(t, inbox)
             newest = self._newest[task.name]
             if newest:
-                topic = min(newest, key=lambda k: (newest[k], k))
-                self._latency[task.name] = t - newest[topic]
+                stamp, topic = min((v, k) for k, v in newest.items())  # oldest, then by name
+                self._latency[task.name] = t - stamp
                 self._oldest[task.name] = topic
             if command is not None:
                 self._check(task, command)

@@ -13,7 +13,8 @@ What it adds to :class:`BulletArmPlant` (same URDF builder, same object, same co
   held), ``slip``, and the run's outcome: grasped, held while the human kept moving the object.
 
 One ``getJointStates`` per step reads the arm, the hand and the palm joint together; the base's
-state readers use that cache.
+state readers use that cache, and its one ``getLinkStates`` a step (tool and palm frames) gives the
+effector's motion, the grasp point and the palm's point velocity.
 """
 
 from __future__ import annotations
@@ -39,6 +40,15 @@ from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
 HEAD_JOINTS = ("pan", "tilt")
+# the PyBullet calls the rig's helpers (servos, human hand) and the runner make every step through
+# the client: BulletClient builds a new functools.partial (client id bound) at each attribute
+# access, so the rig keeps one per name on its client (the same call; the base binds its reads)
+PER_STEP_CALLS = (
+    "stepSimulation",
+    "setJointMotorControlArray",
+    "changeConstraint",
+    "getConstraintState",
+)
 
 
 class BulletGraspPlant(BulletArmPlant):
@@ -58,10 +68,14 @@ class BulletGraspPlant(BulletArmPlant):
         self._watch = None  # the catch verdict's watcher: this rig's is outcome()
         P = params
         bc = self.bc
+        for name in PER_STEP_CALLS:
+            setattr(bc, name, getattr(bc, name))
         self._palm_j = self._jidx["palm_joint"]
         assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
+        self._act = np.array(self.active, dtype=int)
+        self._all_active = len(self.active) == self.dof  # no locked joint: no index mapping
         # the servos: every arm and hand joint's own inertia at the initial posture
         bc.setJointMotorControlArray(
             self.robot, self._hand_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._hand_j)
@@ -153,6 +167,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._track_sq = 0.0
         self._track_n = 0
         self._last_pos: np.ndarray | None = None
+        self._head_pose: tuple | None = None
         self._read()
         self._spec = self._grasp_spec(self._spec)
 
@@ -167,30 +182,36 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ state (one read a step)
     def _read(self) -> None:
-        st = self.bc.getJointStates(self.robot, self._all_j)
+        st = self._get_joint_states(self.robot, self._all_j)
         na, nh = len(self._arm_j), len(self._hand_j)
-        q = np.zeros(self.dof)
-        qd = np.zeros(self.dof)
-        for n, val in self.locked.items():
-            q[self.joint_names.index(n)] = val
-        act = list(self.active)
-        q[act] = [s[0] for s in st[:na]]
-        qd[act] = [s[1] for s in st[:na]]
-        self._q, self._qd = q, qd
-        tau = np.zeros(self.dof)
-        tau[act] = self.arm_servos.torque
-        self._tau_applied = self._tau_cmd = tau
-        self._clamped = np.zeros(self.dof, dtype=bool)
-        self._clamped[act] = self.arm_servos.saturated
-        hs = st[na : na + nh]
-        self._hq = np.array([s[0] for s in hs])
-        self._hqd = np.array([s[1] for s in hs])
-        self.hand_servos.read(hs)
+        pos, vel = [s[0] for s in st], [s[1] for s in st]
+        if self._all_active:
+            self._q, self._qd = np.array(pos[:na]), np.array(vel[:na])
+            self._tau_applied = self._tau_cmd = self.arm_servos.torque.copy()
+            self._clamped = self.arm_servos.saturated.copy()
+        else:
+            q = np.zeros(self.dof)
+            qd = np.zeros(self.dof)
+            for n, val in self.locked.items():
+                q[self.joint_names.index(n)] = val
+            act = self._act
+            q[act] = pos[:na]
+            qd[act] = vel[:na]
+            self._q, self._qd = q, qd
+            tau = np.zeros(self.dof)
+            tau[act] = self.arm_servos.torque
+            self._tau_applied = self._tau_cmd = tau
+            self._clamped = np.zeros(self.dof, dtype=bool)
+            self._clamped[act] = self.arm_servos.saturated
+        self._hq = np.array(pos[na : na + nh])
+        self._hqd = np.array(vel[na : na + nh])
+        self.hand_servos.read(st[na : na + nh])
         self._htau = self.hand_servos.torque
         self._wrench = self.ft.convert(st[-1][2])
-        pos, orn = self.bc.getBasePositionAndOrientation(self.obj)
-        v, w = self.bc.getBaseVelocity(self.obj)
-        self._obj = (np.array(pos), np.array(orn), np.array(v), np.array(w))
+        opos, orn = self._get_base_pose(self.obj)
+        v, w = self._get_base_velocity(self.obj)
+        self._obj = (np.array(opos), np.array(orn), np.array(v), np.array(w))
+        self._head_pose = None
 
     def arm_state(self):
         return self._q, self._qd
@@ -201,6 +222,18 @@ class BulletGraspPlant(BulletArmPlant):
     def object_state(self):
         return self._obj
 
+    def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
+        if link != self._palm_link:
+            return super()._link_point_velocity(link, point)
+        # v + (w x (point - com)) of the palm's state read once this step (the base's
+        # _frames_now), summed as np.cross's v + cross: the rig's grasp/slip checks and log
+        # stay bit-identical to the array form
+        (cx, cy, cz), _, _, _, _, _, (vx, vy, vz), (wx, wy, wz) = self._frames_now()[1]
+        rx, ry, rz = float(point[0]) - cx, float(point[1]) - cy, float(point[2]) - cz
+        return np.array(
+            [vx + (wy * rz - wz * ry), vy + (wz * rx - wx * rz), vz + (wx * ry - wy * rx)]
+        )
+
     # ------------------------------------------------------------------ command
     def apply(self, command: ServoCommand) -> None:  # type: ignore[override]
         if not isinstance(command, ServoCommand):
@@ -209,7 +242,7 @@ class BulletGraspPlant(BulletArmPlant):
             qd = np.asarray(command.arm, float).reshape(-1)
             if qd.shape != (self.dof,):
                 raise ValueError(f"ServoCommand.arm needs {self.dof} values, got {qd.shape[0]}")
-            self.arm_servos.set_command(qd[list(self.active)])
+            self.arm_servos.set_command(qd if self._all_active else qd[self._act])
         if command.hand is not None:
             self.hand_servos.set_command(command.hand)
         if command.head is not None:
@@ -217,8 +250,9 @@ class BulletGraspPlant(BulletArmPlant):
 
     def step(self) -> None:
         self.human.drive(self._t)
-        act = list(self.active)
-        apply_torques(self.bc, self.robot, self._servo_j, self.arm_servos.torques(self._qd[act]))
+        apply_torques(
+            self.bc, self.robot, self._servo_j, self.arm_servos.torques(self._qd[self._act])
+        )
         self.hand_servos.actuate()
         self.head_servo.step()
         self._obj_vel_before = self._obj[2]
@@ -279,9 +313,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._last_pos = pos
 
     def _tool_position(self) -> np.ndarray:
-        return np.array(
-            self.bc.getLinkState(self.robot, self._tool_link, computeForwardKinematics=1)[4]
-        )
+        return np.array(self._frames_now()[0][0])
 
     # ------------------------------------------------------------------ verdict
     def outcome(self, t: float) -> dict:
@@ -327,18 +359,19 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ log and scene
     def _head_reading(self):
-        R, c = camera_pose(self.head, *self.head_servo.q)
-        return R, c
+        """(R, c) of the head camera now (computed once a step: the log and the scene)."""
+        if self._head_pose is None:
+            self._head_pose = camera_pose(self.head, *self.head_servo.q)
+        return self._head_pose
 
     def truth(self, t: float) -> dict:
         out = super().truth(t)
         del out["/arm/applied_torque"]
-        act = list(self.active)
         out["/arm/servo"] = ServoState(
             t,
             list(self.joint_names),
-            _full(self.dof, act, self.arm_servos.command),
-            _full(self.dof, act, self.arm_servos.integral),
+            self._full(self.arm_servos.command),
+            self._full(self.arm_servos.integral),
             self._tau_applied.tolist(),
             [bool(c) for c in self._clamped],
         )
@@ -385,6 +418,14 @@ class BulletGraspPlant(BulletArmPlant):
         x, y, z = (float(v) for v in c)
         return super().frames() + [Frame("world", "head_camera", (x, y, z), (qx, qy, qz, qw))]
 
+    def _full(self, values) -> list:
+        """Per-active-joint values as a list over every arm joint (zero where locked)."""
+        if self._all_active:
+            return np.asarray(values, float).tolist()
+        out = np.zeros(self.dof)
+        out[self._act] = values
+        return out.tolist()
+
     def scene(self) -> Scene:
         sc = super().scene()
         hs = self.head_servo
@@ -404,9 +445,3 @@ class BulletGraspPlant(BulletArmPlant):
         }
         sc.readings["wrist"] = {"wrench": self._wrench}
         return sc
-
-
-def _full(n: int, idx: list, values) -> list:
-    out = np.zeros(n)
-    out[idx] = values
-    return out.tolist()

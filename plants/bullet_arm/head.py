@@ -34,15 +34,19 @@ class HeadServo:
         self.command = np.where(np.isfinite(w), w, 0.0)
 
     def step(self) -> None:
-        dt, J, K = self.dt, self.J, self.K
-        qd_new = (J * self.qd + dt * K * self.command) / (J + dt * K)  # implicit velocity loop
-        tau = K * (self.command - qd_new)
-        over = np.abs(tau) > self.tau_max
-        if over.any():
-            tau = np.clip(K * (self.command - self.qd), -self.tau_max, self.tau_max)
-            qd_new = np.where(over, self.qd + dt * tau / J, qd_new)
-        self.torque = tau
-        q = self.q + dt * qd_new
-        stop = (q < self.lower) | (q > self.upper)
-        self.q = np.clip(q, self.lower, self.upper)
-        self.qd = np.where(stop, 0.0, qd_new)
+        # per axis in floats (the same operations as on the 2-vectors, without numpy's per-call
+        # cost on two elements); one axis at its torque limit makes both torques explicit
+        dt = self.dt
+        J, K, w, qd0 = self.J.tolist(), self.K.tolist(), self.command.tolist(), self.qd.tolist()
+        tmax, lo, hi = self.tau_max.tolist(), self.lower.tolist(), self.upper.tolist()
+        qd = [(J[i] * qd0[i] + dt * K[i] * w[i]) / (J[i] + dt * K[i]) for i in (0, 1)]
+        tau = [K[i] * (w[i] - qd[i]) for i in (0, 1)]
+        over = [abs(tau[i]) > tmax[i] for i in (0, 1)]
+        if over[0] or over[1]:
+            tau = [min(max(K[i] * (w[i] - qd0[i]), -tmax[i]), tmax[i]) for i in (0, 1)]
+            qd = [qd0[i] + dt * tau[i] / J[i] if over[i] else qd[i] for i in (0, 1)]
+        q = [self.q[0] + dt * qd[0], self.q[1] + dt * qd[1]]
+        stop = [q[i] < lo[i] or q[i] > hi[i] for i in (0, 1)]
+        self.torque = np.array(tau)
+        self.q = np.array([min(max(q[i], lo[i]), hi[i]) for i in (0, 1)])
+        self.qd = np.array([0.0 if stop[i] else qd[i] for i in (0, 1)])

@@ -66,6 +66,7 @@ class HumanHand:
         self.bc, self.obj = bc, obj
         self.origin = np.asarray(origin, float)
         self.u, self.v, self.n = (np.asarray(x, float) for x in (u, v, n))
+        self._n = self.n.tolist()
         self.start = float(start)
         self.max_force = float(max_force)
         self.w, self.a, self.phi = band_limited_path(
@@ -74,8 +75,12 @@ class HumanHand:
         self.rw, self.ra, self.rphi = band_limited_path(
             rng, components=components, f_min=f_min, f_max=f_max, rms_rate=roll_rate, axes=1
         )
-        self._s0 = np.sin(self.phi)
-        self._rs0 = np.sin(self.rphi)
+        # the three axes' sinusoids stacked (u, v, roll rows): one sin a step; each row's sum is
+        # the same reduction as the separate ones
+        self._W = np.concatenate([self.w, self.rw])
+        self._A = np.concatenate([self.a, self.ra])
+        self._PHI = np.concatenate([self.phi, self.rphi])
+        self._S0 = np.sin(self._PHI)
         self.R0 = _rpy_matrix(rpy0)
         self.q0 = _quat(self.R0)
         self.target = self.origin.copy()
@@ -96,9 +101,8 @@ class HumanHand:
     def offset(self, t: float) -> tuple[float, float, float]:
         """(du, dv, droll) of the path from the start pose at time ``t``."""
         tt = max(t - self.start, 0.0)
-        d = (self.a * (np.sin(self.w * tt + self.phi) - self._s0)).sum(axis=1)
-        r = float((self.ra * (np.sin(self.rw * tt + self.rphi) - self._rs0)).sum())
-        return float(d[0]), float(d[1]), r
+        du, dv, r = (self._A * (np.sin(self._W * tt + self._PHI) - self._S0)).sum(axis=1).tolist()
+        return du, dv, r
 
     def drive(self, t: float) -> None:
         du, dv, dr = self.offset(t)
@@ -106,7 +110,7 @@ class HumanHand:
         self.roll = dr
         # the start orientation turned by dr about the plane normal: q = q_n(dr) q0
         s, c = math.sin(dr / 2.0), math.cos(dr / 2.0)
-        ax, ay, az = (float(x) * s for x in self.n)
+        ax, ay, az = (x * s for x in self._n)
         bx, by, bz, bw = self.q0
         q = [
             c * bx + ax * bw + ay * bz - az * by,

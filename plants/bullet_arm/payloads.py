@@ -4,16 +4,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from replay.messages import Quat, Vec2, Vec3
+
 
 @dataclass
 class AppliedTorque:
     """``/arm/applied_torque``: what the controller asked and what the motors gave (N*m)."""
 
     t: float
-    name: list
-    commanded: list
-    applied: list
-    clamped: list  # bool per joint: the command was cut to the torque/velocity limit
+    name: list[str]
+    commanded: list[float]
+    applied: list[float]
+    clamped: list[bool]  # bool per joint: the command was cut to the torque/velocity limit
 
 
 @dataclass
@@ -21,10 +23,10 @@ class EffectorMotion:
     """``/effector/motion``: the tool frame's pose and twist (world, m, m/s, rad/s)."""
 
     t: float
-    position: list
-    orientation: list  # [qx, qy, qz, qw]
-    velocity: list
-    angular_velocity: list
+    position: Vec3
+    orientation: Quat
+    velocity: Vec3
+    angular_velocity: Vec3
     speed: float
 
 
@@ -33,8 +35,8 @@ class ObjectContacts:
     """``/object/contacts``: which robot parts touch the free object now."""
 
     t: float
-    parts: list  # "palm", finger names, "arm"
-    links: list
+    parts: list[str]  # "palm", finger names, "arm"
+    links: list[str]
     normal_force: float  # N, sum over contact points
 
 
@@ -44,11 +46,11 @@ class ServoState:
     and torque (N*m)."""
 
     t: float
-    name: list
-    command: list
-    integral: list
-    torque: list
-    saturated: list  # bool per joint: the motor gave its torque limit
+    name: list[str]
+    command: list[float]
+    integral: list[float]
+    torque: list[float]
+    saturated: list[bool]  # bool per joint: the motor gave its torque limit
 
 
 @dataclass
@@ -58,9 +60,9 @@ class HeadState:
     t: float
     pan: float
     tilt: float
-    velocity: list
-    camera_position: list
-    camera_orientation: list  # [qx, qy, qz, qw], camera-to-world (x right, y down, z forward)
+    velocity: Vec2  # (pan, tilt) rates
+    camera_position: Vec3
+    camera_orientation: Quat  # [qx, qy, qz, qw], camera-to-world (x right, y down, z forward)
 
 
 @dataclass
@@ -68,9 +70,9 @@ class HumanState:
     """``/human/state``: where the human's hand pulls the object, and with what force."""
 
     t: float
-    target: list  # m, world
+    target: Vec3  # m, world
     roll: float  # rad, about the plane normal, from the start pose
-    force: list  # N, the constraint's force on the object
+    force: Vec3  # N, the constraint's force on the object
     max_force: float  # N
 
 
@@ -79,5 +81,5 @@ class Wrench:
     """``/wrist/wrench`` and ``/wrist/wrench_truth``: force (N) and torque (N*m), palm frame."""
 
     t: float
-    force: list
-    torque: list
+    force: Vec3
+    torque: Vec3

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.messages import TOPIC_WRIST_WRENCH, TOPIC_HAND_TORQUE
+from replay.messages import TOPIC_HAND_TORQUE, TOPIC_WRIST_WRENCH, Vec3
 from replay.interfaces import Sensor
 from replay.params import param
 from replay.scene import Scene
@@ -23,15 +23,15 @@ from replay.scene import Scene
 @dataclass
 class WristWrench:
     t: float
-    force: list  # N, palm frame
-    torque: list  # N m, palm frame, about the flange-palm joint's origin
+    force: Vec3  # N, palm frame
+    torque: Vec3  # N m, palm frame, about the flange-palm joint's origin
 
 
 @dataclass
 class JointTorque:
     t: float
-    name: list
-    torque: list  # N m
+    name: list[str]
+    torque: list[float]  # N m
 
 
 @dataclass

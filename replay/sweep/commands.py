@@ -8,19 +8,16 @@ from pathlib import Path
 
 import click
 
+from replay import completion as complete
+from replay.console import fail, note
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.spec import SweepSpecError
 
 DEFAULT_SWEEP_OUT = Path("out/sweeps")
 
 
-def _fail(message: str, code: int = 2) -> None:
-    click.echo(f"error: {message}", err=True)
-    sys.exit(code)
-
-
 @click.command()
-@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.argument("scenario", type=click.Path(dir_okay=False), shell_complete=complete.scenario)
 @click.option(
     "--grid",
     "grids",
@@ -98,15 +95,15 @@ def sweep(
     try:
         spec = from_options(grids, randoms, n)
     except SweepSpecError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     if not spec.columns:
-        _fail("nothing to vary: give at least one --grid or --random")
+        fail("nothing to vary: give at least one --grid or --random")
     if seed < 0:
-        _fail(f"--seed: expected a seed >= 0, got {seed}")
+        fail(f"--seed: expected a seed >= 0, got {seed}")
     try:
         base = load_scenario(scenario, sets=list(sets))
     except ScenarioError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     out = Path(out) if out else DEFAULT_SWEEP_OUT / base.name
     summary = _run(
         scenario,
@@ -144,17 +141,17 @@ def _run(
     from replay.sweep.variants import check_keys, code_version, expand
 
     if executor != "ray" and address:
-        _fail("--address is for --executor ray")
+        fail("--address is for --executor ray")
     try:
         check_keys(scenario, spec, list(sets))
     except SweepSpecError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     try:
         # the metrics function makes columns: a different one is a different row
         version = code_version() + (f"|{metrics}" if metrics else "")
         variants = expand(scenario, spec, seed, sets=list(sets), version=version)
     except SweepSpecError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     try:
         return run_sweep(
             variants,
@@ -168,11 +165,11 @@ def _run(
             retry_failed=retry_failed,
         )
     except ExecutorError as exc:
-        _fail(str(exc))
+        fail(str(exc))
 
 
 @click.command()
-@click.argument("names", nargs=-1)
+@click.argument("names", nargs=-1, shell_complete=complete.ablation)
 @click.option("--list", "list_", is_flag=True, help="list the ablations (sweeps/*.yaml)")
 @click.option("--workers", type=click.IntRange(min=1), help="parallel variants")
 @click.option("--executor", type=click.Choice(EXECUTORS), default="local", show_default=True)
@@ -202,13 +199,13 @@ def ablate(
     try:
         files = [ablations.load(n) for n in (names or ablations.names())]
     except SweepSpecError as exc:
-        _fail(str(exc))
+        fail(str(exc))
     for sf in files:
         out = ablations.OUT_DIR / sf.name
         if plot_only:
             table, _ = ablations.table_path(sf.name)
             if table is None:
-                _fail(f"{sf.name}: no table yet (run `replay ablate {sf.name}`)")
+                fail(f"{sf.name}: no table yet (run `replay ablate {sf.name}`)")
         else:
             summary = _run(
                 str(sf.scenario),
@@ -251,9 +248,7 @@ def report(out, logs):
     from replay.report import build_report
 
     if not Path(logs).is_dir():
-        click.echo(
-            f"note: no {logs}/: the report has no figures or claims (run `make run`)", err=True
-        )
+        note(f"no {logs}/: the report has no figures or claims (run `make run`)")
     path = build_report(out, logs)
     click.echo(f"report: {path} (and {path.with_suffix('.md')})")
 

@@ -52,6 +52,7 @@ from replay.messages import (
     EffectorState,
     JointCommand,
     OptimizationCost,
+    Vec3,
 )
 from replay.params import ParamError, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
@@ -240,10 +241,10 @@ class CatchingState:
     """``/catching/state``: the mapping's inner quantities at a control step."""
 
     t: float
-    r_o: list  # used object position (m)
-    r_o_velocity: list  # estimated (m/s)
-    q_o: list  # l_c^-1(r_o), active joints (rad)
-    velocity_desired: list  # qd_d (rad/s), all arm joints
+    r_o: Vec3  # used object position (m)
+    r_o_velocity: Vec3  # estimated (m/s)
+    q_o: list[float]  # l_c^-1(r_o), active joints (rad)
+    velocity_desired: list[float]  # qd_d (rad/s), all arm joints
     in_domain: bool
     predicted_catch_time: float  # s, -1 if unknown
     hand_closing: bool
@@ -362,7 +363,7 @@ class CatchingController(Controller):
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
-    def _optimised_alpha(self) -> np.ndarray:
+    def _optimised_alpha(self, progress=None) -> np.ndarray:
         key = self.config.key(self.model)
         path = alpha_path(self.params)
         if path is not None and path.is_file():
@@ -379,15 +380,16 @@ class CatchingController(Controller):
                     },
                 )
             )
-        res = self.problem.solve()
+        res = self.problem.solve(progress)
         self.history = res.history
         self.result = res
         return res.alpha
 
-    def write_alpha_file(self, path) -> None:
-        """Store the optimised alpha (and alpha0, the cost history) for ``alpha_file``."""
+    def write_alpha_file(self, path, progress=None) -> None:
+        """Store the optimised alpha (and alpha0, the cost history) for ``alpha_file``;
+        ``progress(CostRecord)`` is called at each iteration when it is optimised here."""
         if self.alpha_opt is None:
-            self.alpha_opt = self._optimised_alpha()
+            self.alpha_opt = self._optimised_alpha(progress)
         res = OptimResult(
             alpha=np.asarray(self.alpha_opt),
             alpha0=self.alpha0,

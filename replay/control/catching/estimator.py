@@ -26,7 +26,7 @@ class BallisticEstimator:
         self.g = np.asarray(gravity, float)
         self._g = tuple(self.g.tolist())
         self.window = float(window)
-        self.buf: deque = deque(maxlen=max_samples)
+        self.buf: deque[tuple[float, np.ndarray]] = deque(maxlen=max_samples)
         self._fit = None
         self._rebuild(None)
 

@@ -268,6 +268,7 @@ class CatchGeometry:
             dist = (q1 - ref0) ** 2 + (q2 - ref1) ** 2
             if best is None or dist < best[2]:
                 best = (q1, q2, dist)
+        assert best is not None  # the loop runs at least once
         return (best[0], best[1], s + self.q_alpha), bool(ok and ok2)
 
     def derivatives_one(self, p) -> tuple[tuple, tuple, tuple]:

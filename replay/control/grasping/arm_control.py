@@ -40,7 +40,6 @@ from replay.messages import (
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.hand import hand_body
-from replay.robot.serial_chain import dh_transform
 from replay.spatial import cross3, wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
@@ -107,6 +106,17 @@ class ArmControlTask(Controller):
         super().__init__(params, spec=spec)
         self.chain = spec.model
         self.dh = [(r.alpha, r.a, r.d, r.theta_offset) for r in self.chain.dh]
+        # dh_transform's constant entries (alpha, a, d) per joint, filled once: a step only
+        # writes the cos/sin of theta (the same products as dh_transform's, so the same floats)
+        alpha = np.array([r[0] for r in self.dh])
+        self._a = np.array([r[1] for r in self.dh])
+        self._off = np.array([r[3] for r in self.dh])
+        self._ca, self._sa = np.cos(alpha), np.sin(alpha)
+        self._M = np.zeros((len(self.dh), 4, 4))
+        self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
+        self._M[:, 2, 3] = [r[2] for r in self.dh]
+        self._M[:, 3, 3] = 1.0
+        self._eye6 = np.eye(6)
         self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
             raise ValueError("arm control needs a plant with a hand and a constraint plane")
@@ -129,16 +139,30 @@ class ArmControlTask(Controller):
 
     def kinematics(self, q):
         """(tool transform, 6 x n geometric Jacobian at the tool origin)."""
+        n = len(self.dh)
+        theta = np.asarray(q, float)[:n] + self._off
+        ct, st = np.cos(theta), np.sin(theta)
+        M = self._M  # every joint's dh_transform(alpha, a, d, q + offset)
+        M[:, 0, 0], M[:, 0, 1], M[:, 0, 2], M[:, 0, 3] = (
+            ct,
+            -st * self._ca,
+            st * self._sa,
+            self._a * ct,
+        )
+        M[:, 1, 0], M[:, 1, 1], M[:, 1, 2], M[:, 1, 3] = (
+            st,
+            ct * self._ca,
+            -ct * self._sa,
+            self._a * st,
+        )
         T = self.chain.base
-        axes, origins = [], []
-        for (alpha, a, d, off), qi in zip(self.dh, q):
-            axes.append(T[:3, 2])
-            origins.append(T[:3, 3])
-            T = T @ dh_transform(alpha, a, d, qi + off)
+        Z, O = np.empty((3, n)), np.empty((3, n))
+        for i in range(n):
+            Z[:, i] = T[:3, 2]
+            O[:, i] = T[:3, 3]
+            T = T @ M[i]
         T = T @ self.tool
         p = T[:3, 3]
-        Z = np.array(axes).T
-        O = np.array(origins).T
         J = np.vstack([cross3(Z, p[:, None] - O), Z])
         return T, J
 
@@ -197,8 +221,8 @@ class ArmControlTask(Controller):
         e_reach = np.zeros(6)
         e_reach[:3] = xd[:3] - gp
         e_reach[3:] = cross3(n_palm, self.n_plane)
-        JJt = Jg @ Jg.T + (P.damping**2) * np.eye(6)
-        Jpinv = Jg.T @ np.linalg.solve(JJt, np.eye(6))
+        JJt = Jg @ Jg.T + P.damping**2 * self._eye6
+        Jpinv = Jg.T @ np.linalg.solve(JJt, self._eye6)
         track = P.K_ap * Jpinv @ (S_DIAG * self.K_a1 * e_track)
         reach = P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach)
         damp = -P.K_av * self.qd

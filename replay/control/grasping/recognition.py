@@ -93,8 +93,10 @@ class Camera:
         self.f = (width / 2.0) / math.tan(fov / 2.0)
         self.c = np.array([(width - 1) / 2.0, (height - 1) / 2.0])
 
-    def ray(self, angles, pixel) -> tuple[np.ndarray, np.ndarray]:
-        R, o = camera_pose(self.head, *angles)
+    def ray(self, angles, pixel, pose=None) -> tuple[np.ndarray, np.ndarray]:
+        """(origin, direction) of the ray through ``pixel``; ``pose``: the camera pose at
+        ``angles`` if already known (``camera_pose(head, *angles)``)."""
+        R, o = pose if pose is not None else camera_pose(self.head, *angles)
         d = R @ np.array([(pixel[0] - self.c[0]) / self.f, (pixel[1] - self.c[1]) / self.f, 1.0])
         return o, d
 
@@ -103,11 +105,11 @@ class Camera:
         pc = R.T @ (np.asarray(point, float) - o)
         return self.c + self.f * pc[:2] / pc[2]
 
-    def jacobian(self, angles, point) -> np.ndarray:
+    def jacobian(self, angles, point, pose=None) -> np.ndarray:
         """d pixel / d (pan, tilt) at ``angles`` for a fixed world point. The camera turns about
         the head's centre h: about world z (pan) and the panned y axis (tilt, positive down), so
         the point in the camera frame moves by -R^T (k x (X - h)) per radian about axis k."""
-        R, o = camera_pose(self.head, *angles)
+        R, o = pose if pose is not None else camera_pose(self.head, *angles)
         X = np.asarray(point, float)
         pc = R.T @ (X - o)
         r = X - np.asarray(self.head.position, float)
@@ -213,12 +215,13 @@ class RecognitionTask(Controller):
         if reacquired and self.frames > 1:
             self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
         self._had_target = True
-        o, d = self.camera.ray(angles, (b.u, b.v))
+        pose = camera_pose(self.camera.head, *angles)  # once a frame: both rays and J
+        o, d = self.camera.ray(angles, (b.u, b.v), pose)
         X = meet_plane(o, d, self.plane_point, self.pn)
         if X is None:
             return None
         axis = (math.cos(b.phi), math.sin(b.phi))
-        o2, d2 = self.camera.ray(angles, (b.u + axis[0], b.v + axis[1]))
+        o2, d2 = self.camera.ray(angles, (b.u + axis[0], b.v + axis[1]), pose)
         X2 = meet_plane(o2, d2, self.plane_point, self.pn)
         roll = None
         if X2 is not None and b.elongation >= self.params.axis_elongation:
@@ -227,7 +230,7 @@ class RecognitionTask(Controller):
         scale = float(np.linalg.norm(X - o)) / self.camera.f  # m per px at the object
         if not b.touches_border and b.area >= self.params.min_area:
             self._vote(b)
-        J = self.camera.jacobian(angles, X)
+        J = self.camera.jacobian(angles, X, pose)
         x_o = [float(X[0]), float(X[1]), float(X[2]), roll if roll is not None else 0.0, 0.0, 0.0]
         return GraspObject(
             chip.t,

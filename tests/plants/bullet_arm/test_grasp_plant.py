@@ -131,6 +131,40 @@ def test_head_servo_reaches_its_rate_within_its_torque_limit():
     assert servo.qd[0] == pytest.approx(2.0 + DT * 0.5 / 2e-3, rel=1e-9)
 
 
+def _head_step_reference(servo, q, qd, cmd):
+    """The head servo's step on 2-vectors (module docstring of plants/bullet_arm/head.py)."""
+    dt, J, K = servo.dt, servo.J, servo.K
+    qd_new = (J * qd + dt * K * cmd) / (J + dt * K)
+    tau = K * (cmd - qd_new)
+    over = np.abs(tau) > servo.tau_max
+    if over.any():
+        tau = np.clip(K * (cmd - qd), -servo.tau_max, servo.tau_max)
+        qd_new = np.where(over, qd + dt * tau / J, qd_new)
+    q_new = q + dt * qd_new
+    stop = (q_new < servo.lower) | (q_new > servo.upper)
+    return np.clip(q_new, servo.lower, servo.upper), np.where(stop, 0.0, qd_new), tau
+
+
+def test_head_servo_step_equals_the_vector_form_over_random_commands():
+    """Seeded random commands within and beyond the torque limit, into the hard stops: the
+    per-axis float step gives exactly the 2-vector form's angles, rates and torques."""
+    head = HeadSpec(
+        (0.0, 0.0, 1.0), 0.0, 0.03, (-0.2, -0.1), (0.2, 0.1), (2e-3, 1e-3), (0.5, 0.5), (10.0, 10.0)
+    )
+    servo = HeadServo(head, 300.0, DT, [0.0, 0.0])
+    rng = np.random.default_rng(7)
+    n, same, saturated, stopped = 400, 0, 0, 0
+    for k in range(n):
+        servo.set_command(rng.normal(0.0, 3.0 if k % 50 else 400.0, 2))
+        want = _head_step_reference(servo, servo.q, servo.qd, servo.command)
+        servo.step()
+        same += all(np.array_equal(a, b) for a, b in zip((servo.q, servo.qd, servo.torque), want))
+        saturated += bool(np.any(np.abs(want[2]) >= servo.tau_max - 1e-12))
+        stopped += bool(np.any((want[0] == servo.lower) | (want[0] == servo.upper)))
+    print(f"head step: {same}/{n} equal; {saturated} at the torque limit, {stopped} at a stop")
+    assert same == n and saturated > 0 and stopped > 0
+
+
 def test_camera_pose_looks_where_look_angles_says():
     head = HeadSpec((0.0, 0.15, 0.7), 0.2, 0.0, (-2, -2), (2, 2), (1, 1), (1, 1), (1, 1))
     target = np.array([0.75, -0.05, 0.5])
@@ -214,3 +248,85 @@ def test_the_rig_refuses_a_torque_command():
             plant.apply(ArmCommand(torque=[0.0] * 7))
     finally:
         plant.close()
+
+
+def test_frames_read_once_a_step_equal_pybullets_own_reads_while_moving():
+    """The tool/palm link states read once a step (effector motion, grasp point, the palm's point
+    velocity) are what PyBullet's getLinkState gives at that moment, at seeded random commands."""
+    plant = rig(human_speed=0.1)
+    rng = np.random.default_rng(3)
+    try:
+        bc = plant.bc
+        for k in range(60):
+            plant.apply(
+                ServoCommand(
+                    arm=rng.uniform(-0.5, 0.5, 7).tolist(),
+                    hand=rng.uniform(-1.0, 1.0, 14).tolist(),
+                    head=[0.0, 0.0],
+                )
+            )
+            plant.step()
+            if k % 10:
+                continue
+            tool = bc.getLinkState(
+                plant.robot, plant._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+            pe, oe, ve, we = plant.effector_state()
+            for got, want in zip((pe, oe, ve, we), (tool[4], tool[5], tool[6], tool[7])):
+                np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
+            assert np.linalg.norm(ve) > 1e-3  # it moves: a stale cache would differ
+            palm = bc.getLinkState(
+                plant.robot, plant._palm_link, computeLinkVelocity=1, computeForwardKinematics=1
+            )
+            point = plant.object_state()[0]
+            want = np.array(palm[6]) + np.cross(np.array(palm[7]), point - np.array(palm[0]))
+            got = plant._link_point_velocity(plant._palm_link, point)
+            np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
+            np.testing.assert_allclose(plant._tool_position(), tool[4], rtol=0.0, atol=1e-12)
+    finally:
+        plant.close()
+
+
+def test_the_robot_never_collides_with_itself():
+    """Self-collision is off (the URDF is loaded without URDF_USE_SELF_COLLISION): the closing
+    fingers, the palm and the arm links never make contact points with each other, so filtering
+    their pairs cannot change (or speed up) the physics."""
+    plant = rig()
+    try:
+        closed = np.asarray(GRASP4.closed_posture)
+        for _ in range(300):
+            hq = plant.hand_state()[0]
+            plant.apply(
+                ServoCommand(arm=[0.0, 0.5, 0.0, 0.5, 0.0, 0.5, 0.0], hand=(closed - hq) * 20)
+            )
+            plant.step()
+            assert plant.bc.getContactPoints(bodyA=plant.robot, bodyB=plant.robot) == ()
+        # the fingers did close onto each other's space: the hand moved towards its grip
+        assert (
+            np.abs(plant.hand_state()[0] - closed).max()
+            < 0.5 * np.abs(np.asarray(GRASP4.open_posture) - closed).max()
+        )
+    finally:
+        plant.close()
+
+
+def test_kept_pybullet_calls_stay_bound_to_each_rigs_own_client():
+    """Two rigs at once: the per-step calls kept on each client carry that client's id, so
+    stepping one moves only its own world."""
+    from plants.bullet_arm.grasp_plant import PER_STEP_CALLS
+
+    a, b = rig(human_speed=0.1), rig(human_speed=0.1)
+    try:
+        assert a.bc._client != b.bc._client
+        for plant in (a, b):
+            for name in PER_STEP_CALLS:
+                assert getattr(plant.bc, name).keywords["physicsClientId"] == plant.bc._client
+        before = b.object_state()[0].copy()
+        for _ in range(200):
+            a.step()
+        assert np.linalg.norm(a.object_state()[0] - before) > 1e-3  # a's human moved its box
+        b._read()
+        np.testing.assert_array_equal(b.object_state()[0], before)
+    finally:
+        a.close()
+        b.close()

@@ -151,3 +151,23 @@ def test_hand_compliance_balances_the_load_against_the_overclosure(spec):
     fresh = HandControlTask(P, spec=spec)
     cmd = fresh.update(0.0, [(TOPIC_GRASP_STATE, hold), (TOPIC_HAND_ENCODERS, enc)])
     assert fresh.preshape == "none" and np.all(np.asarray(cmd.hand) <= 0)
+
+
+def test_arm_task_kinematics_match_the_chains_fk_and_jacobian_over_random_postures(spec):
+    """Eq. 2's J^a and tool pose (the task's array-filled DH chain) against the nominal chain's
+    own fk/jacobian, at seeded random postures within the joint limits."""
+    task = ArmControlTask(ArmParams(), spec=spec)
+    rng = np.random.default_rng(10)
+    lo, hi = np.asarray(spec.lower), np.asarray(spec.upper)
+    ok = 0
+    n = 50
+    for _ in range(n):
+        q = rng.uniform(lo, hi)
+        T, J = task.kinematics(q)
+        T_ref = spec.model.fk(q)
+        J_ref = spec.model.jacobian(q)
+        ok += bool(
+            np.allclose(T, T_ref, atol=1e-12, rtol=0.0) and np.allclose(J, J_ref, atol=1e-12)
+        )
+    print(f"arm kinematics: {ok}/{n} random postures match the chain")
+    assert ok == n
