@@ -37,7 +37,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from replay.scene import Scene
+from replay.scene import Frame, Scene
 
 
 @dataclass
@@ -87,6 +87,22 @@ class Plant(ABC):
         """The physical verdict at the end of a run: ``{"success": bool, "reason": str, **metrics}``
         (e.g. captured and the final speed; caught and the relative speed at first contact), or
         None when this plant has no notion of success."""
+        return None
+
+    # -- for 3-D viewers (Foxglove, Rerun: replay/foxglove); the scene's bodies need nothing more
+    def frames(self) -> list[Frame]:
+        """The robot's link frames now (``/tf``): the root link in ``world``, every other link
+        in its parent link. Default: none (a plant without a robot model)."""
+        return []
+
+    def joints(self) -> tuple[list, list, list, list] | None:
+        """Every robot joint now (``/joint_states``): names, positions, velocities, efforts;
+        None when the plant has none."""
+        return None
+
+    def robot_description(self) -> str | None:
+        """The robot's URDF text (``/robot_description``, whose links :meth:`frames` names),
+        or None."""
         return None
 
     def close(self) -> None:

@@ -50,6 +50,13 @@ TOPIC_GRASP_HEAD = "/grasping/head"
 TOPIC_GRASP_ARM = "/grasping/arm"
 TOPIC_GRASP_HAND = "/grasping/hand"
 TOPIC_TASK_LOOPS = "/tasks/loops"
+# Foxglove / Rerun well-known topics (replay/foxglove; docs/foxglove.md), Protobuf-encoded except
+# /robot_description (std_msgs/String as JSON); camera images on /camera/SENSOR/VIEW
+TOPIC_TF = "/tf"  # foxglove.FrameTransforms
+TOPIC_SCENE = "/scene"  # foxglove.SceneUpdate
+TOPIC_JOINT_STATES = "/joint_states"  # foxglove.JointStates
+TOPIC_ROBOT_DESCRIPTION = "/robot_description"  # the URDF, once at t = 0
+TOPIC_LOG = "/log"  # foxglove.Log: the /events as log lines
 
 
 @dataclass(frozen=True)

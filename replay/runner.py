@@ -25,6 +25,7 @@ from typing import Any, Callable
 import numpy as np
 
 from replay import __version__, registry
+from replay.foxglove.run import RunTopics
 from replay.log import LogWriter, NonFiniteValueError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
 from replay.scenario import Scenario, resolved_yaml
@@ -154,6 +155,9 @@ class Runner:
         self.log_div = (
             _divider(rate, scenario.timing.state_log_rate) if scenario.timing.state_log_rate else 1
         )
+        fr = scenario.timing.frame_rate  # the 3-D viewer topics (replay/foxglove)
+        self.frame_div = _divider(rate, fr) if fr else 0
+        self.viz: RunTopics | None = None
         self._t_log = 0.0  # seconds in log writes (and observers) this run
 
     def t_ns(self, k: int) -> int:
@@ -174,6 +178,8 @@ class Runner:
         self._write(
             log, TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0
         )
+        viz = self.viz = RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
+        viz.start(0)
         seq = 0
         stop_at: int | None = None
         collisions = 0
@@ -191,14 +197,18 @@ class Runner:
             controller.pop_events,
         )
         write = self._emitter(log)
-        sensors = [(s.measure, s.topic, div, latency) for _, s, div, latency in self.sensors]
+        sensors = [
+            (s.measure, s.topic, div, latency, (name, s) if name in viz.imaging else None)
+            for name, s, div, latency in self.sensors
+        ]
         ctrl_div, log_div, n_ns = self.ctrl_div, self.log_div, 1_000_000_000
+        frame_div = self.frame_div
         progress, progress_div = self.progress, max(1, rate // 20)
         # (deliver at step, sequence, topic, payload), delivered in that order whatever the
         # sensors' order and latencies: a heap; with one latency for all, readings are made in
         # delivery order, so a FIFO (half the cost of a heap's push and pop) is that order
         pending: Any
-        if len({latency for *_, latency in sensors}) <= 1:
+        if len({latency for _, _, _, latency, _ in sensors}) <= 1:
             pending = collections.deque()
             push, pop = pending.append, pending.popleft
         else:
@@ -213,7 +223,7 @@ class Runner:
                 t = k / rate
                 t_ns = k * n_ns // rate
                 scene = None
-                for measure, topic, div, latency in sensors:
+                for measure, topic, div, latency, imaging in sensors:
                     if k % div == 0:
                         c0 = clock()
                         if scene is None:
@@ -224,6 +234,11 @@ class Runner:
                         m = measure(t, scene)
                         c1 = clock()
                         t_sensors += c1 - c0
+                        if imaging is not None:  # its frame, for Foxglove / Rerun
+                            viz.sensor(imaging[0], imaging[1], t_ns)
+                            c0 = clock()
+                            t_log += c0 - c1
+                            c1 = c0
                         if m is not None:
                             write(topic, m, t_ns)
                             t_log += clock() - c1
@@ -272,6 +287,11 @@ class Runner:
                         write(topic, payload, t_ns)
                     c0 = clock()
                     t_log += c0 - c1
+                if frame_div and k % frame_div == 0:  # the 3-D topics (replay/foxglove)
+                    c1 = clock()
+                    viz.frame(scene if scene is not None else scene_of(), t_ns)
+                    c0 = clock()
+                    t_log += c0 - c1
                 step()
                 k += 1
                 occurrences = plant_events()
@@ -292,6 +312,8 @@ class Runner:
             t_end = k / rate
             for topic, payload in self.plant.truth(t_end).items():
                 self._write(log, topic, payload, self.t_ns(k))
+            if frame_div:
+                viz.frame(self.plant.scene(), self.t_ns(k))
             self._outcome(log, result, k, self._verdict(k / rate))
         except NonFiniteValueError as exc:
             result.stopped_by = "error"
@@ -381,6 +403,8 @@ class Runner:
         """A message outside the loop's hot path (scenario, events, outcome), timed as logging."""
         c0 = time.perf_counter()
         self._emitter(log)(topic, payload, t_ns)
+        if topic == TOPIC_EVENTS and self.viz is not None:
+            self.viz.event(payload, t_ns)  # its /log line
         self._t_log += time.perf_counter() - c0
 
     def _event(self, log, occ, t, t_ns, result, stop_at, k):

@@ -39,6 +39,17 @@ class Cylinder:
 Primitive = Box | Sphere | Cylinder
 
 
+@dataclass(frozen=True)
+class Frame:
+    """A moving body's or robot link's frame ``child`` in frame ``parent`` (for 3-D viewers:
+    ``/tf``): translation (m) and rotation [qx, qy, qz, qw] of ``child`` in ``parent``."""
+
+    parent: str
+    child: str
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+
+
 @dataclass
 class Scene:
     """What sensors can measure at one instant: the visible primitives, by name, and the

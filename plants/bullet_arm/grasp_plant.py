@@ -36,7 +36,7 @@ from replay.messages import JointState
 from replay.robot.arm_types import GraspSpec, PlaneSpec, ServoCommand
 from replay.robot.hand import palm_body
 from replay.robot.head import HeadSpec, camera_pose, look_angles
-from replay.scene import Scene
+from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
 HEAD_JOINTS = ("pan", "tilt")
@@ -398,6 +398,25 @@ class BulletGraspPlant(BulletArmPlant):
         w = self._wrench
         out["/wrist/wrench_truth"] = Wrench(t, w[:3].tolist(), w[3:].tolist())
         return out
+
+    def joints(self) -> tuple[list, list, list, list]:
+        """The arm's and hand's joints, then the head's pan and tilt."""
+        names, q, qd, effort = super().joints()
+        hs = self.head_servo
+        return (
+            names + list(HEAD_JOINTS),
+            q + hs.q.tolist(),
+            qd + hs.qd.tolist(),
+            effort + hs.torque.tolist(),
+        )
+
+    def frames(self) -> list[Frame]:
+        """The robot's links and the head's camera (``head_camera``: x right, y down, z the
+        optical axis) in ``world``."""
+        R, c = self._head_reading()
+        qx, qy, qz, qw = (float(x) for x in matrix_to_quaternion(R))
+        x, y, z = (float(v) for v in c)
+        return super().frames() + [Frame("world", "head_camera", (x, y, z), (qx, qy, qz, qw))]
 
     def _full(self, values) -> list:
         """Per-active-joint values as a list over every arm joint (zero where locked)."""

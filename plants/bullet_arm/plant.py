@@ -40,7 +40,7 @@ from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
 from replay.robot.hand import hand_mass
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
-from replay.scene import Box, Scene, Sphere
+from replay.scene import Box, Frame, Scene, Sphere
 
 with quiet_c_output():  # PyBullet's import prints a build banner
     import pybullet as p
@@ -96,6 +96,11 @@ class BulletArmPlant(Plant):
             self._jidx[info[1].decode()] = j
             self._link_name[j] = info[12].decode()
         self._link_index = {v: k for k, v in self._link_name.items()}
+        # each link's parent link (-1: the base), for the link frames of 3-D viewers (frames())
+        self._parent_link = [
+            int(bc.getJointInfo(self.robot, j)[16]) for j in range(bc.getNumJoints(self.robot))
+        ]
+        self._base_pose = (tuple(float(x) for x in P.base_position), tuple(orn))
         self.active = tuple(i for i, n in enumerate(names) if n not in self.locked)
         self._arm_j = [self._jidx[names[i]] for i in self.active]
         self.hand_names = self.model.hand_joints
@@ -618,6 +623,33 @@ class BulletArmPlant(Plant):
 
     def robot_description(self) -> str:
         return self.model.urdf
+
+    def frames(self) -> list[Frame]:
+        """Every URDF link in its parent link (the base in ``world``): PyBullet's link frames
+        (not its centre-of-mass frames), made relative to the parent's."""
+        bc = self.bc
+        n = len(self._parent_link)
+        states = bc.getLinkStates(self.robot, list(range(n)), computeForwardKinematics=1)
+        world = {-1: self._base_pose}
+        out = [Frame("world", self._link_name[-1], *self._base_pose)]
+        for j, st in enumerate(states):
+            world[j] = (st[4], st[5])
+            pp, po = world[self._parent_link[j]]
+            ip, io = bc.invertTransform(pp, po)
+            rp, ro = bc.multiplyTransforms(ip, io, st[4], st[5])
+            out.append(Frame(self._link_name[self._parent_link[j]], self._link_name[j], rp, ro))
+        return out
+
+    def joints(self) -> tuple[list, list, list, list]:
+        """The arm's joints (effort: the applied torque), then the hand's."""
+        q, qd = self.arm_state()
+        hq, hqd, heff = self.hand_state()
+        return (
+            list(self.joint_names) + list(self.hand_names),
+            q.tolist() + hq.tolist(),
+            qd.tolist() + hqd.tolist(),
+            self._tau_applied.tolist() + heff.tolist(),
+        )
 
     def _contact_summary_now(self):
         """(contacts, parts, links, total normal force) of ``_contacts``, summed once per list."""

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from mcap.reader import make_reader
-from mcap.records import Channel, Message
+from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 
 from replay.log.chunks import MAGIC
@@ -33,6 +33,22 @@ class LogMessage:
     topic: str
     t_ns: int
     data: dict
+
+    @property
+    def t(self) -> float:
+        return self.t_ns * 1e-9
+
+
+@dataclass(frozen=True)
+class RawMessage:
+    """A message as stored, for the channels that are not JSON (Foxglove's protobuf topics,
+    the URDF's CDR string: ``replay.foxglove.schemas`` decodes them)."""
+
+    topic: str
+    t_ns: int
+    schema: str  # the schema's name, e.g. foxglove.FrameTransforms
+    encoding: str  # the channel's message encoding: protobuf, cdr
+    data: bytes
 
     @property
     def t(self) -> float:
@@ -181,6 +197,63 @@ class LogReader:
                         item = self._message(topic, record.log_time, record.data)
                         if item is not None:
                             yield item
+
+    def raw(self, topics: Iterable[str] | str | None = None) -> Iterator[RawMessage]:
+        """The messages of the channels that are not JSON, undecoded, in log-time order (file
+        order for a truncated log), optionally by topic."""
+        wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
+        if self._summary is not None:
+            try:
+                with open(self.path, "rb") as f:
+                    for schema, channel, msg in make_reader(f).iter_messages(topics=wanted):
+                        if channel.message_encoding != "json":
+                            name = schema.name if schema is not None else ""
+                            yield RawMessage(
+                                channel.topic,
+                                msg.log_time,
+                                name,
+                                channel.message_encoding,
+                                msg.data,
+                            )
+                return
+            except Exception as exc:  # noqa: BLE001
+                self._damage(f"the index points at bad bytes ({type(exc).__name__})")
+                return
+        yield from self._stream_raw(wanted)
+
+    def _stream_raw(self, wanted) -> Iterator[RawMessage]:
+        schemas: dict[int, str] = {}
+        channels: dict[
+            int, tuple[str, str, int]
+        ] = {}  # the other channels: topic, encoding, schema
+        with open(self.path, "rb") as f:
+            records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
+            while True:
+                try:
+                    record = next(records)
+                except StopIteration:
+                    return
+                except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
+                    return
+                if isinstance(record, Schema):
+                    schemas[record.id] = record.name
+                elif isinstance(record, Channel):
+                    if record.message_encoding != "json":
+                        channels[record.id] = (
+                            record.topic,
+                            record.message_encoding,
+                            record.schema_id,
+                        )
+                elif isinstance(record, Message) and record.channel_id in channels:
+                    topic, encoding, schema_id = channels[record.channel_id]
+                    if wanted is None or topic in wanted:
+                        yield RawMessage(
+                            topic,
+                            record.log_time,
+                            schemas.get(schema_id, ""),
+                            encoding,
+                            record.data,
+                        )
 
     def series(self, topic: str) -> list[dict]:
         """All payloads of one topic, in order."""

@@ -33,6 +33,14 @@ class Timing:
         le=100_000,
         doc="rate of the plant's state topics; 0 = every physics step",
     )
+    frame_rate: int = param(
+        100,
+        unit="Hz",
+        ge=0,
+        le=100_000,
+        doc="rate of the 3-D viewer topics for Foxglove and Rerun (/tf, /scene, /joint_states: "
+        "docs/foxglove.md), rounded to whole physics steps; 0 = none",
+    )
 
 
 @dataclass(kw_only=True)

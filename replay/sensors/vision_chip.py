@@ -61,6 +61,11 @@ class VisionChipParams:
         0.0, unit="grey level", ge=0.0, doc="Gaussian grey-level noise before thresholding (0..255)"
     )
     reading: str = param("head", doc="the plant's reading with the camera pose")
+    log_images: bool = param(
+        True,
+        doc="write the binary image to the log (PNG, 0/255, /camera/SENSOR/image) at the "
+        "camera rate",
+    )
 
 
 class VisionChipSensor(Sensor):
@@ -94,6 +99,12 @@ class VisionChipSensor(Sensor):
         if p.noise_sigma > 0.0:
             img += np.float32(p.noise_sigma) * self.rng.standard_normal(img.shape, dtype=np.float32)
         return img > self.level
+
+    def frame_images(self) -> list[tuple[str, np.ndarray]]:
+        """The last frame: ``[("image", uint8 HxW, 0 or 255)]``."""
+        if self.last_image is None:
+            return []
+        return [("image", self.last_image.astype(np.uint8) * np.uint8(255))]
 
     def measure(self, t: float, scene: Scene) -> VisionChip | None:
         bits = self.image(scene)

@@ -19,6 +19,7 @@ import numpy as np
 
 from replay.viewer.data import RunAccumulator, RunData, load_run
 from replay.viewer.errors import ViewerError
+from replay.viewer.images import ImagePanel, load_image_tracks
 from replay.viewer.plots import PlotPanel
 from replay.viewer.scenes import RunScene, run_color, scene_class
 from replay.viewer.timeline import DEFAULT_SPEED, Timeline
@@ -94,6 +95,7 @@ class Viewer:
         self.scenes: list[RunScene] = []
         self.timeline: Timeline | None = None
         self.plots: PlotPanel | None = None
+        self.images: ImagePanel | None = None
         self.notes: list[str] = []
         self.run_toggles: list = []
         self.time = 0.0
@@ -130,6 +132,7 @@ class Viewer:
         self.server.scene.reset()  # every node, the runs' and the shared ones
         self.server.gui.reset()
         self.scenes, self.timeline, self.plots, self._status = [], None, None, None
+        self.images = None
 
     def _build_scenes(self, runs: list[RunData]) -> None:
         self.runs = list(runs)
@@ -191,6 +194,11 @@ class Viewer:
                             lambda ev, s=s: setattr(s.root_frame, "visible", ev.target.value)
                         )
                         self.run_toggles.append(cb)
+            run0 = self.runs[0]  # its cameras' images (the first run's, when overlaid)
+            tracks = load_image_tracks(run0.path, run0.sensors) if run0.path else []
+            if tracks:
+                with gui.add_folder("Cameras"):
+                    self.images = ImagePanel(self.server, tracks)
             specs = self.scenes[0].plots()
             if specs:
                 with gui.add_folder("Plots"):
@@ -207,9 +215,12 @@ class Viewer:
             tl = self.timeline
             playing = tl is not None and tl.playing
             now = time.perf_counter()
-            if self.plots is not None and (not playing or now - self._last_plot >= PLOT_PERIOD):
+            if not playing or now - self._last_plot >= PLOT_PERIOD:
                 self._last_plot = now
-                self.plots.set_cursor(t)
+                if self.plots is not None:
+                    self.plots.set_cursor(t)
+                if self.images is not None:
+                    self.images.show(t)
             if tl is not None:
                 k = int(np.searchsorted(tl.frames, t + 1e-9, side="right"))
                 tl.status.content = (

@@ -180,7 +180,7 @@ def test_golden_check_passes(project_root):
 
 def test_golden_is_small(project_root):
     size = (project_root / "data" / "golden" / "grasp_hexahedron.mcap").stat().st_size
-    assert size < 250 * 1024
+    assert size < 300 * 1024  # ~270 KiB: 230 + the Foxglove topics (docs/foxglove.md)
 
 
 def test_bench_grasp_measures_against_bare_stepping(monkeypatch):
