@@ -176,6 +176,11 @@ class AirTablePlant(Plant):
         self._check_state()
         self._check_held()
 
+    def invalidate_state(self) -> None:
+        """Re-read the bodies after the space was changed other than by :meth:`step` (the state is
+        read once a step; as the arm plant's ``invalidate_state``)."""
+        self._read_state()
+
     def _read_state(self) -> None:
         """The stick's and the tips' state, read from Pymunk once a step (after it)."""
         x, y, vx, vy, angle, omega = self._read_stick()
