@@ -15,7 +15,7 @@ import os
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import Any, Iterable, Iterator
 
 from mcap.reader import make_reader
 from mcap.records import Channel, Message, Schema
@@ -177,26 +177,30 @@ class LogReader:
             return None
         return LogMessage(topic, t_ns, value)
 
-    def _stream(self, wanted) -> Iterator[LogMessage]:
-        channels: dict[int, str] = {}  # the JSON channels' topics
+    def _records(self) -> Iterator[Any]:
+        """The file's records in order, CRCs checked, ending quietly at a torn or damaged tail."""
         with open(self.path, "rb") as f:
             records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
             while True:
                 try:
-                    record = next(records)
+                    yield next(records)
                 except StopIteration:
                     return
                 except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
                     return
-                if isinstance(record, Channel):
-                    if record.message_encoding == "json":
-                        channels[record.id] = record.topic
-                elif isinstance(record, Message):
-                    topic = channels.get(record.channel_id)
-                    if topic is not None and (wanted is None or topic in wanted):
-                        item = self._message(topic, record.log_time, record.data)
-                        if item is not None:
-                            yield item
+
+    def _stream(self, wanted) -> Iterator[LogMessage]:
+        channels: dict[int, str] = {}  # the JSON channels' topics
+        for record in self._records():
+            if isinstance(record, Channel):
+                if record.message_encoding == "json":
+                    channels[record.id] = record.topic
+            elif isinstance(record, Message):
+                topic = channels.get(record.channel_id)
+                if topic is not None and (wanted is None or topic in wanted):
+                    item = self._message(topic, record.log_time, record.data)
+                    if item is not None:
+                        yield item
 
     def raw(self, topics: Iterable[str] | str | None = None) -> Iterator[RawMessage]:
         """The messages of the channels that are not JSON, undecoded, in log-time order (file
@@ -226,34 +230,26 @@ class LogReader:
         channels: dict[
             int, tuple[str, str, int]
         ] = {}  # the other channels: topic, encoding, schema
-        with open(self.path, "rb") as f:
-            records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
-            while True:
-                try:
-                    record = next(records)
-                except StopIteration:
-                    return
-                except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
-                    return
-                if isinstance(record, Schema):
-                    schemas[record.id] = record.name
-                elif isinstance(record, Channel):
-                    if record.message_encoding != "json":
-                        channels[record.id] = (
-                            record.topic,
-                            record.message_encoding,
-                            record.schema_id,
-                        )
-                elif isinstance(record, Message) and record.channel_id in channels:
-                    topic, encoding, schema_id = channels[record.channel_id]
-                    if wanted is None or topic in wanted:
-                        yield RawMessage(
-                            topic,
-                            record.log_time,
-                            schemas.get(schema_id, ""),
-                            encoding,
-                            record.data,
-                        )
+        for record in self._records():
+            if isinstance(record, Schema):
+                schemas[record.id] = record.name
+            elif isinstance(record, Channel):
+                if record.message_encoding != "json":
+                    channels[record.id] = (
+                        record.topic,
+                        record.message_encoding,
+                        record.schema_id,
+                    )
+            elif isinstance(record, Message) and record.channel_id in channels:
+                topic, encoding, schema_id = channels[record.channel_id]
+                if wanted is None or topic in wanted:
+                    yield RawMessage(
+                        topic,
+                        record.log_time,
+                        schemas.get(schema_id, ""),
+                        encoding,
+                        record.data,
+                    )
 
     def series(self, topic: str) -> list[dict]:
         """All payloads of one topic, in order."""
