@@ -11,7 +11,10 @@ SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml scenarios/
 
 .PHONY: install run lint test bench ablations golden-check clean
 
-$(STAMP): pyproject.toml setup.py replay/sensors/_pixels.c
+# (every C source of an extension module: a changed kernel is rebuilt by the next make)
+CSOURCES := $(wildcard replay/*/*.c replay/*/*/*.c plants/*/*.c)
+
+$(STAMP): pyproject.toml setup.py $(CSOURCES)
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test]'
