@@ -21,9 +21,10 @@ from replay.messages import (
     TOPIC_GRASP_STATE,  # noqa: E402
     TOPIC_HAND_ENCODERS,
     TOPIC_HAND_TORQUE,
+    TOPIC_WRIST_WRENCH,
     JointState,
 )
-from replay.sensors.force import JointTorque  # noqa: E402
+from replay.sensors.force import JointTorque, WristWrench  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -170,4 +171,52 @@ def test_arm_task_kinematics_match_the_chains_fk_and_jacobian_over_random_postur
             np.allclose(T, T_ref, atol=1e-12, rtol=0.0) and np.allclose(J, J_ref, atol=1e-12)
         )
     print(f"arm kinematics: {ok}/{n} random postures match the chain")
+    assert ok == n
+
+
+def test_arm_task_compiled_eq2_matches_its_numpy_reference_over_random_inputs(spec):
+    """The compiled chain, grasp-point Jacobian, damped pseudo-inverse and J^T F
+    (``_arm_kinematics``) against the task's NumPy reference (``reference_command``), at seeded
+    random postures, rates, objects, targets and wrenches: agreement within 1e-9 (rad/s, N)."""
+    rng = np.random.default_rng(11)
+    lo, hi = np.asarray(spec.lower), np.asarray(spec.upper)
+    ok, n = 0, 60
+    for i in range(n):
+        task = ArmControlTask(ArmParams(force_deadband=0.0, force_filter=0.0), spec=spec)
+        q, qd = rng.uniform(lo, hi), rng.normal(0.0, 1.0, 7)
+        T, _ = task.kinematics(q)
+        gp = T[:3, 3] + task.params.grasp_point * T[:3, 2]
+        roll = float(rng.uniform(-1.0, 1.0)) if i % 3 else None
+        o = obj(gp + rng.normal(0.0, 0.05, 3), roll=roll, shape=("rectangle", "circle")[i % 2])
+        st = state(gp + rng.normal(0.0, 0.05, 3), phase="reach")
+        enc = JointState(0.0, list(spec.joint_names), q.tolist(), qd.tolist(), [0.0] * 7)
+        f0, m0, f1, m1 = (rng.normal(0.0, 5.0, 3).tolist() for _ in range(4))
+        # the first wrench is the tare; the second one's difference to it is F^a (no filter)
+        task.update(
+            0.0,
+            [
+                (TOPIC_ARM_ENCODERS, enc),
+                (TOPIC_GRASP_STATE, st),
+                (TOPIC_WRIST_WRENCH, WristWrench(0.0, f0, m0)),
+            ],
+        )
+        cmd = task.update(
+            0.001,
+            [
+                (TOPIC_GRASP_OBJECT, o),
+                (TOPIC_WRIST_WRENCH, WristWrench(0.001, f1, m1)),
+            ],
+        )
+        out = task._out
+        R = T[:3, :3]
+        # the hand's weight cancels in the difference
+        F_ref = np.concatenate([R @ np.subtract(f1, f0), R @ np.subtract(m1, m0)])
+        good = np.allclose(out.wrench, F_ref, atol=1e-9, rtol=0.0)
+        ref = task.reference_command(q, qd, o, st, out.wrench)
+        good &= np.allclose(cmd.arm, ref["command"], atol=1e-9, rtol=0.0)
+        good &= np.allclose(out.x_a[:3], ref["x_a"], atol=1e-12, rtol=0.0)
+        for name, term in out.terms.items():
+            good &= np.allclose(term, ref[name], atol=1e-9, rtol=0.0)
+        ok += bool(good)
+    print(f"arm eq. 2 compiled vs NumPy: {ok}/{n} random inputs agree within 1e-9")
     assert ok == n

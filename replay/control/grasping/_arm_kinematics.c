@@ -1,0 +1,246 @@
+/* The arm task's per-step linear algebra (replay/control/grasping/arm_control.py documents it;
+ * that module is the only caller and keeps the NumPy version as the reference): the DH chain's
+ * forward kinematics and geometric Jacobian, the grasp point's Jacobian, the damped
+ * pseudo-inverse applied to eq. 2's two task vectors, and J^T F. Plain C over the buffer
+ * protocol and sequences of floats: no NumPy headers.
+ *
+ * Matrices are row-major float64. The chain's constants are n rows of (cos alpha, sin alpha, a,
+ * d, theta offset); base and tool are 4 x 4 rigid transforms (last row 0 0 0 1).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <string.h>
+
+#define MAXJ 16
+
+static int read_seq(PyObject *obj, double *out, Py_ssize_t n, const char *what) {
+    PyObject *seq = PySequence_Fast(obj, what);
+    if (seq == NULL) return -1;
+    if (PySequence_Fast_GET_SIZE(seq) < n) {
+        PyErr_Format(PyExc_ValueError, "%s: expected at least %zd values", what, n);
+        Py_DECREF(seq);
+        return -1;
+    }
+    PyObject **items = PySequence_Fast_ITEMS(seq);
+    for (Py_ssize_t i = 0; i < n; i++) {
+        out[i] = PyFloat_AsDouble(items[i]);
+        if (out[i] == -1.0 && PyErr_Occurred()) {
+            Py_DECREF(seq);
+            return -1;
+        }
+    }
+    Py_DECREF(seq);
+    return 0;
+}
+
+static int get_buffer(PyObject *obj, Py_buffer *view, Py_ssize_t n, int writable, const char *what) {
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | (writable ? PyBUF_WRITABLE : 0)) < 0)
+        return -1;
+    if (view->len < n * (Py_ssize_t)sizeof(double)) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd float64 values", what, n);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *list_of(const double *x, Py_ssize_t n) {
+    PyObject *out = PyList_New(n);
+    if (out == NULL) return NULL;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *f = PyFloat_FromDouble(x[i]);
+        if (f == NULL) {
+            Py_DECREF(out);
+            return NULL;
+        }
+        PyList_SET_ITEM(out, i, f);
+    }
+    return out;
+}
+
+/* T (3 x 4 of a rigid transform) = A B */
+static void affine_mul(const double *A, const double *B, double *T) {
+    for (int r = 0; r < 3; r++) {
+        const double a0 = A[4 * r], a1 = A[4 * r + 1], a2 = A[4 * r + 2], a3 = A[4 * r + 3];
+        T[4 * r] = a0 * B[0] + a1 * B[4] + a2 * B[8];
+        T[4 * r + 1] = a0 * B[1] + a1 * B[5] + a2 * B[9];
+        T[4 * r + 2] = a0 * B[2] + a1 * B[6] + a2 * B[10];
+        T[4 * r + 3] = a0 * B[3] + a1 * B[7] + a2 * B[11] + a3;
+    }
+}
+
+/* chain(q, n, consts, base, tool, grasp_point, J, Jg) -> (R00..R22, p0..p2, g0..g2): the tool
+ * pose (R row-major, p), the grasp point g = p + grasp_point R[:, 2]; writes the tool's 6 x n
+ * geometric Jacobian J (rows vx vy vz wx wy wz) and the grasp point's Jg (v_g = v + w x (g - p)). */
+static PyObject *py_chain(PyObject *self, PyObject *args) {
+    PyObject *qo, *co, *bo, *to, *jo, *jgo;
+    Py_ssize_t n;
+    double gp;
+    if (!PyArg_ParseTuple(args, "OnOOOdOO", &qo, &n, &co, &bo, &to, &gp, &jo, &jgo)) return NULL;
+    if (n < 1 || n > MAXJ) {
+        PyErr_SetString(PyExc_ValueError, "chain: 1..16 joints");
+        return NULL;
+    }
+    double q[MAXJ];
+    if (read_seq(qo, q, n, "chain: q") < 0) return NULL;
+    Py_buffer vc, vb, vt, vj, vjg;
+    if (get_buffer(co, &vc, 5 * n, 0, "chain: consts") < 0) return NULL;
+    if (get_buffer(bo, &vb, 16, 0, "chain: base") < 0) goto fail_c;
+    if (get_buffer(to, &vt, 16, 0, "chain: tool") < 0) goto fail_b;
+    if (get_buffer(jo, &vj, 6 * n, 1, "chain: J") < 0) goto fail_t;
+    if (get_buffer(jgo, &vjg, 6 * n, 1, "chain: Jg") < 0) goto fail_j;
+    const double *c = vc.buf;
+    double *J = vj.buf, *Jg = vjg.buf;
+    double T[12], N[12], M[12], Z[3 * MAXJ], O[3 * MAXJ];
+    memcpy(T, vb.buf, sizeof T);
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const double ca = c[5 * i], sa = c[5 * i + 1], a = c[5 * i + 2], d = c[5 * i + 3];
+        const double th = q[i] + c[5 * i + 4], ct = cos(th), st = sin(th);
+        for (int r = 0; r < 3; r++) {
+            Z[3 * i + r] = T[4 * r + 2];
+            O[3 * i + r] = T[4 * r + 3];
+        }
+        M[0] = ct, M[1] = -st * ca, M[2] = st * sa, M[3] = a * ct;
+        M[4] = st, M[5] = ct * ca, M[6] = -ct * sa, M[7] = a * st;
+        M[8] = 0.0, M[9] = sa, M[10] = ca, M[11] = d;
+        affine_mul(T, M, N);
+        memcpy(T, N, sizeof T);
+    }
+    affine_mul(T, (const double *)vt.buf, N);
+    const double px = N[3], py = N[7], pz = N[11];
+    const double rx = gp * N[2], ry = gp * N[6], rz = gp * N[10]; /* g - p */
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const double zx = Z[3 * i], zy = Z[3 * i + 1], zz = Z[3 * i + 2];
+        const double dx = px - O[3 * i], dy = py - O[3 * i + 1], dz = pz - O[3 * i + 2];
+        const double vx = zy * dz - zz * dy, vy = zz * dx - zx * dz, vz = zx * dy - zy * dx;
+        J[i] = vx, J[n + i] = vy, J[2 * n + i] = vz;
+        J[3 * n + i] = zx, J[4 * n + i] = zy, J[5 * n + i] = zz;
+        Jg[i] = vx - (ry * zz - rz * zy);
+        Jg[n + i] = vy - (rz * zx - rx * zz);
+        Jg[2 * n + i] = vz - (rx * zy - ry * zx);
+        Jg[3 * n + i] = zx, Jg[4 * n + i] = zy, Jg[5 * n + i] = zz;
+    }
+    PyBuffer_Release(&vjg);
+    PyBuffer_Release(&vj);
+    PyBuffer_Release(&vt);
+    PyBuffer_Release(&vb);
+    PyBuffer_Release(&vc);
+    return Py_BuildValue("(ddddddddddddddd)", N[0], N[1], N[2], N[4], N[5], N[6], N[8], N[9],
+                         N[10], px, py, pz, px + rx, py + ry, pz + rz);
+fail_j:
+    PyBuffer_Release(&vj);
+fail_t:
+    PyBuffer_Release(&vt);
+fail_b:
+    PyBuffer_Release(&vb);
+fail_c:
+    PyBuffer_Release(&vc);
+    return NULL;
+}
+
+/* dls(Jg, n, lam2, b1, b2) -> (x1, x2): x = Jg^T (Jg Jg^T + lam2 I)^-1 b for the 6-vectors b1
+ * and b2 (the damped pseudo-inverse applied to each; Cholesky of the 6 x 6 SPD matrix). */
+static PyObject *py_dls(PyObject *self, PyObject *args) {
+    PyObject *jo, *b1o, *b2o;
+    Py_ssize_t n;
+    double lam2;
+    if (!PyArg_ParseTuple(args, "OndOO", &jo, &n, &lam2, &b1o, &b2o)) return NULL;
+    if (n < 1 || n > MAXJ) {
+        PyErr_SetString(PyExc_ValueError, "dls: 1..16 joints");
+        return NULL;
+    }
+    double b[2][6];
+    if (read_seq(b1o, b[0], 6, "dls: b1") < 0 || read_seq(b2o, b[1], 6, "dls: b2") < 0)
+        return NULL;
+    Py_buffer vj;
+    if (get_buffer(jo, &vj, 6 * n, 0, "dls: Jg") < 0) return NULL;
+    const double *J = vj.buf;
+    double A[6][6], L[6][6];
+    for (int r = 0; r < 6; r++)
+        for (int s = 0; s <= r; s++) {
+            double acc = 0.0;
+            for (Py_ssize_t k = 0; k < n; k++) acc += J[r * n + k] * J[s * n + k];
+            A[r][s] = A[s][r] = acc + (r == s ? lam2 : 0.0);
+        }
+    for (int r = 0; r < 6; r++) {
+        for (int s = 0; s <= r; s++) {
+            double acc = A[r][s];
+            for (int k = 0; k < s; k++) acc -= L[r][k] * L[s][k];
+            if (r == s) {
+                if (!(acc > 0.0)) {
+                    PyBuffer_Release(&vj);
+                    PyErr_SetString(PyExc_ValueError, "dls: matrix not positive definite");
+                    return NULL;
+                }
+                L[r][r] = sqrt(acc);
+            } else {
+                L[r][s] = acc / L[s][s];
+            }
+        }
+    }
+    double x[2][MAXJ];
+    for (int m = 0; m < 2; m++) {
+        double y[6];
+        for (int r = 0; r < 6; r++) { /* L y = b */
+            double acc = b[m][r];
+            for (int k = 0; k < r; k++) acc -= L[r][k] * y[k];
+            y[r] = acc / L[r][r];
+        }
+        for (int r = 5; r >= 0; r--) { /* L^T z = y */
+            double acc = y[r];
+            for (int k = r + 1; k < 6; k++) acc -= L[k][r] * y[k];
+            y[r] = acc / L[r][r];
+        }
+        for (Py_ssize_t k = 0; k < n; k++) {
+            double acc = 0.0;
+            for (int r = 0; r < 6; r++) acc += J[r * n + k] * y[r];
+            x[m][k] = acc;
+        }
+    }
+    PyBuffer_Release(&vj);
+    PyObject *x1 = list_of(x[0], n);
+    if (x1 == NULL) return NULL;
+    PyObject *x2 = list_of(x[1], n);
+    if (x2 == NULL) {
+        Py_DECREF(x1);
+        return NULL;
+    }
+    return Py_BuildValue("(NN)", x1, x2);
+}
+
+/* jtv(J, n, f) -> J^T f for a 6 x n J and a 6-vector f. */
+static PyObject *py_jtv(PyObject *self, PyObject *args) {
+    PyObject *jo, *fo;
+    Py_ssize_t n;
+    if (!PyArg_ParseTuple(args, "OnO", &jo, &n, &fo)) return NULL;
+    if (n < 1 || n > MAXJ) {
+        PyErr_SetString(PyExc_ValueError, "jtv: 1..16 joints");
+        return NULL;
+    }
+    double f[6], x[MAXJ];
+    if (read_seq(fo, f, 6, "jtv: f") < 0) return NULL;
+    Py_buffer vj;
+    if (get_buffer(jo, &vj, 6 * n, 0, "jtv: J") < 0) return NULL;
+    const double *J = vj.buf;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double acc = 0.0;
+        for (int r = 0; r < 6; r++) acc += J[r * n + k] * f[r];
+        x[k] = acc;
+    }
+    PyBuffer_Release(&vj);
+    return list_of(x, n);
+}
+
+static PyMethodDef methods[] = {
+    {"chain", py_chain, METH_VARARGS, "DH chain: tool pose, grasp point, J and Jg"},
+    {"dls", py_dls, METH_VARARGS, "damped pseudo-inverse applied to two 6-vectors"},
+    {"jtv", py_jtv, METH_VARARGS, "J^T f"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_arm_kinematics",
+                                    "The grasping arm task's per-step linear algebra.", -1,
+                                    methods};
+
+PyMODINIT_FUNC PyInit__arm_kinematics(void) { return PyModule_Create(&module); }

@@ -1,0 +1,22 @@
+"""Types of the grasping arm task's compiled kernels (replay/control/grasping/_arm_kinematics.c
+documents each)."""
+
+from collections.abc import Sequence
+from typing import Any
+
+Buffer = Any  # a C-contiguous float64 buffer (a NumPy array)
+
+def chain(
+    q: Sequence[float],
+    n: int,
+    consts: Buffer,
+    base: Buffer,
+    tool: Buffer,
+    grasp_point: float,
+    J: Buffer,
+    Jg: Buffer,
+) -> tuple[float, ...]: ...
+def dls(
+    Jg: Buffer, n: int, lam2: float, b1: Sequence[float], b2: Sequence[float]
+) -> tuple[list[float], list[float]]: ...
+def jtv(J: Buffer, n: int, f: Sequence[float]) -> list[float]: ...
