@@ -266,10 +266,8 @@ class ArmControlTask(Controller):
         damp = [-K_av * x for x in self.qd]
         F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
         force = [K_af * x for x in _arm_kinematics.jtv(self._J, n, F)]
-        cmd = [
-            min(max(a + b + c + d, -v), v)
-            for a, b, c, d, v in zip(track, reach, damp, force, self._vlim)
-        ]
+        cmd = [a + b + c + d for a, b, c, d in zip(track, reach, damp, force)]
+        cmd = [v if x > v else (-v if x < -v else x) for x, v in zip(cmd, self._vlim)]  # clip
         self._out = ArmLoop(
             t,
             [gp[0], gp[1], gp[2], 0.0, 0.0, 0.0],

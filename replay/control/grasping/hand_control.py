@@ -17,6 +17,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -133,9 +134,12 @@ class HandControlTask(Controller):
         self.open = np.asarray(hand.open_posture, float)
         self.lo, self.hi = np.asarray(hand.lower, float), np.asarray(hand.upper, float)
         self.vmax = float(hand.closing_speed)
-        self.q = self.open.copy()
-        self.qd = np.zeros(n)
-        self.load = np.zeros(n)
+        # the same in floats, for the per-step loop
+        self._postures = {k: (a.tolist(), b.tolist()) for k, (a, b) in self.postures.items()}
+        self._open = self.open.tolist()
+        self.q: list[float] = list(self._open)
+        self.qd = [0.0] * n
+        self.load = [0.0] * n  # F^h, low-passed (a new list each step: logged as is)
         self.shape = "unknown"
         self.preshape = "none"
         self.dt = spec.dt
@@ -149,7 +153,7 @@ class HandControlTask(Controller):
     def update(self, t: float, measurements) -> ServoCommand | None:
         for topic, m in measurements:
             if topic == TOPIC_HAND_ENCODERS:
-                self.q, self.qd = np.asarray(m.position, float), np.asarray(m.velocity, float)
+                self.q, self.qd = m.position, m.velocity
             elif topic == TOPIC_HAND_TORQUE:
                 # F^h: the load on the joints (minus the drive's torque), low-passed
                 a = (
@@ -157,7 +161,7 @@ class HandControlTask(Controller):
                     if self.params.load_filter <= 0.0
                     else min(1.0, self.dt / (self.params.load_filter + self.dt))
                 )
-                self.load += a * (-np.asarray(m.torque, float) - self.load)
+                self.load = [x + a * (-tau - x) for x, tau in zip(self.load, m.torque)]
             elif topic == TOPIC_GRASP_OBJECT:
                 self.shape = m.shape
             elif topic == TOPIC_GRASP_STATE:
@@ -180,21 +184,23 @@ class HandControlTask(Controller):
             if self.preshape != self.shape:
                 self.preshape = self.shape
                 self._events.append(Occurrence("preshape", {"shape": self.shape}))
-        if self.preshape in self.postures:
-            pre, grip = self.postures[self.preshape]
-            theta_d = pre + c * (grip - pre)
+        if self.preshape in self._postures:
+            pre, grip = self._postures[self.preshape]
+            theta_d = [p + c * (g - p) for p, g in zip(pre, grip)]
         else:
-            theta_d = self.open
+            theta_d = self._open
         P = self.params
-        cmd = P.K_hg * (theta_d - self.q) - P.K_hv * self.qd + P.K_hf * self.load  # eq. 4
-        cmd = np.clip(cmd, -self.vmax, self.vmax)
+        K_hg, K_hv, K_hf, vmax = P.K_hg, P.K_hv, P.K_hf, self.vmax
+        cmd = [  # eq. 4
+            K_hg * (td - q) - K_hv * qd + K_hf * f
+            for td, q, qd, f in zip(theta_d, self.q, self.qd, self.load)
+        ]
+        cmd = [vmax if x > vmax else (-vmax if x < -vmax else x) for x in cmd]  # np.clip's
         if st.phase == "hold":
             self._shape_at_grasp.setdefault(st.cycle, self.preshape)
-            deficit = float(np.max(np.abs(theta_d - self.q)))
-            self._holds[st.cycle] = min(self._holds.get(st.cycle, np.inf), deficit)
-        self._out = HandLoop(
-            t, self.preshape, c, theta_d.tolist(), self.load.tolist(), cmd.tolist()
-        )
+            deficit = max([abs(td - q) for td, q in zip(theta_d, self.q)])
+            self._holds[st.cycle] = min(self._holds.get(st.cycle, math.inf), deficit)
+        self._out = HandLoop(t, self.preshape, c, list(theta_d), self.load, cmd)
         return ServoCommand(hand=cmd)
 
     def telemetry(self, t: float) -> dict:

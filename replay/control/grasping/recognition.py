@@ -19,11 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.grasping.features import blob
+from replay.control.grasping.features import blob_rows
 from replay.control.grasping.payloads import GraspObject
-from replay.control.grasping.self_window import track
+from replay.control.grasping.self_window import track_rows
 from replay.interfaces import Controller, Occurrence
-from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP, unpack_rows
+from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import HeadSpec, camera_pose
@@ -149,7 +149,14 @@ class RecognitionTask(Controller):
         self.plane_point = np.asarray(spec.plane.point, float)
         self.pu, self.pv, self.pn = plane_basis(spec.plane.normal)
         self._head: dict[float, tuple[float, float]] = {}
-        self._target: np.ndarray | None = None
+        self._target: list[int] | None = None  # packed rows (self_window.track_rows)
+        self._c = (float(self.camera.c[0]), float(self.camera.c[1]))
+        self._plane_point = [float(x) for x in self.plane_point]
+        self._pu, self._pv, self._pn = (
+            [float(x) for x in self.pu],
+            [float(x) for x in self.pv],
+            [float(x) for x in self.pn],
+        )
         self._had_target = False
         self._votes = {"rectangle": 0, "circle": 0}
         self.shape = "unknown"
@@ -166,9 +173,8 @@ class RecognitionTask(Controller):
                 self._head[round(m.t, 9)] = (m.position[0], m.position[1])
             elif topic == TOPIC_VISION_CHIP:
                 chip = m
-        if len(self._head) > 16:
-            for key in sorted(self._head)[:-16]:
-                del self._head[key]
+        while len(self._head) > 16:
+            del self._head[min(self._head)]
         if chip is not None:
             self._out = self._frame(chip)
         return None
@@ -184,12 +190,11 @@ class RecognitionTask(Controller):
         angles = self._angles_at(chip.t)
         if angles is None:
             return None
-        image = unpack_rows(chip.rows, chip.width)
-        target, reacquired = track(self._target, image)
-        window = int(chip.count) if reacquired else int(target.sum())
+        target, reacquired = track_rows(self._target, chip.rows, chip.width)
         self._target = target
         self.frames += 1
-        b = blob(target, fill=self.shape == "unknown")
+        b = blob_rows(target, chip.width, fill=self.shape == "unknown")
+        window = int(chip.count) if reacquired else (b.area if b is not None else 0)
         if b is None:
             self.lost_frames += 1
             if self._had_target:
@@ -215,23 +220,61 @@ class RecognitionTask(Controller):
         if reacquired and self.frames > 1:
             self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
         self._had_target = True
-        pose = camera_pose(self.camera.head, *angles)  # once a frame: both rays and J
-        o, d = self.camera.ray(angles, (b.u, b.v), pose)
-        X = meet_plane(o, d, self.plane_point, self.pn)
+        # the camera pose at capture (replay.robot.head.camera_pose), in floats: once a frame
+        # for both rays and the image Jacobian (Camera.ray / meet_plane / Camera.jacobian)
+        head = self.camera.head
+        pan, tilt = angles
+        a = head.yaw + pan
+        ca, sa, ct, st = math.cos(a), math.sin(a), math.cos(tilt), math.sin(tilt)
+        R0, R1, R2 = (sa, -st * ca, ca * ct), (-ca, -st * sa, sa * ct), (0.0, -ct, -st)
+        hp, k = head.position, head.camera_offset
+        o = (hp[0] + k * ca * ct, hp[1] + k * sa * ct, hp[2] - k * st)
+        f, (cx, cy) = self.camera.f, self._c
+        P, N = self._plane_point, self._pn
+        po = (P[0] - o[0]) * N[0] + (P[1] - o[1]) * N[1] + (P[2] - o[2]) * N[2]
+
+        def on_plane(x: float, y: float):
+            x, y = (x - cx) / f, (y - cy) / f
+            d = (
+                R0[0] * x + R0[1] * y + R0[2],
+                R1[0] * x + R1[1] * y + R1[2],
+                R2[0] * x + R2[1] * y + R2[2],
+            )
+            denom = d[0] * N[0] + d[1] * N[1] + d[2] * N[2]
+            if abs(denom) < 1e-12:
+                return None
+            s = po / denom
+            return (o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]) if s > 0.0 else None
+
+        X = on_plane(b.u, b.v)
         if X is None:
             return None
-        axis = (math.cos(b.phi), math.sin(b.phi))
-        o2, d2 = self.camera.ray(angles, (b.u + axis[0], b.v + axis[1]), pose)
-        X2 = meet_plane(o2, d2, self.plane_point, self.pn)
+        X2 = on_plane(b.u + math.cos(b.phi), b.v + math.sin(b.phi))
         roll = None
         if X2 is not None and b.elongation >= self.params.axis_elongation:
-            e = X2 - X
-            roll = wrap_half_pi(math.atan2(float(e @ self.pv), float(e @ self.pu)))
-        scale = float(np.linalg.norm(X - o)) / self.camera.f  # m per px at the object
+            e = (X2[0] - X[0], X2[1] - X[1], X2[2] - X[2])
+            pu, pv = self._pu, self._pv
+            roll = wrap_half_pi(
+                math.atan2(
+                    e[0] * pv[0] + e[1] * pv[1] + e[2] * pv[2],
+                    e[0] * pu[0] + e[1] * pu[1] + e[2] * pu[2],
+                )
+            )
+        w = (X[0] - o[0], X[1] - o[1], X[2] - o[2])
+        scale = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) / f  # m per px there
         if not b.touches_border and b.area >= self.params.min_area:
             self._vote(b)
-        J = self.camera.jacobian(angles, X, pose)
-        x_o = [float(X[0]), float(X[1]), float(X[2]), roll if roll is not None else 0.0, 0.0, 0.0]
+        # Camera.jacobian: the point in the camera frame moves by -R^T (k x (X - h)) per radian
+        # about the pan axis k = z and the tilt axis k = (-sin a, cos a, 0)
+        pc = [R0[i] * w[0] + R1[i] * w[1] + R2[i] * w[2] for i in range(3)]
+        r = (X[0] - hp[0], X[1] - hp[1], X[2] - hp[2])
+        J = [[0.0, 0.0], [0.0, 0.0]]
+        for i, (k0, k1, k2) in enumerate(((0.0, 0.0, 1.0), (-sa, ca, 0.0))):
+            kx = (k1 * r[2] - k2 * r[1], k2 * r[0] - k0 * r[2], k0 * r[1] - k1 * r[0])
+            d = [-(R0[j] * kx[0] + R1[j] * kx[1] + R2[j] * kx[2]) for j in range(3)]
+            z2 = pc[2] * pc[2]
+            J[0][i] = f * (d[0] * pc[2] - pc[0] * d[2]) / z2
+            J[1][i] = f * (d[1] * pc[2] - pc[1] * d[2]) / z2
         return GraspObject(
             chip.t,
             True,
@@ -239,14 +282,14 @@ class RecognitionTask(Controller):
             b.phi,
             b.area,
             window,
-            X.tolist(),
+            list(X),
             roll,
-            x_o,
+            [X[0], X[1], X[2], roll if roll is not None else 0.0, 0.0, 0.0],
             [b.length * scale, b.width * scale],
             self.shape,
             b.fill if b.fill == b.fill else None,
             b.elongation,
-            J.tolist(),
+            J,
             list(angles),
         )
 

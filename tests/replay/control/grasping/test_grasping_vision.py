@@ -16,14 +16,19 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 from grasp_rig import rig  # noqa: E402
 
 from plants.bullet_arm.head import HeadServo  # noqa: E402
-from replay.control.grasping.features import blob  # noqa: E402
+from replay.control.grasping.features import blob, blob_rows  # noqa: E402
 from replay.control.grasping.head_tracking import HeadParams, HeadTrackingTask  # noqa: E402
 from replay.control.grasping.recognition import (
     RecognitionParams,
     RecognitionTask,  # noqa: E402
     shape_of,
 )
-from replay.control.grasping.self_window import dilate4, self_window, track  # noqa: E402
+from replay.control.grasping.self_window import (  # noqa: E402
+    dilate4,
+    self_window,
+    track,
+    track_rows,
+)
 from replay.messages import (
     TOPIC_GRASP_OBJECT,
     TOPIC_HEAD_ENCODERS,
@@ -117,6 +122,61 @@ def test_track_reacquires_from_the_whole_image():
     assert again and target.sum() == img.sum()
     target, again = track(np.zeros_like(img), img)
     assert again
+
+
+def random_blobs(rng, n: int, w: int = 16, h: int = 16):
+    """Seeded random binary images: noise, rectangles and discs (some cut by the border), and
+    a target image near each (a moved copy, for Self Windowing)."""
+    out = []
+    v, u = np.mgrid[0:h, 0:w]
+    for i in range(n):
+        kind = i % 3
+        if kind == 0:
+            img = rng.random((h, w)) < rng.uniform(0.05, 0.6)
+        elif kind == 1:
+            c, s = math.cos(rng.uniform(0, math.pi)), math.sin(rng.uniform(0, math.pi))
+            du, dv = u - rng.uniform(-2, w + 1), v - rng.uniform(-2, h + 1)
+            img = (abs(du * c + dv * s) < rng.uniform(0.5, 6)) & (
+                abs(-du * s + dv * c) < rng.uniform(0.5, 4)
+            )
+        else:
+            img = (u - rng.uniform(0, w)) ** 2 + (v - rng.uniform(0, h)) ** 2 < rng.uniform(1, 30)
+        prev = np.roll(img, (int(rng.integers(-2, 3)), int(rng.integers(-2, 3))), axis=(0, 1))
+        out.append((img, prev & (rng.random((h, w)) < 0.9)))
+    return out
+
+
+def test_packed_rows_self_windowing_and_features_equal_the_array_versions():
+    """``track_rows`` and ``blob_rows`` (the task's per-frame path, on the chip's packed rows)
+    against ``track`` and ``blob`` (arrays, the reference) over seeded random images: the same
+    target bits and area, border flag, and features within 1e-9."""
+    rng = np.random.default_rng(12)
+    cases = random_blobs(rng, 300) + random_blobs(rng, 30, w=9, h=12)
+    ok = 0
+    for img, prev in cases:
+        h, w = img.shape
+        rows, prev_rows = pack_rows(img), pack_rows(prev)
+        target, again = track(prev, img)
+        target_rows, again_rows = track_rows(prev_rows, rows, w)
+        good = again == again_rows and target_rows == pack_rows(target)
+        for fill in (True, False):
+            a, b = blob(target, fill=fill), blob_rows(target_rows, w, fill=fill)
+            if a is None or b is None:
+                good &= a is None and b is None
+                continue
+            good &= (a.area, a.touches_border) == (b.area, b.touches_border)
+            fa, fb = (
+                [a.u, a.v, a.elongation, a.length, a.width],
+                [b.u, b.v, b.elongation, b.length, b.width],
+            )
+            good &= bool(np.allclose(fa, fb, rtol=0.0, atol=1e-9))
+            # phi is defined modulo pi (an isotropic blob's is arbitrary: its elongation is 1)
+            dphi = math.remainder(a.phi - b.phi, math.pi)
+            good &= abs(dphi) < 1e-9 or a.elongation < 1.0 + 1e-6
+            good &= (math.isnan(a.fill) and math.isnan(b.fill)) or abs(a.fill - b.fill) < 1e-9
+        ok += bool(good)
+    print(f"packed-row vision: {ok}/{len(cases)} random images agree with the array versions")
+    assert ok == len(cases)
 
 
 def test_moments_give_centre_and_rotation():
