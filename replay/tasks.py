@@ -51,17 +51,22 @@ class TaskSet(Controller):
     def __init__(self, tasks: list[Task], physics_rate: int) -> None:
         self.tasks = tasks
         self.rate = physics_rate
-        self._inbox: dict[str, list] = {t.name: [] for t in tasks}
-        self._newest: dict[str, dict[str, float]] = {t.name: {} for t in tasks}
-        self._latency: dict[str, float | None] = {t.name: None for t in tasks}
-        self._oldest: dict[str, str | None] = {t.name: None for t in tasks}
-        self._ticked = [False] * len(tasks)
-        self._telemetry: dict[str, list] = {}
-        self._readers: dict[str, list[Task]] = {}
-        for t in tasks:
+        n = len(tasks)
+        # per task, by its index: the messages since its last tick, the newest capture time per
+        # input topic, and the latency (and its topic) at its last tick
+        self._inbox: list[list] = [[] for _ in tasks]
+        self._newest: list[dict[str, float]] = [{} for _ in tasks]
+        self._latency: list[float | None] = [None] * n
+        self._oldest: list[str | None] = [None] * n
+        self._ticked = [False] * n
+        self._names = [t.name for t in tasks]
+        self._telemetry: dict[str, Any] = {}
+        self._readers: dict[str, list[int]] = {}
+        for i, t in enumerate(tasks):
             for topic in t.inputs:
-                self._readers.setdefault(topic, []).append(t)
-        self._fields: dict[type, tuple[str, ...]] = {}
+                self._readers.setdefault(topic, []).append(i)
+        # per (task, command type): the command fields the task may not write
+        self._forbidden: dict[tuple[int, type], tuple[str, ...]] = {}
 
     def _route(self, topic: str, payload: Any) -> None:
         readers = self._readers.get(topic)
@@ -69,22 +74,24 @@ class TaskSet(Controller):
             return
         stamp = payload.get("t") if isinstance(payload, dict) else getattr(payload, "t", None)
         item = (topic, payload)
-        for task in readers:
-            self._inbox[task.name].append(item)
+        inbox, newest = self._inbox, self._newest
+        for i in readers:
+            inbox[i].append(item)
             if stamp is not None:
-                self._newest[task.name][topic] = stamp
+                newest[i][topic] = stamp
 
-    def _check(self, task: Task, command: Any) -> None:
-        cls = type(command)
-        names = self._fields.get(cls)
+    def _check(self, i: int, task: Task, command: Any) -> None:
+        key = (i, type(command))
+        names = self._forbidden.get(key)
         if names is None:
-            names = self._fields[cls] = (
+            fields = (
                 tuple(f.name for f in dataclasses.fields(command))
                 if dataclasses.is_dataclass(command)
                 else ()
             )
+            names = self._forbidden[key] = tuple(n for n in fields if n not in task.outputs)
         for n in names:
-            if getattr(command, n) is not None and n not in task.outputs:
+            if getattr(command, n) is not None:
                 raise TaskError(
                     f"task {task.name!r} wrote command field {n!r}, not among its "
                     f"outputs {sorted(task.outputs)}"
@@ -92,41 +99,49 @@ class TaskSet(Controller):
 
     def update(self, t: float, measurements: list[tuple[str, Any]]) -> list | None:
         k = int(round(t * self.rate))
+        route = self._route
         for topic, m in measurements:
-            self._route(topic, m)
+            route(topic, m)
         commands = []
-        self._telemetry = {}
+        out: dict[str, Any] = {}
+        self._telemetry = out
+        inboxes, ticked = self._inbox, self._ticked
         for i, task in enumerate(self.tasks):
             due = k % task.divider == 0
-            self._ticked[i] = due
+            ticked[i] = due
             if not due:
                 continue
-            inbox, self._inbox[task.name] = self._inbox[task.name], []
-            command = task.controller.update(t, inbox)
-            newest = self._newest[task.name]
+            inbox = inboxes[i]
+            inboxes[i] = []
+            controller = task.controller
+            command = controller.update(t, inbox)
+            newest = self._newest[i]
             if newest:
-                stamp, topic = min((v, k) for k, v in newest.items())  # oldest, then by name
-                self._latency[task.name] = t - stamp
-                self._oldest[task.name] = topic
+                stamp, topic = min(zip(newest.values(), newest.keys()))  # oldest, then by name
+                self._latency[i] = t - stamp
+                self._oldest[i] = topic
             if command is not None:
-                self._check(task, command)
+                self._check(i, task, command)
                 commands.append(command)
-            for topic, payload in task.controller.telemetry(t).items():
-                items = payload if isinstance(payload, list) else [payload]
-                self._telemetry.setdefault(topic, []).extend(items)
+            for topic, payload in controller.telemetry(t).items():
+                prev = out.get(topic)
+                if prev is None:
+                    out[topic] = payload
+                else:  # several tasks (or ticks) on one topic: a list, in order
+                    items = prev if isinstance(prev, list) else [prev]
+                    out[topic] = items + (payload if isinstance(payload, list) else [payload])
                 if topic in task.outputs:
-                    for item in items:
-                        self._route(topic, item)
+                    if isinstance(payload, list):
+                        for item in payload:
+                            route(topic, item)
+                    else:
+                        route(topic, payload)
         return commands or None
 
     def telemetry(self, t: float) -> dict[str, Any]:
         out: dict[str, Any] = dict(self._telemetry)
         out[TOPIC_TASK_LOOPS] = TaskLoops(
-            t,
-            [x.name for x in self.tasks],
-            list(self._ticked),
-            [self._latency[x.name] for x in self.tasks],
-            [self._oldest[x.name] for x in self.tasks],
+            t, list(self._names), list(self._ticked), list(self._latency), list(self._oldest)
         )
         return out
 
