@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.grasping.features import blob_rows
+from replay.control.grasping import _chip_target
+from replay.control.grasping.features import DIR_TABLE, Blob, blob_rows
 from replay.control.grasping.payloads import GraspObject
 from replay.control.grasping.self_window import track_rows
 from replay.interfaces import Controller, Occurrence
@@ -190,10 +191,17 @@ class RecognitionTask(Controller):
         angles = self._angles_at(chip.t)
         if angles is None:
             return None
-        target, reacquired = track_rows(self._target, chip.rows, chip.width)
+        fill = self.shape == "unknown"
+        if chip.width <= 63 and len(chip.rows) <= 64:  # track_rows and blob_rows, compiled
+            target, reacquired, feats = _chip_target.target_blob(
+                self._target, chip.rows, chip.width, fill, DIR_TABLE
+            )
+            b = None if feats is None else Blob(*feats)
+        else:
+            target, reacquired = track_rows(self._target, chip.rows, chip.width)
+            b = blob_rows(target, chip.width, fill=fill)
         self._target = target
         self.frames += 1
-        b = blob_rows(target, chip.width, fill=self.shape == "unknown")
         window = int(chip.count) if reacquired else (b.area if b is not None else 0)
         if b is None:
             self.lost_frames += 1
@@ -262,8 +270,8 @@ class RecognitionTask(Controller):
             )
         w = (X[0] - o[0], X[1] - o[1], X[2] - o[2])
         scale = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) / f  # m per px there
-        if not b.touches_border and b.area >= self.params.min_area:
-            self._vote(b)
+        if self.shape == "unknown" and not b.touches_border and b.area >= self.params.min_area:
+            self._vote(b)  # (once decided, the shape is kept: later votes would change nothing)
         # Camera.jacobian: the point in the camera frame moves by -R^T (k x (X - h)) per radian
         # about the pan axis k = z and the tilt axis k = (-sin a, cos a, 0)
         pc = [R0[i] * w[0] + R1[i] * w[1] + R2[i] * w[2] for i in range(3)]
