@@ -118,19 +118,19 @@ def blob_rows(rows: list[int], width: int, fill: bool = True) -> Blob | None:
     ors = 0  # the rows ORed: which columns hold a pixel
     for v, r in enumerate(rows):
         if r:
-            c, s = C[r], S[r]
-            n += c
-            su += s
+            cnt, sm = C[r], S[r]
+            n += cnt
+            su += sm
             suu += Q[r]
-            sv += v * c
-            svv += v * v * c
-            suv += v * s
+            sv += v * cnt
+            svv += v * v * cnt
+            suv += v * sm
             ors |= r
             ends.append((v, (r & -r).bit_length() - 1, r.bit_length() - 1))
     if n == 0:
         return None
     u0, v0 = su / n, sv / n
-    nn = n * n  # central moments from exact integer sums: sum (u - u0)^2 / n = ...
+    nn = n * n  # central moments from exact sums: sum (u - u0)^2 / n = (n Suu - Su^2) / n^2
     mu20, mu02, mu11 = (n * suu - su * su) / nn, (n * svv - sv * sv) / nn, (n * suv - su * sv) / nn
     phi = 0.5 * math.atan2(2.0 * mu11, mu20 - mu02)
     mean, rad = 0.5 * (mu20 + mu02), math.hypot(0.5 * (mu20 - mu02), mu11)
