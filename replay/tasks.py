@@ -67,6 +67,19 @@ class TaskSet(Controller):
                 self._readers.setdefault(topic, []).append(i)
         # per (task, command type): the command fields the task may not write
         self._forbidden: dict[tuple[int, type], tuple[str, ...]] = {}
+        # what a step needs of each task, looked up once
+        self._loop = [
+            (
+                i,
+                t,
+                t.divider,
+                t.controller.update,
+                t.controller.telemetry,
+                t.outputs,
+                self._newest[i],
+            )
+            for i, t in enumerate(tasks)
+        ]
 
     def _route(self, topic: str, payload: Any) -> None:
         readers = self._readers.get(topic)
@@ -105,32 +118,33 @@ class TaskSet(Controller):
         commands = []
         out: dict[str, Any] = {}
         self._telemetry = out
-        inboxes, ticked = self._inbox, self._ticked
-        for i, task in enumerate(self.tasks):
-            due = k % task.divider == 0
+        inboxes, ticked, latency, oldest = self._inbox, self._ticked, self._latency, self._oldest
+        forbidden = self._forbidden
+        for i, task, divider, update, telemetry, outputs, newest in self._loop:
+            due = k % divider == 0
             ticked[i] = due
             if not due:
                 continue
             inbox = inboxes[i]
             inboxes[i] = []
-            controller = task.controller
-            command = controller.update(t, inbox)
-            newest = self._newest[i]
+            command = update(t, inbox)
             if newest:
                 stamp, topic = min(zip(newest.values(), newest.keys()))  # oldest, then by name
-                self._latency[i] = t - stamp
-                self._oldest[i] = topic
+                latency[i] = t - stamp
+                oldest[i] = topic
             if command is not None:
-                self._check(i, task, command)
+                names = forbidden.get((i, type(command)))
+                if names is None or names:
+                    self._check(i, task, command)
                 commands.append(command)
-            for topic, payload in controller.telemetry(t).items():
+            for topic, payload in telemetry(t).items():
                 prev = out.get(topic)
                 if prev is None:
                     out[topic] = payload
                 else:  # several tasks (or ticks) on one topic: a list, in order
                     items = prev if isinstance(prev, list) else [prev]
                     out[topic] = items + (payload if isinstance(payload, list) else [payload])
-                if topic in task.outputs:
+                if topic in outputs:
                     if isinstance(payload, list):
                         for item in payload:
                             route(topic, item)

@@ -1,7 +1,8 @@
 /* The arm task's per-step linear algebra (replay/control/grasping/arm_control.py documents it;
  * that module is the only caller and keeps the NumPy version as the reference): the DH chain's
- * forward kinematics and geometric Jacobian, the grasp point's Jacobian, the damped
- * pseudo-inverse applied to eq. 2's two task vectors, and J^T F. Plain C over the buffer
+ * forward kinematics and geometric Jacobian, the grasp point's Jacobian (``chain``), and eq. 2's
+ * terms: the damped pseudo-inverse applied to its two task vectors, the damping, J^T F and the
+ * clipped sum (``terms``). Plain C over the buffer
  * protocol and sequences of floats: no NumPy headers.
  *
  * Matrices are row-major float64. The chain's constants are n rows of (cos alpha, sin alpha, a,
@@ -139,28 +140,39 @@ fail_c:
     return NULL;
 }
 
-/* dls(Jg, n, lam2, b1, b2) -> (x1, x2): x = Jg^T (Jg Jg^T + lam2 I)^-1 b for the 6-vectors b1
- * and b2 (the damped pseudo-inverse applied to each; Cholesky of the 6 x 6 SPD matrix). */
-static PyObject *py_dls(PyObject *self, PyObject *args) {
-    PyObject *jo, *b1o, *b2o;
+/* terms(Jg, J, n, lam2, b1, b2, qd, F, K_ap, K_av, K_af, vlim) -> (track, reach, damp, force,
+ * command): eq. 2's joint-velocity terms. track = K_ap Jg+ b1 and reach = K_ap Jg+ b2 with the
+ * damped pseudo-inverse Jg+ = Jg^T (Jg Jg^T + lam2 I)^-1 (Cholesky of the 6 x 6 SPD matrix; b1
+ * = S K^a1 e_track, b2 = (I - S) K^a2 e_reach), damp = -K_av qd, force = K_af J^T F; command =
+ * their sum ((track + reach) + damp) + force, clipped to +-vlim (NaN passes, as np.clip). */
+static PyObject *py_terms(PyObject *self, PyObject *args) {
+    PyObject *jgo, *jo, *b1o, *b2o, *qdo, *fo, *vlo;
     Py_ssize_t n;
-    double lam2;
-    if (!PyArg_ParseTuple(args, "OndOO", &jo, &n, &lam2, &b1o, &b2o)) return NULL;
+    double lam2, K_ap, K_av, K_af;
+    if (!PyArg_ParseTuple(args, "OOndOOOOdddO", &jgo, &jo, &n, &lam2, &b1o, &b2o, &qdo, &fo,
+                          &K_ap, &K_av, &K_af, &vlo))
+        return NULL;
     if (n < 1 || n > MAXJ) {
-        PyErr_SetString(PyExc_ValueError, "dls: 1..16 joints");
+        PyErr_SetString(PyExc_ValueError, "terms: 1..16 joints");
         return NULL;
     }
-    double b[2][6];
-    if (read_seq(b1o, b[0], 6, "dls: b1") < 0 || read_seq(b2o, b[1], 6, "dls: b2") < 0)
+    double b[2][6], f[6], qd[MAXJ], vlim[MAXJ];
+    if (read_seq(b1o, b[0], 6, "terms: b1") < 0 || read_seq(b2o, b[1], 6, "terms: b2") < 0 ||
+        read_seq(fo, f, 6, "terms: F") < 0 || read_seq(qdo, qd, n, "terms: qd") < 0 ||
+        read_seq(vlo, vlim, n, "terms: vlim") < 0)
         return NULL;
-    Py_buffer vj;
-    if (get_buffer(jo, &vj, 6 * n, 0, "dls: Jg") < 0) return NULL;
-    const double *J = vj.buf;
+    Py_buffer vjg, vj;
+    if (get_buffer(jgo, &vjg, 6 * n, 0, "terms: Jg") < 0) return NULL;
+    if (get_buffer(jo, &vj, 6 * n, 0, "terms: J") < 0) {
+        PyBuffer_Release(&vjg);
+        return NULL;
+    }
+    const double *Jg = vjg.buf, *J = vj.buf;
     double A[6][6], L[6][6];
     for (int r = 0; r < 6; r++)
         for (int s = 0; s <= r; s++) {
             double acc = 0.0;
-            for (Py_ssize_t k = 0; k < n; k++) acc += J[r * n + k] * J[s * n + k];
+            for (Py_ssize_t k = 0; k < n; k++) acc += Jg[r * n + k] * Jg[s * n + k];
             A[r][s] = A[s][r] = acc + (r == s ? lam2 : 0.0);
         }
     for (int r = 0; r < 6; r++) {
@@ -170,7 +182,8 @@ static PyObject *py_dls(PyObject *self, PyObject *args) {
             if (r == s) {
                 if (!(acc > 0.0)) {
                     PyBuffer_Release(&vj);
-                    PyErr_SetString(PyExc_ValueError, "dls: matrix not positive definite");
+                    PyBuffer_Release(&vjg);
+                    PyErr_SetString(PyExc_ValueError, "terms: J J^T + lambda^2 I not positive definite");
                     return NULL;
                 }
                 L[r][r] = sqrt(acc);
@@ -179,7 +192,7 @@ static PyObject *py_dls(PyObject *self, PyObject *args) {
             }
         }
     }
-    double x[2][MAXJ];
+    double x[5][MAXJ]; /* track, reach, damp, force, command */
     for (int m = 0; m < 2; m++) {
         double y[6];
         for (int r = 0; r < 6; r++) { /* L y = b */
@@ -194,48 +207,36 @@ static PyObject *py_dls(PyObject *self, PyObject *args) {
         }
         for (Py_ssize_t k = 0; k < n; k++) {
             double acc = 0.0;
-            for (int r = 0; r < 6; r++) acc += J[r * n + k] * y[r];
-            x[m][k] = acc;
+            for (int r = 0; r < 6; r++) acc += Jg[r * n + k] * y[r];
+            x[m][k] = K_ap * acc;
         }
     }
-    PyBuffer_Release(&vj);
-    PyObject *x1 = list_of(x[0], n);
-    if (x1 == NULL) return NULL;
-    PyObject *x2 = list_of(x[1], n);
-    if (x2 == NULL) {
-        Py_DECREF(x1);
-        return NULL;
-    }
-    return Py_BuildValue("(NN)", x1, x2);
-}
-
-/* jtv(J, n, f) -> J^T f for a 6 x n J and a 6-vector f. */
-static PyObject *py_jtv(PyObject *self, PyObject *args) {
-    PyObject *jo, *fo;
-    Py_ssize_t n;
-    if (!PyArg_ParseTuple(args, "OnO", &jo, &n, &fo)) return NULL;
-    if (n < 1 || n > MAXJ) {
-        PyErr_SetString(PyExc_ValueError, "jtv: 1..16 joints");
-        return NULL;
-    }
-    double f[6], x[MAXJ];
-    if (read_seq(fo, f, 6, "jtv: f") < 0) return NULL;
-    Py_buffer vj;
-    if (get_buffer(jo, &vj, 6 * n, 0, "jtv: J") < 0) return NULL;
-    const double *J = vj.buf;
     for (Py_ssize_t k = 0; k < n; k++) {
         double acc = 0.0;
         for (int r = 0; r < 6; r++) acc += J[r * n + k] * f[r];
-        x[k] = acc;
+        x[2][k] = -K_av * qd[k];
+        x[3][k] = K_af * acc;
+        const double c = x[0][k] + x[1][k] + x[2][k] + x[3][k], v = vlim[k];
+        x[4][k] = c > v ? v : (c < -v ? -v : c);
     }
     PyBuffer_Release(&vj);
-    return list_of(x, n);
+    PyBuffer_Release(&vjg);
+    PyObject *out = PyTuple_New(5);
+    if (out == NULL) return NULL;
+    for (int m = 0; m < 5; m++) {
+        PyObject *l = list_of(x[m], n);
+        if (l == NULL) {
+            Py_DECREF(out);
+            return NULL;
+        }
+        PyTuple_SET_ITEM(out, m, l);
+    }
+    return out;
 }
 
 static PyMethodDef methods[] = {
     {"chain", py_chain, METH_VARARGS, "DH chain: tool pose, grasp point, J and Jg"},
-    {"dls", py_dls, METH_VARARGS, "damped pseudo-inverse applied to two 6-vectors"},
-    {"jtv", py_jtv, METH_VARARGS, "J^T f"},
+    {"terms", py_terms, METH_VARARGS, "eq. 2's joint-velocity terms and the command"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -16,7 +16,17 @@ def chain(
     J: Buffer,
     Jg: Buffer,
 ) -> tuple[float, ...]: ...
-def dls(
-    Jg: Buffer, n: int, lam2: float, b1: Sequence[float], b2: Sequence[float]
-) -> tuple[list[float], list[float]]: ...
-def jtv(J: Buffer, n: int, f: Sequence[float]) -> list[float]: ...
+def terms(
+    Jg: Buffer,
+    J: Buffer,
+    n: int,
+    lam2: float,
+    b1: Sequence[float],
+    b2: Sequence[float],
+    qd: Sequence[float],
+    F: Sequence[float],
+    K_ap: float,
+    K_av: float,
+    K_af: float,
+    vlim: Sequence[float],
+) -> tuple[list[float], list[float], list[float], list[float], list[float]]: ...

@@ -253,21 +253,21 @@ class ArmControlTask(Controller):
             n_palm[2] * npl[0] - n_palm[0] * npl[2],
             n_palm[0] * npl[1] - n_palm[1] * npl[0],
         ]
-        track, reach = _arm_kinematics.dls(
+        F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
+        track, reach, damp, force, cmd = _arm_kinematics.terms(
             self._Jg,
+            self._J,
             n,
             P.damping**2,
             [g * e for g, e in zip(self._g_track, e_track)],
             [g * e for g, e in zip(self._g_reach, e_reach)],
+            self.qd,
+            F,
+            P.K_ap,
+            P.K_av,
+            P.K_af,
+            self._vlim,
         )
-        K_ap, K_av, K_af = P.K_ap, P.K_av, P.K_af
-        track = [K_ap * x for x in track]
-        reach = [K_ap * x for x in reach]
-        damp = [-K_av * x for x in self.qd]
-        F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
-        force = [K_af * x for x in _arm_kinematics.jtv(self._J, n, F)]
-        cmd = [a + b + c + d for a, b, c, d in zip(track, reach, damp, force)]
-        cmd = [v if x > v else (-v if x < -v else x) for x, v in zip(cmd, self._vlim)]  # clip
         self._out = ArmLoop(
             t,
             [gp[0], gp[1], gp[2], 0.0, 0.0, 0.0],
