@@ -1,8 +1,8 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels and the grasping tasks' per-step kernels are small C extensions
-(replay/sensors/_pixels.c, replay/control/grasping/_arm_kinematics.c and _chip_target.c: plain C
-over the buffer protocol, no NumPy headers)."""
+(replay/sensors/_pixels.c; replay/control/grasping/_arm_kinematics.c, _chip_target.c and
+_hand_servo.c: plain C over the buffer protocol, no NumPy headers)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -29,6 +29,11 @@ setup(
         Extension(
             "replay.control.grasping._chip_target",
             ["replay/control/grasping/_chip_target.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.grasping._hand_servo",
+            ["replay/control/grasping/_hand_servo.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
     ],

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from replay.control.grasping import _hand_servo
 from replay.control.grasping.payloads import HandLoop
 from replay.interfaces import Controller, Occurrence
 from replay.messages import (
@@ -56,6 +57,16 @@ _CIRC_PRE = [
     0.20,
 ]
 _CIRC_GRIP = [-0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, 0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80]
+
+
+def eq4_reference(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax):
+    """(theta_d^h, eq. 4's command clipped to +-vmax, max |theta_d^h - theta^h|) in floats: the
+    reference of the compiled ``_hand_servo.eq4`` the task runs (``grip`` None: theta_d^h =
+    ``pre``)."""
+    theta_d = list(pre) if grip is None else [p + c * (g - p) for p, g in zip(pre, grip)]
+    cmd = [K_hg * (td - x) - K_hv * v + K_hf * f for td, x, v, f in zip(theta_d, q, qd, load)]
+    cmd = [vmax if x > vmax else (-vmax if x < -vmax else x) for x in cmd]  # np.clip's
+    return theta_d, cmd, max(abs(td - x) for td, x in zip(theta_d, q))
 
 
 @dataclass
@@ -135,7 +146,9 @@ class HandControlTask(Controller):
         self.lo, self.hi = np.asarray(hand.lower, float), np.asarray(hand.upper, float)
         self.vmax = float(hand.closing_speed)
         # the same in floats, for the per-step loop
-        self._postures = {k: (a.tolist(), b.tolist()) for k, (a, b) in self.postures.items()}
+        self._postures: dict[str, tuple[list[float], list[float] | None]] = {
+            k: (a.tolist(), b.tolist()) for k, (a, b) in self.postures.items()
+        }
         self._open = self.open.tolist()
         self.q: list[float] = list(self._open)
         self.qd = [0.0] * n
@@ -161,7 +174,7 @@ class HandControlTask(Controller):
                     if self.params.load_filter <= 0.0
                     else min(1.0, self.dt / (self.params.load_filter + self.dt))
                 )
-                self.load = [x + a * (-tau - x) for x, tau in zip(self.load, m.torque)]
+                self.load = _hand_servo.lowpass(self.load, m.torque, a)
             elif topic == TOPIC_GRASP_OBJECT:
                 self.shape = m.shape
             elif topic == TOPIC_GRASP_STATE:
@@ -184,23 +197,15 @@ class HandControlTask(Controller):
             if self.preshape != self.shape:
                 self.preshape = self.shape
                 self._events.append(Occurrence("preshape", {"shape": self.shape}))
-        if self.preshape in self._postures:
-            pre, grip = self._postures[self.preshape]
-            theta_d = [p + c * (g - p) for p, g in zip(pre, grip)]
-        else:
-            theta_d = self._open
+        pre, grip = self._postures.get(self.preshape, (self._open, None))
         P = self.params
-        K_hg, K_hv, K_hf, vmax = P.K_hg, P.K_hv, P.K_hf, self.vmax
-        cmd = [  # eq. 4
-            K_hg * (td - q) - K_hv * qd + K_hf * f
-            for td, q, qd, f in zip(theta_d, self.q, self.qd, self.load)
-        ]
-        cmd = [vmax if x > vmax else (-vmax if x < -vmax else x) for x in cmd]  # np.clip's
+        theta_d, cmd, deficit = _hand_servo.eq4(
+            pre, grip, c, self.q, self.qd, self.load, P.K_hg, P.K_hv, P.K_hf, self.vmax
+        )
         if st.phase == "hold":
             self._shape_at_grasp.setdefault(st.cycle, self.preshape)
-            deficit = max([abs(td - q) for td, q in zip(theta_d, self.q)])
             self._holds[st.cycle] = min(self._holds.get(st.cycle, math.inf), deficit)
-        self._out = HandLoop(t, self.preshape, c, list(theta_d), self.load, cmd)
+        self._out = HandLoop(t, self.preshape, c, theta_d, self.load, cmd)
         return ServoCommand(hand=cmd)
 
     def telemetry(self, t: float) -> dict:
