@@ -1,8 +1,10 @@
-/* The recognition task's per-frame pass over the chip's packed rows (bit u of rows[v] = pixel
- * (u, v)): Self Windowing and the target's features in one call. The Python versions are the
- * reference (replay/control/grasping/self_window.py track_rows, features.py blob_rows, which
- * document the algorithms; tests hold them equal): the same integer sums, the same float
- * operations in the same order, the same libm functions. Plain C: no NumPy headers.
+/* The recognition task's per-frame kernels. ``target_blob``: one pass over the chip's packed
+ * rows (bit u of rows[v] = pixel (u, v)), Self Windowing and the target's features; the Python
+ * versions are the reference (replay/control/grasping/self_window.py track_rows, features.py
+ * blob_rows, which document the algorithms; tests hold them equal): the same integer sums, the
+ * same float operations in the same order, the same libm functions. ``plane_geometry``: the
+ * target's point on the constraint plane, its axis there and the head's image Jacobian, with
+ * recognition.py's Camera (NumPy) as the reference. Plain C: no NumPy headers.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -164,13 +166,73 @@ static PyObject *py_target_blob(PyObject *self, PyObject *args) {
                          cmax - cmin + ext, fill, border ? Py_True : Py_False);
 }
 
+/* the ray through pixel (x, y) of the camera (R row-major, centre o) meets the plane n . X =
+ * n . P where s > 0 along it: recognition.py's Camera.ray + meet_plane. po = n . (P - o). */
+static int on_plane(const double *R, const double *o, const double *n, double po, double f,
+                    double cx, double cy, double x, double y, double *X) {
+    x = (x - cx) / f, y = (y - cy) / f;
+    const double d0 = R[0] * x + R[1] * y + R[2], d1 = R[3] * x + R[4] * y + R[5],
+                 d2 = R[6] * x + R[7] * y + R[8];
+    const double denom = d0 * n[0] + d1 * n[1] + d2 * n[2];
+    if (fabs(denom) < 1e-12) return 0;
+    const double s = po / denom;
+    if (!(s > 0.0)) return 0;
+    X[0] = o[0] + s * d0, X[1] = o[1] + s * d1, X[2] = o[2] + s * d2;
+    return 1;
+}
+
+/* plane_geometry(yaw, pan, tilt, head, offset, f, cx, cy, P, n, pu, pv, u, v, phi) -> None
+ * (the ray through (u, v) misses the plane) or (X0, X1, X2, axis, distance, J00, J01, J10, J11):
+ * the camera pose of replay.robot.head.camera_pose at (pan, tilt); X where the ray through the
+ * target's centre (u, v) meets the constraint plane (point P, unit normal n); axis =
+ * atan2(e . pv, e . pu) of e = X' - X, X' that of (u + cos phi, v + sin phi) (NaN if it misses);
+ * distance = |X - o|; J = d (u, v) / d (pan, tilt) of X (Camera.jacobian: the point in the camera
+ * frame moves by -R^T (k x (X - h)) per radian about k = z and k = (-sin a, cos a, 0)). */
+static PyObject *py_plane_geometry(PyObject *self, PyObject *args) {
+    double yaw, pan, tilt, off, f, cx, cy, u, v, phi, h[3], P[3], n[3], pu[3], pv[3];
+    if (!PyArg_ParseTuple(args, "ddd(ddd)dddd(ddd)(ddd)(ddd)(ddd)ddd", &yaw, &pan, &tilt, &h[0],
+                          &h[1], &h[2], &off, &f, &cx, &cy, &P[0], &P[1], &P[2], &n[0], &n[1],
+                          &n[2], &pu[0], &pu[1], &pu[2], &pv[0], &pv[1], &pv[2], &u, &v, &phi))
+        return NULL;
+    const double a = yaw + pan, ca = cos(a), sa = sin(a), ct = cos(tilt), st = sin(tilt);
+    const double R[9] = {sa, -st * ca, ca * ct, -ca, -st * sa, sa * ct, 0.0, -ct, -st};
+    const double o[3] = {h[0] + off * ca * ct, h[1] + off * sa * ct, h[2] - off * st};
+    const double po = (P[0] - o[0]) * n[0] + (P[1] - o[1]) * n[1] + (P[2] - o[2]) * n[2];
+    double X[3], X2[3];
+    if (!on_plane(R, o, n, po, f, cx, cy, u, v, X)) Py_RETURN_NONE;
+    double axis = NAN;
+    if (on_plane(R, o, n, po, f, cx, cy, u + cos(phi), v + sin(phi), X2)) {
+        const double e0 = X2[0] - X[0], e1 = X2[1] - X[1], e2 = X2[2] - X[2];
+        axis = atan2(e0 * pv[0] + e1 * pv[1] + e2 * pv[2], e0 * pu[0] + e1 * pu[1] + e2 * pu[2]);
+    }
+    const double w0 = X[0] - o[0], w1 = X[1] - o[1], w2 = X[2] - o[2];
+    const double dist = sqrt(w0 * w0 + w1 * w1 + w2 * w2);
+    double pc[3];
+    for (int i = 0; i < 3; i++) pc[i] = R[i] * w0 + R[3 + i] * w1 + R[6 + i] * w2;
+    const double r0 = X[0] - h[0], r1 = X[1] - h[1], r2 = X[2] - h[2];
+    const double ks[2][3] = {{0.0, 0.0, 1.0}, {-sa, ca, 0.0}};
+    double J[2][2];
+    const double z2 = pc[2] * pc[2];
+    for (int i = 0; i < 2; i++) {
+        const double k0 = ks[i][0], k1 = ks[i][1], k2 = ks[i][2];
+        const double kx0 = k1 * r2 - k2 * r1, kx1 = k2 * r0 - k0 * r2, kx2 = k0 * r1 - k1 * r0;
+        double d[3];
+        for (int j = 0; j < 3; j++) d[j] = -(R[j] * kx0 + R[3 + j] * kx1 + R[6 + j] * kx2);
+        J[0][i] = f * (d[0] * pc[2] - pc[0] * d[2]) / z2;
+        J[1][i] = f * (d[1] * pc[2] - pc[1] * d[2]) / z2;
+    }
+    return Py_BuildValue("(ddddddddd)", X[0], X[1], X[2], axis, dist, J[0][0], J[0][1], J[1][0],
+                         J[1][1]);
+}
+
 static PyMethodDef methods[] = {
     {"target_blob", py_target_blob, METH_VARARGS, "Self Windowing and the target's features"},
+    {"plane_geometry", py_plane_geometry, METH_VARARGS, "x_o on the plane and the image Jacobian"},
     {NULL, NULL, 0, NULL},
 };
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_chip_target",
-                                    "The recognition task's per-frame pass over packed rows.",
+                                    "The recognition task's per-frame kernels.",
                                     -1, methods};
 
 PyMODINIT_FUNC PyInit__chip_target(void) { return PyModule_Create(&module); }

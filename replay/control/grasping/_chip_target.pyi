@@ -13,3 +13,20 @@ def target_blob(
     bool,
     tuple[int, float, float, float, float, float, float, float, bool] | None,
 ]: ...
+def plane_geometry(
+    yaw: float,
+    pan: float,
+    tilt: float,
+    head: Sequence[float],
+    offset: float,
+    f: float,
+    cx: float,
+    cy: float,
+    P: Sequence[float],
+    n: Sequence[float],
+    pu: Sequence[float],
+    pv: Sequence[float],
+    u: float,
+    v: float,
+    phi: float,
+) -> tuple[float, float, float, float, float, float, float, float, float] | None: ...

@@ -152,12 +152,13 @@ class RecognitionTask(Controller):
         self._head: dict[float, tuple[float, float]] = {}
         self._target: list[int] | None = None  # packed rows (self_window.track_rows)
         self._c = (float(self.camera.c[0]), float(self.camera.c[1]))
-        self._plane_point = [float(x) for x in self.plane_point]
+        self._plane_point = tuple(float(x) for x in self.plane_point)
         self._pu, self._pv, self._pn = (
-            [float(x) for x in self.pu],
-            [float(x) for x in self.pv],
-            [float(x) for x in self.pn],
+            tuple(float(x) for x in self.pu),
+            tuple(float(x) for x in self.pv),
+            tuple(float(x) for x in self.pn),
         )
+        self._head_position = tuple(float(x) for x in spec.head.position)
         self._had_target = False
         self._votes = {"rectangle": 0, "circle": 0}
         self.shape = "unknown"
@@ -228,61 +229,34 @@ class RecognitionTask(Controller):
         if reacquired and self.frames > 1:
             self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
         self._had_target = True
-        # the camera pose at capture (replay.robot.head.camera_pose), in floats: once a frame
-        # for both rays and the image Jacobian (Camera.ray / meet_plane / Camera.jacobian)
+        # x_o on the constraint plane, the target's axis there and the image Jacobian, from the
+        # camera pose at capture (Camera.ray / meet_plane / Camera.jacobian, compiled)
         head = self.camera.head
-        pan, tilt = angles
-        a = head.yaw + pan
-        ca, sa, ct, st = math.cos(a), math.sin(a), math.cos(tilt), math.sin(tilt)
-        R0, R1, R2 = (sa, -st * ca, ca * ct), (-ca, -st * sa, sa * ct), (0.0, -ct, -st)
-        hp, k = head.position, head.camera_offset
-        o = (hp[0] + k * ca * ct, hp[1] + k * sa * ct, hp[2] - k * st)
-        f, (cx, cy) = self.camera.f, self._c
-        P, N = self._plane_point, self._pn
-        po = (P[0] - o[0]) * N[0] + (P[1] - o[1]) * N[1] + (P[2] - o[2]) * N[2]
-
-        def on_plane(x: float, y: float):
-            x, y = (x - cx) / f, (y - cy) / f
-            d = (
-                R0[0] * x + R0[1] * y + R0[2],
-                R1[0] * x + R1[1] * y + R1[2],
-                R2[0] * x + R2[1] * y + R2[2],
-            )
-            denom = d[0] * N[0] + d[1] * N[1] + d[2] * N[2]
-            if abs(denom) < 1e-12:
-                return None
-            s = po / denom
-            return (o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]) if s > 0.0 else None
-
-        X = on_plane(b.u, b.v)
-        if X is None:
+        g = _chip_target.plane_geometry(
+            head.yaw,
+            angles[0],
+            angles[1],
+            self._head_position,
+            head.camera_offset,
+            self.camera.f,
+            *self._c,
+            self._plane_point,
+            self._pn,
+            self._pu,
+            self._pv,
+            b.u,
+            b.v,
+            b.phi,
+        )
+        if g is None:
             return None
-        X2 = on_plane(b.u + math.cos(b.phi), b.v + math.sin(b.phi))
+        X0, X1, X2, axis, dist, J00, J01, J10, J11 = g
         roll = None
-        if X2 is not None and b.elongation >= self.params.axis_elongation:
-            e = (X2[0] - X[0], X2[1] - X[1], X2[2] - X[2])
-            pu, pv = self._pu, self._pv
-            roll = wrap_half_pi(
-                math.atan2(
-                    e[0] * pv[0] + e[1] * pv[1] + e[2] * pv[2],
-                    e[0] * pu[0] + e[1] * pu[1] + e[2] * pu[2],
-                )
-            )
-        w = (X[0] - o[0], X[1] - o[1], X[2] - o[2])
-        scale = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) / f  # m per px there
+        if axis == axis and b.elongation >= self.params.axis_elongation:
+            roll = wrap_half_pi(axis)
+        scale = dist / self.camera.f  # m per px at the object
         if self.shape == "unknown" and not b.touches_border and b.area >= self.params.min_area:
             self._vote(b)  # (once decided, the shape is kept: later votes would change nothing)
-        # Camera.jacobian: the point in the camera frame moves by -R^T (k x (X - h)) per radian
-        # about the pan axis k = z and the tilt axis k = (-sin a, cos a, 0)
-        pc = [R0[i] * w[0] + R1[i] * w[1] + R2[i] * w[2] for i in range(3)]
-        r = (X[0] - hp[0], X[1] - hp[1], X[2] - hp[2])
-        J = [[0.0, 0.0], [0.0, 0.0]]
-        for i, (k0, k1, k2) in enumerate(((0.0, 0.0, 1.0), (-sa, ca, 0.0))):
-            kx = (k1 * r[2] - k2 * r[1], k2 * r[0] - k0 * r[2], k0 * r[1] - k1 * r[0])
-            d = [-(R0[j] * kx[0] + R1[j] * kx[1] + R2[j] * kx[2]) for j in range(3)]
-            z2 = pc[2] * pc[2]
-            J[0][i] = f * (d[0] * pc[2] - pc[0] * d[2]) / z2
-            J[1][i] = f * (d[1] * pc[2] - pc[1] * d[2]) / z2
         return GraspObject(
             chip.t,
             True,
@@ -290,14 +264,14 @@ class RecognitionTask(Controller):
             b.phi,
             b.area,
             window,
-            list(X),
+            [X0, X1, X2],
             roll,
-            [X[0], X[1], X[2], roll if roll is not None else 0.0, 0.0, 0.0],
+            [X0, X1, X2, roll if roll is not None else 0.0, 0.0, 0.0],
             [b.length * scale, b.width * scale],
             self.shape,
             b.fill if b.fill == b.fill else None,
             b.elongation,
-            J,
+            [[J00, J01], [J10, J11]],
             list(angles),
         )
 
