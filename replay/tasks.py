@@ -61,10 +61,11 @@ class TaskSet(Controller):
         self._ticked = [False] * n
         self._names = [t.name for t in tasks]
         self._telemetry: dict[str, Any] = {}
-        self._readers: dict[str, list[int]] = {}
+        # topic -> (index, newest stamps) of each task reading it
+        self._readers: dict[str, list[tuple[int, dict[str, float]]]] = {}
         for i, t in enumerate(tasks):
             for topic in t.inputs:
-                self._readers.setdefault(topic, []).append(i)
+                self._readers.setdefault(topic, []).append((i, self._newest[i]))
         # per (task, command type): the command fields the task may not write
         self._forbidden: dict[tuple[int, type], tuple[str, ...]] = {}
         # what a step needs of each task, looked up once
@@ -87,11 +88,11 @@ class TaskSet(Controller):
             return
         stamp = payload.get("t") if isinstance(payload, dict) else getattr(payload, "t", None)
         item = (topic, payload)
-        inbox, newest = self._inbox, self._newest
-        for i in readers:
+        inbox = self._inbox
+        for i, newest in readers:
             inbox[i].append(item)
             if stamp is not None:
-                newest[i][topic] = stamp
+                newest[topic] = stamp
 
     def _check(self, i: int, task: Task, command: Any) -> None:
         key = (i, type(command))
@@ -112,13 +113,21 @@ class TaskSet(Controller):
 
     def update(self, t: float, measurements: list[tuple[str, Any]]) -> list | None:
         k = int(round(t * self.rate))
+        inboxes, ticked, latency, oldest = self._inbox, self._ticked, self._latency, self._oldest
+        readers_of = self._readers
+        for topic, m in measurements:  # _route, inline: the sensors' messages of this step
+            readers = readers_of.get(topic)
+            if readers:
+                stamp = m.get("t") if isinstance(m, dict) else getattr(m, "t", None)
+                item = (topic, m)
+                for i, newest in readers:
+                    inboxes[i].append(item)
+                    if stamp is not None:
+                        newest[topic] = stamp
         route = self._route
-        for topic, m in measurements:
-            route(topic, m)
         commands = []
         out: dict[str, Any] = {}
         self._telemetry = out
-        inboxes, ticked, latency, oldest = self._inbox, self._ticked, self._latency, self._oldest
         forbidden = self._forbidden
         for i, task, divider, update, telemetry, outputs, newest in self._loop:
             due = k % divider == 0
