@@ -2,7 +2,7 @@
  * that module is the only caller and keeps the NumPy version as the reference): the DH chain's
  * forward kinematics and geometric Jacobian, the grasp point's Jacobian (``chain``), and eq. 2's
  * terms: the damped pseudo-inverse applied to its two task vectors, the damping, J^T F and the
- * clipped sum (``terms``). Plain C over the buffer
+ * clipped sum (``terms``); F^a from the wrist sensor (``wrench``). Plain C over the buffer
  * protocol and sequences of floats: no NumPy headers.
  *
  * Matrices are row-major float64. The chain's constants are n rows of (cos alpha, sin alpha, a,
@@ -234,9 +234,52 @@ static PyObject *py_terms(PyObject *self, PyObject *args) {
     return out;
 }
 
+/* wrench(R, force, torque, w_hand, com, bias, filtered, a, deadband) -> (ext, filtered, F): the
+ * wrist sensor's wrench turned into the world (R: the tool's rotation, row-major) minus the
+ * hand's weight w_hand acting at R com: ext = (R f - w, R m - (R com) x w); bias None: this ext
+ * is the tare (bias = ext, the filter starts at 0); filtered += a ((ext - bias) - filtered); F =
+ * filtered, or 0 when its force is below the deadband. */
+static PyObject *py_wrench(PyObject *self, PyObject *args) {
+    PyObject *Ro, *fo, *mo, *wo, *co, *bo, *flo;
+    double a, deadband;
+    if (!PyArg_ParseTuple(args, "OOOOOOOdd", &Ro, &fo, &mo, &wo, &co, &bo, &flo, &a, &deadband))
+        return NULL;
+    double R[9], f[3], m[3], w[3], c[3], b[6], fl[6], ext[6], out[6];
+    if (read_seq(Ro, R, 9, "wrench: R") < 0 || read_seq(fo, f, 3, "wrench: force") < 0 ||
+        read_seq(mo, m, 3, "wrench: torque") < 0 || read_seq(wo, w, 3, "wrench: w_hand") < 0 ||
+        read_seq(co, c, 3, "wrench: com") < 0 || read_seq(flo, fl, 6, "wrench: filtered") < 0)
+        return NULL;
+    double r[3];
+    for (int i = 0; i < 3; i++) {
+        r[i] = R[3 * i] * c[0] + R[3 * i + 1] * c[1] + R[3 * i + 2] * c[2];
+        ext[i] = R[3 * i] * f[0] + R[3 * i + 1] * f[1] + R[3 * i + 2] * f[2] - w[i];
+    }
+    const double rxw[3] = {r[1] * w[2] - r[2] * w[1], r[2] * w[0] - r[0] * w[2],
+                           r[0] * w[1] - r[1] * w[0]};
+    for (int i = 0; i < 3; i++)
+        ext[3 + i] = R[3 * i] * m[0] + R[3 * i + 1] * m[1] + R[3 * i + 2] * m[2] - rxw[i];
+    if (bo == Py_None) {
+        for (int i = 0; i < 6; i++) b[i] = ext[i], fl[i] = 0.0;
+    } else if (read_seq(bo, b, 6, "wrench: bias") < 0) {
+        return NULL;
+    }
+    for (int i = 0; i < 6; i++) fl[i] = fl[i] + a * (ext[i] - b[i] - fl[i]);
+    const int quiet = sqrt(fl[0] * fl[0] + fl[1] * fl[1] + fl[2] * fl[2]) < deadband;
+    for (int i = 0; i < 6; i++) out[i] = quiet ? 0.0 : fl[i];
+    PyObject *e = list_of(ext, 6), *g = list_of(fl, 6), *F = list_of(out, 6);
+    if (e == NULL || g == NULL || F == NULL) {
+        Py_XDECREF(e);
+        Py_XDECREF(g);
+        Py_XDECREF(F);
+        return NULL;
+    }
+    return Py_BuildValue("(NNN)", e, g, F);
+}
+
 static PyMethodDef methods[] = {
     {"chain", py_chain, METH_VARARGS, "DH chain: tool pose, grasp point, J and Jg"},
     {"terms", py_terms, METH_VARARGS, "eq. 2's joint-velocity terms and the command"},
+    {"wrench", py_wrench, METH_VARARGS, "F^a: the wrist wrench in the world, tared, filtered"},
     {NULL, NULL, 0, NULL},
 };
 

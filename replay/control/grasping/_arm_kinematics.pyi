@@ -30,3 +30,14 @@ def terms(
     K_af: float,
     vlim: Sequence[float],
 ) -> tuple[list[float], list[float], list[float], list[float], list[float]]: ...
+def wrench(
+    R: Sequence[float],
+    force: Sequence[float],
+    torque: Sequence[float],
+    w_hand: Sequence[float],
+    com: Sequence[float],
+    bias: Sequence[float] | None,
+    filtered: Sequence[float],
+    a: float,
+    deadband: float,
+) -> tuple[list[float], list[float], list[float]]: ...

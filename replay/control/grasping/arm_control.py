@@ -182,34 +182,24 @@ class ArmControlTask(Controller):
         return T, J
 
     def external_wrench(self, R) -> list[float]:
-        """F^a (world, about the flange): the sensor's wrench minus the hand's weight and bias,
-        low-passed, zero within the deadband. ``R``: the tool's rotation, row-major 9 floats."""
-        f0, f1, f2 = self.wrench_raw.force
-        m0, m1, m2 = self.wrench_raw.torque
-        r00, r01, r02, r10, r11, r12, r20, r21, r22 = R
-        w0, w1, w2 = self._w_hand
-        c0, c1, c2 = self._com
-        r0, r1, r2 = (
-            r00 * c0 + r01 * c1 + r02 * c2,
-            r10 * c0 + r11 * c1 + r12 * c2,
-            r20 * c0 + r21 * c1 + r22 * c2,
+        """F^a (world, about the flange): the sensor's wrench minus the hand's weight and bias
+        (the first reading: tare), low-passed, zero within the deadband (compiled). ``R``: the
+        tool's rotation, row-major 9 floats."""
+        a = self.dt / (self.params.force_filter + self.dt)
+        ext, self.filtered, F = _arm_kinematics.wrench(
+            R,
+            self.wrench_raw.force,
+            self.wrench_raw.torque,
+            self._w_hand,
+            self._com,
+            self.bias,
+            self.filtered,
+            a,
+            self.params.force_deadband,
         )
-        ext = [
-            r00 * f0 + r01 * f1 + r02 * f2 - w0,
-            r10 * f0 + r11 * f1 + r12 * f2 - w1,
-            r20 * f0 + r21 * f1 + r22 * f2 - w2,
-            r00 * m0 + r01 * m1 + r02 * m2 - (r1 * w2 - r2 * w1),
-            r10 * m0 + r11 * m1 + r12 * m2 - (r2 * w0 - r0 * w2),
-            r20 * m0 + r21 * m1 + r22 * m2 - (r0 * w1 - r1 * w0),
-        ]
         if self.bias is None:
             self.bias = ext  # tare at start: the sensor's offset
-            self.filtered = [0.0] * 6
-        a = self.dt / (self.params.force_filter + self.dt)
-        fl = self.filtered = [x + a * (e - b - x) for x, e, b in zip(self.filtered, ext, self.bias)]
-        if math.sqrt(fl[0] * fl[0] + fl[1] * fl[1] + fl[2] * fl[2]) < self.params.force_deadband:
-            return [0.0] * 6
-        return list(fl)
+        return F
 
     def update(self, t: float, measurements) -> ServoCommand | None:
         for topic, m in measurements:

@@ -212,6 +212,10 @@ def test_arm_task_compiled_eq2_matches_its_numpy_reference_over_random_inputs(sp
         # the hand's weight cancels in the difference
         F_ref = np.concatenate([R @ np.subtract(f1, f0), R @ np.subtract(m1, m0)])
         good = np.allclose(out.wrench, F_ref, atol=1e-9, rtol=0.0)
+        # the tare: the first reading in the world minus the hand's weight at its centre of mass
+        w_hand, r = task.hand.mass * task.g, R @ np.asarray(task.hand.com, float)
+        bias_ref = np.concatenate([R @ f0 - w_hand, R @ m0 - np.cross(r, w_hand)])
+        good &= np.allclose(task.bias, bias_ref, atol=1e-9, rtol=0.0)
         ref = task.reference_command(q, qd, o, st, out.wrench)
         good &= np.allclose(cmd.arm, ref["command"], atol=1e-9, rtol=0.0)
         good &= np.allclose(out.x_a[:3], ref["x_a"], atol=1e-12, rtol=0.0)
@@ -250,3 +254,26 @@ def test_hand_task_compiled_eq4_and_lowpass_equal_the_float_reference():
         )
     print(f"hand eq. 4 compiled vs floats: {ok}/{n} random inputs agree")
     assert ok == n
+
+
+def test_arm_wrench_below_the_deadband_is_zero_and_the_filter_lags(spec):
+    """F^a: a step of the wrist force passes the first-order low-pass (gain dt / (tau + dt) a
+    step) and is zero while its force is below the deadband."""
+    enc = JointState(0.0, list(spec.joint_names), list(spec.initial_q), [0.0] * 7, [0.0] * 7)
+    st = state([0.6, 0.0, 0.55])
+    for deadband, expect_zero in ((0.0, False), (50.0, True)):
+        task = ArmControlTask(ArmParams(force_deadband=deadband, force_filter=0.009), spec=spec)
+        task.update(
+            0.0,
+            [
+                (TOPIC_ARM_ENCODERS, enc),
+                (TOPIC_GRASP_STATE, st),
+                (TOPIC_WRIST_WRENCH, WristWrench(0.0, [0.0] * 3, [0.0] * 3)),
+            ],
+        )
+        task.update(0.001, [(TOPIC_WRIST_WRENCH, WristWrench(0.001, [10.0, 0.0, 0.0], [0.0] * 3))])
+        F = np.asarray(task._out.wrench)
+        if expect_zero:
+            assert np.all(F == 0.0)
+        else:  # a = 0.001 / (0.009 + 0.001) = 0.1 of the 10 N step
+            assert np.linalg.norm(F[:3]) == pytest.approx(1.0, rel=1e-9)
