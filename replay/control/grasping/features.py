@@ -21,7 +21,7 @@ pixels are at its first and last pixel, so the extents and bounding boxes need o
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -34,8 +34,7 @@ _NORMALS = np.stack([-np.sin(_ANGLES), np.cos(_ANGLES)])
 _PIXEL_EXTENT = np.abs(_DIRS).sum(axis=0)
 
 
-@dataclass(frozen=True)
-class Blob:
+class Blob(NamedTuple):  # a named tuple: built once a frame from the compiled pass's tuple
     area: int
     u: float
     v: float
