@@ -1,4 +1,4 @@
-"""Tracking and reaching control of the arm (Namiki et al. 1999, Sec. 4.2, eqs. 2-3), pure NumPy:
+"""Tracking and reaching control of the arm (Namiki et al. 1999, Sec. 4.2, eqs. 2-3):
 
     theta_dot_d^a = K^ap J^a+ S K^a1 (x^o - x^a) + K^ap J^a+ (I - S) K^a2 (x_d^a - x^a)
                     - K^av theta_dot^a + K^af J^aT F^a                                 (2)
@@ -18,6 +18,9 @@
   mass and centre of mass, open posture) and the sensor's bias at start (tare), about the
   flange: the external wrench on the hand (N, N m).
 - No prediction of the object's motion: x^o is the latest measurement.
+- Per step in floats: the chain, Jg, eq. 2's terms and F^a are one compiled module
+  (``_arm_kinematics.c``); :meth:`ArmControlTask.kinematics` and :meth:`reference_command` are
+  the NumPy reference a seeded test holds it to.
 """
 
 from __future__ import annotations

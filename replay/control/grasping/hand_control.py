@@ -1,4 +1,4 @@
-"""Grasping control of the hand (Namiki et al. 1999, Sec. 4.3, eq. 4) and preshaping, pure NumPy:
+"""Grasping control of the hand (Namiki et al. 1999, Sec. 4.3, eq. 4) and preshaping:
 
     theta_dot_d^h = K^hg (theta_d^h - theta^h) - K^hv theta_dot^h + K^hf F^h          (4)
 

@@ -1,4 +1,4 @@
-"""Tracking control of the active vision (Namiki et al. 1999, Sec. 4.1.2, eq. 1), pure NumPy:
+"""Tracking control of the active vision (Namiki et al. 1999, Sec. 4.1.2, eq. 1), in floats:
 
     theta_dot_d^v = K^v J_image^-1 (xi_d - xi) - K^vv theta_dot^v                    (1)
 

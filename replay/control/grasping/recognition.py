@@ -1,4 +1,4 @@
-"""Object recognition by visual information (Namiki et al. 1999, Sec. 4.1.1), pure NumPy.
+"""Object recognition by visual information (Namiki et al. 1999, Sec. 4.1.1).
 
 Each chip frame: Self Windowing extracts the target (``self_window``); its moments give the image
 centre xi and rotation phi (``features``); the viewing ray through xi, from the camera pose at
@@ -10,6 +10,10 @@ pixel extents at that depth give the size; the fill of the smallest bounding box
 (rectangle vs circle: :func:`shape_of`), decided by a vote over the first ``shape_frames`` whole views (not cut by
 the image border) and then kept. The image Jacobian of the head (d xi / d(pan, tilt), for eq. 1)
 is that of the same model at the estimated point. Nothing here predicts motion.
+
+Per frame the task runs compiled kernels (``_chip_target.c``: Self Windowing and the moments on
+the packed rows, the plane geometry); ``self_window``, ``features`` and :class:`Camera` are their
+references.
 """
 
 from __future__ import annotations
