@@ -19,7 +19,12 @@ setup(
             "replay.sensors._pixels",
             ["replay/sensors/_pixels.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        )
+        ),
+        Extension(
+            "replay.robot._chain",
+            ["replay/robot/_chain.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],
