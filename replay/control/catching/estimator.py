@@ -26,7 +26,7 @@ class BallisticEstimator:
         self.g = np.asarray(gravity, float)
         self._g = tuple(self.g.tolist())
         self.window = float(window)
-        self.buf: deque[tuple[float, np.ndarray]] = deque(maxlen=max_samples)
+        self.buf: deque[tuple[float, tuple[float, float, float]]] = deque(maxlen=max_samples)
         self._fit = None
         self._rebuild(None)
 
@@ -65,7 +65,7 @@ class BallisticEstimator:
             Sty[k] += sign * tau * y
 
     def add(self, t: float, r) -> None:
-        r = np.asarray(r, float)
+        r = (float(r[0]), float(r[1]), float(r[2]))
         if self.buf and t <= self.buf[-1][0]:
             return  # out of order or repeated frame
         if self._t_ref is None:
@@ -82,6 +82,13 @@ class BallisticEstimator:
 
     def fit(self):
         """(t_last, r0, v) at the last measurement time; v is None with a single measurement."""
+        f = self.fit_f()
+        if f is None:
+            return None
+        return f[0], np.array(f[1]), None if f[2] is None else np.array(f[2])
+
+    def fit_f(self):
+        """:meth:`fit` with r0 and v as 3-tuples of floats (the per-step path)."""
         if not self.buf:
             return None
         if self._fit is None:
@@ -96,8 +103,8 @@ class BallisticEstimator:
                 g = self._g
                 b = [(n * self._Sty[k] - s1 * self._Sy[k]) / det for k in range(3)]
                 a = [(self._Sy[k] - b[k] * s1) / n for k in range(3)]
-                r0 = np.array([a[k] + b[k] * tl + 0.5 * g[k] * tl * tl for k in range(3)])
-                v = np.array([b[k] + g[k] * tl for k in range(3)])
+                r0 = tuple(a[k] + b[k] * tl + 0.5 * g[k] * tl * tl for k in range(3))
+                v = tuple(b[k] + g[k] * tl for k in range(3))
                 self._fit = (t_last, r0, v)
         return self._fit
 
@@ -106,22 +113,39 @@ class BallisticEstimator:
 
         With one measurement the velocity is unknown and taken as zero.
         """
-        f = self.fit()
+        st = self.state_f(t, from_fit=from_fit)
+        if st is None:
+            return None
+        return np.array(st[0]), np.array(st[1]), self.g.copy()
+
+    def state_f(self, t: float, *, from_fit: bool = False):
+        """:meth:`state` as 3-tuples of floats: per component the operations NumPy did on the
+        3-vectors (base + v dt + (0.5 g) dt dt), so the same values."""
+        f = self.fit_f()
         if f is None:
             return None
         t_last, r0, v = f
-        r_meas = self.buf[-1][1]
-        v = np.zeros(3) if v is None else v
+        if v is None:
+            v = (0.0, 0.0, 0.0)
         dt = t - t_last
-        base = r0 if from_fit else r_meas
-        return base + v * dt + 0.5 * self.g * dt * dt, v + self.g * dt, self.g.copy()
+        b = r0 if from_fit else self.buf[-1][1]
+        g0, g1, g2 = self._g
+        return (
+            (
+                b[0] + v[0] * dt + 0.5 * g0 * dt * dt,
+                b[1] + v[1] * dt + 0.5 * g1 * dt * dt,
+                b[2] + v[2] * dt + 0.5 * g2 * dt * dt,
+            ),
+            (v[0] + g0 * dt, v[1] + g1 * dt, v[2] + g2 * dt),
+            self._g,
+        )
 
     def time_to_radius(self, t: float, origin, radius: float):
         """Absolute time at which the arc first reaches |r - origin| = radius (None if never)."""
-        st = self.state(t, from_fit=True)
+        st = self.state_f(t, from_fit=True)
         if st is None or self.n < 2:
             return None
-        (rx, ry, rz), v, g = st[0].tolist(), st[1].tolist(), self._g
+        (rx, ry, rz), v, g = st
         ox, oy, oz = (float(x) for x in origin)
         d = (rx - ox, ry - oy, rz - oz)
         dot = lambda a, b: a[0] * b[0] + a[1] * b[1] + a[2] * b[2]  # noqa: E731
