@@ -75,7 +75,7 @@ from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
 from replay.sensors import _pixels
-from replay.sensors.raster import composite, quantise
+from replay.sensors.raster import quantise
 from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
 
 
@@ -214,6 +214,14 @@ class StereoBallCamera(Sensor):
             (tuple(c.position.tolist()), tuple(c.rotation[:, 2].tolist())) for c in self.cameras
         ]
         self._background_level = int(quantise(np.float32([255.0 * params.background]))[0])
+        # the per-frame path's constants: ball_blob's settings, the cameras' principal points
+        self._blob_args = (
+            float(params.threshold),
+            int(params.min_pixels),
+            int(params.moments == "binary"),
+            255.0 * float(params.background),
+        )
+        self._centres = [(c.intrinsics.cx, c.intrinsics.cy) for c in self.cameras]
         self._last: list = [None, None]
         self.last_blobs: list[dict | None] = [None, None]
 
@@ -370,45 +378,82 @@ class StereoBallCamera(Sensor):
             return (0, 0, 0, 0)
         return (wx0, wy0, wx1, wy1)
 
+    def _locate_f(self, uv0, uv1, radius: float | None):
+        """:meth:`locate` on floats: (x, y, z), or None at infinity. The bias correction as
+        :func:`~replay.sensors.silhouette.correct_sphere_centroid` computes it."""
+        P0, P1 = self._P
+        X = _pixels.triangulate(P0, P1, uv0[0], uv0[1], uv1[0], uv1[1])
+        if X is None or radius is None or radius <= 0.0 or not all(map(math.isfinite, X)):
+            return X
+        fixed = []
+        r2 = radius * radius
+        for i, (u, v) in enumerate((uv0, uv1)):
+            z = self._depth(i, X)
+            if z <= radius:
+                return X
+            cx, cy = self._centres[i]
+            s = (z * z - r2) / (z * z)
+            fixed.append((cx + (u - cx) * s, cy + (v - cy) * s))
+        (a, b), (c, d) = fixed
+        return _pixels.triangulate(P0, P1, a, b, c, d)
+
     def measure(self, t: float, scene: Scene) -> VisionObject | None:
+        """The module doc's pipeline; the per-frame glue calls the compiled kernels directly
+        (the same calls :func:`~replay.sensors.raster.composite`, ``quantise``, :meth:`blob`
+        and :meth:`locate` make)."""
         p = self.params
+        noise = p.noise_sigma > 0.0
+        grey = 255.0 * p.background
+        blob_args = self._blob_args
+        W, H = int(p.width), int(p.height)
         blobs: list[dict | None] = []
-        self._last = []
+        last = []
         for camera in self.cameras:
             drawn = drawables(camera, scene)
-            polys = [d[0] for d in drawn]
             window = self._window(camera, [d[2] for d in drawn])
             x0, y0, x1, y1 = window
-            img = np.full((y1 - y0, x1 - x0), 255.0 * p.background, np.float32)
-            composite(img, polys, [d[1] for d in drawn], origin=(x0, y0))
-            if p.noise_sigma > 0.0:
+            w, h = x1 - x0, y1 - y0
+            img = np.full((h, w), grey, np.float32)
+            if drawn and w and h:
+                _pixels.composite([d[0] for d in drawn], [d[1] for d in drawn], x0, y0, img, w, h)
+            if noise:
                 img += np.float32(p.noise_sigma) * self.rng.standard_normal(
                     img.shape, dtype=np.float32
                 )
-            img8 = quantise(img)
-            self._last.append((img8, window))
-            blobs.append(self.blob(img8, p, (x0, y0)) if img8.size else None)
+            img8 = np.empty((h, w), np.uint8)
+            _pixels.quantise(img, img8)
+            last.append((img8, window))
+            found = _pixels.ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
+            blobs.append(
+                None
+                if found is None
+                else {
+                    "u": found[0],
+                    "v": found[1],
+                    "area": found[2],
+                    "background": None if blob_args[2] else found[3],
+                }
+            )
+        self._last = last
         self.last_blobs = blobs
         try:
             tracked = scene.get(p.tracked)
         except KeyError:
             return None
-        if blobs[0] is None or blobs[1] is None:
+        b0, b1 = blobs
+        if b0 is None or b1 is None:
             return None
-        uv = [(b["u"], b["v"]) for b in blobs]
+        uv0, uv1 = (b0["u"], b0["v"]), (b1["u"], b1["v"])
         radius = None
         if p.bias_correction and isinstance(tracked, Sphere):
             radius = float(tracked.radius)
-        X = self.locate(uv[0], uv[1], radius)
-        if not all(map(math.isfinite, X)):
+        X = self._locate_f(uv0, uv1, radius)
+        if X is None or not all(map(math.isfinite, X)):
             return None
-        if any(self._depth(i, X) <= 0.0 for i in range(2)):
+        if self._depth(0, X) <= 0.0 or self._depth(1, X) <= 0.0:
             return None  # a mismatch behind a camera
         return VisionObject(
             t=t,
-            position=[float(v) for v in X],
-            features={
-                "centroids": [[float(u), float(v)] for u, v in uv],
-                "areas": [int(b["area"]) for b in blobs],
-            },
+            position=list(X),
+            features={"centroids": [list(uv0), list(uv1)], "areas": [b0["area"], b1["area"]]},
         )

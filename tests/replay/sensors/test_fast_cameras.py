@@ -14,7 +14,7 @@ import pytest
 from replay.messages import pack_rows
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.sensors import _pixels
-from replay.sensors.silhouette import _body_points, project_hull
+from replay.sensors.silhouette import _body_points, project_hull, sphere_ellipse, sphere_polygon
 from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 from replay.sensors.stick_camera import (
     StickCamera,
@@ -324,6 +324,31 @@ def throw_scene(rng, box=False):
     if box:
         prims.insert(0, Box("wall", (1.2, 0.3, 0.7), (0, 0, 0, 1), (0.2, 0.05, 0.3), albedo=0.4))
     return Scene(prims)
+
+
+def test_compiled_sphere_polygon_equals_the_ellipse_and_its_polygon():
+    """_silhouette.sphere_polygon against sphere_ellipse + Ellipse.polygon_and_box (the same
+    operations but libm's hypot for Python's math.hypot, which may differ in the last bit):
+    seeded balls around the throws, near and behind the cameras too; equal to 1e-12 px, and None
+    exactly where the ellipse is."""
+    rng = np.random.default_rng(21)
+    cams = StereoBallCamera.make_cameras()
+    drawn = behind = 0
+    for _ in range(300):
+        centre = (rng.uniform(-0.5, 3.5), rng.uniform(-0.8, 0.8), rng.uniform(-0.2, 1.5))
+        radius = float(rng.choice([0.0175, 0.05, 0.3]))
+        for cam in cams:
+            e, got = sphere_ellipse(cam, centre, radius), sphere_polygon(cam, centre, radius)
+            assert (e is None) == (got is None)
+            if e is None:
+                behind += 1
+                continue
+            poly, box = e.polygon_and_box()
+            np.testing.assert_allclose(got[0], poly, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(got[1], box, rtol=0, atol=1e-12)
+            drawn += 1
+    print(f"sphere_polygon: {drawn} silhouettes equal, {behind} behind a camera (None)")
+    assert drawn > 300 and behind > 20
 
 
 @pytest.mark.parametrize("sigma,moments", [(0.0, "grey"), (6.0, "grey"), (6.0, "binary")])
