@@ -1,9 +1,9 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
-the cameras' per-pixel kernels, a sphere's silhouette, the catching mapping and the serial chain's
-one-configuration dynamics are small C extensions (replay/sensors/_pixels.c, _silhouette.c,
-replay/control/catching/_mapping.c, replay/robot/_chain.c: plain C over the buffer protocol, no
-NumPy headers)."""
+the cameras' per-pixel kernels, the stereo camera's frame, a sphere's silhouette, the catching
+mapping and the serial chain's one-configuration dynamics are small C extensions
+(replay/sensors/_pixels.c, _stereo.c, _silhouette.c, replay/control/catching/_mapping.c,
+replay/robot/_chain.c: plain C over the buffer protocol, no NumPy headers)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -20,6 +20,12 @@ setup(
         Extension(
             "replay.sensors._pixels",
             ["replay/sensors/_pixels.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.sensors._stereo",
+            ["replay/sensors/_stereo.c"],
+            depends=["replay/sensors/_pixels.c"],  # included: its kernels, unchanged
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
         Extension(

@@ -74,7 +74,7 @@ from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.sensors import _pixels
+from replay.sensors import _pixels, _stereo
 from replay.sensors.raster import quantise
 from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
 
@@ -222,6 +222,10 @@ class StereoBallCamera(Sensor):
             255.0 * float(params.background),
         )
         self._centres = [(c.intrinsics.cx, c.intrinsics.cy) for c in self.cameras]
+        self._axes_c = np.array([x for axis in self._axes for v in axis for x in v], float)
+        self._centres_c = np.array([x for c in self._centres for x in c], float)
+        # noise-free with a background below the threshold: the compiled frame (_stereo.c)
+        self._compiled = params.noise_sigma == 0.0 and self._background_level <= params.threshold
         self._last: list = [None, None]
         self.last_blobs: list[dict | None] = [None, None]
 
@@ -398,9 +402,62 @@ class StereoBallCamera(Sensor):
         return _pixels.triangulate(P0, P1, a, b, c, d)
 
     def measure(self, t: float, scene: Scene) -> VisionObject | None:
-        """The module doc's pipeline; the per-frame glue calls the compiled kernels directly
-        (the same calls :func:`~replay.sensors.raster.composite`, ``quantise``, :meth:`blob`
-        and :meth:`locate` make)."""
+        """The module doc's pipeline: noise-free, each camera's window, image and blob in one
+        compiled call and the triangulation with its bias correction in another
+        (``_stereo.frame``, ``_stereo.locate``: the kernels :meth:`measure_reference` calls, in
+        the same order); with pixel noise :meth:`measure_reference` itself."""
+        if not self._compiled:
+            return self.measure_reference(t, scene)
+        p = self.params
+        blob_args = self._blob_args
+        grey = 255.0 * p.background
+        W, H = int(p.width), int(p.height)
+        blobs: list[dict | None] = []
+        last = []
+        for camera in self.cameras:
+            drawn = drawables(camera, scene)
+            image, window, found = _stereo.frame(
+                [d[0] for d in drawn], [d[1] for d in drawn], [d[2] for d in drawn], grey, W, H,
+                *blob_args,
+            )  # fmt: skip
+            x0, y0, x1, y1 = window
+            last.append((np.frombuffer(image, np.uint8).reshape(y1 - y0, x1 - x0), window))
+            blobs.append(
+                None
+                if found is None
+                else {
+                    "u": found[0],
+                    "v": found[1],
+                    "area": found[2],
+                    "background": None if blob_args[2] else found[3],
+                }
+            )
+        self._last = last
+        self.last_blobs = blobs
+        try:
+            tracked = scene.get(p.tracked)
+        except KeyError:
+            return None
+        b0, b1 = blobs
+        if b0 is None or b1 is None:
+            return None
+        radius = 0.0
+        if p.bias_correction and isinstance(tracked, Sphere):
+            radius = float(tracked.radius)
+        P0, P1 = self._P
+        uv0, uv1 = [b0["u"], b0["v"]], [b1["u"], b1["v"]]
+        X = _stereo.locate(P0, P1, *uv0, *uv1, radius, self._axes_c, self._centres_c)
+        if X is None:
+            return None
+        return VisionObject(
+            t=t,
+            position=list(X),
+            features={"centroids": [uv0, uv1], "areas": [b0["area"], b1["area"]]},
+        )
+
+    def measure_reference(self, t: float, scene: Scene) -> VisionObject | None:
+        """:meth:`measure` step by step, each kernel called from Python (the compiled
+        frame's reference, and the path with pixel noise)."""
         p = self.params
         noise = p.noise_sigma > 0.0
         grey = 255.0 * p.background

@@ -351,6 +351,52 @@ def test_compiled_sphere_polygon_equals_the_ellipse_and_its_polygon():
     assert drawn > 300 and behind > 20
 
 
+@pytest.mark.parametrize("moments,bias", [("grey", True), ("binary", True), ("grey", False)])
+def test_compiled_stereo_frame_equals_the_step_by_step_measurement(moments, bias):
+    """_stereo.frame and _stereo.locate (measure, noise-free) against measure_reference, which
+    calls the same kernels from Python: seeded throws, a box behind the ball in a quarter,
+    balls half out of view, behind a camera or absent in some; the same images, blobs and
+    positions to the bit, and None exactly where the reference gives None."""
+    p = StereoBallCameraParams(moments=moments, bias_correction=bias)
+    fast = StereoBallCamera(p, rng=np.random.default_rng(0))
+    ref = StereoBallCamera(p, rng=np.random.default_rng(0))
+    assert fast._compiled
+    rng = np.random.default_rng(22)
+    seen = n = 0
+    for k in range(200):
+        scene = throw_scene(rng, box=k % 4 == 0)
+        if k % 10 == 3:  # anywhere: out of view, cut by the border, behind the cameras
+            pos = (rng.uniform(-1.0, 4.0), rng.uniform(-1.5, 1.5), rng.uniform(-0.5, 2.0))
+            scene = Scene([Sphere("ball", pos, 0.0175, albedo=0.9)])
+        elif k % 10 == 7:
+            scene = Scene([Box("wall", (1.2, 0.3, 0.7), (0, 0, 0, 1), (0.2, 0.05, 0.3))])
+        got, want = fast.measure(0.0, scene), ref.measure_reference(0.0, scene)
+        n += 1
+        assert (got is None) == (want is None)
+        if want is not None:
+            seen += 1
+            assert got.position == want.position and got.features == want.features
+        assert fast.last_blobs == ref.last_blobs
+        for a, b in zip(fast.last_images, ref.last_images):
+            assert (a is None) == (b is None)
+            if a is not None:
+                np.testing.assert_array_equal(a, b)
+    print(f"compiled stereo frame ({moments}, bias {bias}): {n} frames equal, {seen} measured")
+    assert seen >= 0.6 * n
+
+
+def test_noisy_stereo_measures_step_by_step():
+    """With pixel noise the rng draws every pixel: the step-by-step path, not the compiled one."""
+    p = StereoBallCameraParams(noise_sigma=5.0)
+    a, b = (
+        StereoBallCamera(p, rng=np.random.default_rng(4)),
+        StereoBallCamera(p, rng=np.random.default_rng(4)),
+    )
+    assert not a._compiled
+    scene = throw_scene(np.random.default_rng(5))
+    assert a.measure(0.0, scene) == b.measure_reference(0.0, scene)
+
+
 @pytest.mark.parametrize("sigma,moments", [(0.0, "grey"), (6.0, "grey"), (6.0, "binary")])
 def test_compiled_ball_blob_equals_the_opencv_pipeline(sigma, moments):
     p = StereoBallCameraParams(noise_sigma=sigma, moments=moments)
