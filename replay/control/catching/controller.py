@@ -367,8 +367,9 @@ class CatchingController(Controller):
         self._names_seen = None  # joint-name layout of the last joint state message
         self._idx = None
         self._identity = list(range(self.n))
-        self._ff_key = None  # (q_d, qd_d, qdd_d) of the last feed-forward, and its torque
-        self._ff = None
+        # the feed-forward of the current desired state (q_d, qd_d, qdd_d); None when the
+        # update set a new one (before the ball is seen and while holding, it is computed once)
+        self._ff: tuple | None = None
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
@@ -459,6 +460,7 @@ class CatchingController(Controller):
             if reached and P.after_catch == "hold":
                 self.holding = True
                 self.qd_d = list(self._zeros)
+                self._ff = None
                 self._events.append(
                     Occurrence("mapping_hold", {"q_d": list(self.q_d), "r_o": list(r)})
                 )
@@ -467,6 +469,7 @@ class CatchingController(Controller):
                 for i, k in enumerate(self._act):
                     q_d[k], qd_d[k], qdd_d[k] = q_a[i], qd_a[i], qdd_a[i]
                 self.q_d, self.qd_d = q_d, qd_d
+                self._ff = None
             if not self.holding:
                 self.t_catch = self.est.time_to_radius(t, self.geo.origin, self.geo.catch_radius)
         if (
@@ -489,7 +492,7 @@ class CatchingController(Controller):
         return ArmCommand(torque=list(self.tau), hand=hand)
 
     def _joint_state(self, m) -> None:
-        pos, vel = [float(x) for x in m.position], [float(x) for x in m.velocity]
+        pos, vel = list(m.position), list(m.velocity)
         names = tuple(getattr(m, "name", ()) or ())
         if names != self._names_seen:  # where our joints sit in the message (once per layout)
             self._names_seen = names
@@ -510,9 +513,7 @@ class CatchingController(Controller):
         q_d, qd_d = self.q_d, self.qd_d
         ff: list[float] | tuple
         if P.feedforward == "dynamics":  # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
-            key = (tuple(q_d), tuple(qd_d), tuple(qdd_d))
-            if key != self._ff_key:  # the same desired state (holding, not yet seen): same ff
-                self._ff_key = key
+            if self._ff is None:
                 self._ff = self.model.inverse_dynamics_tuple(q_d, qd_d, qdd_d)
             ff = self._ff
         elif P.feedforward == "gravity":
@@ -535,7 +536,10 @@ class CatchingController(Controller):
             tau = [
                 ff[i] + kp[i] * (q_d[i] - q[i]) + kd[i] * (qd_d[i] - qd[i]) for i in range(self.n)
             ]
-        return [min(max(x, -lim), lim) for x, lim in zip(tau, self._tau_limit)]
+        # saturated at the limits (np.minimum(np.maximum(tau, -limit), limit))
+        return [
+            lim if x > lim else (-lim if x < -lim else x) for x, lim in zip(tau, self._tau_limit)
+        ]
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:

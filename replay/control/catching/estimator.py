@@ -54,15 +54,20 @@ class BallisticEstimator:
 
     def _account(self, t: float, r, sign: float) -> None:
         tau = t - self._t_ref
-        S, Sy, Sty, g = self._S, self._Sy, self._Sty, self._g
+        S, Sy, Sty = self._S, self._Sy, self._Sty
+        g0, g1, g2 = self._g
+        st = sign * tau
         S[0] += sign
-        S[1] += sign * tau
-        S[2] += sign * tau * tau
+        S[1] += st
+        S[2] += st * tau
         h = 0.5 * tau * tau
-        for k in range(3):
-            y = float(r[k]) - g[k] * h
-            Sy[k] += sign * y
-            Sty[k] += sign * tau * y
+        y0, y1, y2 = r[0] - g0 * h, r[1] - g1 * h, r[2] - g2 * h
+        Sy[0] += sign * y0
+        Sy[1] += sign * y1
+        Sy[2] += sign * y2
+        Sty[0] += st * y0
+        Sty[1] += st * y1
+        Sty[2] += st * y2
 
     def add(self, t: float, r) -> None:
         r = (float(r[0]), float(r[1]), float(r[2]))
@@ -145,15 +150,18 @@ class BallisticEstimator:
         st = self.state_f(t, from_fit=True)
         if st is None or self.n < 2:
             return None
-        (rx, ry, rz), v, g = st
-        ox, oy, oz = (float(x) for x in origin)
-        d = (rx - ox, ry - oy, rz - oz)
-        dot = lambda a, b: a[0] * b[0] + a[1] * b[1] + a[2] * b[2]  # noqa: E731
-        dd = dot(d, d)
+        (rx, ry, rz), (vx, vy, vz), (gx, gy, gz) = st
+        dx, dy, dz = rx - float(origin[0]), ry - float(origin[1]), rz - float(origin[2])
+        dd = dx * dx + dy * dy + dz * dz
         if dd <= radius * radius:
             return t
-        coeffs = [0.25 * dot(g, g), dot(v, g), dot(v, v) + dot(d, g), 2.0 * dot(d, v)]
-        coeffs.append(dd - radius * radius)
+        coeffs = [
+            0.25 * (gx * gx + gy * gy + gz * gz),
+            vx * gx + vy * gy + vz * gz,
+            (vx * vx + vy * vy + vz * vz) + (dx * gx + dy * gy + dz * gz),
+            2.0 * (dx * vx + dy * vy + dz * vz),
+            dd - radius * radius,
+        ]
         s = _first_root_newton(coeffs)
         if s is not None:
             return t + s
