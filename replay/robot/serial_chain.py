@@ -1,4 +1,5 @@
-"""A serial chain of revolute joints in standard (Spong) Denavit–Hartenberg form. Pure NumPy.
+"""A serial chain of revolute joints in standard (Spong) Denavit–Hartenberg form. NumPy, with one
+configuration's point and RNEA compiled (``_chain.c``; the Python float forms are the reference).
 
 Conventions (Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control*, Sec. 3.2):
 

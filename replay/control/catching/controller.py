@@ -370,6 +370,7 @@ class CatchingController(Controller):
         # the feed-forward of the current desired state (q_d, qd_d, qdd_d); None when the
         # update set a new one (before the ball is seen and while holding, it is computed once)
         self._ff: tuple | None = None
+        self._fk_desired: tuple = (None, ())  # (the q_d list it is of, l(q_d))
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
@@ -569,6 +570,9 @@ class CatchingController(Controller):
         return ev
 
     def telemetry(self, t: float) -> dict:
+        # l(q_d) once per desired posture: update sets a new q_d list when it changes
+        if self._fk_desired[0] is not self.q_d:
+            self._fk_desired = (self.q_d, self.model.fk_tuple(self.q_d))
         out = {
             TOPIC_ARM_JOINT_COMMAND: JointCommand(
                 t, position=list(self.q_d), torque=list(self.tau)
@@ -576,7 +580,7 @@ class CatchingController(Controller):
             TOPIC_EFFECTOR_STATE: EffectorState(
                 t,
                 position=list(self.model.fk_tuple(self.q)) if self.q is not None else [],
-                desired_position=list(self.model.fk_tuple(self.q_d)),
+                desired_position=list(self._fk_desired[1]),
             ),
         }
         if not self._costs_logged:  # the offline optimisation's history, once (t = 0)

@@ -1,6 +1,7 @@
 """The direct mapping q_d = f(r_o) = g o l_c^-1(r_o) of Namiki & Ishikawa (eqs. 6-8, 12-14, 16, 23).
 
-Pure NumPy, batched: every function takes arrays with a leading sample axis ``(n, ...)``.
+NumPy, batched: every function takes arrays with a leading sample axis ``(n, ...)``; the
+controller's one-sample path (``*_one``) is in Python floats, compiled in ``_mapping.c``.
 
 Coordinates. The arm has four joints; the paper uses axes 1, 2 and 4 and holds axis 3 at 0
 (Sec. IV-A). The mapping works in the *active* coordinates ``p = (q1, q2, q4)`` (m_q = 3); the
