@@ -25,7 +25,8 @@ setup(
         Extension(
             "replay.sensors._stereo",
             ["replay/sensors/_stereo.c"],
-            depends=["replay/sensors/_pixels.c"],  # included: its kernels, unchanged
+            # included: _pixels.c's kernels, unchanged, and _silhouette.c's sphere outline
+            depends=["replay/sensors/_pixels.c", "replay/sensors/_silhouette.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
         Extension(

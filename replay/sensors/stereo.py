@@ -79,7 +79,14 @@ from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
 from replay.sensors import _pixels, _stereo
 from replay.sensors.raster import quantise
-from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
+from replay.sensors.silhouette import (
+    _AREA_SCALE,
+    _COS,
+    _SIN,
+    correct_sphere_centroid,
+    drawables,
+    render_views,
+)
 
 
 @dataclass
@@ -227,6 +234,21 @@ class StereoBallCamera(Sensor):
         self._centres = [(c.intrinsics.cx, c.intrinsics.cy) for c in self.cameras]
         self._axes_c = np.array([x for axis in self._axes for v in axis for x in v], float)
         self._centres_c = np.array([x for c in self._centres for x in c], float)
+        self._cams_c = np.array(
+            [
+                x
+                for c in self.cameras
+                for x in (
+                    *c.rotation.ravel().tolist(),
+                    *c.position.tolist(),
+                    c.intrinsics.fx,
+                    c.intrinsics.fy,
+                    c.intrinsics.cx,
+                    c.intrinsics.cy,
+                )
+            ],
+            float,
+        )
         # noise-free with a background below the threshold: the compiled frame (_stereo.c)
         self._compiled = params.noise_sigma == 0.0 and self._background_level <= params.threshold
         self._last: list = [None, None]
@@ -417,12 +439,22 @@ class StereoBallCamera(Sensor):
         W, H = int(p.width), int(p.height)
         blobs: list[dict | None] = []
         last = []
-        for camera in self.cameras:
-            drawn = drawables(camera, scene)
-            image, window, found = _stereo.frame(
-                [d[0] for d in drawn], [d[1] for d in drawn], [d[2] for d in drawn], grey, W, H,
-                *blob_args,
-            )  # fmt: skip
+        prims = scene.primitives
+        if all(isinstance(q, Sphere) for q in prims):  # both cameras' silhouettes drawn in C
+            frames = _stereo.spheres(
+                self._cams_c, prims, _COS, _SIN, _AREA_SCALE, grey, W, H, *blob_args
+            )
+        else:
+            frames = []
+            for camera in self.cameras:
+                drawn = drawables(camera, scene)
+                polys, greys, boxes = (
+                    [d[0] for d in drawn],
+                    [d[1] for d in drawn],
+                    [d[2] for d in drawn],
+                )
+                frames.append(_stereo.frame(polys, greys, boxes, grey, W, H, *blob_args))
+        for image, window, found in frames:
             x0, y0, x1, y1 = window
             last.append((np.frombuffer(image, np.uint8).reshape(y1 - y0, x1 - x0), window))
             blobs.append(

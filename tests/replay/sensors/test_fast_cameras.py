@@ -355,8 +355,9 @@ def test_compiled_sphere_polygon_equals_the_ellipse_and_its_polygon():
 def test_compiled_stereo_frame_equals_the_step_by_step_measurement(moments, bias):
     """_stereo.frame and _stereo.locate (measure, noise-free) against measure_reference, which
     calls the same kernels from Python: seeded throws, a box behind the ball in a quarter,
-    balls half out of view, behind a camera or absent in some; the same images, blobs and
-    positions to the bit, and None exactly where the reference gives None."""
+    a second ball beside it in a fifth (spheres only: _stereo.spheres draws them), balls half
+    out of view, behind a camera or absent in some; the same images, blobs and positions to the
+    bit, and None exactly where the reference gives None."""
     p = StereoBallCameraParams(moments=moments, bias_correction=bias)
     fast = StereoBallCamera(p, rng=np.random.default_rng(0))
     ref = StereoBallCamera(p, rng=np.random.default_rng(0))
@@ -370,6 +371,11 @@ def test_compiled_stereo_frame_equals_the_step_by_step_measurement(moments, bias
             scene = Scene([Sphere("ball", pos, 0.0175, albedo=0.9)])
         elif k % 10 == 7:
             scene = Scene([Box("wall", (1.2, 0.3, 0.7), (0, 0, 0, 1), (0.2, 0.05, 0.3))])
+        elif k % 10 in (1, 5):  # spheres only, drawn far first: another ball near the first
+            ball = scene.primitives[-1]
+            off = rng.normal(scale=0.05, size=3)
+            other = Sphere("other", tuple(np.add(ball.position, off)), 0.03, albedo=0.5)
+            scene = Scene([other, ball] if k % 10 == 1 else [ball, other])
         got, want = fast.measure(0.0, scene), ref.measure_reference(0.0, scene)
         n += 1
         assert (got is None) == (want is None)
