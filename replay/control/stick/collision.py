@@ -186,15 +186,6 @@ class ContactSolution:
         return np.array([self.r_x, 0.5 * width * self.side])
 
 
-def _valid(sol: "ContactSolution", e: float, u) -> bool:
-    """Eq. 26 (C_i > 0, ``sol.condition``); for e = 0 C_i vanishes, so test the approach before
-    instead."""
-    if e > 0.0:
-        tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
-        return sol.condition > tol
-    return approach_speed(sol.theta, sol.r_x, sol.side, u) > 1e-12
-
-
 def contact_options(
     m: float,
     inertia: float,
@@ -223,10 +214,21 @@ def contact_options(
             roots = f_omega(m, inertia, e, theta, side, u, omega)
         else:
             roots = f_v(m, inertia, e, theta, side, u, speed)
+        roots = tuple(float(r) for r in roots)
         for r in roots:
-            sol = contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
-            if _valid(sol, e, u):
-                out.append(sol)
+            # contact_at, with eq. 26 checked before the solution is made: C_i > 0; for e = 0
+            # C_i vanishes, so the approach before is tested instead
+            g, h = _impulse_terms(m, inertia, theta, r, 0.0, side)
+            after = _after(g, h, e, u)
+            condition = h[0] * after[0] + h[1] * after[1] + h[2] * after[2]
+            if e > 0.0:
+                tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
+                if not condition > tol:
+                    continue
+            elif not approach_speed(theta, r, side, u) > 1e-12:
+                continue
+            sign = 1 if side > 0 else -1
+            out.append(ContactSolution(theta, sign, r, u, after, roots, condition, length))
     return out
 
 
