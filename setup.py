@@ -2,7 +2,8 @@
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
 the buffer protocol, no NumPy headers), as are the stick planners' sweep checks
-(replay/control/stick/_sweep.c)."""
+(replay/control/stick/_sweep.c) and the air table's once-a-step body input/output
+(plants/airtable/_bodies.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -19,6 +20,11 @@ setup(
         Extension(
             "replay.sensors._pixels",
             ["replay/sensors/_pixels.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "plants.airtable._bodies",
+            ["plants/airtable/_bodies.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
         Extension(

@@ -43,6 +43,7 @@ from replay.spatial import yaw_quaternion
 
 from plants.airtable import body_state, settings
 from plants.airtable.hand import HandServo
+from plants.airtable.lean_space import LeanSpace
 from plants.airtable.params import Params
 
 STICK_TYPE = 1
@@ -76,7 +77,7 @@ class AirTablePlant(Plant):
         self._hand_spec = settings.hand_spec(p)
         self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
 
-        space = pymunk.Space()
+        space = LeanSpace()
         space.gravity = (0.0, 0.0)
         space.damping = 1.0  # no velocity damping
         space.iterations = int(p.solver.iterations)
@@ -132,9 +133,7 @@ class AirTablePlant(Plant):
         self._nan_reported = False
         self._collisions = 0
         self._held_since: float | None = None  # the stick held between the tips since
-        self._read_stick = body_state.pose_reader(self.stick_body)
-        self._read_tips = [body_state.position_reader(tb) for tb in self.tip_bodies]
-        self._set_tip_v = [body_state.velocity_setter(tb) for tb in self.tip_bodies]
+        self._io = body_state.TableIO(self.stick_body, self.tip_bodies)
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
 
@@ -161,11 +160,10 @@ class AirTablePlant(Plant):
         dt = self.dt
         # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
         self.hand.advance(dt)
-        for put, (tx, ty), (x, y) in zip(self._set_tip_v, self.hand.tip_list(), self._tip_pos):
-            put((tx - x) / dt, (ty - y) / dt)
-        self.space.step(dt)  # (a collision's velocity before is read in _on_begin)
+        # (a collision's velocity before is read in _on_begin, during the engine's step)
+        self._io.step(self.hand.tip_list(), dt, self.space.step)
         self._steps += 1
-        self._read_state()
+        self._unpack_state()
         if self._pending:
             _, (vx, vy), _, w_after = self._state
             for c in self._pending:
@@ -182,10 +180,14 @@ class AirTablePlant(Plant):
         self._read_state()
 
     def _read_state(self) -> None:
-        """The stick's and the tips' state, read from Pymunk once a step (after it)."""
-        x, y, vx, vy, angle, omega = self._read_stick()
+        """The stick's and the tips' state, read from Pymunk (once a step: by the step itself)."""
+        self._io.read()
+        self._unpack_state()
+
+    def _unpack_state(self) -> None:
+        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = self._io.state
         self._state = ((x, y), (vx, vy), angle, omega)
-        self._tip_pos = [read() for read in self._read_tips]
+        self._tip_pos = [(t0x, t0y), (t1x, t1y)]
 
     def _on_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         """A fingertip started touching the stick (called after position integration, before
