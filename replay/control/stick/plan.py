@@ -181,6 +181,18 @@ class ContactPlanner:
         n = np.array([s, -c]) if sol.side > 0 else np.array([-s, c])  # eq. 4
         return contact, contact - self.hand.tip_radius * n, n
 
+    def tip_at(
+        self, est: StickEstimate, sol: sc.ContactSolution, t_c: float
+    ) -> tuple[float, float]:
+        """:meth:`spot`'s fingertip centre alone, as floats (the same operations)."""
+        x, y, _ = est.at(t_c)
+        c, s = math.cos(sol.theta), math.sin(sol.theta)
+        r_x, r_y = sol.r_x, 0.5 * self.stick.width * sol.side
+        px, py = x + c * r_x - s * r_y, y + s * r_x + c * r_y
+        nx, ny = (s, -c) if sol.side > 0 else (-s, c)  # eq. 4
+        r = self.hand.tip_radius
+        return px - r * nx, py - r * ny
+
     def reach(
         self,
         index: int,
