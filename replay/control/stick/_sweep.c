@@ -79,6 +79,16 @@ static int inside(double px, double py, double cx, double cy, double cs, double 
     return fabs(xb) <= hl && fabs(yb) <= hw;
 }
 
+/* Squared reach of a rectangle of half-sizes (hl, hw), a little beyond its corners: a point
+ * farther than that from the centre is outside whatever the orientation (the rotation keeps
+ * |d| to within a few ulps), so the cosine and sine are only needed for points nearer. */
+static double corner2(double hl, double hw) { return (hl * hl + hw * hw) * (1.0 + 1e-9) + 1e-300; }
+
+static int far_from(double px, double py, double cx, double cy, double r2) {
+    double dx = px - cx, dy = py - cy;
+    return dx * dx + dy * dy > r2;
+}
+
 /* covered_index(motion, t0, t1, n, px, py, half_length, half_width, grow, last): the index and time
  * of the first (last = 0) or last (last = 1) sample at which the fixed point (px, py) is within
  * grow of the stick rectangle (sweep.covered for one point), or None. */
@@ -94,12 +104,13 @@ static PyObject *py_covered_index(PyObject *self, PyObject *args) {
         return NULL;
     if (!parse_motion(mo, &m)) return NULL;
     samples_init(&s, t0, t1, n);
-    const double gl = hl + grow, gw = hw + grow;
+    const double gl = hl + grow, gw = hw + grow, r2 = corner2(gl, gw);
     Py_ssize_t found = -1;
     for (Py_ssize_t j = 0; j < n; j++) {
         Py_ssize_t i = last ? n - 1 - j : j;
         double cx, cy, th;
         pose(&m, sample(&s, i), &cx, &cy, &th);
+        if (far_from(px, py, cx, cy, r2)) continue;
         if (inside(px, py, cx, cy, cos(th), sin(th), gl, gw)) {
             found = i;
             break;
@@ -167,8 +178,8 @@ static PyObject *py_route_hit(PyObject *self, PyObject *args) {
     const double speed[6] = {bs, bs, js, js, js, js};
     const double rx[2] = {r0x, r1x}, ry[2] = {r0y, r1y};
     const int j = 1 - k;
-    const double al = hl + g_act, aw = hw + g_act;
-    double fl = hl + g_far, fw = hw + g_far, ml = 0.0, mw = 0.0;
+    const double al = hl + g_act, aw = hw + g_act, ar2 = corner2(al, aw);
+    double fl = hl + g_far, fw = hw + g_far, ml = 0.0, mw = 0.0, fr2 = corner2(fl, fw), mr2 = 0.0;
     double q[6], prev[6], tip[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
     int have = 0, hit = 0;
     Py_ssize_t i_seg = 0;
@@ -198,10 +209,13 @@ static PyObject *py_route_hit(PyObject *self, PyObject *args) {
             for (int a = 0; a < 6; a++) prev[a] = q[a];
             have = 1;
         }
-        double cx, cy, th;
+        double cx, cy, th, cs = 0.0, sn = 0.0;
+        int trig = 0; /* cs, sn made (only for a tip near the stick) */
         pose(&m, t, &cx, &cy, &th);
-        double cs = cos(th), sn = sin(th);
         if (i == 0 && check_idle) { /* the idle tip's clearance now (plan._body_point) */
+            cs = cos(th);
+            sn = sin(th);
+            trig = 1;
             double dx = tip[j][0] - cx, dy = tip[j][1] - cy;
             double xb = dx * cs + dy * sn, yb = -dx * sn + dy * cs;
             double gx = fabs(xb) - hl, gy = fabs(yb) - hw;
@@ -210,13 +224,26 @@ static PyObject *py_route_hit(PyObject *self, PyObject *args) {
             double on_way = near > g_act ? near : g_act;     /* max(grow_active, ..) */
             ml = hl + on_way;
             mw = hw + on_way;
+            mr2 = corner2(ml, mw);
         }
-        if (t <= t_guard && inside(tip[k][0], tip[k][1], cx, cy, cs, sn, al, aw)) hit = 1;
+        if (t <= t_guard && !far_from(tip[k][0], tip[k][1], cx, cy, ar2)) {
+            if (!trig) {
+                cs = cos(th);
+                sn = sin(th);
+                trig = 1;
+            }
+            hit = inside(tip[k][0], tip[k][1], cx, cy, cs, sn, al, aw);
+        }
         if (check_idle && !hit) {
-            if (t < arrival)
-                hit = inside(tip[j][0], tip[j][1], cx, cy, cs, sn, ml, mw);
-            else
-                hit = inside(tip[j][0], tip[j][1], cx, cy, cs, sn, fl, fw);
+            int moving = t < arrival;
+            double gl = moving ? ml : fl, gw = moving ? mw : fw;
+            if (!far_from(tip[j][0], tip[j][1], cx, cy, moving ? mr2 : fr2)) {
+                if (!trig) {
+                    cs = cos(th);
+                    sn = sin(th);
+                }
+                hit = inside(tip[j][0], tip[j][1], cx, cy, cs, sn, gl, gw);
+            }
         }
     }
     ret = PyBool_FromLong(hit);
