@@ -120,31 +120,6 @@ static PyObject *py_covered_index(PyObject *self, PyObject *args) {
     return Py_BuildValue("(nd)", found, sample(&s, found));
 }
 
-/* any_inside(c, cs, sn, px, py, hl, hw): the fixed point (px, py) within (hl, hw) (grown) of the
- * stick at any of the poses c (float64 (T, 2) centres), cs, sn (float64 (T,) cos, sin of theta):
- * Sweep.hits once its poses are made. */
-static PyObject *py_any_inside(PyObject *self, PyObject *args) {
-    Py_buffer C, CS, SN;
-    double px, py, hl, hw;
-    if (!PyArg_ParseTuple(args, "y*y*y*dddd", &C, &CS, &SN, &px, &py, &hl, &hw)) return NULL;
-    PyObject *ret = NULL;
-    Py_ssize_t T = CS.len / (Py_ssize_t)sizeof(double);
-    if (C.len != 2 * CS.len || SN.len != CS.len) {
-        PyErr_SetString(PyExc_ValueError, "any_inside: c must be (T, 2), cs and sn (T,) float64");
-        goto done;
-    }
-    const double *c = C.buf, *cs = CS.buf, *sn = SN.buf;
-    int hit = 0;
-    for (Py_ssize_t i = 0; i < T && !hit; i++)
-        hit = inside(px, py, c[2 * i], c[2 * i + 1], cs[i], sn[i], hl, hw);
-    ret = PyBool_FromLong(hit);
-done:
-    PyBuffer_Release(&C);
-    PyBuffer_Release(&CS);
-    PyBuffer_Release(&SN);
-    return ret;
-}
-
 /* route_hit(motion, t0, t1, n, segments, speeds, geometry, k, t_guard, half_length, half_width,
  *           grow_active, check_idle, arrival, grow_far):
  * ContactPlanner.route_clear's sweep test along a route. segments: float64 (S, 13), each row
@@ -254,7 +229,6 @@ done:
 
 static PyMethodDef methods[] = {
     {"covered_index", py_covered_index, METH_VARARGS, "first or last sample covering a point"},
-    {"any_inside", py_any_inside, METH_VARARGS, "a point within the stick at any given pose"},
     {"route_hit", py_route_hit, METH_VARARGS, "a fingertip hit by the sweep along a route"},
     {NULL, NULL, 0, NULL},
 };

@@ -18,9 +18,6 @@ def covered_index(
     grow: float,
     last: bool,
 ) -> tuple[int, float] | None: ...
-def any_inside(
-    c: Buffer, cs: Buffer, sn: Buffer, px: float, py: float, hl: float, hw: float
-) -> bool: ...
 def route_hit(
     motion: MotionTuple,
     t0: float,

@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
 REANCHOR = 1.0  # s, the running sums are rebuilt from the window once their anchor is this old
 

@@ -48,7 +48,7 @@ from replay.control.stick.hand_model import (
     route_target,
     travel,
 )
-from replay.control.stick.sweep import Motion, Sweep, first_covered, sample_count, sample_times
+from replay.control.stick.sweep import Motion, Sweep, first_covered, sample_count
 
 CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
 GO_DELAY = 0.003  # s, a staged tip moves in this long after the stick's last pass
@@ -213,7 +213,7 @@ class ContactPlanner:
         contact, tip, n = self.spot(est, sol, t_c)
         motion = Motion(est, t_c, sol.u_after)
         now = self.model.config
-        sweep_all = Sweep(motion, sample_times(t, t_c + p.post_horizon))
+        sweep_all = Sweep(motion, t, t_c + p.post_horizon)
         # Every base is tried and the quickest arrival wins (ties: the earlier finger, then the
         # earlier base). A route arrives no sooner than t + the travel time to the contact
         # posture with the idle finger unmoved (``need``: travel times obey the triangle

@@ -148,42 +148,13 @@ def first_covered(
 
 
 class Sweep:
-    """The stick's poses at fixed sample times, for many "is this fixed point ever covered"
-    questions (the same answer as :func:`covered`, asked one point at a time).
+    """The stick's sweep over :func:`sample_times` (t0, t1), for many "is this fixed point ever
+    covered" questions (the same answer as :func:`covered`, asked one point at a time)."""
 
-    A point farther from the centre's whole path (two straight segments: before and after the
-    switch) than the rectangle's corner reach cannot be covered at any sample, so it is answered
-    without sampling; the others are tested at every sample time."""
-
-    def __init__(self, motion: Motion, times) -> None:
-        self.motion = motion
-        self.times = np.asarray(times, dtype=float)
-        self._poses: tuple | None = None
-        e, t0, t1 = motion.est, float(self.times[0]), float(self.times[-1])
-        ts = min(max(motion.t_switch, t0), t1)
-        a = np.array([e.x + e.vx * (t0 - e.t_ref), e.y + e.vy * (t0 - e.t_ref)])
-        b = np.array([e.x + e.vx * (ts - e.t_ref), e.y + e.vy * (ts - e.t_ref)])
-        c = b + np.array(motion.u_after[:2]) * (t1 - ts) if t1 > motion.t_switch else b
-        self._segments = ((a, b), (b, c))
-
-    def _near_path(self, point, reach: float) -> bool:
-        p = np.asarray(point, dtype=float)
-        for a, b in self._segments:
-            ab = b - a
-            ll = float(ab @ ab)
-            s = 0.0 if ll == 0.0 else min(1.0, max(0.0, float((p - a) @ ab) / ll))
-            d = p - (a + s * ab)
-            if float(d @ d) <= reach * reach:
-                return True
-        return False
+    def __init__(self, motion: Motion, t0: float, t1: float) -> None:
+        self.motion, self.t0, self.t1 = motion, t0, t1
 
     def hits(self, point, half_length: float, half_width: float, grow: float) -> bool:
         """``point`` within ``grow`` of the stick rectangle at some sample time."""
-        hl, hw = half_length + grow, half_width + grow
-        if not self._near_path(point, math.hypot(hl, hw) * (1.0 + 1e-9) + 1e-12):
-            return False
-        if self._poses is None:
-            c, th = self.motion.poses(self.times)
-            self._poses = (c, np.cos(th), np.sin(th))
-        c, cs, sn = self._poses
-        return _sweep.any_inside(c, cs, sn, float(point[0]), float(point[1]), hl, hw)
+        m = self.motion
+        return first_covered(m, self.t0, self.t1, point, half_length, half_width, grow) is not None

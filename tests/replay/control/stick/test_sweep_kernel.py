@@ -1,6 +1,6 @@
 """The stick planners' compiled sweep checks (replay/control/stick/_sweep.c) against their NumPy
-references: sweep.covered for a fixed point (first / last covered sample), Sweep.hits, and
-ContactPlanner.route_clear as it was written in NumPy before the kernel (kept here). The kernel
+references: sweep.covered for a fixed point (first / last covered sample; Sweep.hits is that too,
+tests/.../test_stick_fast_paths.py) and ContactPlanner.route_clear as it was written in NumPy before the kernel (kept here). The kernel
 repeats the NumPy operations in the same order, so the answers agree exactly on seeded random
 motions, points and routes, and the random cases exercise both answers."""
 
@@ -17,7 +17,6 @@ from replay.control.stick.estimator import StickEstimate
 from replay.control.stick.strategy import ThreeStepParams
 from replay.control.stick.sweep import (
     Motion,
-    Sweep,
     covered,
     covered_along,
     first_covered,
@@ -80,21 +79,6 @@ def test_first_and_last_covered_sample_are_numpys():
             else:
                 assert first is None and last is None
     assert 0.1 * cases < hits < 0.9 * cases
-
-
-def test_sweep_hits_are_numpys():
-    rng = np.random.default_rng(22)
-    agree = hits = 0
-    for _ in range(200):
-        motion = random_motion(rng)
-        times = sample_times(0.0, rng.uniform(0.05, 0.8))
-        sweep = Sweep(motion, times)
-        for p in near_points(rng, motion, 0.0, float(times[-1]), 10):
-            grow = rng.uniform(0.0, 0.01)
-            ref = bool(covered(motion, times, [p], 0.05, 0.005, grow).any())
-            agree += sweep.hits(p, 0.05, 0.005, grow) == ref
-            hits += ref
-    assert agree == 2000 and 100 < hits < 1900
 
 
 def route_clear_reference(planner, t, now, route, k, motion, t_c, check_idle=True):
