@@ -134,6 +134,8 @@ class AirTablePlant(Plant):
         self._collisions = 0
         self._held_since: float | None = None  # the stick held between the tips since
         self._io = body_state.TableIO(self.stick_body, self.tip_bodies)
+        self._rest_speed, self._rest_omega = p.rest_speed, p.rest_omega
+        self._hold_speed, self._hold_omega = p.hold_speed, p.hold_omega
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
 
@@ -157,22 +159,37 @@ class AirTablePlant(Plant):
             self._events.append(Occurrence("limit", clamped))
 
     def step(self) -> None:
-        dt = self.dt
+        dt, hand, io = self.dt, self.hand, self._io
         # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
-        self.hand.advance(dt)
+        hand.advance(dt)
         # (a collision's velocity before is read in _on_begin, during the engine's step)
-        self._io.step(self.hand.tip_list(), dt, self.space.step)
+        io.step(hand.tip_list(), dt, self.space.step)
         self._steps += 1
-        self._unpack_state()
+        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = io.state
+        self._state = ((x, y), (vx, vy), angle, omega)
+        self._tip_pos = [(t0x, t0y), (t1x, t1y)]
         if self._pending:
-            _, (vx, vy), _, w_after = self._state
             for c in self._pending:
-                c["v_after"], c["omega_after"] = [vx, vy], w_after
+                c["v_after"], c["omega_after"] = [vx, vy], omega
                 self._events.append(Occurrence("collision", c))
             self._collisions += len(self._pending)
             self._pending = []
-        self._check_state()
-        self._check_held()
+        # the checks' usual case in line (a finite stick moving too fast to rest or be held);
+        # anything else is _check_state's and _check_held's
+        speed, spin = math.hypot(vx, vy), abs(omega)
+        if math.isfinite(x + y + angle + vx + vy + omega + t0x + t0y + t1x + t1y) and not (
+            speed < self._rest_speed and spin < self._rest_omega
+        ):
+            self._rest_since = None
+            self._rest_reported = False  # moving: a later rest is a new event
+        else:
+            self._check_state()
+        if not self._reached:
+            self._reached = self._in_reach()
+        if speed >= self._hold_speed or spin >= self._hold_omega:
+            self._held_since = None  # (not _held)
+        else:
+            self._check_held()
 
     def invalidate_state(self) -> None:
         """Re-read the bodies after the space was changed other than by :meth:`step` (the state is
