@@ -48,7 +48,13 @@ def _impulse_terms(
     """(g, h) with J_i = E_3 - (1 + e) g h^T (eq. 22), in closed form: h = H_i^T n_i and
     g = M^-1 H_i^T K_i^-1 n_i, M = diag(m, m, I) and K_i = H_i M^-1 H_i^T (eqs. 5, 9), K_i
     inverted as a 2 x 2 (the matrix form is the reference in tests/.../test_stick_fast_paths)."""
-    c, s = math.cos(theta), math.sin(theta)
+    return _terms(m, inertia, math.cos(theta), math.sin(theta), r_x, r_y, side)
+
+
+def _terms(
+    m: float, inertia: float, c: float, s: float, r_x: float, r_y: float, side: int
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """:func:`_impulse_terms` with c, s = cos(theta), sin(theta) already made."""
     ax, ay = c * r_x - s * r_y, s * r_x + c * r_y  # a = R_B(theta) ^B r
     nx, ny = (s, -c) if side > 0 else (-s, c)
     k11, k12, k22 = 1.0 / m + ay * ay / inertia, -ax * ay / inertia, 1.0 / m + ax * ax / inertia
@@ -209,6 +215,8 @@ def contact_options(
         raise ValueError("give exactly one of omega, speed")
     u = _u3(u_prev)
     out = []
+    c, s = math.cos(theta), math.sin(theta)
+    tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
     for side in sides:
         if omega is not None:
             roots = f_omega(m, inertia, e, theta, side, u, omega)
@@ -218,11 +226,10 @@ def contact_options(
         for r in roots:
             # contact_at, with eq. 26 checked before the solution is made: C_i > 0; for e = 0
             # C_i vanishes, so the approach before is tested instead
-            g, h = _impulse_terms(m, inertia, theta, r, 0.0, side)
+            g, h = _terms(m, inertia, c, s, r, 0.0, side)
             after = _after(g, h, e, u)
             condition = h[0] * after[0] + h[1] * after[1] + h[2] * after[2]
             if e > 0.0:
-                tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
                 if not condition > tol:
                     continue
             elif not approach_speed(theta, r, side, u) > 1e-12:
