@@ -110,6 +110,9 @@ class TableIO:
             self._set_tip_v = [velocity_setter(tb) for tb in tips]
         self.read()
 
+    def __getstate__(self):
+        raise TypeError("TableIO holds the bodies' Chipmunk addresses: it cannot be copied")
+
     def read(self) -> None:
         if self._ptrs is not None:
             _bodies.read(self._ptrs, self.state)

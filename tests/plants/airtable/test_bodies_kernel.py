@@ -66,6 +66,15 @@ def test_table_io_steps_as_the_python_readers_and_setter():
     assert hit >= 2  # contacts were compared too
 
 
+def test_table_io_cannot_be_copied():
+    """Its addresses are the bodies'; a copy would read the originals."""
+    import copy
+
+    _, stick, tips = table(pymunk.Space, np.random.default_rng(0))
+    with pytest.raises(TypeError, match="cannot be copied"):
+        copy.deepcopy(body_state.TableIO(stick, tips))
+
+
 def test_lean_space_refuses_changes_made_during_a_step():
     space = LeanSpace()
     a = pymunk.Body(1.0, 1.0)
