@@ -361,11 +361,11 @@ class AirTablePlant(Plant):
         return out
 
     def truth(self, t: float) -> dict[str, Any]:
-        (x, y), (vx, vy), angle, omega = self._state
+        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = self._io.state  # (= _state, _tip_pos)
         base, joints, base_target, joint_targets = self.hand.state_lists()
         return {
-            TOPIC_STICK_STATE: StickState(t=t, x=x, y=y, theta=angle, vx=vx, vy=vy, omega=omega),
-            TOPIC_FINGERS_STATE: FingersState(t=t, tips=[[tx, ty] for tx, ty in self._tip_pos]),
+            TOPIC_STICK_STATE: StickState(t, x, y, angle, vx, vy, omega),
+            TOPIC_FINGERS_STATE: FingersState(t, [[t0x, t0y], [t1x, t1y]]),
             TOPIC_HAND_STATE: {
                 "t": t,
                 "base": base,
