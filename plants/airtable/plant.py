@@ -166,8 +166,6 @@ class AirTablePlant(Plant):
         io.step(hand.tip_list(), dt, self.space.step)
         self._steps += 1
         x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = io.state
-        self._state = ((x, y), (vx, vy), angle, omega)
-        self._tip_pos = [(t0x, t0y), (t1x, t1y)]
         if self._pending:
             for c in self._pending:
                 c["v_after"], c["omega_after"] = [vx, vy], omega
@@ -199,12 +197,18 @@ class AirTablePlant(Plant):
     def _read_state(self) -> None:
         """The stick's and the tips' state, read from Pymunk (once a step: by the step itself)."""
         self._io.read()
-        self._unpack_state()
 
-    def _unpack_state(self) -> None:
-        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = self._io.state
-        self._state = ((x, y), (vx, vy), angle, omega)
-        self._tip_pos = [(t0x, t0y), (t1x, t1y)]
+    @property
+    def _state(self) -> tuple:
+        """((x, y), (vx, vy), angle, omega) of the stick as last read."""
+        x, y, vx, vy, angle, omega = self._io.state[:6]
+        return (x, y), (vx, vy), angle, omega
+
+    @property
+    def _tip_pos(self) -> list[tuple[float, float]]:
+        """The fingertips' [(x, y), (x, y)] as last read."""
+        t0x, t0y, t1x, t1y = self._io.state[6:]
+        return [(t0x, t0y), (t1x, t1y)]
 
     def _on_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         """A fingertip started touching the stick (called after position integration, before
