@@ -157,11 +157,37 @@ static PyObject *py_route_hit(PyObject *self, PyObject *args) {
     double fl = hl + g_far, fw = hw + g_far, ml = 0.0, mw = 0.0, fr2 = corner2(fl, fw), mr2 = 0.0;
     double q[6], prev[6], tip[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
     int have = 0, hit = 0;
-    Py_ssize_t i_seg = 0;
+    /* route_configs' segments: segment i is written at samples lo_i <= j < hi_i, lo_0 = 0,
+     * lo_i = the first sample at or after its start (searchsorted 'left'), hi_i = lo_(i+1)
+     * (the last: n), a later segment overwriting an earlier one (starts may step back by the
+     * 1e-9 s route_clear allows) */
+    Py_ssize_t *lo = PyMem_Malloc(2 * (size_t)S * sizeof(Py_ssize_t));
+    if (!lo) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t *hi = lo + S;
+    lo[0] = 0;
+    for (Py_ssize_t i = 1; i < S; i++) { /* the samples ascend: a binary search */
+        Py_ssize_t a = 0, b = n;
+        while (a < b) {
+            Py_ssize_t mid = a + (b - a) / 2;
+            if (sample(&s, mid) < seg[13 * i])
+                a = mid + 1;
+            else
+                b = mid;
+        }
+        lo[i] = a;
+    }
+    for (Py_ssize_t i = 0; i < S; i++) hi[i] = i + 1 < S ? lo[i + 1] : n;
     for (Py_ssize_t i = 0; i < n && !hit; i++) {
         double t = sample(&s, i);
-        /* segment i covers its start <= t < the next start (searchsorted 'left') */
-        while (i_seg + 1 < S && t >= seg[13 * (i_seg + 1)]) i_seg++;
+        Py_ssize_t i_seg = 0;
+        for (Py_ssize_t g = S - 1; g >= 0; g--)
+            if (lo[g] <= i && i < hi[g]) {
+                i_seg = g;
+                break;
+            }
         const double *row = seg + 13 * i_seg;
         double tau = t - row[0];
         if (!(tau > 0.0)) tau = 0.0;
@@ -221,6 +247,7 @@ static PyObject *py_route_hit(PyObject *self, PyObject *args) {
             }
         }
     }
+    PyMem_Free(lo);
     ret = PyBool_FromLong(hit);
 done:
     PyBuffer_Release(&SEG);
