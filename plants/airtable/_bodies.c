@@ -12,6 +12,7 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <math.h>
 #include <stdint.h>
 
 typedef struct {
@@ -90,16 +91,21 @@ static PyObject *py_read(PyObject *self, PyObject *args) {
     return ret;
 }
 
-/* step(ptrs, state, tx0, ty0, tx1, ty1, dt, space_step): each tip's velocity set to
- * ((tx - x) / dt, (ty - y) / dt) from its position in state (so that the step's position
- * integration lands it on the target), space_step(dt) called (the engine, and the collision
- * callbacks it runs), and the state read again into state. */
+/* step(ptrs, state, tx0, ty0, tx1, ty1, dt, space_step, rest_speed, rest_omega, hold_speed,
+ *      hold_omega): each tip's velocity set to ((tx - x) / dt, (ty - y) / dt) from its position in
+ * state (so that the step's position integration lands it on the target), space_step(dt) called
+ * (the engine, and the collision callbacks it runs), and the state read again into state.
+ * Returns True when the state after the step is certainly the plant's usual case: every number
+ * finite (their sum, in the plant's order) and the stick too fast or spinning too fast both to
+ * rest (speed >= rest_speed or |omega| >= rest_omega) and to be held (the same with hold_*).
+ * The speed is compared squared with a margin of 1e-9 (the plant compares math.hypot), so True
+ * is never wrong; False leaves the decision to the plant's own checks. */
 static PyObject *py_step(PyObject *self, PyObject *args) {
     Py_buffer P, S;
-    double tx[2], ty[2];
+    double tx[2], ty[2], rest_v, rest_w, hold_v, hold_w;
     PyObject *dt_obj, *space_step;
-    if (!PyArg_ParseTuple(args, "y*w*ddddOO", &P, &S, &tx[0], &ty[0], &tx[1], &ty[1], &dt_obj,
-                          &space_step))
+    if (!PyArg_ParseTuple(args, "y*w*ddddOOdddd", &P, &S, &tx[0], &ty[0], &tx[1], &ty[1],
+                          &dt_obj, &space_step, &rest_v, &rest_w, &hold_v, &hold_w))
         return NULL;
     PyObject *ret = NULL;
     table_t t;
@@ -115,8 +121,14 @@ static PyObject *py_step(PyObject *self, PyObject *args) {
     if (!r) goto done;
     Py_DECREF(r);
     read_state(&t, s);
-    Py_INCREF(Py_None);
-    ret = Py_None;
+    int usual = 0;
+    double sum = s[0] + s[1] + s[4] + s[2] + s[3] + s[5] + s[6] + s[7] + s[8] + s[9];
+    if (isfinite(sum)) {
+        double sq = s[2] * s[2] + s[3] * s[3], w = fabs(s[5]);
+        double rv = rest_v * (1.0 + 1e-9), hv = hold_v * (1.0 + 1e-9);
+        usual = (sq > rv * rv || w >= rest_w) && (sq > hv * hv || w >= hold_w);
+    }
+    ret = PyBool_FromLong(usual);
 done:
     PyBuffer_Release(&P);
     PyBuffer_Release(&S);

@@ -15,4 +15,8 @@ def step(
     ty1: float,
     dt: float,
     space_step: Callable[[float], None],
-) -> None: ...
+    rest_speed: float,
+    rest_omega: float,
+    hold_speed: float,
+    hold_omega: float,
+) -> bool: ...

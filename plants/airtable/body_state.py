@@ -122,13 +122,16 @@ class TableIO:
         for k, read in enumerate(self._read_tips):
             s[6 + 2 * k : 8 + 2 * k] = array("d", read())
 
-    def step(self, tips, dt: float, space_step: Callable[[float], None]) -> None:
+    def step(self, tips, dt: float, space_step: Callable[[float], None], limits: tuple) -> bool:
+        """One step; True when the state after it is certainly the usual case for ``limits``
+        (rest_speed, rest_omega, hold_speed, hold_omega): all finite, too fast to rest or to be
+        held (``_bodies.c`` says how; False: the caller's own checks decide)."""
         (tx0, ty0), (tx1, ty1) = tips
         if self._ptrs is not None:
-            _bodies.step(self._ptrs, self.state, tx0, ty0, tx1, ty1, dt, space_step)
-            return
+            return _bodies.step(self._ptrs, self.state, tx0, ty0, tx1, ty1, dt, space_step, *limits)
         s = self.state  # pragma: no cover - the fallback
         for k, (put, tx, ty) in enumerate(zip(self._set_tip_v, (tx0, tx1), (ty0, ty1))):
             put((tx - s[6 + 2 * k]) / dt, (ty - s[7 + 2 * k]) / dt)
         space_step(dt)
         self.read()
+        return False

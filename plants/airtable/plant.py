@@ -136,6 +136,7 @@ class AirTablePlant(Plant):
         self._io = body_state.TableIO(self.stick_body, self.tip_bodies)
         self._rest_speed, self._rest_omega = p.rest_speed, p.rest_omega
         self._hold_speed, self._hold_omega = p.hold_speed, p.hold_omega
+        self._limits = tuple(map(float, (p.rest_speed, p.rest_omega, p.hold_speed, p.hold_omega)))
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
 
@@ -163,17 +164,25 @@ class AirTablePlant(Plant):
         # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
         hand.advance(dt)
         # (a collision's velocity before is read in _on_begin, during the engine's step)
-        io.step(hand.tip_list(), dt, self.space.step)
+        usual = io.step(hand.tip_list(), dt, self.space.step, self._limits)
         self._steps += 1
-        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = io.state
         if self._pending:
+            _, _, vx, vy, _, omega = io.state[:6]
             for c in self._pending:
                 c["v_after"], c["omega_after"] = [vx, vy], omega
                 self._events.append(Occurrence("collision", c))
             self._collisions += len(self._pending)
             self._pending = []
+        if usual:  # certainly finite and too fast to rest or be held (TableIO.step)
+            self._rest_since = None
+            self._rest_reported = False  # moving: a later rest is a new event
+            if not self._reached:
+                self._reached = self._in_reach()
+            self._held_since = None
+            return
         # the checks' usual case in line (a finite stick moving too fast to rest or be held);
         # anything else is _check_state's and _check_held's
+        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = io.state
         speed, spin = math.hypot(vx, vy), abs(omega)
         if math.isfinite(x + y + angle + vx + vy + omega + t0x + t0y + t1x + t1y) and not (
             speed < self._rest_speed and spin < self._rest_omega

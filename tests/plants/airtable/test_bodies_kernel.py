@@ -59,7 +59,7 @@ def test_table_io_steps_as_the_python_readers_and_setter():
             for tb, (tx, ty), (x, y) in zip(tips_a, targets, pos):
                 body_state.velocity_setter(tb)((tx - x) / dt, (ty - y) / dt)
             space_a.step(dt)
-            io.step(targets, dt, space_b.step)
+            io.step(targets, dt, space_b.step, (0.01, 0.1, 0.02, 0.5))
             assert tuple(io.state) == python_state(stick_a, tips_a)
             assert tuple(io.state) == python_state(stick_b, tips_b)
         hit += tuple(stick_a.velocity) != v0  # only a contact changes it (no gravity)
@@ -90,3 +90,36 @@ def test_lean_space_refuses_changes_made_during_a_step():
     b.position = (0.15, 0.0)
     with pytest.raises(RuntimeError, match="during a step"):
         space.step(0.01)
+
+
+def test_the_usual_case_flag_is_never_wrong():
+    """TableIO.step's True (finite, too fast to rest or be held) agrees with the plant's own
+    checks (math.hypot) wherever it is given, on speeds and spins about the thresholds."""
+    import math
+
+    rng = np.random.default_rng(41)
+    limits = (0.01, 0.1, 0.02, 0.5)  # rest_speed, rest_omega, hold_speed, hold_omega
+    space, stick, tips = table(pymunk.Space, rng)
+    for tb in tips:
+        tb.position = (5.0, 5.0)  # far away: no contact, the velocity stays as set
+    io = body_state.TableIO(stick, tips)
+    flagged = usual = 0
+    for _ in range(3000):
+        v = rng.choice(limits[::2]) * (1.0 + rng.choice([0.0, 1e-16, -1e-16, rng.normal() * 0.5]))
+        a = rng.uniform(0.0, 2.0 * math.pi)
+        stick.velocity = (v * math.cos(a), v * math.sin(a))
+        stick.angular_velocity = rng.choice(limits[1::2]) * rng.choice([0.5, 1.0, 2.0, -2.0])
+        io.read()
+        flag = io.step([(5.0, 5.0), (5.0, 5.0)], 1.0 / 3000.0, space.step, limits)
+        x, y, vx, vy, th, w, *tp = io.state
+        speed, spin = math.hypot(vx, vy), abs(w)
+        finite = math.isfinite(x + y + th + vx + vy + w + sum(tp))
+        ok = (
+            finite
+            and not (speed < limits[0] and spin < limits[1])
+            and (speed >= limits[2] or spin >= limits[3])
+        )
+        assert not flag or ok
+        flagged += flag
+        usual += ok
+    assert 0.3 * usual < flagged <= usual  # mostly decided by the kernel
