@@ -23,7 +23,7 @@ The result is a :class:`ContactPlan` (the approach phase's plan; its ``intent`` 
 event's data). :class:`Shortfall` keeps the best time needed vs available of failed attempts
 (the ``unreachable`` report).
 
-Pure NumPy.
+Pure NumPy; the sampled sweep checks are compiled (``_sweep.c``, see ``sweep``).
 """
 
 from __future__ import annotations
