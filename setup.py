@@ -1,7 +1,9 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
-the buffer protocol, no NumPy headers)."""
+the buffer protocol, no NumPy headers), as are the stick planners' sweep checks
+(replay/control/stick/_sweep.c) and the air table's once-a-step body input/output
+(plants/airtable/_bodies.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -19,7 +21,17 @@ setup(
             "replay.sensors._pixels",
             ["replay/sensors/_pixels.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        )
+        ),
+        Extension(
+            "plants.airtable._bodies",
+            ["plants/airtable/_bodies.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.stick._sweep",
+            ["replay/control/stick/_sweep.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],
