@@ -1,9 +1,11 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
-the cameras' per-pixel kernels, the stereo camera's frame, a sphere's silhouette, the catching
-mapping and the serial chain's one-configuration dynamics are small C extensions
-(replay/sensors/_pixels.c, _stereo.c, _silhouette.c, replay/control/catching/_mapping.c,
-replay/robot/_chain.c: plain C over the buffer protocol, no NumPy headers)."""
+the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
+the buffer protocol, no NumPy headers), as are the stereo camera's frame and a sphere's silhouette
+(replay/sensors/_stereo.c, _silhouette.c), the catching mapping
+(replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
+(replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c) and the
+air table's once-a-step body input/output (plants/airtable/_bodies.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -42,6 +44,16 @@ setup(
         Extension(
             "replay.robot._chain",
             ["replay/robot/_chain.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "plants.airtable._bodies",
+            ["plants/airtable/_bodies.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.stick._sweep",
+            ["replay/control/stick/_sweep.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
     ],
