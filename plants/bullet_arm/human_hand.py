@@ -83,7 +83,8 @@ class HumanHand:
         self._S0 = np.sin(self._PHI)
         self.R0 = _rpy_matrix(rpy0)
         self.q0 = _quat(self.R0)
-        self.target = self.origin.copy()
+        self._origin, self._u, self._v = self.origin.tolist(), self.u.tolist(), self.v.tolist()
+        self.target_l = self.origin.tolist()
         self.roll = 0.0
         self.cid = bc.createConstraint(
             obj,
@@ -104,9 +105,15 @@ class HumanHand:
         du, dv, r = (self._A * (np.sin(self._W * tt + self._PHI) - self._S0)).sum(axis=1).tolist()
         return du, dv, r
 
+    @property
+    def target(self) -> np.ndarray:
+        """Where the hand pulls the object now (m, world)."""
+        return np.array(self.target_l)
+
     def drive(self, t: float) -> None:
         du, dv, dr = self.offset(t)
-        self.target = self.origin + du * self.u + dv * self.v
+        # origin + du u + dv v per axis in floats (the vector form's operations and order)
+        self.target_l = [o + du * a + dv * b for o, a, b in zip(self._origin, self._u, self._v)]
         self.roll = dr
         # the start orientation turned by dr about the plane normal: q = q_n(dr) q0
         s, c = math.sin(dr / 2.0), math.cos(dr / 2.0)
@@ -120,7 +127,7 @@ class HumanHand:
         ]
         self.bc.changeConstraint(
             self.cid,
-            jointChildPivot=self.target.tolist(),
+            jointChildPivot=self.target_l,
             jointChildFrameOrientation=q,
             maxForce=self.max_force,
         )
