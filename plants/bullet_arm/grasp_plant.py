@@ -40,15 +40,6 @@ from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
 HEAD_JOINTS = ("pan", "tilt")
-# the PyBullet calls the rig's helpers (servos, human hand) and the runner make every step through
-# the client: BulletClient builds a new functools.partial (client id bound) at each attribute
-# access, so the rig keeps one per name on its client (the same call; the base binds its reads)
-PER_STEP_CALLS = (
-    "stepSimulation",
-    "setJointMotorControlArray",
-    "changeConstraint",
-    "getConstraintState",
-)
 
 
 class BulletGraspPlant(BulletArmPlant):
@@ -68,8 +59,6 @@ class BulletGraspPlant(BulletArmPlant):
         self._watch = None  # the catch verdict's watcher: this rig's is outcome()
         P = params
         bc = self.bc
-        for name in PER_STEP_CALLS:
-            setattr(bc, name, getattr(bc, name))
         self._palm_j = self._jidx["palm_joint"]
         assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
@@ -183,28 +172,25 @@ class BulletGraspPlant(BulletArmPlant):
     def _read(self) -> None:
         """The base's state cache (plain floats) from one getJointStates of arm, hand and palm
         joint, with the servos' torques, the wrist's wrench and the object's state."""
-        st = self._get_joint_states(self.robot, self._all_j)
+        pos, vel, reaction, eff = zip(*self._get_joint_states(self.robot, self._all_j))
+        q, qd = self._arm_q(pos, vel)
         na, nh = self._na, len(self._hand_j)
-        arm, hs = st[:na], st[na : na + nh]
         servos = self.arm_servos
         if self._all_active:
-            q, qd = [s[0] for s in arm], [s[1] for s in arm]
             tau, clamped = servos.torque_l[:], servos.saturated_l[:]
         else:
-            q, qd = self._q_locked_l.copy(), [0.0] * self.dof
             tau, clamped = [0.0] * self.dof, [False] * self.dof
             for k, i in enumerate(self.active):
-                q[i], qd[i] = arm[k][0], arm[k][1]
                 tau[i], clamped[i] = servos.torque_l[k], servos.saturated_l[k]
         self._tau_applied = self._tau_cmd = tau
         self._clamped = clamped
-        self.hand_servos.read(hs)
-        self._wrench = self.ft.convert(st[-1][2])
+        self.hand_servos.read(eff[na : na + nh])
+        self._wrench = self.ft.convert(reaction[-1])
         opos, orn = self._get_base_pose(self.obj)
         v, w = self._get_base_velocity(self.obj)
         self._cache = (
             (q, qd),
-            ([s[0] for s in hs], [s[1] for s in hs], self.hand_servos.torque),
+            (list(pos[na : na + nh]), list(vel[na : na + nh]), self.hand_servos.torque),
             (opos, orn, v, w),
         )
         self._head_pose = None

@@ -16,6 +16,7 @@ PyBullet facts used (shared/robots/README.md, measured on this machine):
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 
@@ -45,6 +46,17 @@ from replay.scene import Box, Frame, Scene, Sphere
 with quiet_c_output():  # PyBullet's import prints a build banner
     import pybullet as p
     from pybullet_utils import bullet_client
+
+
+# the PyBullet calls made every step through the client (the plant, the grasp rig's helpers, the
+# bench): BulletClient builds a new functools.partial (client id bound) at each attribute access,
+# so the plant keeps one per name on its client (the same call)
+PER_STEP_CALLS = (
+    "stepSimulation",
+    "setJointMotorControlArray",
+    "changeConstraint",
+    "getConstraintState",
+)
 
 
 class BulletArmPlant(Plant):
@@ -138,12 +150,21 @@ class BulletArmPlant(Plant):
         self._na = len(self._arm_j)
         self._all_active = len(self.active) == dof  # no locked joint: no index mapping
         self._q_locked_l = [float(self.locked.get(n, 0.0)) for n in names]
+        # every arm joint's value from the read joints' (locked ones appended): one itemgetter
+        na = self._na
+        slot = {i: k for k, i in enumerate(self.active)}
+        self._arm_pick = operator.itemgetter(*[slot.get(i, na + i) for i in range(dof)])
+        self._locked_tail = tuple(self._q_locked_l)
+        self._zero_tail = (0.0,) * dof
         # the tool frame and the palm: one getLinkStates a step (_frames_now)
         self._frame_links = [self._tool_link] + (
             [] if self._palm_link is None else [self._palm_link]
         )
         # BulletClient makes a new functools.partial on every attribute access: bind the calls
-        # made every step once (stepSimulation stays an attribute: the bench times it there)
+        # made every step once; those called through the client (stepSimulation: the bench
+        # times it there) are kept on it as attributes
+        for name in PER_STEP_CALLS:
+            setattr(bc, name, getattr(bc, name))
         self._get_joint_states = bc.getJointStates
         self._get_base_pose = bc.getBasePositionAndOrientation
         self._get_base_velocity = bc.getBaseVelocity
@@ -299,17 +320,10 @@ class BulletArmPlant(Plant):
         after changing the simulation other than by stepping it). Shared, never mutated: the
         accessors below give copies."""
         if self._cache is None:
-            st = self._get_joint_states(self.robot, self._read_j)
+            pos, vel, _, eff = zip(*self._get_joint_states(self.robot, self._read_j))
+            q, qd = self._arm_q(pos, vel)
             na = self._na
-            if self._all_active:
-                q = [s[0] for s in st[:na]]
-                qd = [s[1] for s in st[:na]]
-            else:
-                q, qd = self._q_locked_l.copy(), [0.0] * self.dof
-                for i, s in zip(self.active, st[:na]):
-                    q[i], qd[i] = s[0], s[1]
-            hs = st[na:]
-            hand = ([s[0] for s in hs], [s[1] for s in hs], [s[3] for s in hs])
+            hand = (list(pos[na:]), list(vel[na:]), list(eff[na:]))
             obj = None
             if self.obj is not None:
                 pos, orn = self._get_base_pose(self.obj)
@@ -317,6 +331,15 @@ class BulletArmPlant(Plant):
                 obj = (pos, orn, v, w)
             self._cache = ((q, qd), hand, obj)
         return self._cache
+
+    def _arm_q(self, pos: tuple, vel: tuple) -> tuple[list, list]:
+        """(q, qd) of every arm joint from the read joints' positions and velocities (locked
+        joints at their lock value, zero speed)."""
+        if self._all_active:
+            na = self._na
+            return list(pos[:na]), list(vel[:na])
+        pick, na = self._arm_pick, self._na
+        return list(pick(pos[:na] + self._locked_tail)), list(pick(vel[:na] + self._zero_tail))
 
     def invalidate_state(self) -> None:
         """Forget the state read from PyBullet (after a reset* call: the next read is fresh)."""

@@ -109,6 +109,6 @@ class VelocityMotors:
             forces=self._forces,
         )
 
-    def read(self, states) -> None:
-        """The motors' torques from this step's joint states (index 3)."""
-        self.torque = [s[3] for s in states]
+    def read(self, torques) -> None:
+        """The motors' torques of this step (the joint states' appliedJointMotorTorque)."""
+        self.torque = list(torques)
