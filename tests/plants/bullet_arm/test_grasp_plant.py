@@ -313,7 +313,7 @@ def test_the_robot_never_collides_with_itself():
 def test_kept_pybullet_calls_stay_bound_to_each_rigs_own_client():
     """Two rigs at once: the per-step calls kept on each client carry that client's id, so
     stepping one moves only its own world."""
-    from plants.bullet_arm.grasp_plant import PER_STEP_CALLS
+    from plants.bullet_arm.plant import PER_STEP_CALLS
 
     a, b = rig(human_speed=0.1), rig(human_speed=0.1)
     try:
