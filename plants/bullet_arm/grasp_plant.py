@@ -351,9 +351,11 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ log and scene
     def _head_reading(self):
-        """(R, c) of the head camera now (computed once a step: the log and the scene)."""
+        """(R, c, [qx, qy, qz, qw]) of the head camera now (computed once a step: the log, the
+        scene and the 3-D frames)."""
         if self._head_pose is None:
-            self._head_pose = camera_pose(self.head, *self.head_servo.q_l)
+            R, c = camera_pose(self.head, *self.head_servo.q_l)
+            self._head_pose = (R, c, [float(x) for x in matrix_to_quaternion(R)])
         return self._head_pose
 
     def truth(self, t: float) -> dict:
@@ -372,15 +374,8 @@ class BulletGraspPlant(BulletArmPlant):
         out["/head/joint_state"] = JointState(
             t, list(HEAD_JOINTS), hs.q_l[:], hs.qd_l[:], hs.torque_l[:]
         )
-        R, c = self._head_reading()
-        out["/head/state"] = HeadState(
-            t,
-            hs.q_l[0],
-            hs.q_l[1],
-            hs.qd_l[:],
-            c.tolist(),
-            [float(x) for x in matrix_to_quaternion(R)],
-        )
+        _, c, quat = self._head_reading()
+        out["/head/state"] = HeadState(t, hs.q_l[0], hs.q_l[1], hs.qd_l[:], c.tolist(), quat[:])
         human = self.human
         out["/human/state"] = HumanState(
             t, human.target_l[:], float(human.roll), human.force(), human.max_force
@@ -403,10 +398,9 @@ class BulletGraspPlant(BulletArmPlant):
     def frames(self) -> list[Frame]:
         """The robot's links and the head's camera (``head_camera``: x right, y down, z the
         optical axis) in ``world``."""
-        R, c = self._head_reading()
-        qx, qy, qz, qw = (float(x) for x in matrix_to_quaternion(R))
+        _, c, quat = self._head_reading()
         x, y, z = (float(v) for v in c)
-        return super().frames() + [Frame("world", "head_camera", (x, y, z), (qx, qy, qz, qw))]
+        return super().frames() + [Frame("world", "head_camera", (x, y, z), tuple(quat))]
 
     def _full(self, values: list) -> list:
         """Per-active-joint values as a list over every arm joint (zero where locked)."""
@@ -420,7 +414,7 @@ class BulletGraspPlant(BulletArmPlant):
     def scene(self) -> Scene:
         sc = super().scene()
         hs = self.head_servo
-        R, c = self._head_reading()
+        R, c, _ = self._head_reading()
         hq, hqd, htau = self._state()[1]
         sc.readings["hand"] = {"name": list(self.hand_names), "position": hq[:], "velocity": hqd[:]}
         sc.readings["hand_torque"] = {"name": list(self.hand_names), "torque": htau}

@@ -231,6 +231,8 @@ class BulletArmPlant(Plant):
         self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
         self._locked_l = [n in self.locked for n in self.joint_names]
         self._contact_summary = (None, (), (), 0.0)  # (contacts list it is of, parts, links, N)
+        self._contact_key: tuple = ()  # the touching links of the last summary, and their names
+        self._contact_names: tuple = ((), ())
         # the scene's primitive sizes as floats, once
         self._obj_radius = float(P.object_radius)
         self._obj_albedo = float(P.object_albedo)
@@ -682,14 +684,19 @@ class BulletArmPlant(Plant):
     def _contact_summary_now(self) -> tuple[tuple, tuple, float]:
         """(parts, links, total normal force) of ``_contacts`` (tuples, shared: copy them into
         a payload), summed once per list."""
-        if self._contact_summary[0] is not self._contacts:
-            if self._contacts:
-                links = sorted({self._link_name[c[4]] for c in self._contacts})
-                parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
-                force = float(sum(c[9] for c in self._contacts))
-                self._contact_summary = (self._contacts, tuple(parts), tuple(links), force)
+        contacts = self._contacts
+        if self._contact_summary[0] is not contacts:
+            if contacts:
+                key = tuple(c[4] for c in contacts)  # the touching links: names once per set
+                if key != self._contact_key:
+                    links = sorted({self._link_name[k] for k in key})
+                    parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
+                    self._contact_key, self._contact_names = key, (tuple(parts), tuple(links))
+                parts, links = self._contact_names
+                force = float(sum(c[9] for c in contacts))
+                self._contact_summary = (contacts, parts, links, force)
             else:
-                self._contact_summary = (self._contacts, (), (), 0.0)
+                self._contact_summary = (contacts, (), (), 0.0)
         return self._contact_summary[1:]
 
     def scene(self) -> Scene:
