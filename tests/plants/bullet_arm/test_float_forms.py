@@ -78,7 +78,9 @@ def test_row_sum_is_numpys_over_random_rows():
 
 
 def test_human_offset_equals_the_array_form():
-    """HumanHand.offset in floats = sum(A (sin(W t + PHI) - sin(PHI)), axis=1) on arrays."""
+    """HumanHand.offset in floats = sum(A (sin(W t + PHI) - sin(PHI)), axis=1) on arrays: equal
+    here (math.sin and NumPy's sin agree on this machine); within 1e-15 m where NumPy's SIMD sin
+    may round differently."""
     from plants.bullet_arm.human_hand import HumanHand
 
     rng = np.random.default_rng(9)
@@ -95,4 +97,4 @@ def test_human_offset_equals_the_array_form():
         for t in rng.uniform(0.0, 3.0, 200):
             tt = max(t - h.start, 0.0)
             want = (h._A * (np.sin(h._W * tt + h._PHI) - h._S0)).sum(axis=1).tolist()
-            assert list(h.offset(float(t))) == want
+            np.testing.assert_allclose(h.offset(float(t)), want, rtol=0.0, atol=1e-15)
