@@ -1,7 +1,7 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
-the buffer protocol, no NumPy headers)."""
+the buffer protocol, no NumPy headers), and so is the PNG encoder's (replay/foxglove/_png.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -19,7 +19,12 @@ setup(
             "replay.sensors._pixels",
             ["replay/sensors/_pixels.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        )
+        ),
+        Extension(
+            "replay.foxglove._png",
+            ["replay/foxglove/_png.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],

@@ -1,0 +1,9 @@
+"""Types of the PNG encoder's compiled kernel (replay/foxglove/_png.c documents it)."""
+
+from typing import Any
+
+Buffer = Any  # a C-contiguous uint8 (or bool) buffer
+
+def zlib_stream(
+    pixels: Buffer, background: int, x0: int, y0: int, x1: int, y1: int, w: int, h: int, binary: int
+) -> bytes: ...
