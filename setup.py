@@ -1,7 +1,8 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
-the buffer protocol, no NumPy headers), and so is the PNG encoder's (replay/foxglove/_png.c)."""
+the buffer protocol, no NumPy headers), and so are the PNG encoder's (replay/foxglove/_png.c) and the
+log's finiteness check (replay/log/_finite.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -23,6 +24,11 @@ setup(
         Extension(
             "replay.foxglove._png",
             ["replay/foxglove/_png.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.log._finite",
+            ["replay/log/_finite.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
     ],
