@@ -2,7 +2,7 @@
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
 the buffer protocol, no NumPy headers), and so are the PNG encoder's (replay/foxglove/_png.c) and the
-log's finiteness check (replay/log/_finite.c)."""
+log's chunk buffer and finiteness check (replay/log/_chunk.c, _finite.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -24,6 +24,11 @@ setup(
         Extension(
             "replay.foxglove._png",
             ["replay/foxglove/_png.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.log._chunk",
+            ["replay/log/_chunk.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
         Extension(
