@@ -12,8 +12,10 @@ the ``mcap`` tools and by :class:`replay.log.LogReader`.
 
 from __future__ import annotations
 
+import contextlib
 import struct
 import zlib
+from contextlib import AbstractContextManager
 from typing import Any, Protocol
 
 import zstandard
@@ -53,7 +55,9 @@ def _record(record) -> bytes:
 
 class McapFile:
     """``start()``, ``schema()`` / ``channel()``, many ``message()``, ``metadata()``, ``finish()``
-    on a binary stream; ``stream.write`` is called once a chunk (with its message indexes)."""
+    on a binary stream; ``stream.write`` is called once a chunk (with its message indexes), under
+    ``guard`` (a context manager) when a message fills the chunk. ``message()`` is compiled: a
+    signal handler runs in it only there."""
 
     def __init__(
         self,
@@ -62,10 +66,12 @@ class McapFile:
         chunk_size: int = 1024 * 1024,
         compression: str = "zstd",
         level: int = 3,
+        guard: AbstractContextManager = contextlib.nullcontext(),
     ) -> None:
         if compression not in ("zstd", ""):
             raise ValueError(f"compression {compression!r}: zstd or '' (none)")
         self._stream = stream
+        self._guard = guard  # held around writing a finished chunk (the only Python a message runs)
         self._chunk_size = chunk_size
         self._compression = compression
         self._compressor = zstandard.ZstdCompressor(level=level) if compression else None
@@ -127,6 +133,10 @@ class McapFile:
             self._finish_chunk()
 
     def _finish_chunk(self) -> None:
+        with self._guard:
+            self._write_chunk()
+
+    def _write_chunk(self) -> None:
         taken = self._chunk.take()
         if taken is None:
             return  # (schemas and channels alone wait for the first message, as mcap's do)
@@ -182,7 +192,7 @@ class McapFile:
     def finish(self) -> None:
         """The last chunk, the data end, the summary (schemas, channels, statistics, chunk and
         metadata indexes, summary offsets), the footer and the closing magic."""
-        self._finish_chunk()
+        self._write_chunk()
         self._write(_record(DataEnd(0)))
         summary_start = self._offset
         groups: list[tuple[int, bytes]] = [

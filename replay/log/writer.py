@@ -249,7 +249,9 @@ class LogWriter:
             chunk_size=chunk_size,
             compression="" if compression == "none" else "zstd",
             level=ZSTD_LEVEL,
+            guard=self._held,
         )
+        self._message = self._mcap.message
         self._mcap.start(profile="", library=f"paper-replay {__version__}")
         self._json_channels: dict[str, int] = {}  # topic -> channel id
         self._topics: set[str] = set()  # every channel's topic
@@ -300,22 +302,17 @@ class LogWriter:
         """Write one message; ``t_ns`` (simulated time) is both log and publish time."""
         data = encode(topic, payload)  # NonFiniteValueError before anything is written
         channel = self._json_channels.get(topic) or self._json_channel(topic, payload)  # ids > 0
-        self.write_raw(channel, data, t_ns)
+        try:  # (compiled, so whole: a finished chunk is written under the held SIGINT)
+            self._message(channel, t_ns, t_ns, data)
+        except OSError as exc:
+            raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
 
     def write_raw(self, channel_id: int, data: bytes, t_ns: int) -> None:
         """Write one message's encoded bytes on a channel of :meth:`register_channel`."""
-        held = self._held
-        held.depth += 1  # (inline ``with held:``: this runs for every message)
         try:
-            self._mcap.message(channel_id, t_ns, t_ns, data)
+            self._message(channel_id, t_ns, t_ns, data)
         except OSError as exc:
-            held.pending = False
             raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
-        finally:
-            held.depth -= 1
-        if held.pending and not held.depth:
-            held.pending = False
-            raise KeyboardInterrupt
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         with self._held:
