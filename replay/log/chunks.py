@@ -66,12 +66,12 @@ class McapFile:
         chunk_size: int = 1024 * 1024,
         compression: str = "zstd",
         level: int = 3,
-        guard: AbstractContextManager = contextlib.nullcontext(),
+        guard: AbstractContextManager | None = None,
     ) -> None:
         if compression not in ("zstd", ""):
             raise ValueError(f"compression {compression!r}: zstd or '' (none)")
         self._stream = stream
-        self._guard = guard  # held around writing a finished chunk (the only Python a message runs)
+        self._guard = guard or contextlib.nullcontext()  # held around writing a finished chunk (the only Python a message runs)
         self._chunk_size = chunk_size
         self._compression = compression
         self._compressor = zstandard.ZstdCompressor(level=level) if compression else None
