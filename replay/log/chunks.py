@@ -71,7 +71,9 @@ class McapFile:
         if compression not in ("zstd", ""):
             raise ValueError(f"compression {compression!r}: zstd or '' (none)")
         self._stream = stream
-        self._guard = guard or contextlib.nullcontext()  # held around writing a finished chunk (the only Python a message runs)
+        self._guard = (
+            guard or contextlib.nullcontext()
+        )  # held around writing a finished chunk (the only Python a message runs)
         self._chunk_size = chunk_size
         self._compression = compression
         self._compressor = zstandard.ZstdCompressor(level=level) if compression else None
