@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import struct
 import zlib
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -29,8 +29,7 @@ _pack_u32 = struct.Struct(">I").pack
 _pack_ihdr = struct.Struct(">4sIIBBBBB").pack
 
 
-@dataclass(frozen=True)
-class WindowedImage:
+class WindowedImage(NamedTuple):  # (a tuple: ~5x cheaper to make than a frozen dataclass)
     """An (height, width) grey frame that is ``background`` outside ``window`` = (x0, y0, x1,
     y1), where it is ``pixels`` (uint8, (y1 - y0, x1 - x0)): what a windowed camera renders."""
 
