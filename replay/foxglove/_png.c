@@ -1,5 +1,6 @@
-/* The zlib stream of a grey PNG's image data (replay/foxglove/png.py is the only caller and
- * documents it). Plain C over the buffer protocol: no NumPy headers, no zlib.
+/* A grey PNG (replay/foxglove/png.py is the only caller and documents it): signature, IHDR
+ * (8-bit grey), one IDAT holding the zlib stream of the filtered rows, IEND; CRC-32 of each
+ * chunk (ISO 3309, as zlib's). Plain C over the buffer protocol: no NumPy headers, no zlib.
  *
  * The image is (h, w) uint8, `bg` outside the window [x0, x1) x [y0, y1), where it is `pix`
  * (C-contiguous, (y1 - y0) rows of x1 - x0; with `binary`, any non-zero byte is 255). Each row
@@ -17,6 +18,32 @@
 #include <string.h>
 
 #define ADLER_BASE 65521u
+
+static uint32_t CRC_TABLE[256];
+
+static void crc_init(void) {
+    for (uint32_t n = 0; n < 256; n++) {
+        uint32_t c = n;
+        for (int k = 0; k < 8; k++) c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        CRC_TABLE[n] = c;
+    }
+}
+
+static uint32_t crc32(const uint8_t *p, size_t n) {
+    uint32_t c = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; i++) c = CRC_TABLE[(c ^ p[i]) & 0xFF] ^ (c >> 8);
+    return c ^ 0xFFFFFFFFu;
+}
+
+static inline void be32(uint8_t *p, uint32_t v) {
+    p[0] = (uint8_t)(v >> 24);
+    p[1] = (uint8_t)(v >> 16);
+    p[2] = (uint8_t)(v >> 8);
+    p[3] = (uint8_t)v;
+}
+
+/* PNG signature, IHDR chunk, IDAT length and tag: what comes before the zlib stream */
+#define PNG_HEAD (8 + 25 + 8)
 
 static const uint16_t LEN_BASE[29] = {3,  4,  5,  6,  7,  8,  9,  10, 11,  13,  15,  17,  19,  23, 27,
                                       31, 35, 43, 51, 59, 67, 83, 99, 115, 131, 163, 195, 227, 258};
@@ -122,7 +149,7 @@ static inline void adler_run(uint64_t *rs, uint64_t *rt, uint64_t n, uint64_t c)
     *rs += n * c;
 }
 
-static PyObject *py_zlib_stream(PyObject *self, PyObject *args) {
+static PyObject *py_png(PyObject *self, PyObject *args) {
     Py_buffer P;
     int bg, x0, y0, x1, y1, w, h, binary;
     if (!PyArg_ParseTuple(args, "y*iiiiiiii", &P, &bg, &x0, &y0, &x1, &y1, &w, &h, &binary))
@@ -131,13 +158,14 @@ static PyObject *py_zlib_stream(PyObject *self, PyObject *args) {
     uint8_t *rows = NULL, *out = NULL;
     if (w < 1 || h < 1 || w > 32767 || bg < 0 || bg > 255 || x0 < 0 || y0 < 0 || x1 > w ||
         y1 > h || x1 < x0 || y1 < y0 || P.len != (Py_ssize_t)(x1 - x0) * (y1 - y0)) {
-        PyErr_SetString(PyExc_ValueError, "zlib_stream: bad image size, window or pixels");
+        PyErr_SetString(PyExc_ValueError, "png: bad image size, window or pixels");
         goto done;
     }
     const size_t n = (size_t)w + 1;
     rows = malloc(3 * n);
-    /* worst case every byte a 9-bit literal, plus header, end code and Adler-32 */
-    const size_t cap = (size_t)h * n * 9 / 8 + 64;
+    /* worst case every byte a 9-bit literal, plus the PNG's chunks, zlib header, end code and
+     * Adler-32 */
+    const size_t cap = (size_t)h * n * 9 / 8 + PNG_HEAD + 64;
     out = malloc(cap);
     if (!rows || !out) {
         PyErr_NoMemory();
@@ -155,7 +183,17 @@ static PyObject *py_zlib_stream(PyObject *self, PyObject *args) {
     adler_run(&bg_s, &bg_t, (uint64_t)w, (uint64_t)bg);
     bg_s %= ADLER_BASE;
     bg_t %= ADLER_BASE;
-    BitWriter bw = {out, 0, 0, 0};
+    static const uint8_t SIGNATURE[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    memcpy(out, SIGNATURE, 8);
+    be32(out + 8, 13);
+    memcpy(out + 12, "IHDR", 4);
+    be32(out + 16, (uint32_t)w);
+    be32(out + 20, (uint32_t)h);
+    const uint8_t ihdr[5] = {8, 0, 0, 0, 0}; /* 8-bit grey, deflate, filter set 0, no interlace */
+    memcpy(out + 24, ihdr, 5);
+    be32(out + 29, crc32(out + 12, 17));
+    memcpy(out + 37, "IDAT", 4);
+    BitWriter bw = {out, PNG_HEAD, 0, 0};
     out[bw.n++] = 0x78; /* deflate, 32 KiB window */
     out[bw.n++] = 0x01; /* fastest; (0x78 << 8 | 0x01) % 31 == 0 */
     put(&bw, 1, 1);     /* BFINAL */
@@ -219,6 +257,12 @@ static PyObject *py_zlib_stream(PyObject *self, PyObject *args) {
     out[bw.n++] = (uint8_t)(adler >> 16);
     out[bw.n++] = (uint8_t)(adler >> 8);
     out[bw.n++] = (uint8_t)adler;
+    be32(out + 33, (uint32_t)(bw.n - PNG_HEAD)); /* the IDAT's length */
+    be32(out + bw.n, crc32(out + 37, bw.n - 37));
+    bw.n += 4;
+    static const uint8_t IEND[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
+    memcpy(out + bw.n, IEND, 12);
+    bw.n += 12;
     ret = PyBytes_FromStringAndSize((const char *)out, (Py_ssize_t)bw.n);
 done:
     free(rows);
@@ -228,11 +272,14 @@ done:
 }
 
 static PyMethodDef methods[] = {
-    {"zlib_stream", py_zlib_stream, METH_VARARGS, "a windowed grey image's PNG zlib stream"},
+    {"png", py_png, METH_VARARGS, "a windowed grey image as a PNG file"},
     {NULL, NULL, 0, NULL},
 };
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_png",
-                                    "The zlib stream of a grey PNG's image data.", -1, methods};
+                                    "A grey PNG of a windowed image.", -1, methods};
 
-PyMODINIT_FUNC PyInit__png(void) { return PyModule_Create(&module); }
+PyMODINIT_FUNC PyInit__png(void) {
+    crc_init();
+    return PyModule_Create(&module);
+}

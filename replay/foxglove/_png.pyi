@@ -4,6 +4,6 @@ from typing import Any
 
 Buffer = Any  # a C-contiguous uint8 (or bool) buffer
 
-def zlib_stream(
+def png(
     pixels: Buffer, background: int, x0: int, y0: int, x1: int, y1: int, w: int, h: int, binary: int
 ) -> bytes: ...

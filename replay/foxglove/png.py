@@ -2,8 +2,8 @@
 
 ``cv2.imencode(".png", ...)`` of a 128 x 128 image costs ~250 us, zlib's level 1 on the whole
 filtered frame ~30 us. A camera frame is mostly background, often the same row many times, so
-the image data is written by a small compiled encoder (``_png.c``): one deflate block of fixed
-Huffman codes (RFC 1951) in which a row equal to the row above is one copy of it and a run of
+the PNG is written by a small compiled encoder (``_png.c``): its image data one deflate block of
+fixed Huffman codes (RFC 1951) in which a row equal to the row above is one copy of it and a run of
 equal bytes is one copy at distance 1; no zlib, no per-image allocation of its state. A
 :class:`WindowedImage` (the sensor's rendered window and the background level around it) is
 encoded without building the whole frame in Python. The encoder reads the rows, not the window:
@@ -14,19 +14,11 @@ encoder of the same rows as the reference).
 
 from __future__ import annotations
 
-import struct
-import zlib
 from typing import NamedTuple
 
 import numpy as np
 
 from replay.foxglove import _png
-
-_SIGNATURE = b"\x89PNG\r\n\x1a\n"
-_IEND = struct.pack(">I", 0) + b"IEND" + struct.pack(">I", zlib.crc32(b"IEND"))
-_IDAT_CRC = zlib.crc32(b"IDAT")
-_pack_u32 = struct.Struct(">I").pack
-_pack_ihdr = struct.Struct(">4sIIBBBBB").pack
 
 
 class WindowedImage(NamedTuple):  # (a tuple: ~5x cheaper to make than a frozen dataclass)
@@ -51,24 +43,6 @@ class WindowedImage(NamedTuple):  # (a tuple: ~5x cheaper to make than a frozen 
         return out
 
 
-def png_file(height: int, width: int, stream: bytes) -> bytes:
-    """An 8-bit grey PNG of (height, width) from the zlib stream of its filtered rows."""
-    ihdr = _pack_ihdr(b"IHDR", width, height, 8, 0, 0, 0, 0)  # 8-bit grey, no interlace
-    return b"".join(
-        (
-            _SIGNATURE,
-            b"\x00\x00\x00\x0d",
-            ihdr,
-            _pack_u32(zlib.crc32(ihdr)),
-            _pack_u32(len(stream)),
-            b"IDAT",
-            stream,
-            _pack_u32(zlib.crc32(stream, _IDAT_CRC)),
-            _IEND,
-        )
-    )
-
-
 def encode_png(image: np.ndarray | WindowedImage) -> bytes:
     """An (h, w) image as an 8-bit grey PNG: uint8 as is, bool as 0 / 255; a
     :class:`WindowedImage` as its whole frame."""
@@ -90,4 +64,4 @@ def encode_png(image: np.ndarray | WindowedImage) -> bytes:
         binary = int(pix.dtype == bool)
     if h < 1 or w < 1:
         raise ValueError(f"an empty image ({h} x {w}) has no PNG")
-    return png_file(h, w, _png.zlib_stream(pix, bg, x0, y0, x1, y1, w, h, binary))
+    return _png.png(pix, bg, x0, y0, x1, y1, w, h, binary)

@@ -96,7 +96,8 @@ class FoxgloveTopics:
         self.log = log  # a replay.log.LogWriter
         self._channels: dict[str, int] = {}  # topic -> channel id
         self._schemas: dict[str, int] = {}  # schema name -> id (each stored once)
-        self._images: dict[tuple[str, str], int] = {}  # (sensor, view) -> channel id
+        # (sensor, view) -> (channel id, the image messages' last fields)
+        self._images: dict[tuple[str, str], tuple[int, bytes]] = {}
 
     def _channel(self, topic: str, schema: str, encoding: str, data: bytes, message: str) -> int:
         if schema not in self._schemas:
@@ -130,9 +131,12 @@ class FoxgloveTopics:
 
     # The messages at the frame and camera rates are written straight in the wire format
     # (replay.foxglove.wire: ~5x cheaper than filling the protobuf classes, same messages).
-    def transforms(self, frames: Iterable[Frame], t_ns: int) -> None:
+    def transforms(self, frames: Iterable[Frame], t_ns: int, bodies: Sequence = ()) -> None:
+        """``frames``, after each of ``bodies`` (scene primitives) as a frame of its own name in
+        ``world``."""
         channel = self._channels.get(TOPIC_TF) or self._wire(TOPIC_TF, FrameTransforms)
-        self.log.write_raw(channel, wire.frame_transforms(frames, t_ns), t_ns)
+        data = wire.body_transforms(bodies, WORLD, t_ns) + wire.frame_transforms(frames, t_ns)
+        self.log.write_raw(channel, data, t_ns)
 
     def scene(self, primitives: Sequence, t_ns: int) -> None:
         """The primitives as one entity each (id = name) at their world poses."""
@@ -161,9 +165,12 @@ class FoxgloveTopics:
         )
 
     def image(self, sensor: str, view: str, image: np.ndarray | WindowedImage, t_ns: int) -> None:
-        key = (sensor, view)
-        channel = self._images.get(key)
-        if channel is None:
-            channel = self._images[key] = self._wire(camera_topic(sensor, view), CompressedImage)
-        data = wire.compressed_image(t_ns, f"{sensor}/{view}", encode_png(image), "png")
-        self.log.write_raw(channel, data, t_ns)
+        slot = self._images.get((sensor, view))
+        if slot is None:
+            channel = self._wire(camera_topic(sensor, view), CompressedImage)
+            slot = self._images[(sensor, view)] = (
+                channel,
+                wire.image_tail(f"{sensor}/{view}", "png"),
+            )
+        channel, tail = slot
+        self.log.write_raw(channel, wire.image_message(t_ns, encode_png(image), tail), t_ns)

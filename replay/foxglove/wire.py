@@ -27,6 +27,7 @@ _TRANSFORM = struct.Struct("<BBBdBdBdBBBdBdBdBd")
 _POSE = struct.Struct("<BBBBBdBdBdBBBdBdBdBd")  # Pose: position 1, orientation 2, in its field 1
 _JOINT = struct.Struct("<BdBdBd")  # JointState position 2, velocity 3, effort 5
 _DOUBLE = struct.Struct("<Bd")
+_IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 
 def varint(n: int) -> bytes:
@@ -51,6 +52,7 @@ def _text(tag: int, text: str) -> bytes:
     return field(tag, text.encode())
 
 
+@functools.lru_cache(maxsize=8)  # (a frame's topics and images share their time)
 def timestamp(t_ns: int) -> bytes:
     """A ``google.protobuf.Timestamp`` of ``t_ns`` as field 1 of its message (seconds 1 and
     nanos 2, each left out at 0 as the library does)."""
@@ -78,12 +80,31 @@ def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
     return b"".join(parts)
 
 
+def body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
+    """``foxglove.FrameTransforms`` of each primitive as a frame of its own name in ``parent``
+    (a sphere unrotated): the transforms of :func:`frame_transforms` without making the frames
+    (the messages' repeated fields concatenate)."""
+    ts = timestamp(t_ns)
+    head = ts + _text(0x12, parent)
+    pack = _TRANSFORM.pack
+    parts = []
+    for p in primitives:
+        (x, y, z) = p.position
+        qx, qy, qz, qw = _IDENTITY if isinstance(p, Sphere) else p.orientation
+        body = b"".join(
+            (
+                head,
+                _text(0x1A, p.name),
+                pack(0x22, 27, 9, x, 17, y, 25, z, 0x2A, 36, 9, qx, 17, qy, 25, qz, 33, qw),
+            )
+        )
+        parts.append(b"\x0a" + varint(len(body)) + body)
+    return b"".join(parts)
+
+
 def _grey(albedo: float) -> float:
     """The albedo as a grey, lifted so that a black body still shows on a dark background."""
     return 0.25 + 0.75 * min(max(float(albedo), 0.0), 1.0)
-
-
-_IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 
 def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
@@ -139,6 +160,15 @@ def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
 
 def compressed_image(t_ns: int, frame_id: str, data: bytes, fmt: str) -> bytes:
     """``foxglove.CompressedImage``: timestamp 1, data 2, format 3, frame id 4."""
-    return b"".join(
-        (timestamp(t_ns), b"\x12", varint(len(data)), data, _text(0x1A, fmt), _text(0x22, frame_id))
-    )
+    return image_message(t_ns, data, image_tail(frame_id, fmt))
+
+
+@functools.lru_cache(maxsize=256)
+def image_tail(frame_id: str, fmt: str) -> bytes:
+    """The fields of a ``foxglove.CompressedImage`` after its data: format, frame id."""
+    return _text(0x1A, fmt) + _text(0x22, frame_id)
+
+
+def image_message(t_ns: int, data: bytes, tail: bytes) -> bytes:
+    """A ``foxglove.CompressedImage`` of ``data`` and the fields of :func:`image_tail`."""
+    return b"".join((timestamp(t_ns), b"\x12", varint(len(data)), data, tail))

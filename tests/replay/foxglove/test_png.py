@@ -14,9 +14,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from replay.foxglove.png import WindowedImage, encode_png, png_file
+from replay.foxglove.png import WindowedImage, encode_png
 from replay.scene import Scene, Sphere
 from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
+
+
+def _chunk(tag: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
 
 
 def reference_png(img: np.ndarray) -> bytes:
@@ -26,7 +30,12 @@ def reference_png(img: np.ndarray) -> bytes:
     h, w = img.shape
     rows = np.zeros((h, w + 1), np.uint8)
     rows[:, 1:] = img
-    return png_file(h, w, zlib.compress(rows.tobytes(), 1))
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + _chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0))
+        + _chunk(b"IDAT", zlib.compress(rows.tobytes(), 1))
+        + _chunk(b"IEND", b"")
+    )
 
 
 def idat(data: bytes) -> bytes:
@@ -84,6 +93,7 @@ def test_compiled_png_decodes_to_the_reference_pixels_everywhere():
         assert encode_png(full) == data  # the bytes depend on the pixels, not on the window
         assert encode_png(WindowedImage(*full.shape, 0, (0, 0, *full.shape[::-1]), full)) == data
         agree += all(np.array_equal(d, full) for d in decoders(data) + decoders(ref))
+        assert data[:33] == ref[:33] and data[-12:] == ref[-12:]  # IHDR, IEND as the reference
         smaller += len(data) <= len(ref)
     print(f"compiled PNG = reference pixels for {agree}/{n} images ({smaller} no bigger)")
     assert agree == n

@@ -60,6 +60,12 @@ def reference_scene(primitives, t_ns):
     return msg
 
 
+def body_frame(p):
+    """A primitive as a frame of its own name in world (a sphere unrotated)."""
+    q = (0.0, 0.0, 0.0, 1.0) if isinstance(p, Sphere) else p.orientation
+    return Frame("world", p.name, p.position, q)
+
+
 def reference_joints(names, q, v, e, t_ns):
     msg = JointStates()
     _stamp(msg.timestamp, t_ns)
@@ -124,6 +130,8 @@ def test_wire_messages_decode_to_the_protobuf_classes_own():
             == reference_transforms(frames, t)
             and SceneUpdate.FromString(wire.scene_update(prims, "world", t))
             == reference_scene(prims, t)
+            and FrameTransforms.FromString(wire.body_transforms(prims, "world", t))
+            == reference_transforms([body_frame(p) for p in prims], t)
             and JointStates.FromString(wire.joint_states(*joints, t))
             == reference_joints(*joints, t)
             and CompressedImage.FromString(wire.compressed_image(t, image.frame_id, data, "png"))
