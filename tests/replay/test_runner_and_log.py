@@ -296,3 +296,19 @@ def test_readings_are_delivered_their_latency_after_capture_over_random_sensor_s
         passed += ok
     print(f"runner delivery over random sensor sets: {passed}/{trials} passed")
     assert passed == trials
+
+
+def test_resolved_yaml_is_the_pure_python_emitters_text_for_every_scenario():
+    """The logs' /scenario text comes from libyaml's emitter when PyYAML has it: the same text
+    as PyYAML's own (so a machine without libyaml writes the same logs)."""
+    import yaml
+
+    from conftest import ROOT
+    from replay.scenario.loader import resolved_yaml, to_plain
+
+    paths = sorted((ROOT / "scenarios").glob("*.yaml"))
+    assert paths
+    for path in paths:
+        sc = load_scenario(path)
+        text = yaml.safe_dump(to_plain(sc), sort_keys=False, default_flow_style=None, width=100)
+        assert resolved_yaml(sc) == text, path.name
