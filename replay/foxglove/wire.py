@@ -84,21 +84,21 @@ def body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
     """``foxglove.FrameTransforms`` of each primitive as a frame of its own name in ``parent``
     (a sphere unrotated): the transforms of :func:`frame_transforms` without making the frames
     (the messages' repeated fields concatenate)."""
-    ts = timestamp(t_ns)
-    head = ts + _text(0x12, parent)
+    head = timestamp(t_ns) + _text(0x12, parent)
+    n_head = len(head) + 67  # + the translation and rotation fields
     pack = _TRANSFORM.pack
     parts = []
     for p in primitives:
+        child = _text(0x1A, p.name)
         (x, y, z) = p.position
         qx, qy, qz, qw = _IDENTITY if isinstance(p, Sphere) else p.orientation
-        body = b"".join(
-            (
-                head,
-                _text(0x1A, p.name),
-                pack(0x22, 27, 9, x, 17, y, 25, z, 0x2A, 36, 9, qx, 17, qy, 25, qz, 33, qw),
-            )
+        parts += (
+            b"\x0a",
+            varint(n_head + len(child)),
+            head,
+            child,
+            pack(0x22, 27, 9, x, 17, y, 25, z, 0x2A, 36, 9, qx, 17, qy, 25, qz, 33, qw),
         )
-        parts.append(b"\x0a" + varint(len(body)) + body)
     return b"".join(parts)
 
 
@@ -107,44 +107,72 @@ def _grey(albedo: float) -> float:
     return 0.25 + 0.75 * min(max(float(albedo), 0.0), 1.0)
 
 
+# (kind, name, shape, albedo) -> (the entity's id and primitive field up to its pose, the
+# primitive's fields after its pose): a scene's bodies keep their shape and colour from frame to
+# frame, so only their poses are packed each time (keys compare by value: a size of -0.0 is
+# written as the 0.0 seen first)
+_SHAPES: dict[tuple, tuple[bytes, bytes]] = {}
+
+
+def _shape_fields(p) -> tuple[bytes, bytes] | None:
+    if isinstance(p, Box):
+        key: tuple = (Box, p.name, tuple(p.size), p.albedo)
+    elif isinstance(p, Sphere):
+        key = (Sphere, p.name, p.radius, p.albedo)
+    elif isinstance(p, Cylinder):
+        key = (Cylinder, p.name, p.radius, p.length, p.albedo)
+    else:
+        return None
+    fields = _SHAPES.get(key)
+    if fields is None:
+        if len(_SHAPES) > 4096:
+            _SHAPES.clear()
+        v = _grey(p.albedo)
+        color = _QUAT.pack(9, v, 17, v, 25, v, 33, 1.0)
+        vec3 = _VEC3.pack
+        if isinstance(p, Box):  # cubes 8: size 2, color 3
+            tag, sx, sy, sz = 0x42, *p.size
+            tail = b"\x12\x1b" + vec3(9, sx, 17, sy, 25, sz) + b"\x1a\x24" + color
+        elif isinstance(p, Sphere):  # spheres 9: size 2, color 3
+            tag, d = 0x4A, 2.0 * p.radius
+            tail = b"\x12\x1b" + vec3(9, d, 17, d, 25, d) + b"\x1a\x24" + color
+        else:  # cylinders 10: size 2, bottom and top scale 3, 4, color 5; its axis body z
+            tag, d = 0x52, 2.0 * p.radius
+            tail = (
+                b"\x12\x1b"
+                + vec3(9, d, 17, d, 25, p.length)
+                + _DOUBLE.pack(0x19, 1.0)
+                + _DOUBLE.pack(0x21, 1.0)
+                + b"\x2a\x24"
+                + color
+            )
+        mid = _text(0x1A, p.name) + bytes((tag,)) + varint(69 + len(tail))  # + the pose
+        fields = _SHAPES[key] = (mid, tail)
+    return fields
+
+
 def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
     """``foxglove.SceneUpdate``: each box, sphere and cylinder as one entity (id = its name) of
     one primitive at its pose in ``frame_id``, grey by albedo (others are left out)."""
     head = timestamp(t_ns) + _text(0x12, frame_id)
-    pose, vec3, quat, double = _POSE.pack, _VEC3.pack, _QUAT.pack, _DOUBLE.pack
+    n_head = len(head) + 69  # + the pose field
+    pose = _POSE.pack
     parts = []
     for p in primitives:
-        if isinstance(p, Box):
-            tag, orientation = 0x42, p.orientation  # cubes 8
-            sx, sy, sz = p.size
-            extra, color_tag = b"", 0x1A  # color 3
-        elif isinstance(p, Sphere):
-            tag, orientation = 0x4A, _IDENTITY  # spheres 9
-            sx = sy = sz = 2.0 * p.radius
-            extra, color_tag = b"", 0x1A
-        elif isinstance(p, Cylinder):  # its axis is the body z axis, as Foxglove's
-            tag, orientation = 0x52, p.orientation  # cylinders 10
-            sx = sy = 2.0 * p.radius
-            sz = p.length
-            extra, color_tag = double(0x19, 1.0) + double(0x21, 1.0), 0x2A  # scales 3, 4; color 5
-        else:
+        fields = _shape_fields(p)
+        if fields is None:
             continue
-        (x, y, z), (qx, qy, qz, qw) = p.position, orientation
-        v = _grey(p.albedo)
-        body = b"".join(
-            (
-                pose(
-                    0x0A, 67, 0x0A, 27, 9, x, 17, y, 25, z, 0x12, 36, 9, qx, 17, qy, 25, qz, 33, qw
-                ),
-                b"\x12\x1b",
-                vec3(9, sx, 17, sy, 25, sz),
-                extra,
-                bytes((color_tag, 36)),
-                quat(9, v, 17, v, 25, v, 33, 1.0),
-            )
+        mid, tail = fields
+        (x, y, z) = p.position
+        qx, qy, qz, qw = _IDENTITY if isinstance(p, Sphere) else p.orientation
+        parts += (
+            b"\x12",  # entities 2
+            varint(n_head + len(mid) + len(tail)),
+            head,
+            mid,
+            pose(0x0A, 67, 0x0A, 27, 9, x, 17, y, 25, z, 0x12, 36, 9, qx, 17, qy, 25, qz, 33, qw),
+            tail,
         )
-        entity = head + _text(0x1A, p.name) + bytes((tag,)) + varint(len(body)) + body
-        parts.append(b"\x12" + varint(len(entity)) + entity)  # entities 2
     return b"".join(parts)
 
 
