@@ -149,11 +149,10 @@ static inline void adler_run(uint64_t *rs, uint64_t *rt, uint64_t n, uint64_t c)
     *rs += n * c;
 }
 
-static PyObject *py_png(PyObject *self, PyObject *args) {
-    Py_buffer P;
-    int bg, x0, y0, x1, y1, w, h, binary;
-    if (!PyArg_ParseTuple(args, "y*iiiiiiii", &P, &bg, &x0, &y0, &x1, &y1, &w, &h, &binary))
-        return NULL;
+/* The PNG of the image; with a prefix, the protobuf message prefix + field 2 (the PNG,
+ * length-delimited) + suffix */
+static PyObject *encode(Py_buffer P, int bg, int x0, int y0, int x1, int y1, int w, int h,
+                        int binary, const Py_buffer *prefix, const Py_buffer *suffix) {
     PyObject *ret = NULL;
     uint8_t *rows = NULL, *out = NULL;
     if (w < 1 || h < 1 || w > 32767 || bg < 0 || bg > 255 || x0 < 0 || y0 < 0 || x1 > w ||
@@ -165,12 +164,16 @@ static PyObject *py_png(PyObject *self, PyObject *args) {
     rows = malloc(3 * n);
     /* worst case every byte a 9-bit literal, plus the PNG's chunks, zlib header, end code and
      * Adler-32 */
-    const size_t cap = (size_t)h * n * 9 / 8 + PNG_HEAD + 64;
+    /* room for the prefix and the field's head */
+    const size_t base = prefix ? (size_t)prefix->len + 1 + 5 : 0;
+    const size_t cap =
+        base + (size_t)h * n * 9 / 8 + PNG_HEAD + 64 + (suffix ? (size_t)suffix->len : 0);
     out = malloc(cap);
     if (!rows || !out) {
         PyErr_NoMemory();
         goto done;
     }
+    uint8_t *png = out + base;
     const uint8_t *pix = P.buf;
     const int ww = x1 - x0;
     if (ww == 0) y1 = y0; /* an empty window: every row is background */
@@ -184,18 +187,18 @@ static PyObject *py_png(PyObject *self, PyObject *args) {
     bg_s %= ADLER_BASE;
     bg_t %= ADLER_BASE;
     static const uint8_t SIGNATURE[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    memcpy(out, SIGNATURE, 8);
-    be32(out + 8, 13);
-    memcpy(out + 12, "IHDR", 4);
-    be32(out + 16, (uint32_t)w);
-    be32(out + 20, (uint32_t)h);
+    memcpy(png, SIGNATURE, 8);
+    be32(png + 8, 13);
+    memcpy(png + 12, "IHDR", 4);
+    be32(png + 16, (uint32_t)w);
+    be32(png + 20, (uint32_t)h);
     const uint8_t ihdr[5] = {8, 0, 0, 0, 0}; /* 8-bit grey, deflate, filter set 0, no interlace */
-    memcpy(out + 24, ihdr, 5);
-    be32(out + 29, crc32(out + 12, 17));
-    memcpy(out + 37, "IDAT", 4);
-    BitWriter bw = {out, PNG_HEAD, 0, 0};
-    out[bw.n++] = 0x78; /* deflate, 32 KiB window */
-    out[bw.n++] = 0x01; /* fastest; (0x78 << 8 | 0x01) % 31 == 0 */
+    memcpy(png + 24, ihdr, 5);
+    be32(png + 29, crc32(png + 12, 17));
+    memcpy(png + 37, "IDAT", 4);
+    BitWriter bw = {png, PNG_HEAD, 0, 0};
+    png[bw.n++] = 0x78; /* deflate, 32 KiB window */
+    png[bw.n++] = 0x01; /* fastest; (0x78 << 8 | 0x01) % 31 == 0 */
     put(&bw, 1, 1);     /* BFINAL */
     put(&bw, 1, 2);     /* BTYPE 01: fixed Huffman codes */
     uint64_t s1 = 1, s2 = 0, rs = 0, rt = 0;
@@ -253,26 +256,63 @@ static PyObject *py_png(PyObject *self, PyObject *args) {
     put_symbol(&bw, 256); /* end of block */
     if (bw.nbits) put(&bw, 0, 8 - bw.nbits);
     const uint32_t adler = (uint32_t)(s2 << 16 | s1);
-    out[bw.n++] = (uint8_t)(adler >> 24);
-    out[bw.n++] = (uint8_t)(adler >> 16);
-    out[bw.n++] = (uint8_t)(adler >> 8);
-    out[bw.n++] = (uint8_t)adler;
-    be32(out + 33, (uint32_t)(bw.n - PNG_HEAD)); /* the IDAT's length */
-    be32(out + bw.n, crc32(out + 37, bw.n - 37));
+    png[bw.n++] = (uint8_t)(adler >> 24);
+    png[bw.n++] = (uint8_t)(adler >> 16);
+    png[bw.n++] = (uint8_t)(adler >> 8);
+    png[bw.n++] = (uint8_t)adler;
+    be32(png + 33, (uint32_t)(bw.n - PNG_HEAD)); /* the IDAT's length */
+    be32(png + bw.n, crc32(png + 37, bw.n - 37));
     bw.n += 4;
     static const uint8_t IEND[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
-    memcpy(out + bw.n, IEND, 12);
+    memcpy(png + bw.n, IEND, 12);
     bw.n += 12;
-    ret = PyBytes_FromStringAndSize((const char *)out, (Py_ssize_t)bw.n);
+    size_t total = bw.n;
+    if (prefix) {
+        size_t k = (size_t)prefix->len;
+        memcpy(out, prefix->buf, k);
+        out[k++] = 0x12;
+        for (size_t v = bw.n; ; v >>= 7) {
+            out[k++] = (uint8_t)(v < 0x80 ? v : (v & 0x7F) | 0x80);
+            if (v < 0x80) break;
+        }
+        memmove(out + k, png, bw.n);
+        k += bw.n;
+        memcpy(out + k, suffix->buf, (size_t)suffix->len);
+        total = k + (size_t)suffix->len;
+    }
+    ret = PyBytes_FromStringAndSize((const char *)out, (Py_ssize_t)total);
 done:
     free(rows);
     free(out);
+    return ret;
+}
+
+static PyObject *py_png(PyObject *self, PyObject *args) {
+    Py_buffer P;
+    int bg, x0, y0, x1, y1, w, h, binary;
+    if (!PyArg_ParseTuple(args, "y*iiiiiiii", &P, &bg, &x0, &y0, &x1, &y1, &w, &h, &binary))
+        return NULL;
+    PyObject *ret = encode(P, bg, x0, y0, x1, y1, w, h, binary, NULL, NULL);
+    PyBuffer_Release(&P);
+    return ret;
+}
+
+static PyObject *py_message(PyObject *self, PyObject *args) {
+    Py_buffer pre, suf, P;
+    int bg, x0, y0, x1, y1, w, h, binary;
+    if (!PyArg_ParseTuple(args, "y*y*y*iiiiiiii", &pre, &suf, &P, &bg, &x0, &y0, &x1, &y1, &w,
+                          &h, &binary))
+        return NULL;
+    PyObject *ret = encode(P, bg, x0, y0, x1, y1, w, h, binary, &pre, &suf);
+    PyBuffer_Release(&pre);
+    PyBuffer_Release(&suf);
     PyBuffer_Release(&P);
     return ret;
 }
 
 static PyMethodDef methods[] = {
     {"png", py_png, METH_VARARGS, "a windowed grey image as a PNG file"},
+    {"message", py_message, METH_VARARGS, "prefix, the PNG as protobuf field 2, suffix"},
     {NULL, NULL, 0, NULL},
 };
 

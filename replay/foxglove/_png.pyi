@@ -7,3 +7,16 @@ Buffer = Any  # a C-contiguous uint8 (or bool) buffer
 def png(
     pixels: Buffer, background: int, x0: int, y0: int, x1: int, y1: int, w: int, h: int, binary: int
 ) -> bytes: ...
+def message(
+    prefix: bytes,
+    suffix: bytes,
+    pixels: Buffer,
+    background: int,
+    x0: int,
+    y0: int,
+    x1: int,
+    y1: int,
+    w: int,
+    h: int,
+    binary: int,
+) -> bytes: ...

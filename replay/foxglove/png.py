@@ -43,13 +43,12 @@ class WindowedImage(NamedTuple):  # (a tuple: ~5x cheaper to make than a frozen 
         return out
 
 
-def encode_png(image: np.ndarray | WindowedImage) -> bytes:
-    """An (h, w) image as an 8-bit grey PNG: uint8 as is, bool as 0 / 255; a
-    :class:`WindowedImage` as its whole frame."""
+def png_args(image: np.ndarray | WindowedImage) -> tuple:
+    """The compiled encoder's arguments for an image (``_png.c``): pixels, background, window,
+    width, height, binary; ValueError for an image it does not take."""
     if isinstance(image, WindowedImage):
-        h, w, bg = image.height, image.width, image.background
-        x0, y0, x1, y1 = image.window
-        pix = np.ascontiguousarray(image.pixels)
+        h, w, bg, (x0, y0, x1, y1), pix = image
+        pix = np.ascontiguousarray(pix)
         if pix.shape != (y1 - y0, x1 - x0) or pix.dtype != np.uint8:
             raise ValueError(f"window {image.window} with pixels {pix.shape} {pix.dtype}")
         binary = 0
@@ -64,4 +63,16 @@ def encode_png(image: np.ndarray | WindowedImage) -> bytes:
         binary = int(pix.dtype == bool)
     if h < 1 or w < 1:
         raise ValueError(f"an empty image ({h} x {w}) has no PNG")
-    return _png.png(pix, bg, x0, y0, x1, y1, w, h, binary)
+    return pix, bg, x0, y0, x1, y1, w, h, binary
+
+
+def encode_png(image: np.ndarray | WindowedImage) -> bytes:
+    """An (h, w) image as an 8-bit grey PNG: uint8 as is, bool as 0 / 255; a
+    :class:`WindowedImage` as its whole frame."""
+    return _png.png(*png_args(image))
+
+
+def png_message(prefix: bytes, image: np.ndarray | WindowedImage, suffix: bytes) -> bytes:
+    """``prefix``, the image's PNG as protobuf field 2 (length-delimited), ``suffix``: a
+    ``foxglove.CompressedImage`` in one compiled call (replay/foxglove/wire.py's fields)."""
+    return _png.message(prefix, suffix, *png_args(image))

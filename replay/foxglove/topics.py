@@ -30,7 +30,7 @@ from google.protobuf.message import Message
 from google.protobuf.timestamp_pb2 import Timestamp
 
 from replay.foxglove import wire
-from replay.foxglove.png import WindowedImage, encode_png
+from replay.foxglove.png import WindowedImage, png_message
 from replay.foxglove.schemas import (
     MESSAGE_ENCODING,
     SCHEMA_ENCODING,
@@ -173,4 +173,4 @@ class FoxgloveTopics:
                 wire.image_tail(f"{sensor}/{view}", "png"),
             )
         channel, tail = slot
-        self.log.write_raw(channel, wire.image_message(t_ns, encode_png(image), tail), t_ns)
+        self.log.write_raw(channel, png_message(wire.timestamp(t_ns), image, tail), t_ns)

@@ -87,7 +87,7 @@ def body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
     head = timestamp(t_ns) + _text(0x12, parent)
     n_head = len(head) + 67  # + the translation and rotation fields
     pack = _TRANSFORM.pack
-    parts = []
+    parts: list[bytes] = []
     for p in primitives:
         child = _text(0x1A, p.name)
         (x, y, z) = p.position
@@ -157,7 +157,7 @@ def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
     head = timestamp(t_ns) + _text(0x12, frame_id)
     n_head = len(head) + 69  # + the pose field
     pose = _POSE.pack
-    parts = []
+    parts: list[bytes] = []
     for p in primitives:
         fields = _shape_fields(p)
         if fields is None:
@@ -186,17 +186,9 @@ def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
     return b"".join(parts)
 
 
-def compressed_image(t_ns: int, frame_id: str, data: bytes, fmt: str) -> bytes:
-    """``foxglove.CompressedImage``: timestamp 1, data 2, format 3, frame id 4."""
-    return image_message(t_ns, data, image_tail(frame_id, fmt))
-
-
 @functools.lru_cache(maxsize=256)
 def image_tail(frame_id: str, fmt: str) -> bytes:
-    """The fields of a ``foxglove.CompressedImage`` after its data: format, frame id."""
+    """The fields of a ``foxglove.CompressedImage`` after its data (field 2): format 3, frame
+    id 4; a camera's message is ``replay.foxglove.png.png_message(timestamp(t_ns), image,
+    image_tail(frame_id, "png"))``."""
     return _text(0x1A, fmt) + _text(0x22, frame_id)
-
-
-def image_message(t_ns: int, data: bytes, tail: bytes) -> bytes:
-    """A ``foxglove.CompressedImage`` of ``data`` and the fields of :func:`image_tail`."""
-    return b"".join((timestamp(t_ns), b"\x12", varint(len(data)), data, tail))

@@ -13,6 +13,7 @@ from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 
 from replay.foxglove import wire
+from replay.foxglove.png import encode_png, png_message
 from replay.scene import Box, Cylinder, Frame, Sphere
 
 
@@ -75,6 +76,12 @@ def reference_joints(names, q, v, e, t_ns):
     return msg
 
 
+def compressed_image(t_ns, frame_id, data):
+    """A CompressedImage of given bytes from the wire module's parts (png_message's layout)."""
+    head = wire.timestamp(t_ns) + b"\x12" + wire.varint(len(data))
+    return head + data + wire.image_tail(frame_id, "png")
+
+
 def _value(rng):
     """A double as the plants give them: often exactly 0 or -0, sometimes huge or tiny."""
     r = rng.random()
@@ -122,6 +129,10 @@ def test_wire_messages_decode_to_the_protobuf_classes_own():
                 prims.append(Cylinder(f"c{i}", pos, q, abs(_value(rng)), 0.3, albedo=albedo))
         joints = [[_name(rng) for _ in range(7)]] + [[_value(rng) for _ in range(7)]] * 3
         data = bytes(rng.integers(0, 256, size=int(rng.integers(0, 300)), dtype=np.uint8))
+        pixels = rng.integers(0, 256, size=(int(rng.integers(1, 40)), 7)).astype(np.uint8)
+        png_image = CompressedImage()
+        _stamp(png_image.timestamp, t)
+        png_image.frame_id, png_image.data, png_image.format = "x", encode_png(pixels), "png"
         image = CompressedImage()
         _stamp(image.timestamp, t)
         image.frame_id, image.data, image.format = _name(rng), data, "png"
@@ -134,8 +145,11 @@ def test_wire_messages_decode_to_the_protobuf_classes_own():
             == reference_transforms([body_frame(p) for p in prims], t)
             and JointStates.FromString(wire.joint_states(*joints, t))
             == reference_joints(*joints, t)
-            and CompressedImage.FromString(wire.compressed_image(t, image.frame_id, data, "png"))
-            == image
+            and CompressedImage.FromString(compressed_image(t, image.frame_id, data)) == image
+            and CompressedImage.FromString(
+                png_message(wire.timestamp(t), pixels, wire.image_tail("x", "png"))
+            )
+            == png_image
         )
         agree += ok
     print(f"wire messages equal to the protobuf classes' for {agree}/{n} random inputs")
