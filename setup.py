@@ -1,8 +1,10 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
-the buffer protocol, no NumPy headers), and so are the PNG encoder's (replay/foxglove/_png.c) and the
-log's chunk buffer and finiteness check (replay/log/_chunk.c, _finite.c)."""
+the buffer protocol, no NumPy headers), as are the stick planners' sweep checks
+(replay/control/stick/_sweep.c), the air table's once-a-step body input/output
+(plants/airtable/_bodies.c), the camera PNG encoder (replay/foxglove/_png.c) and the log's chunk
+buffer and finiteness check (replay/log/_chunk.c, _finite.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -19,6 +21,16 @@ setup(
         Extension(
             "replay.sensors._pixels",
             ["replay/sensors/_pixels.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "plants.airtable._bodies",
+            ["plants/airtable/_bodies.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.stick._sweep",
+            ["replay/control/stick/_sweep.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
         Extension(

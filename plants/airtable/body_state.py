@@ -4,18 +4,26 @@
 the air table reads the stick's and both tips' state every physics step, so it goes through the
 Chipmunk calls Pymunk itself wraps (``pymunk._chipmunk_cffi.lib``, Pymunk 7). Where that module
 is not there, the public properties are used: the same numbers, only slower.
+
+:class:`TableIO` does a step's whole input/output (the tips' velocities, the engine step, the
+state after it) in one compiled call (``_bodies.c``), calling those same Chipmunk functions
+through the addresses the cffi binding gives; the readers and setter below are its reference
+(tests/plants/airtable/test_bodies_kernel.py) and its fallback.
 """
 
 from __future__ import annotations
 
+from array import array
 from typing import Callable
 
 import pymunk
 
+from plants.airtable import _bodies
+
 try:  # Pymunk 7's own cffi binding of Chipmunk
-    from pymunk._chipmunk_cffi import lib as _cp
+    from pymunk._chipmunk_cffi import ffi as _ffi, lib as _cp
 except ImportError:  # pragma: no cover - another Pymunk layout
-    _cp = None
+    _ffi = _cp = None
 
 
 def pose_reader(body: pymunk.Body) -> Callable[[], tuple[float, float, float, float, float, float]]:
@@ -65,3 +73,65 @@ def velocity_setter(body: pymunk.Body) -> Callable[[float, float], None]:
         return public
     ptr, setv = body._body, _cp.cpBodySetVelocity
     return lambda vx, vy: setv(ptr, (vx, vy))
+
+
+class TableIO:
+    """The stick's and two tips' state, read and written once a step.
+
+    ``state`` holds (x, y, vx, vy, angle, omega) of the stick and the tips' (x, y) as last read.
+    :meth:`step` sets each tip's velocity to (target - position) / dt (so the engine's position
+    integration lands it on the target), runs ``space_step(dt)`` (the engine, called as given:
+    what times or wraps ``space.step`` sees every step) and reads the state again."""
+
+    def __init__(self, stick: pymunk.Body, tips: list[pymunk.Body]) -> None:
+        self.state = array("d", [0.0] * 10)
+        self._ptrs: array | None = None
+        if _ffi is not None and all(hasattr(b, "_body") for b in (stick, *tips)):
+
+            def address(obj) -> int:
+                return int(_ffi.cast("uintptr_t", obj))
+
+            fns = [
+                _ffi.addressof(_cp, name)
+                for name in (
+                    "cpBodyGetPosition",
+                    "cpBodyGetVelocity",
+                    "cpBodyGetAngle",
+                    "cpBodyGetAngularVelocity",
+                    "cpBodySetVelocity",
+                )
+            ]
+            bodies = [stick._body, tips[0]._body, tips[1]._body]
+            self._ptrs = array("Q", [address(x) for x in fns + bodies] + [0, 0])
+            self._keep = (stick, tips)  # the bodies outlive the addresses
+        else:  # pragma: no cover - another Pymunk layout
+            self._read_stick = pose_reader(stick)
+            self._read_tips = [position_reader(tb) for tb in tips]
+            self._set_tip_v = [velocity_setter(tb) for tb in tips]
+        self.read()
+
+    def __getstate__(self):
+        raise TypeError("TableIO holds the bodies' Chipmunk addresses: it cannot be copied")
+
+    def read(self) -> None:
+        if self._ptrs is not None:
+            _bodies.read(self._ptrs, self.state)
+            return
+        s = self.state  # pragma: no cover - the fallback
+        s[0:6] = array("d", self._read_stick())
+        for k, read in enumerate(self._read_tips):
+            s[6 + 2 * k : 8 + 2 * k] = array("d", read())
+
+    def step(self, tips, dt: float, space_step: Callable[[float], None], limits: tuple) -> bool:
+        """One step; True when the state after it is certainly the usual case for ``limits``
+        (rest_speed, rest_omega, hold_speed, hold_omega): all finite, too fast to rest or to be
+        held (``_bodies.c`` says how; False: the caller's own checks decide)."""
+        (tx0, ty0), (tx1, ty1) = tips
+        if self._ptrs is not None:
+            return _bodies.step(self._ptrs, self.state, tx0, ty0, tx1, ty1, dt, space_step, *limits)
+        s = self.state  # pragma: no cover - the fallback
+        for k, (put, tx, ty) in enumerate(zip(self._set_tip_v, (tx0, tx1), (ty0, ty1))):
+            put((tx - s[6 + 2 * k]) / dt, (ty - s[7 + 2 * k]) / dt)
+        space_step(dt)
+        self.read()
+        return False

@@ -43,6 +43,7 @@ from replay.spatial import yaw_quaternion
 
 from plants.airtable import body_state, settings
 from plants.airtable.hand import HandServo
+from plants.airtable.lean_space import LeanSpace
 from plants.airtable.params import Params
 
 STICK_TYPE = 1
@@ -76,7 +77,7 @@ class AirTablePlant(Plant):
         self._hand_spec = settings.hand_spec(p)
         self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
 
-        space = pymunk.Space()
+        space = LeanSpace()
         space.gravity = (0.0, 0.0)
         space.damping = 1.0  # no velocity damping
         space.iterations = int(p.solver.iterations)
@@ -132,9 +133,10 @@ class AirTablePlant(Plant):
         self._nan_reported = False
         self._collisions = 0
         self._held_since: float | None = None  # the stick held between the tips since
-        self._read_stick = body_state.pose_reader(self.stick_body)
-        self._read_tips = [body_state.position_reader(tb) for tb in self.tip_bodies]
-        self._set_tip_v = [body_state.velocity_setter(tb) for tb in self.tip_bodies]
+        self._io = body_state.TableIO(self.stick_body, self.tip_bodies)
+        self._rest_speed, self._rest_omega = p.rest_speed, p.rest_omega
+        self._hold_speed, self._hold_omega = p.hold_speed, p.hold_omega
+        self._limits = tuple(map(float, (p.rest_speed, p.rest_omega, p.hold_speed, p.hold_omega)))
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
 
@@ -158,23 +160,43 @@ class AirTablePlant(Plant):
             self._events.append(Occurrence("limit", clamped))
 
     def step(self) -> None:
-        dt = self.dt
+        dt, hand, io = self.dt, self.hand, self._io
         # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
-        self.hand.advance(dt)
-        for put, (tx, ty), (x, y) in zip(self._set_tip_v, self.hand.tip_list(), self._tip_pos):
-            put((tx - x) / dt, (ty - y) / dt)
-        self.space.step(dt)  # (a collision's velocity before is read in _on_begin)
+        hand.advance(dt)
+        # (a collision's velocity before is read in _on_begin, during the engine's step)
+        usual = io.step(hand.tip_list(), dt, self.space.step, self._limits)
         self._steps += 1
-        self._read_state()
         if self._pending:
-            _, (vx, vy), _, w_after = self._state
+            _, _, vx, vy, _, omega = io.state[:6]
             for c in self._pending:
-                c["v_after"], c["omega_after"] = [vx, vy], w_after
+                c["v_after"], c["omega_after"] = [vx, vy], omega
                 self._events.append(Occurrence("collision", c))
             self._collisions += len(self._pending)
             self._pending = []
-        self._check_state()
-        self._check_held()
+        if usual:  # certainly finite and too fast to rest or be held (TableIO.step)
+            self._rest_since = None
+            self._rest_reported = False  # moving: a later rest is a new event
+            if not self._reached:
+                self._reached = self._in_reach()
+            self._held_since = None
+            return
+        # the checks' usual case in line (a finite stick moving too fast to rest or be held);
+        # anything else is _check_state's and _check_held's
+        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = io.state
+        speed, spin = math.hypot(vx, vy), abs(omega)
+        if math.isfinite(x + y + angle + vx + vy + omega + t0x + t0y + t1x + t1y) and not (
+            speed < self._rest_speed and spin < self._rest_omega
+        ):
+            self._rest_since = None
+            self._rest_reported = False  # moving: a later rest is a new event
+        else:
+            self._check_state()
+        if not self._reached:
+            self._reached = self._in_reach()
+        if speed >= self._hold_speed or spin >= self._hold_omega:
+            self._held_since = None  # (not _held)
+        else:
+            self._check_held()
 
     def invalidate_state(self) -> None:
         """Re-read the bodies after the space was changed other than by :meth:`step` (the state is
@@ -182,10 +204,20 @@ class AirTablePlant(Plant):
         self._read_state()
 
     def _read_state(self) -> None:
-        """The stick's and the tips' state, read from Pymunk once a step (after it)."""
-        x, y, vx, vy, angle, omega = self._read_stick()
-        self._state = ((x, y), (vx, vy), angle, omega)
-        self._tip_pos = [read() for read in self._read_tips]
+        """The stick's and the tips' state, read from Pymunk (once a step: by the step itself)."""
+        self._io.read()
+
+    @property
+    def _state(self) -> tuple:
+        """((x, y), (vx, vy), angle, omega) of the stick as last read."""
+        x, y, vx, vy, angle, omega = self._io.state[:6]
+        return (x, y), (vx, vy), angle, omega
+
+    @property
+    def _tip_pos(self) -> list[tuple[float, float]]:
+        """The fingertips' [(x, y), (x, y)] as last read."""
+        t0x, t0y, t1x, t1y = self._io.state[6:]
+        return [(t0x, t0y), (t1x, t1y)]
 
     def _on_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         """A fingertip started touching the stick (called after position integration, before
@@ -342,11 +374,11 @@ class AirTablePlant(Plant):
         return out
 
     def truth(self, t: float) -> dict[str, Any]:
-        (x, y), (vx, vy), angle, omega = self._state
+        x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = self._io.state  # (= _state, _tip_pos)
         base, joints, base_target, joint_targets = self.hand.state_lists()
         return {
-            TOPIC_STICK_STATE: StickState(t=t, x=x, y=y, theta=angle, vx=vx, vy=vy, omega=omega),
-            TOPIC_FINGERS_STATE: FingersState(t=t, tips=[[tx, ty] for tx, ty in self._tip_pos]),
+            TOPIC_STICK_STATE: StickState(t, x, y, angle, vx, vy, omega),
+            TOPIC_FINGERS_STATE: FingersState(t, [[t0x, t0y], [t1x, t1y]]),
             TOPIC_HAND_STATE: {
                 "t": t,
                 "base": base,

@@ -91,12 +91,13 @@ def finger_ik(hand: HandSpec, base, k: int, tip, q_near=None):
         return None
     c2 = min(1.0, max(-1.0, c2))
     best = None
+    (lo1, hi1), (lo2, hi2) = hand.joint_limits
     for sign in (1.0, -1.0):
         q2 = sign * math.acos(c2)
         q1 = math.atan2(dy, dx) - math.atan2(l2 * math.sin(q2), l1 + l2 * math.cos(q2))
         q1 = (q1 + math.pi) % (2.0 * math.pi) - math.pi
         q = (q1, q2)
-        if not all(lo - 1e-9 <= v <= hi + 1e-9 for v, (lo, hi) in zip(q, hand.joint_limits)):
+        if not (lo1 - 1e-9 <= q1 <= hi1 + 1e-9 and lo2 - 1e-9 <= q2 <= hi2 + 1e-9):
             continue
         cost = 0.0 if q_near is None else abs(q1 - q_near[0]) + abs(q2 - q_near[1])
         if best is None or cost < best[0]:
@@ -107,8 +108,10 @@ def finger_ik(hand: HandSpec, base, k: int, tip, q_near=None):
 def travel_time(hand: HandSpec, base_from, base_to, joints_from, joints_to) -> float:
     """Least time (s) to move base and joints between two configurations at the speed limits
     (every axis moves independently at its own limit)."""
-    t_base = max(abs(b - a) for a, b in zip(base_from, base_to)) / hand.base_speed
-    t_joint = max(abs(b - a) for qa, qb in zip(joints_from, joints_to) for a, b in zip(qa, qb))
+    (x0, y0), (x1, y1) = base_from, base_to
+    ((a0, b0), (c0, d0)), ((a1, b1), (c1, d1)) = joints_from, joints_to
+    t_base = max(abs(x1 - x0), abs(y1 - y0)) / hand.base_speed
+    t_joint = max(abs(a1 - a0), abs(b1 - b0), abs(c1 - c0), abs(d1 - d0))
     return max(t_base, t_joint / hand.joint_speed)
 
 

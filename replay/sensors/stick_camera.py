@@ -143,11 +143,12 @@ def _outline_points(camera: PinholeCamera, prim) -> np.ndarray:
     raise TypeError(f"cannot render {type(prim).__name__}")
 
 
-def _silhouette(camera: PinholeCamera, prim):
+def _silhouette(camera: PinholeCamera, prim, origin: tuple | None = None):
     """(distance of its centre from the camera, albedo, convex hull in pixels, name, pixel box
     (umin, vmin, umax, vmax)) of a primitive, or None if it reaches behind the camera (or has
     no area). The outline's projection and hull: :func:`~replay.sensors.silhouette.project_hull`
-    (the same float32 pixels as NumPy's projection and ``cv2.convexHull`` gave)."""
+    (the same float32 pixels as NumPy's projection and ``cv2.convexHull`` gave). ``origin``: the
+    camera's position as a tuple of floats, if already made."""
     if isinstance(prim, (Box, Cylinder)):
         body, q, pos = _body_points(prim), prim.orientation, prim.position
     else:
@@ -157,7 +158,7 @@ def _silhouette(camera: PinholeCamera, prim):
     found = project_hull(camera, body, q, pos)
     if found is None or len(found[0]) < 3:
         return None
-    distance = math.dist(prim.position, camera.position.tolist())
+    distance = math.dist(prim.position, camera.position.tolist() if origin is None else origin)
     return (distance, prim.albedo, found[0], prim.name, found[1])
 
 
@@ -392,19 +393,7 @@ class StickCamera(Sensor):
         ~5 mm at 1.25 mm/px), the brighter end winning (a dark fingertip may cover one end).
         Computed in one compiled pass (``_pixels.marker_moments``; the OpenCV pipeline it
         replaced is the reference in tests/replay/sensors/test_stick_camera.py)."""
-        img = np.ascontiguousarray(image, dtype=np.uint8)
-        h, w = img.shape
-        found = _pixels.marker_moments(
-            img,
-            w,
-            h,
-            float(params.threshold),
-            int(params.min_pixels),
-            int(origin[0]),
-            int(origin[1]),
-            int(params.width),
-            int(params.height),
-        )
+        found = StickCamera._moments(image, params, origin)
         if found is None:
             return None
         u, v, angle, pixels, background, *m = found
@@ -416,6 +405,24 @@ class StickCamera(Sensor):
             "background": background,
             "moments": dict(zip(("m00", "m10", "m01", "mu20", "mu11", "mu02"), m)),
         }
+
+    @staticmethod
+    def _moments(image: np.ndarray, params: StickCameraParams, origin: tuple[int, int]):
+        """:meth:`marker_moments` as the compiled kernel returns it: (u, v, angle, pixels,
+        background, m00, m10, m01, mu20, mu11, mu02) or None."""
+        img = np.ascontiguousarray(image, dtype=np.uint8)
+        h, w = img.shape
+        return _pixels.marker_moments(
+            img,
+            w,
+            h,
+            float(params.threshold),
+            int(params.min_pixels),
+            int(origin[0]),
+            int(origin[1]),
+            int(params.width),
+            int(params.height),
+        )
 
     # --- the sensor ---------------------------------------------------------------------------
     @property
@@ -450,7 +457,7 @@ class StickCamera(Sensor):
             marker = scene.get(p.marker)
         except KeyError:
             marker = None
-        seen = _silhouette(cam, marker) if marker is not None else None
+        seen = _silhouette(cam, marker, self._o) if marker is not None else None
         window = None if seen is None else hull_window(cam, seen[4])
         if window is None:  # no marker in view: the whole (rare) frame
             window = (0, 0, p.width, p.height)
@@ -461,7 +468,7 @@ class StickCamera(Sensor):
                 if prim is marker:
                     items.append(seen)
                 elif not _misses(cam, prim, window, self._R, self._o):
-                    it = _silhouette(cam, prim)
+                    it = _silhouette(cam, prim, self._o)
                     if it is not None:
                         items.append(it)
             _by_distance(items)
@@ -474,14 +481,14 @@ class StickCamera(Sensor):
         self._last = (img, window)
         if marker is None:
             return None
-        found = self.marker_moments(img, p, origin=window[:2])
+        found = self._moments(img, p, window[:2])  # (marker_moments without its dict)
         if found is None:
             return None
         # The marker's silhouette seen from above is its top face swept down to its bottom face;
         # its centroid lies on the ray through the box's centre (exactly so for a thin box), so
         # the centroid is back-projected onto the horizontal plane through the marker's centre.
         z = float(marker.position[2])
-        u, v, a = found["u"], found["v"], found["angle"]
+        u, v, a = found[0], found[1], found[2]
         step = 10.0  # px along the axis, for its angle
         p0 = self._to_height(u, v, z)
         p1 = self._to_height(u + step * math.cos(a), v + step * math.sin(a), z)

@@ -445,29 +445,34 @@ class StickCaptureController(Controller):
 
     def telemetry(self, t: float) -> dict:
         e = self.est.estimate()
-        msg = {
-            "t": float(t),
-            "phase": self.phase,
-            "step": self.step,
-            "ready": bool(self.est.ready()),
-        }
-        if e is not None:
-            x, y, th = e.at(t)
-            msg.update(
-                {
-                    "t_ref": e.t_ref,
-                    "x": x,
-                    "y": y,
-                    "theta": th,
-                    "vx": e.vx,
-                    "vy": e.vy,
-                    "omega": e.omega,
-                    "n": e.n,
-                    "rms_xy": e.rms_xy,
-                    "rms_theta": e.rms_theta,
+        if e is None:
+            return {
+                TOPIC_STICK_ESTIMATE: {
+                    "t": float(t),
+                    "phase": self.phase,
+                    "step": self.step,
+                    "ready": False,
                 }
-            )
-        return {TOPIC_STICK_ESTIMATE: msg}
+            }
+        dt = t - e.t_ref  # e.at(t)
+        return {
+            TOPIC_STICK_ESTIMATE: {
+                "t": float(t),
+                "phase": self.phase,
+                "step": self.step,
+                "ready": e.n >= self.est.min_samples,  # est.ready()
+                "t_ref": e.t_ref,
+                "x": e.x + e.vx * dt,
+                "y": e.y + e.vy * dt,
+                "theta": e.theta + e.omega * dt,
+                "vx": e.vx,
+                "vy": e.vy,
+                "omega": e.omega,
+                "n": e.n,
+                "rms_xy": e.rms_xy,
+                "rms_theta": e.rms_theta,
+            }
+        }
 
     # -- strategy hooks -------------------------------------------------------------------------
     def _options(self, est: StickEstimate, step: int) -> list[sc.ContactSolution]:
@@ -797,8 +802,8 @@ class StickCaptureController(Controller):
         dt = abs(t_c - old.t)
         if dt > p.replan_dt or abs(est.omega) * dt > p.replan_theta:
             return False
-        _, tip, _ = self.planner.spot(est, sol, t_c)
-        return math.hypot(tip[0] - old.tip[0], tip[1] - old.tip[1]) <= p.replan_tol
+        tx, ty = self.planner.tip_at(est, sol, t_c)
+        return math.hypot(tx - old.tip[0], ty - old.tip[1]) <= p.replan_tol
 
     # -- closing (eqs. 32, 33, 38) --------------------------------------------------------------
     def _plan_close(self, t: float, est: StickEstimate) -> None:

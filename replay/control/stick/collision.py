@@ -48,7 +48,13 @@ def _impulse_terms(
     """(g, h) with J_i = E_3 - (1 + e) g h^T (eq. 22), in closed form: h = H_i^T n_i and
     g = M^-1 H_i^T K_i^-1 n_i, M = diag(m, m, I) and K_i = H_i M^-1 H_i^T (eqs. 5, 9), K_i
     inverted as a 2 x 2 (the matrix form is the reference in tests/.../test_stick_fast_paths)."""
-    c, s = math.cos(theta), math.sin(theta)
+    return _terms(m, inertia, math.cos(theta), math.sin(theta), r_x, r_y, side)
+
+
+def _terms(
+    m: float, inertia: float, c: float, s: float, r_x: float, r_y: float, side: int
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """:func:`_impulse_terms` with c, s = cos(theta), sin(theta) already made."""
     ax, ay = c * r_x - s * r_y, s * r_x + c * r_y  # a = R_B(theta) ^B r
     nx, ny = (s, -c) if side > 0 else (-s, c)
     k11, k12, k22 = 1.0 / m + ay * ay / inertia, -ax * ay / inertia, 1.0 / m + ax * ax / inertia
@@ -186,15 +192,6 @@ class ContactSolution:
         return np.array([self.r_x, 0.5 * width * self.side])
 
 
-def _valid(sol: "ContactSolution", e: float, u) -> bool:
-    """Eq. 26 (C_i > 0, ``sol.condition``); for e = 0 C_i vanishes, so test the approach before
-    instead."""
-    if e > 0.0:
-        tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
-        return sol.condition > tol
-    return approach_speed(sol.theta, sol.r_x, sol.side, u) > 1e-12
-
-
 def contact_options(
     m: float,
     inertia: float,
@@ -218,15 +215,27 @@ def contact_options(
         raise ValueError("give exactly one of omega, speed")
     u = _u3(u_prev)
     out = []
+    c, s = math.cos(theta), math.sin(theta)
+    tol = 1e-12 * max(1.0, math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
     for side in sides:
         if omega is not None:
             roots = f_omega(m, inertia, e, theta, side, u, omega)
         else:
             roots = f_v(m, inertia, e, theta, side, u, speed)
+        roots = tuple(float(r) for r in roots)
         for r in roots:
-            sol = contact_at(m, inertia, e, theta, side, u, r, length=length, roots=roots)
-            if _valid(sol, e, u):
-                out.append(sol)
+            # contact_at, with eq. 26 checked before the solution is made: C_i > 0; for e = 0
+            # C_i vanishes, so the approach before is tested instead
+            g, h = _terms(m, inertia, c, s, r, 0.0, side)
+            after = _after(g, h, e, u)
+            condition = h[0] * after[0] + h[1] * after[1] + h[2] * after[2]
+            if e > 0.0:
+                if not condition > tol:
+                    continue
+            elif not approach_speed(theta, r, side, u) > 1e-12:
+                continue
+            sign = 1 if side > 0 else -1
+            out.append(ContactSolution(theta, sign, r, u, after, roots, condition, length))
     return out
 
 

@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
 REANCHOR = 1.0  # s, the running sums are rebuilt from the window once their anchor is this old
 
@@ -47,9 +46,9 @@ class StickEstimate:
     rms_theta: float  # rad, residual rms of the orientation fit
 
     @property
-    def u(self) -> np.ndarray:
-        """[vx, vy, omega], the paper's u_B."""
-        return np.array([self.vx, self.vy, self.omega])
+    def u(self) -> tuple[float, float, float]:
+        """(vx, vy, omega), the paper's u_B."""
+        return (self.vx, self.vy, self.omega)
 
     @property
     def speed(self) -> float:
@@ -172,15 +171,25 @@ class StickEstimator:
 
     def _sum(self, sample, sign: float) -> None:
         t0, x0, y0, th0 = self._anchor
-        t = sample[0] - t0
+        ts, xs, ys, ths = sample
+        t = ts - t0
         s = self._sums
         s[0] += sign
         s[1] += sign * t
         s[2] += sign * t * t
-        for i, v in ((3, sample[1] - x0), (6, sample[2] - y0), (9, sample[3] - th0)):
-            s[i] += sign * v
-            s[i + 1] += sign * t * v
-            s[i + 2] += sign * v * v
+        # x, y, theta: the value, t * value and value^2 sums (unrolled)
+        v = xs - x0
+        s[3] += sign * v
+        s[4] += sign * t * v
+        s[5] += sign * v * v
+        v = ys - y0
+        s[6] += sign * v
+        s[7] += sign * t * v
+        s[8] += sign * v * v
+        v = ths - th0
+        s[9] += sign * v
+        s[10] += sign * t * v
+        s[11] += sign * v * v
 
     def _refit(self) -> None:
         """Least squares of (x, y, theta) = value at t_ref + rate (t - t_ref), in closed form

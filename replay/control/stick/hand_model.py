@@ -9,7 +9,9 @@ gives no equations for them; the kinematics are ``replay.robot.hand2d``'s (``fin
 The controllers have no hand feedback. They track their own commands with the plant's motion
 model: every axis moves toward its target at its speed limit, from where the spec says the hand
 was homed. :class:`HandModel` follows it in time; :func:`route_configs` and :func:`route_tips`
-sample it along a planned route of waypoints [(t_start, Config)] (:func:`route_target`).
+sample it along a planned route of waypoints [(t_start, Config)] (:func:`route_target`): the
+NumPy reference of the route check the planner runs compiled (``_sweep.route_hit``, compared
+with them in tests/replay/control/stick/test_sweep_kernel.py).
 
 Pure NumPy.
 """
@@ -67,19 +69,22 @@ class HandModel:
         self._t: float | None = None
 
     def advance(self, t: float) -> None:
-        if self._t is not None and t > self._t and self.config != self.target:
+        now, target = self.config, self.target
+        if self._t is not None and t > self._t and now is not target and now != target:
             dt = t - self._t
-            step_b = self.hand.base_speed * dt
-            step_q = self.hand.joint_speed * dt
-            base = tuple(
-                a + min(step_b, max(-step_b, b - a))
-                for a, b in zip(self.config.base, self.target.base)
+            sb = self.hand.base_speed * dt
+            sq = self.hand.joint_speed * dt
+            (x, y), ((a, b), (c, d)) = now.base, now.joints
+            (tx, ty), ((ta, tb), (tc, td)) = target.base, target.joints
+            moved = Config(
+                (x + min(sb, max(-sb, tx - x)), y + min(sb, max(-sb, ty - y))),
+                (
+                    (a + min(sq, max(-sq, ta - a)), b + min(sq, max(-sq, tb - b))),
+                    (c + min(sq, max(-sq, tc - c)), d + min(sq, max(-sq, td - d))),
+                ),
             )
-            joints = tuple(
-                tuple(a + min(step_q, max(-step_q, b - a)) for a, b in zip(qa, qb))
-                for qa, qb in zip(self.config.joints, self.target.joints)
-            )
-            self.config = Config(base, joints)
+            # on the target: the target itself (equal numbers), so later ticks see it at once
+            self.config = target if moved == target else moved
         self._t = t
 
 

@@ -23,12 +23,13 @@ The result is a :class:`ContactPlan` (the approach phase's plan; its ``intent`` 
 event's data). :class:`Shortfall` keeps the best time needed vs available of failed attempts
 (the ``unreachable`` report).
 
-Pure NumPy.
+Pure NumPy; the sampled sweep checks are compiled (``_sweep.c``, see ``sweep``).
 """
 
 from __future__ import annotations
 
 import math
+from array import array
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,28 +39,19 @@ from replay.robot.hand2d import HandSpec
 from replay.spatial import wrap_half_pi
 from replay.control.stick import collision as sc
 from replay.control.stick.estimator import StickEstimate
+from replay.control.stick import _sweep
 from replay.control.stick.hand_model import (
     Config,
     HandModel,
     base_candidates,
     posture_grid,
-    route_configs,
     route_target,
-    route_tips,
     travel,
 )
-from replay.control.stick.sweep import Motion, Sweep, covered, covered_along, sample_times
+from replay.control.stick.sweep import Motion, Sweep, first_covered, sample_count
 
 CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
 GO_DELAY = 0.003  # s, a staged tip moves in this long after the stick's last pass
-
-
-def _body_point(motion: Motion, t: float, point) -> tuple[float, float]:
-    """``point`` (world) in the stick frame at time ``t``."""
-    c, th = motion.pose(t)
-    d = np.asarray(point, dtype=float) - c
-    cs, sn = math.cos(th), math.sin(th)
-    return float(d[0] * cs + d[1] * sn), float(-d[0] * sn + d[1] * cs)
 
 
 # ------------------------------------------------------------------------------------------
@@ -151,6 +143,9 @@ class ContactPlanner:
             l2 * np.cos(q[:, 0] + q[:, 1]),
             l2 * np.sin(q[:, 0] + q[:, 1]),
         )
+        (r0x, r0y), (r1x, r1y) = hand.root_offsets
+        self._geometry = tuple(map(float, (l1, l2, r0x, r0y, r1x, r1y)))
+        self._speeds = (float(hand.base_speed), float(hand.joint_speed))
 
     def crossings(
         self, t: float, est: StickEstimate, theta_star: float, keep_past: bool = False
@@ -186,6 +181,18 @@ class ContactPlanner:
         n = np.array([s, -c]) if sol.side > 0 else np.array([-s, c])  # eq. 4
         return contact, contact - self.hand.tip_radius * n, n
 
+    def tip_at(
+        self, est: StickEstimate, sol: sc.ContactSolution, t_c: float
+    ) -> tuple[float, float]:
+        """:meth:`spot`'s fingertip centre alone, as floats (the same operations)."""
+        x, y, _ = est.at(t_c)
+        c, s = math.cos(sol.theta), math.sin(sol.theta)
+        r_x, r_y = sol.r_x, 0.5 * self.stick.width * sol.side
+        px, py = x + c * r_x - s * r_y, y + s * r_x + c * r_y
+        nx, ny = (s, -c) if sol.side > 0 else (-s, c)  # eq. 4
+        r = self.hand.tip_radius
+        return px - r * nx, py - r * ny
+
     def reach(
         self,
         index: int,
@@ -206,7 +213,7 @@ class ContactPlanner:
         contact, tip, n = self.spot(est, sol, t_c)
         motion = Motion(est, t_c, sol.u_after)
         now = self.model.config
-        sweep_all = Sweep(motion, sample_times(t, t_c + p.post_horizon))
+        sweep_all = Sweep(motion, t, t_c + p.post_horizon)
         # Every base is tried and the quickest arrival wins (ties: the earlier finger, then the
         # earlier base). A route arrives no sooner than t + the travel time to the contact
         # posture with the idle finger unmoved (``need``: travel times obey the triangle
@@ -279,15 +286,16 @@ class ContactPlanner:
         first pulling any fingertip out of the stick's reach."""
         p, st, hand = self.params, self.stick, self.hand
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
-        times = sample_times(t, t_c - CONTACT_GUARD)
-        hit = covered(motion, times, [tip], half_l, half_w, hand.tip_radius - 5e-4)[:, 0]
+        t_hit = first_covered(
+            motion, t, t_c - CONTACT_GUARD, tip, half_l, half_w, hand.tip_radius - 5e-4, last=True
+        )
         heads: list[list] = [[]]
         exit_cfg = self._exit_config(t, now, motion)
         if exit_cfg is not None:
             heads.append([(t, exit_cfg)])
         tails: list[list] = [[]]
-        if hit.any():
-            t_go = float(times[hit][-1]) + GO_DELAY
+        if t_hit is not None:
+            t_go = t_hit + GO_DELAY
             u = np.asarray(tip) - c_c
             if np.linalg.norm(u) > 1e-9:
                 stage = c_c + u / np.linalg.norm(u) * (half_l + hand.tip_radius + p.stage_margin)
@@ -322,53 +330,45 @@ class ContactPlanner:
         way (both tips) and, once arrived, finger k's tip until just before t_c and the idle
         tip (``sweep_margin`` clear) until t_c + post_horizon. Else None."""
         p, st, hand = self.params, self.stick, self.hand
-        starts, frm, to = [], [], []
-        prev = now
+        rows = array("d")
+        prev = last = now
         for i, (t_start, cfg) in enumerate(route):
             if i + 1 < len(route):
                 if t_start + travel(hand, prev, cfg) > route[i + 1][0] + 1e-9:
                     return None
-            starts.append(t_start)
-            frm.append(prev)
-            to.append(cfg)
-            prev = cfg
-        arrival = starts[-1] + travel(hand, frm[-1], to[-1])
+            rows.append(t_start)
+            for c in (prev, cfg):  # the axes route_configs moves: base x, y, then the joints
+                rows.extend(c.base)
+                rows.extend(c.joints[0])
+                rows.extend(c.joints[1])
+            last, prev = prev, cfg
+        arrival = route[-1][0] + travel(hand, last, prev)
         if arrival > t_c - p.arrive_margin:
             return None
-        times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
-        base, joints = route_configs(hand, starts, frm, to, times)
-        # once every axis is on its target the configuration no longer changes: the tips of
-        # that (bit-identical) tail are those of its first sample
-        flat = np.concatenate([base, joints.reshape(len(times), 4)], axis=1)
-        changing = np.flatnonzero(np.any(flat != flat[-1], axis=1))
-        i0 = int(changing[-1]) + 1 if changing.size else 0
-        tips = np.empty((len(times), 2, 2))
-        tips[: i0 + 1] = route_tips(hand, base[: i0 + 1], joints[: i0 + 1])
-        tips[i0 + 1 :] = tips[i0]
-        half_l, half_w = 0.5 * st.length, 0.5 * st.width
-        moving = times < arrival
-        act = times <= t_c - CONTACT_GUARD
-        c, th = poses = motion.poses(times)
-        if covered_along(
-            motion,
-            times[act],
-            tips[act, k],
-            half_l,
-            half_w,
+        # sampled every SAMPLE_DT from t: the hand along the route (route_configs, route_tips);
+        # finger k's tip must stay out of the sweep (sweep.covered_along) until CONTACT_GUARD
+        # before t_c; the idle tip, with check_idle, until t_c + post_horizon, keeping
+        # sweep_margin, or on the way at least the clearance it has now (it may start at the
+        # stick it just hit: a route grazing the stick at speed is a hit)
+        t1 = t_c + (p.post_horizon if check_idle else 0.0)
+        hit = _sweep.route_hit(
+            motion.packed,
+            float(t),
+            float(t1),
+            sample_count(t, t1),
+            rows,
+            self._speeds,
+            self._geometry,
+            k,
+            t_c - CONTACT_GUARD,
+            0.5 * st.length,
+            0.5 * st.width,
             hand.tip_radius - 5e-4,
-            poses=(c[act], th[act]),
-        ).any():
-            return None
-        if check_idle:
-            # on the way the idle tip keeps sweep_margin, or at least the clearance it has now
-            # (it may start at the stick it just hit): a route grazing the stick at speed is a hit
-            xb, yb = _body_point(motion, t, tips[0, 1 - k])
-            gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
-            on_way = max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
-            grow = np.where(moving, on_way, hand.tip_radius + p.sweep_margin)
-            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow, poses).any():
-                return None
-        return arrival
+            check_idle,
+            arrival,
+            hand.tip_radius + p.sweep_margin,
+        )
+        return None if hit else arrival
 
     def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip, n) -> Config | None:
         """Finger k's tip backed away along -n (the way it came, away from the face the contact
@@ -380,10 +380,12 @@ class ContactPlanner:
         p, st, hand = self.params, self.stick, self.hand
         w = abs(motion.u_after[2])
         span = max(p.post_horizon, min(p.horizon, math.pi / w + 0.02 if w > 1e-6 else 0.0))
-        times = sample_times(t_c + 2.0 * GO_DELAY, t_c + span)  # up to half a turn
-        if not covered(
-            motion, times, [tip], 0.5 * st.length, 0.5 * st.width, hand.tip_radius
-        ).any():
+        # up to half a turn
+        t0, t1 = t_c + 2.0 * GO_DELAY, t_c + span
+        if (
+            first_covered(motion, t0, t1, tip, 0.5 * st.length, 0.5 * st.width, hand.tip_radius)
+            is None
+        ):
             return None
         c, _ = motion.pose(t_c)
         d = np.asarray(tip) - c

@@ -6,16 +6,20 @@ velocities the contact solution predicts, u_i = J_i u_{i-1} (eq. 22). A point is
 stick when it lies within a margin of the spec's L x W rectangle (W may be 0, the paper's
 Assumption 5). The planners sample the sweep every ``SAMPLE_DT``.
 
-Pure NumPy.
+Pure NumPy, with the sampled checks compiled (``_sweep.c``: the same operations, element by
+element; :func:`covered` and :func:`covered_along` are their NumPy references, which
+tests/replay/control/stick/test_sweep_kernel.py compares with them).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from replay.control.stick import _sweep
 from replay.control.stick.estimator import StickEstimate
 
 SAMPLE_DT = 0.001  # s, time step of the predicted-sweep checks
@@ -43,6 +47,24 @@ class Motion:
             c[..., 1] += self.u_after[1] * t2
             th = th + self.u_after[2] * t2
         return c, th
+
+    @functools.cached_property
+    def packed(self) -> tuple:
+        """(x, y, theta, vx, vy, omega, t_ref, t_switch, u0, u1, u2): the compiled checks' motion."""
+        e, u = self.est, self.u_after
+        return (
+            float(e.x),
+            float(e.y),
+            float(e.theta),
+            float(e.vx),
+            float(e.vy),
+            float(e.omega),
+            float(e.t_ref),
+            float(self.t_switch),
+            float(u[0]),
+            float(u[1]),
+            float(u[2]),
+        )
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
         e, ts = self.est, self.t_switch
@@ -86,53 +108,53 @@ def covered_along(
     return (np.abs(xb) <= half_length + grow) & (np.abs(yb) <= half_width + grow)
 
 
+def sample_count(t0: float, t1: float) -> int:
+    """How many :func:`sample_times` from t0 to t1."""
+    return 1 if t1 <= t0 else max(2, int(math.ceil((t1 - t0) / SAMPLE_DT)) + 1)
+
+
 def sample_times(t0: float, t1: float) -> np.ndarray:
     """Times from t0 to t1 at most ``SAMPLE_DT`` apart (just t0 when t1 <= t0)."""
     if t1 <= t0:
         return np.array([t0])
-    return np.linspace(t0, t1, max(2, int(math.ceil((t1 - t0) / SAMPLE_DT)) + 1))
+    return np.linspace(t0, t1, sample_count(t0, t1))
+
+
+def first_covered(
+    motion: Motion,
+    t0: float,
+    t1: float,
+    point,
+    half_length: float,
+    half_width: float,
+    grow: float,
+    last: bool = False,
+) -> float | None:
+    """The first (``last``: the last) of :func:`sample_times` (t0, t1) at which the fixed
+    ``point`` is within ``grow`` of the stick rectangle (:func:`covered`), or None."""
+    found = _sweep.covered_index(
+        motion.packed,
+        float(t0),
+        float(t1),
+        sample_count(t0, t1),
+        float(point[0]),
+        float(point[1]),
+        half_length,
+        half_width,
+        grow,
+        last,
+    )
+    return None if found is None else found[1]
 
 
 class Sweep:
-    """The stick's poses at fixed sample times, for many "is this fixed point ever covered"
-    questions (the same answer as :func:`covered`, asked one point at a time).
+    """The stick's sweep over :func:`sample_times` (t0, t1), for many "is this fixed point ever
+    covered" questions (the same answer as :func:`covered`, asked one point at a time)."""
 
-    A point farther from the centre's whole path (two straight segments: before and after the
-    switch) than the rectangle's corner reach cannot be covered at any sample, so it is answered
-    without sampling; the others are tested at every sample time."""
-
-    def __init__(self, motion: Motion, times) -> None:
-        self.motion = motion
-        self.times = np.asarray(times, dtype=float)
-        self._poses: tuple | None = None
-        e, t0, t1 = motion.est, float(self.times[0]), float(self.times[-1])
-        ts = min(max(motion.t_switch, t0), t1)
-        a = np.array([e.x + e.vx * (t0 - e.t_ref), e.y + e.vy * (t0 - e.t_ref)])
-        b = np.array([e.x + e.vx * (ts - e.t_ref), e.y + e.vy * (ts - e.t_ref)])
-        c = b + np.array(motion.u_after[:2]) * (t1 - ts) if t1 > motion.t_switch else b
-        self._segments = ((a, b), (b, c))
-
-    def _near_path(self, point, reach: float) -> bool:
-        p = np.asarray(point, dtype=float)
-        for a, b in self._segments:
-            ab = b - a
-            ll = float(ab @ ab)
-            s = 0.0 if ll == 0.0 else min(1.0, max(0.0, float((p - a) @ ab) / ll))
-            d = p - (a + s * ab)
-            if float(d @ d) <= reach * reach:
-                return True
-        return False
+    def __init__(self, motion: Motion, t0: float, t1: float) -> None:
+        self.motion, self.t0, self.t1 = motion, t0, t1
 
     def hits(self, point, half_length: float, half_width: float, grow: float) -> bool:
         """``point`` within ``grow`` of the stick rectangle at some sample time."""
-        hl, hw = half_length + grow, half_width + grow
-        if not self._near_path(point, math.hypot(hl, hw) * (1.0 + 1e-9) + 1e-12):
-            return False
-        if self._poses is None:
-            c, th = self.motion.poses(self.times)
-            self._poses = (c, np.cos(th), np.sin(th))
-        c, cs, sn = self._poses
-        d0, d1 = point[0] - c[:, 0], point[1] - c[:, 1]
-        xb = d0 * cs + d1 * sn
-        yb = -d0 * sn + d1 * cs
-        return bool(((np.abs(xb) <= hl) & (np.abs(yb) <= hw)).any())
+        m = self.motion
+        return first_covered(m, self.t0, self.t1, point, half_length, half_width, grow) is not None

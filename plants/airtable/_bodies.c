@@ -1,0 +1,148 @@
+/* The air table's once-a-step body input/output, compiled (plants/airtable/body_state.py
+ * documents it and keeps the Python version, the reference of
+ * tests/plants/airtable/test_bodies_kernel.py). Plain C over the buffer protocol, no NumPy or
+ * Chipmunk headers: Chipmunk's own functions are called through the addresses Pymunk's cffi
+ * binding gives (body_state.py passes them), so the numbers are Chipmunk's, read and written
+ * exactly as the Python path does.
+ *
+ * ptrs: uint64 buffer of 10 addresses: cpBodyGetPosition, cpBodyGetVelocity, cpBodyGetAngle,
+ * cpBodyGetAngularVelocity, cpBodySetVelocity, then the bodies: the stick, tip 0, tip 1 (and
+ * two unused slots). state: float64 buffer of 10: x, y, vx, vy, angle, omega of the stick, then
+ * the tips' x, y.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+
+typedef struct {
+    double x, y;
+} vect_t; /* cpVect (cpFloat = double) */
+
+typedef vect_t (*get_vect_fn)(const void *);
+typedef double (*get_float_fn)(const void *);
+typedef void (*set_vect_fn)(void *, vect_t);
+
+typedef struct {
+    get_vect_fn position, velocity;
+    get_float_fn angle, omega;
+    set_vect_fn set_velocity;
+    void *stick, *tip[2];
+} table_t;
+
+static int unpack(Py_buffer *P, table_t *t) {
+    if (P->len != 10 * (Py_ssize_t)sizeof(uint64_t)) {
+        PyErr_SetString(PyExc_ValueError, "ptrs: 10 uint64 addresses");
+        return 0;
+    }
+    const uint64_t *a = P->buf;
+    t->position = (get_vect_fn)(uintptr_t)a[0];
+    t->velocity = (get_vect_fn)(uintptr_t)a[1];
+    t->angle = (get_float_fn)(uintptr_t)a[2];
+    t->omega = (get_float_fn)(uintptr_t)a[3];
+    t->set_velocity = (set_vect_fn)(uintptr_t)a[4];
+    t->stick = (void *)(uintptr_t)a[5];
+    t->tip[0] = (void *)(uintptr_t)a[6];
+    t->tip[1] = (void *)(uintptr_t)a[7];
+    for (int i = 0; i < 8; i++)
+        if (!a[i]) {
+            PyErr_SetString(PyExc_ValueError, "ptrs: a null address");
+            return 0;
+        }
+    return 1;
+}
+
+static void read_state(const table_t *t, double *s) {
+    vect_t p = t->position(t->stick), v = t->velocity(t->stick);
+    s[0] = p.x;
+    s[1] = p.y;
+    s[2] = v.x;
+    s[3] = v.y;
+    s[4] = t->angle(t->stick);
+    s[5] = t->omega(t->stick);
+    for (int k = 0; k < 2; k++) {
+        vect_t q = t->position(t->tip[k]);
+        s[6 + 2 * k] = q.x;
+        s[7 + 2 * k] = q.y;
+    }
+}
+
+static int state_ok(Py_buffer *S) {
+    if (S->len != 10 * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "state: 10 float64");
+        return 0;
+    }
+    return 1;
+}
+
+/* read(ptrs, state): the stick's and the tips' state now, into state. */
+static PyObject *py_read(PyObject *self, PyObject *args) {
+    Py_buffer P, S;
+    if (!PyArg_ParseTuple(args, "y*w*", &P, &S)) return NULL;
+    PyObject *ret = NULL;
+    table_t t;
+    if (unpack(&P, &t) && state_ok(&S)) {
+        read_state(&t, S.buf);
+        Py_INCREF(Py_None);
+        ret = Py_None;
+    }
+    PyBuffer_Release(&P);
+    PyBuffer_Release(&S);
+    return ret;
+}
+
+/* step(ptrs, state, tx0, ty0, tx1, ty1, dt, space_step, rest_speed, rest_omega, hold_speed,
+ *      hold_omega): each tip's velocity set to ((tx - x) / dt, (ty - y) / dt) from its position in
+ * state (so that the step's position integration lands it on the target), space_step(dt) called
+ * (the engine, and the collision callbacks it runs), and the state read again into state.
+ * Returns True when the state after the step is certainly the plant's usual case: every number
+ * finite (their sum, in the plant's order) and the stick too fast or spinning too fast both to
+ * rest (speed >= rest_speed or |omega| >= rest_omega) and to be held (the same with hold_*).
+ * The speed is compared squared with a margin of 1e-9 (the plant compares math.hypot), so True
+ * is never wrong; False leaves the decision to the plant's own checks. */
+static PyObject *py_step(PyObject *self, PyObject *args) {
+    Py_buffer P, S;
+    double tx[2], ty[2], rest_v, rest_w, hold_v, hold_w;
+    PyObject *dt_obj, *space_step;
+    if (!PyArg_ParseTuple(args, "y*w*ddddOOdddd", &P, &S, &tx[0], &ty[0], &tx[1], &ty[1],
+                          &dt_obj, &space_step, &rest_v, &rest_w, &hold_v, &hold_w))
+        return NULL;
+    PyObject *ret = NULL;
+    table_t t;
+    double dt = PyFloat_AsDouble(dt_obj);
+    if (dt == -1.0 && PyErr_Occurred()) goto done;
+    if (!unpack(&P, &t) || !state_ok(&S)) goto done;
+    double *s = S.buf;
+    for (int k = 0; k < 2; k++) {
+        vect_t v = {(tx[k] - s[6 + 2 * k]) / dt, (ty[k] - s[7 + 2 * k]) / dt};
+        t.set_velocity(t.tip[k], v);
+    }
+    PyObject *r = PyObject_CallOneArg(space_step, dt_obj);
+    if (!r) goto done;
+    Py_DECREF(r);
+    read_state(&t, s);
+    int usual = 0;
+    double sum = s[0] + s[1] + s[4] + s[2] + s[3] + s[5] + s[6] + s[7] + s[8] + s[9];
+    if (isfinite(sum)) {
+        double sq = s[2] * s[2] + s[3] * s[3], w = fabs(s[5]);
+        double rv = rest_v * (1.0 + 1e-9), hv = hold_v * (1.0 + 1e-9);
+        usual = (sq > rv * rv || w >= rest_w) && (sq > hv * hv || w >= hold_w);
+    }
+    ret = PyBool_FromLong(usual);
+done:
+    PyBuffer_Release(&P);
+    PyBuffer_Release(&S);
+    return ret;
+}
+
+static PyMethodDef methods[] = {
+    {"read", py_read, METH_VARARGS, "the stick's and the tips' state"},
+    {"step", py_step, METH_VARARGS, "tip velocities, one engine step, the state after it"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_bodies",
+                                    "The air table's once-a-step body input/output.", -1,
+                                    methods};
+
+PyMODINIT_FUNC PyInit__bodies(void) { return PyModule_Create(&module); }

@@ -1,0 +1,125 @@
+"""The air table's compiled body input/output (plants/airtable/_bodies.c, body_state.TableIO)
+against its Python reference, the Chipmunk readers and setter of body_state: on seeded random
+bodies and tip targets the same state after every engine step (exactly: the same Chipmunk
+calls on the same numbers), and LeanSpace's step is Pymunk's (the same trajectory, contacts
+included)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pymunk
+import pytest
+
+from plants.airtable import body_state
+from plants.airtable.lean_space import LeanSpace
+
+
+def table(space_cls, rng):
+    """A stick (dynamic, spinning) and two kinematic tips near it in a fresh space."""
+    space = space_cls()
+    space.gravity = (0.0, 0.0)
+    stick = pymunk.Body(0.0225, 3.2e-5)
+    stick.position = tuple(rng.uniform(-0.05, 0.05, 2))
+    stick.velocity = tuple(rng.normal(size=2) * 0.5)
+    stick.angle, stick.angular_velocity = rng.uniform(-3, 3), rng.normal() * 10.0
+    seg = pymunk.Segment(stick, (-0.05, 0.0), (0.05, 0.0), 0.0)
+    seg.elasticity, seg.friction = 0.19, 0.3
+    space.add(stick, seg)
+    tips = []
+    for _ in range(2):
+        tb = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        tb.position = tuple(rng.uniform(-0.06, 0.06, 2))
+        c = pymunk.Circle(tb, 0.005)
+        c.filter = pymunk.ShapeFilter(group=1)
+        space.add(tb, c)
+        tips.append(tb)
+    return space, stick, tips
+
+
+def python_state(stick, tips):
+    """The reference: body_state's Chipmunk readers."""
+    return body_state.pose_reader(stick)() + sum(
+        (body_state.position_reader(tb)() for tb in tips), ()
+    )
+
+
+def test_table_io_steps_as_the_python_readers_and_setter():
+    dt = 1.0 / 3000.0
+    hit = 0
+    for seed in range(6):
+        rng = np.random.default_rng(40 + seed)
+        space_a, stick_a, tips_a = table(pymunk.Space, np.random.default_rng(seed))
+        space_b, stick_b, tips_b = table(LeanSpace, np.random.default_rng(seed))
+        io = body_state.TableIO(stick_b, tips_b)
+        assert tuple(io.state) == python_state(stick_a, tips_a)
+        v0 = tuple(stick_a.velocity)
+        for _ in range(600):
+            targets = [tuple(t.position + rng.normal(size=2) * 1e-4) for t in tips_a]
+            pos = [body_state.position_reader(tb)() for tb in tips_a]
+            for tb, (tx, ty), (x, y) in zip(tips_a, targets, pos):
+                body_state.velocity_setter(tb)((tx - x) / dt, (ty - y) / dt)
+            space_a.step(dt)
+            io.step(targets, dt, space_b.step, (0.01, 0.1, 0.02, 0.5))
+            assert tuple(io.state) == python_state(stick_a, tips_a)
+            assert tuple(io.state) == python_state(stick_b, tips_b)
+        hit += tuple(stick_a.velocity) != v0  # only a contact changes it (no gravity)
+    assert hit >= 2  # contacts were compared too
+
+
+def test_table_io_cannot_be_copied():
+    """Its addresses are the bodies'; a copy would read the originals."""
+    import copy
+
+    _, stick, tips = table(pymunk.Space, np.random.default_rng(0))
+    with pytest.raises(TypeError, match="cannot be copied"):
+        copy.deepcopy(body_state.TableIO(stick, tips))
+
+
+def test_lean_space_refuses_changes_made_during_a_step():
+    space = LeanSpace()
+    a = pymunk.Body(1.0, 1.0)
+    sa = pymunk.Circle(a, 0.1)
+    b = pymunk.Body(1.0, 1.0)
+    b.position = (0.15, 0.0)
+    sb = pymunk.Circle(b, 0.1)
+    space.add(a, sa, b, sb)
+    space.step(0.01)  # a plain step: fine
+    b.position = (0.5, 0.0)
+    space.step(0.01)  # apart again
+    space.on_collision(begin=lambda arb, sp, data: sp.add_post_step_callback(print, "x"))
+    b.position = (0.15, 0.0)
+    with pytest.raises(RuntimeError, match="during a step"):
+        space.step(0.01)
+
+
+def test_the_usual_case_flag_is_never_wrong():
+    """TableIO.step's True (finite, too fast to rest or be held) agrees with the plant's own
+    checks (math.hypot) wherever it is given, on speeds and spins about the thresholds."""
+    import math
+
+    rng = np.random.default_rng(41)
+    limits = (0.01, 0.1, 0.02, 0.5)  # rest_speed, rest_omega, hold_speed, hold_omega
+    space, stick, tips = table(pymunk.Space, rng)
+    for tb in tips:
+        tb.position = (5.0, 5.0)  # far away: no contact, the velocity stays as set
+    io = body_state.TableIO(stick, tips)
+    flagged = usual = 0
+    for _ in range(3000):
+        v = rng.choice(limits[::2]) * (1.0 + rng.choice([0.0, 1e-16, -1e-16, rng.normal() * 0.5]))
+        a = rng.uniform(0.0, 2.0 * math.pi)
+        stick.velocity = (v * math.cos(a), v * math.sin(a))
+        stick.angular_velocity = rng.choice(limits[1::2]) * rng.choice([0.5, 1.0, 2.0, -2.0])
+        io.read()
+        flag = io.step([(5.0, 5.0), (5.0, 5.0)], 1.0 / 3000.0, space.step, limits)
+        x, y, vx, vy, th, w, *tp = io.state
+        speed, spin = math.hypot(vx, vy), abs(w)
+        finite = math.isfinite(x + y + th + vx + vy + w + sum(tp))
+        ok = (
+            finite
+            and not (speed < limits[0] and spin < limits[1])
+            and (speed >= limits[2] or spin >= limits[3])
+        )
+        assert not flag or ok
+        flagged += flag
+        usual += ok
+    assert 0.3 * usual < flagged <= usual  # mostly decided by the kernel
