@@ -1,10 +1,13 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
-the buffer protocol, no NumPy headers), as are the stick planners' sweep checks
-(replay/control/stick/_sweep.c), the air table's once-a-step body input/output
-(plants/airtable/_bodies.c), the camera PNG encoder (replay/foxglove/_png.c) and the log's chunk
-buffer and finiteness check (replay/log/_chunk.c, _finite.c)."""
+the buffer protocol, no NumPy headers), as are the stereo camera's frame and a sphere's silhouette
+(replay/sensors/_stereo.c, _silhouette.c), the catching mapping
+(replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
+(replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
+air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
+(replay/foxglove/_png.c) and the log's chunk buffer and finiteness check (replay/log/_chunk.c,
+_finite.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -21,6 +24,28 @@ setup(
         Extension(
             "replay.sensors._pixels",
             ["replay/sensors/_pixels.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.sensors._stereo",
+            ["replay/sensors/_stereo.c"],
+            # included: _pixels.c's kernels, unchanged, and _silhouette.c's sphere outline
+            depends=["replay/sensors/_pixels.c", "replay/sensors/_silhouette.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.sensors._silhouette",
+            ["replay/sensors/_silhouette.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.catching._mapping",
+            ["replay/control/catching/_mapping.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.robot._chain",
+            ["replay/robot/_chain.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
         Extension(

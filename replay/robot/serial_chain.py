@@ -1,4 +1,5 @@
-"""A serial chain of revolute joints in standard (Spong) Denavit–Hartenberg form. Pure NumPy.
+"""A serial chain of revolute joints in standard (Spong) Denavit–Hartenberg form. NumPy, with one
+configuration's point and RNEA compiled (``_chain.c``; the Python float forms are the reference).
 
 Conventions (Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control*, Sec. 3.2):
 
@@ -20,6 +21,8 @@ from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
+
+from replay.robot import _chain
 
 
 def dh_transform(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
@@ -128,7 +131,12 @@ class SerialChain:
             tuple(B[:3, 2].tolist()),
             tuple(B[:3, 3].tolist()),
         )
-        self._memo: dict = {}  # q (tuple) -> _frames_f(q), the last few configurations
+        # the same rows and base as flat float64 buffers for the compiled path (_chain.c)
+        self._rows_c = np.array(
+            [[*r[:6], *r[6], *(x for row in r[7] for x in row)] for r in self._rows_f], float
+        ).ravel()
+        self._base_c = np.array([x for axis in self._base_f for x in axis], float)
+        self._g_f = tuple(float(x) for x in self.gravity)
 
     # ------------------------------------------------------------------ variants
     def with_payload(self, body: RigidBody) -> SerialChain:
@@ -162,13 +170,9 @@ class SerialChain:
         """Frames 0..n as (X, Y, Z, o): the world axes and origin of each, 3-tuples of floats.
 
         The same products as :meth:`frames` (T_i = T_{i-1} Rz(q_i + offset) Tz(d) Tx(a) Rx(alpha),
-        Spong Sec. 3.2) written per column, for one configuration: ~10x less time than 4x4
-        NumPy products. The last few configurations are remembered (a controller asks for the
-        kinematics and the dynamics at the same q in one step)."""
+        Spong Sec. 3.2) written per column, for one configuration: the reference of the
+        compiled frames in ``_chain.c`` (:meth:`point`, :meth:`rnea`)."""
         key = tuple(q)
-        hit = self._memo.get(key)
-        if hit is not None:
-            return hit
         (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._base_f
         out = [self._base_f]
         cos, sin = math.cos, math.sin
@@ -188,14 +192,20 @@ class SerialChain:
             )
             xx, xy, xz = x1x, x1y, x1z
             out.append(((xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz)))
-        if len(self._memo) >= 4:
-            self._memo.pop(next(iter(self._memo)))
-        self._memo[key] = out
         return out
 
     def point(self, q, point_in_last=(0.0, 0.0, 0.0)) -> np.ndarray:
         """World position of a point given in the last DH frame (for a tool point: ``tool`` @
-        the point), one configuration, from :meth:`_frames_f`."""
+        the point), one configuration: compiled (``_chain.point``), :meth:`point_floats`'s
+        operations in the same order."""
+        return np.array(self.point_tuple(q, point_in_last))
+
+    def point_tuple(self, q, point_in_last=(0.0, 0.0, 0.0)) -> tuple[float, float, float]:
+        """:meth:`point` as a 3-tuple of floats (q: n floats, a list, tuple or array)."""
+        return _chain.point(self._rows_c, self._base_c, q, point_in_last)
+
+    def point_floats(self, q, point_in_last=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """:meth:`point` in Python floats on :meth:`_frames_f` (the compiled one's reference)."""
         (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._frames_f(
             self._q(q).tolist()
         )[-1]
@@ -252,6 +262,16 @@ class SerialChain:
 
     # ------------------------------------------------------------------ dynamics
     def rnea(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> np.ndarray:
+        """Inverse dynamics tau = M qdd + H qd + g (n,): :meth:`rnea_floats` compiled
+        (``_chain.rnea``, the same operations in the same order)."""
+        return np.array(self.rnea_tuple(q, qd, qdd, gravity))
+
+    def rnea_tuple(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> tuple:
+        """:meth:`rnea` as a tuple of n floats (q, qd, qdd: n floats each, lists or arrays)."""
+        g = self._g_f if gravity is None else tuple(float(x) for x in gravity)
+        return _chain.rnea(self._rows_c, self._base_c, q, qd, qdd, g)
+
+    def rnea_floats(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> np.ndarray:
         """Inverse dynamics tau = M qdd + H qd + g: recursive Newton–Euler in world coordinates.
 
         Forward pass: angular velocity/acceleration of link i and linear acceleration of o_{i-1}

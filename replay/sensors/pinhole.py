@@ -91,7 +91,8 @@ class PinholeCamera:
     """
 
     def __init__(self, intrinsics: Intrinsics, rotation=None, position=(0.0, 0.0, 0.0)) -> None:
-        R = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
+        # C-contiguous: the compiled silhouettes read them as buffers
+        R = np.eye(3) if rotation is None else np.ascontiguousarray(rotation, dtype=float)
         if (
             R.shape != (3, 3)
             or not np.allclose(R.T @ R, np.eye(3), atol=1e-9)
@@ -100,7 +101,7 @@ class PinholeCamera:
             raise ValueError("rotation must be a proper 3x3 rotation matrix (camera-to-world)")
         self.intrinsics = intrinsics
         self.rotation = R
-        self.position = np.asarray(position, dtype=float).reshape(3)
+        self.position = np.ascontiguousarray(position, dtype=float).reshape(3)
 
     # --- construction --------------------------------------------------------------------
     @classmethod

@@ -33,7 +33,7 @@ import numpy as np
 
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.sensors.pinhole import PinholeCamera
-from replay.sensors import _pixels
+from replay.sensors import _pixels, _silhouette
 from replay.sensors.raster import composite
 
 ELLIPSE_VERTICES = 48  # vertices of the polygon standing in for an ellipse
@@ -212,11 +212,43 @@ def silhouette(
 # --- raster --------------------------------------------------------------------------------
 
 
+def sphere_polygon(camera: PinholeCamera, centre, radius: float):
+    """(polygon (N, 2), box) of a sphere's silhouette, or None if it reaches behind the camera:
+    :func:`sphere_ellipse` and :meth:`Ellipse.polygon_and_box` in one compiled call
+    (``_silhouette.sphere_polygon``, the same operations; test_fast_cameras.py)."""
+    k = camera.intrinsics
+    poly = np.empty((ELLIPSE_VERTICES, 2))
+    box = _silhouette.sphere_polygon(
+        camera.rotation,
+        camera.position,
+        k.fx,
+        k.fy,
+        k.cx,
+        k.cy,
+        float(centre[0]),
+        float(centre[1]),
+        float(centre[2]),
+        float(radius),
+        _COS,
+        _SIN,
+        _AREA_SCALE,
+        poly,
+    )
+    return None if box is None else (poly, box)
+
+
 def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float, tuple]]:
     """(convex polygon in pixels, grey level, its box (umin, vmin, umax, vmax)) of each
-    primitive drawn by ``camera``, far first."""
+    primitive drawn by ``camera``, far first (spheres by :func:`sphere_polygon`)."""
     items = []
+    eye = None
     for i, prim in enumerate(scene.primitives):
+        if isinstance(prim, Sphere):
+            found = sphere_polygon(camera, prim.position, prim.radius)
+            if found is not None:
+                eye = camera.position.tolist() if eye is None else eye
+                items.append((-math.dist(prim.position, eye), i, prim, found[0], found[1]))
+            continue
         s = silhouette(camera, prim)
         if s is not None:
             items.append((-s[0], i, prim, s[1], s[2]))

@@ -59,7 +59,10 @@ per-pixel work (ellipse polygon, exact-coverage compositing, quantising, segment
 moments) and the triangulation are compiled kernels (``_pixels.c``) of the same algorithms the
 NumPy/OpenCV code used (kept as references in tests/replay/sensors/test_fast_cameras.py; equal
 to 1e-9 px there, positions of a recorded catch_optimised run equal to 2e-15 m): ~0.1 ms a
-pair noise-free instead of ~1 ms.
+pair noise-free instead of ~1 ms. Noise-free, each camera's window, image and blob is one
+compiled call (``_stereo.c``: the same kernels, the blob's background median from a histogram)
+and so is the triangulation with its bias correction; :meth:`StereoBallCamera.measure_reference`
+keeps the step-by-step path (equal to the bit, test_fast_cameras.py): ~35 us a pair.
 """
 
 from __future__ import annotations
@@ -75,9 +78,16 @@ from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.sensors import _pixels
-from replay.sensors.raster import composite, quantise
-from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
+from replay.sensors import _pixels, _stereo
+from replay.sensors.raster import quantise
+from replay.sensors.silhouette import (
+    _AREA_SCALE,
+    _COS,
+    _SIN,
+    correct_sphere_centroid,
+    drawables,
+    render_views,
+)
 
 
 @dataclass
@@ -215,6 +225,33 @@ class StereoBallCamera(Sensor):
             (tuple(c.position.tolist()), tuple(c.rotation[:, 2].tolist())) for c in self.cameras
         ]
         self._background_level = int(quantise(np.float32([255.0 * params.background]))[0])
+        # the per-frame path's constants: ball_blob's settings, the cameras' principal points
+        self._blob_args = (
+            float(params.threshold),
+            int(params.min_pixels),
+            int(params.moments == "binary"),
+            255.0 * float(params.background),
+        )
+        self._centres = [(c.intrinsics.cx, c.intrinsics.cy) for c in self.cameras]
+        self._axes_c = np.array([x for axis in self._axes for v in axis for x in v], float)
+        self._centres_c = np.array([x for c in self._centres for x in c], float)
+        self._cams_c = np.array(
+            [
+                x
+                for c in self.cameras
+                for x in (
+                    *c.rotation.ravel().tolist(),
+                    *c.position.tolist(),
+                    c.intrinsics.fx,
+                    c.intrinsics.fy,
+                    c.intrinsics.cx,
+                    c.intrinsics.cy,
+                )
+            ],
+            float,
+        )
+        # noise-free with a background below the threshold: the compiled frame (_stereo.c)
+        self._compiled = params.noise_sigma == 0.0 and self._background_level <= params.threshold
         self._last: list = [None, None]
         self.last_blobs: list[dict | None] = [None, None]
 
@@ -377,45 +414,145 @@ class StereoBallCamera(Sensor):
             return (0, 0, 0, 0)
         return (wx0, wy0, wx1, wy1)
 
+    def _locate_f(self, uv0, uv1, radius: float | None):
+        """:meth:`locate` on floats: (x, y, z), or None at infinity. The bias correction as
+        :func:`~replay.sensors.silhouette.correct_sphere_centroid` computes it."""
+        P0, P1 = self._P
+        X = _pixels.triangulate(P0, P1, uv0[0], uv0[1], uv1[0], uv1[1])
+        if X is None or radius is None or radius <= 0.0 or not all(map(math.isfinite, X)):
+            return X
+        fixed = []
+        r2 = radius * radius
+        for i, (u, v) in enumerate((uv0, uv1)):
+            z = self._depth(i, X)
+            if z <= radius:
+                return X
+            cx, cy = self._centres[i]
+            s = (z * z - r2) / (z * z)
+            fixed.append((cx + (u - cx) * s, cy + (v - cy) * s))
+        (a, b), (c, d) = fixed
+        return _pixels.triangulate(P0, P1, a, b, c, d)
+
     def measure(self, t: float, scene: Scene) -> VisionObject | None:
+        """The module doc's pipeline: noise-free, each camera's window, image and blob in one
+        compiled call and the triangulation with its bias correction in another
+        (``_stereo.frame``, ``_stereo.locate``: the kernels :meth:`measure_reference` calls, in
+        the same order); with pixel noise :meth:`measure_reference` itself."""
+        if not self._compiled:
+            return self.measure_reference(t, scene)
         p = self.params
+        blob_args = self._blob_args
+        grey = 255.0 * p.background
+        W, H = int(p.width), int(p.height)
         blobs: list[dict | None] = []
-        self._last = []
-        for camera in self.cameras:
-            drawn = drawables(camera, scene)
-            polys = [d[0] for d in drawn]
-            window = self._window(camera, [d[2] for d in drawn])
-            x0, y0, x1, y1 = window
-            img = np.full((y1 - y0, x1 - x0), 255.0 * p.background, np.float32)
-            composite(img, polys, [d[1] for d in drawn], origin=(x0, y0))
-            if p.noise_sigma > 0.0:
-                img += np.float32(p.noise_sigma) * self.rng.standard_normal(
-                    img.shape, dtype=np.float32
+        last = []
+        prims = scene.primitives
+        if all(isinstance(q, Sphere) for q in prims):  # both cameras' silhouettes drawn in C
+            frames = _stereo.spheres(
+                self._cams_c, prims, _COS, _SIN, _AREA_SCALE, grey, W, H, *blob_args
+            )
+        else:
+            frames = []
+            for camera in self.cameras:
+                drawn = drawables(camera, scene)
+                polys, greys, boxes = (
+                    [d[0] for d in drawn],
+                    [d[1] for d in drawn],
+                    [d[2] for d in drawn],
                 )
-            img8 = quantise(img)
-            self._last.append((img8, window))
-            blobs.append(self.blob(img8, p, (x0, y0)) if img8.size else None)
+                frames.append(_stereo.frame(polys, greys, boxes, grey, W, H, *blob_args))
+        for image, window, found in frames:
+            x0, y0, x1, y1 = window
+            last.append((np.frombuffer(image, np.uint8).reshape(y1 - y0, x1 - x0), window))
+            blobs.append(
+                None
+                if found is None
+                else {
+                    "u": found[0],
+                    "v": found[1],
+                    "area": found[2],
+                    "background": None if blob_args[2] else found[3],
+                }
+            )
+        self._last = last
         self.last_blobs = blobs
         try:
             tracked = scene.get(p.tracked)
         except KeyError:
             return None
-        if blobs[0] is None or blobs[1] is None:
+        b0, b1 = blobs
+        if b0 is None or b1 is None:
             return None
-        uv = [(b["u"], b["v"]) for b in blobs]
+        radius = 0.0
+        if p.bias_correction and isinstance(tracked, Sphere):
+            radius = float(tracked.radius)
+        P0, P1 = self._P
+        uv0, uv1 = [b0["u"], b0["v"]], [b1["u"], b1["v"]]
+        X = _stereo.locate(P0, P1, *uv0, *uv1, radius, self._axes_c, self._centres_c)
+        if X is None:
+            return None
+        return VisionObject(
+            t=t,
+            position=list(X),
+            features={"centroids": [uv0, uv1], "areas": [b0["area"], b1["area"]]},
+        )
+
+    def measure_reference(self, t: float, scene: Scene) -> VisionObject | None:
+        """:meth:`measure` step by step, each kernel called from Python (the compiled
+        frame's reference, and the path with pixel noise)."""
+        p = self.params
+        noise = p.noise_sigma > 0.0
+        grey = 255.0 * p.background
+        blob_args = self._blob_args
+        W, H = int(p.width), int(p.height)
+        blobs: list[dict | None] = []
+        last = []
+        for camera in self.cameras:
+            drawn = drawables(camera, scene)
+            window = self._window(camera, [d[2] for d in drawn])
+            x0, y0, x1, y1 = window
+            w, h = x1 - x0, y1 - y0
+            img = np.full((h, w), grey, np.float32)
+            if drawn and w and h:
+                _pixels.composite([d[0] for d in drawn], [d[1] for d in drawn], x0, y0, img, w, h)
+            if noise:
+                img += np.float32(p.noise_sigma) * self.rng.standard_normal(
+                    img.shape, dtype=np.float32
+                )
+            img8 = np.empty((h, w), np.uint8)
+            _pixels.quantise(img, img8)
+            last.append((img8, window))
+            found = _pixels.ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
+            blobs.append(
+                None
+                if found is None
+                else {
+                    "u": found[0],
+                    "v": found[1],
+                    "area": found[2],
+                    "background": None if blob_args[2] else found[3],
+                }
+            )
+        self._last = last
+        self.last_blobs = blobs
+        try:
+            tracked = scene.get(p.tracked)
+        except KeyError:
+            return None
+        b0, b1 = blobs
+        if b0 is None or b1 is None:
+            return None
+        uv0, uv1 = (b0["u"], b0["v"]), (b1["u"], b1["v"])
         radius = None
         if p.bias_correction and isinstance(tracked, Sphere):
             radius = float(tracked.radius)
-        X = self.locate(uv[0], uv[1], radius)
-        if not all(map(math.isfinite, X)):
+        X = self._locate_f(uv0, uv1, radius)
+        if X is None or not all(map(math.isfinite, X)):
             return None
-        if any(self._depth(i, X) <= 0.0 for i in range(2)):
+        if self._depth(0, X) <= 0.0 or self._depth(1, X) <= 0.0:
             return None  # a mismatch behind a camera
         return VisionObject(
             t=t,
-            position=[float(v) for v in X],
-            features={
-                "centroids": [[float(u), float(v)] for u, v in uv],
-                "areas": [int(b["area"]) for b in blobs],
-            },
+            position=list(X),
+            features={"centroids": [list(uv0), list(uv1)], "areas": [b0["area"], b1["area"]]},
         )

@@ -338,14 +338,23 @@ class CatchingController(Controller):
             self.close_time = float(
                 np.max(np.abs(self.hand_closed - self.hand_open)) / hand.closing_speed
             )
+            self._hand_open_l = self.hand_open.tolist()
+            self._hand_closed_l = self.hand_closed.tolist()
         else:
             self.close_time = 0.0
+        # the per-step path works on Python floats: joint vectors are lists of n floats
+        self._act = tuple(int(i) for i in self.model.active)
+        self._q_fixed = self.model.q_fixed.tolist()
+        self._kp, self._kd = self.kp.tolist(), self.kd.tolist()
+        self._tau_limit = self.tau_limit.tolist()
+        self._origin = tuple(self.geo.origin.tolist())
+        self._zeros = [0.0] * self.n
         # run-time state
-        self.q = None
-        self.qd = None
-        self.q_d = self.q_init.copy()
-        self.qd_d = np.zeros(self.n)
-        self.tau = np.zeros(self.n)
+        self.q: list[float] | None = None
+        self.qd: list[float] | None = None
+        self.q_d: list[float] = self.q_init.tolist()
+        self.qd_d: list[float] = list(self._zeros)
+        self.tau: list[float] = list(self._zeros)
         self.t_catch = None
         self.closing = False
         self.holding = False
@@ -358,8 +367,10 @@ class CatchingController(Controller):
         self._names_seen = None  # joint-name layout of the last joint state message
         self._idx = None
         self._identity = list(range(self.n))
-        self._ff_key = None  # (q_d, qd_d, qdd_d) of the last feed-forward, and its torque
-        self._ff = None
+        # the feed-forward of the current desired state (q_d, qd_d, qdd_d); None when the
+        # update set a new one (before the ball is seen and while holding, it is computed once)
+        self._ff: tuple | None = None
+        self._fk_desired: tuple = (None, ())  # (the q_d list it is of, l(q_d))
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
@@ -422,37 +433,44 @@ class CatchingController(Controller):
             elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
                 self._joint_state(m)
         P = self.params
-        qdd_d = np.zeros(self.n)
+        qdd_d = self._zeros
         if self.est.n and not self.holding:
             r, v, a = (
-                self.est.state(t) if P.latency_compensation else self.est.state(self.est.last[0])
+                self.est.state_f(t)
+                if P.latency_compensation
+                else self.est.state_f(self.est.buf[-1][0])
             )
-            q_a, qd_a, qdd_a, q_o, in_dom = self.mapping.evaluate_one(r, v, a)  # eqs. 7, 23, 16
+            # eqs. 7, 23, 16 (compiled, 3-tuples)
+            q_a, qd_a, qdd_a, q_o, in_dom = self.mapping.evaluate_one_tuple(r, v, a)
             if in_dom != self._in_domain and not in_dom:
                 self._events.append(
                     Occurrence(
                         "infeasible",
                         {
                             "reason": "r_o outside the domain of l_c^-1 (clamped)",
-                            "r_o": r.tolist(),
+                            "r_o": list(r),
                             "d_min": self.geo.d_min,
                         },
                     )
                 )
             self._in_domain = in_dom
             self._r, self._v, self._q_o = r, v, q_o
-            d = r - self.geo.origin
-            reached = math.sqrt(float(d @ d)) <= self.geo.catch_radius
+            O = self._origin
+            dx, dy, dz = r[0] - O[0], r[1] - O[1], r[2] - O[2]
+            reached = math.sqrt(dx * dx + dy * dy + dz * dz) <= self.geo.catch_radius
             if reached and P.after_catch == "hold":
                 self.holding = True
-                self.qd_d = np.zeros(self.n)
+                self.qd_d = list(self._zeros)
+                self._ff = None
                 self._events.append(
-                    Occurrence("mapping_hold", {"q_d": self.q_d.tolist(), "r_o": r.tolist()})
+                    Occurrence("mapping_hold", {"q_d": list(self.q_d), "r_o": list(r)})
                 )
-            else:
-                self.q_d = self.model.full(q_a)
-                self.qd_d = self.model.full_rate(qd_a)
-                qdd_d = self.model.full_rate(qdd_a)
+            else:  # the active joints' values in the full vector (q3 held, model.full)
+                q_d, qd_d, qdd_d = list(self._q_fixed), list(self._zeros), list(self._zeros)
+                for i, k in enumerate(self._act):
+                    q_d[k], qd_d[k], qdd_d[k] = q_a[i], qd_a[i], qdd_a[i]
+                self.q_d, self.qd_d = q_d, qd_d
+                self._ff = None
             if not self.holding:
                 self.t_catch = self.est.time_to_radius(t, self.geo.origin, self.geo.catch_radius)
         if (
@@ -471,11 +489,11 @@ class CatchingController(Controller):
         self.tau = self._torque(qdd_d)
         hand = None
         if self.hand is not None:
-            hand = (self.hand_closed if self.closing else self.hand_open).tolist()
-        return ArmCommand(torque=self.tau.tolist(), hand=hand)
+            hand = list(self._hand_closed_l if self.closing else self._hand_open_l)
+        return ArmCommand(torque=list(self.tau), hand=hand)
 
     def _joint_state(self, m) -> None:
-        pos, vel = np.asarray(m.position, float), np.asarray(m.velocity, float)
+        pos, vel = list(m.position), list(m.velocity)
         names = tuple(getattr(m, "name", ()) or ())
         if names != self._names_seen:  # where our joints sit in the message (once per layout)
             self._names_seen = names
@@ -484,23 +502,25 @@ class CatchingController(Controller):
                 if names and set(self.names) <= set(names)
                 else None
             )
-        if self._idx is not None and self._idx != self._identity:
-            pos, vel = pos[self._idx], vel[self._idx]
-        if pos.shape == (self.n,):
-            self.q, self.qd = pos, (vel if vel.shape == (self.n,) else np.zeros(self.n))
+        idx = self._idx
+        if idx is not None and idx != self._identity:
+            pos = [pos[i] for i in idx]
+            vel = [vel[i] for i in idx] if len(vel) == len(names) else []
+        if len(pos) == self.n:
+            self.q, self.qd = pos, (vel if len(vel) == self.n else list(self._zeros))
 
-    def _torque(self, qdd_d: np.ndarray) -> np.ndarray:
+    def _torque(self, qdd_d: list[float]) -> list[float]:
         P = self.params
         q_d, qd_d = self.q_d, self.qd_d
+        ff: list[float] | tuple
         if P.feedforward == "dynamics":  # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
-            key = (q_d.tobytes(), qd_d.tobytes(), qdd_d.tobytes())
-            if key != self._ff_key:  # the same desired state (holding, not yet seen): same ff
-                self._ff_key, self._ff = key, self.model.inverse_dynamics_full(q_d, qd_d, qdd_d)
+            if self._ff is None:
+                self._ff = self.model.inverse_dynamics_tuple(q_d, qd_d, qdd_d)
             ff = self._ff
         elif P.feedforward == "gravity":
-            ff = self.model.gravity_full(self.q if self.q is not None else q_d)
+            ff = self.model.gravity_full(self.q if self.q is not None else q_d).tolist()
         else:
-            ff = np.zeros(self.n)
+            ff = self._zeros
         if self.q is None:
             if not self._warned_state:
                 self._warned_state = True
@@ -510,10 +530,17 @@ class CatchingController(Controller):
                         {"reason": "no /arm/joint_state delivered: feed-forward torque only"},
                     )
                 )
-            tau = ff
+            tau = list(ff)
         else:
-            tau = ff + self.kp * (q_d - self.q) + self.kd * (qd_d - self.qd)
-        return np.minimum(np.maximum(tau, -self.tau_limit), self.tau_limit)
+            q, qd, kp, kd = self.q, self.qd, self._kp, self._kd
+            assert qd is not None  # set with q
+            tau = [
+                ff[i] + kp[i] * (q_d[i] - q[i]) + kd[i] * (qd_d[i] - qd[i]) for i in range(self.n)
+            ]
+        # saturated at the limits (np.minimum(np.maximum(tau, -limit), limit))
+        return [
+            lim if x > lim else (-lim if x < -lim else x) for x, lim in zip(tau, self._tau_limit)
+        ]
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:
@@ -543,14 +570,17 @@ class CatchingController(Controller):
         return ev
 
     def telemetry(self, t: float) -> dict:
+        # l(q_d) once per desired posture: update sets a new q_d list when it changes
+        if self._fk_desired[0] is not self.q_d:
+            self._fk_desired = (self.q_d, self.model.fk_tuple(self.q_d))
         out = {
             TOPIC_ARM_JOINT_COMMAND: JointCommand(
-                t, position=self.q_d.tolist(), torque=self.tau.tolist()
+                t, position=list(self.q_d), torque=list(self.tau)
             ),
             TOPIC_EFFECTOR_STATE: EffectorState(
                 t,
-                position=self.model.fk(self.q).tolist() if self.q is not None else [],
-                desired_position=self.model.fk(self.q_d).tolist(),
+                position=list(self.model.fk_tuple(self.q)) if self.q is not None else [],
+                desired_position=list(self._fk_desired[1]),
             ),
         }
         if not self._costs_logged:  # the offline optimisation's history, once (t = 0)
@@ -559,10 +589,10 @@ class CatchingController(Controller):
         if self._r is not None:
             out[TOPIC_CATCHING_STATE] = CatchingState(
                 t,
-                self._r.tolist(),
-                self._v.tolist(),
-                self._q_o.tolist(),
-                self.qd_d.tolist(),
+                list(self._r),
+                list(self._v),
+                list(self._q_o),
+                list(self.qd_d),
                 self._in_domain,
                 float(self.t_catch) if self.t_catch is not None else -1.0,
                 self.closing,

@@ -26,7 +26,7 @@ class BallisticEstimator:
         self.g = np.asarray(gravity, float)
         self._g = tuple(self.g.tolist())
         self.window = float(window)
-        self.buf: deque[tuple[float, np.ndarray]] = deque(maxlen=max_samples)
+        self.buf: deque[tuple[float, tuple[float, float, float]]] = deque(maxlen=max_samples)
         self._fit = None
         self._rebuild(None)
 
@@ -54,18 +54,23 @@ class BallisticEstimator:
 
     def _account(self, t: float, r, sign: float) -> None:
         tau = t - self._t_ref
-        S, Sy, Sty, g = self._S, self._Sy, self._Sty, self._g
+        S, Sy, Sty = self._S, self._Sy, self._Sty
+        g0, g1, g2 = self._g
+        st = sign * tau
         S[0] += sign
-        S[1] += sign * tau
-        S[2] += sign * tau * tau
+        S[1] += st
+        S[2] += st * tau
         h = 0.5 * tau * tau
-        for k in range(3):
-            y = float(r[k]) - g[k] * h
-            Sy[k] += sign * y
-            Sty[k] += sign * tau * y
+        y0, y1, y2 = r[0] - g0 * h, r[1] - g1 * h, r[2] - g2 * h
+        Sy[0] += sign * y0
+        Sy[1] += sign * y1
+        Sy[2] += sign * y2
+        Sty[0] += st * y0
+        Sty[1] += st * y1
+        Sty[2] += st * y2
 
     def add(self, t: float, r) -> None:
-        r = np.asarray(r, float)
+        r = (float(r[0]), float(r[1]), float(r[2]))
         if self.buf and t <= self.buf[-1][0]:
             return  # out of order or repeated frame
         if self._t_ref is None:
@@ -82,6 +87,13 @@ class BallisticEstimator:
 
     def fit(self):
         """(t_last, r0, v) at the last measurement time; v is None with a single measurement."""
+        f = self.fit_f()
+        if f is None:
+            return None
+        return f[0], np.array(f[1]), None if f[2] is None else np.array(f[2])
+
+    def fit_f(self):
+        """:meth:`fit` with r0 and v as 3-tuples of floats (the per-step path)."""
         if not self.buf:
             return None
         if self._fit is None:
@@ -96,8 +108,8 @@ class BallisticEstimator:
                 g = self._g
                 b = [(n * self._Sty[k] - s1 * self._Sy[k]) / det for k in range(3)]
                 a = [(self._Sy[k] - b[k] * s1) / n for k in range(3)]
-                r0 = np.array([a[k] + b[k] * tl + 0.5 * g[k] * tl * tl for k in range(3)])
-                v = np.array([b[k] + g[k] * tl for k in range(3)])
+                r0 = tuple(a[k] + b[k] * tl + 0.5 * g[k] * tl * tl for k in range(3))
+                v = tuple(b[k] + g[k] * tl for k in range(3))
                 self._fit = (t_last, r0, v)
         return self._fit
 
@@ -106,30 +118,50 @@ class BallisticEstimator:
 
         With one measurement the velocity is unknown and taken as zero.
         """
-        f = self.fit()
+        st = self.state_f(t, from_fit=from_fit)
+        if st is None:
+            return None
+        return np.array(st[0]), np.array(st[1]), self.g.copy()
+
+    def state_f(self, t: float, *, from_fit: bool = False):
+        """:meth:`state` as 3-tuples of floats: per component the operations NumPy did on the
+        3-vectors (base + v dt + (0.5 g) dt dt), so the same values."""
+        f = self.fit_f()
         if f is None:
             return None
         t_last, r0, v = f
-        r_meas = self.buf[-1][1]
-        v = np.zeros(3) if v is None else v
+        if v is None:
+            v = (0.0, 0.0, 0.0)
         dt = t - t_last
-        base = r0 if from_fit else r_meas
-        return base + v * dt + 0.5 * self.g * dt * dt, v + self.g * dt, self.g.copy()
+        b = r0 if from_fit else self.buf[-1][1]
+        g0, g1, g2 = self._g
+        return (
+            (
+                b[0] + v[0] * dt + 0.5 * g0 * dt * dt,
+                b[1] + v[1] * dt + 0.5 * g1 * dt * dt,
+                b[2] + v[2] * dt + 0.5 * g2 * dt * dt,
+            ),
+            (v[0] + g0 * dt, v[1] + g1 * dt, v[2] + g2 * dt),
+            self._g,
+        )
 
     def time_to_radius(self, t: float, origin, radius: float):
         """Absolute time at which the arc first reaches |r - origin| = radius (None if never)."""
-        st = self.state(t, from_fit=True)
+        st = self.state_f(t, from_fit=True)
         if st is None or self.n < 2:
             return None
-        (rx, ry, rz), v, g = st[0].tolist(), st[1].tolist(), self._g
-        ox, oy, oz = (float(x) for x in origin)
-        d = (rx - ox, ry - oy, rz - oz)
-        dot = lambda a, b: a[0] * b[0] + a[1] * b[1] + a[2] * b[2]  # noqa: E731
-        dd = dot(d, d)
+        (rx, ry, rz), (vx, vy, vz), (gx, gy, gz) = st
+        dx, dy, dz = rx - float(origin[0]), ry - float(origin[1]), rz - float(origin[2])
+        dd = dx * dx + dy * dy + dz * dz
         if dd <= radius * radius:
             return t
-        coeffs = [0.25 * dot(g, g), dot(v, g), dot(v, v) + dot(d, g), 2.0 * dot(d, v)]
-        coeffs.append(dd - radius * radius)
+        coeffs = [
+            0.25 * (gx * gx + gy * gy + gz * gz),
+            vx * gx + vy * gy + vz * gz,
+            (vx * vx + vy * vy + vz * vz) + (dx * gx + dy * gy + dz * gz),
+            2.0 * (dx * vx + dy * vy + dz * vz),
+            dd - radius * radius,
+        ]
         s = _first_root_newton(coeffs)
         if s is not None:
             return t + s

@@ -26,9 +26,13 @@ class ArmModel:
         q_fixed=None,
         inverse_dynamics: Callable | None = None,
         axis: Callable | None = None,
+        fk_tuple: Callable | None = None,
+        inverse_dynamics_tuple: Callable | None = None,
     ) -> None:
         self._fk, self._M, self._bias, self._g = fk, mass_matrix, bias, gravity
         self._id = inverse_dynamics
+        # the per-step forms on floats (a chain's compiled point and RNEA), if there are any
+        self._fk_t, self._id_t = fk_tuple, inverse_dynamics_tuple
         self._axis = axis  # q -> the tool z axis (the palm normal), world (3,)
         self.n = n
         self.active = np.asarray(active, dtype=int)
@@ -43,6 +47,9 @@ class ArmModel:
         def fk(q):
             return chain.point(q, pt_last)
 
+        def fk_tuple(q):
+            return chain.point_tuple(q, pt_last)
+
         def axis(q):
             return (chain.frames(q)[-1] @ chain.tool)[:3, 2]
 
@@ -56,6 +63,8 @@ class ArmModel:
             q_fixed=q_fixed,
             inverse_dynamics=chain.rnea,
             axis=axis,
+            fk_tuple=fk_tuple,
+            inverse_dynamics_tuple=chain.rnea_tuple,
         )
 
     # ---- coordinates
@@ -72,6 +81,13 @@ class ArmModel:
     # ---- kinematics (full q)
     def fk(self, q) -> np.ndarray:
         return np.asarray(self._fk(np.asarray(q, float)), float)
+
+    def fk_tuple(self, q) -> tuple[float, float, float]:
+        """:meth:`fk` as a 3-tuple of floats, q n floats (a list or tuple): the per-step path."""
+        if self._fk_t is not None:
+            return self._fk_t(q)
+        x, y, z = self.fk(q).tolist()
+        return x, y, z
 
     def point(self, p) -> np.ndarray:
         """l(q) (eq. 3) at active coordinates p."""
@@ -103,6 +119,13 @@ class ArmModel:
         if self._id is not None:
             return np.asarray(self._id(q, qd, qdd), float)
         return self._M(q) @ qdd + self._bias(q, qd)
+
+    def inverse_dynamics_tuple(self, q, qd, qdd) -> tuple:
+        """:meth:`inverse_dynamics_full` as a tuple of n floats (lists or tuples in): the
+        per-step path."""
+        if self._id_t is not None:
+            return self._id_t(q, qd, qdd)
+        return tuple(self.inverse_dynamics_full(np.array(q), np.array(qd), np.array(qdd)).tolist())
 
     def tau(self, p, pd, pdd) -> np.ndarray:
         """Active joint torques of eq. 15 / 17 (the locked joint's holding torque dropped)."""

@@ -76,6 +76,31 @@ def test_evaluate_one_equals_the_batched_mapping(mapping):
     assert compared >= 0.75 * len(states) and clamped >= 0.15 * len(states)
 
 
+def test_compiled_evaluate_one_equals_the_float_reference(mapping):
+    """_mapping.c against evaluate_one_floats over the same seeded neighbourhood, clamped and
+    on-axis states included: the same operations in the same order but the final sum over the
+    monomials (NumPy's matmul there), so equal to 1e-12."""
+    rng = np.random.default_rng(16)
+    states = _states(rng, mapping.geo, 400)
+    states += [(mapping.geo.origin + np.array([0.0, 0.0, h]), states[0][1], G) for h in (0.3, 1.0)]
+    worst, equal_flags, singular = 0.0, 0, 0
+    for r, v, a in states:
+        try:
+            ref = mapping.evaluate_one_floats(r, v, a)
+        except np.linalg.LinAlgError:
+            singular += 1
+            with pytest.raises(np.linalg.LinAlgError):
+                mapping.evaluate_one(r, v, a)
+            continue
+        got = mapping.evaluate_one(r, v, a)
+        equal_flags += got[4] == ref[4]
+        for one, want in zip(got[:4], ref[:4]):
+            worst = max(worst, float(np.abs(one - want).max() / max(1.0, np.abs(want).max())))
+    print(f"compiled vs float mapping: worst relative difference {worst:.1e}, {singular} singular")
+    assert equal_flags == len(states) - singular
+    assert worst <= 1e-12
+
+
 def test_coefficients_one_equals_the_monomials(mapping):
     poly = mapping.poly
     rng = np.random.default_rng(12)
