@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from replay.spatial import cross3
-
 
 class WristFT:
     def __init__(self, bc, body: int, joint: int, palm_com) -> None:
@@ -28,8 +26,18 @@ class WristFT:
         self.r_c = np.asarray(palm_com, float)
         bc.enableJointForceTorqueSensor(body, joint, True)
 
-    def convert(self, raw) -> np.ndarray:
-        """PyBullet's joint reaction (F, M) -> the hand's load on the flange about the joint."""
-        raw = np.asarray(raw, float)
-        f, m = raw[:3], raw[3:]
-        return np.concatenate([-f, -(m + cross3(self.r_c, f))])
+        self._rc = self.r_c.tolist()
+
+    def convert(self, raw) -> list[float]:
+        """PyBullet's joint reaction (F, M) -> the hand's load on the flange about the joint:
+        [Fx, Fy, Fz, Mx, My, Mz] in floats (cross3's products and sums, per component)."""
+        fx, fy, fz, mx, my, mz = raw
+        ax, ay, az = self._rc
+        return [
+            -fx,
+            -fy,
+            -fz,
+            -(mx + (ay * fz - az * fy)),
+            -(my + (az * fx - ax * fz)),
+            -(mz + (ax * fy - ay * fx)),
+        ]

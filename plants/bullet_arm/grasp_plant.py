@@ -30,7 +30,7 @@ from plants.bullet_arm.human_hand import HumanHand
 from plants.bullet_arm.params import GraspParams
 from plants.bullet_arm.payloads import HeadState, HumanState, ServoState, Wrench
 from plants.bullet_arm.plant import BulletArmPlant
-from plants.bullet_arm.servo import VelocityMotors, VelocityServos, apply_torques
+from plants.bullet_arm.servo import VelocityMotors, VelocityServos
 from replay.interfaces import Occurrence
 from replay.messages import JointState
 from replay.robot.arm_types import GraspSpec, PlaneSpec, ServoCommand
@@ -40,15 +40,6 @@ from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
 HEAD_JOINTS = ("pan", "tilt")
-# the PyBullet calls the rig's helpers (servos, human hand) and the runner make every step through
-# the client: BulletClient builds a new functools.partial (client id bound) at each attribute
-# access, so the rig keeps one per name on its client (the same call; the base binds its reads)
-PER_STEP_CALLS = (
-    "stepSimulation",
-    "setJointMotorControlArray",
-    "changeConstraint",
-    "getConstraintState",
-)
 
 
 class BulletGraspPlant(BulletArmPlant):
@@ -68,14 +59,10 @@ class BulletGraspPlant(BulletArmPlant):
         self._watch = None  # the catch verdict's watcher: this rig's is outcome()
         P = params
         bc = self.bc
-        for name in PER_STEP_CALLS:
-            setattr(bc, name, getattr(bc, name))
         self._palm_j = self._jidx["palm_joint"]
         assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
-        self._act = np.array(self.active, dtype=int)
-        self._all_active = len(self.active) == self.dof  # no locked joint: no index mapping
         # the servos: every arm and hand joint's own inertia at the initial posture
         bc.setJointMotorControlArray(
             self.robot, self._hand_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._hand_j)
@@ -138,6 +125,7 @@ class BulletGraspPlant(BulletArmPlant):
             point=(op[0], op[1], op[2]), normal=(float(n[0]), float(n[1]), float(n[2]))
         )
         self._u, self._v = u, v
+        self._u_l, self._v_l = u.tolist(), v.tolist()
         assert self.obj is not None and self._palm_link is not None
         self.human = HumanHand(
             bc,
@@ -166,7 +154,7 @@ class BulletGraspPlant(BulletArmPlant):
         self._touched: set = set()
         self._track_sq = 0.0
         self._track_n = 0
-        self._last_pos: np.ndarray | None = None
+        self._last_pos: tuple | None = None
         self._head_pose: tuple | None = None
         self._read()
         self._spec = self._grasp_spec(self._spec)
@@ -182,47 +170,38 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ state (one read a step)
     def _read(self) -> None:
-        st = self._get_joint_states(self.robot, self._all_j)
-        na, nh = len(self._arm_j), len(self._hand_j)
-        pos, vel = [s[0] for s in st], [s[1] for s in st]
+        """The base's state cache (plain floats) from one getJointStates of arm, hand and palm
+        joint, with the servos' torques, the wrist's wrench and the object's state."""
+        pos, vel, reaction, eff = zip(*self._get_joint_states(self.robot, self._all_j))
+        q, qd = self._arm_q(pos, vel)
+        na, nh = self._na, len(self._hand_j)
+        servos = self.arm_servos
         if self._all_active:
-            self._q, self._qd = np.array(pos[:na]), np.array(vel[:na])
-            self._tau_applied = self._tau_cmd = self.arm_servos.torque.copy()
-            self._clamped = self.arm_servos.saturated.copy()
+            tau, clamped = servos.torque_l[:], servos.saturated_l[:]
         else:
-            q = np.zeros(self.dof)
-            qd = np.zeros(self.dof)
-            for n, val in self.locked.items():
-                q[self.joint_names.index(n)] = val
-            act = self._act
-            q[act] = pos[:na]
-            qd[act] = vel[:na]
-            self._q, self._qd = q, qd
-            tau = np.zeros(self.dof)
-            tau[act] = self.arm_servos.torque
-            self._tau_applied = self._tau_cmd = tau
-            self._clamped = np.zeros(self.dof, dtype=bool)
-            self._clamped[act] = self.arm_servos.saturated
-        self._hq = np.array(pos[na : na + nh])
-        self._hqd = np.array(vel[na : na + nh])
-        self.hand_servos.read(st[na : na + nh])
-        self._htau = self.hand_servos.torque
-        self._wrench = self.ft.convert(st[-1][2])
+            tau, clamped = [0.0] * self.dof, [False] * self.dof
+            for k, i in enumerate(self.active):
+                tau[i], clamped[i] = servos.torque_l[k], servos.saturated_l[k]
+        self._tau_applied = self._tau_cmd = tau
+        self._clamped = clamped
+        self.hand_servos.read(eff[na : na + nh])
+        self._wrench = self.ft.convert(reaction[-1])
         opos, orn = self._get_base_pose(self.obj)
         v, w = self._get_base_velocity(self.obj)
-        self._obj = (np.array(opos), np.array(orn), np.array(v), np.array(w))
+        self._cache = (
+            (q, qd),
+            (list(pos[na : na + nh]), list(vel[na : na + nh]), self.hand_servos.torque),
+            (opos, orn, v, w),
+        )
         self._head_pose = None
 
-    def arm_state(self):
-        return self._q, self._qd
+    def _state(self) -> tuple:
+        if self._cache is None:
+            self._read()
+            assert self._cache is not None
+        return self._cache
 
-    def hand_state(self):
-        return self._hq, self._hqd, self._htau
-
-    def object_state(self):
-        return self._obj
-
-    def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
+    def _link_point_velocity(self, link: int, point) -> tuple[float, float, float]:
         if link != self._palm_link:
             return super()._link_point_velocity(link, point)
         # v + (w x (point - com)) of the palm's state read once this step (the base's
@@ -230,9 +209,7 @@ class BulletGraspPlant(BulletArmPlant):
         # stay bit-identical to the array form
         (cx, cy, cz), _, _, _, _, _, (vx, vy, vz), (wx, wy, wz) = self._frames_now()[1]
         rx, ry, rz = float(point[0]) - cx, float(point[1]) - cy, float(point[2]) - cz
-        return np.array(
-            [vx + (wy * rz - wz * ry), vy + (wz * rx - wx * rz), vz + (wx * ry - wy * rx)]
-        )
+        return (vx + (wy * rz - wz * ry), vy + (wz * rx - wx * rz), vz + (wx * ry - wy * rx))
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ServoCommand) -> None:  # type: ignore[override]
@@ -242,7 +219,7 @@ class BulletGraspPlant(BulletArmPlant):
             qd = np.asarray(command.arm, float).reshape(-1)
             if qd.shape != (self.dof,):
                 raise ValueError(f"ServoCommand.arm needs {self.dof} values, got {qd.shape[0]}")
-            self.arm_servos.set_command(qd if self._all_active else qd[self._act])
+            self.arm_servos.set_command(qd if self._all_active else qd[list(self.active)])
         if command.hand is not None:
             self.hand_servos.set_command(command.hand)
         if command.head is not None:
@@ -250,36 +227,45 @@ class BulletGraspPlant(BulletArmPlant):
 
     def step(self) -> None:
         self.human.drive(self._t)
-        apply_torques(
-            self.bc, self.robot, self._servo_j, self.arm_servos.torques(self._qd[self._act])
+        (_, qd), _, obj = self._state()
+        self._set_motors(
+            self.robot,
+            self._servo_j,
+            p.TORQUE_CONTROL,
+            forces=self.arm_servos.torques(
+                qd if self._all_active else [qd[i] for i in self.active]
+            ),
         )
         self.hand_servos.actuate()
         self.head_servo.step()
-        self._obj_vel_before = self._obj[2]
+        self._obj_vel_before = obj[2]
         self.bc.stepSimulation()
         self._steps += 1
         self._t = self._steps * self.dt
         self._read()
-        for i in np.flatnonzero(self._clamped & ~self._torque_episode):
-            self._events.append(
-                Occurrence(
-                    "torque_limit",
-                    {
-                        "joint": self.joint_names[i],
-                        "applied": float(self._tau_applied[i]),
-                        "limit": float(self.torque_limits[i]),
-                    },
-                )
-            )
-        self._torque_episode = self._clamped
-        self.clamp_count += int(self._clamped.sum())
+        clamped, episode = self._clamped, self._torque_episode
+        if True in clamped:
+            for i, c in enumerate(clamped):
+                if c and not episode[i]:
+                    self._events.append(
+                        Occurrence(
+                            "torque_limit",
+                            {
+                                "joint": self.joint_names[i],
+                                "applied": self._tau_applied[i],
+                                "limit": self._tlim_l[i],
+                            },
+                        )
+                    )
+            self.clamp_count += sum(clamped)
+        self._torque_episode = clamped
         was_held = self.caught
         n_before = len(self._events)
         self._check_events()
         self._grasp_bookkeeping(was_held, n_before)
 
     def _grasp_bookkeeping(self, was_held: bool, n_before: int) -> None:
-        pos, _, v, _ = self._obj
+        pos, _, v, _ = self._state()[2]
         for ev in self._events[n_before:]:
             if ev.kind == "grasp":
                 self._grasp_start = self._t - ev.data.get("hold_time", 0.0)
@@ -289,31 +275,37 @@ class BulletGraspPlant(BulletArmPlant):
                 held = self._t - self._grasp_start
                 self._grasps[-1]["held_for"] = held
                 ev.data["held_for"] = held
-        parts = {self.model.part_of_link.get(self._link_name[c[4]], "arm") for c in self._contacts}
-        parts.discard("arm")
-        self._touched |= parts
-        self._max_parts = max(self._max_parts, len(parts))
-        pe = self._tool_position()
-        d = pos - pe
+        parts = self._contact_summary_now()[0]  # sorted, "arm" among them if it touches
+        n_hand = len(parts) - ("arm" in parts)
+        if n_hand:
+            self._touched.update(x for x in parts if x != "arm")
+        self._max_parts = max(self._max_parts, n_hand)
+        # 3-vectors in floats (sums and products in np.dot's / np.linalg.norm's order)
+        ox, oy, oz = pos
         if self.caught:
             if self._last_pos is not None:
-                self._held_path += float(np.linalg.norm(pos - self._last_pos))
-            rel = float(np.linalg.norm(v - self._link_point_velocity(self._palm_link or -1, pos)))
+                lx, ly, lz = ox - self._last_pos[0], oy - self._last_pos[1], oz - self._last_pos[2]
+                self._held_path += math.sqrt(lx * lx + ly * ly + lz * lz)
+            px, py, pz = self._link_point_velocity(self._palm_link or -1, pos)
+            rx, ry, rz = v[0] - px, v[1] - py, v[2] - pz
+            rel = math.sqrt(rx * rx + ry * ry + rz * rz)
             # a slip episode: faster than slip_speed on the hand, over when below half of it
             if rel > self.params.slip_speed and not self._slipping:
                 self._slips += 1
                 self._slipping = True
-                self._events.append(Occurrence("slip", {"speed": rel, "position": pos.tolist()}))
+                self._events.append(Occurrence("slip", {"speed": rel, "position": list(pos)}))
             elif self._slipping and rel < 0.5 * self.params.slip_speed:
                 self._slipping = False
         else:
             self._slipping = False
-            self._track_sq += float((d @ self._u) ** 2 + (d @ self._v) ** 2)
+            ex, ey, ez = self._frames_now()[0][0]
+            dx, dy, dz = ox - ex, oy - ey, oz - ez
+            (ux, uy, uz), (vx, vy, vz) = self._u_l, self._v_l
+            du = dx * ux + dy * uy + dz * uz
+            dv = dx * vx + dy * vy + dz * vz
+            self._track_sq += du**2 + dv**2
             self._track_n += 1
         self._last_pos = pos
-
-    def _tool_position(self) -> np.ndarray:
-        return np.array(self._frames_now()[0][0])
 
     # ------------------------------------------------------------------ verdict
     def outcome(self, t: float) -> dict:
@@ -359,44 +351,37 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ log and scene
     def _head_reading(self):
-        """(R, c) of the head camera now (computed once a step: the log and the scene)."""
+        """(R, c, [qx, qy, qz, qw]) of the head camera now (computed once a step: the log, the
+        scene and the 3-D frames)."""
         if self._head_pose is None:
-            self._head_pose = camera_pose(self.head, *self.head_servo.q)
+            R, c = camera_pose(self.head, *self.head_servo.q_l)
+            self._head_pose = (R, c, [float(x) for x in matrix_to_quaternion(R)])
         return self._head_pose
 
     def truth(self, t: float) -> dict:
         out = super().truth(t)
         del out["/arm/applied_torque"]
+        servos = self.arm_servos
         out["/arm/servo"] = ServoState(
             t,
             list(self.joint_names),
-            self._full(self.arm_servos.command),
-            self._full(self.arm_servos.integral),
-            self._tau_applied.tolist(),
-            [bool(c) for c in self._clamped],
+            self._full(servos.command_l),
+            self._full(servos.integral_l),
+            self._tau_applied[:],
+            self._clamped[:],
         )
         hs = self.head_servo
         out["/head/joint_state"] = JointState(
-            t, list(HEAD_JOINTS), hs.q.tolist(), hs.qd.tolist(), hs.torque.tolist()
+            t, list(HEAD_JOINTS), hs.q_l[:], hs.qd_l[:], hs.torque_l[:]
         )
-        R, c = self._head_reading()
-        out["/head/state"] = HeadState(
-            t,
-            float(hs.q[0]),
-            float(hs.q[1]),
-            hs.qd.tolist(),
-            c.tolist(),
-            [float(x) for x in matrix_to_quaternion(R)],
-        )
+        _, c, quat = self._head_reading()
+        out["/head/state"] = HeadState(t, hs.q_l[0], hs.q_l[1], hs.qd_l[:], c.tolist(), quat[:])
+        human = self.human
         out["/human/state"] = HumanState(
-            t,
-            self.human.target.tolist(),
-            float(self.human.roll),
-            self.human.force(),
-            self.human.max_force,
+            t, human.target_l[:], float(human.roll), human.force(), human.max_force
         )
         w = self._wrench
-        out["/wrist/wrench_truth"] = Wrench(t, w[:3].tolist(), w[3:].tolist())
+        out["/wrist/wrench_truth"] = Wrench(t, w[:3], w[3:])
         return out
 
     def joints(self) -> tuple[list, list, list, list]:
@@ -405,41 +390,38 @@ class BulletGraspPlant(BulletArmPlant):
         hs = self.head_servo
         return (
             names + list(HEAD_JOINTS),
-            q + hs.q.tolist(),
-            qd + hs.qd.tolist(),
-            effort + hs.torque.tolist(),
+            q + hs.q_l,
+            qd + hs.qd_l,
+            effort + hs.torque_l,
         )
 
     def frames(self) -> list[Frame]:
         """The robot's links and the head's camera (``head_camera``: x right, y down, z the
         optical axis) in ``world``."""
-        R, c = self._head_reading()
-        qx, qy, qz, qw = (float(x) for x in matrix_to_quaternion(R))
+        _, c, quat = self._head_reading()
         x, y, z = (float(v) for v in c)
-        return super().frames() + [Frame("world", "head_camera", (x, y, z), (qx, qy, qz, qw))]
+        return super().frames() + [Frame("world", "head_camera", (x, y, z), tuple(quat))]
 
-    def _full(self, values) -> list:
+    def _full(self, values: list) -> list:
         """Per-active-joint values as a list over every arm joint (zero where locked)."""
         if self._all_active:
-            return np.asarray(values, float).tolist()
-        out = np.zeros(self.dof)
-        out[self._act] = values
-        return out.tolist()
+            return list(values)
+        out = [0.0] * self.dof
+        for i, x in zip(self.active, values):
+            out[i] = x
+        return out
 
     def scene(self) -> Scene:
         sc = super().scene()
         hs = self.head_servo
-        R, c = self._head_reading()
-        sc.readings["hand"] = {
-            "name": list(self.hand_names),
-            "position": self._hq.tolist(),
-            "velocity": self._hqd.tolist(),
-        }
-        sc.readings["hand_torque"] = {"name": list(self.hand_names), "torque": self._htau}
+        R, c, _ = self._head_reading()
+        hq, hqd, htau = self._state()[1]
+        sc.readings["hand"] = {"name": list(self.hand_names), "position": hq[:], "velocity": hqd[:]}
+        sc.readings["hand_torque"] = {"name": list(self.hand_names), "torque": htau}
         sc.readings["head"] = {
             "name": list(HEAD_JOINTS),
-            "position": hs.q.tolist(),
-            "velocity": hs.qd.tolist(),
+            "position": hs.q_l[:],
+            "velocity": hs.qd_l[:],
             "camera_rotation": R,
             "camera_position": c,
         }

@@ -81,9 +81,17 @@ class HumanHand:
         self._A = np.concatenate([self.a, self.ra])
         self._PHI = np.concatenate([self.phi, self.rphi])
         self._S0 = np.sin(self._PHI)
+        # per row (u, v, roll) as floats for offset(): (omega, amplitude, phase, sin(phase))
+        self._rows = [
+            list(zip(*row))
+            for row in zip(
+                self._W.tolist(), self._A.tolist(), self._PHI.tolist(), self._S0.tolist()
+            )
+        ]
         self.R0 = _rpy_matrix(rpy0)
         self.q0 = _quat(self.R0)
-        self.target = self.origin.copy()
+        self._origin, self._u, self._v = self.origin.tolist(), self.u.tolist(), self.v.tolist()
+        self.target_l = self.origin.tolist()
         self.roll = 0.0
         self.cid = bc.createConstraint(
             obj,
@@ -101,12 +109,24 @@ class HumanHand:
     def offset(self, t: float) -> tuple[float, float, float]:
         """(du, dv, droll) of the path from the start pose at time ``t``."""
         tt = max(t - self.start, 0.0)
-        du, dv, r = (self._A * (np.sin(self._W * tt + self._PHI) - self._S0)).sum(axis=1).tolist()
+        sin = math.sin
+        # sum_i a_i (sin(w_i tt + phi_i) - sin(phi_i)) per axis, in floats; the sum in NumPy's
+        # order (numpy_row_sum), so the path is the array form's to the bit
+        du, dv, r = (
+            numpy_row_sum([a * (sin(w * tt + phi) - s0) for w, a, phi, s0 in row])
+            for row in self._rows
+        )
         return du, dv, r
+
+    @property
+    def target(self) -> np.ndarray:
+        """Where the hand pulls the object now (m, world)."""
+        return np.array(self.target_l)
 
     def drive(self, t: float) -> None:
         du, dv, dr = self.offset(t)
-        self.target = self.origin + du * self.u + dv * self.v
+        # origin + du u + dv v per axis in floats (the vector form's operations and order)
+        self.target_l = [o + du * a + dv * b for o, a, b in zip(self._origin, self._u, self._v)]
         self.roll = dr
         # the start orientation turned by dr about the plane normal: q = q_n(dr) q0
         s, c = math.sin(dr / 2.0), math.cos(dr / 2.0)
@@ -120,7 +140,7 @@ class HumanHand:
         ]
         self.bc.changeConstraint(
             self.cid,
-            jointChildPivot=self.target.tolist(),
+            jointChildPivot=self.target_l,
             jointChildFrameOrientation=q,
             maxForce=self.max_force,
         )
@@ -129,6 +149,29 @@ class HumanHand:
         """The constraint's force on the object (N, world), from the last step."""
         st = self.bc.getConstraintState(self.cid)
         return [float(st[0]), float(st[1]), float(st[2])]
+
+
+def numpy_row_sum(xs: list) -> float:
+    """sum(xs) in the order of NumPy's pairwise summation of a contiguous float64 row
+    (numpy/_core/src/umath/loops_utils.h: sequential below 8 terms, eight running sums up to
+    its 128-term block); longer rows are left to NumPy itself."""
+    n = len(xs)
+    if n < 8:
+        acc = 0.0
+        for x in xs:
+            acc += x
+        return acc
+    if n > 128:
+        return float(np.sum(np.asarray(xs, float)))
+    r = xs[:8]
+    m = n - n % 8
+    for i in range(8, m, 8):
+        for j in range(8):
+            r[j] += xs[i + j]
+    acc = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    for x in xs[m:]:
+        acc += x
+    return acc
 
 
 def _rpy_matrix(rpy) -> np.ndarray:

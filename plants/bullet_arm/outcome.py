@@ -42,12 +42,24 @@ class CatchWatch:
         self.kind = kind
         self.palm_radius = float(palm_radius)
         self.palm_thickness = float(palm_thickness)
-        self.last: PalmSample | None = None
+        # the last and the closest sample as PalmSample's fields (a tuple: made every step; the
+        # dataclass only when asked for)
+        self._last: tuple | None = None
+        self._closest: tuple | None = None
         self.first_contact: tuple[PalmSample, list] | None = None
-        self.closest: PalmSample | None = None
         self.catch_time: float | None = None
         self.approaching = True
         self._closest_d2 = math.inf  # |world_offset|^2 of ``closest``
+
+    @property
+    def last(self) -> PalmSample | None:
+        """The last step's sample."""
+        return None if self._last is None else PalmSample(*self._last)
+
+    @property
+    def closest(self) -> PalmSample | None:
+        """The sample of the closest approach (object centre to the palm face centre)."""
+        return None if self._closest is None else PalmSample(*self._closest)
 
     def observe(
         self,
@@ -89,26 +101,20 @@ class CatchWatch:
         inward = -(Z[0] * rel[0] + Z[1] * rel[1] + Z[2] * rel[2])  # towards the palm face
         angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
         dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-        sample = PalmSample(t, math.hypot(lx, ly), lz, speed, angle, tuple(float(x) for x in d))
-        if self.closest is None or dist2 < self._closest_d2:
-            self.closest, self._closest_d2 = sample, dist2
-        self.approaching = self.closest is sample  # still closing in at the last step
+        sample = (t, math.hypot(lx, ly), lz, speed, angle, d)  # PalmSample's fields
+        # still closing in at the last step: this sample is the closest so far
+        self.approaching = self._closest is None or dist2 < self._closest_d2
+        if self.approaching:
+            self._closest, self._closest_d2 = sample, dist2
         if parts and self.first_contact is None:
-            before = self.last or sample
+            before = self._last or sample
             self.first_contact = (
-                PalmSample(
-                    t,
-                    sample.offset,
-                    sample.height,
-                    before.rel_speed,
-                    before.approach_angle,
-                    sample.world_offset,
-                ),
+                PalmSample(t, sample[1], sample[2], before[3], before[4], d),
                 sorted(parts),
             )
         if caught and self.catch_time is None:
             self.catch_time = t
-        self.last = sample
+        self._last = sample
 
     def verdict(self, *, caught: bool, ever_caught: bool) -> dict:
         k = self.kind

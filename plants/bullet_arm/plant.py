@@ -16,6 +16,7 @@ PyBullet facts used (shared/robots/README.md, measured on this machine):
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 
@@ -45,6 +46,17 @@ from replay.scene import Box, Frame, Scene, Sphere
 with quiet_c_output():  # PyBullet's import prints a build banner
     import pybullet as p
     from pybullet_utils import bullet_client
+
+
+# the PyBullet calls made every step through the client (the plant, the grasp rig's helpers, the
+# bench): BulletClient builds a new functools.partial (client id bound) at each attribute access,
+# so the plant keeps one per name on its client (the same call)
+PER_STEP_CALLS = (
+    "stepSimulation",
+    "setJointMotorControlArray",
+    "changeConstraint",
+    "getConstraintState",
+)
 
 
 class BulletArmPlant(Plant):
@@ -101,18 +113,19 @@ class BulletArmPlant(Plant):
             int(bc.getJointInfo(self.robot, j)[16]) for j in range(bc.getNumJoints(self.robot))
         ]
         self._base_pose = (tuple(float(x) for x in P.base_position), tuple(orn))
+        self._all_links = list(range(len(self._parent_link)))
         self.active = tuple(i for i, n in enumerate(names) if n not in self.locked)
         self._arm_j = [self._jidx[names[i]] for i in self.active]
         self.hand_names = self.model.hand_joints
         self._hand_j = [self._jidx[n] for n in self.hand_names]
+        self._tool_link = self._link_index["wam_tool"]
+        self._palm_link = self._link_index.get("palm")
         # pybullet dof order (movable joints in index order) -> for calculate* helpers
         self._dofs = [
             j
             for j in range(bc.getNumJoints(self.robot))
             if bc.getJointInfo(self.robot, j)[2] == p.JOINT_REVOLUTE
         ]
-        self._tool_link = self._link_index["wam_tool"]
-        self._palm_link = self._link_index.get("palm")
         for j in range(-1, bc.getNumJoints(self.robot)):
             bc.changeDynamics(
                 self.robot,
@@ -131,16 +144,27 @@ class BulletArmPlant(Plant):
         h0 = S.hand_initial.copy()
         for j, v in zip(self._hand_j, h0):
             bc.resetJointState(self.robot, j, float(v), 0.0)
-        self._hand_target = h0.copy()
+        self._hand_target = h0.tolist()
         # one getJointStates a step for the arm and the hand; q of the locked joints preset
         self._read_j = self._arm_j + self._hand_j
-        self._act_idx = np.array(self.active, dtype=int)
-        self._q_locked = np.zeros(dof)
-        for n, v in self.locked.items():
-            self._q_locked[names.index(n)] = v
-        self._locked_idx = np.array([names.index(n) for n in self.locked], dtype=int)
+        self._na = len(self._arm_j)
+        self._all_active = len(self.active) == dof  # no locked joint: no index mapping
+        self._q_locked_l = [float(self.locked.get(n, 0.0)) for n in names]
+        # every arm joint's value from the read joints' (locked ones appended): one itemgetter
+        na = self._na
+        slot = {i: k for k, i in enumerate(self.active)}
+        self._arm_pick = operator.itemgetter(*[slot.get(i, na + i) for i in range(dof)])
+        self._locked_tail = tuple(self._q_locked_l)
+        self._zero_tail = (0.0,) * dof
+        # the tool frame and the palm: one getLinkStates a step (_frames_now)
+        self._frame_links = [self._tool_link] + (
+            [] if self._palm_link is None else [self._palm_link]
+        )
         # BulletClient makes a new functools.partial on every attribute access: bind the calls
-        # made every step once (stepSimulation stays an attribute: the bench times it there)
+        # made every step once; those called through the client (stepSimulation: the bench
+        # times it there) are kept on it as attributes
+        for name in PER_STEP_CALLS:
+            setattr(bc, name, getattr(bc, name))
         self._get_joint_states = bc.getJointStates
         self._get_base_pose = bc.getBasePositionAndOrientation
         self._get_base_velocity = bc.getBaseVelocity
@@ -151,6 +175,9 @@ class BulletArmPlant(Plant):
         if ht is not None:
             self._hand_lo = np.array([j.lower for j in ht.joints])
             self._hand_hi = np.array([j.upper for j in ht.joints])
+            self._hand_lo_l, self._hand_hi_l = self._hand_lo.tolist(), self._hand_hi.tolist()
+        self._hand_speed = float(P.hand_closing_speed)
+        self._hand_forces = [float(P.hand_max_torque)] * len(self._hand_j)
 
         # ---- the free object
         self.obj = None
@@ -182,9 +209,10 @@ class BulletArmPlant(Plant):
             bc.resetBaseVelocity(self.obj, list(P.object_velocity), list(P.object_angular_velocity))
 
         # ---- command and bookkeeping
-        self._tau_cmd = np.zeros(dof)
-        self._tau_applied = np.zeros(dof)
-        self._clamped = np.zeros(dof, dtype=bool)
+        # per joint in plain floats and bools (4-7 of them: lists beat arrays)
+        self._tau_cmd = [0.0] * dof
+        self._tau_applied = [0.0] * dof
+        self._clamped = [False] * dof
         self._events: list[Occurrence] = []
         self._t = 0.0
         self._steps = 0
@@ -202,14 +230,20 @@ class BulletArmPlant(Plant):
         self._tlim_l = self.torque_limits.tolist()
         self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
         self._locked_l = [n in self.locked for n in self.joint_names]
-        self._contact_summary = (None, [], [], 0.0)  # (contacts list it is of, parts, links, N)
-        self._torque_episode = np.zeros(dof, dtype=bool)
+        self._contact_summary = (None, (), (), 0.0)  # (contacts list it is of, parts, links, N)
+        self._contact_key: tuple = ()  # the touching links of the last summary, and their names
+        self._contact_names: tuple = ((), ())
+        # the scene's primitive sizes as floats, once
+        self._obj_radius = float(P.object_radius)
+        self._obj_albedo = float(P.object_albedo)
+        self._obj_size = tuple(float(s) for s in P.object_size)
+        self._torque_episode = [False] * dof
         self._obj_vel_before = (
-            np.asarray(P.object_velocity, float) if self.obj is not None else np.zeros(3)
+            tuple(float(x) for x in P.object_velocity) if self.obj is not None else (0.0,) * 3
         )
         self._contacts: list = []
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
-        self._cache = None
+        self._cache: tuple | None = None
         self._effector = None  # (step, the tool link's state): read at most once a step
         self._spec = self._make_spec(q0)
         ht = self.hand_table  # the catch verdict (outcome.py): a free object and a hand
@@ -229,7 +263,7 @@ class BulletArmPlant(Plant):
     def _make_spec(self, q0: np.ndarray) -> ArmSpec:
         P = self.params
         ht = self.hand_table
-        model = self.settings.chain(self._hand_target)
+        model = self.settings.chain(np.asarray(self._hand_target, float))
         hand = None
         if ht is not None:
             hand = HandSpec(
@@ -282,32 +316,32 @@ class BulletArmPlant(Plant):
 
     # ------------------------------------------------------------------ state
     def _state(self) -> tuple:
-        """((q, qd), hand (q, qd, effort), object (pos, orn, v, w) or None), read from PyBullet
-        once after each step (one getJointStates for arm and hand) and kept until the next one
-        (``invalidate_state`` after changing the simulation other than by stepping it)."""
+        """((q, qd), hand (q, qd, effort), object (pos, orn, v, w) or None) as plain floats
+        (lists; the object's PyBullet tuples), read from PyBullet once after each step (one
+        getJointStates for arm and hand) and kept until the next one (``invalidate_state``
+        after changing the simulation other than by stepping it). Shared, never mutated: the
+        accessors below give copies."""
         if self._cache is None:
-            st = self._get_joint_states(self.robot, self._read_j)
-            na = len(self._arm_j)
-            q = self._q_locked.copy()
-            qd = np.zeros(self.dof)
-            q[self._act_idx] = [s[0] for s in st[:na]]
-            qd[self._act_idx] = [s[1] for s in st[:na]]
-            if na < len(st):
-                hs = st[na:]
-                hand = (
-                    np.array([s[0] for s in hs]),
-                    np.array([s[1] for s in hs]),
-                    np.array([s[3] for s in hs]),
-                )
-            else:
-                hand = (np.zeros(0), np.zeros(0), np.zeros(0))
+            pos, vel, _, eff = zip(*self._get_joint_states(self.robot, self._read_j))
+            q, qd = self._arm_q(pos, vel)
+            na = self._na
+            hand = (list(pos[na:]), list(vel[na:]), list(eff[na:]))
             obj = None
             if self.obj is not None:
                 pos, orn = self._get_base_pose(self.obj)
                 v, w = self._get_base_velocity(self.obj)
-                obj = (np.array(pos), np.array(orn), np.array(v), np.array(w))
+                obj = (pos, orn, v, w)
             self._cache = ((q, qd), hand, obj)
         return self._cache
+
+    def _arm_q(self, pos: tuple, vel: tuple) -> tuple[list, list]:
+        """(q, qd) of every arm joint from the read joints' positions and velocities (locked
+        joints at their lock value, zero speed)."""
+        if self._all_active:
+            na = self._na
+            return list(pos[:na]), list(vel[:na])
+        pick, na = self._arm_pick, self._na
+        return list(pick(pos[:na] + self._locked_tail)), list(pick(vel[:na] + self._zero_tail))
 
     def invalidate_state(self) -> None:
         """Forget the state read from PyBullet (after a reset* call: the next read is fresh)."""
@@ -317,13 +351,13 @@ class BulletArmPlant(Plant):
     def arm_state(self) -> tuple[np.ndarray, np.ndarray]:
         """(q, qd) of every arm joint (locked ones at their lock value, zero speed)."""
         q, qd = self._state()[0]
-        return q.copy(), qd.copy()
+        return np.array(q), np.array(qd)
 
     def hand_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return tuple(a.copy() for a in self._state()[1])
+        return tuple(np.array(a, dtype=float) for a in self._state()[1])
 
     def object_state(self):
-        return tuple(a.copy() for a in self._state()[2])
+        return tuple(np.array(a) for a in self._state()[2])
 
     def effector_state(self):
         """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity (read
@@ -338,11 +372,8 @@ class BulletArmPlant(Plant):
         """(tool (pos, orn, v, w), palm link state or None): one getLinkStates a step for the
         tool frame and the palm (the catch check's point velocity)."""
         if self._effector is None or self._effector[0] != self._steps:
-            links = (
-                [self._tool_link] if self._palm_link is None else [self._tool_link, self._palm_link]
-            )
             st = self._get_link_states(
-                self.robot, links, computeLinkVelocity=1, computeForwardKinematics=1
+                self.robot, self._frame_links, computeLinkVelocity=1, computeForwardKinematics=1
             )
             ls = st[0]
             self._effector = (
@@ -356,20 +387,23 @@ class BulletArmPlant(Plant):
         tau = np.asarray(command.torque, dtype=float).reshape(-1)
         if tau.shape != (self.dof,):
             raise ValueError(f"ArmCommand.torque needs {self.dof} values, got {tau.shape[0]}")
-        self._tau_cmd = tau
+        self._tau_cmd = tau.tolist()
         if command.hand is not None and self._hand_j:
             h = np.asarray(command.hand, dtype=float).reshape(-1)
             if h.shape != (len(self._hand_j),):
                 raise ValueError(f"ArmCommand.hand needs {len(self._hand_j)} values")
-            self._hand_target = np.clip(h, self._hand_lo, self._hand_hi)
+            # np.clip per joint in floats (NaN stays NaN, as there)
+            self._hand_target = [
+                min(max(x, lo), hi)
+                for x, lo, hi in zip(h.tolist(), self._hand_lo_l, self._hand_hi_l)
+            ]
 
-    def _limit_torque(self, qd: np.ndarray) -> None:
+    def _limit_torque(self, qdl: list) -> None:
         """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
         locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
         its speed limit further. Per joint in plain Python (4-7 floats)."""
         enforce = self.params.enforce_velocity_limits
-        cmd = self._tau_cmd.tolist()
-        qdl = qd.tolist()
+        cmd = self._tau_cmd
         applied, clamped = [0.0] * self.dof, [False] * self.dof
         sign = lambda x: (x > 0.0) - (x < 0.0)  # noqa: E731  (np.sign)
         for i, (x, lim) in enumerate(zip(cmd, self._tlim_l)):
@@ -383,7 +417,7 @@ class BulletArmPlant(Plant):
             if enforce and abs(qdl[i]) >= self._vlim_l[i] and sign(a) == sign(qdl[i]) and a != 0:
                 a, c = 0.0, True
             applied[i], clamped[i] = a, c
-        if any(clamped):
+        if True in clamped:
             for i, c in enumerate(clamped):
                 if c and not self._torque_episode[i]:
                     x = cmd[i]
@@ -399,48 +433,49 @@ class BulletArmPlant(Plant):
                         )
                     )
             self.clamp_count += sum(clamped)
-        self._tau_applied = np.array(applied)
-        self._clamped = self._torque_episode = np.array(clamped, dtype=bool)
+        self._tau_applied = applied
+        self._clamped = self._torque_episode = clamped
 
     def step(self) -> None:
         bc = self.bc
-        self._limit_torque(self._state()[0][1])
+        (_, qd), hand, obj = self._state()
+        self._limit_torque(qd)
+        applied = self._tau_applied
         self._set_motors(
             self.robot,
             self._arm_j,
             p.TORQUE_CONTROL,
-            forces=self._tau_applied[self._act_idx].tolist(),
+            forces=[applied[i] for i in self.active],
         )
         if self._hand_j:
-            hq = self._state()[1][0]
-            speed = self.params.hand_closing_speed
+            speed, dt = self._hand_speed, self.dt
             # rate-limited position servo: reach the target at most at the closing speed, the
             # last step landing on it (PyBullet's velocity motor is implicit, so this is stable)
-            v = np.minimum(np.maximum((self._hand_target - hq) / self.dt, -speed), speed)
+            v = [min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])]
             self._set_motors(
                 self.robot,
                 self._hand_j,
                 p.VELOCITY_CONTROL,
-                targetVelocities=v.tolist(),
-                forces=[self.params.hand_max_torque] * len(v),
+                targetVelocities=v,
+                forces=self._hand_forces,
             )
-        if self.obj is not None:
-            pos, _, v, _ = self._state()[2]
+        if obj is not None:
+            pos, _, v, w = obj
             J = self._impulses.pop(self._steps) if self._impulses else None
             if J is not None:  # a scenario-set kick (impulse.py)
-                v = v + J / self.params.object_mass
-                bc.resetBaseVelocity(self.obj, v.tolist(), self.object_state()[3].tolist())
+                v = (np.asarray(v) + J / self.params.object_mass).tolist()
+                bc.resetBaseVelocity(self.obj, v, list(w))
                 self.invalidate_state()
                 self._events.append(
-                    Occurrence("impulse", {"impulse": J.tolist(), "velocity_after": v.tolist()})
+                    Occurrence("impulse", {"impulse": J.tolist(), "velocity_after": v})
                 )
-            self._obj_vel_before = v
+            self._obj_vel_before = tuple(v)
             if not self.params.object_gravity:
                 bc.applyExternalForce(
                     self.obj,
                     -1,
                     [0.0, 0.0, self.params.object_mass * self.params.gravity],
-                    pos.tolist(),
+                    list(pos),
                     p.WORLD_FRAME,
                 )
         bc.stepSimulation()
@@ -455,9 +490,10 @@ class BulletArmPlant(Plant):
         pts = self._get_contact_points(bodyA=self.obj, bodyB=self.robot)
         return [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
 
-    def _link_point_velocity(self, link: int, point: np.ndarray) -> np.ndarray:
+    def _link_point_velocity(self, link: int, point) -> tuple[float, float, float]:
+        """v + w x (point - link COM) of a robot link now (world), as floats."""
         if link < 0:
-            return np.zeros(3)
+            return (0.0, 0.0, 0.0)
         ls = self._frames_now()[1] if link == self._palm_link else None
         if ls is None:
             ls = self._get_link_state(
@@ -466,17 +502,16 @@ class BulletArmPlant(Plant):
         (vx, vy, vz), (wx, wy, wz), (cx, cy, cz) = ls[6], ls[7], ls[0]
         rx, ry, rz = (float(x) for x in point)
         rx, ry, rz = rx - cx, ry - cy, rz - cz  # v + w x (point - link COM)
-        return np.array([vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx])
+        return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx)
 
     def _check_events(self) -> None:
         P = self.params
-        q, qd = self.arm_state()
-        ql, qdl = q.tolist(), qd.tolist()  # per-joint checks on 4-7 floats: plain Python
+        (ql, qdl), _, obj = self._state()  # per-joint checks on 4-7 floats: plain Python
         isfinite = math.isfinite
         finite = all(map(isfinite, ql)) and all(map(isfinite, qdl))
-        if self.obj is not None:
-            pos, orn, v, w = self.object_state()
-            finite = finite and all(map(isfinite, pos.tolist())) and all(map(isfinite, v.tolist()))
+        if obj is not None:
+            pos, orn, v, w = obj
+            finite = finite and all(map(isfinite, pos)) and all(map(isfinite, v))
         if not finite:
             if not self.diverged:
                 self.diverged = True
@@ -511,27 +546,27 @@ class BulletArmPlant(Plant):
                     )
                 )
         self._at_limit = at
-        if self.obj is None:
+        if obj is None:
             return
         contacts = self._robot_contacts()
         self._contacts = contacts
-        _, parts, links, _ = self._contact_summary_now()
+        parts, links, _ = self._contact_summary_now()
         if contacts and not self._in_contact:
             c = max(contacts, key=lambda c: c[9])
             point = np.array(c[6])
             n = np.array(c[7])  # from the robot towards the object
-            v_rel = self._obj_vel_before - self._link_point_velocity(c[4], point)
+            v_rel = np.subtract(self._obj_vel_before, self._link_point_velocity(c[4], point))
             self._events.append(
                 Occurrence(
                     "contact",
                     {
-                        "links": links,
-                        "parts": parts,
+                        "links": list(links),
+                        "parts": list(parts),
                         "position": point.tolist(),
                         "speed": float(np.linalg.norm(v_rel)),
                         "normal_speed": float(-v_rel @ n),
-                        "object_velocity_before": self._obj_vel_before.tolist(),
-                        "object_velocity_after": v.tolist(),
+                        "object_velocity_before": list(self._obj_vel_before),
+                        "object_velocity_after": list(v),
                     },
                 )
             )
@@ -540,8 +575,9 @@ class BulletArmPlant(Plant):
         hand_parts = [x for x in parts if x != "arm"]
         held = False
         if self._palm_link is not None and len(hand_parts) >= P.catch_min_parts:
-            rel = v - self._link_point_velocity(self._palm_link, pos)
-            held = math.sqrt(float(rel @ rel)) < P.catch_relative_speed
+            px, py, pz = self._link_point_velocity(self._palm_link, pos)
+            dx, dy, dz = v[0] - px, v[1] - py, v[2] - pz
+            held = math.sqrt(dx * dx + dy * dy + dz * dz) < P.catch_relative_speed
         if held:
             self._hold += self.dt
             self._unhold = 0.0
@@ -556,26 +592,22 @@ class BulletArmPlant(Plant):
                     self.hold_event,
                     {
                         "parts": hand_parts,
-                        "links": links,
-                        "position": pos.tolist(),
+                        "links": list(links),
+                        "position": list(pos),
                         "hold_time": float(self._hold),
                     },
                 )
             )
         if self.caught and not held and self._unhold >= P.catch_hold_time - eps:
             self.caught = False
-            self._events.append(Occurrence("release", {"position": pos.tolist()}))
+            self._events.append(Occurrence("release", {"position": list(pos)}))
         if not self._fallen and pos[2] < P.miss_height:
             self._fallen = True
             kind = "drop" if self._ever_caught else "miss"
-            self._events.append(
-                Occurrence(kind, {"position": pos.tolist(), "velocity": v.tolist()})
-            )
+            self._events.append(Occurrence(kind, {"position": list(pos), "velocity": list(v)}))
         if self._watch is not None:
             pe, oe, ve, we = self._effector_now()  # floats: faster than arrays here
-            self._watch.observe(
-                self._t, pos.tolist(), v.tolist(), pe, oe, ve, we, parts, self.caught
-            )
+            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []
@@ -589,36 +621,34 @@ class BulletArmPlant(Plant):
 
     # ------------------------------------------------------------------ log and scene
     def truth(self, t: float) -> dict:
-        q, qd = self.arm_state()
+        (q, qd), (hq, hqd, heff), obj = self._state()
+        applied = self._tau_applied
+        isfinite = math.isfinite
         out = {
-            TOPIC_ARM_JOINT_STATE: JointState(
-                t, list(self.joint_names), q.tolist(), qd.tolist(), self._tau_applied.tolist()
-            ),
+            TOPIC_ARM_JOINT_STATE: JointState(t, list(self.joint_names), q[:], qd[:], applied[:]),
             TOPIC_ARM_APPLIED_TORQUE: AppliedTorque(
                 t,
                 list(self.joint_names),
-                [float(x) if math.isfinite(x) else None for x in self._tau_cmd.tolist()],
-                self._tau_applied.tolist(),
-                [bool(c) for c in self._clamped.tolist()],
+                [x if isfinite(x) else None for x in self._tau_cmd],
+                applied[:],
+                self._clamped[:],
             ),
         }
         if self._hand_j:
-            hq, hqd, heff = self.hand_state()
             out[TOPIC_HAND_JOINT_STATE] = JointState(
-                t, list(self.hand_names), hq.tolist(), hqd.tolist(), heff.tolist()
+                t, list(self.hand_names), hq[:], hqd[:], heff[:]
             )
         # the tool frame's motion; /effector/state (actual and desired point) is the controller's
-        pe, oe, ve, we = self.effector_state()
+        pe, oe, ve, we = self._effector_now()
+        vx, vy, vz = ve
         out[TOPIC_EFFECTOR_MOTION] = EffectorMotion(
-            t, pe.tolist(), oe.tolist(), ve.tolist(), we.tolist(), math.sqrt(float(ve @ ve))
+            t, list(pe), list(oe), list(ve), list(we), math.sqrt(vx * vx + vy * vy + vz * vz)
         )
-        if self.obj is not None:
-            pos, orn, v, w = self.object_state()
-            out[TOPIC_OBJECT_STATE] = ObjectState(
-                t, pos.tolist(), orn.tolist(), v.tolist(), w.tolist()
-            )
-            _, parts, links, force = self._contact_summary_now()
-            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(t, parts, links, force)
+        if obj is not None:
+            pos, orn, v, w = obj
+            out[TOPIC_OBJECT_STATE] = ObjectState(t, list(pos), list(orn), list(v), list(w))
+            parts, links, force = self._contact_summary_now()
+            out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(t, list(parts), list(links), force)
         return out
 
     def robot_description(self) -> str:
@@ -626,66 +656,59 @@ class BulletArmPlant(Plant):
 
     def frames(self) -> list[Frame]:
         """Every URDF link in its parent link (the base in ``world``): PyBullet's link frames
-        (not its centre-of-mass frames), made relative to the parent's."""
-        bc = self.bc
-        n = len(self._parent_link)
-        states = bc.getLinkStates(self.robot, list(range(n)), computeForwardKinematics=1)
+        (not its centre-of-mass frames), made relative to the parent's. The transform helpers
+        are the module's (they need no physics client: no BulletClient partial per call)."""
+        states = self._get_link_states(self.robot, self._all_links, computeForwardKinematics=1)
         world = {-1: self._base_pose}
-        out = [Frame("world", self._link_name[-1], *self._base_pose)]
+        names, parents = self._link_name, self._parent_link
+        invert, multiply = p.invertTransform, p.multiplyTransforms
+        out = [Frame("world", names[-1], *self._base_pose)]
         for j, st in enumerate(states):
             world[j] = (st[4], st[5])
-            pp, po = world[self._parent_link[j]]
-            ip, io = bc.invertTransform(pp, po)
-            rp, ro = bc.multiplyTransforms(ip, io, st[4], st[5])
-            out.append(Frame(self._link_name[self._parent_link[j]], self._link_name[j], rp, ro))
+            parent = parents[j]
+            ip, io = invert(*world[parent])
+            rp, ro = multiply(ip, io, st[4], st[5])
+            out.append(Frame(names[parent], names[j], rp, ro))
         return out
 
     def joints(self) -> tuple[list, list, list, list]:
         """The arm's joints (effort: the applied torque), then the hand's."""
-        q, qd = self.arm_state()
-        hq, hqd, heff = self.hand_state()
+        (q, qd), (hq, hqd, heff), _ = self._state()
         return (
             list(self.joint_names) + list(self.hand_names),
-            q.tolist() + hq.tolist(),
-            qd.tolist() + hqd.tolist(),
-            self._tau_applied.tolist() + heff.tolist(),
+            q + hq,
+            qd + hqd,
+            self._tau_applied + heff,
         )
 
-    def _contact_summary_now(self):
-        """(contacts, parts, links, total normal force) of ``_contacts``, summed once per list."""
-        if self._contact_summary[0] is not self._contacts:
-            links = sorted({self._link_name[c[4]] for c in self._contacts})
-            parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
-            force = float(sum(c[9] for c in self._contacts))
-            self._contact_summary = (self._contacts, parts, links, force)
-        _, parts, links, force = self._contact_summary
-        return self._contact_summary[0], list(parts), list(links), force
+    def _contact_summary_now(self) -> tuple[tuple, tuple, float]:
+        """(parts, links, total normal force) of ``_contacts`` (tuples, shared: copy them into
+        a payload), summed once per list."""
+        contacts = self._contacts
+        if self._contact_summary[0] is not contacts:
+            if contacts:
+                key = tuple(c[4] for c in contacts)  # the touching links: names once per set
+                if key != self._contact_key:
+                    links = sorted({self._link_name[k] for k in key})
+                    parts = sorted({self.model.part_of_link.get(l, "arm") for l in links})
+                    self._contact_key, self._contact_names = key, (tuple(parts), tuple(links))
+                parts, links = self._contact_names
+                force = float(sum(c[9] for c in contacts))
+                self._contact_summary = (contacts, parts, links, force)
+            else:
+                self._contact_summary = (contacts, (), (), 0.0)
+        return self._contact_summary[1:]
 
     def scene(self) -> Scene:
+        (q, qd), _, obj = self._state()
         prims = []
-        if self.obj is not None:
-            pos, orn, _, _ = self.object_state()
-            if self.params.object == "ball":
-                prims.append(
-                    Sphere(
-                        "ball",
-                        tuple(pos.tolist()),
-                        float(self.params.object_radius),
-                        float(self.params.object_albedo),
-                    )
-                )
+        if obj is not None:
+            P = self.params
+            if P.object == "ball":
+                prims.append(Sphere("ball", obj[0], self._obj_radius, self._obj_albedo))
             else:
-                prims.append(
-                    Box(
-                        "box",
-                        tuple(pos.tolist()),
-                        tuple(orn.tolist()),
-                        tuple(float(s) for s in self.params.object_size),
-                        float(self.params.object_albedo),
-                    )
-                )
-        q, qd = self.arm_state()
-        encoders = {"name": list(self.joint_names), "position": q.tolist(), "velocity": qd.tolist()}
+                prims.append(Box("box", obj[0], obj[1], self._obj_size, self._obj_albedo))
+        encoders = {"name": list(self.joint_names), "position": q[:], "velocity": qd[:]}
         return Scene(prims, readings={"arm": encoders})
 
     def close(self) -> None:

@@ -17,12 +17,16 @@ joint). The torque given is what a strain gauge on the drive reads.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pybullet as p
 
 
 class VelocityServos:
-    """A bank of PI velocity servos on joints ``joints`` of body ``body``."""
+    """A bank of PI velocity servos on joints ``joints`` of body ``body``. The state is kept
+    per joint in plain floats (7 joints: lists beat arrays); the attributes ``command``,
+    ``integral``, ``torque``, ``saturated`` give it as arrays."""
 
     def __init__(self, inertia, torque_limits, bandwidth: float, dt: float) -> None:
         self.limits = np.asarray(torque_limits, float).reshape(-1)
@@ -31,39 +35,48 @@ class VelocityServos:
             raise ValueError("one torque limit and one inertia per servo joint")
         self.wi = float(bandwidth) / 4.0
         self.dt = dt
-        self.command = np.zeros(len(self.K))
-        self.integral = np.zeros(len(self.K))
-        self.torque = np.zeros(len(self.K))
-        self.saturated = np.zeros(len(self.K), dtype=bool)
+        n = len(self.K)
+        self._lim, self._K = self.limits.tolist(), self.K.tolist()
+        self.command_l = [0.0] * n
+        self.integral_l = [0.0] * n
+        self.torque_l = [0.0] * n
+        self.saturated_l = [False] * n
+
+    command = property(lambda self: np.array(self.command_l))
+    integral = property(lambda self: np.array(self.integral_l))
+    torque = property(lambda self: np.array(self.torque_l))
+    saturated = property(lambda self: np.array(self.saturated_l, dtype=bool))
 
     def preload(self, torque) -> None:
         """Start with the integral that gives ``torque`` at zero velocity error (a servo that was
         holding its joint before the run began)."""
         tau = np.clip(np.asarray(torque, float), -self.limits, self.limits)
-        self.integral = tau / (self.K * self.wi)
-        self.torque = tau
+        self.integral_l = (tau / (self.K * self.wi)).tolist()
+        self.torque_l = tau.tolist()
 
     def set_command(self, qd) -> None:
         v = np.asarray(qd, float).reshape(-1)
-        if v.shape != self.command.shape:
+        if v.shape != (len(self._K),):
             raise ValueError(f"velocity command needs {len(self.K)} values, got {v.shape[0]}")
-        self.command = np.where(np.isfinite(v), v, 0.0)  # a non-finite command: stop
+        self.command_l = [x if math.isfinite(x) else 0.0 for x in v.tolist()]  # non-finite: stop
 
-    def torques(self, qd: np.ndarray) -> np.ndarray:
-        """The motors' torques for joint velocities ``qd`` (before a physics step)."""
-        e = self.command - qd
-        integral = self.integral + e * self.dt
-        raw = self.K * (e + self.wi * integral)
-        lim = self.limits
-        sat = np.abs(raw) > lim
-        self.integral = np.where(sat, self.integral, integral)  # anti-windup
-        self.torque = np.clip(raw, -lim, lim)
-        self.saturated = sat
-        return self.torque
-
-
-def apply_torques(bc, body: int, joints: list, torques: np.ndarray) -> None:
-    bc.setJointMotorControlArray(body, joints, p.TORQUE_CONTROL, forces=torques.tolist())
+    def torques(self, qd: list) -> list:
+        """The motors' torques for joint velocities ``qd`` (before a physics step), per joint in
+        floats: the same operations as the vector form (e = w_d - w; integral + e dt; K (e + w_i
+        integral); clipped; the integral held at the limit)."""
+        dt, wi = self.dt, self.wi
+        integral, torque, sat = self.integral_l[:], [0.0] * len(qd), [False] * len(qd)
+        for i, (c, w, K, lim) in enumerate(zip(self.command_l, qd, self._K, self._lim)):
+            e = c - w
+            acc = integral[i] + e * dt
+            raw = K * (e + wi * acc)
+            if abs(raw) > lim:
+                sat[i] = True  # anti-windup: the integral stays
+            else:
+                integral[i] = acc
+            torque[i] = min(max(raw, -lim), lim)
+        self.integral_l, self.torque_l, self.saturated_l = integral, torque, sat
+        return torque
 
 
 class VelocityMotors:
@@ -78,24 +91,24 @@ class VelocityMotors:
         self.bc, self.body, self.joints = bc, body, list(joints)
         self.limits = np.asarray(torque_limits, float).reshape(-1)
         self._forces = [float(x) for x in self.limits]
-        self.command = np.zeros(len(self.joints))
-        self.torque = np.zeros(len(self.joints))
+        self.command = [0.0] * len(self.joints)
+        self.torque = [0.0] * len(self.joints)  # N m per joint, floats
 
     def set_command(self, qd) -> None:
         v = np.asarray(qd, float).reshape(-1)
-        if v.shape != self.command.shape:
+        if v.shape != (len(self.joints),):
             raise ValueError(f"velocity command needs {len(self.joints)} values, got {v.shape[0]}")
-        self.command = np.where(np.isfinite(v), v, 0.0)
+        self.command = [x if math.isfinite(x) else 0.0 for x in v.tolist()]
 
     def actuate(self) -> None:
         self.bc.setJointMotorControlArray(
             self.body,
             self.joints,
             p.VELOCITY_CONTROL,
-            targetVelocities=self.command.tolist(),
+            targetVelocities=self.command,
             forces=self._forces,
         )
 
-    def read(self, states) -> None:
-        """The motors' torques from this step's joint states (index 3)."""
-        self.torque = np.array([s[3] for s in states])
+    def read(self, torques) -> None:
+        """The motors' torques of this step (the joint states' appliedJointMotorTorque)."""
+        self.torque = list(torques)

@@ -45,7 +45,9 @@ class JointEncoders(Sensor):
         r = scene.readings.get(self.params.reading)
         if r is None:
             return None
-        q = np.asarray(r["position"], dtype=float)
-        if self.params.resolution > 0.0:
-            q = np.round(q / self.params.resolution) * self.params.resolution
-        return JointState(t, list(r["name"]), q.tolist(), list(r["velocity"]), [0.0] * len(q))
+        res = self.params.resolution
+        if res > 0.0:
+            q = (np.round(np.asarray(r["position"], dtype=float) / res) * res).tolist()
+        else:  # exact: the reading's floats as they are (no array round trip)
+            q = [float(x) for x in r["position"]]
+        return JointState(t, list(r["name"]), q, list(r["velocity"]), [0.0] * len(q))

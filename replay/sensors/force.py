@@ -57,10 +57,12 @@ class WristFTSensor(Sensor):
         r = scene.readings.get("wrist")
         if r is None:
             return None
-        w = np.asarray(r["wrench"], dtype=float)
         if self._noisy:
-            w = w + self._sigma * self.rng.standard_normal(6)
-        v = w.tolist()
+            v = (
+                np.asarray(r["wrench"], dtype=float) + self._sigma * self.rng.standard_normal(6)
+            ).tolist()
+        else:  # exact: the reading's floats as they are (no array round trip)
+            v = [float(x) for x in r["wrench"]]
         return WristWrench(t, v[:3], v[3:])
 
 

@@ -39,7 +39,7 @@ def test_wrist_sensor_reads_the_hands_weight_when_still():
     plant = rig()
     try:
         settle(plant)
-        w = plant._wrench
+        w = np.array(plant._wrench)
         R = palm_rotation(plant)
         m = hand_mass(GRASP4)
         g = np.array([0.0, 0.0, -9.81])
@@ -59,7 +59,7 @@ def test_wrist_sensor_reads_an_added_static_force():
     plant = rig()
     try:
         settle(plant)
-        base = plant._wrench.copy()
+        base = np.array(plant._wrench)
         F = np.array([0.0, 5.0, 0.0])
         for _ in range(400):
             pos = plant.bc.getLinkState(plant.robot, plant._palm_link)[0]  # the palm's CoM
@@ -69,7 +69,7 @@ def test_wrist_sensor_reads_an_added_static_force():
             plant.apply(ServoCommand(arm=[0.0] * 7, hand=[0.0] * 14))
             plant.step()
         R = palm_rotation(plant)
-        extra = plant._wrench - base
+        extra = np.array(plant._wrench) - base
         # the hand pushed +y; it loads the flange with the same force (palm frame)
         np.testing.assert_allclose(R @ extra[:3], F, atol=0.05)
         r = R @ np.array([0.0, 0.0, GRASP4.palm_size[2] / 2.0])
@@ -88,7 +88,7 @@ def test_arm_servo_torque_is_limited_and_the_joint_lags():
             assert np.all(np.abs(plant._tau_applied) <= lim + 1e-9)
         assert plant._clamped[0]  # J1 at its 60 N m
         assert abs(plant._tau_applied[0]) == pytest.approx(lim[0])
-        assert 0.0 < plant._qd[0] < 3.0  # not an ideal joint: it lags
+        assert 0.0 < plant.arm_state()[1][0] < 3.0  # not an ideal joint: it lags
         kinds = [e.kind for e in plant.pop_events()]
         assert "torque_limit" in kinds
     finally:
@@ -104,12 +104,12 @@ def test_arm_servo_follows_a_feasible_velocity_command():
             plant.apply(ServoCommand(arm=cmd))
             plant.step()
             if k >= 200:
-                err.append(plant._qd - cmd)
+                err.append(plant.arm_state()[1] - cmd)
         err = np.abs(np.array(err))
         # the mean follows; the redundant axes (J1, J3, J5, J7 nearly coupled at this posture)
         # keep a ~10 Hz wobble of a few 0.01 rad/s with the fingers
         assert err.mean() < 0.01 and err.max() < 0.06
-        assert not plant._clamped.any()
+        assert not any(plant._clamped)
     finally:
         plant.close()
 
@@ -282,7 +282,7 @@ def test_frames_read_once_a_step_equal_pybullets_own_reads_while_moving():
             want = np.array(palm[6]) + np.cross(np.array(palm[7]), point - np.array(palm[0]))
             got = plant._link_point_velocity(plant._palm_link, point)
             np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
-            np.testing.assert_allclose(plant._tool_position(), tool[4], rtol=0.0, atol=1e-12)
+            np.testing.assert_allclose(plant._frames_now()[0][0], tool[4], rtol=0.0, atol=1e-12)
     finally:
         plant.close()
 
@@ -313,7 +313,7 @@ def test_the_robot_never_collides_with_itself():
 def test_kept_pybullet_calls_stay_bound_to_each_rigs_own_client():
     """Two rigs at once: the per-step calls kept on each client carry that client's id, so
     stepping one moves only its own world."""
-    from plants.bullet_arm.grasp_plant import PER_STEP_CALLS
+    from plants.bullet_arm.plant import PER_STEP_CALLS
 
     a, b = rig(human_speed=0.1), rig(human_speed=0.1)
     try:
