@@ -4,8 +4,10 @@ the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c
 the buffer protocol, no NumPy headers), as are the stereo camera's frame and a sphere's silhouette
 (replay/sensors/_stereo.c, _silhouette.c), the catching mapping
 (replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
-(replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c) and the
-air table's once-a-step body input/output (plants/airtable/_bodies.c)."""
+(replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
+air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
+(replay/foxglove/_png.c) and the log's chunk buffer and finiteness check (replay/log/_chunk.c,
+_finite.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -54,6 +56,21 @@ setup(
         Extension(
             "replay.control.stick._sweep",
             ["replay/control/stick/_sweep.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.foxglove._png",
+            ["replay/foxglove/_png.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.log._chunk",
+            ["replay/log/_chunk.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.log._finite",
+            ["replay/log/_finite.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
     ],
