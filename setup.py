@@ -5,8 +5,10 @@ the buffer protocol, no NumPy headers), as are the stereo camera's frame and a s
 (replay/sensors/_stereo.c, _silhouette.c), the catching mapping
 (replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
 (replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
-air table's once-a-step body input/output (plants/airtable/_bodies.c) and the grasping tasks'
-per-step kernels (replay/control/grasping/_arm_kinematics.c, _chip_target.c, _hand_servo.c)."""
+air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
+(replay/foxglove/_png.c), the log's chunk buffer and finiteness check (replay/log/_chunk.c,
+_finite.c) and the grasping tasks' per-step kernels (replay/control/grasping/_arm_kinematics.c,
+_chip_target.c, _hand_servo.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -55,6 +57,21 @@ setup(
         Extension(
             "replay.control.stick._sweep",
             ["replay/control/stick/_sweep.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.foxglove._png",
+            ["replay/foxglove/_png.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.log._chunk",
+            ["replay/log/_chunk.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.log._finite",
+            ["replay/log/_finite.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
         Extension(

@@ -6,7 +6,8 @@ users of the machine do not inflate much) and wall time; the real-time factor (s
 per second, CPU and wall); the CPU time per simulated second; the ratio of a full run's CPU time
 to the bare engine's stepping the same scene the same number of steps (Pymunk ``space.step``,
 PyBullet ``stepSimulation``, nothing else); the share of each part of the loop (the runner's own
-timers: sensors, controller, plant, logging, runner); and, apart, the interpreter's start-up and
+timers: sensors, controller, plant, logging, runner); what a JSON message, a camera image, a
+3-D frame and a /log line cost each (one more run, each such call timed); and, apart, the interpreter's start-up and
 the imports a run needs. Nothing here is a test: it prints, it does not judge.
 """
 
@@ -21,6 +22,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from replay.foxglove.run import RunTopics
+from replay.foxglove.topics import FoxgloveTopics
+from replay.log import LogWriter
 from replay.resources import scenario_dir
 from replay.runner import COMPONENTS, Runner
 from replay.scenario import load_scenario
@@ -92,6 +96,66 @@ def engine_in_run(sc, out: Path) -> tuple[float, float, int]:
     return clock() - c0, spent[0], spent[1]
 
 
+# what ``logging_costs`` times in a run: (name, class, method); the JSON messages, the camera
+# frames (the sensor's frame_images, PNG, message), the 3-D frames (/tf, /scene, /joint_states
+# with the plant's frames() and joints()), the Foxglove /log lines and opening and closing
+LOGGED = (
+    ("message", LogWriter, "write"),
+    ("image", RunTopics, "sensor"),
+    ("frame", RunTopics, "frame"),
+    ("log_line", RunTopics, "event"),
+    ("open", LogWriter, "__init__"),
+    ("close", LogWriter, "close"),
+)
+
+
+def _clock_cost(n: int = 20000) -> float:
+    """CPU seconds two ``time.process_time`` readings cost (subtracted from each timed call)."""
+    clock = time.process_time
+    c0 = clock()
+    for _ in range(n):
+        clock()
+        clock()
+    return (clock() - c0) / n
+
+
+def logging_costs(sc, out: Path) -> dict[str, tuple[float, int]]:
+    """(CPU s, calls) of each of ``LOGGED`` in one run, each call timed by ``process_time`` less
+    the timer's own cost; "image" counts the images written (a stereo frame is two)."""
+    spent = {name: [0.0, 0] for name, _, _ in LOGGED}
+    images = [0]
+    clock, overhead = time.process_time, _clock_cost()
+    original = {(cls, attr): getattr(cls, attr) for _, cls, attr in LOGGED}
+    image_of = FoxgloveTopics.image
+
+    def timed(name, fn):
+        def wrapper(*args, **kw):
+            c0 = clock()
+            out = fn(*args, **kw)
+            spent[name][0] += clock() - c0 - overhead
+            spent[name][1] += 1
+            return out
+
+        return wrapper
+
+    def counted(self, *args, **kw):
+        images[0] += 1
+        return image_of(self, *args, **kw)
+
+    try:
+        for name, cls, attr in LOGGED:
+            setattr(cls, attr, timed(name, original[(cls, attr)]))
+        FoxgloveTopics.image = counted  # type: ignore[method-assign]
+        Runner(sc).run(out)
+    finally:
+        for (cls, attr), fn in original.items():
+            setattr(cls, attr, fn)
+        FoxgloveTopics.image = image_of  # type: ignore[method-assign]
+    result = {name: (max(v[0], 0.0), v[1]) for name, v in spent.items()}
+    result["image"] = (result["image"][0], images[0])
+    return result
+
+
 def _stats(values: list[float]) -> tuple[float, float, float]:
     return statistics.median(values), min(values), max(values)
 
@@ -136,6 +200,7 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
             for c in COMPONENTS:
                 shares[c].append(result.timings[c] / total)
         run_cpu, engine_cpu, engine_steps = engine_in_run(sc, Path(tmp) / "engine.mcap")
+        logged = logging_costs(sc, Path(tmp) / "logging.mcap")
     engine, plant, step = bare_stepper(Runner(sc))
     bare = []
     for _ in range(max(runs, 3)):
@@ -157,6 +222,7 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
         "engine_in_run": (engine_cpu / run_cpu, engine_cpu / max(engine_steps, 1)),
         "engine_steps": engine_steps,
         "shares": {c: statistics.median(v) for c, v in shares.items()},
+        "logged": logged,
     }
     for key in ("cpu", "wall"):  # (median, min, max) of simulated s per second
         med, lo, hi = out[key]
@@ -203,6 +269,29 @@ def _engine_in_run(r: dict) -> str:
     )
 
 
+def _logging_line(r: dict) -> str:
+    """What each kind of logged item costs (CPU, one instrumented run) and how often."""
+    sim, logged = r["sim_time"], r["logged"]
+    parts = []
+    for name, label in (
+        ("message", "JSON message"),
+        ("image", "camera image"),
+        ("frame", "3-D frame (/tf, /scene, /joint_states)"),
+        ("log_line", "/log line"),
+    ):
+        cpu, n = logged[name]
+        if n:
+            parts.append(
+                f"{label} {1e6 * cpu / n:.1f} us x {n / sim:.0f}/s = {1e3 * cpu / sim:.1f} ms/s"
+            )
+    opened = logged["open"][0] + logged["close"][0]
+    return (
+        "logging, CPU per item (one run, each call timed): "
+        + "; ".join(parts)
+        + f"; opening and closing the log {1e3 * opened:.1f} ms a run"
+    )
+
+
 def report(r: dict) -> str:
     sim = r["sim_time"]
     lines = [
@@ -222,6 +311,8 @@ def report(r: dict) -> str:
         + " ms CPU per simulated s; logging "
         + f"{1e6 * r['shares']['logging'] * r['cpu'][0] / max(r['messages'], 1):.1f} us a message]",
     ]
+    if "logged" in r:
+        lines.append("  " + _logging_line(r))
     target = TARGETS.get(r["scenario"])
     if target is not None:
         rtf = r["rtf_cpu"][0]

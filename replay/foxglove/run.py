@@ -4,20 +4,10 @@ camera frame of a sensor with ``log_images``, each event as a ``/log`` line."""
 
 from __future__ import annotations
 
-from replay.foxglove.topics import WORLD, FoxgloveTopics
+from replay.foxglove.topics import FoxgloveTopics
 from replay.log.writer import encode
 from replay.messages import TOPIC_EVENTS, Event
-from replay.scene import Frame, Scene, Sphere
-
-_IDENTITY = (0.0, 0.0, 0.0, 1.0)
-
-
-def scene_frames(scene: Scene) -> list[Frame]:
-    """Each primitive of the scene as a frame of its own name in ``world``."""
-    return [
-        Frame(WORLD, p.name, p.position, _IDENTITY if isinstance(p, Sphere) else p.orientation)
-        for p in scene.primitives
-    ]
+from replay.scene import Scene
 
 
 class RunTopics:
@@ -39,7 +29,7 @@ class RunTopics:
 
     def frame(self, scene: Scene, t_ns: int) -> None:
         """The plant now: its bodies' and links' frames, its primitives, its joints."""
-        self.out.transforms(scene_frames(scene) + self.plant.frames(), t_ns)
+        self.out.transforms(self.plant.frames(), t_ns, bodies=scene.primitives)
         self.out.scene(scene.primitives, t_ns)
         joints = self.plant.joints()
         if joints is not None:

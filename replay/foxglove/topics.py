@@ -21,7 +21,6 @@ from __future__ import annotations
 from typing import Iterable, Sequence
 
 import numpy as np
-from foxglove_schemas_protobuf.Color_pb2 import Color
 from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
@@ -30,7 +29,8 @@ from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from google.protobuf.message import Message
 from google.protobuf.timestamp_pb2 import Timestamp
 
-from replay.foxglove.png import encode_png
+from replay.foxglove import wire
+from replay.foxglove.png import WindowedImage, png_message
 from replay.foxglove.schemas import (
     MESSAGE_ENCODING,
     SCHEMA_ENCODING,
@@ -45,7 +45,7 @@ from replay.messages import (
     TOPIC_SCENE,
     TOPIC_TF,
 )
-from replay.scene import Box, Cylinder, Frame, Sphere
+from replay.scene import Frame
 
 WORLD = "world"  # the fixed frame every pose hangs from
 
@@ -58,12 +58,6 @@ def camera_topic(sensor: str, view: str) -> str:
 
 def _stamp(t_ns: int) -> Timestamp:
     return Timestamp(seconds=t_ns // 1_000_000_000, nanos=t_ns % 1_000_000_000)
-
-
-def _grey(albedo: float) -> Color:
-    """The albedo as a grey, lifted so that a black body still shows on a dark background."""
-    v = 0.25 + 0.75 * min(max(float(albedo), 0.0), 1.0)
-    return Color(r=v, g=v, b=v, a=1.0)
 
 
 # the /events kinds that are shown as warnings / errors in the Log panel
@@ -102,6 +96,8 @@ class FoxgloveTopics:
         self.log = log  # a replay.log.LogWriter
         self._channels: dict[str, int] = {}  # topic -> channel id
         self._schemas: dict[str, int] = {}  # schema name -> id (each stored once)
+        # (sensor, view) -> (channel id, the image messages' last fields)
+        self._images: dict[tuple[str, str], tuple[int, bytes]] = {}
 
     def _channel(self, topic: str, schema: str, encoding: str, data: bytes, message: str) -> int:
         if schema not in self._schemas:
@@ -112,12 +108,7 @@ class FoxgloveTopics:
         return channel
 
     def _write(self, topic: str, msg: Message, t_ns: int) -> None:
-        channel = self._channels.get(topic)
-        if channel is None:
-            name = msg.DESCRIPTOR.full_name
-            channel = self._channel(
-                topic, name, SCHEMA_ENCODING, schema_data(type(msg)), MESSAGE_ENCODING
-            )
+        channel = self._channels.get(topic) or self._wire(topic, type(msg))
         self.log.write_raw(channel, msg.SerializeToString(deterministic=True), t_ns)
 
     def robot_description(self, urdf: str, t_ns: int) -> None:
@@ -128,58 +119,37 @@ class FoxgloveTopics:
             )
         self.log.write_raw(channel, encode_string(urdf), t_ns)
 
-    # The messages are filled in place (``add()``, attribute by attribute): ~4x faster than
-    # building them from nested constructors, same bytes.
-    def transforms(self, frames: Iterable[Frame], t_ns: int) -> None:
-        msg = FrameTransforms()
-        sec, nsec = divmod(t_ns, 1_000_000_000)
-        for f in frames:
-            x = msg.transforms.add()
-            x.timestamp.seconds, x.timestamp.nanos = sec, nsec
-            x.parent_frame_id, x.child_frame_id = f.parent, f.child
-            tr, rot = x.translation, x.rotation
-            tr.x, tr.y, tr.z = f.position
-            rot.x, rot.y, rot.z, rot.w = f.orientation
-        self._write(TOPIC_TF, msg, t_ns)
+    def _wire(self, topic: str, cls: type[Message]) -> int:
+        """The channel of a topic of ``cls`` messages (made on first use)."""
+        channel = self._channels.get(topic)
+        if channel is None:
+            name = cls.DESCRIPTOR.full_name
+            channel = self._channel(
+                topic, name, SCHEMA_ENCODING, schema_data(cls), MESSAGE_ENCODING
+            )
+        return channel
+
+    # The messages at the frame and camera rates are written straight in the wire format
+    # (replay.foxglove.wire: ~5x cheaper than filling the protobuf classes, same messages).
+    def transforms(self, frames: Iterable[Frame], t_ns: int, bodies: Sequence = ()) -> None:
+        """``frames``, after each of ``bodies`` (scene primitives) as a frame of its own name in
+        ``world``."""
+        channel = self._channels.get(TOPIC_TF) or self._wire(TOPIC_TF, FrameTransforms)
+        data = wire.body_transforms(bodies, WORLD, t_ns) + wire.frame_transforms(frames, t_ns)
+        self.log.write_raw(channel, data, t_ns)
 
     def scene(self, primitives: Sequence, t_ns: int) -> None:
         """The primitives as one entity each (id = name) at their world poses."""
-        msg = SceneUpdate()
-        sec, nsec = divmod(t_ns, 1_000_000_000)
-        for p in primitives:
-            if not isinstance(p, (Box, Sphere, Cylinder)):
-                continue
-            e = msg.entities.add()
-            e.timestamp.seconds, e.timestamp.nanos = sec, nsec
-            e.frame_id, e.id = WORLD, p.name
-            if isinstance(p, Box):
-                shape = e.cubes.add()
-                shape.size.x, shape.size.y, shape.size.z = p.size
-                orientation = p.orientation
-            elif isinstance(p, Sphere):
-                shape = e.spheres.add()
-                d = 2.0 * p.radius
-                shape.size.x = shape.size.y = shape.size.z = d
-                orientation = (0.0, 0.0, 0.0, 1.0)
-            else:  # a Cylinder: its axis is the body z axis, as Foxglove's
-                shape = e.cylinders.add()
-                d = 2.0 * p.radius
-                shape.size.x, shape.size.y, shape.size.z = d, d, p.length
-                shape.bottom_scale = shape.top_scale = 1.0
-                orientation = p.orientation
-            pos, rot = shape.pose.position, shape.pose.orientation
-            pos.x, pos.y, pos.z = p.position
-            rot.x, rot.y, rot.z, rot.w = orientation
-            shape.color.CopyFrom(_grey(p.albedo))
-        self._write(TOPIC_SCENE, msg, t_ns)
+        channel = self._channels.get(TOPIC_SCENE) or self._wire(TOPIC_SCENE, SceneUpdate)
+        self.log.write_raw(channel, wire.scene_update(primitives, WORLD, t_ns), t_ns)
 
     def joint_states(self, names, position, velocity, effort, t_ns: int) -> None:
-        msg = JointStates()
-        msg.timestamp.seconds, msg.timestamp.nanos = divmod(t_ns, 1_000_000_000)
-        for n, q, v, e in zip(names, position, velocity, effort):
-            j = msg.joints.add()
-            j.name, j.position, j.velocity, j.effort = n, q, v, e
-        self._write(TOPIC_JOINT_STATES, msg, t_ns)
+        channel = self._channels.get(TOPIC_JOINT_STATES) or self._wire(
+            TOPIC_JOINT_STATES, JointStates
+        )
+        self.log.write_raw(
+            channel, wire.joint_states(names, position, velocity, effort, t_ns), t_ns
+        )
 
     def event(self, kind: str, data: dict, text: str, t_ns: int) -> None:
         """One ``/events`` message as a log line: ``KIND {data as JSON}``."""
@@ -194,14 +164,13 @@ class FoxgloveTopics:
             t_ns,
         )
 
-    def image(self, sensor: str, view: str, image: np.ndarray, t_ns: int) -> None:
-        self._write(
-            camera_topic(sensor, view),
-            CompressedImage(
-                timestamp=_stamp(t_ns),
-                frame_id=f"{sensor}/{view}",
-                data=encode_png(image),
-                format="png",
-            ),
-            t_ns,
-        )
+    def image(self, sensor: str, view: str, image: np.ndarray | WindowedImage, t_ns: int) -> None:
+        slot = self._images.get((sensor, view))
+        if slot is None:
+            channel = self._wire(camera_topic(sensor, view), CompressedImage)
+            slot = self._images[(sensor, view)] = (
+                channel,
+                wire.image_tail(f"{sensor}/{view}", "png"),
+            )
+        channel, tail = slot
+        self.log.write_raw(channel, png_message(wire.timestamp(t_ns), image, tail), t_ns)

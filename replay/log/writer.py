@@ -17,6 +17,7 @@ Same messages in the same order give the same bytes.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 import os
@@ -29,6 +30,7 @@ from typing import Any
 import orjson
 
 from replay import __version__
+from replay.log._finite import finite
 from replay.log.chunks import MAGIC, McapFile
 from replay.log.errors import LogError, NonFiniteValueError
 from replay.messages import TOPICS, json_schema, to_dict
@@ -62,8 +64,10 @@ def encode(topic: str, payload: Any) -> bytes:
                 return _ENCODER.encode(body).encode()
             except ValueError:
                 raise NonFiniteValueError(topic, body) from None
-    if b"null" in data and not _finite(payload):
-        raise NonFiniteValueError(topic, to_dict(payload))
+    if b"null" in data:
+        ok = finite(payload)  # compiled: ~20x the speed of _finite, its reference
+        if ok is False or (ok is None and not _finite(payload)):
+            raise NonFiniteValueError(topic, to_dict(payload))
     return data
 
 
@@ -100,6 +104,18 @@ def _finite(value: Any) -> bool:
         elif tv not in _LEAVES and not _finite(v):
             return False
     return True
+
+
+@functools.cache  # once a process (a payload class's type hints cost ~1 ms a topic a run)
+def _schema_record(cls: type) -> tuple[str, bytes]:
+    """(title, JSON schema bytes) of a payload dataclass."""
+    schema = json_schema(cls)
+    return schema["title"], json.dumps(schema, separators=(",", ":")).encode()
+
+
+def _topic_schema(topic: str) -> tuple[str, bytes]:
+    """(title, JSON schema bytes) of a topic of plain dicts."""
+    return topic, json.dumps({"title": topic, "type": "object"}, separators=(",", ":")).encode()
 
 
 def seconds_to_ns(t: float) -> int:
@@ -233,7 +249,9 @@ class LogWriter:
             chunk_size=chunk_size,
             compression="" if compression == "none" else "zstd",
             level=ZSTD_LEVEL,
+            guard=self._held,
         )
+        self._message = self._mcap.message
         self._mcap.start(profile="", library=f"paper-replay {__version__}")
         self._json_channels: dict[str, int] = {}  # topic -> channel id
         self._topics: set[str] = set()  # every channel's topic
@@ -275,10 +293,8 @@ class LogWriter:
 
     def _json_channel(self, topic: str, payload: Any) -> int:
         cls = TOPICS.get(topic) or (None if isinstance(payload, dict) else type(payload))
-        schema = json_schema(cls) if cls is not None else {"title": topic, "type": "object"}
-        schema_id = self.register_schema(
-            schema["title"], "jsonschema", json.dumps(schema, separators=(",", ":")).encode()
-        )
+        title, data = _schema_record(cls) if cls is not None else _topic_schema(topic)
+        schema_id = self.register_schema(title, "jsonschema", data)
         channel = self._json_channels[topic] = self.register_channel(topic, "json", schema_id)
         return channel
 
@@ -286,22 +302,17 @@ class LogWriter:
         """Write one message; ``t_ns`` (simulated time) is both log and publish time."""
         data = encode(topic, payload)  # NonFiniteValueError before anything is written
         channel = self._json_channels.get(topic) or self._json_channel(topic, payload)  # ids > 0
-        self.write_raw(channel, data, t_ns)
+        try:  # (compiled, so whole: a finished chunk is written under the held SIGINT)
+            self._message(channel, t_ns, t_ns, data)
+        except OSError as exc:
+            raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
 
     def write_raw(self, channel_id: int, data: bytes, t_ns: int) -> None:
         """Write one message's encoded bytes on a channel of :meth:`register_channel`."""
-        held = self._held
-        held.depth += 1  # (inline ``with held:``: this runs for every message)
         try:
-            self._mcap.message(channel_id, t_ns, t_ns, data)
+            self._message(channel_id, t_ns, t_ns, data)
         except OSError as exc:
-            held.pending = False
             raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
-        finally:
-            held.depth -= 1
-        if held.pending and not held.depth:
-            held.pending = False
-            raise KeyboardInterrupt
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         with self._held:

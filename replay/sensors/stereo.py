@@ -72,6 +72,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replay.foxglove.png import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import ParamError, param
@@ -335,9 +336,15 @@ class StereoBallCamera(Sensor):
             "background": None if p.moments == "binary" else background,
         }
 
-    def frame_images(self) -> list[tuple[str, np.ndarray]]:
-        """The last frame's images (with their noise): ``[("cam0", uint8 HxW), ("cam1", ...)]``."""
-        return [(f"cam{i}", img) for i, img in enumerate(self.last_images) if img is not None]
+    def frame_images(self) -> list[tuple[str, WindowedImage]]:
+        """The last frame's images (with their noise): ``[("cam0", WindowedImage), ("cam1",
+        ...)]``, each its rendered window in the background (:attr:`last_images` whole)."""
+        p, level = self.params, self._background_level
+        return [
+            (f"cam{i}", WindowedImage(p.height, p.width, level, last[1], last[0]))
+            for i, last in enumerate(self._last)
+            if last is not None
+        ]
 
     def triangulate(self, uv0, uv1) -> np.ndarray:
         """World point (3,) from a pixel in each image: the linear (DLT) triangulation of

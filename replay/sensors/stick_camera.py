@@ -58,6 +58,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replay.foxglove.png import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_STICK, VisionStick
 from replay.params import ParamError, param
@@ -435,10 +436,16 @@ class StickCamera(Sensor):
         full[y0:y1, x0:x1] = crop
         return full
 
-    def frame_images(self) -> list[tuple[str, np.ndarray]]:
-        """The last frame (:attr:`last_image`): ``[("image", uint8 HxW)]``."""
-        image = self.last_image
-        return [] if image is None else [("image", image)]
+    def frame_images(self) -> list[tuple[str, WindowedImage]]:
+        """The last frame (:attr:`last_image`, as its rendered window in the background):
+        ``[("image", WindowedImage)]``."""
+        if self._last is None:
+            return []
+        crop, window = self._last
+        p = self.params
+        return [
+            ("image", WindowedImage(p.height, p.width, round(255.0 * p.background), window, crop))
+        ]
 
     def measure(self, t: float, scene: Scene) -> VisionStick | None:
         p = self.params

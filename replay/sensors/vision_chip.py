@@ -101,10 +101,8 @@ class VisionChipSensor(Sensor):
         return img > self.level
 
     def frame_images(self) -> list[tuple[str, np.ndarray]]:
-        """The last frame: ``[("image", uint8 HxW, 0 or 255)]``."""
-        if self.last_image is None:
-            return []
-        return [("image", self.last_image.astype(np.uint8) * np.uint8(255))]
+        """The last frame: ``[("image", bool HxW)]`` (its PNG is 0 / 255)."""
+        return [] if self.last_image is None else [("image", self.last_image)]
 
     def measure(self, t: float, scene: Scene) -> VisionChip | None:
         bits = self.image(scene)

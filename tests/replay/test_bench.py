@@ -76,3 +76,29 @@ def test_the_report_says_whether_each_target_is_met():
 def test_an_engine_step_the_bench_cannot_see_is_said_not_measured():
     r = report(_result("stick_3step", cpu=1.0, engine_steps=0))
     assert "seen 0 times in 100 steps" in r and "not measured" in r
+
+
+def test_the_logging_costs_count_every_logged_item_and_restore_the_classes(tmp_path):
+    from replay.bench import LOGGED, logging_costs
+    from replay.log import LogReader
+
+    sc = load_scenario("scenarios/catch_optimised.yaml", sets=["timing.duration=0.03"])
+    before = {(cls, attr): getattr(cls, attr) for _, cls, attr in LOGGED}
+    costs = logging_costs(sc, tmp_path / "run.mcap")
+    assert {(cls, attr): getattr(cls, attr) for _, cls, attr in LOGGED} == before
+    counts = LogReader(tmp_path / "run.mcap").topic_counts()
+    assert costs["image"][1] == counts["/camera/stereo/cam0"] + counts["/camera/stereo/cam1"]
+    assert costs["frame"][1] == counts["/tf"] == counts["/scene"]
+    assert costs["log_line"][1] == counts["/log"] == counts["/events"]
+    # every JSON message went through LogWriter.write (the Foxglove ones through write_raw)
+    foxglove = {"/tf", "/scene", "/joint_states", "/log", "/robot_description"}
+    json_count = sum(
+        n for t, n in counts.items() if t not in foxglove and not t.startswith("/camera/")
+    )
+    assert costs["message"][1] == json_count
+    assert costs["open"][1] == costs["close"][1] == 1
+    assert all(cpu >= 0.0 for cpu, _ in costs.values()) and costs["message"][0] > 0.0
+    line = report(
+        {**_result("catch_optimised", cpu=1.0), "logged": costs, "sim_time": 0.03}
+    ).splitlines()
+    assert any(x.startswith("  logging, CPU per item") and "camera image" in x for x in line)

@@ -218,20 +218,21 @@ def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
 
 def test_sigint_mid_record_is_held_until_the_record_is_whole(tmp_path):
     """Ctrl-C while a record is written is raised only once the write is done, so the log never
-    holds a torn record; after close the default handler is back."""
+    holds a torn record; after close the default handler is back. (A message is appended by
+    compiled code, where no handler runs; the Python it runs is writing a chunk it filled.)"""
     w = LogWriter(tmp_path / "x.mcap", chunk_size=100)
-    add, reached = w._mcap.message, []
+    add, reached = w._mcap._write, []
 
-    def interrupted_mid_record(*args):  # Ctrl-C arrives while the record is being written
+    def interrupted_mid_chunk(data):  # Ctrl-C arrives while the chunk is being written
         os.kill(os.getpid(), signal.SIGINT)
-        add(*args)
+        add(data)
         reached.append(True)
 
-    w._mcap.message = interrupted_mid_record
+    w._mcap._write = interrupted_mid_chunk
     with pytest.raises(KeyboardInterrupt):
-        w.write("/events", Event(0.0, "a"), 0)
+        w.write("/events", Event(0.0, "a"), 0)  # the schema, channel and it fill the chunk
     assert reached
-    w._mcap.message = add
+    w._mcap._write = add
     w.write("/events", Event(0.001, "interrupted"), 1_000_000)
     assert w.close("interrupted") == tmp_path / "x.interrupted.mcap"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
@@ -295,3 +296,19 @@ def test_readings_are_delivered_their_latency_after_capture_over_random_sensor_s
         passed += ok
     print(f"runner delivery over random sensor sets: {passed}/{trials} passed")
     assert passed == trials
+
+
+def test_resolved_yaml_is_the_pure_python_emitters_text_for_every_scenario():
+    """The logs' /scenario text comes from libyaml's emitter when PyYAML has it: the same text
+    as PyYAML's own (so a machine without libyaml writes the same logs)."""
+    import yaml
+
+    from conftest import ROOT
+    from replay.scenario.loader import resolved_yaml, to_plain
+
+    paths = sorted((ROOT / "scenarios").glob("*.yaml"))
+    assert paths
+    for path in paths:
+        sc = load_scenario(path)
+        text = yaml.safe_dump(to_plain(sc), sort_keys=False, default_flow_style=None, width=100)
+        assert resolved_yaml(sc) == text, path.name

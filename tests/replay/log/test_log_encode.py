@@ -60,3 +60,42 @@ def test_non_finite_values_beside_nulls_and_in_nested_payloads_are_refused(bad):
             encode("/x", payload)
     fine = Event(0.0, "x", {"none": None, "v": (1.0, [None, 2.0]), "s": "null"})
     assert json.loads(encode("/x", fine))["data"]["none"] is None
+
+
+def _random_payload(rng, depth=0):
+    """A random payload of what messages hold: floats (sometimes NaN or infinite), ints, bools,
+    None, strings, lists, tuples, dicts and payload dataclasses."""
+    kind = int(rng.integers(0, 9 if depth < 3 else 5))
+    if kind == 0:
+        return float(rng.choice([math.nan, math.inf, -math.inf])) if rng.random() < 0.1 else 0.5
+    if kind == 1:
+        return int(rng.integers(-5, 5))
+    if kind == 2:
+        return bool(rng.random() < 0.5)
+    if kind == 3:
+        return None
+    if kind == 4:
+        return "text"
+    items = [_random_payload(rng, depth + 1) for _ in range(int(rng.integers(0, 5)))]
+    if kind == 5:
+        return items
+    if kind == 6:
+        return tuple(items)
+    if kind == 7:
+        return {f"k{i}": v for i, v in enumerate(items)}
+    return Event(0.1, "x", {"v": items})
+
+
+def test_compiled_finiteness_check_equals_the_python_reference():
+    from replay.log._finite import finite
+    from replay.log.writer import _finite
+
+    rng = np.random.default_rng(21)
+    n, agree, non_finite = 2000, 0, 0
+    for _ in range(n):
+        payload = _random_payload(rng)
+        agree += finite(payload) is _finite(payload)
+        non_finite += not _finite(payload)
+    print(f"compiled finite() = _finite() for {agree}/{n} payloads ({non_finite} non-finite)")
+    assert agree == n and 0 < non_finite < n
+    assert finite(np.float64("inf")) is False and finite(StickState(0, 1, 2, 3, 4, 5, 6)) is True

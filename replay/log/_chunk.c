@@ -1,0 +1,268 @@
+/* The MCAP chunk being built (replay/log/chunks.py is the only caller and documents the file):
+ * its records, and per channel id its messages' (log time, offset) pairs for the message index
+ * and its message count. Plain C, no NumPy headers.
+ *
+ * Chunk(chunk_size, on_full): message(channel_id, log_time, publish_time, data) appends one
+ * Message record (MCAP spec: opcode 0x05, record length, channel id u16, sequence u32 = the
+ * channel's count so far, log time u64, publish time u64, data; little endian) and calls
+ * on_full() when the chunk has grown beyond chunk_size; append(record) adds other records
+ * (schemas, channels); take() returns the chunk and its indexes and starts a new one.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    uint64_t *pairs; /* log time, offset, log time, offset, ... */
+    size_t n, cap;   /* pairs used (2 a message), allocated */
+} Index;
+
+typedef struct {
+    PyObject_HEAD uint8_t *buf;
+    size_t len, cap;
+    Py_ssize_t chunk_size;
+    PyObject *on_full;
+    Index *index; /* per channel id */
+    uint64_t *counts;
+    size_t channels; /* ids 0 .. channels - 1 allocated */
+    uint64_t total;
+    size_t in_chunk; /* messages in the chunk being built */
+} Chunk;
+
+static int reserve(Chunk *c, size_t extra) {
+    if (c->len + extra <= c->cap) return 0;
+    size_t cap = c->cap ? c->cap : 4096;
+    while (cap < c->len + extra) cap *= 2;
+    uint8_t *b = realloc(c->buf, cap);
+    if (!b) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    c->buf = b;
+    c->cap = cap;
+    return 0;
+}
+
+static int channel_slot(Chunk *c, size_t id) {
+    if (id < c->channels) return 0;
+    size_t n = id + 1 > 2 * c->channels ? id + 1 : 2 * c->channels;
+    Index *ix = realloc(c->index, n * sizeof(Index));
+    if (!ix) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    c->index = ix;
+    uint64_t *counts = realloc(c->counts, n * sizeof(uint64_t));
+    if (!counts) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    c->counts = counts;
+    for (size_t i = c->channels; i < n; i++) {
+        c->index[i] = (Index){NULL, 0, 0};
+        c->counts[i] = 0;
+    }
+    c->channels = n;
+    return 0;
+}
+
+static inline void le(uint8_t *p, uint64_t v, int n) {
+    for (int i = 0; i < n; i++) p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static PyObject *Chunk_message(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "message(channel_id, log_time, publish_time, data)");
+        return NULL;
+    }
+    unsigned long long ch = PyLong_AsUnsignedLongLong(args[0]);
+    unsigned long long lt = PyLong_AsUnsignedLongLong(args[1]);
+    unsigned long long pt = PyLong_AsUnsignedLongLong(args[2]);
+    if (PyErr_Occurred()) return NULL;
+    if (ch > 0xFFFF) {
+        PyErr_SetString(PyExc_ValueError, "channel id beyond u16");
+        return NULL;
+    }
+    Py_buffer D;
+    if (PyObject_GetBuffer(args[3], &D, PyBUF_SIMPLE) < 0) return NULL;
+    if (channel_slot(c, (size_t)ch) < 0 || reserve(c, 31 + (size_t)D.len) < 0) {
+        PyBuffer_Release(&D);
+        return NULL;
+    }
+    Index *ix = &c->index[ch];
+    if (ix->n + 2 > ix->cap) {
+        size_t cap = ix->cap ? 2 * ix->cap : 64;
+        uint64_t *p = realloc(ix->pairs, cap * sizeof(uint64_t));
+        if (!p) {
+            PyBuffer_Release(&D);
+            return PyErr_NoMemory();
+        }
+        ix->pairs = p;
+        ix->cap = cap;
+    }
+    ix->pairs[ix->n++] = lt;
+    ix->pairs[ix->n++] = c->len;
+    uint8_t *p = c->buf + c->len;
+    p[0] = 0x05;
+    le(p + 1, 2 + 4 + 8 + 8 + (uint64_t)D.len, 8);
+    le(p + 9, ch, 2);
+    le(p + 11, c->counts[ch], 4);
+    le(p + 15, lt, 8);
+    le(p + 23, pt, 8);
+    memcpy(p + 31, D.buf, (size_t)D.len);
+    c->len += 31 + (size_t)D.len;
+    PyBuffer_Release(&D);
+    c->counts[ch]++;
+    c->total++;
+    c->in_chunk++;
+    if ((Py_ssize_t)c->len > c->chunk_size) {
+        PyObject *r = PyObject_CallNoArgs(c->on_full);
+        if (!r) return NULL;
+        Py_DECREF(r);
+    }
+    Py_RETURN_NONE;
+}
+
+static PyObject *Chunk_append(Chunk *c, PyObject *arg) {
+    Py_buffer D;
+    if (PyObject_GetBuffer(arg, &D, PyBUF_SIMPLE) < 0) return NULL;
+    if (reserve(c, (size_t)D.len) < 0) {
+        PyBuffer_Release(&D);
+        return NULL;
+    }
+    memcpy(c->buf + c->len, D.buf, (size_t)D.len);
+    c->len += (size_t)D.len;
+    PyBuffer_Release(&D);
+    return PyLong_FromSize_t(c->len);
+}
+
+/* (records, [(first offset, channel id, message index entries, min log time, max log time),
+ * ...] in channel id order) of the chunk, which starts again empty; None (the chunk kept) while
+ * it holds no message */
+static PyObject *Chunk_take(Chunk *c, PyObject *unused) {
+    if (c->in_chunk == 0) Py_RETURN_NONE;
+    PyObject *list = PyList_New(0);
+    if (!list) return NULL;
+    for (size_t id = 0; id < c->channels; id++) {
+        Index *ix = &c->index[id];
+        if (ix->n == 0) continue;
+        uint64_t lo = UINT64_MAX, hi = 0;
+        PyObject *entries = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)(8 * ix->n));
+        if (!entries) goto fail;
+        uint8_t *e = (uint8_t *)PyBytes_AS_STRING(entries);
+        for (size_t i = 0; i < ix->n; i++) le(e + 8 * i, ix->pairs[i], 8);
+        for (size_t i = 0; i < ix->n; i += 2) {
+            if (ix->pairs[i] < lo) lo = ix->pairs[i];
+            if (ix->pairs[i] > hi) hi = ix->pairs[i];
+        }
+        PyObject *item = Py_BuildValue("(KnNKK)", (unsigned long long)ix->pairs[1], (Py_ssize_t)id,
+                                       entries, (unsigned long long)lo, (unsigned long long)hi);
+        if (!item || PyList_Append(list, item) < 0) {
+            Py_XDECREF(item);
+            goto fail;
+        }
+        Py_DECREF(item);
+    }
+    PyObject *raw = PyBytes_FromStringAndSize((const char *)c->buf, (Py_ssize_t)c->len);
+    if (!raw) goto fail;
+    c->len = 0;
+    c->in_chunk = 0;
+    for (size_t id = 0; id < c->channels; id++) c->index[id].n = 0;
+    return Py_BuildValue("(NN)", raw, list);
+fail:
+    Py_DECREF(list);
+    return NULL;
+}
+
+static PyObject *Chunk_count(Chunk *c, PyObject *arg) {
+    size_t id = PyLong_AsSize_t(arg);
+    if (PyErr_Occurred()) return NULL;
+    return PyLong_FromUnsignedLongLong(id < c->channels ? c->counts[id] : 0);
+}
+
+static PyObject *Chunk_get_total(Chunk *c, void *closure) {
+    return PyLong_FromUnsignedLongLong(c->total);
+}
+
+static PyObject *Chunk_get_size(Chunk *c, void *closure) { return PyLong_FromSize_t(c->len); }
+
+static int Chunk_init(Chunk *c, PyObject *args, PyObject *kw) {
+    Py_ssize_t size;
+    PyObject *on_full;
+    if (!PyArg_ParseTuple(args, "nO", &size, &on_full)) return -1;
+    if (!PyCallable_Check(on_full)) {
+        PyErr_SetString(PyExc_TypeError, "on_full must be callable");
+        return -1;
+    }
+    c->chunk_size = size;
+    Py_INCREF(on_full);
+    Py_XSETREF(c->on_full, on_full);
+    return 0;
+}
+
+static int Chunk_traverse(Chunk *c, visitproc visit, void *arg) {
+    Py_VISIT(c->on_full);
+    return 0;
+}
+
+static int Chunk_clear(Chunk *c) {
+    Py_CLEAR(c->on_full);
+    return 0;
+}
+
+static void Chunk_dealloc(Chunk *c) {
+    PyObject_GC_UnTrack(c);
+    Chunk_clear(c);
+    free(c->buf);
+    for (size_t i = 0; i < c->channels; i++) free(c->index[i].pairs);
+    free(c->index);
+    free(c->counts);
+    Py_TYPE(c)->tp_free((PyObject *)c);
+}
+
+static PyMethodDef Chunk_methods[] = {
+    {"message", (PyCFunction)(void (*)(void))Chunk_message, METH_FASTCALL,
+     "append one Message record"},
+    {"append", (PyCFunction)Chunk_append, METH_O, "append other records; returns the size"},
+    {"take", (PyCFunction)Chunk_take, METH_NOARGS, "the chunk and its indexes, then empty"},
+    {"count", (PyCFunction)Chunk_count, METH_O, "messages of a channel id so far"},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyGetSetDef Chunk_getset[] = {
+    {"total", (getter)Chunk_get_total, NULL, "messages so far", NULL},
+    {"size", (getter)Chunk_get_size, NULL, "bytes of the chunk being built", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyTypeObject ChunkType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "replay.log._chunk.Chunk",
+    .tp_basicsize = sizeof(Chunk),
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    .tp_doc = "The MCAP chunk being built: its records and message indexes.",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)Chunk_init,
+    .tp_dealloc = (destructor)Chunk_dealloc,
+    .tp_traverse = (traverseproc)Chunk_traverse,
+    .tp_clear = (inquiry)Chunk_clear,
+    .tp_methods = Chunk_methods,
+    .tp_getset = Chunk_getset,
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_chunk",
+                                    "The MCAP chunk being built.", -1, NULL};
+
+PyMODINIT_FUNC PyInit__chunk(void) {
+    if (PyType_Ready(&ChunkType) < 0) return NULL;
+    PyObject *m = PyModule_Create(&module);
+    if (!m) return NULL;
+    Py_INCREF(&ChunkType);
+    if (PyModule_AddObject(m, "Chunk", (PyObject *)&ChunkType) < 0) {
+        Py_DECREF(&ChunkType);
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}

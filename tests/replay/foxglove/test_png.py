@@ -1,0 +1,128 @@
+"""The compiled PNG encoder (replay/foxglove/_png.c through png.py) against the reference it
+replaced: zlib's level-1 deflate of the same filtered rows (kept here). Every PNG decodes to the
+same pixels with zlib, OpenCV (libpng) and PIL; a window in the background gives the same bytes
+as its whole frame; the sensors' frames are their images."""
+
+from __future__ import annotations
+
+import io
+import struct
+import zlib
+
+import cv2
+import numpy as np
+import pytest
+from PIL import Image
+
+from replay.foxglove.png import WindowedImage, encode_png
+from replay.scene import Scene, Sphere
+from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
+
+
+def _chunk(tag: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
+
+
+def reference_png(img: np.ndarray) -> bytes:
+    """The Python encoder the compiled one replaced: filter 0 rows, zlib.compress level 1."""
+    if img.dtype == bool:
+        img = img.astype(np.uint8) * np.uint8(255)
+    h, w = img.shape
+    rows = np.zeros((h, w + 1), np.uint8)
+    rows[:, 1:] = img
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + _chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0))
+        + _chunk(b"IDAT", zlib.compress(rows.tobytes(), 1))
+        + _chunk(b"IEND", b"")
+    )
+
+
+def idat(data: bytes) -> bytes:
+    """The IDAT payload of a PNG (one IDAT chunk), its CRC checked."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, out = 8, b""
+    while pos < len(data):
+        (n,) = struct.unpack(">I", data[pos : pos + 4])
+        tag, body = data[pos + 4 : pos + 8], data[pos + 8 : pos + 8 + n]
+        assert struct.unpack(">I", data[pos + 8 + n : pos + 12 + n])[0] == zlib.crc32(tag + body)
+        if tag == b"IDAT":
+            out += body
+        pos += 12 + n
+    return out
+
+
+def decoders(data: bytes) -> list[np.ndarray]:
+    """The image as zlib (the raw rows), OpenCV and PIL read it."""
+    w, h = struct.unpack(">II", data[16:24])
+    raw = np.frombuffer(zlib.decompress(idat(data)), np.uint8).reshape(h, w + 1)
+    assert not raw[:, 0].any()  # filter type 0 on every row
+    return [
+        raw[:, 1:],
+        cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED),
+        np.asarray(Image.open(io.BytesIO(data))),
+    ]
+
+
+def random_window(rng) -> WindowedImage:
+    """A frame of random size with a random window: noise, flat rows, repeated rows or mostly
+    background inside it."""
+    h, w = int(rng.integers(1, 260)), int(rng.integers(1, 260))
+    bg = int(rng.integers(0, 256))
+    x0, x1 = sorted(int(v) for v in rng.integers(0, w + 1, 2))
+    y0, y1 = sorted(int(v) for v in rng.integers(0, h + 1, 2))
+    pix = rng.integers(0, 256, (y1 - y0, x1 - x0)).astype(np.uint8)
+    kind = rng.integers(0, 4)
+    if kind == 1:  # mostly background, as the cameras' windows are
+        pix[rng.random(pix.shape) < 0.8] = bg
+    elif kind == 2:  # flat rows (runs)
+        pix[:] = pix[:, :1]
+    elif kind == 3 and pix.shape[0]:  # the same row again and again
+        pix[:] = pix[:1]
+    return WindowedImage(h, w, bg, (x0, y0, x1, y1), pix)
+
+
+def test_compiled_png_decodes_to_the_reference_pixels_everywhere():
+    rng = np.random.default_rng(10)
+    n, agree, smaller = 300, 0, 0
+    for _ in range(n):
+        win = random_window(rng)
+        full = win.full()
+        data = encode_png(win)
+        ref = reference_png(full)
+        assert encode_png(full) == data  # the bytes depend on the pixels, not on the window
+        assert encode_png(WindowedImage(*full.shape, 0, (0, 0, *full.shape[::-1]), full)) == data
+        agree += all(np.array_equal(d, full) for d in decoders(data) + decoders(ref))
+        assert data[:33] == ref[:33] and data[-12:] == ref[-12:]  # IHDR, IEND as the reference
+        smaller += len(data) <= len(ref)
+    print(f"compiled PNG = reference pixels for {agree}/{n} images ({smaller} no bigger)")
+    assert agree == n
+
+
+def test_png_of_bool_images_and_bad_input():
+    rng = np.random.default_rng(11)
+    for _ in range(30):
+        bits = rng.random((16, 16)) < rng.uniform(0.0, 0.6)
+        data = encode_png(bits)
+        assert data == encode_png(bits.astype(np.uint8) * np.uint8(255))
+        for d in decoders(data):
+            assert set(np.unique(d)) <= {0, 255} and np.array_equal(d == 255, bits)
+    for bad in (np.zeros((4, 4, 3), np.uint8), np.zeros((4, 4), np.float32), np.zeros((0, 4))):
+        with pytest.raises(ValueError):
+            encode_png(bad)
+    with pytest.raises(ValueError):  # pixels that do not fill their window
+        encode_png(WindowedImage(8, 8, 0, (0, 0, 4, 4), np.zeros((3, 4), np.uint8)))
+
+
+def test_stereo_frames_are_its_whole_images():
+    s = StereoBallCamera(StereoBallCameraParams(), rng=np.random.default_rng(0))
+    rng = np.random.default_rng(12)
+    for _ in range(20):
+        X = (rng.uniform(0.8, 2.3), rng.uniform(-0.1, 0.1), rng.uniform(0.5, 1.0))
+        s.measure(0.0, Scene([Sphere("ball", X, 0.0175, albedo=1.0)]))
+        frames = s.frame_images()
+        assert [v for v, _ in frames] == ["cam0", "cam1"]
+        for (_, win), whole in zip(frames, s.last_images):
+            assert whole is not None
+            np.testing.assert_array_equal(win.full(), whole)
+            assert encode_png(win) == encode_png(whole)
