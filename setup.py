@@ -6,8 +6,9 @@ the buffer protocol, no NumPy headers), as are the stereo camera's frame and a s
 (replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
 (replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
 air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
-(replay/foxglove/_png.c) and the log's chunk buffer and finiteness check (replay/log/_chunk.c,
-_finite.c)."""
+(replay/foxglove/_png.c), the log's chunk buffer and finiteness check (replay/log/_chunk.c,
+_finite.c) and the grasping tasks' per-step kernels (replay/control/grasping/_arm_kinematics.c,
+_chip_target.c, _hand_servo.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -71,6 +72,21 @@ setup(
         Extension(
             "replay.log._finite",
             ["replay/log/_finite.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.grasping._arm_kinematics",
+            ["replay/control/grasping/_arm_kinematics.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.grasping._chip_target",
+            ["replay/control/grasping/_chip_target.c"],
+            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+        ),
+        Extension(
+            "replay.control.grasping._hand_servo",
+            ["replay/control/grasping/_hand_servo.c"],
             extra_compile_args=["-O2", "-fexcess-precision=standard"],
         ),
     ],

@@ -51,17 +51,36 @@ class TaskSet(Controller):
     def __init__(self, tasks: list[Task], physics_rate: int) -> None:
         self.tasks = tasks
         self.rate = physics_rate
-        self._inbox: dict[str, list] = {t.name: [] for t in tasks}
-        self._newest: dict[str, dict[str, float]] = {t.name: {} for t in tasks}
-        self._latency: dict[str, float | None] = {t.name: None for t in tasks}
-        self._oldest: dict[str, str | None] = {t.name: None for t in tasks}
-        self._ticked = [False] * len(tasks)
-        self._telemetry: dict[str, list] = {}
-        self._readers: dict[str, list[Task]] = {}
-        for t in tasks:
+        n = len(tasks)
+        # per task, by its index: the messages since its last tick, the newest capture time per
+        # input topic, and the latency (and its topic) at its last tick
+        self._inbox: list[list] = [[] for _ in tasks]
+        self._newest: list[dict[str, float]] = [{} for _ in tasks]
+        self._latency: list[float | None] = [None] * n
+        self._oldest: list[str | None] = [None] * n
+        self._ticked = [False] * n
+        self._names = [t.name for t in tasks]
+        self._telemetry: dict[str, Any] = {}
+        # topic -> (index, newest stamps) of each task reading it
+        self._readers: dict[str, list[tuple[int, dict[str, float]]]] = {}
+        for i, t in enumerate(tasks):
             for topic in t.inputs:
-                self._readers.setdefault(topic, []).append(t)
-        self._fields: dict[type, tuple[str, ...]] = {}
+                self._readers.setdefault(topic, []).append((i, self._newest[i]))
+        # per (task, command type): the command fields the task may not write
+        self._forbidden: dict[tuple[int, type], tuple[str, ...]] = {}
+        # what a step needs of each task, looked up once
+        self._loop = [
+            (
+                i,
+                t,
+                t.divider,
+                t.controller.update,
+                t.controller.telemetry,
+                t.outputs,
+                self._newest[i],
+            )
+            for i, t in enumerate(tasks)
+        ]
 
     def _route(self, topic: str, payload: Any) -> None:
         readers = self._readers.get(topic)
@@ -69,22 +88,24 @@ class TaskSet(Controller):
             return
         stamp = payload.get("t") if isinstance(payload, dict) else getattr(payload, "t", None)
         item = (topic, payload)
-        for task in readers:
-            self._inbox[task.name].append(item)
+        inbox = self._inbox
+        for i, newest in readers:
+            inbox[i].append(item)
             if stamp is not None:
-                self._newest[task.name][topic] = stamp
+                newest[topic] = stamp
 
-    def _check(self, task: Task, command: Any) -> None:
-        cls = type(command)
-        names = self._fields.get(cls)
+    def _check(self, i: int, task: Task, command: Any) -> None:
+        key = (i, type(command))
+        names = self._forbidden.get(key)
         if names is None:
-            names = self._fields[cls] = (
+            fields = (
                 tuple(f.name for f in dataclasses.fields(command))
                 if dataclasses.is_dataclass(command)
                 else ()
             )
+            names = self._forbidden[key] = tuple(n for n in fields if n not in task.outputs)
         for n in names:
-            if getattr(command, n) is not None and n not in task.outputs:
+            if getattr(command, n) is not None:
                 raise TaskError(
                     f"task {task.name!r} wrote command field {n!r}, not among its "
                     f"outputs {sorted(task.outputs)}"
@@ -92,41 +113,58 @@ class TaskSet(Controller):
 
     def update(self, t: float, measurements: list[tuple[str, Any]]) -> list | None:
         k = int(round(t * self.rate))
-        for topic, m in measurements:
-            self._route(topic, m)
+        inboxes, ticked, latency, oldest = self._inbox, self._ticked, self._latency, self._oldest
+        readers_of = self._readers
+        for topic, m in measurements:  # _route, inline: the sensors' messages of this step
+            readers = readers_of.get(topic)
+            if readers:
+                stamp = m.get("t") if isinstance(m, dict) else getattr(m, "t", None)
+                item = (topic, m)
+                for i, newest in readers:
+                    inboxes[i].append(item)
+                    if stamp is not None:
+                        newest[topic] = stamp
+        route = self._route
         commands = []
-        self._telemetry = {}
-        for i, task in enumerate(self.tasks):
-            due = k % task.divider == 0
-            self._ticked[i] = due
+        out: dict[str, Any] = {}
+        self._telemetry = out
+        forbidden = self._forbidden
+        for i, task, divider, update, telemetry, outputs, newest in self._loop:
+            due = k % divider == 0
+            ticked[i] = due
             if not due:
                 continue
-            inbox, self._inbox[task.name] = self._inbox[task.name], []
-            command = task.controller.update(t, inbox)
-            newest = self._newest[task.name]
+            inbox = inboxes[i]
+            inboxes[i] = []
+            command = update(t, inbox)
             if newest:
-                stamp, topic = min((v, k) for k, v in newest.items())  # oldest, then by name
-                self._latency[task.name] = t - stamp
-                self._oldest[task.name] = topic
+                stamp, topic = min(zip(newest.values(), newest.keys()))  # oldest, then by name
+                latency[i] = t - stamp
+                oldest[i] = topic
             if command is not None:
-                self._check(task, command)
+                names = forbidden.get((i, type(command)))
+                if names is None or names:
+                    self._check(i, task, command)
                 commands.append(command)
-            for topic, payload in task.controller.telemetry(t).items():
-                items = payload if isinstance(payload, list) else [payload]
-                self._telemetry.setdefault(topic, []).extend(items)
-                if topic in task.outputs:
-                    for item in items:
-                        self._route(topic, item)
+            for topic, payload in telemetry(t).items():
+                prev = out.get(topic)
+                if prev is None:
+                    out[topic] = payload
+                else:  # several tasks (or ticks) on one topic: a list, in order
+                    items = prev if isinstance(prev, list) else [prev]
+                    out[topic] = items + (payload if isinstance(payload, list) else [payload])
+                if topic in outputs:
+                    if isinstance(payload, list):
+                        for item in payload:
+                            route(topic, item)
+                    else:
+                        route(topic, payload)
         return commands or None
 
     def telemetry(self, t: float) -> dict[str, Any]:
         out: dict[str, Any] = dict(self._telemetry)
         out[TOPIC_TASK_LOOPS] = TaskLoops(
-            t,
-            [x.name for x in self.tasks],
-            list(self._ticked),
-            [self._latency[x.name] for x in self.tasks],
-            [self._oldest[x.name] for x in self.tasks],
+            t, list(self._names), list(self._ticked), list(self._latency), list(self._oldest)
         )
         return out
 

@@ -1,4 +1,4 @@
-"""Tracking and reaching control of the arm (Namiki et al. 1999, Sec. 4.2, eqs. 2-3), pure NumPy:
+"""Tracking and reaching control of the arm (Namiki et al. 1999, Sec. 4.2, eqs. 2-3):
 
     theta_dot_d^a = K^ap J^a+ S K^a1 (x^o - x^a) + K^ap J^a+ (I - S) K^a2 (x_d^a - x^a)
                     - K^av theta_dot^a + K^af J^aT F^a                                 (2)
@@ -18,6 +18,9 @@
   mass and centre of mass, open posture) and the sensor's bias at start (tare), about the
   flange: the external wrench on the hand (N, N m).
 - No prediction of the object's motion: x^o is the latest measurement.
+- Per step in floats: the chain, Jg, eq. 2's terms and F^a are one compiled module
+  (``_arm_kinematics.c``); :meth:`ArmControlTask.kinematics` and :meth:`reference_command` are
+  the NumPy reference a seeded test holds it to.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from replay.control.grasping import _arm_kinematics
 from replay.control.grasping.payloads import ArmLoop
 from replay.interfaces import Controller
 from replay.messages import (
@@ -116,24 +120,38 @@ class ArmControlTask(Controller):
         self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
         self._M[:, 2, 3] = [r[2] for r in self.dh]
         self._M[:, 3, 3] = 1.0
-        self._eye6 = np.eye(6)
+        # the compiled chain's constants (cos alpha, sin alpha, a, d, theta offset) per joint,
+        # its base and tool, the Jacobians it fills, and eq. 2's gains on the task vectors
+        n = self._n = len(self.dh)
+        self._consts = np.ascontiguousarray(
+            np.column_stack([self._ca, self._sa, self._a, self._M[:, 2, 3], self._off])
+        )
+        self._base = np.ascontiguousarray(self.chain.base, float)
+        self._tool = np.ascontiguousarray(self.chain.tool, float)
+        self._J, self._Jg = np.zeros((6, n)), np.zeros((6, n))
         self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
             raise ValueError("arm control needs a plant with a hand and a constraint plane")
         self.n_plane = np.asarray(spec.plane.normal, float)
+        self._n_plane = [float(x) for x in self.n_plane]
         self.hand = hand_body(spec.hand.table)
         self.g = np.array([0.0, 0.0, -spec.gravity])
+        self._w_hand = (self.hand.mass * self.g).tolist()
+        self._com = [float(x) for x in self.hand.com]
         self.vlim = np.asarray(spec.velocity_limits, float)
+        self._vlim = self.vlim.tolist()
         self.dt = spec.dt  # the task's period (from its update times)
         self._t_last: float | None = None
         self.K_a1, self.K_a2 = np.asarray(params.K_a1, float), np.asarray(params.K_a2, float)
-        self.q = np.asarray(spec.initial_q, float).copy()
-        self.qd = np.zeros(len(self.q))
+        self._g_track = (S_DIAG * self.K_a1).tolist()  # eq. 2's S K^a1 and (I - S) K^a2
+        self._g_reach = ((1.0 - S_DIAG) * self.K_a2).tolist()
+        self.q: list[float] = [float(x) for x in spec.initial_q]
+        self.qd = [0.0] * len(self.q)
         self.obj: Any = None
         self.state: Any = None
         self.wrench_raw: Any = None
-        self.bias: np.ndarray | None = None
-        self.filtered = np.zeros(6)
+        self.bias: list[float] | None = None
+        self.filtered = [0.0] * 6
         self._out: ArmLoop | None = None
         self.track_sq: dict[str, list] = {}
 
@@ -166,28 +184,30 @@ class ArmControlTask(Controller):
         J = np.vstack([cross3(Z, p[:, None] - O), Z])
         return T, J
 
-    def external_wrench(self, R: np.ndarray) -> np.ndarray:
-        """F^a (world, about the flange): the sensor's wrench minus the hand's weight and bias."""
-        f = R @ np.asarray(self.wrench_raw.force, float)
-        m = R @ np.asarray(self.wrench_raw.torque, float)
-        w_hand = self.hand.mass * self.g
-        r = R @ np.asarray(self.hand.com, float)
-        ext = np.concatenate([f - w_hand, m - cross3(r, w_hand)])
-        if self.bias is None:
-            self.bias = ext.copy()  # tare at start: the sensor's offset
-            self.filtered = np.zeros(6)
-        ext = ext - self.bias
+    def external_wrench(self, R) -> list[float]:
+        """F^a (world, about the flange): the sensor's wrench minus the hand's weight and bias
+        (the first reading: tare), low-passed, zero within the deadband (compiled). ``R``: the
+        tool's rotation, row-major 9 floats."""
         a = self.dt / (self.params.force_filter + self.dt)
-        self.filtered += a * (ext - self.filtered)
-        out = self.filtered.copy()
-        if np.linalg.norm(out[:3]) < self.params.force_deadband:
-            out[:] = 0.0
-        return out
+        ext, self.filtered, F = _arm_kinematics.wrench(
+            R,
+            self.wrench_raw.force,
+            self.wrench_raw.torque,
+            self._w_hand,
+            self._com,
+            self.bias,
+            self.filtered,
+            a,
+            self.params.force_deadband,
+        )
+        if self.bias is None:
+            self.bias = ext  # tare at start: the sensor's offset
+        return F
 
     def update(self, t: float, measurements) -> ServoCommand | None:
         for topic, m in measurements:
             if topic == TOPIC_ARM_ENCODERS:
-                self.q, self.qd = np.asarray(m.position, float), np.asarray(m.velocity, float)
+                self.q, self.qd = m.position, m.velocity
             elif topic == TOPIC_WRIST_WRENCH:
                 self.wrench_raw = m
             elif topic == TOPIC_GRASP_OBJECT:
@@ -200,55 +220,94 @@ class ArmControlTask(Controller):
         self._t_last = t
         if self.state is None:
             return None
+        P, n = self.params, self._n
+        # tool pose, grasp point x^a, J (tool) and Jg (grasp point: v_gp = v_tool + w x (gp - p))
+        k = _arm_kinematics.chain(
+            self.q, n, self._consts, self._base, self._tool, P.grasp_point, self._J, self._Jg
+        )
+        R = k[:9]
+        gp = k[12:15]
+        n_palm, row = (R[2], R[5], R[8]), (R[1], R[4], R[7])
+        # x^a (the hand) and its errors to x^o and x_d^a, as world 6-vectors
+        e_track = [0.0] * 6
+        obj = self.obj
+        if obj is not None:
+            xo = obj.position
+            e_track[0], e_track[1], e_track[2] = xo[0] - gp[0], xo[1] - gp[1], xo[2] - gp[2]
+            if obj.roll is not None and obj.shape != "circle":
+                e_track[3] = wrap_half_pi(obj.roll - math.atan2(row[2], row[1]))
+        xd = self.state.x_d
+        npl = self._n_plane
+        e_reach = [
+            xd[0] - gp[0],
+            xd[1] - gp[1],
+            xd[2] - gp[2],
+            n_palm[1] * npl[2] - n_palm[2] * npl[1],
+            n_palm[2] * npl[0] - n_palm[0] * npl[2],
+            n_palm[0] * npl[1] - n_palm[1] * npl[0],
+        ]
+        F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
+        track, reach, damp, force, cmd = _arm_kinematics.terms(
+            self._Jg,
+            self._J,
+            n,
+            P.damping**2,
+            [g * e for g, e in zip(self._g_track, e_track)],
+            [g * e for g, e in zip(self._g_reach, e_reach)],
+            self.qd,
+            F,
+            P.K_ap,
+            P.K_av,
+            P.K_af,
+            self._vlim,
+        )
+        self._out = ArmLoop(
+            t,
+            [gp[0], gp[1], gp[2], 0.0, 0.0, 0.0],
+            (obj.x_o if obj is not None else []),
+            list(xd),
+            [e_track[1], e_track[2], e_track[3]],
+            F,
+            {"track": track, "reach": reach, "damp": damp, "force": force},
+            cmd,
+        )
+        ph = self.state.phase
+        acc = self.track_sq.get(ph)
+        if acc is None:
+            acc = self.track_sq[ph] = [0.0, 0]
+        acc[0] += e_track[1] ** 2 + e_track[2] ** 2
+        acc[1] += 1
+        return ServoCommand(arm=cmd)
+
+    def reference_command(self, q, qd, obj, state, F) -> dict[str, np.ndarray]:
+        """Eq. 2's terms the NumPy way (the reference of the compiled path in :meth:`update`):
+        ``F`` the external wrench as :meth:`external_wrench` gives it."""
         P = self.params
-        T, J = self.kinematics(self.q)
+        T, J = self.kinematics(q)
         R = T[:3, :3]
         gp = T[:3, 3] + P.grasp_point * R[:, 2]
-        # the Jacobian of the grasp point: v_gp = v_tool + w x (gp - tool)
         r = gp - T[:3, 3]
         Jg = J.copy()
         Jg[:3] -= cross3(r[:, None], J[3:])
-        n_palm, row = R[:, 2], R[:, 1]
-        # x^a (the hand) and its errors to x^o and x_d^a, as world 6-vectors
         e_track = np.zeros(6)
-        if self.obj is not None:
-            xo = np.asarray(self.obj.position, float)
-            e_track[:3] = xo - gp
-            if self.obj.roll is not None and self.obj.shape != "circle":
-                row_roll = math.atan2(float(row[2]), float(row[1]))
-                e_track[3] = wrap_half_pi(self.obj.roll - row_roll)
-        xd = np.asarray(self.state.x_d, float)
+        if obj is not None:
+            e_track[:3] = np.asarray(obj.position, float) - gp
+            if obj.roll is not None and obj.shape != "circle":
+                e_track[3] = wrap_half_pi(obj.roll - math.atan2(float(R[2, 1]), float(R[1, 1])))
         e_reach = np.zeros(6)
-        e_reach[:3] = xd[:3] - gp
-        e_reach[3:] = cross3(n_palm, self.n_plane)
-        JJt = Jg @ Jg.T + P.damping**2 * self._eye6
-        Jpinv = Jg.T @ np.linalg.solve(JJt, self._eye6)
-        track = P.K_ap * Jpinv @ (S_DIAG * self.K_a1 * e_track)
-        reach = P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach)
-        damp = -P.K_av * self.qd
-        F = self.external_wrench(R) if self.wrench_raw is not None else np.zeros(6)
-        force = P.K_af * (J.T @ F)
-        cmd = np.clip(track + reach + damp + force, -self.vlim, self.vlim)
-        self._out = ArmLoop(
-            t,
-            [*gp.tolist(), 0.0, 0.0, 0.0],
-            (self.obj.x_o if self.obj is not None else []),
-            xd.tolist(),
-            [float(e_track[1]), float(e_track[2]), float(e_track[3])],
-            F.tolist(),
-            {
-                "track": track.tolist(),
-                "reach": reach.tolist(),
-                "damp": damp.tolist(),
-                "force": force.tolist(),
-            },
-            cmd.tolist(),
-        )
-        ph = self.state.phase
-        acc = self.track_sq.setdefault(ph, [0.0, 0])
-        acc[0] += float(e_track[1] ** 2 + e_track[2] ** 2)
-        acc[1] += 1
-        return ServoCommand(arm=cmd)
+        e_reach[:3] = np.asarray(state.x_d, float)[:3] - gp
+        e_reach[3:] = cross3(R[:, 2], self._n_plane)
+        JJt = Jg @ Jg.T + P.damping**2 * np.eye(6)
+        Jpinv = Jg.T @ np.linalg.solve(JJt, np.eye(6))
+        out = {
+            "track": P.K_ap * Jpinv @ (S_DIAG * self.K_a1 * e_track),
+            "reach": P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach),
+            "damp": -P.K_av * np.asarray(qd, float),
+            "force": P.K_af * (J.T @ np.asarray(F, float)),
+        }
+        out["command"] = np.clip(sum(out.values()), -self.vlim, self.vlim)
+        out["x_a"] = gp
+        return out
 
     def telemetry(self, t: float) -> dict:
         return {TOPIC_GRASP_ARM: self._out} if self._out is not None else {}

@@ -9,14 +9,23 @@ give the centre xi and rotation phi; its extents and fill the object's size and 
   squares counted whole): a rectangle fills its box (~1), a disc pi/4 of it (~0.79); at
   16 x 16 a rolled rectangle's jagged outline fills only ~0.75, so the shape decision
   (``recognition.shape_of``) uses the elongation as well.
+
+:func:`blob_rows` gives the same features from the chip's packed rows (bit u of ``rows[v]`` =
+pixel (u, v)) in one pass over the rows: each row's pixel count, sum of u and of u^2 from a
+table, so the moments are exact integer sums; the extremes of a linear function over a row's
+pixels are at its first and last pixel, so the extents and bounding boxes need only those two.
+:func:`blob` (arrays) is its reference; the recognition task runs both steps compiled
+(``_chip_target.target_blob``, held equal to :func:`blob_rows` and ``track_rows`` by a test).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+
+from replay.messages import unpack_rows
 
 _ANGLES = np.radians(np.arange(0.0, 90.0, 5.0))
 _DIRS = np.stack([np.cos(_ANGLES), np.sin(_ANGLES)])  # (2, n)
@@ -25,8 +34,7 @@ _NORMALS = np.stack([-np.sin(_ANGLES), np.cos(_ANGLES)])
 _PIXEL_EXTENT = np.abs(_DIRS).sum(axis=0)
 
 
-@dataclass(frozen=True)
-class Blob:
+class Blob(NamedTuple):  # a named tuple: built once a frame from the compiled pass's tuple
     area: int
     u: float
     v: float
@@ -73,6 +81,90 @@ def blob(target: np.ndarray, fill: bool = True) -> Blob | None:
         elongation=math.sqrt(lam1 / max(lam2, 1e-12)),
         length=length,
         width=width,
+        fill=fill_ratio,
+        touches_border=border,
+    )
+
+
+_ROW_TABLE_MAX = 16  # px: the widest row the per-row tables cover (2^16 entries)
+_ROW_TABLES: dict[int, tuple[list[int], list[int], list[int]]] = {}
+_DIR_PAIRS = list(zip(_DIRS[0].tolist(), _DIRS[1].tolist(), _PIXEL_EXTENT.tolist()))
+# the same as float64 triples (cos, sin, pixel extent), for the compiled pass (_chip_target.c)
+DIR_TABLE = np.ascontiguousarray(np.column_stack([_DIRS[0], _DIRS[1], _PIXEL_EXTENT]))
+
+
+def _row_tables(width: int) -> tuple[list[int], list[int], list[int]]:
+    """Per row value: (pixels, sum of u, sum of u^2)."""
+    t = _ROW_TABLES.get(width)
+    if t is None:
+        u = np.arange(width, dtype=np.int64)
+        bits = (np.arange(1 << width, dtype=np.int64)[:, None] >> u) & 1
+        t = _ROW_TABLES[width] = (
+            bits.sum(axis=1).tolist(),
+            (bits @ u).tolist(),
+            (bits @ (u * u)).tolist(),
+        )
+    return t
+
+
+def blob_rows(rows: list[int], width: int, fill: bool = True) -> Blob | None:
+    """:func:`blob` of the binary image packed as rows (bit u of ``rows[v]`` = pixel (u, v))."""
+    if width > _ROW_TABLE_MAX:
+        return blob(unpack_rows(rows, width), fill)
+    C, S, Q = _row_tables(width)
+    n = su = sv = suu = svv = suv = 0
+    ends = []  # (v, first u, last u) of each non-empty row
+    ors = 0  # the rows ORed: which columns hold a pixel
+    for v, r in enumerate(rows):
+        if r:
+            cnt, sm = C[r], S[r]
+            n += cnt
+            su += sm
+            suu += Q[r]
+            sv += v * cnt
+            svv += v * v * cnt
+            suv += v * sm
+            ors |= r
+            ends.append((v, (r & -r).bit_length() - 1, r.bit_length() - 1))
+    if n == 0:
+        return None
+    u0, v0 = su / n, sv / n
+    nn = n * n  # central moments from exact sums: sum (u - u0)^2 / n = (n Suu - Su^2) / n^2
+    mu20, mu02, mu11 = (n * suu - su * su) / nn, (n * svv - sv * sv) / nn, (n * suv - su * sv) / nn
+    phi = 0.5 * math.atan2(2.0 * mu11, mu20 - mu02)
+    mean, rad = 0.5 * (mu20 + mu02), math.hypot(0.5 * (mu20 - mu02), mu11)
+    lam1, lam2 = mean + rad + 1.0 / 12.0, mean - rad + 1.0 / 12.0  # + a pixel square's own
+    c, s = math.cos(phi), math.sin(phi)
+    pts = []  # (du, dv) of each row's first and last pixel: the extremes' candidates
+    for v, lo, hi in ends:
+        dv = v - v0
+        pts.append((lo - u0, dv))
+        if hi != lo:
+            pts.append((hi - u0, dv))
+    along = [du * c + dv * s for du, dv in pts]
+    across = [-du * s + dv * c for du, dv in pts]
+    ext = abs(c) + abs(s)
+    fill_ratio = math.nan
+    if fill:
+        best = math.inf
+        for dc, ds, e in _DIR_PAIRS:
+            pa = [du * dc + dv * ds for du, dv in pts]
+            pn = [du * -ds + dv * dc for du, dv in pts]
+            box = (max(pa) - min(pa) + e) * (max(pn) - min(pn) + e)
+            if box < best:
+                best = box
+        fill_ratio = n / best
+    border = bool(
+        ors & 1 or ors >> (width - 1) & 1 or ends[0][0] == 0 or ends[-1][0] == len(rows) - 1
+    )
+    return Blob(
+        area=n,
+        u=u0,
+        v=v0,
+        phi=phi,
+        elongation=math.sqrt(lam1 / max(lam2, 1e-12)),
+        length=max(along) - min(along) + ext,
+        width=max(across) - min(across) + ext,
         fill=fill_ratio,
         touches_border=border,
     )

@@ -1,4 +1,4 @@
-"""Grasping control of the hand (Namiki et al. 1999, Sec. 4.3, eq. 4) and preshaping, pure NumPy:
+"""Grasping control of the hand (Namiki et al. 1999, Sec. 4.3, eq. 4) and preshaping:
 
     theta_dot_d^h = K^hg (theta_d^h - theta^h) - K^hv theta_dot^h + K^hf F^h          (4)
 
@@ -17,11 +17,13 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from replay.control.grasping import _hand_servo
 from replay.control.grasping.payloads import HandLoop
 from replay.interfaces import Controller, Occurrence
 from replay.messages import (
@@ -55,6 +57,16 @@ _CIRC_PRE = [
     0.20,
 ]
 _CIRC_GRIP = [-0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, 0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80]
+
+
+def eq4_reference(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax):
+    """(theta_d^h, eq. 4's command clipped to +-vmax, max |theta_d^h - theta^h|) in floats: the
+    reference of the compiled ``_hand_servo.eq4`` the task runs (``grip`` None: theta_d^h =
+    ``pre``)."""
+    theta_d = list(pre) if grip is None else [p + c * (g - p) for p, g in zip(pre, grip)]
+    cmd = [K_hg * (td - x) - K_hv * v + K_hf * f for td, x, v, f in zip(theta_d, q, qd, load)]
+    cmd = [vmax if x > vmax else (-vmax if x < -vmax else x) for x in cmd]  # np.clip's
+    return theta_d, cmd, max(abs(td - x) for td, x in zip(theta_d, q))
 
 
 @dataclass
@@ -133,9 +145,14 @@ class HandControlTask(Controller):
         self.open = np.asarray(hand.open_posture, float)
         self.lo, self.hi = np.asarray(hand.lower, float), np.asarray(hand.upper, float)
         self.vmax = float(hand.closing_speed)
-        self.q = self.open.copy()
-        self.qd = np.zeros(n)
-        self.load = np.zeros(n)
+        # the same in floats, for the per-step loop
+        self._postures: dict[str, tuple[list[float], list[float] | None]] = {
+            k: (a.tolist(), b.tolist()) for k, (a, b) in self.postures.items()
+        }
+        self._open = self.open.tolist()
+        self.q: list[float] = list(self._open)
+        self.qd = [0.0] * n
+        self.load = [0.0] * n  # F^h, low-passed (a new list each step: logged as is)
         self.shape = "unknown"
         self.preshape = "none"
         self.dt = spec.dt
@@ -149,7 +166,7 @@ class HandControlTask(Controller):
     def update(self, t: float, measurements) -> ServoCommand | None:
         for topic, m in measurements:
             if topic == TOPIC_HAND_ENCODERS:
-                self.q, self.qd = np.asarray(m.position, float), np.asarray(m.velocity, float)
+                self.q, self.qd = m.position, m.velocity
             elif topic == TOPIC_HAND_TORQUE:
                 # F^h: the load on the joints (minus the drive's torque), low-passed
                 a = (
@@ -157,7 +174,7 @@ class HandControlTask(Controller):
                     if self.params.load_filter <= 0.0
                     else min(1.0, self.dt / (self.params.load_filter + self.dt))
                 )
-                self.load += a * (-np.asarray(m.torque, float) - self.load)
+                self.load = _hand_servo.lowpass(self.load, m.torque, a)
             elif topic == TOPIC_GRASP_OBJECT:
                 self.shape = m.shape
             elif topic == TOPIC_GRASP_STATE:
@@ -180,21 +197,15 @@ class HandControlTask(Controller):
             if self.preshape != self.shape:
                 self.preshape = self.shape
                 self._events.append(Occurrence("preshape", {"shape": self.shape}))
-        if self.preshape in self.postures:
-            pre, grip = self.postures[self.preshape]
-            theta_d = pre + c * (grip - pre)
-        else:
-            theta_d = self.open
+        pre, grip = self._postures.get(self.preshape, (self._open, None))
         P = self.params
-        cmd = P.K_hg * (theta_d - self.q) - P.K_hv * self.qd + P.K_hf * self.load  # eq. 4
-        cmd = np.clip(cmd, -self.vmax, self.vmax)
+        theta_d, cmd, deficit = _hand_servo.eq4(
+            pre, grip, c, self.q, self.qd, self.load, P.K_hg, P.K_hv, P.K_hf, self.vmax
+        )
         if st.phase == "hold":
             self._shape_at_grasp.setdefault(st.cycle, self.preshape)
-            deficit = float(np.max(np.abs(theta_d - self.q)))
-            self._holds[st.cycle] = min(self._holds.get(st.cycle, np.inf), deficit)
-        self._out = HandLoop(
-            t, self.preshape, c, theta_d.tolist(), self.load.tolist(), cmd.tolist()
-        )
+            self._holds[st.cycle] = min(self._holds.get(st.cycle, math.inf), deficit)
+        self._out = HandLoop(t, self.preshape, c, theta_d, self.load, cmd)
         return ServoCommand(hand=cmd)
 
     def telemetry(self, t: float) -> dict:

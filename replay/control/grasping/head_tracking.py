@@ -1,4 +1,4 @@
-"""Tracking control of the active vision (Namiki et al. 1999, Sec. 4.1.2, eq. 1), pure NumPy:
+"""Tracking control of the active vision (Namiki et al. 1999, Sec. 4.1.2, eq. 1), in floats:
 
     theta_dot_d^v = K^v J_image^-1 (xi_d - xi) - K^vv theta_dot^v                    (1)
 
@@ -62,23 +62,36 @@ class HeadTrackingTask(Controller):
         if spec.head is None:
             raise ValueError("head tracking needs a plant with a head")
         self.limit = np.asarray(spec.head.velocity_limit, float)
-        self.rate = np.zeros(2)
+        self.rate: list[float] = [0.0, 0.0]
+        self._xi_d, self._K_v = self.xi_d.tolist(), self.K_v.tolist()
+        self._K_vv, self._limit = self.K_vv.tolist(), self.limit.tolist()
         self.obj: Any = None
         self._out: HeadLoop | None = None
 
     def update(self, t: float, measurements) -> ServoCommand:
         for topic, m in measurements:
             if topic == TOPIC_HEAD_ENCODERS:
-                self.rate = np.asarray(m.velocity, float)
+                self.rate = m.velocity
             elif topic == TOPIC_GRASP_OBJECT:
                 self.obj = m
-        err = np.zeros(2)
-        cmd = -self.K_vv * self.rate
-        if self.obj is not None and self.obj.found:
-            err = self.xi_d - np.asarray(self.obj.xi, float)
-            cmd = self.K_v * np.linalg.solve(np.asarray(self.obj.jacobian, float), err) + cmd
-        cmd = np.clip(cmd, -self.limit, self.limit)
-        self._out = HeadLoop(t, err.tolist(), cmd.tolist())
+        # eq. 1 per axis in floats (2 x 2: J^-1 e by Cramer's rule)
+        (kv0, kv1), (kvv0, kvv1), (lim0, lim1) = self._K_v, self._K_vv, self._limit
+        c0, c1 = -kvv0 * self.rate[0], -kvv1 * self.rate[1]
+        err = [0.0, 0.0]
+        obj = self.obj
+        if obj is not None and obj.found:
+            err = [self._xi_d[0] - obj.xi[0], self._xi_d[1] - obj.xi[1]]
+            (a, b), (c, d) = obj.jacobian
+            det = a * d - b * c
+            if det == 0.0:
+                raise np.linalg.LinAlgError(f"singular image Jacobian {obj.jacobian}")
+            c0 += kv0 * ((d * err[0] - b * err[1]) / det)
+            c1 += kv1 * ((a * err[1] - c * err[0]) / det)
+        cmd = [  # np.clip's
+            lim0 if c0 > lim0 else (-lim0 if c0 < -lim0 else c0),
+            lim1 if c1 > lim1 else (-lim1 if c1 < -lim1 else c1),
+        ]
+        self._out = HeadLoop(t, err, cmd)
         return ServoCommand(head=cmd)
 
     def telemetry(self, t: float) -> dict:

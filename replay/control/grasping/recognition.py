@@ -1,4 +1,4 @@
-"""Object recognition by visual information (Namiki et al. 1999, Sec. 4.1.1), pure NumPy.
+"""Object recognition by visual information (Namiki et al. 1999, Sec. 4.1.1).
 
 Each chip frame: Self Windowing extracts the target (``self_window``); its moments give the image
 centre xi and rotation phi (``features``); the viewing ray through xi, from the camera pose at
@@ -10,6 +10,10 @@ pixel extents at that depth give the size; the fill of the smallest bounding box
 (rectangle vs circle: :func:`shape_of`), decided by a vote over the first ``shape_frames`` whole views (not cut by
 the image border) and then kept. The image Jacobian of the head (d xi / d(pan, tilt), for eq. 1)
 is that of the same model at the estimated point. Nothing here predicts motion.
+
+Per frame the task runs compiled kernels (``_chip_target.c``: Self Windowing and the moments on
+the packed rows, the plane geometry); ``self_window``, ``features`` and :class:`Camera` are their
+references.
 """
 
 from __future__ import annotations
@@ -19,11 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.grasping.features import blob
+from replay.control.grasping import _chip_target
+from replay.control.grasping.features import DIR_TABLE, Blob, blob_rows
 from replay.control.grasping.payloads import GraspObject
-from replay.control.grasping.self_window import track
+from replay.control.grasping.self_window import track_rows
 from replay.interfaces import Controller, Occurrence
-from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP, unpack_rows
+from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import HeadSpec, camera_pose
@@ -149,7 +154,15 @@ class RecognitionTask(Controller):
         self.plane_point = np.asarray(spec.plane.point, float)
         self.pu, self.pv, self.pn = plane_basis(spec.plane.normal)
         self._head: dict[float, tuple[float, float]] = {}
-        self._target: np.ndarray | None = None
+        self._target: list[int] | None = None  # packed rows (self_window.track_rows)
+        self._c = (float(self.camera.c[0]), float(self.camera.c[1]))
+        self._plane_point = tuple(float(x) for x in self.plane_point)
+        self._pu, self._pv, self._pn = (
+            tuple(float(x) for x in self.pu),
+            tuple(float(x) for x in self.pv),
+            tuple(float(x) for x in self.pn),
+        )
+        self._head_position = tuple(float(x) for x in spec.head.position)
         self._had_target = False
         self._votes = {"rectangle": 0, "circle": 0}
         self.shape = "unknown"
@@ -166,9 +179,8 @@ class RecognitionTask(Controller):
                 self._head[round(m.t, 9)] = (m.position[0], m.position[1])
             elif topic == TOPIC_VISION_CHIP:
                 chip = m
-        if len(self._head) > 16:
-            for key in sorted(self._head)[:-16]:
-                del self._head[key]
+        while len(self._head) > 16:
+            del self._head[min(self._head)]
         if chip is not None:
             self._out = self._frame(chip)
         return None
@@ -184,12 +196,18 @@ class RecognitionTask(Controller):
         angles = self._angles_at(chip.t)
         if angles is None:
             return None
-        image = unpack_rows(chip.rows, chip.width)
-        target, reacquired = track(self._target, image)
-        window = int(chip.count) if reacquired else int(target.sum())
+        fill = self.shape == "unknown"
+        if chip.width <= 63 and len(chip.rows) <= 64:  # track_rows and blob_rows, compiled
+            target, reacquired, feats = _chip_target.target_blob(
+                self._target, chip.rows, chip.width, fill, DIR_TABLE
+            )
+            b = None if feats is None else Blob(*feats)
+        else:
+            target, reacquired = track_rows(self._target, chip.rows, chip.width)
+            b = blob_rows(target, chip.width, fill=fill)
         self._target = target
         self.frames += 1
-        b = blob(target, fill=self.shape == "unknown")
+        window = int(chip.count) if reacquired else (b.area if b is not None else 0)
         if b is None:
             self.lost_frames += 1
             if self._had_target:
@@ -215,23 +233,34 @@ class RecognitionTask(Controller):
         if reacquired and self.frames > 1:
             self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
         self._had_target = True
-        pose = camera_pose(self.camera.head, *angles)  # once a frame: both rays and J
-        o, d = self.camera.ray(angles, (b.u, b.v), pose)
-        X = meet_plane(o, d, self.plane_point, self.pn)
-        if X is None:
+        # x_o on the constraint plane, the target's axis there and the image Jacobian, from the
+        # camera pose at capture (Camera.ray / meet_plane / Camera.jacobian, compiled)
+        head = self.camera.head
+        g = _chip_target.plane_geometry(
+            head.yaw,
+            angles[0],
+            angles[1],
+            self._head_position,
+            head.camera_offset,
+            self.camera.f,
+            *self._c,
+            self._plane_point,
+            self._pn,
+            self._pu,
+            self._pv,
+            b.u,
+            b.v,
+            b.phi,
+        )
+        if g is None:
             return None
-        axis = (math.cos(b.phi), math.sin(b.phi))
-        o2, d2 = self.camera.ray(angles, (b.u + axis[0], b.v + axis[1]), pose)
-        X2 = meet_plane(o2, d2, self.plane_point, self.pn)
+        X0, X1, X2, axis, dist, J00, J01, J10, J11 = g
         roll = None
-        if X2 is not None and b.elongation >= self.params.axis_elongation:
-            e = X2 - X
-            roll = wrap_half_pi(math.atan2(float(e @ self.pv), float(e @ self.pu)))
-        scale = float(np.linalg.norm(X - o)) / self.camera.f  # m per px at the object
-        if not b.touches_border and b.area >= self.params.min_area:
-            self._vote(b)
-        J = self.camera.jacobian(angles, X, pose)
-        x_o = [float(X[0]), float(X[1]), float(X[2]), roll if roll is not None else 0.0, 0.0, 0.0]
+        if axis == axis and b.elongation >= self.params.axis_elongation:
+            roll = wrap_half_pi(axis)
+        scale = dist / self.camera.f  # m per px at the object
+        if self.shape == "unknown" and not b.touches_border and b.area >= self.params.min_area:
+            self._vote(b)  # (once decided, the shape is kept: later votes would change nothing)
         return GraspObject(
             chip.t,
             True,
@@ -239,14 +268,14 @@ class RecognitionTask(Controller):
             b.phi,
             b.area,
             window,
-            X.tolist(),
+            [X0, X1, X2],
             roll,
-            x_o,
+            [X0, X1, X2, roll if roll is not None else 0.0, 0.0, 0.0],
             [b.length * scale, b.width * scale],
             self.shape,
             b.fill if b.fill == b.fill else None,
             b.elongation,
-            J.tolist(),
+            [[J00, J01], [J10, J11]],
             list(angles),
         )
 

@@ -14,6 +14,10 @@ makes the algorithm work: 1 pixel a millisecond is fast (here ~13 mrad/ms, 10 m/
 
 When the window holds nothing (the target lost, or the first frame), the whole image is the
 window: the algorithm re-acquires whatever is bright (:func:`track`).
+
+:func:`track_rows` is the same on the chip's packed rows (``rows[v]`` an int whose bit ``u`` is
+pixel (u, v), as ``/vision/chip`` carries them): a row's dilation is a few shifts and ORs, like
+the PEs' neighbour exchange. The array functions are its reference.
 """
 
 from __future__ import annotations
@@ -42,3 +46,15 @@ def track(previous: np.ndarray | None, image: np.ndarray) -> tuple[np.ndarray, b
     if previous is None or not previous.any():
         return image.copy(), True
     return self_window(previous, image), False
+
+
+def track_rows(previous: list[int] | None, rows: list[int], width: int) -> tuple[list[int], bool]:
+    """:func:`track` on packed rows (bit u of ``rows[v]`` = pixel (u, v)): (target rows,
+    reacquired)."""
+    if not previous or not any(previous):
+        return list(rows), True
+    mask = (1 << width) - 1
+    above, below = [0, *previous[:-1]], [*previous[1:], 0]
+    return [
+        (p | p << 1 | p >> 1 | a | b) & mask & r for p, a, b, r in zip(previous, above, below, rows)
+    ], False

@@ -21,9 +21,10 @@ from replay.messages import (
     TOPIC_GRASP_STATE,  # noqa: E402
     TOPIC_HAND_ENCODERS,
     TOPIC_HAND_TORQUE,
+    TOPIC_WRIST_WRENCH,
     JointState,
 )
-from replay.sensors.force import JointTorque  # noqa: E402
+from replay.sensors.force import JointTorque, WristWrench  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -171,3 +172,108 @@ def test_arm_task_kinematics_match_the_chains_fk_and_jacobian_over_random_postur
         )
     print(f"arm kinematics: {ok}/{n} random postures match the chain")
     assert ok == n
+
+
+def test_arm_task_compiled_eq2_matches_its_numpy_reference_over_random_inputs(spec):
+    """The compiled chain, grasp-point Jacobian, damped pseudo-inverse and J^T F
+    (``_arm_kinematics``) against the task's NumPy reference (``reference_command``), at seeded
+    random postures, rates, objects, targets and wrenches: agreement within 1e-9 (rad/s, N)."""
+    rng = np.random.default_rng(11)
+    lo, hi = np.asarray(spec.lower), np.asarray(spec.upper)
+    ok, n = 0, 60
+    for i in range(n):
+        task = ArmControlTask(ArmParams(force_deadband=0.0, force_filter=0.0), spec=spec)
+        q, qd = rng.uniform(lo, hi), rng.normal(0.0, 1.0, 7)
+        T, _ = task.kinematics(q)
+        gp = T[:3, 3] + task.params.grasp_point * T[:3, 2]
+        roll = float(rng.uniform(-1.0, 1.0)) if i % 3 else None
+        o = obj(gp + rng.normal(0.0, 0.05, 3), roll=roll, shape=("rectangle", "circle")[i % 2])
+        st = state(gp + rng.normal(0.0, 0.05, 3), phase="reach")
+        enc = JointState(0.0, list(spec.joint_names), q.tolist(), qd.tolist(), [0.0] * 7)
+        f0, m0, f1, m1 = (rng.normal(0.0, 5.0, 3).tolist() for _ in range(4))
+        # the first wrench is the tare; the second one's difference to it is F^a (no filter)
+        task.update(
+            0.0,
+            [
+                (TOPIC_ARM_ENCODERS, enc),
+                (TOPIC_GRASP_STATE, st),
+                (TOPIC_WRIST_WRENCH, WristWrench(0.0, f0, m0)),
+            ],
+        )
+        cmd = task.update(
+            0.001,
+            [
+                (TOPIC_GRASP_OBJECT, o),
+                (TOPIC_WRIST_WRENCH, WristWrench(0.001, f1, m1)),
+            ],
+        )
+        out = task._out
+        R = T[:3, :3]
+        # the hand's weight cancels in the difference
+        F_ref = np.concatenate([R @ np.subtract(f1, f0), R @ np.subtract(m1, m0)])
+        good = np.allclose(out.wrench, F_ref, atol=1e-9, rtol=0.0)
+        # the tare: the first reading in the world minus the hand's weight at its centre of mass
+        w_hand, r = task.hand.mass * task.g, R @ np.asarray(task.hand.com, float)
+        bias_ref = np.concatenate([R @ f0 - w_hand, R @ m0 - np.cross(r, w_hand)])
+        good &= np.allclose(task.bias, bias_ref, atol=1e-9, rtol=0.0)
+        ref = task.reference_command(q, qd, o, st, out.wrench)
+        good &= np.allclose(cmd.arm, ref["command"], atol=1e-9, rtol=0.0)
+        good &= np.allclose(out.x_a[:3], ref["x_a"], atol=1e-12, rtol=0.0)
+        for name, term in out.terms.items():
+            good &= np.allclose(term, ref[name], atol=1e-9, rtol=0.0)
+        ok += bool(good)
+    print(f"arm eq. 2 compiled vs NumPy: {ok}/{n} random inputs agree within 1e-9")
+    assert ok == n
+
+
+def test_hand_task_compiled_eq4_and_lowpass_equal_the_float_reference():
+    """``_hand_servo.eq4`` and ``lowpass`` (the hand task's per-step path) against
+    ``eq4_reference`` and the low-pass written out, over seeded random postures, rates, loads,
+    closures and gains (some commands beyond the limit): equal within 1e-12."""
+    from replay.control.grasping import _hand_servo
+    from replay.control.grasping.hand_control import eq4_reference
+
+    rng = np.random.default_rng(14)
+    ok, n = 0, 200
+    for i in range(n):
+        pre, grip, q = (rng.uniform(-0.3, 1.3, 14).tolist() for _ in range(3))
+        qd, load, tau = (rng.normal(0.0, 2.0, 14).tolist() for _ in range(3))
+        c, a = float(rng.uniform(0.0, 1.0)), float(rng.uniform(0.0, 1.0))
+        gains = (float(rng.uniform(0, 50)), float(rng.uniform(0, 0.1)), float(rng.uniform(0, 80)))
+        vmax = float(rng.uniform(0.5, 20.0))
+        g = None if i % 5 == 0 else grip
+        td, cmd, deficit = _hand_servo.eq4(pre, g, c, q, qd, load, *gains, vmax)
+        td_ref, cmd_ref, deficit_ref = eq4_reference(pre, g, c, q, qd, load, *gains, vmax)
+        low = _hand_servo.lowpass(load, tau, a)
+        low_ref = [x + a * (-t - x) for x, t in zip(load, tau)]
+        ok += bool(
+            np.allclose(td, td_ref, rtol=0.0, atol=1e-12)
+            and np.allclose(cmd, cmd_ref, rtol=0.0, atol=1e-12)
+            and abs(deficit - deficit_ref) < 1e-12
+            and np.allclose(low, low_ref, rtol=0.0, atol=1e-12)
+        )
+    print(f"hand eq. 4 compiled vs floats: {ok}/{n} random inputs agree")
+    assert ok == n
+
+
+def test_arm_wrench_below_the_deadband_is_zero_and_the_filter_lags(spec):
+    """F^a: a step of the wrist force passes the first-order low-pass (gain dt / (tau + dt) a
+    step) and is zero while its force is below the deadband."""
+    enc = JointState(0.0, list(spec.joint_names), list(spec.initial_q), [0.0] * 7, [0.0] * 7)
+    st = state([0.6, 0.0, 0.55])
+    for deadband, expect_zero in ((0.0, False), (50.0, True)):
+        task = ArmControlTask(ArmParams(force_deadband=deadband, force_filter=0.009), spec=spec)
+        task.update(
+            0.0,
+            [
+                (TOPIC_ARM_ENCODERS, enc),
+                (TOPIC_GRASP_STATE, st),
+                (TOPIC_WRIST_WRENCH, WristWrench(0.0, [0.0] * 3, [0.0] * 3)),
+            ],
+        )
+        task.update(0.001, [(TOPIC_WRIST_WRENCH, WristWrench(0.001, [10.0, 0.0, 0.0], [0.0] * 3))])
+        F = np.asarray(task._out.wrench)
+        if expect_zero:
+            assert np.all(F == 0.0)
+        else:  # a = 0.001 / (0.009 + 0.001) = 0.1 of the 10 N step
+            assert np.linalg.norm(F[:3]) == pytest.approx(1.0, rel=1e-9)

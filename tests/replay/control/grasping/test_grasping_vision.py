@@ -16,14 +16,19 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 from grasp_rig import rig  # noqa: E402
 
 from plants.bullet_arm.head import HeadServo  # noqa: E402
-from replay.control.grasping.features import blob  # noqa: E402
+from replay.control.grasping.features import blob, blob_rows  # noqa: E402
 from replay.control.grasping.head_tracking import HeadParams, HeadTrackingTask  # noqa: E402
 from replay.control.grasping.recognition import (
     RecognitionParams,
     RecognitionTask,  # noqa: E402
     shape_of,
 )
-from replay.control.grasping.self_window import dilate4, self_window, track  # noqa: E402
+from replay.control.grasping.self_window import (  # noqa: E402
+    dilate4,
+    self_window,
+    track,
+    track_rows,
+)
 from replay.messages import (
     TOPIC_GRASP_OBJECT,
     TOPIC_HEAD_ENCODERS,
@@ -119,6 +124,94 @@ def test_track_reacquires_from_the_whole_image():
     assert again
 
 
+def random_blobs(rng, n: int, w: int = 16, h: int = 16):
+    """Seeded random binary images: noise, rectangles and discs (some cut by the border), and
+    a target image near each (a moved copy, for Self Windowing)."""
+    out = []
+    v, u = np.mgrid[0:h, 0:w]
+    for i in range(n):
+        kind = i % 3
+        if kind == 0:
+            img = rng.random((h, w)) < rng.uniform(0.05, 0.6)
+        elif kind == 1:
+            c, s = math.cos(rng.uniform(0, math.pi)), math.sin(rng.uniform(0, math.pi))
+            du, dv = u - rng.uniform(-2, w + 1), v - rng.uniform(-2, h + 1)
+            img = (abs(du * c + dv * s) < rng.uniform(0.5, 6)) & (
+                abs(-du * s + dv * c) < rng.uniform(0.5, 4)
+            )
+        else:
+            img = (u - rng.uniform(0, w)) ** 2 + (v - rng.uniform(0, h)) ** 2 < rng.uniform(1, 30)
+        prev = np.roll(img, (int(rng.integers(-2, 3)), int(rng.integers(-2, 3))), axis=(0, 1))
+        out.append((img, prev & (rng.random((h, w)) < 0.9)))
+    return out
+
+
+def test_packed_rows_self_windowing_and_features_equal_the_array_versions():
+    """``track_rows`` and ``blob_rows`` (the task's per-frame path, on the chip's packed rows)
+    against ``track`` and ``blob`` (arrays, the reference) over seeded random images: the same
+    target bits and area, border flag, and features within 1e-9."""
+    rng = np.random.default_rng(12)
+    cases = random_blobs(rng, 300) + random_blobs(rng, 30, w=9, h=12)
+    ok = 0
+    for img, prev in cases:
+        h, w = img.shape
+        rows, prev_rows = pack_rows(img), pack_rows(prev)
+        target, again = track(prev, img)
+        target_rows, again_rows = track_rows(prev_rows, rows, w)
+        good = again == again_rows and target_rows == pack_rows(target)
+        for fill in (True, False):
+            a, b = blob(target, fill=fill), blob_rows(target_rows, w, fill=fill)
+            if a is None or b is None:
+                good &= a is None and b is None
+                continue
+            good &= (a.area, a.touches_border) == (b.area, b.touches_border)
+            fa, fb = (
+                [a.u, a.v, a.elongation, a.length, a.width],
+                [b.u, b.v, b.elongation, b.length, b.width],
+            )
+            good &= bool(np.allclose(fa, fb, rtol=0.0, atol=1e-9))
+            # phi is defined modulo pi (an isotropic blob's is arbitrary: its elongation is 1)
+            dphi = math.remainder(a.phi - b.phi, math.pi)
+            good &= abs(dphi) < 1e-9 or a.elongation < 1.0 + 1e-6
+            good &= (math.isnan(a.fill) and math.isnan(b.fill)) or abs(a.fill - b.fill) < 1e-9
+        ok += bool(good)
+    print(f"packed-row vision: {ok}/{len(cases)} random images agree with the array versions")
+    assert ok == len(cases)
+
+
+def test_compiled_target_pass_equals_the_packed_row_functions():
+    """``_chip_target.target_blob`` (the recognition task's compiled per-frame pass) against
+    ``track_rows`` and ``blob_rows`` over seeded random images and previous targets (also none,
+    and empty ones): the same target rows and reacquired flag, features within 1e-12."""
+    from replay.control.grasping import _chip_target
+    from replay.control.grasping.features import DIR_TABLE
+
+    rng = np.random.default_rng(13)
+    cases = random_blobs(rng, 300) + random_blobs(rng, 30, w=9, h=12)
+    ok = 0
+    for i, (img, prev) in enumerate(cases):
+        h, w = img.shape
+        rows = pack_rows(img)
+        prev_rows = None if i % 7 == 0 else [0] * h if i % 7 == 1 else pack_rows(prev)
+        for fill in (True, False):
+            target, again, feats = _chip_target.target_blob(prev_rows, rows, w, fill, DIR_TABLE)
+            ref_target, ref_again = track_rows(prev_rows, rows, w)
+            ref = blob_rows(ref_target, w, fill=fill)
+            good = target == ref_target and again == ref_again
+            if ref is None or feats is None:
+                good &= ref is None and feats is None
+            else:
+                a = [ref.area, ref.u, ref.v, ref.phi, ref.elongation, ref.length, ref.width]
+                good &= feats[8] == ref.touches_border and feats[0] == ref.area
+                good &= bool(np.allclose(feats[:7], a, rtol=0.0, atol=1e-12))
+                good &= (math.isnan(feats[7]) and math.isnan(ref.fill)) or abs(
+                    feats[7] - ref.fill
+                ) < 1e-12
+            ok += bool(good)
+    print(f"compiled chip pass: {ok}/{2 * len(cases)} random cases equal the Python one")
+    assert ok == 2 * len(cases)
+
+
 def test_moments_give_centre_and_rotation():
     img = np.zeros((16, 16), bool)
     img[5:8, 3:11] = True  # 8 x 3, along u
@@ -201,6 +294,48 @@ def test_position_on_the_constraint_plane_from_one_chip_image(spec):
     _, out = recognise(spec, box, angles)
     assert out.shape == "rectangle"
     assert out.roll == pytest.approx(roll, abs=0.1)
+
+
+def test_recognised_pose_and_jacobian_equal_the_numpy_camera_over_random_views(spec):
+    """The task's x_o, roll, size and image Jacobian (its compiled plane geometry) against the
+    NumPy ``Camera`` (ray, meet_plane, jacobian) at the target's own moments, for seeded random
+    boxes (rolled, off centre) and head angles off the line of sight: equal within 1e-9."""
+    from replay.control.grasping.recognition import Camera, meet_plane
+
+    rng = np.random.default_rng(15)
+    cam = Camera(spec.head, FOV, 16, 16)
+    centre = np.array([0.75, 0.0, 0.55])
+    ok, n = 0, 40
+    for _ in range(n):
+        p = centre + np.array([0.0, *rng.uniform(-0.03, 0.03, 2)])
+        roll = float(rng.uniform(-1.0, 1.0))
+        box = Box(
+            "box",
+            tuple(p),
+            (math.sin(roll / 2), 0.0, 0.0, math.cos(roll / 2)),
+            (0.05, 0.10, 0.05),
+            0.9,
+        )
+        angles = tuple(np.add(look_angles(spec.head, centre), rng.uniform(-0.02, 0.02, 2)))
+        task, out = recognise(spec, box, angles)
+        task_b = blob_rows(task._target, 16)  # the target the task measured
+        pose = camera_pose(spec.head, *angles)
+        o, d = cam.ray(angles, (task_b.u, task_b.v), pose)
+        X = meet_plane(o, d, task.plane_point, task.pn)
+        o2, d2 = cam.ray(
+            angles, (task_b.u + math.cos(task_b.phi), task_b.v + math.sin(task_b.phi)), pose
+        )
+        e = meet_plane(o2, d2, task.plane_point, task.pn) - X
+        axis = math.atan2(float(e @ task.pv), float(e @ task.pu))
+        J = cam.jacobian(angles, X, pose)
+        scale = float(np.linalg.norm(X - o)) / cam.f
+        good = out.found and np.allclose(out.position, X, rtol=0.0, atol=1e-9)
+        good &= np.allclose(out.jacobian, J, rtol=1e-9, atol=1e-9)
+        good &= np.allclose(out.size, [task_b.length * scale, task_b.width * scale], atol=1e-9)
+        good &= out.roll is None or abs(math.remainder(out.roll - axis, math.pi)) < 1e-9
+        ok += bool(good)
+    print(f"recognised pose and Jacobian: {ok}/{n} random views equal the NumPy camera's")
+    assert ok == n
 
 
 def test_head_loop_centres_the_target(spec):
