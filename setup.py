@@ -12,6 +12,18 @@ _chip_target.c, _hand_servo.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
+# -fexcess-precision=standard: every double operation rounds once, as in Python and NumPy (the
+# kernels' tests compare with their Python references to the bit)
+FLAGS = ["-O2", "-fexcess-precision=standard"]
+
+
+def _ext(module: str, depends: tuple[str, ...] = ()) -> Extension:
+    """The extension ``module`` built from the one C file of that dotted path."""
+    return Extension(
+        module, [module.replace(".", "/") + ".c"], depends=list(depends), extra_compile_args=FLAGS
+    )
+
+
 SHIPPED = {
     "replay._shipped.data": "data",
     "replay._shipped.scenarios": "scenarios",
@@ -22,73 +34,23 @@ setup(
     packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
     package_dir=SHIPPED,
     ext_modules=[
-        Extension(
-            "replay.sensors._pixels",
-            ["replay/sensors/_pixels.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
+        _ext("replay.sensors._pixels"),
+        # includes _pixels.c's kernels, unchanged, and _silhouette.c's sphere outline
+        _ext(
             "replay.sensors._stereo",
-            ["replay/sensors/_stereo.c"],
-            # included: _pixels.c's kernels, unchanged, and _silhouette.c's sphere outline
-            depends=["replay/sensors/_pixels.c", "replay/sensors/_silhouette.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
+            ("replay/sensors/_pixels.c", "replay/sensors/_silhouette.c"),
         ),
-        Extension(
-            "replay.sensors._silhouette",
-            ["replay/sensors/_silhouette.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.control.catching._mapping",
-            ["replay/control/catching/_mapping.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.robot._chain",
-            ["replay/robot/_chain.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "plants.airtable._bodies",
-            ["plants/airtable/_bodies.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.control.stick._sweep",
-            ["replay/control/stick/_sweep.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.foxglove._png",
-            ["replay/foxglove/_png.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.log._chunk",
-            ["replay/log/_chunk.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.log._finite",
-            ["replay/log/_finite.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.control.grasping._arm_kinematics",
-            ["replay/control/grasping/_arm_kinematics.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.control.grasping._chip_target",
-            ["replay/control/grasping/_chip_target.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
-        Extension(
-            "replay.control.grasping._hand_servo",
-            ["replay/control/grasping/_hand_servo.c"],
-            extra_compile_args=["-O2", "-fexcess-precision=standard"],
-        ),
+        _ext("replay.sensors._silhouette"),
+        _ext("replay.control.catching._mapping"),
+        _ext("replay.robot._chain"),
+        _ext("plants.airtable._bodies"),
+        _ext("replay.control.stick._sweep"),
+        _ext("replay.foxglove._png"),
+        _ext("replay.log._chunk"),
+        _ext("replay.log._finite"),
+        _ext("replay.control.grasping._arm_kinematics"),
+        _ext("replay.control.grasping._chip_target"),
+        _ext("replay.control.grasping._hand_servo"),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],
