@@ -322,12 +322,14 @@ class VisionChip:
 
 
 def pack_rows(bits: np.ndarray) -> list[int]:
-    """A (h, w) 0/1 array as h ints, bit u of row v = bits[v, u]."""
-    weights = 1 << np.arange(bits.shape[1], dtype=np.int64)
-    return [int(x) for x in (bits.astype(np.int64) @ weights)]
+    """A (h, w) 0/1 array as h ints, bit u of row v = bits[v, u] (any width: Python ints)."""
+    packed = np.packbits(np.asarray(bits, dtype=bool), axis=1, bitorder="little")
+    return [int.from_bytes(row.tobytes(), "little") for row in packed]
 
 
 def unpack_rows(rows, width: int) -> np.ndarray:
     """The inverse of :func:`pack_rows`: a (len(rows), width) bool array."""
-    r = np.asarray(rows, dtype=np.int64)[:, None]
-    return ((r >> np.arange(width, dtype=np.int64)) & 1).astype(bool)
+    n = (width + 7) // 8
+    data = b"".join(int(r).to_bytes(n, "little") for r in rows)
+    bits = np.unpackbits(np.frombuffer(data, np.uint8).reshape(-1, n), axis=1, bitorder="little")
+    return bits[:, :width].astype(bool)

@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
-from replay.messages import pack_rows
+from replay.messages import pack_rows, unpack_rows
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.sensors import _pixels
 from replay.sensors.silhouette import _body_points, project_hull, sphere_ellipse, sphere_polygon
@@ -471,6 +471,16 @@ def test_compiled_pack_rows_equals_pack_rows():
         assert rows == pack_rows(bits) and count == int(bits.sum())
     with pytest.raises(ValueError):
         _pixels.pack_rows(np.zeros((2, 64), bool), 64, 2)  # pack_rows' int64: 63 bits
+
+
+def test_pack_rows_is_exact_at_any_width():
+    """Rows are Python ints: a chip wider than 63 px (int64) packs and unpacks exactly."""
+    rng = np.random.default_rng(2)
+    for w in (1, 8, 63, 64, 65, 80, 200):
+        bits = rng.random((int(rng.integers(1, 12)), w)) < 0.5
+        rows = pack_rows(bits)
+        assert rows == [sum(1 << u for u in range(w) if row[u]) for row in bits]
+        assert (unpack_rows(rows, w) == bits).all()
 
 
 def test_window_of_a_box_on_the_stick_camera_is_clipped_to_the_image():

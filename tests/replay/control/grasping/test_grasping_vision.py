@@ -12,6 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from replay.log.reader import LogReader
+from replay.resources import scenario_dir
+from replay.runner import Runner
+from replay.scenario import load_scenario
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 from grasp_rig import rig  # noqa: E402
 
@@ -377,3 +382,21 @@ def test_image_jacobian_is_the_head_models(spec):
         ]
     )
     np.testing.assert_allclose(J, num, rtol=1e-5, atol=1e-4)
+
+
+def test_a_chip_wider_than_63_px_runs_the_grasp_method(tmp_path):
+    """The compiled chip paths stop at 63 px; wider chips take the Python ones (it was an
+    OverflowError in the recognition task: rows unpacked as int64)."""
+    sc = load_scenario(
+        scenario_dir() / "grasp_hexahedron.yaml",
+        sets=[
+            "sensors.chip.params.width=80",
+            "sensors.chip.params.height=70",
+            "timing.duration=0.05",
+        ],
+    )
+    result = Runner(sc).run(tmp_path / "wide.mcap")
+    assert result.stopped_by != "error", result.error
+    chips = [m.data for m in LogReader(tmp_path / "wide.mcap").messages("/vision/chip")]
+    assert len(chips) == 50 and {c["width"] for c in chips} == {80}
+    assert max(c["count"] for c in chips) > 0  # the object is seen
