@@ -596,39 +596,29 @@ done:
     return ret;
 }
 
-/* ball_blob(img, w, h, threshold, min_pixels, binary, default_background, ox, oy, full_w,
- * full_h): the stereo camera's blob measurement (replay/sensors/stereo.py StereoBallCamera.blob
- * says what and why) on the uint8 image img (h x w, a window of the full_w x full_h image whose
- * first pixel is (ox, oy)). None, or (u, v, area, background) in full-image pixels, background
- * NaN for binary moments. */
-static PyObject *py_ball_blob(PyObject *self, PyObject *args) {
-    Py_buffer I;
-    int w, h, min_pixels, binary, ox, oy, fw, fh;
-    double thr, default_bg;
-    if (!PyArg_ParseTuple(args, "y*iidiidiiii", &I, &w, &h, &thr, &min_pixels, &binary,
-                          &default_bg, &ox, &oy, &fw, &fh))
-        return NULL;
-    PyObject *ret = NULL;
-    int32_t *lab = NULL, *stack = NULL;
+/* The stereo camera's blob measurement (replay/sensors/stereo.py StereoBallCamera.blob says what
+ * and why) on a w x h uint8 window img whose first pixel is (ox, oy) of the fw x fh image. The
+ * local background is the (upper) median of the free grey levels around the grown blob, taken
+ * from a histogram (O(n); the (n/2)-th smallest, as sorting them gives). 1 and *out = (u, v, area,
+ * background; NaN for binary moments) in full-image pixels if found, 0 if not, -1 out of memory. */
+static int blob_of(const uint8_t *img, int w, int h, double thr, int min_pixels, int binary,
+                   double default_bg, int ox, int oy, int fw, int fh, double *out) {
+    int ex0, ey0, ex1, ey1, found = 0;
+    if (w == 0 || h == 0 || !bright_box(img, w, h, thr, &ex0, &ey0, &ex1, &ey1)) return 0;
+    int32_t *lab = calloc((size_t)w * h, sizeof(int32_t));
+    int32_t *stack = malloc((size_t)w * h * sizeof(int32_t));
     double *wt = NULL;
-    if (!sizes_ok(w, h) || !check(&I, 1, (Py_ssize_t)w * h, "img")) goto done;
-    if (w == 0 || h == 0) goto none; /* an empty window: nothing seen */
-    const uint8_t *img = I.buf;
-    int ex0, ey0, ex1, ey1;
-    if (!bright_box(img, w, h, thr, &ex0, &ey0, &ex1, &ey1)) goto none;
-    lab = calloc((size_t)w * h, sizeof(int32_t));
-    stack = malloc((size_t)w * h * sizeof(int32_t));
     if (!lab || !stack) goto nomem;
     Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1, ey1, lab, stack);
-    if (b.area < min_pixels) goto none;
+    if (b.area < min_pixels) goto done;
     if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
-        goto none; /* cut by the image border */
+        goto done; /* cut by the image border */
     int x0 = b.x - 4 > 0 ? b.x - 4 : 0, y0 = b.y - 4 > 0 ? b.y - 4 : 0;
     int x1 = b.x + b.w + 4 < w ? b.x + b.w + 4 : w, y1 = b.y + b.h + 4 < h ? b.y + b.h + 4 : h;
     int bw = x1 - x0, bh = y1 - y0;
-    wt = malloc((size_t)bw * bh * 2 * sizeof(double) + 2 * (size_t)bw * bh);
+    wt = malloc((size_t)bw * bh * sizeof(double) + 2 * (size_t)bw * bh);
     if (!wt) goto nomem;
-    uint8_t *near = (uint8_t *)(wt + 2 * (size_t)bw * bh), *tmp = near + (size_t)bw * bh;
+    uint8_t *near = (uint8_t *)(wt + (size_t)bw * bh), *tmp = near + (size_t)bw * bh;
     dilate_blob(lab, w, b.label, x0, y0, x1, y1, near, tmp);
     double background = NAN;
     if (binary) {
@@ -636,20 +626,19 @@ static PyObject *py_ball_blob(PyObject *self, PyObject *args) {
             for (int c = 0; c < bw; c++)
                 wt[(size_t)r * bw + c] = lab[(size_t)(r + y0) * w + c + x0] == b.label;
     } else {
-        /* the local background: the (upper) median of the free pixels around the grown blob */
-        double *ring = wt + (size_t)bw * bh;
-        int nr = 0;
+        int hist[256] = {0}, nr = 0;
         for (int r = y0; r < y1; r++)
             for (int c = x0; c < x1; c++) {
                 int32_t L = lab[(size_t)r * w + c];
                 int region = L == b.label ||
                              (L == 0 && near[(size_t)(r - y0) * bw + c - x0]);
-                if (!region && L == 0) ring[nr++] = img[(size_t)r * w + c];
+                if (!region && L == 0) hist[img[(size_t)r * w + c]]++, nr++;
                 wt[(size_t)(r - y0) * bw + c - x0] = region ? 1.0 : 0.0;
             }
         if (nr) {
-            qsort(ring, nr, sizeof(double), cmp_double);
-            background = ring[nr / 2];
+            int k = 0, seen = hist[0];
+            while (seen <= nr / 2) seen += hist[++k];
+            background = k;
         } else {
             background = default_bg;
         }
@@ -662,20 +651,42 @@ static PyObject *py_ball_blob(PyObject *self, PyObject *args) {
             }
     }
     Moments m = moments_of(wt, bw, bh);
-    if (m.m00 <= 0.0) goto none;
-    ret = Py_BuildValue("(ddid)", ox + x0 + m.m10 / m.m00, oy + y0 + m.m01 / m.m00, b.area,
-                        background);
+    if (m.m00 > 0.0) {
+        out[0] = ox + x0 + m.m10 / m.m00, out[1] = oy + y0 + m.m01 / m.m00;
+        out[2] = b.area, out[3] = background;
+        found = 1;
+    }
     goto done;
 nomem:
-    PyErr_NoMemory();
-    goto done;
-none:
-    Py_INCREF(Py_None);
-    ret = Py_None;
+    found = -1;
 done:
     free(lab);
     free(stack);
     free(wt);
+    return found;
+}
+
+/* ball_blob(img, w, h, threshold, min_pixels, binary, default_background, ox, oy, full_w,
+ * full_h): blob_of on the uint8 image img (h x w, a window of the full_w x full_h image whose
+ * first pixel is (ox, oy)). None, or (u, v, area, background) in full-image pixels, background
+ * NaN for binary moments. */
+static PyObject *py_ball_blob(PyObject *self, PyObject *args) {
+    Py_buffer I;
+    int w, h, min_pixels, binary, ox, oy, fw, fh;
+    double thr, default_bg, out[4];
+    if (!PyArg_ParseTuple(args, "y*iidiidiiii", &I, &w, &h, &thr, &min_pixels, &binary,
+                          &default_bg, &ox, &oy, &fw, &fh))
+        return NULL;
+    PyObject *ret = NULL;
+    if (sizes_ok(w, h) && check(&I, 1, (Py_ssize_t)w * h, "img")) {
+        int found = blob_of(I.buf, w, h, thr, min_pixels, binary, default_bg, ox, oy, fw, fh, out);
+        if (found < 0)
+            PyErr_NoMemory();
+        else if (found == 0)
+            ret = Py_NewRef(Py_None);
+        else
+            ret = Py_BuildValue("(ddid)", out[0], out[1], (int)out[2], out[3]);
+    }
     PyBuffer_Release(&I);
     return ret;
 }

@@ -3,8 +3,7 @@
  * exact-coverage compositing, quantising and the blob's moments of one camera (frame); the two
  * triangulations around the sphere's bias correction and the depth checks (locate). They are the
  * kernels of _pixels.c (included here unchanged: py_composite, py_quantise and py_triangulate
- * are called as they are from Python; its blob helpers make blob_of, ball_blob with the median
- * from a histogram), so the results are those of the Python glue they replace, kept in
+ * are called as they are from Python, and blob_of is ball_blob's core), so the results are those of the Python glue they replace, kept in
  * stereo.py as the reference (measure_reference;
  * tests/replay/sensors/test_fast_cameras.py holds the two together). Plain C over the buffer
  * protocol: no NumPy headers.
@@ -18,75 +17,6 @@ static PyObject *call(PyObject *(*kernel)(PyObject *, PyObject *), PyObject *arg
     PyObject *ret = kernel(NULL, args);
     Py_DECREF(args);
     return ret;
-}
-
-/* _pixels.c's ball_blob on a w x h uint8 window img whose first pixel is (ox, oy) of the
- * fw x fh image, with the local background's (upper) median taken from a histogram of the ring's
- * grey levels (O(n), where sorting them was most of the blob's time; the same value: the
- * (n/2)-th smallest). 1 and *out = (u, v, area, background) if found, 0 if not, -1 out of memory. */
-static int blob_of(const uint8_t *img, int w, int h, double thr, int min_pixels, int binary,
-                   double default_bg, int ox, int oy, int fw, int fh, double *out) {
-    int ex0, ey0, ex1, ey1, found = 0;
-    if (w == 0 || h == 0 || !bright_box(img, w, h, thr, &ex0, &ey0, &ex1, &ey1)) return 0;
-    int32_t *lab = calloc((size_t)w * h, sizeof(int32_t));
-    int32_t *stack = malloc((size_t)w * h * sizeof(int32_t));
-    double *wt = NULL;
-    if (!lab || !stack) goto nomem;
-    Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1, ey1, lab, stack);
-    if (b.area < min_pixels) goto done;
-    if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
-        goto done; /* cut by the image border */
-    int x0 = b.x - 4 > 0 ? b.x - 4 : 0, y0 = b.y - 4 > 0 ? b.y - 4 : 0;
-    int x1 = b.x + b.w + 4 < w ? b.x + b.w + 4 : w, y1 = b.y + b.h + 4 < h ? b.y + b.h + 4 : h;
-    int bw = x1 - x0, bh = y1 - y0;
-    wt = malloc((size_t)bw * bh * sizeof(double) + 2 * (size_t)bw * bh);
-    if (!wt) goto nomem;
-    uint8_t *near = (uint8_t *)(wt + (size_t)bw * bh), *tmp = near + (size_t)bw * bh;
-    dilate_blob(lab, w, b.label, x0, y0, x1, y1, near, tmp);
-    double background = NAN;
-    if (binary) {
-        for (int r = 0; r < bh; r++)
-            for (int c = 0; c < bw; c++)
-                wt[(size_t)r * bw + c] = lab[(size_t)(r + y0) * w + c + x0] == b.label;
-    } else {
-        int hist[256] = {0}, nr = 0;
-        for (int r = y0; r < y1; r++)
-            for (int c = x0; c < x1; c++) {
-                int32_t L = lab[(size_t)r * w + c];
-                int region = L == b.label ||
-                             (L == 0 && near[(size_t)(r - y0) * bw + c - x0]);
-                if (!region && L == 0) hist[img[(size_t)r * w + c]]++, nr++;
-                wt[(size_t)(r - y0) * bw + c - x0] = region ? 1.0 : 0.0;
-            }
-        if (nr) {
-            int k = 0, seen = hist[0];
-            while (seen <= nr / 2) seen += hist[++k];
-            background = k;
-        } else {
-            background = default_bg;
-        }
-        /* signed weights: zero-mean noise around the blob leaves the centroid unbiased */
-        const float bg = (float)background;
-        for (int r = 0; r < bh; r++)
-            for (int c = 0; c < bw; c++) {
-                size_t k = (size_t)r * bw + c;
-                wt[k] = wt[k] != 0.0 ? (float)img[(size_t)(r + y0) * w + c + x0] - bg : 0.0f;
-            }
-    }
-    Moments m = moments_of(wt, bw, bh);
-    if (m.m00 > 0.0) {
-        out[0] = ox + x0 + m.m10 / m.m00, out[1] = oy + y0 + m.m01 / m.m00;
-        out[2] = b.area, out[3] = background;
-        found = 1;
-    }
-    goto done;
-nomem:
-    found = -1;
-done:
-    free(lab);
-    free(stack);
-    free(wt);
-    return found;
 }
 
 /* (image, window, blob) of one noise-free camera (see frame below) from the polygons (a list of
