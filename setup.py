@@ -34,13 +34,17 @@ setup(
     packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
     package_dir=SHIPPED,
     ext_modules=[
-        _ext("replay.sensors._pixels"),
+        _ext("replay.sensors._pixels", ("replay/sensors/_ellipse.h",)),
         # includes _pixels.c's kernels, unchanged, and _silhouette.c's sphere outline
         _ext(
             "replay.sensors._stereo",
-            ("replay/sensors/_pixels.c", "replay/sensors/_silhouette.c"),
+            (
+                "replay/sensors/_pixels.c",
+                "replay/sensors/_silhouette.c",
+                "replay/sensors/_ellipse.h",
+            ),
         ),
-        _ext("replay.sensors._silhouette"),
+        _ext("replay.sensors._silhouette", ("replay/sensors/_ellipse.h",)),
         _ext("replay.control.catching._mapping"),
         _ext("replay.robot._chain"),
         _ext("plants.airtable._bodies"),

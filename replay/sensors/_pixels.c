@@ -11,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "_ellipse.h"
+
 /* Signed-area accumulation of one polygon (n vertices xy[2n], pixels of the full image) into
  * acc (h rows of w + 1) of the block whose first pixel is (ox, oy): each edge is cut where it
  * crosses a pixel boundary, so every piece lies in one pixel; a piece rising dy at mean distance
@@ -736,18 +738,9 @@ static PyObject *py_ellipse_polygon(PyObject *self, PyObject *args) {
     Py_ssize_t n = C.len / (Py_ssize_t)sizeof(double);
     if (!check(&S, sizeof(double), n, "sin") || !check(&O, sizeof(double), 2 * n, "out"))
         goto done;
-    const double *ct = C.buf, *st = S.buf;
-    double *out = O.buf, ac = a * c, bs = b * s, as = a * s, bc = b * c;
-    double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
-    for (Py_ssize_t k = 0; k < n; k++) {
-        double pu = u + ac * ct[k] - bs * st[k], pv = v + as * ct[k] + bc * st[k];
-        out[2 * k] = pu, out[2 * k + 1] = pv;
-        if (pu < umin) umin = pu;
-        if (pu > umax) umax = pu;
-        if (pv < vmin) vmin = pv;
-        if (pv > vmax) vmax = pv;
-    }
-    ret = Py_BuildValue("(dddd)", umin, vmin, umax, vmax);
+    double box[4];
+    ellipse_ngon(C.buf, S.buf, n, u, v, a, b, c, s, O.buf, box);
+    ret = Py_BuildValue("(dddd)", box[0], box[1], box[2], box[3]);
 done:
     PyBuffer_Release(&C);
     PyBuffer_Release(&S);

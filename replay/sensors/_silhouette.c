@@ -8,6 +8,8 @@
 #include <Python.h>
 #include <math.h>
 
+#include "_ellipse.h"
+
 /* The sphere of centre (x, y, z) (world) and radius seen by the camera at o (3) with
  * camera-to-world rotation R (3 x 3, row-major) and intrinsics fx, fy, cx, cy: its outline as the
  * n-gon of the tables ct, st with both semi-axes times scale into out (2n), its box into box (4).
@@ -39,18 +41,7 @@ static int sphere_outline(const double *R, const double *o, double fx, double fy
     /* Ellipse.polygon_and_box(inset = 0, area_exact): semi-axes max(a, 0.05 a) * scale */
     a = (a > 0.05 * a ? a : 0.05 * a) * scale;
     b = (b > 0.05 * b ? b : 0.05 * b) * scale;
-    double c = cos(angle), s = sin(angle);
-    double ac = a * c, bs = b * s, as = a * s, bc = b * c;
-    double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
-    for (Py_ssize_t k = 0; k < n; k++) {
-        double pu = u + ac * ct[k] - bs * st[k], pv = v + as * ct[k] + bc * st[k];
-        out[2 * k] = pu, out[2 * k + 1] = pv;
-        if (pu < umin) umin = pu;
-        if (pu > umax) umax = pu;
-        if (pv < vmin) vmin = pv;
-        if (pv > vmax) vmax = pv;
-    }
-    box[0] = umin, box[1] = vmin, box[2] = umax, box[3] = vmax;
+    ellipse_ngon(ct, st, n, u, v, a, b, cos(angle), sin(angle), out, box);
     return 1;
 }
 
