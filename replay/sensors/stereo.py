@@ -203,6 +203,19 @@ class StereoBallCameraParams:
             )
 
 
+def _blob(found: tuple | None, binary: bool) -> dict | None:
+    """A blob kernel's (u, v, area, background) as the camera's blob record (no background for
+    binary moments)."""
+    if found is None:
+        return None
+    return {
+        "u": found[0],
+        "v": found[1],
+        "area": found[2],
+        "background": None if binary else found[3],
+    }
+
+
 class StereoBallCamera(Sensor):
     """Two 128 x 128 cameras, blob moments and triangulation: ``/vision/object`` (``r_o``)."""
 
@@ -326,15 +339,7 @@ class StereoBallCamera(Sensor):
             int(p.width),
             int(p.height),
         )
-        if found is None:
-            return None
-        u, v, area, background = found
-        return {
-            "u": u,
-            "v": v,
-            "area": area,
-            "background": None if p.moments == "binary" else background,
-        }
+        return _blob(found, p.moments == "binary")
 
     def frame_images(self) -> list[tuple[str, WindowedImage]]:
         """The last frame's images (with their noise): ``[("cam0", WindowedImage), ("cam1",
@@ -464,16 +469,7 @@ class StereoBallCamera(Sensor):
         for image, window, found in frames:
             x0, y0, x1, y1 = window
             last.append((np.frombuffer(image, np.uint8).reshape(y1 - y0, x1 - x0), window))
-            blobs.append(
-                None
-                if found is None
-                else {
-                    "u": found[0],
-                    "v": found[1],
-                    "area": found[2],
-                    "background": None if blob_args[2] else found[3],
-                }
-            )
+            blobs.append(_blob(found, blob_args[2]))
         self._last = last
         self.last_blobs = blobs
         try:
@@ -523,16 +519,7 @@ class StereoBallCamera(Sensor):
             _pixels.quantise(img, img8)
             last.append((img8, window))
             found = _pixels.ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
-            blobs.append(
-                None
-                if found is None
-                else {
-                    "u": found[0],
-                    "v": found[1],
-                    "area": found[2],
-                    "background": None if blob_args[2] else found[3],
-                }
-            )
+            blobs.append(_blob(found, blob_args[2]))
         self._last = last
         self.last_blobs = blobs
         try:
