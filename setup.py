@@ -2,7 +2,8 @@
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
 the buffer protocol, no NumPy headers), as are the stereo camera's frame and a sphere's silhouette
-(replay/sensors/_stereo.c, _silhouette.c), the catching mapping
+(replay/sensors/_stereo.c, _silhouette.c), the stick camera's frame
+(replay/sensors/_stick_frame.c), the catching mapping
 (replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
 (replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
 air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
@@ -45,6 +46,11 @@ setup(
             ),
         ),
         _ext("replay.sensors._silhouette", ("replay/sensors/_ellipse.h",)),
+        # includes _pixels.c's kernels, unchanged
+        _ext(
+            "replay.sensors._stick_frame",
+            ("replay/sensors/_pixels.c", "replay/sensors/_ellipse.h"),
+        ),
         _ext("replay.control.catching._mapping"),
         _ext("replay.robot._chain"),
         _ext("plants.airtable._bodies"),

@@ -65,7 +65,7 @@ from replay.params import ParamError, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
-from replay.sensors import _pixels
+from replay.sensors import _pixels, _stick_frame
 from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
 
@@ -341,6 +341,10 @@ class StickCamera(Sensor):
         self.camera = self.make_camera(params)
         self._R = tuple(tuple(float(v) for v in row) for row in self.camera.rotation)
         self._o = tuple(float(v) for v in self.camera.position)
+        self._R_array = np.ascontiguousarray(self.camera.rotation, dtype=np.float64)
+        self._o_array = np.ascontiguousarray(self.camera.position, dtype=np.float64)
+        self._threshold, self._min_pixels = float(params.threshold), int(params.min_pixels)
+        self._shapes: dict = {}  # _frame's (body points, bounding radius, hull buffer) by shape
         self._last = None
 
     # --- helpers usable without a sensor instance -------------------------------------------
@@ -448,6 +452,67 @@ class StickCamera(Sensor):
         ]
 
     def measure(self, t: float, scene: Scene) -> VisionStick | None:
+        """The marker's pose in a frame of ``scene``: noise-free frames in one compiled call
+        (:meth:`_frame`, the same pixels and moments as :meth:`measure_reference`), the rest
+        (noise, a scene with spheres, no marker in view: the whole image) by the reference."""
+        framed = self._frame(scene) if self.params.noise_sigma == 0.0 else None
+        if framed is None:
+            return self.measure_reference(t, scene)
+        img, window, found, marker = framed
+        self._last = (img, window)
+        return self._pose(t, marker, found)
+
+    def _frame(self, scene: Scene):
+        """(image window, window, moments, marker) of a noise-free frame in one compiled call
+        (``_stick_frame.frame``: the steps of :meth:`measure_reference` and its kernels), or
+        None when the reference path must do it."""
+        p, prims, shapes = self.params, scene.primitives, self._shapes
+        entries, marker, o = [], -1, self._o
+        for i, prim in enumerate(prims):
+            kind = type(prim)
+            if kind is Box:
+                key: tuple = (i, kind, prim.size)
+            elif kind is Cylinder:
+                key = (i, kind, prim.radius, prim.length)
+            else:
+                return None
+            shape = shapes.get(key)
+            if shape is None:
+                shape = shapes[key] = self._shape(prim)
+            body, rb, out = shape
+            pos = prim.position
+            entries.append((body, prim.orientation, pos, prim.albedo, rb, math.dist(pos, o), out))
+            if marker < 0 and prim.name == p.marker:
+                marker = i
+        if marker < 0:
+            return None
+        k = self.camera.intrinsics
+        framed = _stick_frame.frame(
+            entries, marker, self._R_array, self._o_array, k.fx, k.fy, k.cx, k.cy,
+            p.width, p.height, p.background, self._threshold, self._min_pixels,
+        )  # fmt: skip
+        if framed is None:
+            return None
+        data, window, found = framed
+        img = np.frombuffer(data, np.uint8).reshape(window[3] - window[1], window[2] - window[0])
+        return img, window, found, prims[marker]
+
+    @staticmethod
+    def _shape(prim: Box | Cylinder) -> tuple[np.ndarray, float, np.ndarray]:
+        """(body outline points, bounding-sphere radius as :func:`_misses` takes it, a hull
+        buffer) of a box or cylinder, for :meth:`_frame`."""
+        body = _body_points(prim)
+        if isinstance(prim, Box):
+            sx, sy, sz = prim.size
+            rb = 0.5 * math.sqrt(sx * sx + sy * sy + sz * sz)
+        else:
+            rb = math.hypot(prim.radius, 0.5 * prim.length)
+        return body, rb, np.empty((len(body), 2))
+
+    def measure_reference(self, t: float, scene: Scene) -> VisionStick | None:
+        """:meth:`measure` in Python between the compiled kernels (the reference of
+        ``_stick_frame.frame``, tests/replay/sensors/test_stick_frame.py, and the path of frames
+        with noise)."""
         p = self.params
         cam = self.camera
         # Only a window around the marker is rendered (and given noise): the moments use
@@ -482,8 +547,13 @@ class StickCamera(Sensor):
         if marker is None:
             return None
         found = self._moments(img, p, window[:2])  # (marker_moments without its dict)
+        return self._pose(t, marker, found)
+
+    def _pose(self, t: float, marker: Box, found: tuple | None) -> VisionStick | None:
+        """The measurement from the marker's moments (``_pixels.marker_moments``), or None."""
         if found is None:
             return None
+        p = self.params
         # The marker's silhouette seen from above is its top face swept down to its bottom face;
         # its centroid lies on the ray through the box's centre (exactly so for a thin box), so
         # the centroid is back-projected onto the horizontal plane through the marker's centre.
