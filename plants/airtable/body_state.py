@@ -8,7 +8,8 @@ is not there, the public properties are used: the same numbers, only slower.
 :class:`TableIO` does a step's whole input/output (the tips' velocities, the engine step, the
 state after it) in one compiled call (``_bodies.c``), calling those same Chipmunk functions
 through the addresses the cffi binding gives; the readers and setter below are its reference
-(tests/plants/airtable/test_bodies_kernel.py) and its fallback.
+(tests/plants/airtable/test_bodies_kernel.py) and its fallback. :meth:`TableIO.step_hand` also
+advances the hand's servo first (``HandServo.advance`` and ``tip_list`` are its reference).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from typing import Callable
 import pymunk
 
 from plants.airtable import _bodies
+from plants.airtable.hand import HandServo
 
 try:  # Pymunk 7's own cffi binding of Chipmunk
     from pymunk._chipmunk_cffi import ffi as _ffi, lib as _cp
@@ -135,3 +137,13 @@ class TableIO:
         space_step(dt)
         self.read()
         return False
+
+    def step_hand(
+        self, hand: HandServo, dt: float, space_step: Callable[[float], None], limits: tuple
+    ) -> bool:
+        """The hand servo's step (``hand.advance(dt)``, its reference) and then :meth:`step`
+        with its tips (``hand.tip_list()``) as the targets, in one compiled call."""
+        if self._ptrs is not None:
+            return _bodies.step_hand(self._ptrs, self.state, hand.state, dt, space_step, *limits)
+        hand.advance(dt)  # pragma: no cover - the fallback
+        return self.step(hand.tip_list(), dt, space_step, limits)  # pragma: no cover

@@ -123,3 +123,41 @@ def test_the_usual_case_flag_is_never_wrong():
         flagged += flag
         usual += ok
     assert 0.3 * usual < flagged <= usual  # mostly decided by the kernel
+
+
+def test_step_hand_advances_the_servo_as_its_python_reference():
+    """_bodies.step_hand (the servo's step and the tips' kinematics, then step) against
+    HandServo.advance and tip_list, then TableIO.step: the same hand state and bodies, exactly,
+    with targets set now and then (the servo moving, landing and resting)."""
+    from plants.airtable.hand import HandServo
+    from plants.airtable.params import Params
+    from plants.airtable.settings import hand_spec
+
+    dt = 1.0 / 3000.0
+    spec = hand_spec(Params())
+    moved = settled = 0
+    for seed in range(4):
+        rng = np.random.default_rng(70 + seed)
+        space_a, stick_a, tips_a = table(LeanSpace, np.random.default_rng(seed))
+        space_b, stick_b, tips_b = table(LeanSpace, np.random.default_rng(seed))
+        io_a, io_b = body_state.TableIO(stick_a, tips_a), body_state.TableIO(stick_b, tips_b)
+        q0 = [[0.3, 1.2], [-0.4, -1.0]]
+        hand_a, hand_b = HandServo(spec, [0.0, 0.0], q0), HandServo(spec, [0.0, 0.0], q0)
+        for i in range(900):
+            if rng.uniform() < 0.02:  # a new target: far (now and then beyond the limits) or near
+                if rng.uniform() < 0.3:
+                    base, joints = rng.uniform(-0.25, 0.25, 2), rng.uniform(-3.5, 3.5, (2, 2))
+                else:
+                    base = hand_a.base + rng.normal(size=2) * 0.002
+                    joints = hand_a.joints + rng.normal(size=(2, 2)) * 0.02
+                assert hand_a.set_targets(base, joints) == hand_b.set_targets(base, joints)
+            hand_a.advance(dt)
+            usual_a = io_a.step(hand_a.tip_list(), dt, space_a.step, (0.01, 0.1, 0.02, 0.5))
+            usual_b = io_b.step_hand(hand_b, dt, space_b.step, (0.01, 0.1, 0.02, 0.5))
+            assert usual_a == usual_b
+            assert tuple(hand_a.state) == tuple(hand_b.state)
+            assert tuple(io_a.state) == tuple(io_b.state)
+            moved += not hand_a.state[12]
+            settled += bool(hand_a.state[12])
+    print(f"servo compared moving {moved} and settled {settled} steps")
+    assert moved > 100 and settled > 100
