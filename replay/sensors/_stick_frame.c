@@ -17,6 +17,157 @@ static PyObject *call_kernel(PyObject *(*kernel)(PyObject *, PyObject *), PyObje
     return ret;
 }
 
+/* _pixels.c marker_moments on the uint8 window img (w x h, whose first pixel is (ox, oy) of the
+ * fw x fh image), the same numbers by the same operations in the same order, with less work:
+ * the threshold compared as an integer (for a uint8 v, v > thr is v > floor(thr)), and the sums
+ * of the moments taken over the pixels of nonzero weight only (a zero weight adds +-0 to a sum
+ * of non-negative or mixed terms, which changes no sum but +-0 itself: never, as each sum
+ * starts at +0 and +0 + -0 = +0). py_marker_moments is its reference
+ * (tests/replay/sensors/test_stick_frame.py); the returned tuple is its. */
+typedef struct {
+    int c, r;   /* box-local pixel */
+    double v;   /* weight */
+} Weight;
+
+static Moments moments_sparse(const Weight *wt, int n) {
+    Moments m = {0, 0, 0, 0, 0, 0};
+    for (int i = 0; i < n; i++) {
+        double v = wt[i].v;
+        m.m00 += v, m.m10 += v * wt[i].c, m.m01 += v * wt[i].r;
+    }
+    if (m.m00 == 0.0) return m;
+    double cx = m.m10 / m.m00, cy = m.m01 / m.m00;
+    for (int i = 0; i < n; i++) {
+        double v = wt[i].v, dx = wt[i].c - cx, dy = wt[i].r - cy;
+        m.mu20 += v * dx * dx, m.mu11 += v * dx * dy, m.mu02 += v * dy * dy;
+    }
+    return m;
+}
+
+static PyObject *marker_moments_fast(const uint8_t *img, int w, int h, double thr,
+                                     int min_pixels, int ox, int oy, int fw, int fh) {
+    PyObject *ret = NULL;
+    int32_t *lab = NULL, *stack = NULL;
+    uint8_t *near = NULL;
+    Weight *wt = NULL;
+    if (w == 0 || h == 0 || isnan(thr) || thr >= 255.0) goto none;
+    const int ti = thr < 0.0 ? -1 : (int)floor(thr); /* v > thr <=> v > ti */
+    int ex0 = w, ey0 = h, ex1 = -1, ey1 = -1;         /* bright_box */
+    for (int r = 0; r < h; r++) {
+        const uint8_t *row = img + (size_t)r * w;
+        int lo = -1, hi = -1;
+        for (int c = 0; c < w; c++)
+            if (row[c] > ti) {
+                if (lo < 0) lo = c;
+                hi = c;
+            }
+        if (lo < 0) continue;
+        if (lo < ex0) ex0 = lo;
+        if (hi > ex1) ex1 = hi;
+        if (r < ey0) ey0 = r;
+        ey1 = r;
+    }
+    if (ex1 < 0) goto none;
+    lab = calloc((size_t)w * h, sizeof(int32_t));
+    stack = malloc((size_t)w * h * sizeof(int32_t));
+    if (!lab || !stack) goto nomem;
+    Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1 + 1, ey1 + 1, lab, stack);
+    if (b.area < min_pixels) goto none;
+    if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
+        goto none; /* cut by the image border */
+    int x0 = b.x - 3 > 0 ? b.x - 3 : 0, y0 = b.y - 3 > 0 ? b.y - 3 : 0;
+    int x1 = b.x + b.w + 3 < w ? b.x + b.w + 3 : w, y1 = b.y + b.h + 3 < h ? b.y + b.h + 3 : h;
+    int bw = x1 - x0, bh = y1 - y0;
+    near = malloc(2 * (size_t)bw * bh);
+    wt = malloc((size_t)bw * bh * sizeof(Weight));
+    if (!near || !wt) goto nomem;
+    dilate_blob(lab, w, b.label, x0, y0, x1, y1, near, near + (size_t)bw * bh);
+    /* the blob's binary moments (weights 1, in raster order) */
+    int n = 0;
+    for (int r = 0; r < bh; r++) {
+        const int32_t *row = lab + (size_t)(r + y0) * w + x0;
+        for (int c = 0; c < bw; c++)
+            if (row[c] == b.label) wt[n].c = c, wt[n].r = r, wt[n].v = 1.0, n++;
+    }
+    Moments mb = moments_sparse(wt, n);
+    double a = 0.5 * atan2(2.0 * mb.mu11, mb.mu20 - mb.mu02);
+    double ex = cos(a), ey = sin(a), nx = -ey, ny = ex;
+    double cx = x0 + mb.m10 / mb.m00, cy = y0 + mb.m01 / mb.m00;
+    double amax = -INFINITY, amin = INFINITY;
+    for (int i = 0; i < n; i++) {
+        double al = (wt[i].c + x0 - cx) * ex + (wt[i].r + y0 - cy) * ey;
+        if (al > amax) amax = al;
+        if (al < amin) amin = al;
+    }
+    /* the background: as py_marker_moments */
+    double background = -INFINITY;
+    int have = 0;
+    double ends[2] = {amax, amin};
+    for (int e = 0; e < 2; e++) {
+        double sgn = ends[e] > 0 ? 1.0 : -1.0, vals[9];
+        int nv = 0;
+        for (int si = 0; si < 3; si++)
+            for (int oi = 0; oi < 3; oi++) {
+                double s = 2.0 + si, o = -1.0 + oi;
+                double px = cx + (ends[e] + sgn * s) * ex + o * nx;
+                double py = cy + (ends[e] + sgn * s) * ey + o * ny;
+                double ix = rint(px), iy = rint(py);
+                if (ix >= 0 && ix < w && iy >= 0 && iy < h)
+                    vals[nv++] = img[(size_t)iy * w + (size_t)ix];
+            }
+        if (!nv) continue;
+        qsort(vals, nv, sizeof(double), cmp_double);
+        double med = nv % 2 ? vals[nv / 2] : 0.5 * (vals[nv / 2 - 1] + vals[nv / 2]);
+        if (!have || med > background) background = med;
+        have = 1;
+    }
+    if (!have) goto none;
+    /* the grey level above the background within the blob dilated by 2 px */
+    const float bg = (float)background;
+    n = 0;
+    for (int r = 0; r < bh; r++) {
+        const uint8_t *row = img + (size_t)(r + y0) * w + x0, *nr = near + (size_t)r * bw;
+        for (int c = 0; c < bw; c++)
+            if (nr[c]) {
+                float d = (float)row[c] - bg;
+                if (d > 0.0f) wt[n].c = c, wt[n].r = r, wt[n].v = d, n++;
+            }
+    }
+    Moments m = moments_sparse(wt, n);
+    if (m.m00 <= 0.0) goto none;
+    ret = Py_BuildValue("(dddidddddd)", ox + x0 + m.m10 / m.m00, oy + y0 + m.m01 / m.m00,
+                        0.5 * atan2(2.0 * m.mu11, m.mu20 - m.mu02), b.area, background, m.m00,
+                        m.m10, m.m01, m.mu20, m.mu11, m.mu02);
+    goto done;
+nomem:
+    PyErr_NoMemory();
+    goto done;
+none:
+    Py_INCREF(Py_None);
+    ret = Py_None;
+done:
+    free(lab);
+    free(stack);
+    free(near);
+    free(wt);
+    return ret;
+}
+
+/* moments(img, w, h, threshold, min_pixels, ox, oy, full_w, full_h): marker_moments_fast, for
+ * its test against _pixels.marker_moments (the same arguments and result) */
+static PyObject *py_moments(PyObject *self, PyObject *args) {
+    Py_buffer I;
+    int w, h, min_pixels, ox, oy, fw, fh;
+    double thr;
+    if (!PyArg_ParseTuple(args, "y*iidiiiii", &I, &w, &h, &thr, &min_pixels, &ox, &oy, &fw, &fh))
+        return NULL;
+    PyObject *ret = NULL;
+    if (sizes_ok(w, h) && check(&I, 1, (Py_ssize_t)w * h, "img"))
+        ret = marker_moments_fast(I.buf, w, h, thr, min_pixels, ox, oy, fw, fh);
+    PyBuffer_Release(&I);
+    return ret;
+}
+
 typedef struct {
     PyObject *body, *q, *pos, *out; /* borrowed: body points, quaternion, position, hull buffer */
     double albedo, rb, distance, box[4];
@@ -84,7 +235,8 @@ static int get_point(PyObject *seq, double *out, Py_ssize_t n, const char *what)
  * centre from the camera, a float64 (n, 2) scratch buffer for the hull), marker the index of
  * the marker's; R (float64 3 x 3, camera to world, row-major) and o (float64 (3,)) the camera's
  * rotation and position. Returns (image, (x0, y0, x1, y1), moments): the quantised window
- * (a bytearray, rows of x1 - x0 pixels), the window and _pixels.marker_moments of it (or None);
+ * (a bytearray, rows of x1 - x0 pixels), the window and _pixels.marker_moments of it (or None;
+ * by marker_moments_fast);
  * or None when the marker has no silhouette or no window (the caller's reference path does
  * that rare frame: the whole image). */
 static PyObject *py_frame(PyObject *self, PyObject *args) {
@@ -209,8 +361,7 @@ static PyObject *py_frame(PyObject *self, PyObject *args) {
     }
 
     /* the marker's moments */
-    found = call_kernel(py_marker_moments, Py_BuildValue("(Oiidiiiii)", image, w, h, thr,
-                                                         min_pixels, win[0], win[1], W, H));
+    found = marker_moments_fast(out, w, h, thr, min_pixels, win[0], win[1], W, H);
     if (!found) goto done;
     ret = Py_BuildValue("(O(iiii)O)", image, win[0], win[1], win[2], win[3], found);
     goto done;
@@ -230,6 +381,7 @@ done:
 
 static PyMethodDef stick_frame_methods[] = {
     {"frame", py_frame, METH_VARARGS, "the stick camera's noise-free frame and marker moments"},
+    {"moments", py_moments, METH_VARARGS, "_pixels.marker_moments with less work"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -20,3 +20,14 @@ def frame(
     threshold: float,
     min_pixels: int,
 ) -> tuple[bytearray, tuple[int, int, int, int], tuple | None] | None: ...
+def moments(
+    img: Buffer,
+    w: int,
+    h: int,
+    threshold: float,
+    min_pixels: int,
+    ox: int,
+    oy: int,
+    full_w: int,
+    full_h: int,
+) -> tuple | None: ...

@@ -80,3 +80,34 @@ def test_frames_the_compiled_path_leaves_to_the_reference():
         StickCameraParams(**STICK_3STEP, noise_sigma=10.0), rng=np.random.default_rng(5)
     )
     assert noisy.measure(0.0, scene) == again.measure_reference(0.0, scene)
+
+
+def test_moments_kernel_equals_pixels_marker_moments():
+    """_stick_frame.moments (the frame's marker moments, summing only nonzero weights) against
+    _pixels.marker_moments on seeded random images: rendered stick frames, with noise, and
+    blobs of random pixels at random thresholds; the same tuple, to the bit."""
+    from replay.sensors import _pixels, _stick_frame
+
+    rng = np.random.default_rng(5)
+    cam = StickCamera(StickCameraParams(**STICK_3STEP, noise_sigma=0.0), rng=rng)
+    images = []
+    for i in range(150):
+        cam.measure_reference(0.0, table_scene(rng, tips=i % 3))
+        img, window = cam._last
+        images.append((img, window[0], window[1], 192.0))
+        noisy = np.clip(img + rng.normal(0.0, 20.0, img.shape), 0, 255).astype(np.uint8)
+        images.append((noisy, window[0], window[1], float(rng.uniform(100.0, 250.0))))
+    for _ in range(150):
+        h, w = rng.integers(1, 40, 2)
+        img = (rng.uniform(size=(h, w)) < rng.uniform(0.05, 0.9)) * rng.integers(0, 256, (h, w))
+        thr = float(rng.choice([-1.0, 0.0, 254.5, 255.0, rng.uniform(0, 255)]))
+        images.append((img.astype(np.uint8), int(rng.integers(0, 3)), int(rng.integers(0, 3)), thr))
+    found = 0
+    for img, ox, oy, thr in images:
+        h, w = img.shape
+        args = (np.ascontiguousarray(img), w, h, thr, 5, ox, oy, 512, 512)
+        ref = _pixels.marker_moments(*args)
+        assert _stick_frame.moments(*args) == ref
+        found += ref is not None
+    print(f"moments kernel = reference on {len(images)} images ({found} with a blob)")
+    assert found > 0.4 * len(images)
