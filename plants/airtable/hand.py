@@ -36,6 +36,14 @@ SETTLED, TIPS, TIPS_VALID = 12, slice(13, 17), 17
 ROOTS, LINKS, BASE_SPEED, JOINT_SPEED, STATE_SIZE = slice(18, 22), slice(22, 24), 24, 25, 26
 
 
+def _clip(v: float, lo: float, hi: float) -> float:
+    """``np.clip(v, lo, hi)`` of one float, as NumPy's clip loop does it: max then min, each
+    keeping a NaN ``v`` and ``v`` unless it is strictly beyond the limit (so -0.0 at a limit
+    0.0 becomes the limit)."""
+    m = v if (v > lo or v != v) else lo
+    return m if (m < hi or m != m) else hi
+
+
 class HandServo:
     """Base position and joint angles of the two fingers, and their (clamped) targets.
 
@@ -51,6 +59,11 @@ class HandServo:
         self._base_hi = np.array([spec.base_limits[0][1], spec.base_limits[1][1]])
         self._q_lo = np.array([spec.joint_limits[0][0], spec.joint_limits[1][0]])
         self._q_hi = np.array([spec.joint_limits[0][1], spec.joint_limits[1][1]])
+        # (lows, highs) of base x, y and the four joints, as floats (set_targets)
+        self._limits = (
+            [float(v) for v in (*self._base_lo, *self._q_lo, *self._q_lo)],
+            [float(v) for v in (*self._base_hi, *self._q_hi, *self._q_hi)],
+        )
         base = np.asarray(base, dtype=float)
         joints = np.asarray(joints, dtype=float).reshape(2, 2)
         s = self.state = array("d", [0.0] * STATE_SIZE)
@@ -98,22 +111,27 @@ class HandServo:
         return c, bool(np.any(c != joints))
 
     def set_targets(self, base, joints) -> dict | None:
-        """Set new targets (clamped to the limits); the clamping as a dict, or None if none."""
-        base = np.asarray(base, dtype=float)
-        joints = np.asarray(joints, dtype=float).reshape(2, 2)
-        base_c, base_clamped = self.clamp_base(base)
-        joints_c, joints_clamped = self.clamp_joints(joints)
+        """Set new targets (clamped to the limits); the clamping as a dict, or None if none.
+        ``base`` (x, y), ``joints`` ((q1, q2), (q1, q2)); clamped as :meth:`clamp_base` and
+        :meth:`clamp_joints` do (``np.clip``), in scalars (:func:`_clip`)."""
+        b = [float(v) for v in base]
+        q = [float(v) for row in joints for v in row]
+        lo, hi = self._limits
+        bc = [_clip(v, lo[i], hi[i]) for i, v in enumerate(b)]
+        qc = [_clip(v, lo[2 + i], hi[2 + i]) for i, v in enumerate(q)]
         s = self.state
-        s[BASE_TARGET] = array("d", base_c.tolist())
-        s[JOINT_TARGETS] = array("d", joints_c.ravel().tolist())
+        s[BASE_TARGET], s[JOINT_TARGETS] = array("d", bc), array("d", qc)
         s[SETTLED] = 0.0
+        # elementwise, as np.any(c != v) (a list's == would take a NaN as equal to itself)
+        base_clamped = any(c != v for c, v in zip(bc, b))
+        joints_clamped = any(c != v for c, v in zip(qc, q))
         if not (base_clamped or joints_clamped):
             return None
         return {
-            "base_requested": base.tolist(),
-            "base_target": base_c.tolist(),
-            "joints_requested": joints.tolist(),
-            "joint_targets": joints_c.tolist(),
+            "base_requested": b,
+            "base_target": bc,
+            "joints_requested": [q[0:2], q[2:4]],
+            "joint_targets": [qc[0:2], qc[2:4]],
             "base_clamped": base_clamped,
             "joints_clamped": joints_clamped,
         }

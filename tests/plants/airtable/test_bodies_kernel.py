@@ -161,3 +161,43 @@ def test_step_hand_advances_the_servo_as_its_python_reference():
             settled += bool(hand_a.state[12])
     print(f"servo compared moving {moved} and settled {settled} steps")
     assert moved > 100 and settled > 100
+
+
+def test_set_targets_clamps_as_np_clip():
+    """HandServo.set_targets' scalar clamping against np.clip (its reference): the same targets
+    to the bit (NaN, -0.0 at a limit 0.0 and values beyond the limits included) and the same
+    clamping report."""
+    import math
+
+    from plants.airtable.hand import BASE_TARGET, JOINT_TARGETS, HandServo
+    from plants.airtable.params import Params
+    from plants.airtable.settings import hand_spec
+
+    spec = hand_spec(Params())
+    hand = HandServo(spec, [0.0, 0.0], [[0.0, 0.0], [0.0, 0.0]])
+    lims = [
+        *spec.base_limits[0],
+        *spec.base_limits[1],
+        *spec.joint_limits[0],
+        *spec.joint_limits[1],
+    ]
+    rng = np.random.default_rng(8)
+    specials = [math.nan, -0.0, 0.0, *lims, *(-v for v in lims)]
+    clamped = 0
+    for _ in range(500):
+        v = rng.uniform(-4.0, 4.0, 6)
+        for i in np.flatnonzero(rng.uniform(size=6) < 0.2):
+            v[i] = specials[rng.integers(len(specials))]
+        base, joints = v[:2], v[2:].reshape(2, 2)
+        report = hand.set_targets(tuple(base), tuple(map(tuple, joints)))
+        ref_b, b_clamped = hand.clamp_base(base)
+        ref_q, q_clamped = hand.clamp_joints(joints)
+        got = np.array(hand.state[BASE_TARGET]), np.array(hand.state[JOINT_TARGETS])
+        for a, ref in zip(got, (ref_b.ravel(), ref_q.ravel())):
+            assert a.tobytes() == np.ascontiguousarray(ref, dtype=float).tobytes()
+        assert (report is not None) == (b_clamped or q_clamped)
+        if report is not None:
+            clamped += 1
+            assert report["base_clamped"] == b_clamped and report["joints_clamped"] == q_clamped
+            np.testing.assert_array_equal(report["joint_targets"], ref_q)
+    assert clamped > 100
