@@ -6,8 +6,8 @@
  * exactly as the Python path does.
  *
  * ptrs: uint64 buffer of 10 addresses: cpBodyGetPosition, cpBodyGetVelocity, cpBodyGetAngle,
- * cpBodyGetAngularVelocity, cpBodySetVelocity, then the bodies: the stick, tip 0, tip 1 (and
- * two unused slots). state: float64 buffer of 10: x, y, vx, vy, angle, omega of the stick, then
+ * cpBodyGetAngularVelocity, cpBodySetVelocity, then the bodies: the stick, tip 0, tip 1, then
+ * cpSpaceStep and the space (0, 0 when the engine is only called through Python). state: float64 buffer of 10: x, y, vx, vy, angle, omega of the stick, then
  * the tips' x, y.
  */
 #define PY_SSIZE_T_CLEAN
@@ -22,12 +22,15 @@ typedef struct {
 typedef vect_t (*get_vect_fn)(const void *);
 typedef double (*get_float_fn)(const void *);
 typedef void (*set_vect_fn)(void *, vect_t);
+typedef void (*space_step_fn)(void *, double);
 
 typedef struct {
     get_vect_fn position, velocity;
     get_float_fn angle, omega;
     set_vect_fn set_velocity;
     void *stick, *tip[2];
+    space_step_fn space_step; /* cpSpaceStep and the space, or NULL */
+    void *space;
 } table_t;
 
 static int unpack(Py_buffer *P, table_t *t) {
@@ -44,6 +47,12 @@ static int unpack(Py_buffer *P, table_t *t) {
     t->stick = (void *)(uintptr_t)a[5];
     t->tip[0] = (void *)(uintptr_t)a[6];
     t->tip[1] = (void *)(uintptr_t)a[7];
+    t->space_step = (space_step_fn)(uintptr_t)a[8];
+    t->space = (void *)(uintptr_t)a[9];
+    if (!a[8] != !a[9]) {
+        PyErr_SetString(PyExc_ValueError, "ptrs: cpSpaceStep and the space, or neither");
+        return 0;
+    }
     for (int i = 0; i < 8; i++)
         if (!a[i]) {
             PyErr_SetString(PyExc_ValueError, "ptrs: a null address");
@@ -100,9 +109,17 @@ static int step_core(const table_t *t, double *s, const double *tx, const double
         vect_t v = {(tx[k] - s[6 + 2 * k]) / dt, (ty[k] - s[7 + 2 * k]) / dt};
         t->set_velocity(t->tip[k], v);
     }
-    PyObject *r = PyObject_CallOneArg(space_step, dt_obj);
-    if (!r) return -1;
-    Py_DECREF(r);
+    if (space_step == Py_None) { /* the engine's step itself (body_state.TableIO says when) */
+        if (!t->space) {
+            PyErr_SetString(PyExc_ValueError, "space_step None: no cpSpaceStep in ptrs");
+            return -1;
+        }
+        t->space_step(t->space, dt);
+    } else {
+        PyObject *r = PyObject_CallOneArg(space_step, dt_obj);
+        if (!r) return -1;
+        Py_DECREF(r);
+    }
     read_state(t, s);
     int usual = 0;
     double sum = s[0] + s[1] + s[4] + s[2] + s[3] + s[5] + s[6] + s[7] + s[8] + s[9];
@@ -117,7 +134,8 @@ static int step_core(const table_t *t, double *s, const double *tx, const double
 /* step(ptrs, state, tx0, ty0, tx1, ty1, dt, space_step, rest_speed, rest_omega, hold_speed,
  *      hold_omega): each tip's velocity set to ((tx - x) / dt, (ty - y) / dt) from its position in
  * state (so that the step's position integration lands it on the target), space_step(dt) called
- * (the engine, and the collision callbacks it runs), and the state read again into state.
+ * (the engine, and the collision callbacks it runs; None: cpSpaceStep(space, dt) of ptrs), and
+ * the state read again into state.
  * Returns True when the state after the step is certainly the plant's usual case: every number
  * finite (their sum, in the plant's order) and the stick too fast or spinning too fast both to
  * rest (speed >= rest_speed or |omega| >= rest_omega) and to be held (the same with hold_*).

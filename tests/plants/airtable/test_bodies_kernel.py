@@ -43,14 +43,20 @@ def python_state(stick, tips):
     )
 
 
-def test_table_io_steps_as_the_python_readers_and_setter():
+@pytest.mark.parametrize("direct", [False, True])
+def test_table_io_steps_as_the_python_readers_and_setter(direct):
+    """direct: the engine's cpSpaceStep called from C (space_step None), else LeanSpace.step."""
     dt = 1.0 / 3000.0
     hit = 0
     for seed in range(6):
         rng = np.random.default_rng(40 + seed)
         space_a, stick_a, tips_a = table(pymunk.Space, np.random.default_rng(seed))
         space_b, stick_b, tips_b = table(LeanSpace, np.random.default_rng(seed))
-        io = body_state.TableIO(stick_b, tips_b)
+        io = body_state.TableIO(stick_b, tips_b, space_b if direct else None)
+        assert io.direct == direct
+        if direct:  # (a space's first step checks the bodies added: Pymunk's own)
+            space_a.step(dt), space_b.step(dt)
+            io.read()
         assert tuple(io.state) == python_state(stick_a, tips_a)
         v0 = tuple(stick_a.velocity)
         for _ in range(600):
@@ -59,7 +65,7 @@ def test_table_io_steps_as_the_python_readers_and_setter():
             for tb, (tx, ty), (x, y) in zip(tips_a, targets, pos):
                 body_state.velocity_setter(tb)((tx - x) / dt, (ty - y) / dt)
             space_a.step(dt)
-            io.step(targets, dt, space_b.step, (0.01, 0.1, 0.02, 0.5))
+            io.step(targets, dt, None if direct else space_b.step, (0.01, 0.1, 0.02, 0.5))
             assert tuple(io.state) == python_state(stick_a, tips_a)
             assert tuple(io.state) == python_state(stick_b, tips_b)
         hit += tuple(stick_a.velocity) != v0  # only a contact changes it (no gravity)
@@ -126,9 +132,10 @@ def test_the_usual_case_flag_is_never_wrong():
 
 
 def test_step_hand_advances_the_servo_as_its_python_reference():
-    """_bodies.step_hand (the servo's step and the tips' kinematics, then step) against
-    HandServo.advance and tip_list, then TableIO.step: the same hand state and bodies, exactly,
-    with targets set now and then (the servo moving, landing and resting)."""
+    """_bodies.step_hand (the servo's step and the tips' kinematics, then step, the engine's
+    cpSpaceStep called from C) against HandServo.advance and tip_list, then TableIO.step through
+    LeanSpace.step: the same hand state and bodies, exactly, with targets set now and then (the
+    servo moving, landing and resting)."""
     from plants.airtable.hand import HandServo
     from plants.airtable.params import Params
     from plants.airtable.settings import hand_spec
@@ -140,7 +147,12 @@ def test_step_hand_advances_the_servo_as_its_python_reference():
         rng = np.random.default_rng(70 + seed)
         space_a, stick_a, tips_a = table(LeanSpace, np.random.default_rng(seed))
         space_b, stick_b, tips_b = table(LeanSpace, np.random.default_rng(seed))
-        io_a, io_b = body_state.TableIO(stick_a, tips_a), body_state.TableIO(stick_b, tips_b)
+        io_a = body_state.TableIO(stick_a, tips_a)
+        io_b = body_state.TableIO(stick_b, tips_b, space_b)  # b: the engine called from C
+        assert io_b.direct and not io_a.direct
+        space_b.step(dt)  # (a space's first step checks the bodies added: Pymunk's own)
+        space_a.step(dt)
+        io_a.read(), io_b.read()
         q0 = [[0.3, 1.2], [-0.4, -1.0]]
         hand_a, hand_b = HandServo(spec, [0.0, 0.0], q0), HandServo(spec, [0.0, 0.0], q0)
         for i in range(900):
@@ -153,7 +165,7 @@ def test_step_hand_advances_the_servo_as_its_python_reference():
                 assert hand_a.set_targets(base, joints) == hand_b.set_targets(base, joints)
             hand_a.advance(dt)
             usual_a = io_a.step(hand_a.tip_list(), dt, space_a.step, (0.01, 0.1, 0.02, 0.5))
-            usual_b = io_b.step_hand(hand_b, dt, space_b.step, (0.01, 0.1, 0.02, 0.5))
+            usual_b = io_b.step_hand(hand_b, dt, None, (0.01, 0.1, 0.02, 0.5))
             assert usual_a == usual_b
             assert tuple(hand_a.state) == tuple(hand_b.state)
             assert tuple(io_a.state) == tuple(io_b.state)
