@@ -13,7 +13,7 @@ from array import array
 
 import numpy as np
 
-from replay.robot.hand2d import HandSpec, finger_tip_xy
+from replay.robot.hand2d import HandSpec, clip, finger_tip_xy
 
 
 def _toward(current: list, target: list, max_delta: float) -> bool:
@@ -34,14 +34,6 @@ def _toward(current: list, target: list, max_delta: float) -> bool:
 BASE, JOINTS, BASE_TARGET, JOINT_TARGETS = slice(0, 2), slice(2, 6), slice(6, 8), slice(8, 12)
 SETTLED, TIPS, TIPS_VALID = 12, slice(13, 17), 17
 ROOTS, LINKS, BASE_SPEED, JOINT_SPEED, STATE_SIZE = slice(18, 22), slice(22, 24), 24, 25, 26
-
-
-def _clip(v: float, lo: float, hi: float) -> float:
-    """``np.clip(v, lo, hi)`` of one float, as NumPy's clip loop does it: max then min, each
-    keeping a NaN ``v`` and ``v`` unless it is strictly beyond the limit (so -0.0 at a limit
-    0.0 becomes the limit)."""
-    m = v if (v > lo or v != v) else lo
-    return m if (m < hi or m != m) else hi
 
 
 class HandServo:
@@ -113,12 +105,12 @@ class HandServo:
     def set_targets(self, base, joints) -> dict | None:
         """Set new targets (clamped to the limits); the clamping as a dict, or None if none.
         ``base`` (x, y), ``joints`` ((q1, q2), (q1, q2)); clamped as :meth:`clamp_base` and
-        :meth:`clamp_joints` do (``np.clip``), in scalars (:func:`_clip`)."""
+        :meth:`clamp_joints` do (``np.clip``), in scalars (:func:`~replay.robot.hand2d.clip`)."""
         b = [float(v) for v in base]
         q = [float(v) for row in joints for v in row]
         lo, hi = self._limits
-        bc = [_clip(v, lo[i], hi[i]) for i, v in enumerate(b)]
-        qc = [_clip(v, lo[2 + i], hi[2 + i]) for i, v in enumerate(q)]
+        bc = [clip(v, lo[i], hi[i]) for i, v in enumerate(b)]
+        qc = [clip(v, lo[2 + i], hi[2 + i]) for i, v in enumerate(q)]
         s = self.state
         s[BASE_TARGET], s[JOINT_TARGETS] = array("d", bc), array("d", qc)
         s[SETTLED] = 0.0

@@ -55,6 +55,21 @@ class HandCommand:
     joints: tuple[tuple[float, float], tuple[float, float]]  # rad, (q1, q2) per finger
 
 
+def clip(v: float, lo: float, hi: float) -> float:
+    """``np.clip`` of arrays, for one float: NumPy's clip loop (max, then min, each keeping a
+    NaN ``v``, and ``v`` unless strictly beyond the limit: -0.0 at a limit 0.0 becomes the
+    limit), without NumPy's call overhead (~5 us)."""
+    m = v if (v > lo or v != v) else lo
+    return m if (m < hi or m != m) else hi
+
+
+def clip_scalar(v: float, lo: float, hi: float) -> float:
+    """``float(np.clip(np.float64(v), lo, hi))`` with float limits: as :func:`clip` but ``v``
+    kept when equal to a limit (NumPy's scalar path: -0.0 at a limit 0.0 stays -0.0)."""
+    m = v if (v >= lo or v != v) else lo
+    return m if (m <= hi or m != m) else hi
+
+
 def _chain(base, root_offset, link_lengths, q) -> tuple[tuple[float, float], ...]:
     l1, l2 = link_lengths
     root = (base[0] + root_offset[0], base[1] + root_offset[1])

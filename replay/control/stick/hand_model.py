@@ -157,11 +157,13 @@ def base_candidates(hand: HandSpec, k: int, tip, here: tuple) -> list[tuple]:
     out = []
     if np.linalg.norm(np.asarray(tip) - root - np.array(here)) <= 0.85 * reach:
         out.append(here)
+    # (tip - root - rho (cos a, sin a)) clipped to the range, in scalars: NumPy's operations
+    tx, ty = float(tip[0]) - float(root[0]), float(tip[1]) - float(root[1])
     for rho in (0.7 * reach, 0.5 * reach, 0.85 * reach):
         for deg in (90.0, 65.0, 115.0, 40.0, 140.0):
             a = math.radians(deg)
-            b = np.asarray(tip) - root - rho * np.array([math.cos(a), math.sin(a)])
-            out.append((float(np.clip(b[0], xlo, xhi)), float(np.clip(b[1], ylo, yhi))))
+            bx, by = tx - rho * math.cos(a), ty - rho * math.sin(a)
+            out.append((hand2d.clip_scalar(bx, xlo, xhi), hand2d.clip_scalar(by, ylo, yhi)))
     return out
 
 

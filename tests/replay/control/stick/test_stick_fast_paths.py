@@ -198,3 +198,42 @@ def test_reach_bound_finds_the_exhaustive_search_plan():
             assert fast.finger == slow.finger and fast.config == slow.config
             assert fast.route == slow.route
     assert compared >= 1
+
+
+def test_base_candidates_in_scalars_are_numpys():
+    """base_candidates works in scalars (hand2d.clip_scalar for np.clip): the bases NumPy's and
+    np.clip gave, to the bit, for seeded random tips and current bases (in and beyond the
+    slider range)."""
+    hand = air_spec().hand
+    (xlo, xhi), (ylo, yhi) = hand.base_limits
+    rng = np.random.default_rng(21)
+    reach = sum(hand.link_lengths)
+    for _ in range(300):
+        k = int(rng.integers(2))
+        tip, here = rng.uniform(-0.45, 0.45, 2), tuple(float(v) for v in rng.uniform(-0.3, 0.3, 2))
+        root = np.array(hand.root_offsets[k])
+        ref = [here] if np.linalg.norm(tip - root - np.array(here)) <= 0.85 * reach else []
+        for rho in (0.7 * reach, 0.5 * reach, 0.85 * reach):
+            for deg in (90.0, 65.0, 115.0, 40.0, 140.0):
+                a = math.radians(deg)
+                b = np.asarray(tip) - root - rho * np.array([math.cos(a), math.sin(a)])
+                ref.append((float(np.clip(b[0], xlo, xhi)), float(np.clip(b[1], ylo, yhi))))
+        got = base_candidates(hand, k, tip, here)
+        assert repr(got) == repr(ref)  # (repr: -0.0 and 0.0 told apart)
+
+
+def test_hand2d_clips_are_np_clips():
+    """hand2d.clip against np.clip of arrays, clip_scalar against np.clip of a float64 scalar
+    (NumPy's two paths differ at signed zeros): NaN, signed zeros, limits and beyond."""
+    from replay.robot.hand2d import clip, clip_scalar
+
+    rng = np.random.default_rng(4)
+    vals = [math.nan, -0.0, 0.0, math.inf, -math.inf, *rng.uniform(-3.0, 3.0, 200)]
+    lims = [(-1.0, 1.0), (0.0, 2.0), (-2.0, -0.0), (-0.0, 0.0), (0.5, 0.5)]
+    for v in vals:
+        for lo, hi in lims:
+            arr = np.clip(np.array([v]), np.array([lo]), np.array([hi]))[0]
+            assert repr(clip(float(v), lo, hi)) == repr(float(arr))
+            assert repr(clip_scalar(float(v), lo, hi)) == repr(
+                float(np.clip(np.float64(v), lo, hi))
+            )
