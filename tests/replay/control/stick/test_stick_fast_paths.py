@@ -237,3 +237,29 @@ def test_hand2d_clips_are_np_clips():
             assert repr(clip_scalar(float(v), lo, hi)) == repr(
                 float(np.clip(np.float64(v), lo, hi))
             )
+
+
+def test_passive_posture_search_is_the_array_references():
+    """ContactPlanner._passive (postures in order of distance, each tip worked out only when its
+    turn comes) against _passive_reference (every tip and distance as arrays, then the first
+    clear one): the same posture or None, for seeded random idle postures, active tips and
+    spinning sticks over the idle tip (so that nearer postures are often swept)."""
+    ctrl, _, _ = three_step_run(1e-4, t_end=0.12)
+    planner, hand, rng = ctrl.planner, ctrl.hand, np.random.default_rng(31)
+    (a0, a1), (b0, b1) = hand.joint_limits
+    moved = compared = 0
+    for _ in range(300):
+        j = int(rng.integers(2))
+        cfg = ctrl.model.config.with_finger(j, (rng.uniform(a0, a1), rng.uniform(b0, b1)))
+        x, y = cfg.tip(hand, j) + rng.normal(0.0, 0.02, 2)
+        est = StickEstimate(
+            0.0, x, y, 0.0, *rng.normal(0.0, 0.3, 2), rng.normal(0.0, 30.0), 6, 0, 0
+        )
+        sweep = Sweep(Motion(est, 0.1, tuple(rng.normal(0.0, 1.0, 3))), 0.0, 0.3)
+        active = cfg.tip(hand, 1 - j) + rng.normal(0.0, 0.01, 2)
+        got = planner._passive(cfg, j, sweep, active)
+        assert got == planner._passive_reference(cfg, j, sweep, active)
+        compared += 1
+        moved += got is not None and got != tuple(cfg.joints[j])
+    print(f"_passive = reference in {compared} cases ({moved} moved the idle finger)")
+    assert moved > 0.3 * compared
