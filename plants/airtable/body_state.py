@@ -14,6 +14,7 @@ advances the hand's servo first (``HandServo.advance`` and ``tip_list`` are its 
 
 from __future__ import annotations
 
+import functools
 from array import array
 from typing import Callable
 
@@ -160,3 +161,13 @@ class TableIO:
             return _bodies.step_hand(self._ptrs, self.state, hand.state, dt, space_step, *limits)
         hand.advance(dt)  # pragma: no cover - the fallback
         return self.step(hand.tip_list(), dt, space_step, limits)  # pragma: no cover
+
+    def lean_stepper(self, hand: HandServo, dt: float, limits: tuple) -> Callable[[], bool] | None:
+        """``step_hand(hand, dt, None, limits)`` as one callable of no arguments (the compiled
+        call with its arguments bound: no Python frame a step), or None when the engine cannot
+        be called from C (:attr:`direct` False)."""
+        if not self.direct or self._ptrs is None:
+            return None
+        return functools.partial(
+            _bodies.step_hand, self._ptrs, self.state, hand.state, dt, None, *limits
+        )

@@ -137,6 +137,7 @@ class AirTablePlant(Plant):
         self._rest_speed, self._rest_omega = p.rest_speed, p.rest_omega
         self._hold_speed, self._hold_omega = p.hold_speed, p.hold_omega
         self._limits = tuple(map(float, (p.rest_speed, p.rest_omega, p.hold_speed, p.hold_omega)))
+        self._lean_step = self._io.lean_stepper(self.hand, self.dt, self._limits)
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
         # scene(): the boxes' centre heights and sizes, and the fingertips' last primitives
@@ -174,8 +175,11 @@ class AirTablePlant(Plant):
         # engine is called from C when LeanSpace.step would only call it (no body added since
         # the last step: the collision callback adds nothing, LeanSpace's contract) and nothing
         # wraps space.step (a timer: replay.bench)
-        lean = io.direct and not space._bodies_to_check and "step" not in space.__dict__
-        usual = io.step_hand(self.hand, self.dt, None if lean else space.step, self._limits)
+        lean = self._lean_step
+        if lean is not None and not space._bodies_to_check and "step" not in space.__dict__:
+            usual = lean()  # io.step_hand(self.hand, self.dt, None, self._limits)
+        else:
+            usual = io.step_hand(self.hand, self.dt, space.step, self._limits)
         self._steps += 1
         if self._pending:
             _, _, vx, vy, _, omega = io.state[:6]
