@@ -401,7 +401,29 @@ class ContactPlanner:
 
     def _exit_config(self, t: float, now: Config, motion: Motion) -> Config | None:
         """``now`` with every fingertip within the stick's reach moved radially out of it
-        (base kept), or None when no tip is inside or a tip cannot get out."""
+        (base kept), or None when no tip is inside or a tip cannot get out. In floats: the
+        operations of the array version (:meth:`_exit_config_reference`; a 2-vector's norm is
+        sqrt(x x + y y), as NumPy's dot sums it here: test_stick_fast_paths.py)."""
+        p, st, hand = self.params, self.stick, self.hand
+        cx, cy, _ = motion.pose_floats(t)
+        r_in = 0.5 * st.length + hand.tip_radius + p.sweep_margin
+        r_out = 0.5 * st.length + hand.tip_radius + p.stage_margin
+        cfg, moved = now, False
+        for k in (0, 1):
+            tx, ty = hand2d.finger_tip_xy(hand, now.base, k, now.joints[k])
+            dx, dy = tx - cx, ty - cy
+            dist = math.sqrt(dx * dx + dy * dy)
+            if dist >= r_in or dist < 1e-9:
+                continue
+            out = (cx + dx / dist * r_out, cy + dy / dist * r_out)
+            q = hand2d.finger_ik(hand, now.base, k, out, q_near=now.joints[k])
+            if q is None:
+                return None
+            cfg, moved = cfg.with_finger(k, q), True
+        return cfg if moved else None
+
+    def _exit_config_reference(self, t: float, now: Config, motion: Motion) -> Config | None:
+        """:meth:`_exit_config` on arrays (its reference)."""
         p, st, hand = self.params, self.stick, self.hand
         c, _ = motion.pose(t)
         r_in = 0.5 * st.length + hand.tip_radius + p.sweep_margin

@@ -67,6 +67,11 @@ class Motion:
         )
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
+        x, y, th = self.pose_floats(t)
+        return np.array([x, y]), float(th)
+
+    def pose_floats(self, t: float) -> tuple[float, float, float]:
+        """:meth:`pose` as (x, y, theta) floats."""
         e, ts = self.est, self.t_switch
         t1 = min(t, ts) - e.t_ref
         x, y, th = e.x + e.vx * t1, e.y + e.vy * t1, e.theta + e.omega * t1
@@ -74,7 +79,7 @@ class Motion:
             t2 = max(t - ts, 0.0)
             u = self.u_after
             x, y, th = x + u[0] * t2, y + u[1] * t2, th + u[2] * t2
-        return np.array([x, y]), float(th)
+        return x, y, th
 
 
 def _body(motion: Motion, times, points) -> tuple[np.ndarray, np.ndarray]:

@@ -263,3 +263,30 @@ def test_passive_posture_search_is_the_array_references():
         moved += got is not None and got != tuple(cfg.joints[j])
     print(f"_passive = reference in {compared} cases ({moved} moved the idle finger)")
     assert moved > 0.3 * compared
+
+
+def test_exit_config_in_floats_is_the_array_references():
+    """ContactPlanner._exit_config (floats) against _exit_config_reference (NumPy arrays, a
+    2-vector's norm by np.linalg.norm): the same configuration or None, for seeded random hands
+    with fingertips inside, at the edge of and outside the stick's reach. Equal only while
+    NumPy's 2-element dot is the plain sum x x + y y (the BLAS of this build): this test says
+    so when a build fuses it."""
+    ctrl, _, _ = three_step_run(1e-4, t_end=0.12)
+    planner, hand, rng = ctrl.planner, ctrl.hand, np.random.default_rng(41)
+    (a0, a1), (b0, b1) = hand.joint_limits
+    moved = none = 0
+    for _ in range(400):
+        cfg = ctrl.model.config
+        for k in (0, 1):
+            cfg = cfg.with_finger(k, (rng.uniform(a0, a1), rng.uniform(b0, b1)))
+        k = int(rng.integers(2))
+        x, y = cfg.tip(hand, k) + rng.normal(0.0, 0.04, 2)
+        est = StickEstimate(0.0, x, y, 0.0, *rng.normal(0.0, 0.3, 3), 6, 0, 0)
+        motion = Motion(est, 0.05, tuple(rng.normal(0.0, 1.0, 3)))
+        t = float(rng.uniform(0.0, 0.1))
+        got = planner._exit_config(t, cfg, motion)
+        assert got == planner._exit_config_reference(t, cfg, motion)
+        moved += got is not None
+        none += got is None
+    print(f"_exit_config = reference in 400 cases ({moved} moved a tip out)")
+    assert moved > 50 and none > 50
