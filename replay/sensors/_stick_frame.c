@@ -3,9 +3,10 @@
  * replaces, kept as the reference of tests/replay/sensors/test_stick_frame.py): the marker's
  * silhouette and the window around it, the bounding-sphere test of the other primitives, their
  * silhouettes, far-to-near exact-coverage compositing, quantising and the marker's moments. The
- * kernels are _pixels.c's (included here unchanged: py_project_hull and py_marker_moments are
- * called as they are from Python, accumulate is composite's core), so the pixels and the moments
- * are those of the Python path to the bit. Plain C over the buffer protocol: no NumPy headers.
+ * kernels are _pixels.c's (included here unchanged: py_project_hull is called as it is from
+ * Python, accumulate is composite's core; marker_moments_fast is py_marker_moments with less
+ * work), so the pixels and the moments are those of the Python path to the bit; the primitives
+ * are read from the scene and the pose worked out from the moments here too (py_measure). Plain C over the buffer protocol: no NumPy headers.
  */
 #include "_pixels.c"
 
@@ -229,45 +230,19 @@ static int get_point(PyObject *seq, double *out, Py_ssize_t n, const char *what)
 
 #define MAX_PRIMS 64
 
-/* frame(prims, marker, R, o, fx, fy, cx, cy, width, height, background, threshold,
- *       min_pixels): prims a sequence of (body, q, position, albedo, rb, distance, out) (body
- * points float64 (n, 3), quaternion, position, albedo, bounding-sphere radius, distance of the
- * centre from the camera, a float64 (n, 2) scratch buffer for the hull), marker the index of
- * the marker's; R (float64 3 x 3, camera to world, row-major) and o (float64 (3,)) the camera's
- * rotation and position. Returns (image, (x0, y0, x1, y1), moments): the quantised window
- * (a bytearray, rows of x1 - x0 pixels), the window and _pixels.marker_moments of it (or None;
- * by marker_moments_fast);
- * or None when the marker has no silhouette or no window (the caller's reference path does
- * that rare frame: the whole image). */
-static PyObject *py_frame(PyObject *self, PyObject *args) {
-    PyObject *prims_in, *R, *o;
-    int marker, W, H, min_pixels;
-    double fx, fy, cx, cy, background, thr;
-    if (!PyArg_ParseTuple(args, "OiOOddddiiddi", &prims_in, &marker, &R, &o, &fx, &fy, &cx, &cy,
-                          &W, &H, &background, &thr, &min_pixels))
-        return NULL;
-    PyObject *seq = PySequence_Fast(prims_in, "prims: not a sequence");
-    if (!seq) return NULL;
+/* The frame of the primitives prims[0..n) (marker: the marker's index) seen by the camera (R:
+ * float64 3 x 3, camera to world, row-major; o: float64 (3,), its position; fx, fy, cx, cy;
+ * width W x height H): (image, (x0, y0, x1, y1), moments): the quantised window (a bytearray,
+ * rows of x1 - x0 pixels), the window and _pixels.marker_moments of it (marker_moments_fast; or
+ * None); or None when the marker has no silhouette or no window (the caller's reference path
+ * does that rare frame: the whole image). A new reference, or NULL with an exception set. */
+static PyObject *frame_core(Prim *prims, Py_ssize_t n, int marker, PyObject *R, PyObject *o,
+                            double fx, double fy, double cx, double cy, int W, int H,
+                            double background, double thr, int min_pixels) {
     PyObject *ret = NULL, *image = NULL, *found = NULL;
     float *img = NULL;
     double *acc = NULL;
     Py_buffer RB = {0}, OB = {0};
-    Prim prims[MAX_PRIMS];
-    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
-    if (n > MAX_PRIMS) {
-        PyErr_Format(PyExc_ValueError, "frame: at most %d primitives", MAX_PRIMS);
-        goto done;
-    }
-    if (marker < 0 || marker >= n) {
-        PyErr_SetString(PyExc_IndexError, "frame: marker index out of range");
-        goto done;
-    }
-    for (Py_ssize_t i = 0; i < n; i++) {
-        Prim *p = &prims[i];
-        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(seq, i), "OOOdddO", &p->body, &p->q,
-                              &p->pos, &p->albedo, &p->rb, &p->distance, &p->out))
-            goto done;
-    }
     if (PyObject_GetBuffer(R, &RB, PyBUF_C_CONTIGUOUS) < 0 ||
         PyObject_GetBuffer(o, &OB, PyBUF_C_CONTIGUOUS) < 0)
         goto done;
@@ -375,12 +350,159 @@ done:
     Py_XDECREF(found);
     if (RB.obj) PyBuffer_Release(&RB);
     if (OB.obj) PyBuffer_Release(&OB);
+    return ret;
+}
+
+
+static PyObject *s_position, *s_orientation, *s_albedo, *s_name, *s_size, *s_radius, *s_length;
+
+/* stick_camera.StickCamera._to_height: world (x, y) where pixel (u, v)'s ray meets the plane at
+ * height z (the same operations); 0 when it does not */
+static int to_height(const double *R, const double *o, double fx, double fy, double cx,
+                     double cy, double u, double v, double z, double *x, double *y) {
+    double a = (u - cx) / fx, b = (v - cy) / fy;
+    double dx = R[0] * a + R[1] * b + R[2], dy = R[3] * a + R[4] * b + R[5],
+           dz = R[6] * a + R[7] * b + R[8];
+    double nn = sqrt(dx * dx + dy * dy + dz * dz);
+    double s = dz != 0.0 ? (z - o[2]) / dz : NAN;
+    if (!(fabs(dz / nn) > 1e-12 && s > 0.0)) return 0;
+    *x = o[0] + s * dx, *y = o[1] + s * dy;
+    return 1;
+}
+
+/* measure(prims, shapes, camera): StickCamera.measure's noise-free frame of scene.primitives
+ * prims in one call: each primitive's (body points, bounding radius, hull buffer) from the dict
+ * shapes by the key (i, Box, size) or (i, Cylinder, radius, length), its distance from the
+ * camera by camera's dist (math.dist), the marker the first primitive named so, frame_core and
+ * the pose (StickCamera._pose: the centroid and a point 10 px along the axis back-projected
+ * onto the marker's height, theta wrapped to (-pi/2, pi/2], the offset added). camera: (R, o,
+ * fx, fy, cx, cy, width, height, background, threshold, min_pixels, marker name, Box,
+ * Cylinder, o as a tuple, dist, offset x, offset y). Returns (image, window, moments, pose or
+ * None); (None, i, key) when shapes has no entry for primitive i yet (the caller adds it and
+ * calls again); None for the reference path (another primitive type, no marker, or frame_core's
+ * None). */
+static PyObject *py_measure(PyObject *self, PyObject *args) {
+    PyObject *prims_in, *shapes, *camera;
+    if (!PyArg_ParseTuple(args, "OO!O!", &prims_in, &PyDict_Type, &shapes, &PyTuple_Type,
+                          &camera))
+        return NULL;
+    PyObject *R, *o, *name, *box_t, *cyl_t, *o_tuple, *dist;
+    double fx, fy, cx, cy, background, thr, off_x, off_y;
+    int W, H, min_pixels;
+    if (!PyArg_ParseTuple(camera, "OOddddiiddiOOOOOdd", &R, &o, &fx, &fy, &cx, &cy, &W, &H,
+                          &background, &thr, &min_pixels, &name, &box_t, &cyl_t, &o_tuple,
+                          &dist, &off_x, &off_y))
+        return NULL;
+    PyObject *seq = PySequence_Fast(prims_in, "prims: not a sequence");
+    if (!seq) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    PyObject *ret = NULL, *framed = NULL, *owned[2 * MAX_PRIMS];
+    int n_owned = 0, marker = -1;
+    Prim prims[MAX_PRIMS];
+    if (n > MAX_PRIMS) goto reference;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *prim = PySequence_Fast_GET_ITEM(seq, i), *key;
+        Prim *p = &prims[i];
+        if ((PyObject *)Py_TYPE(prim) == box_t) {
+            PyObject *size = PyObject_GetAttr(prim, s_size);
+            key = size ? Py_BuildValue("(nON)", i, box_t, size) : NULL;
+        } else if ((PyObject *)Py_TYPE(prim) == cyl_t) {
+            PyObject *r = PyObject_GetAttr(prim, s_radius);
+            PyObject *l = r ? PyObject_GetAttr(prim, s_length) : NULL;
+            key = l ? Py_BuildValue("(nONN)", i, cyl_t, r, l) : NULL;
+            if (!l) Py_XDECREF(r);
+        } else {
+            goto reference; /* a sphere: the reference path */
+        }
+        if (!key) goto done;
+        PyObject *shape = PyDict_GetItemWithError(shapes, key); /* borrowed */
+        if (!shape) {
+            if (!PyErr_Occurred()) ret = Py_BuildValue("(OnO)", Py_None, i, key);
+            Py_DECREF(key);
+            goto done;
+        }
+        Py_DECREF(key);
+        if (!PyArg_ParseTuple(shape, "OdO", &p->body, &p->rb, &p->out)) goto done;
+        p->pos = owned[n_owned++] = PyObject_GetAttr(prim, s_position);
+        if (!p->pos) goto done;
+        p->q = owned[n_owned++] = PyObject_GetAttr(prim, s_orientation);
+        if (!p->q) goto done;
+        PyObject *albedo = PyObject_GetAttr(prim, s_albedo);
+        if (!albedo) goto done;
+        p->albedo = PyFloat_AsDouble(albedo);
+        Py_DECREF(albedo);
+        if (p->albedo == -1.0 && PyErr_Occurred()) goto done;
+        PyObject *d = PyObject_CallFunctionObjArgs(dist, p->pos, o_tuple, NULL);
+        if (!d) goto done;
+        p->distance = PyFloat_AsDouble(d);
+        Py_DECREF(d);
+        if (p->distance == -1.0 && PyErr_Occurred()) goto done;
+        if (marker < 0) {
+            PyObject *pname = PyObject_GetAttr(prim, s_name);
+            if (!pname) goto done;
+            int same = PyObject_RichCompareBool(pname, name, Py_EQ);
+            Py_DECREF(pname);
+            if (same < 0) goto done;
+            if (same) marker = (int)i;
+        }
+    }
+    if (marker < 0) goto reference;
+    framed = frame_core(prims, n, marker, R, o, fx, fy, cx, cy, W, H, background, thr,
+                        min_pixels);
+    if (!framed) goto done;
+    if (framed == Py_None) goto reference;
+    PyObject *image = PyTuple_GET_ITEM(framed, 0), *window = PyTuple_GET_ITEM(framed, 1),
+             *found = PyTuple_GET_ITEM(framed, 2);
+    PyObject *pose = Py_None;
+    Py_INCREF(pose);
+    if (found != Py_None) { /* StickCamera._pose */
+        Py_buffer RB, OB;
+        double u = PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(found, 0)),
+               v = PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(found, 1)),
+               a = PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(found, 2));
+        PyObject *zo = PySequence_GetItem(prims[marker].pos, 2);
+        double z = zo ? PyFloat_AsDouble(zo) : -1.0;
+        Py_XDECREF(zo);
+        if ((z == -1.0 && PyErr_Occurred()) || PyObject_GetBuffer(R, &RB, PyBUF_C_CONTIGUOUS) < 0) {
+            Py_DECREF(pose);
+            goto done;
+        }
+        if (PyObject_GetBuffer(o, &OB, PyBUF_C_CONTIGUOUS) < 0) {
+            PyBuffer_Release(&RB);
+            Py_DECREF(pose);
+            goto done;
+        }
+        const double step = 10.0; /* px along the axis, for its angle */
+        double x0, y0, x1, y1;
+        if (to_height(RB.buf, OB.buf, fx, fy, cx, cy, u, v, z, &x0, &y0) &&
+            to_height(RB.buf, OB.buf, fx, fy, cx, cy, u + step * cos(a), v + step * sin(a), z,
+                      &x1, &y1)) {
+            double th = fmod(atan2(y1 - y0, x1 - x0), M_PI); /* spatial.wrap_half_pi */
+            if (th <= -M_PI / 2.0)
+                th += M_PI;
+            else if (th > M_PI / 2.0)
+                th -= M_PI;
+            Py_DECREF(pose);
+            pose = Py_BuildValue("(ddd)", x0 + off_x, y0 + off_y, th);
+        }
+        PyBuffer_Release(&RB);
+        PyBuffer_Release(&OB);
+        if (!pose) goto done;
+    }
+    ret = Py_BuildValue("(OOON)", image, window, found, pose);
+    goto done;
+reference:
+    Py_INCREF(Py_None);
+    ret = Py_None;
+done:
+    Py_XDECREF(framed);
+    for (int i = 0; i < n_owned; i++) Py_XDECREF(owned[i]);
     Py_DECREF(seq);
     return ret;
 }
 
 static PyMethodDef stick_frame_methods[] = {
-    {"frame", py_frame, METH_VARARGS, "the stick camera's noise-free frame and marker moments"},
+    {"measure", py_measure, METH_VARARGS, "the stick camera's noise-free frame and pose"},
     {"moments", py_moments, METH_VARARGS, "_pixels.marker_moments with less work"},
     {NULL, NULL, 0, NULL},
 };
@@ -389,4 +511,11 @@ static struct PyModuleDef stick_frame_module = {
     PyModuleDef_HEAD_INIT, "_stick_frame", "The stick camera's whole frame in one call.", -1,
     stick_frame_methods};
 
-PyMODINIT_FUNC PyInit__stick_frame(void) { return PyModule_Create(&stick_frame_module); }
+PyMODINIT_FUNC PyInit__stick_frame(void) {
+    const char *names[] = {"position", "orientation", "albedo", "name", "size", "radius", "length"};
+    PyObject **slots[] = {&s_position, &s_orientation, &s_albedo, &s_name,
+                          &s_size,     &s_radius,      &s_length};
+    for (int i = 0; i < 7; i++)
+        if (!(*slots[i] = PyUnicode_InternFromString(names[i]))) return NULL;
+    return PyModule_Create(&stick_frame_module);
+}

@@ -5,21 +5,9 @@ from typing import Any
 
 Buffer = Any  # a C-contiguous buffer (a NumPy array of the dtype the kernel documents)
 
-def frame(
-    prims: Sequence[tuple[Buffer, Sequence[float], Sequence[float], float, float, float, Buffer]],
-    marker: int,
-    R: Buffer,
-    o: Buffer,
-    fx: float,
-    fy: float,
-    cx: float,
-    cy: float,
-    width: int,
-    height: int,
-    background: float,
-    threshold: float,
-    min_pixels: int,
-) -> tuple[bytearray, tuple[int, int, int, int], tuple | None] | None: ...
+def measure(
+    prims: Sequence[Any], shapes: dict, camera: tuple
+) -> tuple[bytearray, tuple[int, int, int, int], tuple | None, tuple | None] | tuple | None: ...
 def moments(
     img: Buffer,
     w: int,

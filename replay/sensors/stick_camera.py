@@ -341,9 +341,16 @@ class StickCamera(Sensor):
         self.camera = self.make_camera(params)
         self._R = tuple(tuple(float(v) for v in row) for row in self.camera.rotation)
         self._o = tuple(float(v) for v in self.camera.position)
-        self._R_array = np.ascontiguousarray(self.camera.rotation, dtype=np.float64)
-        self._o_array = np.ascontiguousarray(self.camera.position, dtype=np.float64)
-        self._threshold, self._min_pixels = float(params.threshold), int(params.min_pixels)
+        k = self.camera.intrinsics
+        self._frame_camera = (  # _stick_frame.measure's camera, made once
+            np.ascontiguousarray(self.camera.rotation, dtype=np.float64),
+            np.ascontiguousarray(self.camera.position, dtype=np.float64),
+            float(k.fx), float(k.fy), float(k.cx), float(k.cy),
+            int(params.width), int(params.height), float(params.background),
+            float(params.threshold), int(params.min_pixels), str(params.marker),
+            Box, Cylinder, self._o, math.dist,
+            float(params.position_offset[0]), float(params.position_offset[1]),
+        )  # fmt: skip
         self._shapes: dict = {}  # _frame's (body points, bounding radius, hull buffer) by shape
         self._last = None
 
@@ -453,49 +460,32 @@ class StickCamera(Sensor):
 
     def measure(self, t: float, scene: Scene) -> VisionStick | None:
         """The marker's pose in a frame of ``scene``: noise-free frames in one compiled call
-        (:meth:`_frame`, the same pixels and moments as :meth:`measure_reference`), the rest
-        (noise, a scene with spheres, no marker in view: the whole image) by the reference."""
+        (:meth:`_frame`, the same pixels, moments and pose as :meth:`measure_reference`), the
+        rest (noise, a scene with spheres, no marker in view: the whole image) by the
+        reference."""
         framed = self._frame(scene) if self.params.noise_sigma == 0.0 else None
         if framed is None:
             return self.measure_reference(t, scene)
-        img, window, found, marker = framed
+        img, window, pose = framed
         self._last = (img, window)
-        return self._pose(t, marker, found)
+        return None if pose is None else VisionStick(t, *pose)
 
     def _frame(self, scene: Scene):
-        """(image window, window, moments, marker) of a noise-free frame in one compiled call
-        (``_stick_frame.frame``: the steps of :meth:`measure_reference` and its kernels), or
-        None when the reference path must do it."""
-        p, prims, shapes = self.params, scene.primitives, self._shapes
-        entries, marker, o = [], -1, self._o
-        for i, prim in enumerate(prims):
-            kind = type(prim)
-            if kind is Box:
-                key: tuple = (i, kind, prim.size)
-            elif kind is Cylinder:
-                key = (i, kind, prim.radius, prim.length)
-            else:
-                return None
-            shape = shapes.get(key)
-            if shape is None:
-                shape = shapes[key] = self._shape(prim)
-            body, rb, out = shape
-            pos = prim.position
-            entries.append((body, prim.orientation, pos, prim.albedo, rb, math.dist(pos, o), out))
-            if marker < 0 and prim.name == p.marker:
-                marker = i
-        if marker < 0:
-            return None
-        k = self.camera.intrinsics
-        framed = _stick_frame.frame(
-            entries, marker, self._R_array, self._o_array, k.fx, k.fy, k.cx, k.cy,
-            p.width, p.height, p.background, self._threshold, self._min_pixels,
-        )  # fmt: skip
+        """(image window, window, pose (x, y, theta) or None) of a noise-free frame in one
+        compiled call (``_stick_frame.measure``: the steps of :meth:`measure_reference`, its
+        kernels and :meth:`_pose`), or None when the reference path must do it."""
+        prims, shapes = scene.primitives, self._shapes
+        while True:
+            framed = _stick_frame.measure(prims, shapes, self._frame_camera)
+            if framed is None or framed[0] is not None:
+                break
+            _, i, key = framed  # a shape not seen yet: its outline points, once
+            shapes[key] = self._shape(prims[i])
         if framed is None:
             return None
-        data, window, found = framed
+        data, window, _, pose = framed
         img = np.frombuffer(data, np.uint8).reshape(window[3] - window[1], window[2] - window[0])
-        return img, window, found, prims[marker]
+        return img, window, pose
 
     @staticmethod
     def _shape(prim: Box | Cylinder) -> tuple[np.ndarray, float, np.ndarray]:
