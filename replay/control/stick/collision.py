@@ -170,7 +170,7 @@ def approach_speed(theta: float, r_x: float, side: int, u_prev) -> float:
     return -(nx * vx + ny * vy + (-ay * nx + ax * ny) * w)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class ContactSolution:
     """One planned friction independent collision: where, from which side, and what it does."""
 
@@ -182,6 +182,24 @@ class ContactSolution:
     roots: tuple  # both roots of eq. 25 / 28 (m)
     condition: float  # C_i (eq. 26) of the chosen root (m/s)
     length: float | None = None
+
+    def __init__(
+        self,
+        theta: float,
+        side: int,
+        r_x: float,
+        u_before: tuple,
+        u_after: tuple,
+        roots: tuple,
+        condition: float,
+        length: float | None = None,
+    ) -> None:
+        # the fields straight into the instance's dict (a frozen dataclass's generated __init__ sets
+        # each through object.__setattr__, ~1 us a field on Python 3.11; test_stick_fast_paths.py
+        # holds this one to the generated one's result)
+        d = self.__dict__
+        d["theta"], d["side"], d["r_x"], d["u_before"] = theta, side, r_x, u_before
+        d["u_after"], d["roots"], d["condition"], d["length"] = u_after, roots, condition, length
 
     @property
     def within(self) -> bool:

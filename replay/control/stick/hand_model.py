@@ -33,10 +33,17 @@ from replay.robot.hand2d import HandCommand, HandSpec
 # ------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Config:
     base: tuple  # (x, y) m
     joints: tuple  # ((q1, q2), (q1, q2)) rad
+
+    def __init__(self, base: tuple, joints: tuple) -> None:
+        # the fields straight into the instance's dict (a frozen dataclass's generated __init__ sets
+        # each through object.__setattr__, ~1 us a field on Python 3.11; test_stick_fast_paths.py
+        # holds this one to the generated one's result)
+        d = self.__dict__
+        d["base"], d["joints"] = base, joints
 
     def with_finger(self, k: int, q) -> "Config":
         j = [tuple(self.joints[0]), tuple(self.joints[1])]
