@@ -294,37 +294,11 @@ def test_exit_config_in_floats_is_the_array_references():
 
 def test_hand_written_frozen_inits_are_the_generated_ones():
     """StickEstimate, ContactSolution and Config store their fields straight into the instance
-    dict (a frozen dataclass's generated __init__ costs ~1 us a field): the same signature
-    (names, order, defaults) as dataclasses would generate, the same instance, equal and
-    hashing alike, still frozen, and dataclasses.replace works."""
-    import dataclasses
-    import inspect
-
+    dict (a frozen dataclass's generated __init__ costs ~1 us a field): what dataclasses would
+    generate (tests/replay/test_scene_inits.py says what that means)."""
     from replay.control.stick.hand_model import Config
+    from tests.replay.test_scene_inits import assert_generated_init
 
     rng = np.random.default_rng(9)
     for cls in (StickEstimate, sc.ContactSolution, Config):
-        fields = dataclasses.fields(cls)
-        ref = dataclasses.make_dataclass(
-            "Ref",
-            [
-                (f.name, f.type)
-                if f.default is dataclasses.MISSING
-                else (f.name, f.type, dataclasses.field(default=f.default))
-                for f in fields
-            ],
-            frozen=True,
-        )
-        params = list(inspect.signature(cls.__init__).parameters.values())[1:]
-        assert [p.name for p in params] == [f.name for f in fields]
-        assert [p.default for p in params] == [
-            inspect.Parameter.empty if f.default is dataclasses.MISSING else f.default
-            for f in fields
-        ]
-        for _ in range(20):
-            values = [float(v) for v in rng.normal(size=len(fields))]
-            a, b = cls(*values), ref(*values)
-            assert vars(a) == vars(b) and a == cls(**vars(b)) and hash(a) == hash(cls(*values))
-            with pytest.raises(dataclasses.FrozenInstanceError):
-                setattr(a, fields[0].name, 1.0)
-            assert dataclasses.replace(a, **{fields[0].name: 2.0}) == cls(2.0, *values[1:])
+        assert_generated_init(cls, rng)
