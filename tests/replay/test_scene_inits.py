@@ -1,7 +1,7 @@
 """Frozen dataclasses whose __init__ is written by hand for speed (the generated one sets each
 field through object.__setattr__, ~1 us a field on Python 3.11): replay.scene's Box and Cylinder
-here, the stick controller's StickEstimate, ContactSolution and Config in
-tests/replay/control/stick/test_stick_fast_paths.py. Each must be what dataclasses generates:
+here, with the stick hand's HandCommand and the planner's Motion; the stick controller's
+StickEstimate, ContactSolution and Config in tests/replay/control/stick/test_stick_fast_paths.py. Each must be what dataclasses generates:
 the same signature (names, order, defaults), the same instance, equal and hashing alike, still
 frozen, and dataclasses.replace works."""
 
@@ -11,6 +11,8 @@ import inspect
 import numpy as np
 import pytest
 
+from replay.control.stick.sweep import Motion
+from replay.robot.hand2d import HandCommand
 from replay.scene import Box, Cylinder
 
 
@@ -43,6 +45,6 @@ def assert_generated_init(cls, rng, n: int = 20) -> None:
             assert vars(cls(*values[:-1])) == vars(ref(*values[:-1]))  # the default
 
 
-@pytest.mark.parametrize("cls", [Box, Cylinder])
-def test_scene_primitives_inits_are_the_generated_ones(cls):
+@pytest.mark.parametrize("cls", [Box, Cylinder, HandCommand, Motion])
+def test_hand_written_inits_are_the_generated_ones(cls):
     assert_generated_init(cls, np.random.default_rng(3))
