@@ -5,8 +5,8 @@ the buffer protocol, no NumPy headers), as are the stereo camera's frame and a s
 (replay/sensors/_stereo.c, _silhouette.c), the stick camera's frame
 (replay/sensors/_stick_frame.c), the catching mapping
 (replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
-(replay/robot/_chain.c), the stick planners' sweep checks and contact solver (replay/control/stick/_sweep.c,
-_contacts.c), the
+(replay/robot/_chain.c), the stick planners' sweep checks, contact solver and estimator fit
+(replay/control/stick/_sweep.c, _contacts.c, _fit.c), the
 air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
 (replay/foxglove/_png.c), the log's chunk buffer and finiteness check (replay/log/_chunk.c,
 _finite.c) and the grasping tasks' per-step kernels (replay/control/grasping/_arm_kinematics.c,
@@ -57,6 +57,7 @@ setup(
         _ext("plants.airtable._bodies"),
         _ext("replay.control.stick._sweep"),
         _ext("replay.control.stick._contacts"),
+        _ext("replay.control.stick._fit"),
         _ext("replay.foxglove._png"),
         _ext("replay.log._chunk"),
         _ext("replay.log._finite"),
