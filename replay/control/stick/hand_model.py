@@ -77,7 +77,13 @@ class HandModel:
 
     def advance(self, t: float) -> None:
         now, target = self.config, self.target
-        if self._t is not None and t > self._t and now is not target and now != target:
+        # (Config equality field by field: what the dataclass's == compares, without its tuples)
+        if (
+            self._t is not None
+            and t > self._t
+            and now is not target
+            and (now.base != target.base or now.joints != target.joints)
+        ):
             dt = t - self._t
             sb = self.hand.base_speed * dt
             sq = self.hand.joint_speed * dt
@@ -91,7 +97,8 @@ class HandModel:
                 ),
             )
             # on the target: the target itself (equal numbers), so later ticks see it at once
-            self.config = target if moved == target else moved
+            same = moved.base == target.base and moved.joints == target.joints
+            self.config = target if same else moved
         self._t = t
 
 
