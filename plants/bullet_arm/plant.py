@@ -25,6 +25,7 @@ from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
+from plants.bullet_arm.reach import robot_reach
 from plants.bullet_arm.settings import resolve
 from replay.interfaces import Occurrence, Plant
 from replay.messages import (
@@ -57,6 +58,20 @@ PER_STEP_CALLS = (
     "changeConstraint",
     "getConstraintState",
 )
+
+
+def _floats(values, n: int, what: str) -> list[float]:
+    """``np.asarray(values, dtype=float).reshape(-1).tolist()`` of ``n`` values: a flat list or
+    tuple of numbers by ``float()`` (the same doubles, no array made a step), else NumPy's."""
+    if type(values) in (list, tuple) and len(values) == n:
+        try:
+            return [float(x) for x in values]
+        except (TypeError, ValueError):
+            pass  # nested or odd entries: NumPy decides
+    a = np.asarray(values, dtype=float).reshape(-1)
+    if a.shape != (n,):
+        raise ValueError(f"{what} needs {n} values, got {a.shape[0]}")
+    return a.tolist()
 
 
 class BulletArmPlant(Plant):
@@ -178,6 +193,7 @@ class BulletArmPlant(Plant):
             self._hand_lo_l, self._hand_hi_l = self._hand_lo.tolist(), self._hand_hi.tolist()
         self._hand_speed = float(P.hand_closing_speed)
         self._hand_forces = [float(P.hand_max_torque)] * len(self._hand_j)
+        self._hand_v: list | None = None  # the hand motors' last targets (None: none set yet)
 
         # ---- the free object
         self.obj = None
@@ -230,6 +246,8 @@ class BulletArmPlant(Plant):
         self._tlim_l = self.torque_limits.tolist()
         self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
         self._locked_l = [n in self.locked for n in self.joint_names]
+        self._locked_i = [i for i, x in enumerate(self._locked_l) if x]
+        self._enforce_vlim = bool(P.enforce_velocity_limits)
         self._contact_summary = (None, (), (), 0.0)  # (contacts list it is of, parts, links, N)
         self._contact_key: tuple = ()  # the touching links of the last summary, and their names
         self._contact_names: tuple = ((), ())
@@ -242,6 +260,12 @@ class BulletArmPlant(Plant):
             tuple(float(x) for x in P.object_velocity) if self.obj is not None else (0.0,) * 3
         )
         self._contacts: list = []
+        # beyond this distance from the base the object touches nothing of the robot (m)
+        self._contact_radius = (
+            robot_reach(bc, self.robot, self._base_pose[0], self._parent_link)
+            + (self._obj_radius if P.object == "ball" else 0.5 * math.hypot(*self._obj_size))
+            + 0.05
+        )
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
         self._cache: tuple | None = None
         self._effector = None  # (step, the tool link's state): read at most once a step
@@ -384,25 +408,35 @@ class BulletArmPlant(Plant):
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ArmCommand) -> None:
-        tau = np.asarray(command.torque, dtype=float).reshape(-1)
-        if tau.shape != (self.dof,):
-            raise ValueError(f"ArmCommand.torque needs {self.dof} values, got {tau.shape[0]}")
-        self._tau_cmd = tau.tolist()
+        self._tau_cmd = _floats(command.torque, self.dof, "ArmCommand.torque")
         if command.hand is not None and self._hand_j:
-            h = np.asarray(command.hand, dtype=float).reshape(-1)
-            if h.shape != (len(self._hand_j),):
-                raise ValueError(f"ArmCommand.hand needs {len(self._hand_j)} values")
+            h = _floats(command.hand, len(self._hand_j), "ArmCommand.hand")
             # np.clip per joint in floats (NaN stays NaN, as there)
             self._hand_target = [
-                min(max(x, lo), hi)
-                for x, lo, hi in zip(h.tolist(), self._hand_lo_l, self._hand_hi_l)
+                min(max(x, lo), hi) for x, lo, hi in zip(h, self._hand_lo_l, self._hand_hi_l)
             ]
 
     def _limit_torque(self, qdl: list) -> None:
         """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
         locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
-        its speed limit further. Per joint in plain Python (4-7 floats)."""
-        enforce = self.params.enforce_velocity_limits
+        its speed limit further. The usual case (no speed limit enforced, every command finite
+        and within its limit) in one pass; else joint by joint (``_limit_torque_loop``)."""
+        cmd = self._tau_cmd
+        if not self._enforce_vlim:
+            clip = [min(max(x, -lim), lim) for x, lim in zip(cmd, self._tlim_l)]
+            # (a NaN is its own clip, and a list compares items by identity first: the sum
+            # says it; an inf is cut)
+            if clip == cmd and math.isfinite(sum(cmd)):
+                for i in self._locked_i:
+                    clip[i] = 0.0
+                self._tau_applied = clip
+                self._clamped = self._torque_episode = [False] * self.dof
+                return
+        self._limit_torque_loop(qdl)
+
+    def _limit_torque_loop(self, qdl: list) -> None:
+        """``_limit_torque`` joint by joint in plain Python (4-7 floats), with the events."""
+        enforce = self._enforce_vlim
         cmd = self._tau_cmd
         applied, clamped = [0.0] * self.dof, [False] * self.dof
         sign = lambda x: (x > 0.0) - (x < 0.0)  # noqa: E731  (np.sign)
@@ -445,20 +479,24 @@ class BulletArmPlant(Plant):
             self.robot,
             self._arm_j,
             p.TORQUE_CONTROL,
-            forces=[applied[i] for i in self.active],
+            forces=applied if self._all_active else [applied[i] for i in self.active],
         )
         if self._hand_j:
             speed, dt = self._hand_speed, self.dt
             # rate-limited position servo: reach the target at most at the closing speed, the
             # last step landing on it (PyBullet's velocity motor is implicit, so this is stable)
             v = [min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])]
-            self._set_motors(
-                self.robot,
-                self._hand_j,
-                p.VELOCITY_CONTROL,
-                targetVelocities=v,
-                forces=self._hand_forces,
-            )
+            # PyBullet keeps a velocity motor's target and force until set again: the same
+            # targets as last step (closing at full speed, at rest) need no call
+            if v != self._hand_v:
+                self._set_motors(
+                    self.robot,
+                    self._hand_j,
+                    p.VELOCITY_CONTROL,
+                    targetVelocities=v,
+                    forces=self._hand_forces,
+                )
+                self._hand_v = v
         if obj is not None:
             pos, _, v, w = obj
             J = self._impulses.pop(self._steps) if self._impulses else None
@@ -485,8 +523,18 @@ class BulletArmPlant(Plant):
         self._check_events()
 
     # ------------------------------------------------------------------ events
-    def _robot_contacts(self):
-        """Contact points object-robot that touch (normal force > 0 or no gap)."""
+    def _robot_contacts(self, pos, v) -> list:
+        """Contact points object-robot that touch (normal force > 0 or no gap); none while
+        the object at ``pos`` (moving at ``v``) is beyond the robot's reach (reach.py) by more
+        than its bounding radius, its travel in two steps and 5 cm: no point can be there (the
+        points of a step are found at its start, nearer than Bullet's contact threshold)."""
+        x, y, z = pos
+        bx, by, bz = self._base_pose[0]
+        vx, vy, vz = v
+        far = self._contact_radius + 2.0 * self.dt * math.sqrt(vx * vx + vy * vy + vz * vz)
+        dx, dy, dz = x - bx, y - by, z - bz
+        if dx * dx + dy * dy + dz * dz > far * far:
+            return []
         pts = self._get_contact_points(bodyA=self.obj, bodyB=self.robot)
         return [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
 
@@ -508,10 +556,17 @@ class BulletArmPlant(Plant):
         P = self.params
         (ql, qdl), _, obj = self._state()  # per-joint checks on 4-7 floats: plain Python
         isfinite = math.isfinite
-        finite = all(map(isfinite, ql)) and all(map(isfinite, qdl))
         if obj is not None:
             pos, orn, v, w = obj
-            finite = finite and all(map(isfinite, pos)) and all(map(isfinite, v))
+            # a sum of finite numbers is finite unless it overflows: then the checks one by one
+            finite = isfinite(sum(ql) + sum(qdl) + sum(pos) + sum(v)) or (
+                all(map(isfinite, ql))
+                and all(map(isfinite, qdl))
+                and all(map(isfinite, pos))
+                and all(map(isfinite, v))
+            )
+        else:
+            finite = all(map(isfinite, ql)) and all(map(isfinite, qdl))
         if not finite:
             if not self.diverged:
                 self.diverged = True
@@ -548,7 +603,7 @@ class BulletArmPlant(Plant):
         self._at_limit = at
         if obj is None:
             return
-        contacts = self._robot_contacts()
+        contacts = self._robot_contacts(pos, v)
         self._contacts = contacts
         parts, links, _ = self._contact_summary_now()
         if contacts and not self._in_contact:
