@@ -7,8 +7,9 @@ the buffer protocol, no NumPy headers), as are the stereo camera's frame and a s
 (replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
 air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
 (replay/foxglove/_png.c), the log's chunk buffer and finiteness check (replay/log/_chunk.c,
-_finite.c) and the grasping tasks' per-step kernels (replay/control/grasping/_arm_kinematics.c,
-_chip_target.c, _hand_servo.c)."""
+_finite.c), the grasping tasks' per-step kernels (replay/control/grasping/_arm_kinematics.c,
+_chip_target.c, _hand_servo.c) and the arm plant's once-a-step state arithmetic
+(plants/bullet_arm/_arm_state.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -55,6 +56,7 @@ setup(
         _ext("replay.control.grasping._arm_kinematics"),
         _ext("replay.control.grasping._chip_target"),
         _ext("replay.control.grasping._hand_servo"),
+        _ext("plants.bullet_arm._arm_state"),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],

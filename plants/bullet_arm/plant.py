@@ -20,6 +20,7 @@ import operator
 
 import numpy as np
 
+from plants.bullet_arm._arm_state import joint_state, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
@@ -169,6 +170,7 @@ class BulletArmPlant(Plant):
         na = self._na
         slot = {i: k for k, i in enumerate(self.active)}
         self._arm_pick = operator.itemgetter(*[slot.get(i, na + i) for i in range(dof)])
+        self._pick = tuple(slot.get(i, -1) for i in range(dof))  # _arm_state.joint_state's
         self._locked_tail = tuple(self._q_locked_l)
         self._zero_tail = (0.0,) * dof
         # the tool frame and the palm: one getLinkStates a step (_frames_now)
@@ -346,16 +348,18 @@ class BulletArmPlant(Plant):
         after changing the simulation other than by stepping it). Shared, never mutated: the
         accessors below give copies."""
         if self._cache is None:
-            pos, vel, _, eff = zip(*self._get_joint_states(self.robot, self._read_j))
-            q, qd = self._arm_q(pos, vel)
-            na = self._na
-            hand = (list(pos[na:]), list(vel[na:]), list(eff[na:]))
+            arm, hand = joint_state(
+                self._get_joint_states(self.robot, self._read_j),
+                self._na,
+                self._pick,
+                self._q_locked_l,
+            )
             obj = None
             if self.obj is not None:
                 pos, orn = self._get_base_pose(self.obj)
                 v, w = self._get_base_velocity(self.obj)
                 obj = (pos, orn, v, w)
-            self._cache = ((q, qd), hand, obj)
+            self._cache = (arm, hand, obj)
         return self._cache
 
     def _arm_q(self, pos: tuple, vel: tuple) -> tuple[list, list]:
@@ -499,7 +503,7 @@ class BulletArmPlant(Plant):
                 self._hand_v = v
         if obj is not None:
             pos, _, v, w = obj
-            J = self._impulses.pop(self._steps) if self._impulses else None
+            J = self._impulses.pop(self._steps) if self._impulses.due else None
             if J is not None:  # a scenario-set kick (impulse.py)
                 v = (np.asarray(v) + J / self.params.object_mass).tolist()
                 bc.resetBaseVelocity(self.obj, v, list(w))
@@ -548,31 +552,12 @@ class BulletArmPlant(Plant):
                 self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
             )
         (vx, vy, vz), (wx, wy, wz), (cx, cy, cz) = ls[6], ls[7], ls[0]
-        rx, ry, rz = (float(x) for x in point)
+        rx, ry, rz = map(float, point)
         rx, ry, rz = rx - cx, ry - cy, rz - cz  # v + w x (point - link COM)
         return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx)
 
-    def _check_events(self) -> None:
-        P = self.params
-        (ql, qdl), _, obj = self._state()  # per-joint checks on 4-7 floats: plain Python
-        isfinite = math.isfinite
-        if obj is not None:
-            pos, orn, v, w = obj
-            # a sum of finite numbers is finite unless it overflows: then the checks one by one
-            finite = isfinite(sum(ql) + sum(qdl) + sum(pos) + sum(v)) or (
-                all(map(isfinite, ql))
-                and all(map(isfinite, qdl))
-                and all(map(isfinite, pos))
-                and all(map(isfinite, v))
-            )
-        else:
-            finite = all(map(isfinite, ql)) and all(map(isfinite, qdl))
-        if not finite:
-            if not self.diverged:
-                self.diverged = True
-                self._events.append(Occurrence("nan", {"step": self._steps}))
-            return
-        over = [abs(x) > lim for x, lim in zip(qdl, self._vlim_l)]
+    def _limit_events(self, ql: list, qdl: list, over: list, at: list) -> None:
+        """velocity_limit and joint_limit events of the joints whose flags rose this step."""
         for i in range(self.dof) if over != self._vel_over else ():
             if over[i] and not self._vel_over[i]:
                 self._events.append(
@@ -586,7 +571,6 @@ class BulletArmPlant(Plant):
                     )
                 )
         self._vel_over = over
-        at = [x <= lo or x >= hi for x, lo, hi in zip(ql, self._lower_l, self._upper_l)]
         for i in range(self.dof) if at != self._at_limit else ():
             if at[i] and not self._at_limit[i] and not self._locked_l[i]:
                 self._events.append(
@@ -601,6 +585,32 @@ class BulletArmPlant(Plant):
                     )
                 )
         self._at_limit = at
+
+    def _check_events(self) -> None:
+        P = self.params
+        (ql, qdl), _, obj = self._state()
+        pos = v = None
+        if obj is not None:
+            pos, orn, v, w = obj
+        flags = limit_flags(
+            ql,
+            qdl,
+            pos,
+            v,
+            self._vlim_l,
+            self._lower_l,
+            self._upper_l,
+            self._vel_over,
+            self._at_limit,
+        )
+        if flags is not None:  # not finite, or a joint's limit flags changed
+            finite, over, at = flags
+            if not finite:
+                if not self.diverged:
+                    self.diverged = True
+                    self._events.append(Occurrence("nan", {"step": self._steps}))
+                return
+            self._limit_events(ql, qdl, over, at)
         if obj is None:
             return
         contacts = self._robot_contacts(pos, v)
