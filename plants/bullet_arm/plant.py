@@ -66,7 +66,7 @@ def _floats(values, n: int, what: str) -> list[float]:
     tuple of numbers by ``float()`` (the same doubles, no array made a step), else NumPy's."""
     if type(values) in (list, tuple) and len(values) == n:
         try:
-            return [float(x) for x in values]
+            return list(map(float, values))
         except (TypeError, ValueError):
             pass  # nested or odd entries: NumPy decides
     a = np.asarray(values, dtype=float).reshape(-1)
@@ -423,23 +423,23 @@ class BulletArmPlant(Plant):
     def _limit_torque(self, qdl: list) -> None:
         """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
         locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
-        its speed limit further. The usual case (no speed limit enforced, every command finite
-        and within its limit) in one pass; else joint by joint (``_limit_torque_loop``)."""
+        its speed limit further. The usual case (no speed limit enforced, every command finite)
+        in one pass over the joints; else joint by joint (``_limit_torque_loop``)."""
         cmd = self._tau_cmd
-        if not self._enforce_vlim:
-            clip = [min(max(x, -lim), lim) for x, lim in zip(cmd, self._tlim_l)]
-            # (a NaN is its own clip, and a list compares items by identity first: the sum
-            # says it; an inf is cut)
-            if clip == cmd and math.isfinite(sum(cmd)):
-                for i in self._locked_i:
-                    clip[i] = 0.0
-                self._tau_applied = clip
-                self._clamped = self._torque_episode = [False] * self.dof
-                return
-        self._limit_torque_loop(qdl)
+        if self._enforce_vlim or not math.isfinite(sum(cmd)):
+            self._limit_torque_loop(qdl)
+            return
+        applied = [min(max(x, -lim), lim) for x, lim in zip(cmd, self._tlim_l)]
+        clamped = [a != x for a, x in zip(applied, cmd)]
+        for i in self._locked_i:
+            applied[i], clamped[i] = 0.0, False
+        self._tau_applied = applied
+        if True in clamped:
+            self._torque_events(clamped)
+        self._clamped = self._torque_episode = clamped
 
     def _limit_torque_loop(self, qdl: list) -> None:
-        """``_limit_torque`` joint by joint in plain Python (4-7 floats), with the events."""
+        """``_limit_torque`` joint by joint in plain Python (4-7 floats)."""
         enforce = self._enforce_vlim
         cmd = self._tau_cmd
         applied, clamped = [0.0] * self.dof, [False] * self.dof
@@ -455,24 +455,29 @@ class BulletArmPlant(Plant):
             if enforce and abs(qdl[i]) >= self._vlim_l[i] and sign(a) == sign(qdl[i]) and a != 0:
                 a, c = 0.0, True
             applied[i], clamped[i] = a, c
-        if True in clamped:
-            for i, c in enumerate(clamped):
-                if c and not self._torque_episode[i]:
-                    x = cmd[i]
-                    self._events.append(
-                        Occurrence(
-                            "torque_limit",
-                            {
-                                "joint": self.joint_names[i],
-                                "commanded": x if math.isfinite(x) else None,
-                                "applied": applied[i],
-                                "limit": self._tlim_l[i],
-                            },
-                        )
-                    )
-            self.clamp_count += sum(clamped)
         self._tau_applied = applied
+        if True in clamped:
+            self._torque_events(clamped)
         self._clamped = self._torque_episode = clamped
+
+    def _torque_events(self, clamped: list) -> None:
+        """A torque_limit event per joint clamped now and not the step before; the count."""
+        cmd, applied = self._tau_cmd, self._tau_applied
+        for i, c in enumerate(clamped):
+            if c and not self._torque_episode[i]:
+                x = cmd[i]
+                self._events.append(
+                    Occurrence(
+                        "torque_limit",
+                        {
+                            "joint": self.joint_names[i],
+                            "commanded": x if math.isfinite(x) else None,
+                            "applied": applied[i],
+                            "limit": self._tlim_l[i],
+                        },
+                    )
+                )
+        self.clamp_count += sum(clamped)
 
     def step(self) -> None:
         bc = self.bc
