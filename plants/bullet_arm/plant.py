@@ -16,7 +16,6 @@ PyBullet facts used (shared/robots/README.md, measured on this machine):
 from __future__ import annotations
 
 import math
-import operator
 
 import numpy as np
 
@@ -166,13 +165,9 @@ class BulletArmPlant(Plant):
         self._na = len(self._arm_j)
         self._all_active = len(self.active) == dof  # no locked joint: no index mapping
         self._q_locked_l = [float(self.locked.get(n, 0.0)) for n in names]
-        # every arm joint's value from the read joints' (locked ones appended): one itemgetter
-        na = self._na
+        # per arm joint its read joint's index, -1 for a locked one (_arm_state.joint_state)
         slot = {i: k for k, i in enumerate(self.active)}
-        self._arm_pick = operator.itemgetter(*[slot.get(i, na + i) for i in range(dof)])
-        self._pick = tuple(slot.get(i, -1) for i in range(dof))  # _arm_state.joint_state's
-        self._locked_tail = tuple(self._q_locked_l)
-        self._zero_tail = (0.0,) * dof
+        self._pick = tuple(slot.get(i, -1) for i in range(dof))
         # the tool frame and the palm: one getLinkStates a step (_frames_now)
         self._frame_links = [self._tool_link] + (
             [] if self._palm_link is None else [self._palm_link]
@@ -361,15 +356,6 @@ class BulletArmPlant(Plant):
                 obj = (pos, orn, v, w)
             self._cache = (arm, hand, obj)
         return self._cache
-
-    def _arm_q(self, pos: tuple, vel: tuple) -> tuple[list, list]:
-        """(q, qd) of every arm joint from the read joints' positions and velocities (locked
-        joints at their lock value, zero speed)."""
-        if self._all_active:
-            na = self._na
-            return list(pos[:na]), list(vel[:na])
-        pick, na = self._arm_pick, self._na
-        return list(pick(pos[:na] + self._locked_tail)), list(pick(vel[:na] + self._zero_tail))
 
     def invalidate_state(self) -> None:
         """Forget the state read from PyBullet (after a reset* call: the next read is fresh)."""
