@@ -254,6 +254,7 @@ class LogWriter:
         self._message = self._mcap.message
         self._mcap.start(profile="", library=f"paper-replay {__version__}")
         self._json_channels: dict[str, int] = {}  # topic -> channel id
+        self._json = self._mcap.json_messages(self._json_channels, _dumps, finite)
         self._topics: set[str] = set()  # every channel's topic
         self.closed = False
 
@@ -299,11 +300,18 @@ class LogWriter:
         return channel
 
     def write(self, topic: str, payload: Any, t_ns: int) -> None:
-        """Write one message; ``t_ns`` (simulated time) is both log and publish time."""
-        data = encode(topic, payload)  # NonFiniteValueError before anything is written
-        channel = self._json_channels.get(topic) or self._json_channel(topic, payload)  # ids > 0
+        """Write one message; ``t_ns`` (simulated time) is both log and publish time.
+
+        A topic with a channel is written by one compiled call (``_chunk.c`` ``json``: orjson's
+        bytes, the finite check when they hold ``null``, the record); the rest (a topic's first
+        message, a payload only :func:`encode`'s fallbacks take, a ``null`` to look into) here,
+        the same bytes either way."""
         try:  # (compiled, so whole: a finished chunk is written under the held SIGINT)
-            self._message(channel, t_ns, t_ns, data)
+            if self._json(topic, payload, t_ns):
+                return
+            data = encode(topic, payload)  # NonFiniteValueError before anything is written
+            channel = self._json_channels.get(topic) or self._json_channel(topic, payload)
+            self._message(channel, t_ns, t_ns, data)  # (channel ids > 0)
         except OSError as exc:
             raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
 
