@@ -2,21 +2,7 @@
 
 from typing import Any
 
-Buffer = Any  # a C-contiguous uint8 (or bool) buffer
+Image = Any  # a WindowedImage (its pixels uint8) or an (h, w) uint8 or bool array
 
-def png(
-    pixels: Buffer, background: int, x0: int, y0: int, x1: int, y1: int, w: int, h: int, binary: int
-) -> bytes: ...
-def message(
-    prefix: bytes,
-    suffix: bytes,
-    pixels: Buffer,
-    background: int,
-    x0: int,
-    y0: int,
-    x1: int,
-    y1: int,
-    w: int,
-    h: int,
-    binary: int,
-) -> bytes: ...
+def png(image: Image, /) -> bytes: ...
+def message(prefix: bytes, suffix: bytes, image: Image, /) -> bytes: ...
