@@ -6,9 +6,9 @@ the buffer protocol, no NumPy headers), as are the stereo camera's frame and a s
 (replay/control/catching/_mapping.c), the serial chain's one-configuration dynamics
 (replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
 air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
-(replay/foxglove/_png.c), the log's chunk buffer and finiteness check (replay/log/_chunk.c,
-_finite.c) and the grasping tasks' per-step kernels (replay/control/grasping/_arm_kinematics.c,
-_chip_target.c, _hand_servo.c)."""
+(replay/foxglove/_png.c), Foxglove's /tf and /joint_states wire format (_wire.c), the log's
+chunk buffer and finiteness check (replay/log/_chunk.c, _finite.c) and the grasping tasks'
+per-step kernels (replay/control/grasping/_arm_kinematics.c, _chip_target.c, _hand_servo.c)."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -50,6 +50,7 @@ setup(
         _ext("plants.airtable._bodies"),
         _ext("replay.control.stick._sweep"),
         _ext("replay.foxglove._png"),
+        _ext("replay.foxglove._wire"),
         _ext("replay.log._chunk"),
         _ext("replay.log._finite"),
         _ext("replay.control.grasping._arm_kinematics"),

@@ -54,7 +54,7 @@ def encode_png(image: np.ndarray | WindowedImage) -> bytes:
     return _png.png(image)
 
 
-def png_message(prefix: bytes, image: np.ndarray | WindowedImage, suffix: bytes) -> bytes:
-    """``prefix``, the image's PNG as protobuf field 2 (length-delimited), ``suffix``: a
-    ``foxglove.CompressedImage`` in one compiled call (replay/foxglove/wire.py's fields)."""
-    return _png.message(prefix, suffix, image)
+# png_message(prefix, suffix, image): ``prefix``, the image's PNG as protobuf field 2
+# (length-delimited), ``suffix``: a ``foxglove.CompressedImage`` in one compiled call
+# (replay/foxglove/wire.py's fields), called straight (no Python frame an image)
+png_message = _png.message

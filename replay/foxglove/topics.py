@@ -165,12 +165,19 @@ class FoxgloveTopics:
         )
 
     def image(self, sensor: str, view: str, image: np.ndarray | WindowedImage, t_ns: int) -> None:
-        slot = self._images.get((sensor, view))
-        if slot is None:
-            channel = self._wire(camera_topic(sensor, view), CompressedImage)
-            slot = self._images[(sensor, view)] = (
-                channel,
-                wire.image_tail(f"{sensor}/{view}", "png"),
-            )
-        channel, tail = slot
-        self.log.write_raw(channel, png_message(wire.timestamp(t_ns), image, tail), t_ns)
+        self.images(sensor, ((view, image),), t_ns)
+
+    def images(
+        self, sensor: str, frames: Iterable[tuple[str, np.ndarray | WindowedImage]], t_ns: int
+    ) -> None:
+        """A sensor's frame: each (view, image) on its ``/camera/SENSOR/VIEW`` topic, one
+        timestamp for all, each message one compiled call (:func:`png_message`)."""
+        ts, slots, write = wire.timestamp(t_ns), self._images, self.log.write_raw
+        for view, image in frames:
+            slot = slots.get((sensor, view)) or self._image_slot(sensor, view)
+            write(slot[0], png_message(ts, slot[1], image), t_ns)
+
+    def _image_slot(self, sensor: str, view: str) -> tuple[int, bytes]:
+        channel = self._wire(camera_topic(sensor, view), CompressedImage)
+        slot = self._images[(sensor, view)] = (channel, wire.image_tail(f"{sensor}/{view}", "png"))
+        return slot

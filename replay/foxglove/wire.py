@@ -4,7 +4,9 @@ camera rate.
 
 Filling the ``foxglove_schemas_protobuf`` classes costs ~0.2 us an attribute (a /tf of 15
 frames ~60 us); here a frame transform is one ``struct.pack`` of its seven doubles behind the
-cached bytes of its frame names. Every double is written, zeros too (the library leaves a zero
+cached bytes of its frame names, and the timestamp, /tf's frame transforms and the joint states
+are compiled (``_wire.c``, ~20x cheaper; the Python references ``_timestamp``,
+``_frame_transforms`` and ``_joint_states`` kept for the tests). Every double is written, zeros too (the library leaves a zero
 out; a reader gives 0.0 either way), so the bytes are fixed by the values; the messages decode
 to the library's own (tests/replay/foxglove/test_wire.py builds both from seeded random
 input). Field numbers are those of the schemas (foxglove.FrameTransform: timestamp 1, parent
@@ -17,6 +19,7 @@ import functools
 import struct
 from typing import Iterable, Sequence
 
+from replay.foxglove import _wire
 from replay.scene import Box, Cylinder, Frame, Sphere
 
 # tag bytes: (field number << 3) | wire type (0 varint, 1 fixed64, 2 length-delimited)
@@ -52,18 +55,17 @@ def _text(tag: int, text: str) -> bytes:
     return field(tag, text.encode())
 
 
-@functools.lru_cache(maxsize=8)  # (a frame's topics and images share their time)
-def timestamp(t_ns: int) -> bytes:
+def _timestamp(t_ns: int) -> bytes:
     """A ``google.protobuf.Timestamp`` of ``t_ns`` as field 1 of its message (seconds 1 and
-    nanos 2, each left out at 0 as the library does)."""
+    nanos 2, each left out at 0 as the library does): the reference of :func:`timestamp`."""
     sec, nsec = divmod(t_ns, 1_000_000_000)
     body = (b"\x08" + varint(sec) if sec else b"") + (b"\x10" + varint(nsec) if nsec else b"")
     return b"\x0a" + bytes((len(body),)) + body
 
 
-def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
-    """``foxglove.FrameTransforms``: each frame's pose in its parent at ``t_ns``."""
-    ts = timestamp(t_ns)
+def _frame_transforms(frames: Iterable[Frame], ts: bytes) -> bytes:
+    """The reference of :func:`frame_transforms`' compiled transforms (``ts``: a timestamp
+    field)."""
     pack = _TRANSFORM.pack
     parts = []
     for f in frames:
@@ -78,6 +80,15 @@ def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
         )
         parts.append(b"\x0a" + varint(len(body)) + body)
     return b"".join(parts)
+
+
+# compiled (_wire.c; the references above and _joint_states below): ~20x cheaper a call
+timestamp = _wire.timestamp
+
+
+def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
+    """``foxglove.FrameTransforms``: each frame's pose in its parent at ``t_ns``."""
+    return _wire.frame_transforms(frames, timestamp(t_ns))
 
 
 def body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
@@ -176,19 +187,24 @@ def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
     return b"".join(parts)
 
 
-def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
-    """``foxglove.JointStates``: each joint's name, position, velocity and effort."""
+def _joint_states(names, position, velocity, effort, ts: bytes) -> bytes:
+    """The reference of :func:`joint_states`' compiled message (``ts``: a timestamp field)."""
     pack = _JOINT.pack
-    parts = [timestamp(t_ns)]
+    parts = [ts]
     for n, q, v, e in zip(names, position, velocity, effort):
         joint = _text(0x0A, n) + pack(0x11, q, 0x19, v, 0x29, e)
         parts.append(b"\x12" + varint(len(joint)) + joint)
     return b"".join(parts)
 
 
+def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
+    """``foxglove.JointStates``: each joint's name, position, velocity and effort."""
+    return _wire.joint_states(names, position, velocity, effort, timestamp(t_ns))
+
+
 @functools.lru_cache(maxsize=256)
 def image_tail(frame_id: str, fmt: str) -> bytes:
     """The fields of a ``foxglove.CompressedImage`` after its data (field 2): format 3, frame
-    id 4; a camera's message is ``replay.foxglove.png.png_message(timestamp(t_ns), image,
-    image_tail(frame_id, "png"))``."""
+    id 4; a camera's message is ``replay.foxglove.png.png_message(timestamp(t_ns),
+    image_tail(frame_id, "png"), image)``."""
     return _text(0x1A, fmt) + _text(0x22, frame_id)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
@@ -147,7 +148,7 @@ def test_wire_messages_decode_to_the_protobuf_classes_own():
             == reference_joints(*joints, t)
             and CompressedImage.FromString(compressed_image(t, image.frame_id, data)) == image
             and CompressedImage.FromString(
-                png_message(wire.timestamp(t), pixels, wire.image_tail("x", "png"))
+                png_message(wire.timestamp(t), wire.image_tail("x", "png"), pixels)
             )
             == png_image
         )
@@ -163,3 +164,42 @@ def test_wire_doubles_are_exact_and_the_bytes_fixed_by_the_values():
     assert tr.x == math.pi and math.copysign(1.0, tr.y) == -1.0 and tr.z == 1e-300
     assert wire.frame_transforms(f, 5) == wire.frame_transforms(list(f), 5)
     assert wire.varint(300) == b"\xac\x02" and wire.varint(0) == b"\x00"
+
+
+def test_compiled_wire_parts_equal_their_python_references():
+    """_wire.c's timestamp, frame transforms and joint states: the bytes of wire.py's Python
+    references on seeded random frames (long names: multi-byte varints), joints and times."""
+    rng = np.random.default_rng(31)
+    n, equal = 300, 0
+    for i in range(n):
+        t_ns = _t_ns(rng) if i % 3 else int(rng.integers(0, 2**62))
+        ts = wire._timestamp(t_ns)
+        frames = [
+            Frame(
+                _name(rng) * int(rng.integers(1, 30)),
+                _name(rng),
+                tuple(_value(rng) for _ in range(3)),
+                _quat(rng),
+            )
+            for _ in range(int(rng.integers(0, 20)))
+        ]
+        k = int(rng.integers(0, 9))
+        names = [_name(rng) * int(rng.integers(1, 20)) for _ in range(k)]
+        q, v, e = (
+            np.array([_value(rng) for _ in range(k + int(rng.integers(0, 2)))]) for _ in "qve"
+        )
+        same = (
+            wire.timestamp(t_ns) == ts
+            and wire.frame_transforms(frames, t_ns) == wire._frame_transforms(frames, ts)
+            and wire.frame_transforms(iter(frames), t_ns) == wire._frame_transforms(frames, ts)
+            and wire.joint_states(names, q, v, e, t_ns) == wire._joint_states(names, q, v, e, ts)
+            and wire.joint_states(names, list(q), tuple(v), e, t_ns)
+            == wire._joint_states(names, q, v, e, ts)
+        )
+        equal += same
+    print(f"compiled wire parts = Python references for {equal}/{n} random messages")
+    assert equal == n
+    with pytest.raises(TypeError):
+        wire.frame_transforms([Frame("a", 1, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))], 0)
+    with pytest.raises(ValueError):
+        wire.frame_transforms([Frame("a", "b", (0.0, 0.0), (0.0, 0.0, 0.0, 1.0))], 0)
