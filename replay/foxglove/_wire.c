@@ -16,6 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* a frame's attribute names, interned once */
+static PyObject *NAME_PARENT, *NAME_CHILD, *NAME_POSITION, *NAME_ORIENTATION;
+
 typedef struct {
     uint8_t *buf;
     size_t len, cap;
@@ -122,10 +125,10 @@ static PyObject *py_frame_transforms(PyObject *self, PyObject *const *args, Py_s
         double v[7];
         Py_ssize_t np, nc;
         const char *sp, *sc;
-        if (!(parent = PyObject_GetAttrString(f, "parent")) ||
-            !(child = PyObject_GetAttrString(f, "child")) ||
-            !(pos = PyObject_GetAttrString(f, "position")) ||
-            !(rot = PyObject_GetAttrString(f, "orientation")) ||
+        if (!(parent = PyObject_GetAttr(f, NAME_PARENT)) ||
+            !(child = PyObject_GetAttr(f, NAME_CHILD)) ||
+            !(pos = PyObject_GetAttr(f, NAME_POSITION)) ||
+            !(rot = PyObject_GetAttr(f, NAME_ORIENTATION)) ||
             !(sp = utf8(parent, &np)) || !(sc = utf8(child, &nc)) ||
             doubles(pos, v, 3, "frame position") < 0 ||
             doubles(rot, v + 3, 4, "frame orientation") < 0)
@@ -242,4 +245,11 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_wire",
                                     "Foxglove messages' hot parts in the protobuf wire format.",
                                     -1, methods};
 
-PyMODINIT_FUNC PyInit__wire(void) { return PyModule_Create(&module); }
+PyMODINIT_FUNC PyInit__wire(void) {
+    if (!(NAME_PARENT = PyUnicode_InternFromString("parent")) ||
+        !(NAME_CHILD = PyUnicode_InternFromString("child")) ||
+        !(NAME_POSITION = PyUnicode_InternFromString("position")) ||
+        !(NAME_ORIENTATION = PyUnicode_InternFromString("orientation")))
+        return NULL;
+    return PyModule_Create(&module);
+}
