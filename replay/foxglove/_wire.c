@@ -8,7 +8,9 @@
  * FrameTransform of ts (a timestamp field's bytes), parent 2, child 3, translation 4 and
  * rotation 5 with every double written. joint_states(names, position, velocity, effort, ts):
  * ts, then per joint (as zip: up to the shortest) field 2, a JointState of name 1, position 2,
- * velocity 3, effort 5. Doubles little endian (fixed64), lengths as varints.
+ * velocity 3, effort 5. body_transforms(primitives, head, sphere) and scene_update(primitives,
+ * head, shape_fields, sphere): the primitives' frame transforms and scene entities (below).
+ * Doubles little endian (fixed64), lengths as varints.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -17,7 +19,7 @@
 #include <string.h>
 
 /* a frame's attribute names, interned once */
-static PyObject *NAME_PARENT, *NAME_CHILD, *NAME_POSITION, *NAME_ORIENTATION;
+static PyObject *NAME_PARENT, *NAME_CHILD, *NAME_POSITION, *NAME_ORIENTATION, *NAME_NAME;
 
 typedef struct {
     uint8_t *buf;
@@ -232,12 +234,154 @@ done:
     return ret;
 }
 
+/* a primitive's name, position and orientation (unrotated for a sphere); 0, or -1 */
+static int primitive_pose(PyObject *p, PyObject *sphere, PyObject **name, double v[7]) {
+    PyObject *pos = NULL, *rot = NULL;
+    int sph = PyObject_IsInstance(p, sphere);
+    if (sph < 0) return -1;
+    if (!(*name = PyObject_GetAttr(p, NAME_NAME)) || !(pos = PyObject_GetAttr(p, NAME_POSITION)) ||
+        (!sph && !(rot = PyObject_GetAttr(p, NAME_ORIENTATION))) ||
+        doubles(pos, v, 3, "primitive position") < 0 ||
+        (!sph && doubles(rot, v + 3, 4, "primitive orientation") < 0)) {
+        Py_CLEAR(*name);
+        Py_XDECREF(pos);
+        Py_XDECREF(rot);
+        return -1;
+    }
+    if (sph) v[3] = v[4] = v[5] = 0.0, v[6] = 1.0;
+    Py_DECREF(pos);
+    Py_XDECREF(rot);
+    return 0;
+}
+
+static uint8_t *put_vector_quaternion(uint8_t *p, uint8_t vtag, uint8_t qtag, const double v[7]) {
+    *p++ = vtag;
+    *p++ = 27;
+    p = put_double(p, 9, v[0]);
+    p = put_double(p, 17, v[1]);
+    p = put_double(p, 25, v[2]);
+    *p++ = qtag;
+    *p++ = 36;
+    p = put_double(p, 9, v[3]);
+    p = put_double(p, 17, v[4]);
+    p = put_double(p, 25, v[5]);
+    return put_double(p, 33, v[6]);
+}
+
+/* body_transforms(primitives, head, sphere): each primitive as a FrameTransform (field 1) of
+ * head (its timestamp and parent fields) and its name as the child */
+static PyObject *py_body_transforms(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "body_transforms(primitives, head, sphere)");
+        return NULL;
+    }
+    Py_buffer head;
+    if (PyObject_GetBuffer(args[1], &head, PyBUF_SIMPLE) < 0) return NULL;
+    PyObject *it = PyObject_GetIter(args[0]), *p = NULL, *name = NULL, *ret = NULL;
+    Out o = {NULL, 0, 0};
+    if (!it) goto done;
+    while ((p = PyIter_Next(it))) {
+        double v[7];
+        Py_ssize_t nc;
+        const char *sc;
+        if (primitive_pose(p, args[2], &name, v) < 0 || !(sc = utf8(name, &nc))) goto done;
+        const size_t body = (size_t)head.len + 1 + varint_size((uint64_t)nc) + (size_t)nc + 67;
+        if (grow(&o, 1 + 10 + body) < 0) goto done;
+        uint8_t *q = o.buf + o.len;
+        *q++ = 0x0A;
+        q = put_varint(q, body);
+        memcpy(q, head.buf, (size_t)head.len);
+        q += head.len;
+        *q++ = 0x1A;
+        q = put_varint(q, (uint64_t)nc);
+        memcpy(q, sc, (size_t)nc);
+        q += nc;
+        q = put_vector_quaternion(q, 0x22, 0x2A, v);
+        o.len = (size_t)(q - o.buf);
+        Py_CLEAR(name);
+        Py_CLEAR(p);
+    }
+    if (!PyErr_Occurred())
+        ret = PyBytes_FromStringAndSize(o.buf ? (const char *)o.buf : "", (Py_ssize_t)o.len);
+done:
+    Py_XDECREF(name);
+    Py_XDECREF(p);
+    Py_XDECREF(it);
+    PyBuffer_Release(&head);
+    free(o.buf);
+    return ret;
+}
+
+/* scene_update(primitives, head, shape_fields, sphere): each primitive of which
+ * shape_fields(p) gives (mid, tail) (None: left out) as an entity (field 2): head (its
+ * timestamp and frame id), mid (its id and primitive field up to the pose), the pose (field 1:
+ * position 1, orientation 2), tail */
+static PyObject *py_scene_update(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "scene_update(primitives, head, shape_fields, sphere)");
+        return NULL;
+    }
+    Py_buffer head;
+    if (PyObject_GetBuffer(args[1], &head, PyBUF_SIMPLE) < 0) return NULL;
+    PyObject *it = PyObject_GetIter(args[0]), *p = NULL, *name = NULL, *fields = NULL;
+    PyObject *ret = NULL;
+    Out o = {NULL, 0, 0};
+    if (!it) goto done;
+    while ((p = PyIter_Next(it))) {
+        if (!(fields = PyObject_CallOneArg(args[2], p))) goto done;
+        if (fields != Py_None) {
+            double v[7];
+            if (!PyTuple_Check(fields) || PyTuple_GET_SIZE(fields) != 2 ||
+                !PyBytes_Check(PyTuple_GET_ITEM(fields, 0)) ||
+                !PyBytes_Check(PyTuple_GET_ITEM(fields, 1))) {
+                PyErr_SetString(PyExc_TypeError, "scene_update: shape_fields gives (bytes, bytes)");
+                goto done;
+            }
+            if (primitive_pose(p, args[3], &name, v) < 0) goto done;
+            PyObject *mid = PyTuple_GET_ITEM(fields, 0), *tail = PyTuple_GET_ITEM(fields, 1);
+            const size_t nm = (size_t)PyBytes_GET_SIZE(mid), nt = (size_t)PyBytes_GET_SIZE(tail);
+            const size_t body = (size_t)head.len + 69 + nm + nt;
+            if (grow(&o, 1 + 10 + body) < 0) goto done;
+            uint8_t *q = o.buf + o.len;
+            *q++ = 0x12;
+            q = put_varint(q, body);
+            memcpy(q, head.buf, (size_t)head.len);
+            q += head.len;
+            memcpy(q, PyBytes_AS_STRING(mid), nm);
+            q += nm;
+            *q++ = 0x0A;
+            *q++ = 67;
+            q = put_vector_quaternion(q, 0x0A, 0x12, v);
+            memcpy(q, PyBytes_AS_STRING(tail), nt);
+            q += nt;
+            o.len = (size_t)(q - o.buf);
+            Py_CLEAR(name);
+        }
+        Py_CLEAR(fields);
+        Py_CLEAR(p);
+    }
+    if (!PyErr_Occurred())
+        ret = PyBytes_FromStringAndSize(o.buf ? (const char *)o.buf : "", (Py_ssize_t)o.len);
+done:
+    Py_XDECREF(fields);
+    Py_XDECREF(name);
+    Py_XDECREF(p);
+    Py_XDECREF(it);
+    PyBuffer_Release(&head);
+    free(o.buf);
+    return ret;
+}
+
 static PyMethodDef methods[] = {
     {"timestamp", py_timestamp, METH_O, "a Timestamp of t_ns as field 1"},
     {"frame_transforms", (PyCFunction)(void (*)(void))py_frame_transforms, METH_FASTCALL,
      "FrameTransforms' transforms of frames at a timestamp field"},
     {"joint_states", (PyCFunction)(void (*)(void))py_joint_states, METH_FASTCALL,
      "JointStates of names, position, velocity, effort after a timestamp field"},
+    {"body_transforms", (PyCFunction)(void (*)(void))py_body_transforms, METH_FASTCALL,
+     "FrameTransforms' transforms of primitives as frames of their names"},
+    {"scene_update", (PyCFunction)(void (*)(void))py_scene_update, METH_FASTCALL,
+     "SceneUpdate's entities of primitives at their poses"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -249,7 +393,8 @@ PyMODINIT_FUNC PyInit__wire(void) {
     if (!(NAME_PARENT = PyUnicode_InternFromString("parent")) ||
         !(NAME_CHILD = PyUnicode_InternFromString("child")) ||
         !(NAME_POSITION = PyUnicode_InternFromString("position")) ||
-        !(NAME_ORIENTATION = PyUnicode_InternFromString("orientation")))
+        !(NAME_ORIENTATION = PyUnicode_InternFromString("orientation")) ||
+        !(NAME_NAME = PyUnicode_InternFromString("name")))
         return NULL;
     return PyModule_Create(&module);
 }

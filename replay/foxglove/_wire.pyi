@@ -1,7 +1,15 @@
 """Types of the Foxglove wire format's compiled parts (replay/foxglove/_wire.c documents them)."""
 
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 def timestamp(t_ns: int, /) -> bytes: ...
 def frame_transforms(frames: Iterable[Any], ts: bytes, /) -> bytes: ...
 def joint_states(names: Any, position: Any, velocity: Any, effort: Any, ts: bytes, /) -> bytes: ...
+def body_transforms(primitives: Iterable[Any], head: bytes, sphere: type, /) -> bytes: ...
+def scene_update(
+    primitives: Iterable[Any],
+    head: bytes,
+    shape_fields: Callable[[Any], tuple[bytes, bytes] | None],
+    sphere: type,
+    /,
+) -> bytes: ...

@@ -5,8 +5,9 @@ camera rate.
 Filling the ``foxglove_schemas_protobuf`` classes costs ~0.2 us an attribute (a /tf of 15
 frames ~60 us); here a frame transform is one ``struct.pack`` of its seven doubles behind the
 cached bytes of its frame names, and the timestamp, /tf's frame transforms and the joint states
-are compiled (``_wire.c``, ~20x cheaper; the Python references ``_timestamp``,
-``_frame_transforms`` and ``_joint_states`` kept for the tests). Every double is written, zeros too (the library leaves a zero
+are compiled, as are the primitives' transforms and scene entities (``_wire.c``, 3-20x
+cheaper; the Python references ``_timestamp``, ``_frame_transforms``, ``_body_transforms``,
+``_scene_update`` and ``_joint_states`` kept for the tests). Every double is written, zeros too (the library leaves a zero
 out; a reader gives 0.0 either way), so the bytes are fixed by the values; the messages decode
 to the library's own (tests/replay/foxglove/test_wire.py builds both from seeded random
 input). Field numbers are those of the schemas (foxglove.FrameTransform: timestamp 1, parent
@@ -94,8 +95,13 @@ def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
 def body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
     """``foxglove.FrameTransforms`` of each primitive as a frame of its own name in ``parent``
     (a sphere unrotated): the transforms of :func:`frame_transforms` without making the frames
-    (the messages' repeated fields concatenate)."""
-    head = timestamp(t_ns) + _text(0x12, parent)
+    (the messages' repeated fields concatenate). Compiled (``_wire.c``)."""
+    return _wire.body_transforms(primitives, timestamp(t_ns) + _text(0x12, parent), Sphere)
+
+
+def _body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
+    """The reference of :func:`body_transforms`' compiled transforms."""
+    head = _timestamp(t_ns) + _text(0x12, parent)
     n_head = len(head) + 67  # + the translation and rotation fields
     pack = _TRANSFORM.pack
     parts: list[bytes] = []
@@ -164,8 +170,15 @@ def _shape_fields(p) -> tuple[bytes, bytes] | None:
 
 def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
     """``foxglove.SceneUpdate``: each box, sphere and cylinder as one entity (id = its name) of
-    one primitive at its pose in ``frame_id``, grey by albedo (others are left out)."""
+    one primitive at its pose in ``frame_id``, grey by albedo (others are left out). Compiled
+    (``_wire.c``), the shapes' fixed fields from :func:`_shape_fields`."""
     head = timestamp(t_ns) + _text(0x12, frame_id)
+    return _wire.scene_update(primitives, head, _shape_fields, Sphere)
+
+
+def _scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
+    """The reference of :func:`scene_update`'s compiled entities."""
+    head = _timestamp(t_ns) + _text(0x12, frame_id)
     n_head = len(head) + 69  # + the pose field
     pose = _POSE.pack
     parts: list[bytes] = []

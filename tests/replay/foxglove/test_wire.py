@@ -107,6 +107,22 @@ def _quat(rng):
     return tuple(float(x) for x in q) if rng.random() < 0.7 else (0.0, 0.0, 0.0, 1.0)
 
 
+def _primitives(rng, names=None):
+    """Random boxes, spheres and cylinders (named b0, s1, ... or ``names(rng)``)."""
+    prims = []
+    for i in range(int(rng.integers(0, 8))):
+        pos, q, albedo = tuple(_value(rng) for _ in range(3)), _quat(rng), rng.uniform(-1, 2)
+        kind = rng.integers(0, 3)
+        name = f"{'bsc'[kind]}{i}" if names is None else names(rng)
+        if kind == 0:
+            prims.append(Box(name, pos, q, tuple(abs(_value(rng)) for _ in range(3)), albedo))
+        elif kind == 1:
+            prims.append(Sphere(name, pos, abs(_value(rng)), albedo=albedo))
+        else:
+            prims.append(Cylinder(name, pos, q, abs(_value(rng)), 0.3, albedo=albedo))
+    return prims
+
+
 def test_wire_messages_decode_to_the_protobuf_classes_own():
     rng = np.random.default_rng(31)
     n, agree = 200, 0
@@ -116,18 +132,7 @@ def test_wire_messages_decode_to_the_protobuf_classes_own():
             Frame(_name(rng), _name(rng), tuple(_value(rng) for _ in range(3)), _quat(rng))
             for _ in range(int(rng.integers(0, 20)))
         ]
-        prims = []
-        for i in range(int(rng.integers(0, 8))):
-            pos, q, albedo = tuple(_value(rng) for _ in range(3)), _quat(rng), rng.uniform(-1, 2)
-            kind = rng.integers(0, 3)
-            if kind == 0:
-                prims.append(
-                    Box(f"b{i}", pos, q, tuple(abs(_value(rng)) for _ in range(3)), albedo)
-                )
-            elif kind == 1:
-                prims.append(Sphere(f"s{i}", pos, abs(_value(rng)), albedo=albedo))
-            else:
-                prims.append(Cylinder(f"c{i}", pos, q, abs(_value(rng)), 0.3, albedo=albedo))
+        prims = _primitives(rng)
         joints = [[_name(rng) for _ in range(7)]] + [[_value(rng) for _ in range(7)]] * 3
         data = bytes(rng.integers(0, 256, size=int(rng.integers(0, 300)), dtype=np.uint8))
         pixels = rng.integers(0, 256, size=(int(rng.integers(1, 40)), 7)).astype(np.uint8)
@@ -188,6 +193,8 @@ def test_compiled_wire_parts_equal_their_python_references():
         q, v, e = (
             np.array([_value(rng) for _ in range(k + int(rng.integers(0, 2)))]) for _ in "qve"
         )
+        prims = _primitives(rng, names=lambda rng: _name(rng) * int(rng.integers(1, 20)))
+        parent = _name(rng)
         same = (
             wire.timestamp(t_ns) == ts
             and wire.frame_transforms(frames, t_ns) == wire._frame_transforms(frames, ts)
@@ -195,6 +202,9 @@ def test_compiled_wire_parts_equal_their_python_references():
             and wire.joint_states(names, q, v, e, t_ns) == wire._joint_states(names, q, v, e, ts)
             and wire.joint_states(names, list(q), tuple(v), e, t_ns)
             == wire._joint_states(names, q, v, e, ts)
+            and wire.body_transforms(prims, parent, t_ns)
+            == wire._body_transforms(prims, parent, t_ns)
+            and wire.scene_update(prims, parent, t_ns) == wire._scene_update(prims, parent, t_ns)
         )
         equal += same
     print(f"compiled wire parts = Python references for {equal}/{n} random messages")
