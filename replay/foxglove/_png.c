@@ -489,10 +489,76 @@ static PyObject *py_message(PyObject *self, PyObject *const *args, Py_ssize_t na
     return ret;
 }
 
+/* messages(message, views, frames, start, prefix, t_ns): a sensor's frame in one call. For
+ * each (view, image) of the sequence frames from index start: views[view] = (channel id, suffix)
+ * gives its channel and the message's fields after the PNG; the image's message (prefix, the
+ * PNG, suffix, as message() makes it) goes to message(channel, t_ns, t_ns, data) (a log's
+ * compiled record writer). Returns -1 when all are written, else the index of the first frame
+ * whose view has no channel yet (it and those after it not written: the caller makes the channel
+ * and calls again from there). */
+static PyObject *py_messages(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 6 || !PyDict_Check(args[1])) {
+        PyErr_SetString(PyExc_TypeError,
+                        "messages(message, views: dict, frames, start, prefix, t_ns)");
+        return NULL;
+    }
+    PyObject *message = args[0], *views = args[1], *t_ns = args[5];
+    Py_ssize_t start = PyLong_AsSsize_t(args[3]);
+    if (start == -1 && PyErr_Occurred()) return NULL;
+    PyObject *frames = PySequence_Fast(args[2], "messages: frames is a sequence");
+    if (!frames) return NULL;
+    Py_buffer pre;
+    if (PyObject_GetBuffer(args[4], &pre, PyBUF_SIMPLE) < 0) {
+        Py_DECREF(frames);
+        return NULL;
+    }
+    PyObject *ret = NULL;
+    const Py_ssize_t n = PySequence_Fast_GET_SIZE(frames);
+    Py_ssize_t i;
+    for (i = start < 0 ? 0 : start; i < n; i++) {
+        PyObject *frame = PySequence_Fast_GET_ITEM(frames, i);
+        if (!PyTuple_Check(frame) || PyTuple_GET_SIZE(frame) != 2) {
+            PyErr_SetString(PyExc_TypeError, "messages: a frame is (view, image)");
+            goto done;
+        }
+        PyObject *slot = PyDict_GetItemWithError(views, PyTuple_GET_ITEM(frame, 0));
+        if (!slot) {
+            if (PyErr_Occurred()) goto done;
+            break; /* a view without a channel: the caller's */
+        }
+        if (!PyTuple_Check(slot) || PyTuple_GET_SIZE(slot) != 2) {
+            PyErr_SetString(PyExc_TypeError, "messages: views[view] is (channel, suffix)");
+            goto done;
+        }
+        Py_buffer suf;
+        if (PyObject_GetBuffer(PyTuple_GET_ITEM(slot, 1), &suf, PyBUF_SIMPLE) < 0) goto done;
+        Image im;
+        PyObject *data = NULL;
+        if (image_parse(PyTuple_GET_ITEM(frame, 1), &im) == 0) {
+            data = encode_image(&im, &pre, &suf);
+            image_release(&im);
+        }
+        PyBuffer_Release(&suf);
+        if (!data) goto done;
+        PyObject *call[4] = {PyTuple_GET_ITEM(slot, 0), t_ns, t_ns, data};
+        PyObject *r = PyObject_Vectorcall(message, call, 4, NULL);
+        Py_DECREF(data);
+        if (!r) goto done;
+        Py_DECREF(r);
+    }
+    ret = PyLong_FromSsize_t(i < n ? i : -1);
+done:
+    PyBuffer_Release(&pre);
+    Py_DECREF(frames);
+    return ret;
+}
+
 static PyMethodDef methods[] = {
     {"png", py_png, METH_O, "a grey image (a WindowedImage or an array) as a PNG file"},
     {"message", (PyCFunction)(void (*)(void))py_message, METH_FASTCALL,
      "prefix, the image's PNG as protobuf field 2, suffix"},
+    {"messages", (PyCFunction)(void (*)(void))py_messages, METH_FASTCALL,
+     "a sensor's frame: each view's image message to its channel"},
     {NULL, NULL, 0, NULL},
 };
 

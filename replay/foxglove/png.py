@@ -58,3 +58,8 @@ def encode_png(image: np.ndarray | WindowedImage) -> bytes:
 # (length-delimited), ``suffix``: a ``foxglove.CompressedImage`` in one compiled call
 # (replay/foxglove/wire.py's fields), called straight (no Python frame an image)
 png_message = _png.message
+
+# png_messages(message, views, frames, start, prefix, t_ns): a camera frame's images, each as
+# png_message(prefix, views[view][1], image) to message(views[view][0], t_ns, t_ns, data), in
+# one compiled call; -1, or the index of the first frame whose view has no channel yet
+png_messages = _png.messages

@@ -30,7 +30,7 @@ from google.protobuf.message import Message
 from google.protobuf.timestamp_pb2 import Timestamp
 
 from replay.foxglove import wire
-from replay.foxglove.png import WindowedImage, png_message
+from replay.foxglove.png import WindowedImage, png_messages
 from replay.foxglove.schemas import (
     MESSAGE_ENCODING,
     SCHEMA_ENCODING,
@@ -96,8 +96,9 @@ class FoxgloveTopics:
         self.log = log  # a replay.log.LogWriter
         self._channels: dict[str, int] = {}  # topic -> channel id
         self._schemas: dict[str, int] = {}  # schema name -> id (each stored once)
-        # (sensor, view) -> (channel id, the image messages' last fields)
-        self._images: dict[tuple[str, str], tuple[int, bytes]] = {}
+        # sensor -> view -> (channel id, the image messages' fields after the PNG)
+        self._images: dict[str, dict[str, tuple[int, bytes]]] = {}
+        self._record = log.raw_message  # the log's compiled record writer
 
     def _channel(self, topic: str, schema: str, encoding: str, data: bytes, message: str) -> int:
         if schema not in self._schemas:
@@ -168,16 +169,24 @@ class FoxgloveTopics:
         self.images(sensor, ((view, image),), t_ns)
 
     def images(
-        self, sensor: str, frames: Iterable[tuple[str, np.ndarray | WindowedImage]], t_ns: int
+        self, sensor: str, frames: Sequence[tuple[str, np.ndarray | WindowedImage]], t_ns: int
     ) -> None:
         """A sensor's frame: each (view, image) on its ``/camera/SENSOR/VIEW`` topic, one
-        timestamp for all, each message one compiled call (:func:`png_message`)."""
-        ts, slots, write = wire.timestamp(t_ns), self._images, self.log.write_raw
-        for view, image in frames:
-            slot = slots.get((sensor, view)) or self._image_slot(sensor, view)
-            write(slot[0], png_message(ts, slot[1], image), t_ns)
-
-    def _image_slot(self, sensor: str, view: str) -> tuple[int, bytes]:
-        channel = self._wire(camera_topic(sensor, view), CompressedImage)
-        slot = self._images[(sensor, view)] = (channel, wire.image_tail(f"{sensor}/{view}", "png"))
-        return slot
+        timestamp for all, in one compiled call (``_png.messages``: each image's PNG message
+        to the log's record writer) but for a view's first image, which makes its channel."""
+        views = self._images.get(sensor)
+        if views is None:
+            views = self._images[sensor] = {}
+        if not isinstance(frames, (list, tuple)):
+            frames = list(frames)
+        ts, start = wire.timestamp(t_ns), 0
+        while True:
+            try:
+                start = png_messages(self._record, views, frames, start, ts, t_ns)
+            except OSError as exc:
+                raise self.log.write_error(exc) from None
+            if start < 0:
+                return
+            view = frames[start][0]
+            channel = self._wire(camera_topic(sensor, view), CompressedImage)
+            views[view] = (channel, wire.image_tail(f"{sensor}/{view}", "png"))

@@ -25,7 +25,7 @@ import signal
 import tempfile
 import threading
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import orjson
 
@@ -313,14 +313,25 @@ class LogWriter:
             channel = self._json_channels.get(topic) or self._json_channel(topic, payload)
             self._message(channel, t_ns, t_ns, data)  # (channel ids > 0)
         except OSError as exc:
-            raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+            raise self.write_error(exc) from None
 
     def write_raw(self, channel_id: int, data: bytes, t_ns: int) -> None:
         """Write one message's encoded bytes on a channel of :meth:`register_channel`."""
         try:
             self._message(channel_id, t_ns, t_ns, data)
         except OSError as exc:
-            raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+            raise self.write_error(exc) from None
+
+    @property
+    def raw_message(self) -> Callable[[int, int, int, bytes], None]:
+        """The compiled record writer :meth:`write_raw` calls, ``message(channel_id, log_time,
+        publish_time, data)``, for compiled code that writes many messages in one call (a
+        camera frame's images); the OSError it may raise is for :meth:`write_error`."""
+        return self._message
+
+    def write_error(self, exc: OSError) -> LogError:
+        """The LogError of a failed write."""
+        return LogError(f"cannot write log {self.part_path}: {exc.strerror}")
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         with self._held:

@@ -144,3 +144,44 @@ def test_stereo_frames_are_its_whole_images():
             assert whole is not None
             np.testing.assert_array_equal(win.full(), whole)
             assert encode_png(win) == encode_png(whole)
+
+
+def test_a_frames_images_in_one_call_are_the_messages_one_at_a_time(tmp_path):
+    """FoxgloveTopics.images (compiled: _png.messages) writes the file that writing each
+    image's png_message by write_raw writes, new views' channels made in the same order."""
+    from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
+
+    from replay.foxglove import wire
+    from replay.foxglove.png import png_message
+    from replay.foxglove.topics import FoxgloveTopics, camera_topic
+    from replay.log import LogWriter
+
+    rng = np.random.default_rng(14)
+    frames = []
+    for k in range(60):
+        views = ["cam0", "cam1", "cam2"][: int(rng.integers(1, 4))]
+        bits = rng.random((8, 8)) < 0.3
+        frames.append(
+            (
+                ["a", "b"][k % 2],
+                [(v, random_window(rng) if v != "cam2" else bits) for v in views],
+                1_000_000 * k,
+            )
+        )
+    with LogWriter(tmp_path / "one_call.mcap", chunk_size=2048) as log:
+        out = FoxgloveTopics(log)
+        for sensor, views, t_ns in frames:
+            out.images(sensor, views, t_ns)
+    with LogWriter(tmp_path / "each.mcap", chunk_size=2048) as log:
+        ref = FoxgloveTopics(log)
+        channels: dict = {}
+        for sensor, views, t_ns in frames:
+            for view, image in views:
+                if (sensor, view) not in channels:
+                    channels[sensor, view] = ref._wire(camera_topic(sensor, view), CompressedImage)
+                tail = wire.image_tail(f"{sensor}/{view}", "png")
+                log.write_raw(
+                    channels[sensor, view], png_message(wire._timestamp(t_ns), tail, image), t_ns
+                )
+    data = (tmp_path / "one_call.mcap").read_bytes()
+    assert data == (tmp_path / "each.mcap").read_bytes() and len(data) > 10_000
