@@ -27,7 +27,6 @@ from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
 from foxglove_schemas_protobuf.Log_pb2 import Log
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from google.protobuf.message import Message
-from google.protobuf.timestamp_pb2 import Timestamp
 
 from replay.foxglove import wire
 from replay.foxglove.png import WindowedImage, png_messages
@@ -54,10 +53,6 @@ def camera_topic(sensor: str, view: str) -> str:
     """The image topic of one camera view: ``/camera/SENSOR/VIEW``; its frame is
     ``SENSOR/VIEW``."""
     return f"/camera/{sensor}/{view}"
-
-
-def _stamp(t_ns: int) -> Timestamp:
-    return Timestamp(seconds=t_ns // 1_000_000_000, nanos=t_ns % 1_000_000_000)
 
 
 # the /events kinds that are shown as warnings / errors in the Log panel
@@ -108,10 +103,6 @@ class FoxgloveTopics:
         )
         return channel
 
-    def _write(self, topic: str, msg: Message, t_ns: int) -> None:
-        channel = self._channels.get(topic) or self._wire(topic, type(msg))
-        self.log.write_raw(channel, msg.SerializeToString(deterministic=True), t_ns)
-
     def robot_description(self, urdf: str, t_ns: int) -> None:
         channel = self._channels.get(TOPIC_ROBOT_DESCRIPTION)
         if channel is None:
@@ -154,14 +145,10 @@ class FoxgloveTopics:
 
     def event(self, kind: str, data: dict, text: str, t_ns: int) -> None:
         """One ``/events`` message as a log line: ``KIND {data as JSON}``."""
-        self._write(
-            TOPIC_LOG,
-            Log(
-                timestamp=_stamp(t_ns),
-                level=log_level(kind, data),
-                message=f"{kind} {text}",
-                name="paper-replay",
-            ),
+        channel = self._channels.get(TOPIC_LOG) or self._wire(TOPIC_LOG, Log)
+        self.log.write_raw(
+            channel,
+            wire.log_line(int(log_level(kind, data)), f"{kind} {text}", "paper-replay", t_ns),
             t_ns,
         )
 

@@ -1,6 +1,6 @@
 """Foxglove's messages written straight in the protobuf wire format (protobuf.dev, "Encoding"):
 ``/tf``, ``/scene``, ``/joint_states`` and camera images, the ones written at the frame or
-camera rate.
+camera rate, and ``/log``'s lines (the protobuf classes' first use in a run is slow).
 
 Filling the ``foxglove_schemas_protobuf`` classes costs ~0.2 us an attribute (a /tf of 15
 frames ~60 us); here a frame transform is one ``struct.pack`` of its seven doubles behind the
@@ -213,6 +213,19 @@ def _joint_states(names, position, velocity, effort, ts: bytes) -> bytes:
 def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
     """``foxglove.JointStates``: each joint's name, position, velocity and effort."""
     return _wire.joint_states(names, position, velocity, effort, timestamp(t_ns))
+
+
+def log_line(level: int, message: str, name: str, t_ns: int) -> bytes:
+    """``foxglove.Log``: timestamp 1, level 2 (an enum: left out at 0), message 3 and name 4
+    (left out when empty), as the library writes them."""
+    return b"".join(
+        (
+            timestamp(t_ns),
+            b"\x10" + varint(level) if level else b"",
+            field(0x1A, message.encode()) if message else b"",
+            _text(0x22, name) if name else b"",
+        )
+    )
 
 
 @functools.lru_cache(maxsize=256)

@@ -213,3 +213,21 @@ def test_compiled_wire_parts_equal_their_python_references():
         wire.frame_transforms([Frame("a", 1, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))], 0)
     with pytest.raises(ValueError):
         wire.frame_transforms([Frame("a", "b", (0.0, 0.0), (0.0, 0.0, 0.0, 1.0))], 0)
+
+
+def test_log_lines_are_the_protobuf_classes_bytes():
+    from foxglove_schemas_protobuf.Log_pb2 import Log
+
+    rng = np.random.default_rng(32)
+    n = 300
+    for _ in range(n):
+        t_ns, level = _t_ns(rng), int(rng.integers(0, 6))
+        message = _name(rng) * int(rng.integers(0, 30))
+        name = "paper-replay" if rng.random() < 0.8 else _name(rng)
+        msg = Log(level=level, message=message, name=name)
+        _stamp(msg.timestamp, t_ns)
+        msg.timestamp.SetInParent()  # (set, even when 0 s 0 ns, as the topic's messages are)
+        assert wire.log_line(level, message, name, t_ns) == msg.SerializeToString(
+            deterministic=True
+        )
+    print(f"/log lines = the protobuf class's bytes for {n}/{n} random lines")
