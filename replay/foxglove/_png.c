@@ -143,6 +143,11 @@ static inline void put_symbol(BitWriter *bw, int sym) { /* fixed literal/length 
 
 /* a distance's code (5 bits, reversed) and extra bits as one value for `put`, and its bits */
 static inline void distance_code(int distance, uint32_t *value, int *nbits) {
+    if (distance == 1) { /* (a run's copy: code 0, no extra bits) */
+        *value = 0;
+        *nbits = 5;
+        return;
+    }
     int di = 29;
     while (DIST_BASE[di] > distance) di--;
     *value = reversed((uint32_t)di, 5) | (uint32_t)(distance - DIST_BASE[di]) << 5;
