@@ -8,9 +8,9 @@ equal bytes is one copy at distance 1; no zlib, no per-image allocation of its s
 :class:`WindowedImage` (the sensor's rendered window and the background level around it) is
 encoded without building the whole frame in Python: the encoder takes the image itself (a
 WindowedImage's fields or an array's buffer), its codes from tables made at import (each fixed
-Huffman code, each match length's code), the CRC eight bytes a step. It reads the rows, not the window:
-the bytes depend only on the pixels (a whole array and the same pixels as a window give the same
-PNG). Every decoder reads them (zlib, libpng through OpenCV, PIL: tests, which keep zlib's
+Huffman code, each match length's code), the CRC eight bytes a step. It reads the rows, not the
+window: the bytes depend only on the pixels (a whole array and the same pixels as a window give
+the same PNG). Every decoder reads them (zlib, libpng through OpenCV, PIL: tests, which keep zlib's
 encoder of the same rows as the reference).
 """
 

@@ -152,9 +152,6 @@ class FoxgloveTopics:
             t_ns,
         )
 
-    def image(self, sensor: str, view: str, image: np.ndarray | WindowedImage, t_ns: int) -> None:
-        self.images(sensor, ((view, image),), t_ns)
-
     def images(
         self, sensor: str, frames: Sequence[tuple[str, np.ndarray | WindowedImage]], t_ns: int
     ) -> None:
