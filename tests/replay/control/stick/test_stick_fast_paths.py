@@ -268,9 +268,8 @@ def test_passive_posture_search_is_the_array_references():
 def test_exit_config_in_floats_is_the_array_references():
     """ContactPlanner._exit_config (floats) against _exit_config_reference (NumPy arrays, a
     2-vector's norm by np.linalg.norm): the same configuration or None, for seeded random hands
-    with fingertips inside, at the edge of and outside the stick's reach. Equal only while
-    NumPy's 2-element dot is the plain sum x x + y y (the BLAS of this build): this test says
-    so when a build fuses it."""
+    with fingertips inside, at the edge of and outside the stick's reach. Within 1e-12: NumPy's
+    2-element dot is BLAS's, which may fuse x x + y y on another CPU (equal to the bit here)."""
     ctrl, _, _ = three_step_run(1e-4, t_end=0.12)
     planner, hand, rng = ctrl.planner, ctrl.hand, np.random.default_rng(41)
     (a0, a1), (b0, b1) = hand.joint_limits
@@ -285,7 +284,11 @@ def test_exit_config_in_floats_is_the_array_references():
         motion = Motion(est, 0.05, tuple(rng.normal(0.0, 1.0, 3)))
         t = float(rng.uniform(0.0, 0.1))
         got = planner._exit_config(t, cfg, motion)
-        assert got == planner._exit_config_reference(t, cfg, motion)
+        want = planner._exit_config_reference(t, cfg, motion)
+        assert (got is None) == (want is None)
+        if got is not None:
+            np.testing.assert_allclose(got.base, want.base, rtol=0.0, atol=1e-12)
+            np.testing.assert_allclose(got.joints, want.joints, rtol=0.0, atol=1e-12)
         moved += got is not None
         none += got is None
     print(f"_exit_config = reference in 400 cases ({moved} moved a tip out)")
