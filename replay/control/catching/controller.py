@@ -472,7 +472,7 @@ class CatchingController(Controller):
                 self.q_d, self.qd_d = q_d, qd_d
                 self._ff = None
             if not self.holding:
-                self.t_catch = self.est.time_to_radius(t, self.geo.origin, self.geo.catch_radius)
+                self.t_catch = self.est.time_to_radius(t, self._origin, self.geo.catch_radius)
         if (
             self.hand is not None
             and not self.closing
