@@ -2,8 +2,8 @@
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
 the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
 the buffer protocol, no NumPy headers), as are the stereo camera's frame and a sphere's silhouette
-(replay/sensors/_stereo.c, _silhouette.c), the catching mapping
-(replay/control/catching/_mapping.c, _ballistic.c), the serial chain's one-configuration dynamics
+(replay/sensors/_stereo.c, _silhouette.c), the catching mapping, ball estimator and torques
+(replay/control/catching/_mapping.c, _ballistic.c, _torque.c), the serial chain's dynamics
 (replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
 air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
 (replay/foxglove/_png.c), the log's chunk buffer and finiteness check (replay/log/_chunk.c,
@@ -47,6 +47,7 @@ setup(
         _ext("replay.sensors._silhouette", ("replay/sensors/_ellipse.h",)),
         _ext("replay.control.catching._mapping"),
         _ext("replay.control.catching._ballistic"),
+        _ext("replay.control.catching._torque"),
         _ext("replay.robot._chain"),
         _ext("plants.airtable._bodies"),
         _ext("replay.control.stick._sweep"),
