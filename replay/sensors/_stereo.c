@@ -225,6 +225,10 @@ done:
 static int spheres_c(const double *cams, PyObject *prims, const double *ct, const double *st,
                      Py_ssize_t nt, double scale, double grey, int W, int H, double thr,
                      int min_pixels, int binary, double default_bg, Frame out[2]) {
+    static PyObject *names[3] = {NULL, NULL, NULL}; /* interned once */
+    static const char *const attrs[3] = {"position", "radius", "albedo"};
+    for (int k = 0; k < 3; k++)
+        if (!names[k] && !(names[k] = PyUnicode_InternFromString(attrs[k]))) return -1;
     int ret = -1;
     out[0].image = out[1].image = NULL;
     PyObject *seq = PySequence_Fast(prims, "prims: not a sequence");
@@ -244,12 +248,21 @@ static int spheres_c(const double *cams, PyObject *prims, const double *ct, cons
     Py_ssize_t *nv = order + m;
     for (Py_ssize_t i = 0; i < n; i++) {
         PyObject *p = PySequence_Fast_GET_ITEM(seq, i);
-        PyObject *pos = PyObject_GetAttrString(p, "position");
-        PyObject *rad = pos ? PyObject_GetAttrString(p, "radius") : NULL;
-        PyObject *alb = rad ? PyObject_GetAttrString(p, "albedo") : NULL;
-        PyObject *xyz = alb ? PySequence_Tuple(pos) : NULL; /* a tuple, list or array */
-        int ok = xyz && PyArg_ParseTuple(xyz, "ddd", S + 5 * i, S + 5 * i + 1, S + 5 * i + 2);
-        Py_XDECREF(xyz);
+        PyObject *pos = PyObject_GetAttr(p, names[0]);
+        PyObject *rad = pos ? PyObject_GetAttr(p, names[1]) : NULL;
+        PyObject *alb = rad ? PyObject_GetAttr(p, names[2]) : NULL;
+        int ok;
+        if (alb && PyTuple_CheckExact(pos) && PyTuple_GET_SIZE(pos) == 3 &&
+            PyFloat_CheckExact(PyTuple_GET_ITEM(pos, 0)) &&
+            PyFloat_CheckExact(PyTuple_GET_ITEM(pos, 1)) &&
+            PyFloat_CheckExact(PyTuple_GET_ITEM(pos, 2))) { /* the usual: a tuple of floats */
+            for (int k = 0; k < 3; k++) S[5 * i + k] = PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(pos, k));
+            ok = 1;
+        } else {
+            PyObject *xyz = alb ? PySequence_Tuple(pos) : NULL; /* a tuple, list or array */
+            ok = xyz && PyArg_ParseTuple(xyz, "ddd", S + 5 * i, S + 5 * i + 1, S + 5 * i + 2);
+            Py_XDECREF(xyz);
+        }
         if (ok) {
             S[5 * i + 3] = PyFloat_AsDouble(rad);
             S[5 * i + 4] = 255.0 * PyFloat_AsDouble(alb);

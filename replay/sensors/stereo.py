@@ -267,16 +267,16 @@ class StereoBallCamera(Sensor):
         self._compiled = params.noise_sigma == 0.0 and self._background_level <= params.threshold
         grey, W, H = 255.0 * params.background, int(params.width), int(params.height)
         self._frame_args = (grey, W, H, *self._blob_args)
-        self._measure_args = (  # _stereo.measure's after (prims, locate, radius)
-            self._cams_c,
-            _COS,
-            _SIN,
+        self._measure_args = (  # _stereo.measure's after (prims, locate, radius), buffers as
+            self._cams_c.tobytes(),  # bytes (the cheapest to take a buffer of, per call)
+            _COS.tobytes(),
+            _SIN.tobytes(),
             _AREA_SCALE,
             *self._frame_args,
             self._P[0].tobytes(),
             self._P[1].tobytes(),
-            self._axes_c,
-            self._centres_c,
+            self._axes_c.tobytes(),
+            self._centres_c.tobytes(),
         )
         self._u8 = np.dtype(np.uint8)
         self._last: list = [None, None]
