@@ -376,9 +376,6 @@ class CatchingController(Controller):
         self.closing = False
         self.holding = False
         self._in_domain = True
-        self._r = None
-        self._v = None
-        self._q_o = None
         self._warned_state = False
         self._t = 0.0
         self._names_seen = None  # joint-name layout of the last joint state message
@@ -387,7 +384,8 @@ class CatchingController(Controller):
         # the feed-forward of the current desired state (q_d, qd_d, qdd_d); None when the
         # update set a new one (before the ball is seen and while holding, it is computed once)
         self._ff: tuple | None = None
-        self._fk_desired: tuple = (None, ())  # (the q_d list it is of, l(q_d))
+        self._fk_desired: tuple = (None, [])  # (the q_d list it is of, l(q_d))
+        self._state_lists: tuple | None = None  # (r_o, r_o', q_o) lists of /catching/state
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
@@ -468,7 +466,7 @@ class CatchingController(Controller):
                     )
                 )
             self._in_domain = in_dom
-            self._r, self._v, self._q_o = r, v, q_o
+            self._state_lists = (list(r), list(v), list(q_o))  # /catching/state's, until the next
             O = self._origin
             dx, dy, dz = r[0] - O[0], r[1] - O[1], r[2] - O[2]
             reached = math.sqrt(dx * dx + dy * dy + dz * dz) <= self.geo.catch_radius
@@ -479,10 +477,12 @@ class CatchingController(Controller):
                 self._events.append(
                     Occurrence("mapping_hold", {"q_d": list(self.q_d), "r_o": list(r)})
                 )
-            else:  # the active joints' values in the full vector (q3 held, model.full)
-                q_d, qd_d, qdd_d = list(self._q_fixed), list(self._zeros), list(self._zeros)
-                for i, k in enumerate(self._act):
-                    q_d[k], qd_d[k], qdd_d[k] = q_a[i], qd_a[i], qdd_a[i]
+            else:  # the 3 active joints' values in the full vector (q3 held, model.full)
+                k0, k1, k2 = self._act
+                q_d, qd_d, qdd_d = self._q_fixed[:], self._zeros[:], self._zeros[:]
+                q_d[k0], q_d[k1], q_d[k2] = q_a
+                qd_d[k0], qd_d[k1], qd_d[k2] = qd_a
+                qdd_d[k0], qdd_d[k1], qdd_d[k2] = qdd_a
                 self.q_d, self.qd_d = q_d, qd_d
                 self._ff = None
             if not self.holding:
@@ -578,29 +578,29 @@ class CatchingController(Controller):
         return ev
 
     def telemetry(self, t: float) -> dict:
-        # l(q_d) once per desired posture: update sets a new q_d list when it changes
-        if self._fk_desired[0] is not self.q_d:
-            self._fk_desired = (self.q_d, self.model.fk_tuple(self.q_d))
+        # The messages take the controller's lists as they are: update never changes one in
+        # place (it makes new q_d, qd_d, tau and /catching/state lists), so none is copied here.
+        q_d, q = self.q_d, self.q
+        fk_d = self._fk_desired  # l(q_d) once per desired posture
+        if fk_d[0] is not q_d:
+            fk_d = self._fk_desired = (q_d, list(self.model.fk_tuple(q_d)))
         out = {
-            TOPIC_ARM_JOINT_COMMAND: JointCommand(
-                t, position=list(self.q_d), torque=list(self.tau)
-            ),
+            TOPIC_ARM_JOINT_COMMAND: JointCommand(t, q_d, self.tau),
             TOPIC_EFFECTOR_STATE: EffectorState(
-                t,
-                position=list(self.model.fk_tuple(self.q)) if self.q is not None else [],
-                desired_position=list(self._fk_desired[1]),
+                t, list(self.model.fk_tuple(q)) if q is not None else [], fk_d[1]
             ),
         }
         if not self._costs_logged:  # the offline optimisation's history, once (t = 0)
             self._costs_logged = True
             out[TOPIC_OPTIMIZATION_COST] = self.optimization_costs()
-        if self._r is not None:
+        if self._state_lists is not None:
+            r, v, q_o = self._state_lists
             out[TOPIC_CATCHING_STATE] = CatchingState(
                 t,
-                list(self._r),
-                list(self._v),
-                list(self._q_o),
-                list(self.qd_d),
+                r,
+                v,
+                q_o,
+                self.qd_d,
                 self._in_domain,
                 float(self.t_catch) if self.t_catch is not None else -1.0,
                 self.closing,
