@@ -369,20 +369,30 @@ static PyObject *py_locate(PyObject *self, PyObject *args) {
     return ret;
 }
 
-/* measure(prims, locate, radius, cams, cos, sin, scale, grey, W, H, threshold, min_pixels,
- * binary, default_bg, P0, P1, axes, centres): the whole noise-free measurement of a scene of
- * spheres in one call: both cameras' frame_c (spheres_c) and, when locate is true and both
+/* measure(prims, sphere, locate, radius, cams, cos, sin, scale, grey, W, H, threshold,
+ * min_pixels, binary, default_bg, P0, P1, axes, centres): the whole noise-free measurement of a
+ * scene of spheres (every primitive of the type sphere, else None: not done) in one call: both cameras' frame_c (spheres_c) and, when locate is true and both
  * images hold a blob, locate_c of their centroids: (image0, window0, blob0, image1, window1,
  * blob1, (x, y, z) or None). P0, P1: the projection matrices (float64 12 each). */
 static PyObject *py_measure(PyObject *self, PyObject *args) {
     Py_buffer Cm, Ct, St, Ab, Cb;
-    PyObject *prims, *P0, *P1, *ret = NULL;
+    PyObject *prims, *sphere, *P0, *P1, *ret = NULL;
     double scale, grey, thr, default_bg, radius;
     int W, H, min_pixels, binary, locate;
-    if (!PyArg_ParseTuple(args, "Opdy*y*y*ddiidiidOOy*y*", &prims, &locate, &radius, &Cm, &Ct,
-                          &St, &scale, &grey, &W, &H, &thr, &min_pixels, &binary, &default_bg,
-                          &P0, &P1, &Ab, &Cb))
+    if (!PyArg_ParseTuple(args, "OOpdy*y*y*ddiidiidOOy*y*", &prims, &sphere, &locate, &radius,
+                          &Cm, &Ct, &St, &scale, &grey, &W, &H, &thr, &min_pixels, &binary,
+                          &default_bg, &P0, &P1, &Ab, &Cb))
         return NULL;
+    PyObject *seq = PySequence_Fast(prims, "prims: not a sequence");
+    if (!seq) goto done;
+    int all = 1;
+    for (Py_ssize_t i = 0; all && i < PySequence_Fast_GET_SIZE(seq); i++)
+        all = (PyObject *)Py_TYPE(PySequence_Fast_GET_ITEM(seq, i)) == sphere;
+    Py_DECREF(seq);
+    if (!all) {
+        ret = Py_NewRef(Py_None);
+        goto done;
+    }
     Py_ssize_t nt = Ct.len / (Py_ssize_t)sizeof(double);
     Frame f[2];
     if (!check(&Cm, sizeof(double), 32, "cams") || !check(&St, sizeof(double), nt, "sin") ||

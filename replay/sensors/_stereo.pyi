@@ -30,6 +30,7 @@ def locate(
 ) -> tuple[float, float, float] | None: ...
 def measure(
     prims: Sequence[Any],
+    sphere: type,
     locate: bool,
     radius: float,
     cams: Buffer,
@@ -47,12 +48,15 @@ def measure(
     P1: Buffer,
     axes: Buffer,
     centres: Buffer,
-) -> tuple[
-    bytearray,
-    tuple[int, int, int, int],
-    tuple[float, float, int, float] | None,
-    bytearray,
-    tuple[int, int, int, int],
-    tuple[float, float, int, float] | None,
-    tuple[float, float, float] | None,
-]: ...
+) -> (
+    tuple[
+        bytearray,
+        tuple[int, int, int, int],
+        tuple[float, float, int, float] | None,
+        bytearray,
+        tuple[int, int, int, int],
+        tuple[float, float, int, float] | None,
+        tuple[float, float, float] | None,
+    ]
+    | None
+): ...

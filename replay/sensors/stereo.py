@@ -472,11 +472,15 @@ class StereoBallCamera(Sensor):
             if q.name == name:
                 tracked = q
                 break
-        radius = self._radius(tracked)
-        if all(type(q) is Sphere for q in prims):  # both cameras' silhouettes drawn in C
-            img0, win0, f0, img1, win1, f1, X = _stereo.measure(
-                prims, tracked is not None, radius, *self._measure_args
-            )
+        radius = (  # for the bias correction: the tracked Sphere's, else 0 (none)
+            float(tracked.radius)
+            if self.params.bias_correction and isinstance(tracked, Sphere)
+            else 0.0
+        )
+        # a scene of spheres: both cameras' silhouettes drawn in C (None: not only spheres)
+        got = _stereo.measure(prims, Sphere, tracked is not None, radius, *self._measure_args)
+        if got is not None:
+            img0, win0, f0, img1, win1, f1, X = got
         else:
             (img0, win0, f0), (img1, win1, f1) = [
                 _stereo.frame(*self._drawn(camera, scene), *self._frame_args)
@@ -494,9 +498,7 @@ class StereoBallCamera(Sensor):
         if X is None:
             return None
         return VisionObject(
-            t=t,
-            position=list(X),
-            features={"centroids": [[f0[0], f0[1]], [f1[0], f1[1]]], "areas": [f0[2], f1[2]]},
+            t, list(X), {"centroids": [[f0[0], f0[1]], [f1[0], f1[1]]], "areas": [f0[2], f1[2]]}
         )
 
     @staticmethod
@@ -504,12 +506,6 @@ class StereoBallCamera(Sensor):
         """The polygons, grey levels and boxes of a scene's silhouettes in a camera, far first."""
         drawn = drawables(camera, scene)
         return [d[0] for d in drawn], [d[1] for d in drawn], [d[2] for d in drawn]
-
-    def _radius(self, tracked) -> float:
-        """The radius for the bias correction: the tracked Sphere's, else 0 (none)."""
-        if self.params.bias_correction and isinstance(tracked, Sphere):
-            return float(tracked.radius)
-        return 0.0
 
     def measure_reference(self, t: float, scene: Scene) -> VisionObject | None:
         """:meth:`measure` step by step, each kernel called from Python (the compiled
