@@ -98,8 +98,21 @@ class BallisticEstimator:
         Sty[1] += tau * y1
         Sty[2] += tau * y2
         limit = self.window + 1e-12
-        while buf and t - buf[0][0] > limit:
-            self._account(*buf.popleft(), -1.0)
+        while t - buf[0][0] > limit:  # (never the newest)
+            # _account(*buf.popleft(), -1.0) written out (x + (-y) is x - y: the same values)
+            t_old, (x0, x1, x2) = buf.popleft()
+            tau = t_old - self._t_ref
+            S[0] -= 1.0
+            S[1] -= tau
+            S[2] -= tau * tau
+            h = 0.5 * tau * tau
+            y0, y1, y2 = x0 - g0 * h, x1 - g1 * h, x2 - g2 * h
+            Sy[0] -= y0
+            Sy[1] -= y1
+            Sy[2] -= y2
+            Sty[0] -= tau * y0
+            Sty[1] -= tau * y1
+            Sty[2] -= tau * y2
         if buf[0][0] - self._t_ref > self.window:  # re-centre: sums of the window only
             self._rebuild(buf[0][0])
         self._fit = None
