@@ -23,12 +23,23 @@ static PyObject *call(PyObject *(*kernel)(PyObject *, PyObject *), PyObject *arg
 
 /* py_composite's compositing of one polygon (n vertices xy, full-image pixels) of grey level
  * grey onto img (h x w, first pixel (ox, oy)) over C arrays: the same accumulate and the same
- * float32 operations in the same order. acc: h (w + 1) + 1 zeros, left zero. */
+ * float32 operations in the same order. acc: h (w + 1) + 1 zeros, left zero. The rows and
+ * columns it may change are added to the box touched (r0, r1, c0, c1; empty when r0 >= r1). */
 static void composite_one(const double *xy, Py_ssize_t n, double greyd, int ox, int oy,
-                          float *img, int w, int h, double *acc) {
+                          float *img, int w, int h, double *acc, int touched[4]) {
     if (n < 3) return;
     int r0, r1, c0, c1;
     accumulate(xy, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1);
+    if (r0 < r1 && c0 < c1) {
+        if (touched[0] >= touched[1]) {
+            touched[0] = r0, touched[1] = r1, touched[2] = c0, touched[3] = c1;
+        } else {
+            touched[0] = r0 < touched[0] ? r0 : touched[0];
+            touched[1] = r1 > touched[1] ? r1 : touched[1];
+            touched[2] = c0 < touched[2] ? c0 : touched[2];
+            touched[3] = c1 > touched[3] ? c1 : touched[3];
+        }
+    }
     const float grey = (float)greyd;
     for (int r = r0; r < r1; r++) {
         double *row = acc + (size_t)r * (w + 1);
@@ -114,13 +125,19 @@ static int frame_c(const double *const *xy, const Py_ssize_t *nv, const double *
     double *acc = (double *)(img + np + pad);
     const float g = (float)grey; /* np.full(..., grey, np.float32) */
     for (size_t i = 0; i < np; i++) img[i] = g;
+    int box[4] = {0, 0, 0, 0}; /* the pixels the polygons may change */
     if (nb) {
         memset(acc, 0, nacc * sizeof(double));
         for (Py_ssize_t i = 0; i < nb; i++)
-            composite_one(xy[i], nv[i], greys[i], x0, y0, img, w, h, acc);
+            composite_one(xy[i], nv[i], greys[i], x0, y0, img, w, h, acc, box);
     }
-    uint8_t *img8 = (uint8_t *)PyByteArray_AS_STRING(f->image);
-    quantise_c(img, img8, np);
+    /* quantised: the background's level outside the box (its pixels are g there, unchanged) */
+    uint8_t *img8 = (uint8_t *)PyByteArray_AS_STRING(f->image), qg;
+    quantise_c(&g, &qg, 1);
+    memset(img8, qg, np);
+    for (int r = box[0]; r < box[1]; r++)
+        quantise_c(img + (size_t)r * w + box[2], img8 + (size_t)r * w + box[2],
+                   (size_t)(box[3] - box[2]));
     free(img);
     int got = blob_of(img8, w, h, thr, min_pixels, binary, default_bg, x0, y0, W, H, f->blob);
     if (got < 0) goto nomem;
