@@ -149,18 +149,45 @@ nomem:
     return -1;
 }
 
+/* A tuple of n new references (stolen, all of them even when one is NULL: then NULL with the
+ * exception set) */
+static PyObject *tuple_of(Py_ssize_t n, PyObject **items) {
+    PyObject *t = NULL;
+    for (Py_ssize_t k = 0; k < n; k++)
+        if (!items[k]) goto fail;
+    if (!(t = PyTuple_New(n))) goto fail;
+    for (Py_ssize_t k = 0; k < n; k++) PyTuple_SET_ITEM(t, k, items[k]);
+    return t;
+fail:
+    for (Py_ssize_t k = 0; k < n; k++) Py_XDECREF(items[k]);
+    return NULL;
+}
+
+/* A frame_c's image (its reference taken), (x0, y0, x1, y1) and blob (u, v, area, background)
+ * or None into out[3] as new references (NULL where one could not be made) */
+static void frame_items(Frame *f, PyObject **out) {
+    PyObject *win[4], *blob[4];
+    for (int k = 0; k < 4; k++) win[k] = PyLong_FromLong(f->window[k]);
+    out[0] = f->image;
+    f->image = NULL;
+    out[1] = tuple_of(4, win);
+    if (f->got) {
+        blob[0] = PyFloat_FromDouble(f->blob[0]);
+        blob[1] = PyFloat_FromDouble(f->blob[1]);
+        blob[2] = PyLong_FromLong((long)f->blob[2]);
+        blob[3] = PyFloat_FromDouble(f->blob[3]);
+        out[2] = tuple_of(4, blob);
+    } else {
+        out[2] = Py_NewRef(Py_None);
+    }
+}
+
 /* (image, (x0, y0, x1, y1), blob or None) of a frame_c; a new reference (the image's is
  * taken), NULL with an exception set */
 static PyObject *frame_tuple(Frame *f) {
-    PyObject *blob = f->got ? Py_BuildValue("(ddid)", f->blob[0], f->blob[1], (int)f->blob[2],
-                                            f->blob[3])
-                            : Py_NewRef(Py_None);
-    PyObject *ret = blob ? Py_BuildValue("(N(iiii)N)", f->image, f->window[0], f->window[1],
-                                         f->window[2], f->window[3], blob)
-                         : NULL;
-    if (!blob) Py_DECREF(f->image);
-    f->image = NULL;
-    return ret;
+    PyObject *items[3];
+    frame_items(f, items);
+    return tuple_of(3, items);
 }
 
 /* frame(polys, greys, boxes, grey, W, H, threshold, min_pixels, binary, default_bg):
@@ -340,16 +367,17 @@ static int locate_c(PyObject *P0, PyObject *P1, double u[2], double v[2], double
                     const double *ax, const double *cc, double p[3]) {
     double z[2];
     for (int pass = 0; pass < 2; pass++) {
-        PyObject *X =
-            call(py_triangulate, Py_BuildValue("(OOdddd)", P0, P1, u[0], v[0], u[1], v[1]));
+        PyObject *a[6] = {Py_NewRef(P0), Py_NewRef(P1), PyFloat_FromDouble(u[0]),
+                          PyFloat_FromDouble(v[0]), PyFloat_FromDouble(u[1]),
+                          PyFloat_FromDouble(v[1])};
+        PyObject *X = call(py_triangulate, tuple_of(6, a));
         if (!X) return -1;
         if (X == Py_None) {
             Py_DECREF(X);
             return 0;
         }
-        int ok = PyArg_ParseTuple(X, "ddd", p, p + 1, p + 2);
+        for (int k = 0; k < 3; k++) p[k] = PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(X, k)); /* floats */
         Py_DECREF(X);
-        if (!ok) return -1;
         if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) return 0;
         for (int i = 0; i < 2; i++) { /* StereoBallCamera._depth */
             const double *a = ax + 6 * i;
@@ -388,9 +416,10 @@ static PyObject *py_locate(PyObject *self, PyObject *args) {
 
 /* measure(prims, sphere, locate, radius, cams, cos, sin, scale, grey, W, H, threshold,
  * min_pixels, binary, default_bg, P0, P1, axes, centres): the whole noise-free measurement of a
- * scene of spheres (every primitive of the type sphere, else None: not done) in one call: both cameras' frame_c (spheres_c) and, when locate is true and both
- * images hold a blob, locate_c of their centroids: (image0, window0, blob0, image1, window1,
- * blob1, (x, y, z) or None). P0, P1: the projection matrices (float64 12 each). */
+ * scene of spheres (every primitive of the type sphere, else None: not done) in one call: both
+ * cameras' frame_c (spheres_c) and, when locate is true and both images hold a blob, locate_c
+ * of their centroids: (image0, window0, blob0, image1, window1, blob1, (x, y, z) or None).
+ * P0, P1: the projection matrices (float64 12 each). */
 static PyObject *py_measure(PyObject *self, PyObject *args) {
     Py_buffer Cm, Ct, St, Ab, Cb;
     PyObject *prims, *sphere, *P0, *P1, *ret = NULL;
@@ -428,16 +457,17 @@ static PyObject *py_measure(PyObject *self, PyObject *args) {
             goto done;
         }
     }
-    PyObject *X = found ? Py_BuildValue("(ddd)", p[0], p[1], p[2]) : Py_NewRef(Py_None);
-    PyObject *a = frame_tuple(f), *b = frame_tuple(f + 1);
-    if (a && b && X)
-        ret = Py_BuildValue("(OOOOOON)", PyTuple_GET_ITEM(a, 0), PyTuple_GET_ITEM(a, 1),
-                            PyTuple_GET_ITEM(a, 2), PyTuple_GET_ITEM(b, 0),
-                            PyTuple_GET_ITEM(b, 1), PyTuple_GET_ITEM(b, 2), X);
-    else
-        Py_XDECREF(X);
-    Py_XDECREF(a);
-    Py_XDECREF(b);
+    PyObject *items[7];
+    frame_items(f, items);
+    frame_items(f + 1, items + 3);
+    if (found) {
+        PyObject *xyz[3];
+        for (int k = 0; k < 3; k++) xyz[k] = PyFloat_FromDouble(p[k]);
+        items[6] = tuple_of(3, xyz);
+    } else {
+        items[6] = Py_NewRef(Py_None);
+    }
+    ret = tuple_of(7, items);
 done:
     PyBuffer_Release(&Cm);
     PyBuffer_Release(&Ct);
