@@ -1,14 +1,8 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
-the cameras' per-pixel kernels are a small C extension (replay/sensors/_pixels.c: plain C over
-the buffer protocol, no NumPy headers), as are the stereo camera's frame and a sphere's silhouette
-(replay/sensors/_stereo.c, _silhouette.c), the catching mapping, ball estimator and torques
-(replay/control/catching/_mapping.c, _ballistic.c, _torque.c), the serial chain's dynamics
-(replay/robot/_chain.c), the stick planners' sweep checks (replay/control/stick/_sweep.c), the
-air table's once-a-step body input/output (plants/airtable/_bodies.c), the camera PNG encoder
-(replay/foxglove/_png.c), the log's chunk buffer and finiteness check (replay/log/_chunk.c,
-_finite.c) and the grasping tasks' per-step kernels (replay/control/grasping/_arm_kinematics.c,
-_chip_target.c, _hand_servo.c)."""
+the hot paths are small C extensions, one ``_name.c`` beside the Python module it speeds (plain C
+over the buffer protocol, no NumPy headers, each with a ``.pyi`` stub and a test holding it to its
+Python reference): the list is ``ext_modules`` below."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -52,6 +46,7 @@ setup(
         _ext("plants.airtable._bodies"),
         _ext("replay.control.stick._sweep"),
         _ext("replay.foxglove._png"),
+        _ext("replay.foxglove._wire"),
         _ext("replay.log._chunk"),
         _ext("replay.log._finite"),
         _ext("replay.control.grasping._arm_kinematics"),

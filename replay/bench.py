@@ -126,7 +126,7 @@ def logging_costs(sc, out: Path) -> dict[str, tuple[float, int]]:
     images = [0]
     clock, overhead = time.process_time, _clock_cost()
     original = {(cls, attr): getattr(cls, attr) for _, cls, attr in LOGGED}
-    image_of = FoxgloveTopics.image
+    images_of = FoxgloveTopics.images  # (a sensor's frame: its views' images)
 
     def timed(name, fn):
         def wrapper(*args, **kw):
@@ -138,19 +138,20 @@ def logging_costs(sc, out: Path) -> dict[str, tuple[float, int]]:
 
         return wrapper
 
-    def counted(self, *args, **kw):
-        images[0] += 1
-        return image_of(self, *args, **kw)
+    def counted(self, sensor, frames, t_ns):
+        frames = list(frames)
+        images[0] += len(frames)
+        return images_of(self, sensor, frames, t_ns)
 
     try:
         for name, cls, attr in LOGGED:
             setattr(cls, attr, timed(name, original[(cls, attr)]))
-        FoxgloveTopics.image = counted  # type: ignore[method-assign]
+        FoxgloveTopics.images = counted  # type: ignore[method-assign]
         Runner(sc).run(out)
     finally:
         for (cls, attr), fn in original.items():
             setattr(cls, attr, fn)
-        FoxgloveTopics.image = image_of  # type: ignore[method-assign]
+        FoxgloveTopics.images = images_of  # type: ignore[method-assign]
     result = {name: (max(v[0], 0.0), v[1]) for name, v in spent.items()}
     result["image"] = (result["image"][0], images[0])
     return result

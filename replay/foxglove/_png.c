@@ -19,19 +19,29 @@
 
 #define ADLER_BASE 65521u
 
-static uint32_t CRC_TABLE[256];
+static uint32_t CRC_TABLE[8][256]; /* slicing by 8: T[k][b] = T[0] applied k more times */
 
 static void crc_init(void) {
     for (uint32_t n = 0; n < 256; n++) {
         uint32_t c = n;
         for (int k = 0; k < 8; k++) c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        CRC_TABLE[n] = c;
+        CRC_TABLE[0][n] = c;
     }
+    for (uint32_t n = 0; n < 256; n++)
+        for (int k = 1; k < 8; k++)
+            CRC_TABLE[k][n] = CRC_TABLE[0][CRC_TABLE[k - 1][n] & 0xFF] ^ (CRC_TABLE[k - 1][n] >> 8);
 }
 
 static uint32_t crc32(const uint8_t *p, size_t n) {
     uint32_t c = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) c = CRC_TABLE[(c ^ p[i]) & 0xFF] ^ (c >> 8);
+    for (; n >= 8; n -= 8, p += 8) { /* eight bytes a step (the same CRC as byte by byte) */
+        const uint32_t lo = c ^ ((uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
+                                 (uint32_t)p[3] << 24);
+        c = CRC_TABLE[7][lo & 0xFF] ^ CRC_TABLE[6][(lo >> 8) & 0xFF] ^
+            CRC_TABLE[5][(lo >> 16) & 0xFF] ^ CRC_TABLE[4][lo >> 24] ^ CRC_TABLE[3][p[4]] ^
+            CRC_TABLE[2][p[5]] ^ CRC_TABLE[1][p[6]] ^ CRC_TABLE[0][p[7]];
+    }
+    for (size_t i = 0; i < n; i++) c = CRC_TABLE[0][(c ^ p[i]) & 0xFF] ^ (c >> 8);
     return c ^ 0xFFFFFFFFu;
 }
 
@@ -62,52 +72,99 @@ typedef struct {
     int nbits;
 } BitWriter;
 
-static inline void put(BitWriter *bw, uint32_t value, int n) { /* n <= 24, LSB first */
+static inline void put(BitWriter *bw, uint32_t value, int n) { /* n <= 32, LSB first */
     bw->bits |= (uint64_t)value << bw->nbits;
     bw->nbits += n;
-    while (bw->nbits >= 8) {
+    if (bw->nbits >= 32) { /* (fewer than 32 bits held between calls) */
+        uint8_t *o = bw->out + bw->n;
+        o[0] = (uint8_t)bw->bits;
+        o[1] = (uint8_t)(bw->bits >> 8);
+        o[2] = (uint8_t)(bw->bits >> 16);
+        o[3] = (uint8_t)(bw->bits >> 24);
+        bw->n += 4;
+        bw->bits >>= 32;
+        bw->nbits -= 32;
+    }
+}
+
+/* the bits held, the last byte padded with zero bits */
+static void flush_bits(BitWriter *bw) {
+    while (bw->nbits > 0) {
         bw->out[bw->n++] = (uint8_t)bw->bits;
         bw->bits >>= 8;
         bw->nbits -= 8;
     }
+    bw->bits = 0;
+    bw->nbits = 0;
 }
 
-/* a Huffman code of n bits, sent most significant bit first */
-static inline void put_code(BitWriter *bw, uint32_t code, int n) {
+/* a Huffman code of n bits, sent most significant bit first: its bits reversed */
+static uint32_t reversed(uint32_t code, int n) {
     uint32_t r = 0;
     for (int i = 0; i < n; i++) r |= ((code >> i) & 1u) << (n - 1 - i);
-    put(bw, r, n);
+    return r;
+}
+
+/* The fixed literal/length codes (RFC 1951, 3.2.6), reversed for `put`, and their lengths;
+ * for each match length 3..258 its symbol's code and extra bits as one value (LEN_PUT, bits
+ * LEN_NBITS): filled once, at import */
+static uint16_t SYM_CODE[288];
+static uint8_t SYM_BITS[288];
+static uint32_t LEN_PUT[259];
+static uint8_t LEN_NBITS[259];
+
+static void huffman_init(void) {
+    for (int sym = 0; sym < 288; sym++) {
+        uint32_t code;
+        int n;
+        if (sym < 144)
+            code = 0x30u + (uint32_t)sym, n = 8;
+        else if (sym < 256)
+            code = 0x190u + (uint32_t)(sym - 144), n = 9;
+        else if (sym < 280)
+            code = (uint32_t)(sym - 256), n = 7;
+        else
+            code = 0xC0u + (uint32_t)(sym - 280), n = 8;
+        SYM_CODE[sym] = (uint16_t)reversed(code, n);
+        SYM_BITS[sym] = (uint8_t)n;
+    }
+    for (int length = 3; length <= 258; length++) {
+        int li = 28;
+        while (LEN_BASE[li] > length) li--;
+        const int sym = 257 + li, n = SYM_BITS[sym];
+        LEN_PUT[length] = SYM_CODE[sym] | (uint32_t)(length - LEN_BASE[li]) << n;
+        LEN_NBITS[length] = (uint8_t)(n + LEN_EXTRA[li]);
+    }
 }
 
 static inline void put_symbol(BitWriter *bw, int sym) { /* fixed literal/length codes */
-    if (sym < 144)
-        put_code(bw, 0x30u + (uint32_t)sym, 8);
-    else if (sym < 256)
-        put_code(bw, 0x190u + (uint32_t)(sym - 144), 9);
-    else if (sym < 280)
-        put_code(bw, (uint32_t)(sym - 256), 7);
-    else
-        put_code(bw, 0xC0u + (uint32_t)(sym - 280), 8);
+    put(bw, SYM_CODE[sym], SYM_BITS[sym]);
 }
 
-static void put_match(BitWriter *bw, int length, int distance) { /* 3 <= length <= 258 */
-    int li = 28;
-    while (LEN_BASE[li] > length) li--;
-    put_symbol(bw, 257 + li);
-    if (LEN_EXTRA[li]) put(bw, (uint32_t)(length - LEN_BASE[li]), LEN_EXTRA[li]);
+/* a distance's code (5 bits, reversed) and extra bits as one value for `put`, and its bits */
+static inline void distance_code(int distance, uint32_t *value, int *nbits) {
+    if (distance == 1) { /* (a run's copy: code 0, no extra bits) */
+        *value = 0;
+        *nbits = 5;
+        return;
+    }
     int di = 29;
     while (DIST_BASE[di] > distance) di--;
-    put_code(bw, (uint32_t)di, 5);
-    if (DIST_EXTRA[di]) put(bw, (uint32_t)(distance - DIST_BASE[di]), DIST_EXTRA[di]);
+    *value = reversed((uint32_t)di, 5) | (uint32_t)(distance - DIST_BASE[di]) << 5;
+    *nbits = 5 + DIST_EXTRA[di];
 }
 
 /* a copy of `length` bytes at `distance`, as matches of 3..258 bytes; a tail of 1 or 2 bytes
  * (only when length < 3) as the literals `src` (the bytes copied) */
 static void put_copy(BitWriter *bw, size_t length, int distance, const uint8_t *src) {
+    uint32_t dvalue = 0;
+    int dbits = 0;
+    if (length >= 3) distance_code(distance, &dvalue, &dbits);
     while (length >= 3) {
         size_t take = length > 258 ? 258 : length;
         if (length - take > 0 && length - take < 3) take = length - 3;
-        put_match(bw, (int)take, distance);
+        /* the length's code and extra bits (at most 13), the distance's (at most 18) */
+        put(bw, LEN_PUT[take] | dvalue << LEN_NBITS[take], LEN_NBITS[take] + dbits);
         length -= take;
         src += take;
     }
@@ -123,7 +180,7 @@ static void put_row(BitWriter *bw, const uint8_t *row, size_t n, int bg, size_t 
     while (i < n) {
         uint8_t b = row[i];
         size_t j = i + 1;
-        if (j == 1 && pre && b == bg) j = 1 + pre;
+        if (i <= 1 && pre && b == bg) j = 1 + pre; /* (row[0], the filter byte, is 0) */
         for (;;) {
             while (j < n && j < tail && row[j] == b) j++;
             if (j == tail && j < n && b == bg)
@@ -151,12 +208,13 @@ static inline void adler_run(uint64_t *rs, uint64_t *rt, uint64_t n, uint64_t c)
 
 /* The PNG of the image; with a prefix, the protobuf message prefix + field 2 (the PNG,
  * length-delimited) + suffix */
-static PyObject *encode(Py_buffer P, int bg, int x0, int y0, int x1, int y1, int w, int h,
-                        int binary, const Py_buffer *prefix, const Py_buffer *suffix) {
+static PyObject *encode(const uint8_t *pix, Py_ssize_t len, int bg, int x0, int y0, int x1,
+                        int y1, int w, int h, int binary, const Py_buffer *prefix,
+                        const Py_buffer *suffix) {
     PyObject *ret = NULL;
     uint8_t *rows = NULL, *out = NULL;
     if (w < 1 || h < 1 || w > 32767 || bg < 0 || bg > 255 || x0 < 0 || y0 < 0 || x1 > w ||
-        y1 > h || x1 < x0 || y1 < y0 || P.len != (Py_ssize_t)(x1 - x0) * (y1 - y0)) {
+        y1 > h || x1 < x0 || y1 < y0 || len != (Py_ssize_t)(x1 - x0) * (y1 - y0)) {
         PyErr_SetString(PyExc_ValueError, "png: bad image size, window or pixels");
         goto done;
     }
@@ -174,7 +232,6 @@ static PyObject *encode(Py_buffer P, int bg, int x0, int y0, int x1, int y1, int
         goto done;
     }
     uint8_t *png = out + base;
-    const uint8_t *pix = P.buf;
     const int ww = x1 - x0;
     if (ww == 0) y1 = y0; /* an empty window: every row is background */
     const size_t pre = (size_t)x0, post = (size_t)(w - x1);
@@ -248,13 +305,18 @@ static PyObject *encode(Py_buffer P, int bg, int x0, int y0, int x1, int y1, int
                 prev_bg = 0;
             }
         }
-        /* Adler-32 over this row: s2 gains n s1 (before) + sum (n - i) b_i, s1 the row's sum */
-        s2 = (s2 + (uint64_t)n % ADLER_BASE * s1 + rt) % ADLER_BASE;
-        s1 = (s1 + rs) % ADLER_BASE;
+        /* Adler-32 over this row: s2 gains n s1 (before) + sum (n - i) b_i, s1 the row's sum;
+         * reduced modulo 65521 only when large (n < 2^16, s1 < 2^41: no overflow) */
+        s2 += (uint64_t)n * s1 + rt;
+        s1 += rs;
+        if (s1 >= (1ull << 40)) s1 %= ADLER_BASE;
+        if (s2 >= (1ull << 40)) s2 %= ADLER_BASE;
     }
+    s1 %= ADLER_BASE;
+    s2 %= ADLER_BASE;
     if (repeat) put_copy(&bw, repeat * n, (int)n, prev);
     put_symbol(&bw, 256); /* end of block */
-    if (bw.nbits) put(&bw, 0, 8 - bw.nbits);
+    flush_bits(&bw);
     const uint32_t adler = (uint32_t)(s2 << 16 | s1);
     png[bw.n++] = (uint8_t)(adler >> 24);
     png[bw.n++] = (uint8_t)(adler >> 16);
@@ -287,32 +349,221 @@ done:
     return ret;
 }
 
-static PyObject *py_png(PyObject *self, PyObject *args) {
-    Py_buffer P;
+/* An image argument: a WindowedImage (a 5-tuple: height, width, background, window (x0, y0,
+ * x1, y1), uint8 pixels of the window) or a whole (h, w) uint8 or bool array (bool: binary);
+ * the pixels through the buffer protocol, strided ones copied to rows. ValueError for an image
+ * the encoder does not take (png.py documents them). */
+typedef struct {
+    Py_buffer view;
+    int have_view;
+    uint8_t *copy; /* strided pixels as contiguous rows, or NULL */
+    const uint8_t *pix;
+    Py_ssize_t len;
     int bg, x0, y0, x1, y1, w, h, binary;
-    if (!PyArg_ParseTuple(args, "y*iiiiiiii", &P, &bg, &x0, &y0, &x1, &y1, &w, &h, &binary))
-        return NULL;
-    PyObject *ret = encode(P, bg, x0, y0, x1, y1, w, h, binary, NULL, NULL);
-    PyBuffer_Release(&P);
+} Image;
+
+static void image_release(Image *im) {
+    if (im->have_view) PyBuffer_Release(&im->view);
+    im->have_view = 0;
+    free(im->copy);
+    im->copy = NULL;
+}
+
+static int as_int(PyObject *o, int *v) {
+    long x = PyLong_AsLong(o);
+    if (x == -1 && PyErr_Occurred()) return -1;
+    if (x < -0x7FFFFFFFL || x > 0x7FFFFFFFL) {
+        PyErr_SetString(PyExc_OverflowError, "png: an image size beyond int");
+        return -1;
+    }
+    *v = (int)x;
+    return 0;
+}
+
+static int image_parse(PyObject *image, Image *im) {
+    memset(im, 0, sizeof *im);
+    PyObject *pixels = image;
+    const int windowed = PyTuple_Check(image) && PyTuple_GET_SIZE(image) == 5;
+    if (windowed) {
+        if (as_int(PyTuple_GET_ITEM(image, 0), &im->h) < 0 ||
+            as_int(PyTuple_GET_ITEM(image, 1), &im->w) < 0 ||
+            as_int(PyTuple_GET_ITEM(image, 2), &im->bg) < 0)
+            return -1;
+        PyObject *win = PySequence_Fast(PyTuple_GET_ITEM(image, 3), "png: window (x0, y0, x1, y1)");
+        if (!win) return -1;
+        int bad = PySequence_Fast_GET_SIZE(win) != 4;
+        if (bad)
+            PyErr_SetString(PyExc_ValueError, "png: window (x0, y0, x1, y1)");
+        else
+            bad = as_int(PySequence_Fast_GET_ITEM(win, 0), &im->x0) < 0 ||
+                  as_int(PySequence_Fast_GET_ITEM(win, 1), &im->y0) < 0 ||
+                  as_int(PySequence_Fast_GET_ITEM(win, 2), &im->x1) < 0 ||
+                  as_int(PySequence_Fast_GET_ITEM(win, 3), &im->y1) < 0;
+        Py_DECREF(win);
+        if (bad) return -1;
+        pixels = PyTuple_GET_ITEM(image, 4);
+    }
+    if (PyObject_GetBuffer(pixels, &im->view, PyBUF_RECORDS_RO) < 0) return -1;
+    im->have_view = 1;
+    const Py_buffer *v = &im->view;
+    const char *f = v->format ? v->format : "B";
+    while (*f == '@' || *f == '=' || *f == '<' || *f == '>' || *f == '!') f++;
+    const int u8 = strcmp(f, "B") == 0, boolean = strcmp(f, "?") == 0;
+    if (v->ndim != 2) {
+        PyErr_Format(PyExc_ValueError, "png: expected an (h, w) grey image, got %d dimensions",
+                     v->ndim);
+        goto fail;
+    }
+    if (v->itemsize != 1 || !(u8 || (boolean && !windowed))) {
+        PyErr_Format(PyExc_ValueError, "png: expected a uint8%s image, got format %s",
+                     windowed ? "" : " or bool", v->format ? v->format : "B");
+        goto fail;
+    }
+    const Py_ssize_t rows = v->shape[0], cols = v->shape[1];
+    if (windowed) {
+        if (rows != (Py_ssize_t)im->y1 - im->y0 || cols != (Py_ssize_t)im->x1 - im->x0) {
+            PyErr_Format(PyExc_ValueError, "png: window (%d, %d, %d, %d) with pixels %zd x %zd",
+                         im->x0, im->y0, im->x1, im->y1, rows, cols);
+            goto fail;
+        }
+    } else {
+        if (rows > 0x7FFFFFFF || cols > 0x7FFFFFFF) {
+            PyErr_SetString(PyExc_ValueError, "png: an image size beyond int");
+            goto fail;
+        }
+        im->h = im->y1 = (int)rows;
+        im->w = im->x1 = (int)cols;
+        im->binary = boolean;
+    }
+    if (im->h < 1 || im->w < 1) {
+        PyErr_Format(PyExc_ValueError, "png: an empty image (%d x %d) has no PNG", im->h, im->w);
+        goto fail;
+    }
+    im->len = rows * cols;
+    im->pix = v->buf;
+    if (im->len && (v->strides[1] != 1 || (rows > 1 && v->strides[0] != cols))) {
+        im->copy = malloc((size_t)im->len);
+        if (!im->copy) {
+            PyErr_NoMemory();
+            goto fail;
+        }
+        for (Py_ssize_t r = 0; r < rows; r++)
+            for (Py_ssize_t c = 0; c < cols; c++)
+                im->copy[r * cols + c] =
+                    *((const uint8_t *)v->buf + r * v->strides[0] + c * v->strides[1]);
+        im->pix = im->copy;
+    }
+    return 0;
+fail:
+    image_release(im);
+    return -1;
+}
+
+static PyObject *encode_image(const Image *im, const Py_buffer *prefix, const Py_buffer *suffix) {
+    return encode(im->pix, im->len, im->bg, im->x0, im->y0, im->x1, im->y1, im->w, im->h,
+                  im->binary, prefix, suffix);
+}
+
+static PyObject *py_png(PyObject *self, PyObject *image) {
+    Image im;
+    if (image_parse(image, &im) < 0) return NULL;
+    PyObject *ret = encode_image(&im, NULL, NULL);
+    image_release(&im);
     return ret;
 }
 
-static PyObject *py_message(PyObject *self, PyObject *args) {
-    Py_buffer pre, suf, P;
-    int bg, x0, y0, x1, y1, w, h, binary;
-    if (!PyArg_ParseTuple(args, "y*y*y*iiiiiiii", &pre, &suf, &P, &bg, &x0, &y0, &x1, &y1, &w,
-                          &h, &binary))
+static PyObject *py_message(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "message(prefix, suffix, image)");
         return NULL;
-    PyObject *ret = encode(P, bg, x0, y0, x1, y1, w, h, binary, &pre, &suf);
+    }
+    Py_buffer pre, suf;
+    Image im;
+    if (PyObject_GetBuffer(args[0], &pre, PyBUF_SIMPLE) < 0) return NULL;
+    if (PyObject_GetBuffer(args[1], &suf, PyBUF_SIMPLE) < 0) {
+        PyBuffer_Release(&pre);
+        return NULL;
+    }
+    PyObject *ret = NULL;
+    if (image_parse(args[2], &im) == 0) {
+        ret = encode_image(&im, &pre, &suf);
+        image_release(&im);
+    }
     PyBuffer_Release(&pre);
     PyBuffer_Release(&suf);
-    PyBuffer_Release(&P);
+    return ret;
+}
+
+/* messages(message, views, frames, start, prefix, t_ns): a sensor's frame in one call. For
+ * each (view, image) of the sequence frames from index start: views[view] = (channel id, suffix)
+ * gives its channel and the message's fields after the PNG; the image's message (prefix, the
+ * PNG, suffix, as message() makes it) goes to message(channel, t_ns, t_ns, data) (a log's
+ * compiled record writer). Returns -1 when all are written, else the index of the first frame
+ * whose view has no channel yet (it and those after it not written: the caller makes the channel
+ * and calls again from there). */
+static PyObject *py_messages(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 6 || !PyDict_Check(args[1])) {
+        PyErr_SetString(PyExc_TypeError,
+                        "messages(message, views: dict, frames, start, prefix, t_ns)");
+        return NULL;
+    }
+    PyObject *message = args[0], *views = args[1], *t_ns = args[5];
+    Py_ssize_t start = PyLong_AsSsize_t(args[3]);
+    if (start == -1 && PyErr_Occurred()) return NULL;
+    PyObject *frames = PySequence_Fast(args[2], "messages: frames is a sequence");
+    if (!frames) return NULL;
+    Py_buffer pre;
+    if (PyObject_GetBuffer(args[4], &pre, PyBUF_SIMPLE) < 0) {
+        Py_DECREF(frames);
+        return NULL;
+    }
+    PyObject *ret = NULL;
+    const Py_ssize_t n = PySequence_Fast_GET_SIZE(frames);
+    Py_ssize_t i;
+    for (i = start < 0 ? 0 : start; i < n; i++) {
+        PyObject *frame = PySequence_Fast_GET_ITEM(frames, i);
+        if (!PyTuple_Check(frame) || PyTuple_GET_SIZE(frame) != 2) {
+            PyErr_SetString(PyExc_TypeError, "messages: a frame is (view, image)");
+            goto done;
+        }
+        PyObject *slot = PyDict_GetItemWithError(views, PyTuple_GET_ITEM(frame, 0));
+        if (!slot) {
+            if (PyErr_Occurred()) goto done;
+            break; /* a view without a channel: the caller's */
+        }
+        if (!PyTuple_Check(slot) || PyTuple_GET_SIZE(slot) != 2) {
+            PyErr_SetString(PyExc_TypeError, "messages: views[view] is (channel, suffix)");
+            goto done;
+        }
+        Py_buffer suf;
+        if (PyObject_GetBuffer(PyTuple_GET_ITEM(slot, 1), &suf, PyBUF_SIMPLE) < 0) goto done;
+        Image im;
+        PyObject *data = NULL;
+        if (image_parse(PyTuple_GET_ITEM(frame, 1), &im) == 0) {
+            data = encode_image(&im, &pre, &suf);
+            image_release(&im);
+        }
+        PyBuffer_Release(&suf);
+        if (!data) goto done;
+        PyObject *call[4] = {PyTuple_GET_ITEM(slot, 0), t_ns, t_ns, data};
+        PyObject *r = PyObject_Vectorcall(message, call, 4, NULL);
+        Py_DECREF(data);
+        if (!r) goto done;
+        Py_DECREF(r);
+    }
+    ret = PyLong_FromSsize_t(i < n ? i : -1);
+done:
+    PyBuffer_Release(&pre);
+    Py_DECREF(frames);
     return ret;
 }
 
 static PyMethodDef methods[] = {
-    {"png", py_png, METH_VARARGS, "a windowed grey image as a PNG file"},
-    {"message", py_message, METH_VARARGS, "prefix, the PNG as protobuf field 2, suffix"},
+    {"png", py_png, METH_O, "a grey image (a WindowedImage or an array) as a PNG file"},
+    {"message", (PyCFunction)(void (*)(void))py_message, METH_FASTCALL,
+     "prefix, the image's PNG as protobuf field 2, suffix"},
+    {"messages", (PyCFunction)(void (*)(void))py_messages, METH_FASTCALL,
+     "a sensor's frame: each view's image message to its channel"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -321,5 +572,6 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_png",
 
 PyMODINIT_FUNC PyInit__png(void) {
     crc_init();
+    huffman_init();
     return PyModule_Create(&module);
 }

@@ -1,22 +1,17 @@
 """Types of the PNG encoder's compiled kernel (replay/foxglove/_png.c documents it)."""
 
-from typing import Any
+from typing import Any, Callable, Sequence
 
-Buffer = Any  # a C-contiguous uint8 (or bool) buffer
+Image = Any  # a WindowedImage (its pixels uint8) or an (h, w) uint8 or bool array
 
-def png(
-    pixels: Buffer, background: int, x0: int, y0: int, x1: int, y1: int, w: int, h: int, binary: int
-) -> bytes: ...
-def message(
+def png(image: Image, /) -> bytes: ...
+def message(prefix: bytes, suffix: bytes, image: Image, /) -> bytes: ...
+def messages(
+    message: Callable[[int, int, int, bytes], Any],
+    views: dict[str, tuple[int, bytes]],
+    frames: Sequence[tuple[str, Image]],
+    start: int,
     prefix: bytes,
-    suffix: bytes,
-    pixels: Buffer,
-    background: int,
-    x0: int,
-    y0: int,
-    x1: int,
-    y1: int,
-    w: int,
-    h: int,
-    binary: int,
-) -> bytes: ...
+    t_ns: int,
+    /,
+) -> int: ...

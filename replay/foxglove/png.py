@@ -6,9 +6,11 @@ the PNG is written by a small compiled encoder (``_png.c``): its image data one 
 fixed Huffman codes (RFC 1951) in which a row equal to the row above is one copy of it and a run of
 equal bytes is one copy at distance 1; no zlib, no per-image allocation of its state. A
 :class:`WindowedImage` (the sensor's rendered window and the background level around it) is
-encoded without building the whole frame in Python. The encoder reads the rows, not the window:
-the bytes depend only on the pixels (a whole array and the same pixels as a window give the same
-PNG). Every decoder reads them (zlib, libpng through OpenCV, PIL: tests, which keep zlib's
+encoded without building the whole frame in Python: the encoder takes the image itself (a
+WindowedImage's fields or an array's buffer), its codes from tables made at import (each fixed
+Huffman code, each match length's code), the CRC eight bytes a step. It reads the rows, not the
+window: the bytes depend only on the pixels (a whole array and the same pixels as a window give
+the same PNG). Every decoder reads them (zlib, libpng through OpenCV, PIL: tests, which keep zlib's
 encoder of the same rows as the reference).
 """
 
@@ -43,36 +45,21 @@ class WindowedImage(NamedTuple):  # (a tuple: ~5x cheaper to make than a frozen 
         return out
 
 
-def png_args(image: np.ndarray | WindowedImage) -> tuple:
-    """The compiled encoder's arguments for an image (``_png.c``): pixels, background, window,
-    width, height, binary; ValueError for an image it does not take."""
-    if isinstance(image, WindowedImage):
-        h, w, bg, (x0, y0, x1, y1), pix = image
-        pix = np.ascontiguousarray(pix)
-        if pix.shape != (y1 - y0, x1 - x0) or pix.dtype != np.uint8:
-            raise ValueError(f"window {image.window} with pixels {pix.shape} {pix.dtype}")
-        binary = 0
-    else:
-        pix = np.ascontiguousarray(image)
-        if pix.ndim != 2:
-            raise ValueError(f"expected an (h, w) grey image, got shape {pix.shape}")
-        if pix.dtype != np.uint8 and pix.dtype != bool:
-            raise ValueError(f"expected a uint8 or bool image, got {pix.dtype}")
-        h, w = pix.shape
-        bg, x0, y0, x1, y1 = 0, 0, 0, w, h
-        binary = int(pix.dtype == bool)
-    if h < 1 or w < 1:
-        raise ValueError(f"an empty image ({h} x {w}) has no PNG")
-    return pix, bg, x0, y0, x1, y1, w, h, binary
-
-
 def encode_png(image: np.ndarray | WindowedImage) -> bytes:
     """An (h, w) image as an 8-bit grey PNG: uint8 as is, bool as 0 / 255; a
-    :class:`WindowedImage` as its whole frame."""
-    return _png.png(*png_args(image))
+    :class:`WindowedImage` (its pixels uint8, (y1 - y0, x1 - x0)) as its whole frame. ValueError
+    for an image it does not take (not 2-D, another dtype, pixels that do not fill the window,
+    an empty frame). The compiled encoder reads the image itself (its fields, the pixels'
+    buffer, strided pixels copied to rows)."""
+    return _png.png(image)
 
 
-def png_message(prefix: bytes, image: np.ndarray | WindowedImage, suffix: bytes) -> bytes:
-    """``prefix``, the image's PNG as protobuf field 2 (length-delimited), ``suffix``: a
-    ``foxglove.CompressedImage`` in one compiled call (replay/foxglove/wire.py's fields)."""
-    return _png.message(prefix, suffix, *png_args(image))
+# png_message(prefix, suffix, image): ``prefix``, the image's PNG as protobuf field 2
+# (length-delimited), ``suffix``: a ``foxglove.CompressedImage`` in one compiled call
+# (replay/foxglove/wire.py's fields), called straight (no Python frame an image)
+png_message = _png.message
+
+# png_messages(message, views, frames, start, prefix, t_ns): a camera frame's images, each as
+# png_message(prefix, views[view][1], image) to message(views[view][0], t_ns, t_ns, data), in
+# one compiled call; -1, or the index of the first frame whose view has no channel yet
+png_messages = _png.messages

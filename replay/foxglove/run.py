@@ -38,8 +38,7 @@ class RunTopics:
 
     def sensor(self, name: str, sensor, t_ns: int) -> None:
         if name in self.imaging:
-            for view, image in sensor.frame_images():
-                self.out.image(name, view, image, t_ns)
+            self.out.images(name, sensor.frame_images(), t_ns)
 
     def event(self, event: Event, t_ns: int) -> None:
         self.out.event(event.kind, event.data, encode(TOPIC_EVENTS, event.data).decode(), t_ns)

@@ -27,10 +27,9 @@ from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
 from foxglove_schemas_protobuf.Log_pb2 import Log
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from google.protobuf.message import Message
-from google.protobuf.timestamp_pb2 import Timestamp
 
 from replay.foxglove import wire
-from replay.foxglove.png import WindowedImage, png_message
+from replay.foxglove.png import WindowedImage, png_messages
 from replay.foxglove.schemas import (
     MESSAGE_ENCODING,
     SCHEMA_ENCODING,
@@ -54,10 +53,6 @@ def camera_topic(sensor: str, view: str) -> str:
     """The image topic of one camera view: ``/camera/SENSOR/VIEW``; its frame is
     ``SENSOR/VIEW``."""
     return f"/camera/{sensor}/{view}"
-
-
-def _stamp(t_ns: int) -> Timestamp:
-    return Timestamp(seconds=t_ns // 1_000_000_000, nanos=t_ns % 1_000_000_000)
 
 
 # the /events kinds that are shown as warnings / errors in the Log panel
@@ -96,8 +91,9 @@ class FoxgloveTopics:
         self.log = log  # a replay.log.LogWriter
         self._channels: dict[str, int] = {}  # topic -> channel id
         self._schemas: dict[str, int] = {}  # schema name -> id (each stored once)
-        # (sensor, view) -> (channel id, the image messages' last fields)
-        self._images: dict[tuple[str, str], tuple[int, bytes]] = {}
+        # sensor -> view -> (channel id, the image messages' fields after the PNG)
+        self._images: dict[str, dict[str, tuple[int, bytes]]] = {}
+        self._record = log.raw_message  # the log's compiled record writer
 
     def _channel(self, topic: str, schema: str, encoding: str, data: bytes, message: str) -> int:
         if schema not in self._schemas:
@@ -106,10 +102,6 @@ class FoxgloveTopics:
             topic, message, self._schemas[schema]
         )
         return channel
-
-    def _write(self, topic: str, msg: Message, t_ns: int) -> None:
-        channel = self._channels.get(topic) or self._wire(topic, type(msg))
-        self.log.write_raw(channel, msg.SerializeToString(deterministic=True), t_ns)
 
     def robot_description(self, urdf: str, t_ns: int) -> None:
         channel = self._channels.get(TOPIC_ROBOT_DESCRIPTION)
@@ -153,24 +145,32 @@ class FoxgloveTopics:
 
     def event(self, kind: str, data: dict, text: str, t_ns: int) -> None:
         """One ``/events`` message as a log line: ``KIND {data as JSON}``."""
-        self._write(
-            TOPIC_LOG,
-            Log(
-                timestamp=_stamp(t_ns),
-                level=log_level(kind, data),
-                message=f"{kind} {text}",
-                name="paper-replay",
-            ),
+        channel = self._channels.get(TOPIC_LOG) or self._wire(TOPIC_LOG, Log)
+        self.log.write_raw(
+            channel,
+            wire.log_line(int(log_level(kind, data)), f"{kind} {text}", "paper-replay", t_ns),
             t_ns,
         )
 
-    def image(self, sensor: str, view: str, image: np.ndarray | WindowedImage, t_ns: int) -> None:
-        slot = self._images.get((sensor, view))
-        if slot is None:
+    def images(
+        self, sensor: str, frames: Sequence[tuple[str, np.ndarray | WindowedImage]], t_ns: int
+    ) -> None:
+        """A sensor's frame: each (view, image) on its ``/camera/SENSOR/VIEW`` topic, one
+        timestamp for all, in one compiled call (``_png.messages``: each image's PNG message
+        to the log's record writer) but for a view's first image, which makes its channel."""
+        views = self._images.get(sensor)
+        if views is None:
+            views = self._images[sensor] = {}
+        if not isinstance(frames, (list, tuple)):
+            frames = list(frames)
+        ts, start = wire.timestamp(t_ns), 0
+        while True:
+            try:
+                start = png_messages(self._record, views, frames, start, ts, t_ns)
+            except OSError as exc:
+                raise self.log.write_error(exc) from None
+            if start < 0:
+                return
+            view = frames[start][0]
             channel = self._wire(camera_topic(sensor, view), CompressedImage)
-            slot = self._images[(sensor, view)] = (
-                channel,
-                wire.image_tail(f"{sensor}/{view}", "png"),
-            )
-        channel, tail = slot
-        self.log.write_raw(channel, png_message(wire.timestamp(t_ns), image, tail), t_ns)
+            views[view] = (channel, wire.image_tail(f"{sensor}/{view}", "png"))

@@ -1,10 +1,13 @@
 """Foxglove's messages written straight in the protobuf wire format (protobuf.dev, "Encoding"):
 ``/tf``, ``/scene``, ``/joint_states`` and camera images, the ones written at the frame or
-camera rate.
+camera rate, and ``/log``'s lines (the protobuf classes' first use in a run is slow).
 
 Filling the ``foxglove_schemas_protobuf`` classes costs ~0.2 us an attribute (a /tf of 15
 frames ~60 us); here a frame transform is one ``struct.pack`` of its seven doubles behind the
-cached bytes of its frame names. Every double is written, zeros too (the library leaves a zero
+cached bytes of its frame names, and the timestamp, /tf's frame transforms and the joint states
+are compiled, as are the primitives' transforms and scene entities (``_wire.c``, 3-20x
+cheaper; the Python references ``_timestamp``, ``_frame_transforms``, ``_body_transforms``,
+``_scene_update`` and ``_joint_states`` kept for the tests). Every double is written, zeros too (the library leaves a zero
 out; a reader gives 0.0 either way), so the bytes are fixed by the values; the messages decode
 to the library's own (tests/replay/foxglove/test_wire.py builds both from seeded random
 input). Field numbers are those of the schemas (foxglove.FrameTransform: timestamp 1, parent
@@ -17,6 +20,7 @@ import functools
 import struct
 from typing import Iterable, Sequence
 
+from replay.foxglove import _wire
 from replay.scene import Box, Cylinder, Frame, Sphere
 
 # tag bytes: (field number << 3) | wire type (0 varint, 1 fixed64, 2 length-delimited)
@@ -52,18 +56,17 @@ def _text(tag: int, text: str) -> bytes:
     return field(tag, text.encode())
 
 
-@functools.lru_cache(maxsize=8)  # (a frame's topics and images share their time)
-def timestamp(t_ns: int) -> bytes:
+def _timestamp(t_ns: int) -> bytes:
     """A ``google.protobuf.Timestamp`` of ``t_ns`` as field 1 of its message (seconds 1 and
-    nanos 2, each left out at 0 as the library does)."""
+    nanos 2, each left out at 0 as the library does): the reference of :func:`timestamp`."""
     sec, nsec = divmod(t_ns, 1_000_000_000)
     body = (b"\x08" + varint(sec) if sec else b"") + (b"\x10" + varint(nsec) if nsec else b"")
     return b"\x0a" + bytes((len(body),)) + body
 
 
-def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
-    """``foxglove.FrameTransforms``: each frame's pose in its parent at ``t_ns``."""
-    ts = timestamp(t_ns)
+def _frame_transforms(frames: Iterable[Frame], ts: bytes) -> bytes:
+    """The reference of :func:`frame_transforms`' compiled transforms (``ts``: a timestamp
+    field)."""
     pack = _TRANSFORM.pack
     parts = []
     for f in frames:
@@ -80,11 +83,25 @@ def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
     return b"".join(parts)
 
 
+# compiled (_wire.c; the references above and _joint_states below): ~20x cheaper a call
+timestamp = _wire.timestamp
+
+
+def frame_transforms(frames: Iterable[Frame], t_ns: int) -> bytes:
+    """``foxglove.FrameTransforms``: each frame's pose in its parent at ``t_ns``."""
+    return _wire.frame_transforms(frames, timestamp(t_ns))
+
+
 def body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
     """``foxglove.FrameTransforms`` of each primitive as a frame of its own name in ``parent``
     (a sphere unrotated): the transforms of :func:`frame_transforms` without making the frames
-    (the messages' repeated fields concatenate)."""
-    head = timestamp(t_ns) + _text(0x12, parent)
+    (the messages' repeated fields concatenate). Compiled (``_wire.c``)."""
+    return _wire.body_transforms(primitives, timestamp(t_ns) + _text(0x12, parent), Sphere)
+
+
+def _body_transforms(primitives: Iterable, parent: str, t_ns: int) -> bytes:
+    """The reference of :func:`body_transforms`' compiled transforms."""
+    head = _timestamp(t_ns) + _text(0x12, parent)
     n_head = len(head) + 67  # + the translation and rotation fields
     pack = _TRANSFORM.pack
     parts: list[bytes] = []
@@ -153,8 +170,15 @@ def _shape_fields(p) -> tuple[bytes, bytes] | None:
 
 def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
     """``foxglove.SceneUpdate``: each box, sphere and cylinder as one entity (id = its name) of
-    one primitive at its pose in ``frame_id``, grey by albedo (others are left out)."""
+    one primitive at its pose in ``frame_id``, grey by albedo (others are left out). Compiled
+    (``_wire.c``), the shapes' fixed fields from :func:`_shape_fields`."""
     head = timestamp(t_ns) + _text(0x12, frame_id)
+    return _wire.scene_update(primitives, head, _shape_fields, Sphere)
+
+
+def _scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
+    """The reference of :func:`scene_update`'s compiled entities."""
+    head = _timestamp(t_ns) + _text(0x12, frame_id)
     n_head = len(head) + 69  # + the pose field
     pose = _POSE.pack
     parts: list[bytes] = []
@@ -176,19 +200,37 @@ def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
     return b"".join(parts)
 
 
-def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
-    """``foxglove.JointStates``: each joint's name, position, velocity and effort."""
+def _joint_states(names, position, velocity, effort, ts: bytes) -> bytes:
+    """The reference of :func:`joint_states`' compiled message (``ts``: a timestamp field)."""
     pack = _JOINT.pack
-    parts = [timestamp(t_ns)]
+    parts = [ts]
     for n, q, v, e in zip(names, position, velocity, effort):
         joint = _text(0x0A, n) + pack(0x11, q, 0x19, v, 0x29, e)
         parts.append(b"\x12" + varint(len(joint)) + joint)
     return b"".join(parts)
 
 
+def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
+    """``foxglove.JointStates``: each joint's name, position, velocity and effort."""
+    return _wire.joint_states(names, position, velocity, effort, timestamp(t_ns))
+
+
+def log_line(level: int, message: str, name: str, t_ns: int) -> bytes:
+    """``foxglove.Log``: timestamp 1, level 2 (an enum: left out at 0), message 3 and name 4
+    (left out when empty), as the library writes them."""
+    return b"".join(
+        (
+            timestamp(t_ns),
+            b"\x10" + varint(level) if level else b"",
+            field(0x1A, message.encode()) if message else b"",
+            _text(0x22, name) if name else b"",
+        )
+    )
+
+
 @functools.lru_cache(maxsize=256)
 def image_tail(frame_id: str, fmt: str) -> bytes:
     """The fields of a ``foxglove.CompressedImage`` after its data (field 2): format 3, frame
-    id 4; a camera's message is ``replay.foxglove.png.png_message(timestamp(t_ns), image,
-    image_tail(frame_id, "png"))``."""
+    id 4; a camera's message is ``replay.foxglove.png.png_message(timestamp(t_ns),
+    image_tail(frame_id, "png"), image)``."""
     return _text(0x1A, fmt) + _text(0x22, frame_id)

@@ -6,7 +6,8 @@
  * Message record (MCAP spec: opcode 0x05, record length, channel id u16, sequence u32 = the
  * channel's count so far, log time u64, publish time u64, data; little endian) and calls
  * on_full() when the chunk has grown beyond chunk_size; append(record) adds other records
- * (schemas, channels); take() returns the chunk and its indexes and starts a new one.
+ * (schemas, channels); take() returns the chunk and its indexes and starts a new one;
+ * json(topic, payload, t_ns) is a JSON message encoded and appended in one call (below).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -24,6 +25,7 @@ typedef struct {
     size_t len, cap;
     Py_ssize_t chunk_size;
     PyObject *on_full;
+    PyObject *json_channels, *dumps, *finite; /* json(): topic -> id, encoder, check */
     Index *index; /* per channel id */
     uint64_t *counts;
     size_t channels; /* ids 0 .. channels - 1 allocated */
@@ -72,6 +74,48 @@ static inline void le(uint8_t *p, uint64_t v, int n) {
     for (int i = 0; i < n; i++) p[i] = (uint8_t)(v >> (8 * i));
 }
 
+/* one Message record appended (its index entry kept); on_full() called once the chunk has grown
+ * beyond chunk_size; -1 with an exception set on failure */
+static int append_message(Chunk *c, unsigned long long ch, unsigned long long lt,
+                          unsigned long long pt, const void *data, size_t len) {
+    if (ch > 0xFFFF) {
+        PyErr_SetString(PyExc_ValueError, "channel id beyond u16");
+        return -1;
+    }
+    if (channel_slot(c, (size_t)ch) < 0 || reserve(c, 31 + len) < 0) return -1;
+    Index *ix = &c->index[ch];
+    if (ix->n + 2 > ix->cap) {
+        size_t cap = ix->cap ? 2 * ix->cap : 64;
+        uint64_t *p = realloc(ix->pairs, cap * sizeof(uint64_t));
+        if (!p) {
+            PyErr_NoMemory();
+            return -1;
+        }
+        ix->pairs = p;
+        ix->cap = cap;
+    }
+    ix->pairs[ix->n++] = lt;
+    ix->pairs[ix->n++] = c->len;
+    uint8_t *p = c->buf + c->len;
+    p[0] = 0x05;
+    le(p + 1, 2 + 4 + 8 + 8 + (uint64_t)len, 8);
+    le(p + 9, ch, 2);
+    le(p + 11, c->counts[ch], 4);
+    le(p + 15, lt, 8);
+    le(p + 23, pt, 8);
+    memcpy(p + 31, data, len);
+    c->len += 31 + len;
+    c->counts[ch]++;
+    c->total++;
+    c->in_chunk++;
+    if ((Py_ssize_t)c->len > c->chunk_size) {
+        PyObject *r = PyObject_CallNoArgs(c->on_full);
+        if (!r) return -1;
+        Py_DECREF(r);
+    }
+    return 0;
+}
+
 static PyObject *Chunk_message(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
     if (nargs != 4) {
         PyErr_SetString(PyExc_TypeError, "message(channel_id, log_time, publish_time, data)");
@@ -81,47 +125,79 @@ static PyObject *Chunk_message(Chunk *c, PyObject *const *args, Py_ssize_t nargs
     unsigned long long lt = PyLong_AsUnsignedLongLong(args[1]);
     unsigned long long pt = PyLong_AsUnsignedLongLong(args[2]);
     if (PyErr_Occurred()) return NULL;
-    if (ch > 0xFFFF) {
-        PyErr_SetString(PyExc_ValueError, "channel id beyond u16");
-        return NULL;
-    }
     Py_buffer D;
     if (PyObject_GetBuffer(args[3], &D, PyBUF_SIMPLE) < 0) return NULL;
-    if (channel_slot(c, (size_t)ch) < 0 || reserve(c, 31 + (size_t)D.len) < 0) {
-        PyBuffer_Release(&D);
+    int r = append_message(c, ch, lt, pt, D.buf, (size_t)D.len);
+    PyBuffer_Release(&D);
+    if (r < 0) return NULL;
+    Py_RETURN_NONE;
+}
+
+/* json(topic, payload, t_ns): the JSON message of a topic whose channel is known, in one call
+ * (replay/log/writer.py's LogWriter.write and encode are the reference): the channel from the
+ * `json_channels` dict, the bytes from `dumps(payload)`, and when they hold "null" (orjson's NaN and
+ * infinity) `finite(payload)` must say True; then one Message record at log and publish time
+ * t_ns. True when written; False, with nothing written, for the Python path to decide (a topic
+ * without a channel yet, a TypeError of dumps, a "null" not known finite). */
+static PyObject *Chunk_json(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "json(topic, payload, t_ns)");
         return NULL;
     }
-    Index *ix = &c->index[ch];
-    if (ix->n + 2 > ix->cap) {
-        size_t cap = ix->cap ? 2 * ix->cap : 64;
-        uint64_t *p = realloc(ix->pairs, cap * sizeof(uint64_t));
-        if (!p) {
-            PyBuffer_Release(&D);
-            return PyErr_NoMemory();
+    if (!c->json_channels || !c->dumps || !c->finite) {
+        PyErr_SetString(PyExc_RuntimeError, "json(): use_json(channels, dumps, finite) first");
+        return NULL;
+    }
+    unsigned long long t = PyLong_AsUnsignedLongLong(args[2]);
+    if (t == (unsigned long long)-1 && PyErr_Occurred()) return NULL;
+    PyObject *channel = PyDict_GetItemWithError(c->json_channels, args[0]); /* borrowed */
+    if (!channel) {
+        if (PyErr_Occurred()) return NULL;
+        Py_RETURN_FALSE;
+    }
+    unsigned long long ch = PyLong_AsUnsignedLongLong(channel);
+    if (ch == (unsigned long long)-1 && PyErr_Occurred()) return NULL;
+    PyObject *data = PyObject_CallOneArg(c->dumps, args[1]);
+    if (!data) {
+        if (!PyErr_ExceptionMatches(PyExc_TypeError)) return NULL;
+        PyErr_Clear();
+        Py_RETURN_FALSE;
+    }
+    if (!PyBytes_Check(data)) {
+        Py_DECREF(data);
+        PyErr_SetString(PyExc_TypeError, "json(): dumps must return bytes");
+        return NULL;
+    }
+    const char *buf = PyBytes_AS_STRING(data);
+    size_t len = (size_t)PyBytes_GET_SIZE(data);
+    if (len >= 4 && memmem(buf, len, "null", 4)) {
+        PyObject *ok = PyObject_CallOneArg(c->finite, args[1]);
+        if (ok != Py_True) {
+            Py_DECREF(data);
+            if (!ok) return NULL;
+            Py_DECREF(ok);
+            Py_RETURN_FALSE;
         }
-        ix->pairs = p;
-        ix->cap = cap;
+        Py_DECREF(ok);
     }
-    ix->pairs[ix->n++] = lt;
-    ix->pairs[ix->n++] = c->len;
-    uint8_t *p = c->buf + c->len;
-    p[0] = 0x05;
-    le(p + 1, 2 + 4 + 8 + 8 + (uint64_t)D.len, 8);
-    le(p + 9, ch, 2);
-    le(p + 11, c->counts[ch], 4);
-    le(p + 15, lt, 8);
-    le(p + 23, pt, 8);
-    memcpy(p + 31, D.buf, (size_t)D.len);
-    c->len += 31 + (size_t)D.len;
-    PyBuffer_Release(&D);
-    c->counts[ch]++;
-    c->total++;
-    c->in_chunk++;
-    if ((Py_ssize_t)c->len > c->chunk_size) {
-        PyObject *r = PyObject_CallNoArgs(c->on_full);
-        if (!r) return NULL;
-        Py_DECREF(r);
+    int r = append_message(c, ch, t, t, buf, len);
+    Py_DECREF(data);
+    if (r < 0) return NULL;
+    Py_RETURN_TRUE;
+}
+
+static PyObject *Chunk_use_json(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3 || !PyDict_Check(args[0]) || !PyCallable_Check(args[1]) ||
+        !PyCallable_Check(args[2])) {
+        PyErr_SetString(PyExc_TypeError, "use_json(channels: dict, dumps, finite)");
+        return NULL;
     }
+    Py_INCREF(args[0]);
+    Py_XSETREF(c->json_channels, args[0]);
+    Py_INCREF(args[1]);
+    Py_XSETREF(c->dumps, args[1]);
+    Py_INCREF(args[2]);
+    Py_XSETREF(c->finite, args[2]);
     Py_RETURN_NONE;
 }
 
@@ -204,11 +280,17 @@ static int Chunk_init(Chunk *c, PyObject *args, PyObject *kw) {
 
 static int Chunk_traverse(Chunk *c, visitproc visit, void *arg) {
     Py_VISIT(c->on_full);
+    Py_VISIT(c->json_channels);
+    Py_VISIT(c->dumps);
+    Py_VISIT(c->finite);
     return 0;
 }
 
 static int Chunk_clear(Chunk *c) {
     Py_CLEAR(c->on_full);
+    Py_CLEAR(c->json_channels);
+    Py_CLEAR(c->dumps);
+    Py_CLEAR(c->finite);
     return 0;
 }
 
@@ -225,6 +307,10 @@ static void Chunk_dealloc(Chunk *c) {
 static PyMethodDef Chunk_methods[] = {
     {"message", (PyCFunction)(void (*)(void))Chunk_message, METH_FASTCALL,
      "append one Message record"},
+    {"json", (PyCFunction)(void (*)(void))Chunk_json, METH_FASTCALL,
+     "a JSON message of a known topic in one call (False: not written, the caller decides)"},
+    {"use_json", (PyCFunction)(void (*)(void))Chunk_use_json, METH_FASTCALL,
+     "the channels dict, the encoder and the finite check json() uses"},
     {"append", (PyCFunction)Chunk_append, METH_O, "append other records; returns the size"},
     {"take", (PyCFunction)Chunk_take, METH_NOARGS, "the chunk and its indexes, then empty"},
     {"count", (PyCFunction)Chunk_count, METH_O, "messages of a channel id so far"},

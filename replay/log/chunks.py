@@ -16,7 +16,7 @@ import contextlib
 import struct
 import zlib
 from contextlib import AbstractContextManager
-from typing import Any, Protocol
+from typing import Any, Callable, Protocol
 
 import zstandard
 
@@ -117,6 +117,16 @@ class McapFile:
         self._channels.append(channel)
         self._add(_record(channel))
         return channel.id
+
+    def json_messages(
+        self, channels: dict[str, int], dumps: Callable[[Any], bytes], finite: Callable[[Any], Any]
+    ) -> Callable[[str, Any, int], bool]:
+        """``json(topic, payload, t_ns)``, compiled: a message of a topic of ``channels`` (topic
+        -> channel id) as ``dumps(payload)`` (when it holds ``null``, only if ``finite(payload)``
+        is True), at log and publish time ``t_ns``; False, nothing written, otherwise (a new
+        topic, a TypeError of ``dumps``, a ``null`` not known finite: the caller decides)."""
+        self._chunk.use_json(channels, dumps, finite)
+        return self._chunk.json
 
     @property
     def message_count(self) -> int:

@@ -25,7 +25,7 @@ import signal
 import tempfile
 import threading
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import orjson
 
@@ -254,6 +254,7 @@ class LogWriter:
         self._message = self._mcap.message
         self._mcap.start(profile="", library=f"paper-replay {__version__}")
         self._json_channels: dict[str, int] = {}  # topic -> channel id
+        self._json = self._mcap.json_messages(self._json_channels, _dumps, finite)
         self._topics: set[str] = set()  # every channel's topic
         self.closed = False
 
@@ -299,20 +300,38 @@ class LogWriter:
         return channel
 
     def write(self, topic: str, payload: Any, t_ns: int) -> None:
-        """Write one message; ``t_ns`` (simulated time) is both log and publish time."""
-        data = encode(topic, payload)  # NonFiniteValueError before anything is written
-        channel = self._json_channels.get(topic) or self._json_channel(topic, payload)  # ids > 0
+        """Write one message; ``t_ns`` (simulated time) is both log and publish time.
+
+        A topic with a channel is written by one compiled call (``_chunk.c`` ``json``: orjson's
+        bytes, the finite check when they hold ``null``, the record); the rest (a topic's first
+        message, a payload only :func:`encode`'s fallbacks take, a ``null`` to look into) here,
+        the same bytes either way."""
         try:  # (compiled, so whole: a finished chunk is written under the held SIGINT)
-            self._message(channel, t_ns, t_ns, data)
+            if self._json(topic, payload, t_ns):
+                return
+            data = encode(topic, payload)  # NonFiniteValueError before anything is written
+            channel = self._json_channels.get(topic) or self._json_channel(topic, payload)
+            self._message(channel, t_ns, t_ns, data)  # (channel ids > 0)
         except OSError as exc:
-            raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+            raise self.write_error(exc) from None
 
     def write_raw(self, channel_id: int, data: bytes, t_ns: int) -> None:
         """Write one message's encoded bytes on a channel of :meth:`register_channel`."""
         try:
             self._message(channel_id, t_ns, t_ns, data)
         except OSError as exc:
-            raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+            raise self.write_error(exc) from None
+
+    @property
+    def raw_message(self) -> Callable[[int, int, int, bytes], None]:
+        """The compiled record writer :meth:`write_raw` calls, ``message(channel_id, log_time,
+        publish_time, data)``, for compiled code that writes many messages in one call (a
+        camera frame's images); the OSError it may raise is for :meth:`write_error`."""
+        return self._message
+
+    def write_error(self, exc: OSError) -> LogError:
+        """The LogError of a failed write."""
+        return LogError(f"cannot write log {self.part_path}: {exc.strerror}")
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         with self._held:

@@ -92,6 +92,8 @@ from replay.sensors.silhouette import (
     render_views,
 )
 
+_VIEWS = ("cam0", "cam1")  # the two cameras' image views (frame_images)
+
 
 @dataclass
 class StereoBallCameraParams:
@@ -369,8 +371,8 @@ class StereoBallCamera(Sensor):
         ...)]``, each its rendered window in the background (:attr:`last_images` whole)."""
         p, level = self.params, self._background_level
         return [
-            (f"cam{i}", WindowedImage(p.height, p.width, level, last[1], last[0]))
-            for i, last in enumerate(self._last)
+            (view, WindowedImage(p.height, p.width, level, last[1], last[0]))
+            for view, last in zip(_VIEWS, self._last)
             if last is not None
         ]
 

@@ -68,7 +68,7 @@ def random_window(rng) -> WindowedImage:
     """A frame of random size with a random window: noise, flat rows, repeated rows or mostly
     background inside it."""
     h, w = int(rng.integers(1, 260)), int(rng.integers(1, 260))
-    bg = int(rng.integers(0, 256))
+    bg = 0 if rng.random() < 0.2 else int(rng.integers(0, 256))  # (0: the rows' filter byte)
     x0, x1 = sorted(int(v) for v in rng.integers(0, w + 1, 2))
     y0, y1 = sorted(int(v) for v in rng.integers(0, h + 1, 2))
     pix = rng.integers(0, 256, (y1 - y0, x1 - x0)).astype(np.uint8)
@@ -112,6 +112,24 @@ def test_png_of_bool_images_and_bad_input():
             encode_png(bad)
     with pytest.raises(ValueError):  # pixels that do not fill their window
         encode_png(WindowedImage(8, 8, 0, (0, 0, 4, 4), np.zeros((3, 4), np.uint8)))
+    with pytest.raises(ValueError):  # a window's pixels are uint8
+        encode_png(WindowedImage(8, 8, 0, (0, 0, 4, 4), np.zeros((4, 4), bool)))
+
+
+def test_strided_pixels_give_the_bytes_of_their_contiguous_copy():
+    rng = np.random.default_rng(13)
+    for _ in range(50):
+        win = random_window(rng)
+        full = win.full()
+        data = encode_png(full)
+        wide = np.zeros((full.shape[0], 2 * full.shape[1]), np.uint8)
+        wide[:, ::2] = full
+        assert encode_png(wide[:, ::2]) == data  # strided columns
+        assert encode_png(np.asfortranarray(full)) == data
+        x0, y0, x1, y1 = win.window
+        tall = np.zeros((2 * (y1 - y0), x1 - x0), np.uint8)
+        tall[::2] = win.pixels
+        assert encode_png(win._replace(pixels=tall[::2])) == data  # strided rows of a window
 
 
 def test_stereo_frames_are_its_whole_images():
@@ -126,3 +144,44 @@ def test_stereo_frames_are_its_whole_images():
             assert whole is not None
             np.testing.assert_array_equal(win.full(), whole)
             assert encode_png(win) == encode_png(whole)
+
+
+def test_a_frames_images_in_one_call_are_the_messages_one_at_a_time(tmp_path):
+    """FoxgloveTopics.images (compiled: _png.messages) writes the file that writing each
+    image's png_message by write_raw writes, new views' channels made in the same order."""
+    from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
+
+    from replay.foxglove import wire
+    from replay.foxglove.png import png_message
+    from replay.foxglove.topics import FoxgloveTopics, camera_topic
+    from replay.log import LogWriter
+
+    rng = np.random.default_rng(14)
+    frames = []
+    for k in range(60):
+        views = ["cam0", "cam1", "cam2"][: int(rng.integers(1, 4))]
+        bits = rng.random((8, 8)) < 0.3
+        frames.append(
+            (
+                ["a", "b"][k % 2],
+                [(v, random_window(rng) if v != "cam2" else bits) for v in views],
+                1_000_000 * k,
+            )
+        )
+    with LogWriter(tmp_path / "one_call.mcap", chunk_size=2048) as log:
+        out = FoxgloveTopics(log)
+        for sensor, views, t_ns in frames:
+            out.images(sensor, views, t_ns)
+    with LogWriter(tmp_path / "each.mcap", chunk_size=2048) as log:
+        ref = FoxgloveTopics(log)
+        channels: dict = {}
+        for sensor, views, t_ns in frames:
+            for view, image in views:
+                if (sensor, view) not in channels:
+                    channels[sensor, view] = ref._wire(camera_topic(sensor, view), CompressedImage)
+                tail = wire.image_tail(f"{sensor}/{view}", "png")
+                log.write_raw(
+                    channels[sensor, view], png_message(wire._timestamp(t_ns), tail, image), t_ns
+                )
+    data = (tmp_path / "one_call.mcap").read_bytes()
+    assert data == (tmp_path / "each.mcap").read_bytes() and len(data) > 10_000

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
@@ -106,6 +107,22 @@ def _quat(rng):
     return tuple(float(x) for x in q) if rng.random() < 0.7 else (0.0, 0.0, 0.0, 1.0)
 
 
+def _primitives(rng, names=None):
+    """Random boxes, spheres and cylinders (named b0, s1, ... or ``names(rng)``)."""
+    prims = []
+    for i in range(int(rng.integers(0, 8))):
+        pos, q, albedo = tuple(_value(rng) for _ in range(3)), _quat(rng), rng.uniform(-1, 2)
+        kind = rng.integers(0, 3)
+        name = f"{'bsc'[kind]}{i}" if names is None else names(rng)
+        if kind == 0:
+            prims.append(Box(name, pos, q, tuple(abs(_value(rng)) for _ in range(3)), albedo))
+        elif kind == 1:
+            prims.append(Sphere(name, pos, abs(_value(rng)), albedo=albedo))
+        else:
+            prims.append(Cylinder(name, pos, q, abs(_value(rng)), 0.3, albedo=albedo))
+    return prims
+
+
 def test_wire_messages_decode_to_the_protobuf_classes_own():
     rng = np.random.default_rng(31)
     n, agree = 200, 0
@@ -115,18 +132,7 @@ def test_wire_messages_decode_to_the_protobuf_classes_own():
             Frame(_name(rng), _name(rng), tuple(_value(rng) for _ in range(3)), _quat(rng))
             for _ in range(int(rng.integers(0, 20)))
         ]
-        prims = []
-        for i in range(int(rng.integers(0, 8))):
-            pos, q, albedo = tuple(_value(rng) for _ in range(3)), _quat(rng), rng.uniform(-1, 2)
-            kind = rng.integers(0, 3)
-            if kind == 0:
-                prims.append(
-                    Box(f"b{i}", pos, q, tuple(abs(_value(rng)) for _ in range(3)), albedo)
-                )
-            elif kind == 1:
-                prims.append(Sphere(f"s{i}", pos, abs(_value(rng)), albedo=albedo))
-            else:
-                prims.append(Cylinder(f"c{i}", pos, q, abs(_value(rng)), 0.3, albedo=albedo))
+        prims = _primitives(rng)
         joints = [[_name(rng) for _ in range(7)]] + [[_value(rng) for _ in range(7)]] * 3
         data = bytes(rng.integers(0, 256, size=int(rng.integers(0, 300)), dtype=np.uint8))
         pixels = rng.integers(0, 256, size=(int(rng.integers(1, 40)), 7)).astype(np.uint8)
@@ -147,7 +153,7 @@ def test_wire_messages_decode_to_the_protobuf_classes_own():
             == reference_joints(*joints, t)
             and CompressedImage.FromString(compressed_image(t, image.frame_id, data)) == image
             and CompressedImage.FromString(
-                png_message(wire.timestamp(t), pixels, wire.image_tail("x", "png"))
+                png_message(wire.timestamp(t), wire.image_tail("x", "png"), pixels)
             )
             == png_image
         )
@@ -163,3 +169,65 @@ def test_wire_doubles_are_exact_and_the_bytes_fixed_by_the_values():
     assert tr.x == math.pi and math.copysign(1.0, tr.y) == -1.0 and tr.z == 1e-300
     assert wire.frame_transforms(f, 5) == wire.frame_transforms(list(f), 5)
     assert wire.varint(300) == b"\xac\x02" and wire.varint(0) == b"\x00"
+
+
+def test_compiled_wire_parts_equal_their_python_references():
+    """_wire.c's timestamp, frame transforms and joint states: the bytes of wire.py's Python
+    references on seeded random frames (long names: multi-byte varints), joints and times."""
+    rng = np.random.default_rng(31)
+    n, equal = 300, 0
+    for i in range(n):
+        t_ns = _t_ns(rng) if i % 3 else int(rng.integers(0, 2**62))
+        ts = wire._timestamp(t_ns)
+        frames = [
+            Frame(
+                _name(rng) * int(rng.integers(1, 30)),
+                _name(rng),
+                tuple(_value(rng) for _ in range(3)),
+                _quat(rng),
+            )
+            for _ in range(int(rng.integers(0, 20)))
+        ]
+        k = int(rng.integers(0, 9))
+        names = [_name(rng) * int(rng.integers(1, 20)) for _ in range(k)]
+        q, v, e = (
+            np.array([_value(rng) for _ in range(k + int(rng.integers(0, 2)))]) for _ in "qve"
+        )
+        prims = _primitives(rng, names=lambda rng: _name(rng) * int(rng.integers(1, 20)))
+        parent = _name(rng)
+        same = (
+            wire.timestamp(t_ns) == ts
+            and wire.frame_transforms(frames, t_ns) == wire._frame_transforms(frames, ts)
+            and wire.frame_transforms(iter(frames), t_ns) == wire._frame_transforms(frames, ts)
+            and wire.joint_states(names, q, v, e, t_ns) == wire._joint_states(names, q, v, e, ts)
+            and wire.joint_states(names, list(q), tuple(v), e, t_ns)
+            == wire._joint_states(names, q, v, e, ts)
+            and wire.body_transforms(prims, parent, t_ns)
+            == wire._body_transforms(prims, parent, t_ns)
+            and wire.scene_update(prims, parent, t_ns) == wire._scene_update(prims, parent, t_ns)
+        )
+        equal += same
+    print(f"compiled wire parts = Python references for {equal}/{n} random messages")
+    assert equal == n
+    with pytest.raises(TypeError):
+        wire.frame_transforms([Frame("a", 1, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))], 0)
+    with pytest.raises(ValueError):
+        wire.frame_transforms([Frame("a", "b", (0.0, 0.0), (0.0, 0.0, 0.0, 1.0))], 0)
+
+
+def test_log_lines_are_the_protobuf_classes_bytes():
+    from foxglove_schemas_protobuf.Log_pb2 import Log
+
+    rng = np.random.default_rng(32)
+    n = 300
+    for _ in range(n):
+        t_ns, level = _t_ns(rng), int(rng.integers(0, 6))
+        message = _name(rng) * int(rng.integers(0, 30))
+        name = "paper-replay" if rng.random() < 0.8 else _name(rng)
+        msg = Log(level=level, message=message, name=name)
+        _stamp(msg.timestamp, t_ns)
+        msg.timestamp.SetInParent()  # (set, even when 0 s 0 ns, as the topic's messages are)
+        assert wire.log_line(level, message, name, t_ns) == msg.SerializeToString(
+            deterministic=True
+        )
+    print(f"/log lines = the protobuf class's bytes for {n}/{n} random lines")
