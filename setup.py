@@ -6,9 +6,10 @@ Python reference): the list is ``ext_modules`` below."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
-# -fexcess-precision=standard: every double operation rounds once, as in Python and NumPy (the
-# kernels' tests compare with their Python references to the bit)
-FLAGS = ["-O2", "-fexcess-precision=standard"]
+# -fexcess-precision=standard and -ffp-contract=off: every double operation rounds once, as in
+# Python and NumPy (no fused multiply-adds where a CPU has them: the kernels' tests compare with
+# their Python references to the bit)
+FLAGS = ["-O2", "-fexcess-precision=standard", "-ffp-contract=off"]
 
 
 def _ext(module: str, depends: tuple[str, ...] = ()) -> Extension:
@@ -39,12 +40,19 @@ setup(
             ),
         ),
         _ext("replay.sensors._silhouette", ("replay/sensors/_ellipse.h",)),
+        # includes _pixels.c's kernels, unchanged
+        _ext(
+            "replay.sensors._stick_frame",
+            ("replay/sensors/_pixels.c", "replay/sensors/_ellipse.h"),
+        ),
         _ext("replay.control.catching._mapping"),
         _ext("replay.control.catching._ballistic"),
         _ext("replay.control.catching._torque"),
         _ext("replay.robot._chain"),
         _ext("plants.airtable._bodies"),
         _ext("replay.control.stick._sweep"),
+        _ext("replay.control.stick._contacts"),
+        _ext("replay.control.stick._fit"),
         _ext("replay.foxglove._png"),
         _ext("replay.foxglove._wire"),
         _ext("replay.log._chunk"),
@@ -52,6 +60,7 @@ setup(
         _ext("replay.control.grasping._arm_kinematics"),
         _ext("replay.control.grasping._chip_target"),
         _ext("replay.control.grasping._hand_servo"),
+        _ext("plants.bullet_arm._arm_state"),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],

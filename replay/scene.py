@@ -9,13 +9,22 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 
-@dataclass(frozen=True)
+# Box and Cylinder store their fields straight into the instance's dict: a frozen dataclass's
+# generated __init__ sets each through object.__setattr__ (~1 us a field on Python 3.11; the
+# air table makes ~800 primitives a simulated second); tests/replay/test_scene_inits.py holds
+# them to the generated signature and result.
+@dataclass(frozen=True, init=False)
 class Box:
     name: str
     position: tuple[float, float, float]
     orientation: tuple[float, float, float, float]
     size: tuple[float, float, float]  # full extents along the body x, y, z axes (m)
     albedo: float = 0.5  # 0 black .. 1 white, as a camera sees it
+
+    def __init__(self, name: str, position, orientation, size, albedo: float = 0.5) -> None:
+        d = self.__dict__
+        d["name"], d["position"], d["orientation"] = name, position, orientation
+        d["size"], d["albedo"] = size, albedo
 
 
 @dataclass(frozen=True)
@@ -26,7 +35,7 @@ class Sphere:
     albedo: float = 0.5
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Cylinder:
     name: str
     position: tuple[float, float, float]
@@ -34,6 +43,13 @@ class Cylinder:
     radius: float
     length: float
     albedo: float = 0.5
+
+    def __init__(
+        self, name: str, position, orientation, radius: float, length: float, albedo: float = 0.5
+    ) -> None:
+        d = self.__dict__
+        d["name"], d["position"], d["orientation"] = name, position, orientation
+        d["radius"], d["length"], d["albedo"] = radius, length, albedo
 
 
 Primitive = Box | Sphere | Cylinder

@@ -1,19 +1,32 @@
 """Why PyBullet's step costs more inside a catch run than bare (not part of the suite).
 
-Two measurements (CPU time, medians): (1) every ``stepSimulation`` of an unmodified run, grouped
-by the number of object-robot contact points after it; (2) a fresh plant stepped bare (its
-initial scene), once back to back and once with ~1 ms of plain Python and small NumPy work
-between steps (what a run does between two engine steps: vision, control, logging), which
-leaves the CPU caches cold for the engine.
+One unmodified run records every motor call the plant makes and the commands it is given, and
+times each ``stepSimulation`` (CPU); the same calls are then replayed into fresh plants with one
+thing added at a time. Rows: mean CPU us of the engine's step over the whole run, the flight
+(before the first contact) and the hold (contact to the end), medians of a few replays.
 
     .venv/bin/python tools/arm_engine_probe.py [scenarios/catch_optimised.yaml]
 
-Measured on this 2-core machine (catch_optimised, busy, 20:50 UTC): in the run 155 us a step
-with no contact (268 steps), 250 us with the ball in the hand (3-4 contact points, 199 steps);
-bare back to back 28 us, bare with ~1 ms of Python between steps 116 us. So the in-run cost is
-cold caches after the run's Python (~4x) and the contacts (~1.6x more), not motor calls (they
-are outside the engine's timer) nor the hand's velocity motors (stepping back to back with
-the plant's motor calls set costs about the same as bare).
+Measured on this 2-core machine (catch_optimised, 470 steps, first contact at step 267; busy,
+02:40 UTC, the bench's bare initial scene stepping in 20-28 us):
+
+- in the run 82 us a step (46 in flight, 130 in the hold);
+- the run's own motor calls replayed back to back, nothing else between: 59 (30 in flight, 97
+  in the hold). So the hold is most of it: the ball resting in the closed hand on 3-4 contact
+  points, each a multibody contact row with two friction rows through the solver's 50
+  iterations (Bullet's setupMultiBodyContactConstraint, resolveSingleConstraintRowGeneric and
+  resolveConeFrictionConstraintRows lead its profile). Bare stepping never has a contact;
+- the motors cost ~4 us a step: with no motor call at all the flight steps in 25 (the arm's
+  torques are joint forces, the hand's three velocity motors rows of the same solve);
+- the rest is cold caches: the plant's own per-step Python between the steps adds ~3 us a step,
+  the whole run ~23 (noisy: 10-45 over the session; ~1 ms of plain Python and NumPy between
+  steps makes it 138). Each PyBullet state query (getJointStates, getLinkStates,
+  getBasePositionAndOrientation, getBaseVelocity) copies PyBullet's whole ~30 KB actual-state
+  block (SendActualStateSharedMemoryStorage; valgrind: ~30 k instructions of memcpy a query,
+  ~35-55 k a query in all), so the plant reads each once a step and asks for contacts only
+  while the ball is within the robot's reach (plants/bullet_arm/reach.py).
+
+Solver settings, time step and physical parameters are the scenario's: not touched here.
 """
 
 from __future__ import annotations
@@ -40,40 +53,96 @@ def _python_work() -> None:
     np.einsum("ij,ij->", x, x)
 
 
-def main(path: str) -> None:
+def _row(label: str, us: list[float], touch: int) -> None:
+    a = np.asarray(us)
+    print(
+        f"  {label:52s} {a.mean():6.1f} | {a[:touch].mean():6.1f} {a[touch:].mean():6.1f}"
+        if touch < len(a)
+        else f"  {label:52s} {a.mean():6.1f}"
+    )
+
+
+def main(path: str, reps: int = 5) -> None:
     sc = load_scenario(path)
+    clock = time.process_time
     runner = Runner(sc)
     plant = runner.plant
-    bc = plant.bc
-    step = bc.stepSimulation  # the BulletClient's partial, bound once
-    clock = time.process_time
-    rows: dict[int, list[float]] = {}
+    motor_calls: list[list] = []
+    pending: list = []
+    commands: dict[int, list] = {}
+    run_us: list[float] = []
+    touch = [None]
+    set_motors, apply, step = plant._set_motors, plant.apply, plant.bc.stepSimulation
 
-    def timed() -> None:
+    def record_motors(*a, **kw):
+        pending.append((a, kw))
+        return set_motors(*a, **kw)
+
+    def record_apply(command):
+        commands.setdefault(plant._steps, []).append(command)
+        apply(command)
+
+    def timed_step():
+        motor_calls.append(list(pending))
+        pending.clear()
         c0 = clock()
         step()
-        dt = clock() - c0
-        n = len(bc.getContactPoints(bodyA=plant.obj, bodyB=plant.robot)) if plant.obj else 0
-        rows.setdefault(n, []).append(dt)
+        run_us.append(1e6 * (clock() - c0))
+        if touch[0] is None and plant.obj is not None:
+            if plant.bc.getContactPoints(bodyA=plant.obj, bodyB=plant.robot):
+                touch[0] = len(run_us)
 
-    bc.stepSimulation = timed
+    plant._set_motors, plant.apply, plant.bc.stepSimulation = (
+        record_motors,
+        record_apply,
+        timed_step,
+    )
     with TemporaryDirectory() as tmp:
         result = runner.run(Path(tmp) / "probe.mcap")
-    print(f"{sc.name} ({result.outcome.get('reason')}): engine step in the run, CPU us (median)")
-    print("  contact points  steps  us")
-    for n in sorted(rows):
-        print(f"  {n:14d}  {len(rows[n]):5d}  {1e6 * statistics.median(rows[n]):6.1f}")
-    for label, between in (("back to back", None), ("~1 ms of Python between", _python_work)):
-        bare_plant = type(plant)(sc.plant.params, dt=runner.dt, rng=plant.rng)
-        bare_step, ts = bare_plant.bc.stepSimulation, []
-        for _ in range(200):
-            if between:
-                between()
-            c0 = clock()
-            bare_step()
-            ts.append(clock() - c0)
-        bare_plant.close()
-        print(f"  bare (initial scene), {label}: {1e6 * statistics.median(ts):.1f} us")
+    n, k = len(run_us), touch[0] or len(run_us)
+    print(f"{sc.name} ({result.outcome.get('reason')}): {n} steps, first contact at step {k}")
+    print(f"  engine step, CPU us (mean | flight, hold){'':20s}")
+    _row("in the run", run_us, k)
+
+    def replay(between=None, motors=True, plant_too=False) -> list[float]:
+        rows = []
+        for _ in range(reps):
+            fresh = type(plant)(sc.plant.params, dt=runner.dt, rng=np.random.default_rng(0))
+            st, sm, us = fresh.bc.stepSimulation, fresh._set_motors, []
+            if plant_too:  # the plant's own per-step work around the engine's step
+
+                def timed(st=st, us=us):
+                    c0 = clock()
+                    st()
+                    us.append(1e6 * (clock() - c0))
+
+                fresh.bc.stepSimulation = timed
+                for i in range(n):
+                    for c in commands.get(i, ()):
+                        fresh.apply(c)
+                    fresh.scene()
+                    fresh.truth(i * runner.dt)
+                    if i % 10 == 0:
+                        fresh.frames()
+                    fresh.step()
+                    fresh.pop_events()
+            else:
+                for i in range(n):
+                    for a, kw in motor_calls[i] if motors else ():
+                        sm(*a, **kw)
+                    if between is not None:
+                        between()
+                    c0 = clock()
+                    st()
+                    us.append(1e6 * (clock() - c0))
+            fresh.close()
+            rows.append(us)
+        return [statistics.median(x) for x in zip(*rows)]
+
+    _row("the run's motor calls replayed back to back", replay(), k)
+    _row("the same, no motor call at all (no catch: no hold)", replay(motors=False), k)
+    _row("the run's commands through the plant (its Python)", replay(plant_too=True), k)
+    _row("the run's motor calls, ~1 ms of Python between", replay(between=_python_work), k)
 
 
 if __name__ == "__main__":

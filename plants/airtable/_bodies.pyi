@@ -3,7 +3,7 @@ each)."""
 
 from typing import Any, Callable
 
-Buffer = Any  # ptrs: array('Q') of 10 addresses; state: array('d') of 10
+Buffer = Any  # ptrs: array('Q') of 10 addresses; state: array('d') of 10; hand: array('d') of 26
 
 def read(ptrs: Buffer, state: Buffer) -> None: ...
 def step(
@@ -14,7 +14,18 @@ def step(
     tx1: float,
     ty1: float,
     dt: float,
-    space_step: Callable[[float], None],
+    space_step: Callable[[float], None] | None,
+    rest_speed: float,
+    rest_omega: float,
+    hold_speed: float,
+    hold_omega: float,
+) -> bool: ...
+def step_hand(
+    ptrs: Buffer,
+    state: Buffer,
+    hand: Buffer,
+    dt: float,
+    space_step: Callable[[float], None] | None,
     rest_speed: float,
     rest_omega: float,
     hold_speed: float,

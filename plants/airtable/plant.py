@@ -133,12 +133,20 @@ class AirTablePlant(Plant):
         self._nan_reported = False
         self._collisions = 0
         self._held_since: float | None = None  # the stick held between the tips since
-        self._io = body_state.TableIO(self.stick_body, self.tip_bodies)
+        self._io = body_state.TableIO(self.stick_body, self.tip_bodies, space)
         self._rest_speed, self._rest_omega = p.rest_speed, p.rest_omega
         self._hold_speed, self._hold_omega = p.hold_speed, p.hold_omega
         self._limits = tuple(map(float, (p.rest_speed, p.rest_omega, p.hold_speed, p.hold_omega)))
+        self._lean_step = self._io.lean_stepper(self.hand, self.dt, self._limits)
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
+        # scene(): the boxes' centre heights and sizes, and the fingertips' last primitives
+        marker_h = 0.0005
+        self._box_shapes = (
+            (st.thickness / 2.0, (st.length, st.visual_width, st.thickness)),
+            (st.thickness + marker_h / 2.0, (st.marker_length, st.marker_width, marker_h)),
+        )
+        self._tip_prims: list[Cylinder | None] = [None, None]
 
     # -- Plant interface ------------------------------------------------------------------
 
@@ -160,11 +168,18 @@ class AirTablePlant(Plant):
             self._events.append(Occurrence("limit", clamped))
 
     def step(self) -> None:
-        dt, hand, io = self.dt, self.hand, self._io
-        # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics.
-        hand.advance(dt)
-        # (a collision's velocity before is read in _on_begin, during the engine's step)
-        usual = io.step(hand.tip_list(), dt, self.space.step, self._limits)
+        io, space = self._io, self.space
+        # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics, the
+        # engine's step and the state after it (one compiled call: TableIO.step_hand)
+        # (a collision's velocity before is read in _on_begin, during the engine's step). The
+        # engine is called from C when LeanSpace.step would only call it (no body added since
+        # the last step: the collision callback adds nothing, LeanSpace's contract) and nothing
+        # wraps space.step (a timer: replay.bench)
+        lean = self._lean_step
+        if lean is not None and not space._bodies_to_check and "step" not in space.__dict__:
+            usual = lean()  # io.step_hand(self.hand, self.dt, None, self._limits)
+        else:
+            usual = io.step_hand(self.hand, self.dt, space.step, self._limits)
         self._steps += 1
         if self._pending:
             _, _, vx, vy, _, omega = io.state[:6]
@@ -389,30 +404,19 @@ class AirTablePlant(Plant):
         }
 
     def scene(self) -> Scene:
-        st = self.params.stick
-        (x, y), _, th, _ = self._state
+        x, y, _, _, th, _, t0x, t0y, t1x, t1y = self._io.state
         q = yaw_quaternion(th)
-        marker_h = 0.0005
+        (stick_z, stick_size), (marker_z, marker_size) = self._box_shapes
         prims: list = [
-            Box(
-                "stick",
-                (x, y, st.thickness / 2.0),
-                q,
-                (st.length, st.visual_width, st.thickness),
-                albedo=0.3,
-            ),
-            Box(
-                "marker",
-                (x, y, st.thickness + marker_h / 2.0),
-                q,
-                (st.marker_length, st.marker_width, marker_h),
-                albedo=1.0,
-            ),
+            Box("stick", (x, y, stick_z), q, stick_size, albedo=0.3),
+            Box("marker", (x, y, marker_z), q, marker_size, albedo=1.0),
         ]
-        h = self.params.hand
-        for k, (tx, ty) in enumerate(self._tip_pos):
-            prims.append(
-                Cylinder(
+        tips = self._tip_prims
+        for k, (tx, ty) in enumerate(((t0x, t0y), (t1x, t1y))):
+            tip = tips[k]
+            if tip is None or tip.position[0] != tx or tip.position[1] != ty:
+                h = self.params.hand
+                tip = tips[k] = Cylinder(
                     f"tip{k}",
                     (tx, ty, h.tip_height / 2.0),
                     (0.0, 0.0, 0.0, 1.0),
@@ -420,7 +424,7 @@ class AirTablePlant(Plant):
                     h.tip_height,
                     albedo=0.1,
                 )
-            )
+            prims.append(tip)  # (the last one made while the tip has not moved: frozen)
         return Scene(prims)
 
     def spec(self) -> AirTableSpec:

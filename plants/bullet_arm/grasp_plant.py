@@ -24,6 +24,7 @@ import math
 import numpy as np
 import pybullet as p
 
+from plants.bullet_arm._arm_state import joint_state
 from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.head import HeadServo
 from plants.bullet_arm.human_hand import HumanHand
@@ -172,9 +173,8 @@ class BulletGraspPlant(BulletArmPlant):
     def _read(self) -> None:
         """The base's state cache (plain floats) from one getJointStates of arm, hand and palm
         joint, with the servos' torques, the wrist's wrench and the object's state."""
-        pos, vel, reaction, eff = zip(*self._get_joint_states(self.robot, self._all_j))
-        q, qd = self._arm_q(pos, vel)
-        na, nh = self._na, len(self._hand_j)
+        states = self._get_joint_states(self.robot, self._all_j)  # arm, hand, palm joint
+        (q, qd), (hq, hqd, heff) = joint_state(states[:-1], self._na, self._pick, self._q_locked_l)
         servos = self.arm_servos
         if self._all_active:
             tau, clamped = servos.torque_l[:], servos.saturated_l[:]
@@ -184,13 +184,13 @@ class BulletGraspPlant(BulletArmPlant):
                 tau[i], clamped[i] = servos.torque_l[k], servos.saturated_l[k]
         self._tau_applied = self._tau_cmd = tau
         self._clamped = clamped
-        self.hand_servos.read(eff[na : na + nh])
-        self._wrench = self.ft.convert(reaction[-1])
+        self.hand_servos.read(heff)
+        self._wrench = self.ft.convert(states[-1][2])  # the palm joint's reaction
         opos, orn = self._get_base_pose(self.obj)
         v, w = self._get_base_velocity(self.obj)
         self._cache = (
             (q, qd),
-            (list(pos[na : na + nh]), list(vel[na : na + nh]), self.hand_servos.torque),
+            (hq, hqd, self.hand_servos.torque),
             (opos, orn, v, w),
         )
         self._head_pose = None

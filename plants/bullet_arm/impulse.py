@@ -12,17 +12,17 @@ import numpy as np
 
 class ImpulseSchedule:
     def __init__(self, entries, dt: float) -> None:
-        self._due: dict[int, np.ndarray] = {}
+        self.due: dict[int, np.ndarray] = {}  # physics step -> summed impulse (N*s), not yet given
         for e in entries:
             e = [float(x) for x in e]
             if len(e) != 4 or not np.all(np.isfinite(e)) or e[0] < 0.0:
                 raise ValueError("object_impulses: each entry is [t >= 0, Jx, Jy, Jz] (s, N*s)")
             k = int(np.ceil(e[0] / dt - 1e-9))
-            self._due[k] = self._due.get(k, np.zeros(3)) + np.asarray(e[1:])
+            self.due[k] = self.due.get(k, np.zeros(3)) + np.asarray(e[1:])
 
     def __bool__(self) -> bool:
-        return bool(self._due)
+        return bool(self.due)
 
     def pop(self, step: int) -> np.ndarray | None:
         """The summed impulse due at physics step ``step`` (None if there is none)."""
-        return self._due.pop(step, None)
+        return self.due.pop(step, None)

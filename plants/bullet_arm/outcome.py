@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from plants.bullet_arm._arm_state import palm_frame
+
 
 @dataclass
 class PalmSample:
@@ -74,33 +76,10 @@ class CatchWatch:
         caught: bool,
     ) -> None:
         """One step: the object's and the palm's state (world) and the parts touching now.
-        Written in floats (3-vectors as tuples): it runs at every physics step."""
-        qx, qy, qz, qw = palm_quat  # the palm frame's z axis and in-plane axes (world)
-        n = qx * qx + qy * qy + qz * qz + qw * qw
-        k = 2.0 / n  # (quaternion_matrix's columns, normalised there too)
-        X = (1 - k * (qy * qy + qz * qz), k * (qx * qy + qz * qw), k * (qx * qz - qy * qw))
-        Y = (k * (qx * qy - qz * qw), 1 - k * (qx * qx + qz * qz), k * (qy * qz + qx * qw))
-        Z = (k * (qx * qz + qy * qw), k * (qy * qz - qx * qw), 1 - k * (qx * qx + qy * qy))
-        ox, oy, oz = obj_pos
-        px, py, pz = palm_pos
-        th = self.palm_thickness
-        d = (ox - px - Z[0] * th, oy - py - Z[1] * th, oz - pz - Z[2] * th)
-        lx = X[0] * d[0] + X[1] * d[1] + X[2] * d[2]
-        ly = Y[0] * d[0] + Y[1] * d[1] + Y[2] * d[2]
-        lz = Z[0] * d[0] + Z[1] * d[1] + Z[2] * d[2]
-        wx, wy, wz = palm_omega
-        ax, ay, az = ox - px, oy - py, oz - pz
-        vx, vy, vz = palm_vel
-        ux, uy, uz = obj_vel
-        rel = (
-            ux - vx - (wy * az - wz * ay),
-            uy - vy - (wz * ax - wx * az),
-            uz - vz - (wx * ay - wy * ax),
+        The geometry compiled (``palm_frame``; ``palm_frame_reference`` below is its Python)."""
+        lx, ly, lz, speed, angle, d, dist2 = palm_frame(
+            obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, self.palm_thickness
         )
-        speed = math.sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2])
-        inward = -(Z[0] * rel[0] + Z[1] * rel[1] + Z[2] * rel[2])  # towards the palm face
-        angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
-        dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
         sample = (t, math.hypot(lx, ly), lz, speed, angle, d)  # PalmSample's fields
         # still closing in at the last step: this sample is the closest so far
         self.approaching = self._closest is None or dist2 < self._closest_d2
@@ -170,3 +149,38 @@ class CatchWatch:
 def _first_part(parts: list) -> str:
     """The part a first touch is attributed to: the palm if it is among them, else the first."""
     return "palm" if "palm" in parts else (parts[0] if parts else "arm")
+
+
+def palm_frame_reference(
+    obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, th: float
+) -> tuple:
+    """(lx, ly, lz, speed, angle, d, |d|^2): the object centre from the palm face centre d
+    (world) and in the palm frame, its speed relative to the palm point under it and that
+    velocity's angle (deg) from the palm's inward normal; in floats (3-vectors as tuples), the
+    reference of the compiled ``_arm_state.palm_frame``."""
+    qx, qy, qz, qw = palm_quat  # the palm frame's z axis and in-plane axes (world)
+    n = qx * qx + qy * qy + qz * qz + qw * qw
+    k = 2.0 / n  # (quaternion_matrix's columns, normalised there too)
+    X = (1 - k * (qy * qy + qz * qz), k * (qx * qy + qz * qw), k * (qx * qz - qy * qw))
+    Y = (k * (qx * qy - qz * qw), 1 - k * (qx * qx + qz * qz), k * (qy * qz + qx * qw))
+    Z = (k * (qx * qz + qy * qw), k * (qy * qz - qx * qw), 1 - k * (qx * qx + qy * qy))
+    ox, oy, oz = obj_pos
+    px, py, pz = palm_pos
+    d = (ox - px - Z[0] * th, oy - py - Z[1] * th, oz - pz - Z[2] * th)
+    lx = X[0] * d[0] + X[1] * d[1] + X[2] * d[2]
+    ly = Y[0] * d[0] + Y[1] * d[1] + Y[2] * d[2]
+    lz = Z[0] * d[0] + Z[1] * d[1] + Z[2] * d[2]
+    wx, wy, wz = palm_omega
+    ax, ay, az = ox - px, oy - py, oz - pz
+    vx, vy, vz = palm_vel
+    ux, uy, uz = obj_vel
+    rel = (
+        ux - vx - (wy * az - wz * ay),
+        uy - vy - (wz * ax - wx * az),
+        uz - vz - (wx * ay - wy * ax),
+    )
+    speed = math.sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2])
+    inward = -(Z[0] * rel[0] + Z[1] * rel[1] + Z[2] * rel[2])  # towards the palm face
+    angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
+    dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    return lx, ly, lz, speed, angle, d, dist2

@@ -16,15 +16,16 @@ PyBullet facts used (shared/robots/README.md, measured on this machine):
 from __future__ import annotations
 
 import math
-import operator
 
 import numpy as np
 
+from plants.bullet_arm._arm_state import joint_state, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
+from plants.bullet_arm.reach import robot_reach
 from plants.bullet_arm.settings import resolve
 from replay.interfaces import Occurrence, Plant
 from replay.messages import (
@@ -57,6 +58,20 @@ PER_STEP_CALLS = (
     "changeConstraint",
     "getConstraintState",
 )
+
+
+def _floats(values, n: int, what: str) -> list[float]:
+    """``np.asarray(values, dtype=float).reshape(-1).tolist()`` of ``n`` values: a flat list or
+    tuple of numbers by ``float()`` (the same doubles, no array made a step), else NumPy's."""
+    if type(values) in (list, tuple) and len(values) == n:
+        try:
+            return list(map(float, values))
+        except (TypeError, ValueError):
+            pass  # nested or odd entries: NumPy decides
+    a = np.asarray(values, dtype=float).reshape(-1)
+    if a.shape != (n,):
+        raise ValueError(f"{what} needs {n} values, got {a.shape[0]}")
+    return a.tolist()
 
 
 class BulletArmPlant(Plant):
@@ -150,12 +165,9 @@ class BulletArmPlant(Plant):
         self._na = len(self._arm_j)
         self._all_active = len(self.active) == dof  # no locked joint: no index mapping
         self._q_locked_l = [float(self.locked.get(n, 0.0)) for n in names]
-        # every arm joint's value from the read joints' (locked ones appended): one itemgetter
-        na = self._na
+        # per arm joint its read joint's index, -1 for a locked one (_arm_state.joint_state)
         slot = {i: k for k, i in enumerate(self.active)}
-        self._arm_pick = operator.itemgetter(*[slot.get(i, na + i) for i in range(dof)])
-        self._locked_tail = tuple(self._q_locked_l)
-        self._zero_tail = (0.0,) * dof
+        self._pick = tuple(slot.get(i, -1) for i in range(dof))
         # the tool frame and the palm: one getLinkStates a step (_frames_now)
         self._frame_links = [self._tool_link] + (
             [] if self._palm_link is None else [self._palm_link]
@@ -178,6 +190,7 @@ class BulletArmPlant(Plant):
             self._hand_lo_l, self._hand_hi_l = self._hand_lo.tolist(), self._hand_hi.tolist()
         self._hand_speed = float(P.hand_closing_speed)
         self._hand_forces = [float(P.hand_max_torque)] * len(self._hand_j)
+        self._hand_v: list | None = None  # the hand motors' last targets (None: none set yet)
 
         # ---- the free object
         self.obj = None
@@ -230,6 +243,8 @@ class BulletArmPlant(Plant):
         self._tlim_l = self.torque_limits.tolist()
         self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
         self._locked_l = [n in self.locked for n in self.joint_names]
+        self._locked_i = [i for i, x in enumerate(self._locked_l) if x]
+        self._enforce_vlim = bool(P.enforce_velocity_limits)
         self._contact_summary = (None, (), (), 0.0)  # (contacts list it is of, parts, links, N)
         self._contact_key: tuple = ()  # the touching links of the last summary, and their names
         self._contact_names: tuple = ((), ())
@@ -242,6 +257,12 @@ class BulletArmPlant(Plant):
             tuple(float(x) for x in P.object_velocity) if self.obj is not None else (0.0,) * 3
         )
         self._contacts: list = []
+        # beyond this distance from the base the object touches nothing of the robot (m)
+        self._contact_radius = (
+            robot_reach(bc, self.robot, self._base_pose[0], self._parent_link)
+            + (self._obj_radius if P.object == "ball" else 0.5 * math.hypot(*self._obj_size))
+            + 0.05
+        )
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
         self._cache: tuple | None = None
         self._effector = None  # (step, the tool link's state): read at most once a step
@@ -322,26 +343,19 @@ class BulletArmPlant(Plant):
         after changing the simulation other than by stepping it). Shared, never mutated: the
         accessors below give copies."""
         if self._cache is None:
-            pos, vel, _, eff = zip(*self._get_joint_states(self.robot, self._read_j))
-            q, qd = self._arm_q(pos, vel)
-            na = self._na
-            hand = (list(pos[na:]), list(vel[na:]), list(eff[na:]))
+            arm, hand = joint_state(
+                self._get_joint_states(self.robot, self._read_j),
+                self._na,
+                self._pick,
+                self._q_locked_l,
+            )
             obj = None
             if self.obj is not None:
                 pos, orn = self._get_base_pose(self.obj)
                 v, w = self._get_base_velocity(self.obj)
                 obj = (pos, orn, v, w)
-            self._cache = ((q, qd), hand, obj)
+            self._cache = (arm, hand, obj)
         return self._cache
-
-    def _arm_q(self, pos: tuple, vel: tuple) -> tuple[list, list]:
-        """(q, qd) of every arm joint from the read joints' positions and velocities (locked
-        joints at their lock value, zero speed)."""
-        if self._all_active:
-            na = self._na
-            return list(pos[:na]), list(vel[:na])
-        pick, na = self._arm_pick, self._na
-        return list(pick(pos[:na] + self._locked_tail)), list(pick(vel[:na] + self._zero_tail))
 
     def invalidate_state(self) -> None:
         """Forget the state read from PyBullet (after a reset* call: the next read is fresh)."""
@@ -384,25 +398,35 @@ class BulletArmPlant(Plant):
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ArmCommand) -> None:
-        tau = np.asarray(command.torque, dtype=float).reshape(-1)
-        if tau.shape != (self.dof,):
-            raise ValueError(f"ArmCommand.torque needs {self.dof} values, got {tau.shape[0]}")
-        self._tau_cmd = tau.tolist()
+        self._tau_cmd = _floats(command.torque, self.dof, "ArmCommand.torque")
         if command.hand is not None and self._hand_j:
-            h = np.asarray(command.hand, dtype=float).reshape(-1)
-            if h.shape != (len(self._hand_j),):
-                raise ValueError(f"ArmCommand.hand needs {len(self._hand_j)} values")
+            h = _floats(command.hand, len(self._hand_j), "ArmCommand.hand")
             # np.clip per joint in floats (NaN stays NaN, as there)
             self._hand_target = [
-                min(max(x, lo), hi)
-                for x, lo, hi in zip(h.tolist(), self._hand_lo_l, self._hand_hi_l)
+                min(max(x, lo), hi) for x, lo, hi in zip(h, self._hand_lo_l, self._hand_hi_l)
             ]
 
     def _limit_torque(self, qdl: list) -> None:
         """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
         locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
-        its speed limit further. Per joint in plain Python (4-7 floats)."""
-        enforce = self.params.enforce_velocity_limits
+        its speed limit further. The usual case (no speed limit enforced, every command finite)
+        in one pass over the joints; else joint by joint (``_limit_torque_loop``)."""
+        cmd = self._tau_cmd
+        if self._enforce_vlim or not math.isfinite(sum(cmd)):
+            self._limit_torque_loop(qdl)
+            return
+        applied = [min(max(x, -lim), lim) for x, lim in zip(cmd, self._tlim_l)]
+        clamped = [a != x for a, x in zip(applied, cmd)]
+        for i in self._locked_i:
+            applied[i], clamped[i] = 0.0, False
+        self._tau_applied = applied
+        if True in clamped:
+            self._torque_events(clamped)
+        self._clamped = self._torque_episode = clamped
+
+    def _limit_torque_loop(self, qdl: list) -> None:
+        """``_limit_torque`` joint by joint in plain Python (4-7 floats)."""
+        enforce = self._enforce_vlim
         cmd = self._tau_cmd
         applied, clamped = [0.0] * self.dof, [False] * self.dof
         sign = lambda x: (x > 0.0) - (x < 0.0)  # noqa: E731  (np.sign)
@@ -417,24 +441,29 @@ class BulletArmPlant(Plant):
             if enforce and abs(qdl[i]) >= self._vlim_l[i] and sign(a) == sign(qdl[i]) and a != 0:
                 a, c = 0.0, True
             applied[i], clamped[i] = a, c
-        if True in clamped:
-            for i, c in enumerate(clamped):
-                if c and not self._torque_episode[i]:
-                    x = cmd[i]
-                    self._events.append(
-                        Occurrence(
-                            "torque_limit",
-                            {
-                                "joint": self.joint_names[i],
-                                "commanded": x if math.isfinite(x) else None,
-                                "applied": applied[i],
-                                "limit": self._tlim_l[i],
-                            },
-                        )
-                    )
-            self.clamp_count += sum(clamped)
         self._tau_applied = applied
+        if True in clamped:
+            self._torque_events(clamped)
         self._clamped = self._torque_episode = clamped
+
+    def _torque_events(self, clamped: list) -> None:
+        """A torque_limit event per joint clamped now and not the step before; the count."""
+        cmd, applied = self._tau_cmd, self._tau_applied
+        for i, c in enumerate(clamped):
+            if c and not self._torque_episode[i]:
+                x = cmd[i]
+                self._events.append(
+                    Occurrence(
+                        "torque_limit",
+                        {
+                            "joint": self.joint_names[i],
+                            "commanded": x if math.isfinite(x) else None,
+                            "applied": applied[i],
+                            "limit": self._tlim_l[i],
+                        },
+                    )
+                )
+        self.clamp_count += sum(clamped)
 
     def step(self) -> None:
         bc = self.bc
@@ -445,23 +474,27 @@ class BulletArmPlant(Plant):
             self.robot,
             self._arm_j,
             p.TORQUE_CONTROL,
-            forces=[applied[i] for i in self.active],
+            forces=applied if self._all_active else [applied[i] for i in self.active],
         )
         if self._hand_j:
             speed, dt = self._hand_speed, self.dt
             # rate-limited position servo: reach the target at most at the closing speed, the
             # last step landing on it (PyBullet's velocity motor is implicit, so this is stable)
             v = [min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])]
-            self._set_motors(
-                self.robot,
-                self._hand_j,
-                p.VELOCITY_CONTROL,
-                targetVelocities=v,
-                forces=self._hand_forces,
-            )
+            # PyBullet keeps a velocity motor's target and force until set again: the same
+            # targets as last step (closing at full speed, at rest) need no call
+            if v != self._hand_v:
+                self._set_motors(
+                    self.robot,
+                    self._hand_j,
+                    p.VELOCITY_CONTROL,
+                    targetVelocities=v,
+                    forces=self._hand_forces,
+                )
+                self._hand_v = v
         if obj is not None:
             pos, _, v, w = obj
-            J = self._impulses.pop(self._steps) if self._impulses else None
+            J = self._impulses.pop(self._steps) if self._impulses.due else None
             if J is not None:  # a scenario-set kick (impulse.py)
                 v = (np.asarray(v) + J / self.params.object_mass).tolist()
                 bc.resetBaseVelocity(self.obj, v, list(w))
@@ -485,8 +518,18 @@ class BulletArmPlant(Plant):
         self._check_events()
 
     # ------------------------------------------------------------------ events
-    def _robot_contacts(self):
-        """Contact points object-robot that touch (normal force > 0 or no gap)."""
+    def _robot_contacts(self, pos, v) -> list:
+        """Contact points object-robot that touch (normal force > 0 or no gap); none while
+        the object at ``pos`` (moving at ``v``) is beyond the robot's reach (reach.py) by more
+        than its bounding radius, its travel in two steps and 5 cm: no point can be there (the
+        points of a step are found at its start, nearer than Bullet's contact threshold)."""
+        x, y, z = pos
+        bx, by, bz = self._base_pose[0]
+        vx, vy, vz = v
+        far = self._contact_radius + 2.0 * self.dt * math.sqrt(vx * vx + vy * vy + vz * vz)
+        dx, dy, dz = x - bx, y - by, z - bz
+        if dx * dx + dy * dy + dz * dz > far * far:
+            return []
         pts = self._get_contact_points(bodyA=self.obj, bodyB=self.robot)
         return [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
 
@@ -500,24 +543,12 @@ class BulletArmPlant(Plant):
                 self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
             )
         (vx, vy, vz), (wx, wy, wz), (cx, cy, cz) = ls[6], ls[7], ls[0]
-        rx, ry, rz = (float(x) for x in point)
+        rx, ry, rz = map(float, point)
         rx, ry, rz = rx - cx, ry - cy, rz - cz  # v + w x (point - link COM)
         return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx)
 
-    def _check_events(self) -> None:
-        P = self.params
-        (ql, qdl), _, obj = self._state()  # per-joint checks on 4-7 floats: plain Python
-        isfinite = math.isfinite
-        finite = all(map(isfinite, ql)) and all(map(isfinite, qdl))
-        if obj is not None:
-            pos, orn, v, w = obj
-            finite = finite and all(map(isfinite, pos)) and all(map(isfinite, v))
-        if not finite:
-            if not self.diverged:
-                self.diverged = True
-                self._events.append(Occurrence("nan", {"step": self._steps}))
-            return
-        over = [abs(x) > lim for x, lim in zip(qdl, self._vlim_l)]
+    def _limit_events(self, ql: list, qdl: list, over: list, at: list) -> None:
+        """velocity_limit and joint_limit events of the joints whose flags rose this step."""
         for i in range(self.dof) if over != self._vel_over else ():
             if over[i] and not self._vel_over[i]:
                 self._events.append(
@@ -531,7 +562,6 @@ class BulletArmPlant(Plant):
                     )
                 )
         self._vel_over = over
-        at = [x <= lo or x >= hi for x, lo, hi in zip(ql, self._lower_l, self._upper_l)]
         for i in range(self.dof) if at != self._at_limit else ():
             if at[i] and not self._at_limit[i] and not self._locked_l[i]:
                 self._events.append(
@@ -546,9 +576,35 @@ class BulletArmPlant(Plant):
                     )
                 )
         self._at_limit = at
+
+    def _check_events(self) -> None:
+        P = self.params
+        (ql, qdl), _, obj = self._state()
+        pos = v = None
+        if obj is not None:
+            pos, orn, v, w = obj
+        flags = limit_flags(
+            ql,
+            qdl,
+            pos,
+            v,
+            self._vlim_l,
+            self._lower_l,
+            self._upper_l,
+            self._vel_over,
+            self._at_limit,
+        )
+        if flags is not None:  # not finite, or a joint's limit flags changed
+            finite, over, at = flags
+            if not finite:
+                if not self.diverged:
+                    self.diverged = True
+                    self._events.append(Occurrence("nan", {"step": self._steps}))
+                return
+            self._limit_events(ql, qdl, over, at)
         if obj is None:
             return
-        contacts = self._robot_contacts()
+        contacts = self._robot_contacts(pos, v)
         self._contacts = contacts
         parts, links, _ = self._contact_summary_now()
         if contacts and not self._in_contact:

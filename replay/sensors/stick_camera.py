@@ -65,7 +65,7 @@ from replay.params import ParamError, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
-from replay.sensors import _pixels
+from replay.sensors import _pixels, _stick_frame
 from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
 
@@ -341,6 +341,17 @@ class StickCamera(Sensor):
         self.camera = self.make_camera(params)
         self._R = tuple(tuple(float(v) for v in row) for row in self.camera.rotation)
         self._o = tuple(float(v) for v in self.camera.position)
+        k = self.camera.intrinsics
+        self._frame_camera = (  # _stick_frame.measure's camera, made once
+            np.ascontiguousarray(self.camera.rotation, dtype=np.float64),
+            np.ascontiguousarray(self.camera.position, dtype=np.float64),
+            float(k.fx), float(k.fy), float(k.cx), float(k.cy),
+            int(params.width), int(params.height), float(params.background),
+            float(params.threshold), int(params.min_pixels), str(params.marker),
+            Box, Cylinder, self._o, math.dist,
+            float(params.position_offset[0]), float(params.position_offset[1]),
+        )  # fmt: skip
+        self._shapes: dict = {}  # _frame's (body points, bounding radius, hull buffer) by shape
         self._last = None
 
     # --- helpers usable without a sensor instance -------------------------------------------
@@ -448,6 +459,50 @@ class StickCamera(Sensor):
         ]
 
     def measure(self, t: float, scene: Scene) -> VisionStick | None:
+        """The marker's pose in a frame of ``scene``: noise-free frames in one compiled call
+        (:meth:`_frame`, the same pixels, moments and pose as :meth:`measure_reference`), the
+        rest (noise, a scene with spheres, no marker in view: the whole image) by the
+        reference."""
+        framed = self._frame(scene) if self.params.noise_sigma == 0.0 else None
+        if framed is None:
+            return self.measure_reference(t, scene)
+        img, window, pose = framed
+        self._last = (img, window)
+        return None if pose is None else VisionStick(t, *pose)
+
+    def _frame(self, scene: Scene):
+        """(image window, window, pose (x, y, theta) or None) of a noise-free frame in one
+        compiled call (``_stick_frame.measure``: the steps of :meth:`measure_reference`, its
+        kernels and :meth:`_pose`), or None when the reference path must do it."""
+        prims, shapes = scene.primitives, self._shapes
+        while True:
+            framed = _stick_frame.measure(prims, shapes, self._frame_camera)
+            if framed is None or framed[0] is not None:
+                break
+            _, i, key = framed  # a shape not seen yet: its outline points, once
+            shapes[key] = self._shape(prims[i])
+        if framed is None:
+            return None
+        data, window, _, pose = framed
+        img = np.frombuffer(data, np.uint8).reshape(window[3] - window[1], window[2] - window[0])
+        return img, window, pose
+
+    @staticmethod
+    def _shape(prim: Box | Cylinder) -> tuple[np.ndarray, float, np.ndarray]:
+        """(body outline points, bounding-sphere radius as :func:`_misses` takes it, a hull
+        buffer) of a box or cylinder, for :meth:`_frame`."""
+        body = _body_points(prim)
+        if isinstance(prim, Box):
+            sx, sy, sz = prim.size
+            rb = 0.5 * math.sqrt(sx * sx + sy * sy + sz * sz)
+        else:
+            rb = math.hypot(prim.radius, 0.5 * prim.length)
+        return body, rb, np.empty((len(body), 2))
+
+    def measure_reference(self, t: float, scene: Scene) -> VisionStick | None:
+        """:meth:`measure` in Python between the compiled kernels (the reference of
+        ``_stick_frame.frame``, tests/replay/sensors/test_stick_frame.py, and the path of frames
+        with noise)."""
         p = self.params
         cam = self.camera
         # Only a window around the marker is rendered (and given noise): the moments use
@@ -482,8 +537,13 @@ class StickCamera(Sensor):
         if marker is None:
             return None
         found = self._moments(img, p, window[:2])  # (marker_moments without its dict)
+        return self._pose(t, marker, found)
+
+    def _pose(self, t: float, marker: Box, found: tuple | None) -> VisionStick | None:
+        """The measurement from the marker's moments (``_pixels.marker_moments``), or None."""
         if found is None:
             return None
+        p = self.params
         # The marker's silhouette seen from above is its top face swept down to its bottom face;
         # its centroid lies on the ray through the box's centre (exactly so for a thin box), so
         # the centroid is back-projected onto the horizontal plane through the marker's centre.

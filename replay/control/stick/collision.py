@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replay.control.stick import _contacts
 from replay.robot.stick_impact import quadratic_roots as _roots
 
 
@@ -169,7 +170,7 @@ def approach_speed(theta: float, r_x: float, side: int, u_prev) -> float:
     return -(nx * vx + ny * vy + (-ay * nx + ax * ny) * w)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class ContactSolution:
     """One planned friction independent collision: where, from which side, and what it does."""
 
@@ -181,6 +182,24 @@ class ContactSolution:
     roots: tuple  # both roots of eq. 25 / 28 (m)
     condition: float  # C_i (eq. 26) of the chosen root (m/s)
     length: float | None = None
+
+    def __init__(
+        self,
+        theta: float,
+        side: int,
+        r_x: float,
+        u_before: tuple,
+        u_after: tuple,
+        roots: tuple,
+        condition: float,
+        length: float | None = None,
+    ) -> None:
+        # the fields straight into the instance's dict (a frozen dataclass's generated __init__ sets
+        # each through object.__setattr__, ~1 us a field on Python 3.11; test_stick_fast_paths.py
+        # holds this one to the generated one's result)
+        d = self.__dict__
+        d["theta"], d["side"], d["r_x"], d["u_before"] = theta, side, r_x, u_before
+        d["u_after"], d["roots"], d["condition"], d["length"] = u_after, roots, condition, length
 
     @property
     def within(self) -> bool:
@@ -210,7 +229,38 @@ def contact_options(
     Both roots of one side can pass eq. 26 (e.g. F_V,1(0) for the Fig. 7 numbers: r_x = -25.8 mm
     gives omega_1 = -10 rad/s, r_x = +10.5 mm gives +18 rad/s): the strategy's own rule (eq. 31,
     35 or 37) then chooses. Roots beyond the stick (|r_x| > L/2) are kept, ``within`` False.
+    The roots, J_i u and C_i are solved compiled (``_contacts.options``: the operations of
+    :func:`contact_options_reference`, its reference).
     """
+    if (omega is None) == (speed is None):
+        raise ValueError("give exactly one of omega, speed")
+    u = _u3(u_prev)
+    if omega is not None:
+        target, by_speed, v = float(omega), False, 0.0
+    else:
+        target, by_speed, v = float(speed), True, math.hypot(u[0], u[1])  # type: ignore[arg-type]
+    return [
+        ContactSolution(theta, side, r, u, after, roots, condition, length)
+        for side, r, after, roots, condition in _contacts.options(
+            m, inertia, e, theta, u[0], u[1], u[2], target, by_speed, v, sides
+        )
+    ]
+
+
+def contact_options_reference(
+    m: float,
+    inertia: float,
+    e: float,
+    theta: float,
+    u_prev,
+    *,
+    omega: float | None = None,
+    speed: float | None = None,
+    length: float | None = None,
+    sides=(1, -1),
+) -> list[ContactSolution]:
+    """:func:`contact_options` in Python (f_omega, f_v, _terms, _after, approach_speed): the
+    reference of its compiled kernel (``_contacts.options``, tests/.../test_contacts_kernel.py)."""
     if (omega is None) == (speed is None):
         raise ValueError("give exactly one of omega, speed")
     u = _u3(u_prev)

@@ -18,19 +18,23 @@ outlier is dropped); the fit then restarts from the deviating samples, and
 :meth:`StickEstimator.add` returns True.
 
 Defaults (SI): window 30 samples (0.1 s at 300 fps), ready after 6 samples (20 ms), pos_tol
-0.002 m, theta_tol 0.03 rad, confirm 2. Pure NumPy.
+0.002 m, theta_tol 0.03 rad, confirm 2. Pure Python; the running sums and the fit are compiled
+(``_fit.c``, with their Python references).
 """
 
 from __future__ import annotations
 
 import math
+from array import array
 from dataclasses import dataclass
+
+from replay.control.stick import _fit
 
 
 REANCHOR = 1.0  # s, the running sums are rebuilt from the window once their anchor is this old
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class StickEstimate:
     """The constant-velocity fit, evaluated at ``t_ref`` (the latest sample's time)."""
 
@@ -44,6 +48,27 @@ class StickEstimate:
     n: int  # samples in the fit
     rms_xy: float  # m, residual rms of the position fit
     rms_theta: float  # rad, residual rms of the orientation fit
+
+    def __init__(
+        self,
+        t_ref: float,
+        x: float,
+        y: float,
+        theta: float,
+        vx: float,
+        vy: float,
+        omega: float,
+        n: int,
+        rms_xy: float,
+        rms_theta: float,
+    ) -> None:
+        # the fields straight into the instance's dict (a frozen dataclass's generated __init__ sets
+        # each through object.__setattr__, ~1 us a field on Python 3.11; test_stick_fast_paths.py
+        # holds this one to the generated one's result)
+        d = self.__dict__
+        d["t_ref"], d["x"], d["y"], d["theta"] = t_ref, x, y, theta
+        d["vx"], d["vy"], d["omega"] = vx, vy, omega
+        d["n"], d["rms_xy"], d["rms_theta"] = n, rms_xy, rms_theta
 
     @property
     def u(self) -> tuple[float, float, float]:
@@ -165,11 +190,17 @@ class StickEstimator:
     # restart and once the anchor is REANCHOR old (rounding never accumulates for long).
     def _rebuild(self) -> None:
         self._anchor = self._samples[0] if self._samples else (0.0, 0.0, 0.0, 0.0)
-        self._sums = [0.0] * 12
+        self._sums = array("d", [0.0] * 12)
         for sample in self._samples:
             self._sum(sample, 1.0)
 
     def _sum(self, sample, sign: float) -> None:
+        """Add ``sign`` times the sample's terms to the running sums (compiled: ``_fit.add``,
+        the operations of :meth:`_sum_reference`)."""
+        _fit.add(self._sums, self._anchor, sample, sign)
+
+    def _sum_reference(self, sample, sign: float) -> None:
+        """:meth:`_sum` in Python (its reference, test_fit_kernel.py)."""
         t0, x0, y0, th0 = self._anchor
         ts, xs, ys, ths = sample
         t = ts - t0
@@ -193,7 +224,20 @@ class StickEstimator:
 
     def _refit(self) -> None:
         """Least squares of (x, y, theta) = value at t_ref + rate (t - t_ref), in closed form
-        from the running sums (rate = S_tv / S_tt of the centred sums)."""
+        from the running sums (rate = S_tv / S_tt of the centred sums; compiled: ``_fit.fit``,
+        the operations of :meth:`_refit_reference`)."""
+        samples = self._samples
+        n = len(samples)
+        t_ref = samples[-1][0]
+        if n == 1:
+            _, x, y, th = samples[0]
+            self._fit = StickEstimate(t_ref, x, y, th, 0.0, 0.0, 0.0, 1, 0.0, 0.0)
+            return
+        x, vx, y, vy, th, w, rms_xy, rms_th = _fit.fit(self._sums, self._anchor, n, t_ref)
+        self._fit = StickEstimate(t_ref, x, y, th, vx, vy, w, n, rms_xy, rms_th)
+
+    def _refit_reference(self) -> None:
+        """:meth:`_refit` in Python (its reference, test_fit_kernel.py)."""
         samples = self._samples
         n = len(samples)
         t_ref = samples[-1][0]

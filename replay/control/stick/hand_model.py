@@ -33,10 +33,17 @@ from replay.robot.hand2d import HandCommand, HandSpec
 # ------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Config:
     base: tuple  # (x, y) m
     joints: tuple  # ((q1, q2), (q1, q2)) rad
+
+    def __init__(self, base: tuple, joints: tuple) -> None:
+        # the fields straight into the instance's dict (a frozen dataclass's generated __init__ sets
+        # each through object.__setattr__, ~1 us a field on Python 3.11; test_stick_fast_paths.py
+        # holds this one to the generated one's result)
+        d = self.__dict__
+        d["base"], d["joints"] = base, joints
 
     def with_finger(self, k: int, q) -> "Config":
         j = [tuple(self.joints[0]), tuple(self.joints[1])]
@@ -70,7 +77,13 @@ class HandModel:
 
     def advance(self, t: float) -> None:
         now, target = self.config, self.target
-        if self._t is not None and t > self._t and now is not target and now != target:
+        # (Config equality field by field: what the dataclass's == compares, without its tuples)
+        if (
+            self._t is not None
+            and t > self._t
+            and now is not target
+            and (now.base != target.base or now.joints != target.joints)
+        ):
             dt = t - self._t
             sb = self.hand.base_speed * dt
             sq = self.hand.joint_speed * dt
@@ -84,7 +97,8 @@ class HandModel:
                 ),
             )
             # on the target: the target itself (equal numbers), so later ticks see it at once
-            self.config = target if moved == target else moved
+            same = moved.base == target.base and moved.joints == target.joints
+            self.config = target if same else moved
         self._t = t
 
 
@@ -157,11 +171,13 @@ def base_candidates(hand: HandSpec, k: int, tip, here: tuple) -> list[tuple]:
     out = []
     if np.linalg.norm(np.asarray(tip) - root - np.array(here)) <= 0.85 * reach:
         out.append(here)
+    # (tip - root - rho (cos a, sin a)) clipped to the range, in scalars: NumPy's operations
+    tx, ty = float(tip[0]) - float(root[0]), float(tip[1]) - float(root[1])
     for rho in (0.7 * reach, 0.5 * reach, 0.85 * reach):
         for deg in (90.0, 65.0, 115.0, 40.0, 140.0):
             a = math.radians(deg)
-            b = np.asarray(tip) - root - rho * np.array([math.cos(a), math.sin(a)])
-            out.append((float(np.clip(b[0], xlo, xhi)), float(np.clip(b[1], ylo, yhi))))
+            bx, by = tx - rho * math.cos(a), ty - rho * math.sin(a)
+            out.append((hand2d.clip_scalar(bx, xlo, xhi), hand2d.clip_scalar(by, ylo, yhi)))
     return out
 
 

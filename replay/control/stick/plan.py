@@ -143,6 +143,7 @@ class ContactPlanner:
             l2 * np.cos(q[:, 0] + q[:, 1]),
             l2 * np.sin(q[:, 0] + q[:, 1]),
         )
+        self._grid_reach_lists = tuple(a.tolist() for a in self._grid_reach)  # (_passive)
         (r0x, r0y), (r1x, r1y) = hand.root_offsets
         self._geometry = tuple(map(float, (l1, l2, r0x, r0y, r1x, r1y)))
         self._speeds = (float(hand.base_speed), float(hand.joint_speed))
@@ -400,7 +401,29 @@ class ContactPlanner:
 
     def _exit_config(self, t: float, now: Config, motion: Motion) -> Config | None:
         """``now`` with every fingertip within the stick's reach moved radially out of it
-        (base kept), or None when no tip is inside or a tip cannot get out."""
+        (base kept), or None when no tip is inside or a tip cannot get out. In floats: the
+        operations of the array version (:meth:`_exit_config_reference`; a 2-vector's norm is
+        sqrt(x x + y y), as NumPy's dot sums it here: test_stick_fast_paths.py)."""
+        p, st, hand = self.params, self.stick, self.hand
+        cx, cy, _ = motion.pose_floats(t)
+        r_in = 0.5 * st.length + hand.tip_radius + p.sweep_margin
+        r_out = 0.5 * st.length + hand.tip_radius + p.stage_margin
+        cfg, moved = now, False
+        for k in (0, 1):
+            tx, ty = hand2d.finger_tip_xy(hand, now.base, k, now.joints[k])
+            dx, dy = tx - cx, ty - cy
+            dist = math.sqrt(dx * dx + dy * dy)
+            if dist >= r_in or dist < 1e-9:
+                continue
+            out = (cx + dx / dist * r_out, cy + dy / dist * r_out)
+            q = hand2d.finger_ik(hand, now.base, k, out, q_near=now.joints[k])
+            if q is None:
+                return None
+            cfg, moved = cfg.with_finger(k, q), True
+        return cfg if moved else None
+
+    def _exit_config_reference(self, t: float, now: Config, motion: Motion) -> Config | None:
+        """:meth:`_exit_config` on arrays (its reference)."""
         p, st, hand = self.params, self.stick, self.hand
         c, _ = motion.pose(t)
         r_in = 0.5 * st.length + hand.tip_radius + p.sweep_margin
@@ -420,7 +443,34 @@ class ContactPlanner:
     def _passive(self, cfg: Config, j: int, sweep: Sweep, active_tip):
         """The idle finger's joints nearest its current ones whose tip stays clear of the
         predicted sweep (and of the active tip); None when no posture is clear. Postures are
-        checked nearest first (ties: current, then grid order), the first clear one wins."""
+        checked nearest first (ties: current, then grid order), the first clear one wins; a
+        posture's tip is worked out only when its turn comes (the floats of the array
+        formulation, :meth:`_passive_reference`, test_stick_fast_paths.py)."""
+        hand, st, p = self.hand, self.stick, self.params
+        cur = cfg.joints[j]
+        c0, c1 = cur
+        grid = self._passive_grid
+        dist = [0.0] + [max(abs(q1 - c0), abs(q2 - c1)) for q1, q2 in grid]
+        g0, g1, g2, g3 = self._grid_reach_lists
+        rx, ry = cfg.base[0] + hand.root_offsets[j][0], cfg.base[1] + hand.root_offsets[j][1]
+        ax, ay = float(active_tip[0]), float(active_tip[1])
+        near = 2.0 * hand.tip_radius + p.sweep_margin
+        half_l, half_w, grow = 0.5 * st.length, 0.5 * st.width, hand.tip_radius + p.sweep_margin
+        for i in sorted(range(len(dist)), key=dist.__getitem__):  # (stable: ties in order)
+            if i == 0:
+                tx, ty = hand2d.finger_tip_xy(hand, cfg.base, j, cur)
+            else:
+                tx, ty = (rx + g0[i - 1]) + g2[i - 1], (ry + g1[i - 1]) + g3[i - 1]
+            dx, dy = tx - ax, ty - ay
+            if math.sqrt(dx * dx + dy * dy) > near and not sweep.hits(
+                (tx, ty), half_l, half_w, grow
+            ):
+                return tuple(cur) if i == 0 else grid[i - 1]
+        return None
+
+    def _passive_reference(self, cfg: Config, j: int, sweep: Sweep, active_tip):
+        """:meth:`_passive` on arrays: every posture's tip and distance, then the first clear
+        one in order (its reference)."""
         hand, st, p = self.hand, self.stick, self.params
         cur = cfg.joints[j]
         g = self._grid_reach  # (l1 cos q1, l1 sin q1, l2 cos q12, l2 sin q12) of the grid

@@ -25,13 +25,21 @@ from replay.control.stick.estimator import StickEstimate
 SAMPLE_DT = 0.001  # s, time step of the predicted-sweep checks
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Motion:
     """Constant velocities from ``est``; from ``t_switch`` on, ``u_after`` (a planned contact)."""
 
     est: StickEstimate
     t_switch: float = math.inf
     u_after: tuple = (0.0, 0.0, 0.0)
+
+    def __init__(
+        self, est: StickEstimate, t_switch: float = math.inf, u_after: tuple = (0.0, 0.0, 0.0)
+    ) -> None:
+        # the fields straight into the instance's dict (the generated frozen __init__ costs
+        # ~1 us a field on Python 3.11; tests/replay/test_scene_inits.py holds it to that one)
+        d = self.__dict__
+        d["est"], d["t_switch"], d["u_after"] = est, t_switch, u_after
 
     def poses(self, times) -> tuple[np.ndarray, np.ndarray]:
         t = np.asarray(times, dtype=float)
@@ -67,6 +75,11 @@ class Motion:
         )
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
+        x, y, th = self.pose_floats(t)
+        return np.array([x, y]), float(th)
+
+    def pose_floats(self, t: float) -> tuple[float, float, float]:
+        """:meth:`pose` as (x, y, theta) floats."""
         e, ts = self.est, self.t_switch
         t1 = min(t, ts) - e.t_ref
         x, y, th = e.x + e.vx * t1, e.y + e.vy * t1, e.theta + e.omega * t1
@@ -74,7 +87,7 @@ class Motion:
             t2 = max(t - ts, 0.0)
             u = self.u_after
             x, y, th = x + u[0] * t2, y + u[1] * t2, th + u[2] * t2
-        return np.array([x, y]), float(th)
+        return x, y, th
 
 
 def _body(motion: Motion, times, points) -> tuple[np.ndarray, np.ndarray]:

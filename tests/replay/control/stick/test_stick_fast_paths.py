@@ -198,3 +198,110 @@ def test_reach_bound_finds_the_exhaustive_search_plan():
             assert fast.finger == slow.finger and fast.config == slow.config
             assert fast.route == slow.route
     assert compared >= 1
+
+
+def test_base_candidates_in_scalars_are_numpys():
+    """base_candidates works in scalars (hand2d.clip_scalar for np.clip): the bases NumPy's and
+    np.clip gave, to the bit, for seeded random tips and current bases (in and beyond the
+    slider range)."""
+    hand = air_spec().hand
+    (xlo, xhi), (ylo, yhi) = hand.base_limits
+    rng = np.random.default_rng(21)
+    reach = sum(hand.link_lengths)
+    for _ in range(300):
+        k = int(rng.integers(2))
+        tip, here = rng.uniform(-0.45, 0.45, 2), tuple(float(v) for v in rng.uniform(-0.3, 0.3, 2))
+        root = np.array(hand.root_offsets[k])
+        ref = [here] if np.linalg.norm(tip - root - np.array(here)) <= 0.85 * reach else []
+        for rho in (0.7 * reach, 0.5 * reach, 0.85 * reach):
+            for deg in (90.0, 65.0, 115.0, 40.0, 140.0):
+                a = math.radians(deg)
+                b = np.asarray(tip) - root - rho * np.array([math.cos(a), math.sin(a)])
+                ref.append((float(np.clip(b[0], xlo, xhi)), float(np.clip(b[1], ylo, yhi))))
+        got = base_candidates(hand, k, tip, here)
+        assert repr(got) == repr(ref)  # (repr: -0.0 and 0.0 told apart)
+
+
+def test_hand2d_clips_are_np_clips():
+    """hand2d.clip against np.clip of arrays, clip_scalar against np.clip of a float64 scalar
+    (NumPy's two paths differ at signed zeros): NaN, signed zeros, limits and beyond."""
+    from replay.robot.hand2d import clip, clip_scalar
+
+    rng = np.random.default_rng(4)
+    vals = [math.nan, -0.0, 0.0, math.inf, -math.inf, *rng.uniform(-3.0, 3.0, 200)]
+    lims = [(-1.0, 1.0), (0.0, 2.0), (-2.0, -0.0), (-0.0, 0.0), (0.5, 0.5)]
+    for v in vals:
+        for lo, hi in lims:
+            arr = np.clip(np.array([v]), np.array([lo]), np.array([hi]))[0]
+            assert repr(clip(float(v), lo, hi)) == repr(float(arr))
+            assert repr(clip_scalar(float(v), lo, hi)) == repr(
+                float(np.clip(np.float64(v), lo, hi))
+            )
+
+
+def test_passive_posture_search_is_the_array_references():
+    """ContactPlanner._passive (postures in order of distance, each tip worked out only when its
+    turn comes) against _passive_reference (every tip and distance as arrays, then the first
+    clear one): the same posture or None, for seeded random idle postures, active tips and
+    spinning sticks over the idle tip (so that nearer postures are often swept)."""
+    ctrl, _, _ = three_step_run(1e-4, t_end=0.12)
+    planner, hand, rng = ctrl.planner, ctrl.hand, np.random.default_rng(31)
+    (a0, a1), (b0, b1) = hand.joint_limits
+    moved = compared = 0
+    for _ in range(300):
+        j = int(rng.integers(2))
+        cfg = ctrl.model.config.with_finger(j, (rng.uniform(a0, a1), rng.uniform(b0, b1)))
+        x, y = cfg.tip(hand, j) + rng.normal(0.0, 0.02, 2)
+        est = StickEstimate(
+            0.0, x, y, 0.0, *rng.normal(0.0, 0.3, 2), rng.normal(0.0, 30.0), 6, 0, 0
+        )
+        sweep = Sweep(Motion(est, 0.1, tuple(rng.normal(0.0, 1.0, 3))), 0.0, 0.3)
+        active = cfg.tip(hand, 1 - j) + rng.normal(0.0, 0.01, 2)
+        got = planner._passive(cfg, j, sweep, active)
+        assert got == planner._passive_reference(cfg, j, sweep, active)
+        compared += 1
+        moved += got is not None and got != tuple(cfg.joints[j])
+    print(f"_passive = reference in {compared} cases ({moved} moved the idle finger)")
+    assert moved > 0.3 * compared
+
+
+def test_exit_config_in_floats_is_the_array_references():
+    """ContactPlanner._exit_config (floats) against _exit_config_reference (NumPy arrays, a
+    2-vector's norm by np.linalg.norm): the same configuration or None, for seeded random hands
+    with fingertips inside, at the edge of and outside the stick's reach. Within 1e-12: NumPy's
+    2-element dot is BLAS's, which may fuse x x + y y on another CPU (equal to the bit here)."""
+    ctrl, _, _ = three_step_run(1e-4, t_end=0.12)
+    planner, hand, rng = ctrl.planner, ctrl.hand, np.random.default_rng(41)
+    (a0, a1), (b0, b1) = hand.joint_limits
+    moved = none = 0
+    for _ in range(400):
+        cfg = ctrl.model.config
+        for k in (0, 1):
+            cfg = cfg.with_finger(k, (rng.uniform(a0, a1), rng.uniform(b0, b1)))
+        k = int(rng.integers(2))
+        x, y = cfg.tip(hand, k) + rng.normal(0.0, 0.04, 2)
+        est = StickEstimate(0.0, x, y, 0.0, *rng.normal(0.0, 0.3, 3), 6, 0, 0)
+        motion = Motion(est, 0.05, tuple(rng.normal(0.0, 1.0, 3)))
+        t = float(rng.uniform(0.0, 0.1))
+        got = planner._exit_config(t, cfg, motion)
+        want = planner._exit_config_reference(t, cfg, motion)
+        assert (got is None) == (want is None)
+        if got is not None:
+            np.testing.assert_allclose(got.base, want.base, rtol=0.0, atol=1e-12)
+            np.testing.assert_allclose(got.joints, want.joints, rtol=0.0, atol=1e-12)
+        moved += got is not None
+        none += got is None
+    print(f"_exit_config = reference in 400 cases ({moved} moved a tip out)")
+    assert moved > 50 and none > 50
+
+
+def test_hand_written_frozen_inits_are_the_generated_ones():
+    """StickEstimate, ContactSolution and Config store their fields straight into the instance
+    dict (a frozen dataclass's generated __init__ costs ~1 us a field): what dataclasses would
+    generate (tests/replay/test_scene_inits.py says what that means)."""
+    from replay.control.stick.hand_model import Config
+    from tests.replay.test_scene_inits import assert_generated_init
+
+    rng = np.random.default_rng(9)
+    for cls in (StickEstimate, sc.ContactSolution, Config):
+        assert_generated_init(cls, rng)
