@@ -46,6 +46,8 @@ setup(
             ("replay/sensors/_pixels.c", "replay/sensors/_ellipse.h"),
         ),
         _ext("replay.control.catching._mapping"),
+        _ext("replay.control.catching._ballistic"),
+        _ext("replay.control.catching._torque"),
         _ext("replay.robot._chain"),
         _ext("plants.airtable._bodies"),
         _ext("replay.control.stick._sweep"),

@@ -28,3 +28,35 @@ def locate(
     axes: Buffer,
     centres: Buffer,
 ) -> tuple[float, float, float] | None: ...
+def measure(
+    prims: Sequence[Any],
+    sphere: type,
+    locate: bool,
+    radius: float,
+    cams: Buffer,
+    cos: Buffer,
+    sin: Buffer,
+    scale: float,
+    grey: float,
+    W: int,
+    H: int,
+    threshold: float,
+    min_pixels: int,
+    binary: int,
+    default_background: float,
+    P0: Buffer,
+    P1: Buffer,
+    axes: Buffer,
+    centres: Buffer,
+) -> (
+    tuple[
+        bytearray,
+        tuple[int, int, int, int],
+        tuple[float, float, int, float] | None,
+        bytearray,
+        tuple[int, int, int, int],
+        tuple[float, float, int, float] | None,
+        tuple[float, float, float] | None,
+    ]
+    | None
+): ...

@@ -59,10 +59,13 @@ per-pixel work (ellipse polygon, exact-coverage compositing, quantising, segment
 moments) and the triangulation are compiled kernels (``_pixels.c``) of the same algorithms the
 NumPy/OpenCV code used (kept as references in tests/replay/sensors/test_fast_cameras.py; equal
 to 1e-9 px there, positions of a recorded catch_optimised run equal to 2e-15 m): ~0.1 ms a
-pair noise-free instead of ~1 ms. Noise-free, each camera's window, image and blob is one
-compiled call (``_stereo.c``: the same kernels, the blob's background median from a histogram)
-and so is the triangulation with its bias correction; :meth:`StereoBallCamera.measure_reference`
-keeps the step-by-step path (equal to the bit, test_fast_cameras.py): ~35 us a pair.
+pair noise-free instead of ~1 ms. Noise-free, a scene of spheres (the catch's) is measured in one
+compiled call (``_stereo.measure``: both cameras' windows, images and blobs and the
+triangulation with its bias correction, on C arrays; the same kernels, the blob's background
+median from a histogram, only the pixels a silhouette may change quantised), other scenes one
+call a camera and one for the triangulation; :meth:`StereoBallCamera.measure_reference` keeps
+the step-by-step path (equal to the bit, test_fast_cameras.py). A catch_optimised frame: ~100 k
+instructions (callgrind), ~157 k on the earlier step-by-step frames.
 """
 
 from __future__ import annotations
@@ -267,8 +270,28 @@ class StereoBallCamera(Sensor):
         )
         # noise-free with a background below the threshold: the compiled frame (_stereo.c)
         self._compiled = params.noise_sigma == 0.0 and self._background_level <= params.threshold
+        grey, W, H = 255.0 * params.background, int(params.width), int(params.height)
+        self._frame_args = (grey, W, H, *self._blob_args)
+        self._measure_args = (  # _stereo.measure's after (prims, locate, radius), buffers as
+            self._cams_c.tobytes(),  # bytes (the cheapest to take a buffer of, per call)
+            _COS.tobytes(),
+            _SIN.tobytes(),
+            _AREA_SCALE,
+            *self._frame_args,
+            self._P[0].tobytes(),
+            self._P[1].tobytes(),
+            self._axes_c.tobytes(),
+            self._centres_c.tobytes(),
+        )
+        self._u8 = np.dtype(np.uint8)
         self._last: list = [None, None]
-        self.last_blobs: list[dict | None] = [None, None]
+        self._found: tuple = (None, None)  # the blob kernels' tuples of the last frame
+
+    @property
+    def last_blobs(self) -> list[dict | None]:
+        """The last frame's blob in each camera (:meth:`blob`'s records), None where none."""
+        binary = bool(self._blob_args[2])
+        return [_blob(f, binary) for f in self._found]
 
     # --- helpers usable without a sensor instance -------------------------------------------
     @staticmethod
@@ -441,59 +464,53 @@ class StereoBallCamera(Sensor):
         return _pixels.triangulate(P0, P1, a, b, c, d)
 
     def measure(self, t: float, scene: Scene) -> VisionObject | None:
-        """The module doc's pipeline: noise-free, each camera's window, image and blob in one
-        compiled call and the triangulation with its bias correction in another
-        (``_stereo.frame``, ``_stereo.locate``: the kernels :meth:`measure_reference` calls, in
-        the same order); with pixel noise :meth:`measure_reference` itself."""
+        """The module doc's pipeline: noise-free, a scene of spheres in one compiled call (both
+        cameras' windows, images and blobs and the triangulation with its bias correction:
+        ``_stereo.measure``), other scenes each camera's frame in one (``_stereo.frame``) and the
+        triangulation in another (``_stereo.locate``): the kernels :meth:`measure_reference`
+        calls, in the same order; with pixel noise :meth:`measure_reference` itself."""
         if not self._compiled:
             return self.measure_reference(t, scene)
-        p = self.params
-        blob_args = self._blob_args
-        grey = 255.0 * p.background
-        W, H = int(p.width), int(p.height)
-        blobs: list[dict | None] = []
-        last = []
-        prims = scene.primitives
-        if all(isinstance(q, Sphere) for q in prims):  # both cameras' silhouettes drawn in C
-            frames = _stereo.spheres(
-                self._cams_c, prims, _COS, _SIN, _AREA_SCALE, grey, W, H, *blob_args
-            )
+        name, prims = self.params.tracked, scene.primitives
+        tracked = None
+        for q in prims:
+            if q.name == name:
+                tracked = q
+                break
+        radius = (  # for the bias correction: the tracked Sphere's, else 0 (none)
+            float(tracked.radius)
+            if self.params.bias_correction and isinstance(tracked, Sphere)
+            else 0.0
+        )
+        # a scene of spheres: both cameras' silhouettes drawn in C (None: not only spheres)
+        got = _stereo.measure(prims, Sphere, tracked is not None, radius, *self._measure_args)
+        if got is not None:
+            img0, win0, f0, img1, win1, f1, X = got
         else:
-            frames = []
-            for camera in self.cameras:
-                drawn = drawables(camera, scene)
-                polys, greys, boxes = (
-                    [d[0] for d in drawn],
-                    [d[1] for d in drawn],
-                    [d[2] for d in drawn],
-                )
-                frames.append(_stereo.frame(polys, greys, boxes, grey, W, H, *blob_args))
-        for image, window, found in frames:
-            x0, y0, x1, y1 = window
-            last.append((np.frombuffer(image, np.uint8).reshape(y1 - y0, x1 - x0), window))
-            blobs.append(_blob(found, blob_args[2]))
-        self._last = last
-        self.last_blobs = blobs
-        try:
-            tracked = scene.get(p.tracked)
-        except KeyError:
-            return None
-        b0, b1 = blobs
-        if b0 is None or b1 is None:
-            return None
-        radius = 0.0
-        if p.bias_correction and isinstance(tracked, Sphere):
-            radius = float(tracked.radius)
-        P0, P1 = self._P
-        uv0, uv1 = [b0["u"], b0["v"]], [b1["u"], b1["v"]]
-        X = _stereo.locate(P0, P1, *uv0, *uv1, radius, self._axes_c, self._centres_c)
+            (img0, win0, f0), (img1, win1, f1) = [
+                _stereo.frame(*self._drawn(camera, scene), *self._frame_args)
+                for camera in self.cameras
+            ]
+            X = None
+            if tracked is not None and f0 is not None and f1 is not None:
+                X = _stereo.locate(*self._P, *f0[:2], *f1[:2], radius, *self._measure_args[-2:])
+        u8 = self._u8
+        self._last = [
+            (np.ndarray((win0[3] - win0[1], win0[2] - win0[0]), u8, img0), win0),
+            (np.ndarray((win1[3] - win1[1], win1[2] - win1[0]), u8, img1), win1),
+        ]
+        self._found = (f0, f1)
         if X is None:
             return None
         return VisionObject(
-            t=t,
-            position=list(X),
-            features={"centroids": [uv0, uv1], "areas": [b0["area"], b1["area"]]},
+            t, list(X), {"centroids": [[f0[0], f0[1]], [f1[0], f1[1]]], "areas": [f0[2], f1[2]]}
         )
+
+    @staticmethod
+    def _drawn(camera: PinholeCamera, scene: Scene) -> tuple[list, list, list]:
+        """The polygons, grey levels and boxes of a scene's silhouettes in a camera, far first."""
+        drawn = drawables(camera, scene)
+        return [d[0] for d in drawn], [d[1] for d in drawn], [d[2] for d in drawn]
 
     def measure_reference(self, t: float, scene: Scene) -> VisionObject | None:
         """:meth:`measure` step by step, each kernel called from Python (the compiled
@@ -504,6 +521,7 @@ class StereoBallCamera(Sensor):
         blob_args = self._blob_args
         W, H = int(p.width), int(p.height)
         blobs: list[dict | None] = []
+        founds = []
         last = []
         for camera in self.cameras:
             drawn = drawables(camera, scene)
@@ -521,9 +539,10 @@ class StereoBallCamera(Sensor):
             _pixels.quantise(img, img8)
             last.append((img8, window))
             found = _pixels.ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
+            founds.append(found)
             blobs.append(_blob(found, blob_args[2]))
         self._last = last
-        self.last_blobs = blobs
+        self._found = tuple(founds)
         try:
             tracked = scene.get(p.tracked)
         except KeyError:

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from replay.control.catching import _torque
 from replay.control.catching.estimator import BallisticEstimator
 from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
 from replay.control.catching.optimise import (
@@ -236,6 +237,22 @@ def alpha_path(params: Params) -> Path | None:
             )
 
 
+def _saturated(tau, limit) -> list[float]:
+    """tau saturated at +-limit (np.minimum(np.maximum(tau, -limit), limit))."""
+    return [lim if x > lim else (-lim if x < -lim else x) for x, lim in zip(tau, limit)]
+
+
+def pd_reference(ff, kp, q_d, q, kd, qd_d, qd, limit) -> list[float]:
+    """tau = ff + Kp (q_d - q) + Kd (qd_d - qd), saturated: the Python of ``_torque.pd``."""
+    return _saturated(
+        [
+            f + p * (a - b) + d * (c - e)
+            for f, p, a, b, d, c, e in zip(ff, kp, q_d, q, kd, qd_d, qd)
+        ],
+        limit,
+    )
+
+
 @dataclass
 class CatchingState:
     """``/catching/state``: the mapping's inner quantities at a control step."""
@@ -359,9 +376,6 @@ class CatchingController(Controller):
         self.closing = False
         self.holding = False
         self._in_domain = True
-        self._r = None
-        self._v = None
-        self._q_o = None
         self._warned_state = False
         self._t = 0.0
         self._names_seen = None  # joint-name layout of the last joint state message
@@ -370,7 +384,8 @@ class CatchingController(Controller):
         # the feed-forward of the current desired state (q_d, qd_d, qdd_d); None when the
         # update set a new one (before the ball is seen and while holding, it is computed once)
         self._ff: tuple | None = None
-        self._fk_desired: tuple = (None, ())  # (the q_d list it is of, l(q_d))
+        self._fk_desired: tuple = (None, [])  # (the q_d list it is of, l(q_d))
+        self._state_lists: tuple | None = None  # (r_o, r_o', q_o) lists of /catching/state
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
     # ------------------------------------------------------------------ parameters
@@ -427,19 +442,16 @@ class CatchingController(Controller):
     # ------------------------------------------------------------------ control
     def update(self, t: float, measurements: list) -> ArmCommand:
         self._t = t
+        est = self.est
         for topic, m in measurements:
             if topic == TOPIC_VISION_OBJECT:
-                self.est.add(m.t, m.position)
-            elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
+                est.add(m.t, m.position)
+            elif topic == TOPIC_ARM_ENCODERS or topic == TOPIC_ARM_JOINT_STATE:
                 self._joint_state(m)
         P = self.params
         qdd_d = self._zeros
-        if self.est.n and not self.holding:
-            r, v, a = (
-                self.est.state_f(t)
-                if P.latency_compensation
-                else self.est.state_f(self.est.buf[-1][0])
-            )
+        if est.buf and not self.holding:
+            r, v, a = est.state_f(t) if P.latency_compensation else est.state_f(est.buf[-1][0])
             # eqs. 7, 23, 16 (compiled, 3-tuples)
             q_a, qd_a, qdd_a, q_o, in_dom = self.mapping.evaluate_one_tuple(r, v, a)
             if in_dom != self._in_domain and not in_dom:
@@ -454,7 +466,7 @@ class CatchingController(Controller):
                     )
                 )
             self._in_domain = in_dom
-            self._r, self._v, self._q_o = r, v, q_o
+            self._state_lists = (list(r), list(v), list(q_o))  # /catching/state's, until the next
             O = self._origin
             dx, dy, dz = r[0] - O[0], r[1] - O[1], r[2] - O[2]
             reached = math.sqrt(dx * dx + dy * dy + dz * dz) <= self.geo.catch_radius
@@ -465,14 +477,16 @@ class CatchingController(Controller):
                 self._events.append(
                     Occurrence("mapping_hold", {"q_d": list(self.q_d), "r_o": list(r)})
                 )
-            else:  # the active joints' values in the full vector (q3 held, model.full)
-                q_d, qd_d, qdd_d = list(self._q_fixed), list(self._zeros), list(self._zeros)
-                for i, k in enumerate(self._act):
-                    q_d[k], qd_d[k], qdd_d[k] = q_a[i], qd_a[i], qdd_a[i]
+            else:  # the 3 active joints' values in the full vector (q3 held, model.full)
+                k0, k1, k2 = self._act
+                q_d, qd_d, qdd_d = self._q_fixed[:], self._zeros[:], self._zeros[:]
+                q_d[k0], q_d[k1], q_d[k2] = q_a
+                qd_d[k0], qd_d[k1], qd_d[k2] = qd_a
+                qdd_d[k0], qdd_d[k1], qdd_d[k2] = qdd_a
                 self.q_d, self.qd_d = q_d, qd_d
                 self._ff = None
             if not self.holding:
-                self.t_catch = self.est.time_to_radius(t, self.geo.origin, self.geo.catch_radius)
+                self.t_catch = est.time_to_radius(t, self._origin, self.geo.catch_radius)
         if (
             self.hand is not None
             and not self.closing
@@ -493,54 +507,48 @@ class CatchingController(Controller):
         return ArmCommand(torque=list(self.tau), hand=hand)
 
     def _joint_state(self, m) -> None:
-        pos, vel = list(m.position), list(m.velocity)
-        names = tuple(getattr(m, "name", ()) or ())
-        if names != self._names_seen:  # where our joints sit in the message (once per layout)
-            self._names_seen = names
-            self._idx = (
+        names = getattr(m, "name", None) or []
+        if names != self._names_seen and list(names) != self._names_seen:  # once per layout
+            self._names_seen = list(names)
+            idx = (
                 [names.index(n) for n in self.names]
                 if names and set(self.names) <= set(names)
                 else None
             )
+            self._idx = idx if idx is not None and idx != self._identity else None
         idx = self._idx
-        if idx is not None and idx != self._identity:
+        pos, vel = m.position, m.velocity
+        if idx is not None:  # reordered to ours
             pos = [pos[i] for i in idx]
             vel = [vel[i] for i in idx] if len(vel) == len(names) else []
+        else:
+            pos, vel = list(pos), list(vel)
         if len(pos) == self.n:
             self.q, self.qd = pos, (vel if len(vel) == self.n else list(self._zeros))
 
     def _torque(self, qdd_d: list[float]) -> list[float]:
-        P = self.params
-        q_d, qd_d = self.q_d, self.qd_d
         ff: list[float] | tuple
-        if P.feedforward == "dynamics":  # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
-            if self._ff is None:
-                self._ff = self.model.inverse_dynamics_tuple(q_d, qd_d, qdd_d)
+        mode = self.params.feedforward
+        if mode == "dynamics":  # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
             ff = self._ff
-        elif P.feedforward == "gravity":
-            ff = self.model.gravity_full(self.q if self.q is not None else q_d).tolist()
+            if ff is None:
+                ff = self._ff = self.model.inverse_dynamics_tuple(self.q_d, self.qd_d, qdd_d)
+        elif mode == "gravity":
+            ff = self.model.gravity_full(self.q if self.q is not None else self.q_d).tolist()
         else:
             ff = self._zeros
-        if self.q is None:
-            if not self._warned_state:
-                self._warned_state = True
-                self._events.append(
-                    Occurrence(
-                        "warning",
-                        {"reason": "no /arm/joint_state delivered: feed-forward torque only"},
-                    )
+        q, qd = self.q, self.qd
+        if q is not None:  # compiled: pd_reference's operations
+            return _torque.pd(ff, self._kp, self.q_d, q, self._kd, self.qd_d, qd, self._tau_limit)
+        if not self._warned_state:
+            self._warned_state = True
+            self._events.append(
+                Occurrence(
+                    "warning",
+                    {"reason": "no /arm/joint_state delivered: feed-forward torque only"},
                 )
-            tau = list(ff)
-        else:
-            q, qd, kp, kd = self.q, self.qd, self._kp, self._kd
-            assert qd is not None  # set with q
-            tau = [
-                ff[i] + kp[i] * (q_d[i] - q[i]) + kd[i] * (qd_d[i] - qd[i]) for i in range(self.n)
-            ]
-        # saturated at the limits (np.minimum(np.maximum(tau, -limit), limit))
-        return [
-            lim if x > lim else (-lim if x < -lim else x) for x, lim in zip(tau, self._tau_limit)
-        ]
+            )
+        return _saturated(ff, self._tau_limit)
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:
@@ -570,29 +578,29 @@ class CatchingController(Controller):
         return ev
 
     def telemetry(self, t: float) -> dict:
-        # l(q_d) once per desired posture: update sets a new q_d list when it changes
-        if self._fk_desired[0] is not self.q_d:
-            self._fk_desired = (self.q_d, self.model.fk_tuple(self.q_d))
+        # The messages take the controller's lists as they are: update never changes one in
+        # place (it makes new q_d, qd_d, tau and /catching/state lists), so none is copied here.
+        q_d, q = self.q_d, self.q
+        fk_d = self._fk_desired  # l(q_d) once per desired posture
+        if fk_d[0] is not q_d:
+            fk_d = self._fk_desired = (q_d, list(self.model.fk_tuple(q_d)))
         out = {
-            TOPIC_ARM_JOINT_COMMAND: JointCommand(
-                t, position=list(self.q_d), torque=list(self.tau)
-            ),
+            TOPIC_ARM_JOINT_COMMAND: JointCommand(t, q_d, self.tau),
             TOPIC_EFFECTOR_STATE: EffectorState(
-                t,
-                position=list(self.model.fk_tuple(self.q)) if self.q is not None else [],
-                desired_position=list(self._fk_desired[1]),
+                t, list(self.model.fk_tuple(q)) if q is not None else [], fk_d[1]
             ),
         }
         if not self._costs_logged:  # the offline optimisation's history, once (t = 0)
             self._costs_logged = True
             out[TOPIC_OPTIMIZATION_COST] = self.optimization_costs()
-        if self._r is not None:
+        if self._state_lists is not None:
+            r, v, q_o = self._state_lists
             out[TOPIC_CATCHING_STATE] = CatchingState(
                 t,
-                list(self._r),
-                list(self._v),
-                list(self._q_o),
-                list(self.qd_d),
+                r,
+                v,
+                q_o,
+                self.qd_d,
                 self._in_domain,
                 float(self.t_catch) if self.t_catch is not None else -1.0,
                 self.closing,

@@ -14,6 +14,8 @@ from collections import deque
 
 import numpy as np
 
+from replay.control.catching import _ballistic
+
 
 class BallisticEstimator:
     """The fit is solved from running sums (the 2 x 2 normal equations per axis) kept as
@@ -71,18 +73,48 @@ class BallisticEstimator:
 
     def add(self, t: float, r) -> None:
         r = (float(r[0]), float(r[1]), float(r[2]))
-        if self.buf and t <= self.buf[-1][0]:
+        buf = self.buf
+        if buf and t <= buf[-1][0]:
             return  # out of order or repeated frame
+        t = float(t)
         if self._t_ref is None:
-            self._t_ref = float(t)
-        if len(self.buf) == self.buf.maxlen:  # the deque drops its oldest: so do the sums
-            self._account(*self.buf[0], -1.0)
-        self.buf.append((float(t), r))
-        self._account(float(t), r, 1.0)
-        while self.buf and self.buf[-1][0] - self.buf[0][0] > self.window + 1e-12:
-            self._account(*self.buf.popleft(), -1.0)
-        if self.buf[0][0] - self._t_ref > self.window:  # re-centre: sums of the window only
-            self._rebuild(self.buf[0][0])
+            self._t_ref = t
+        if len(buf) == buf.maxlen:  # the deque drops its oldest: so do the sums
+            self._account(*buf[0], -1.0)
+        buf.append((t, r))
+        # _account(t, r, 1.0) written out (sign 1: the same values)
+        tau = t - self._t_ref
+        S, Sy, Sty = self._S, self._Sy, self._Sty
+        g0, g1, g2 = self._g
+        S[0] += 1.0
+        S[1] += tau
+        S[2] += tau * tau
+        h = 0.5 * tau * tau
+        y0, y1, y2 = r[0] - g0 * h, r[1] - g1 * h, r[2] - g2 * h
+        Sy[0] += y0
+        Sy[1] += y1
+        Sy[2] += y2
+        Sty[0] += tau * y0
+        Sty[1] += tau * y1
+        Sty[2] += tau * y2
+        limit = self.window + 1e-12
+        while t - buf[0][0] > limit:  # (never the newest)
+            # _account(*buf.popleft(), -1.0) written out (x + (-y) is x - y: the same values)
+            t_old, (x0, x1, x2) = buf.popleft()
+            tau = t_old - self._t_ref
+            S[0] -= 1.0
+            S[1] -= tau
+            S[2] -= tau * tau
+            h = 0.5 * tau * tau
+            y0, y1, y2 = x0 - g0 * h, x1 - g1 * h, x2 - g2 * h
+            Sy[0] -= y0
+            Sy[1] -= y1
+            Sy[2] -= y2
+            Sty[0] -= tau * y0
+            Sty[1] -= tau * y1
+            Sty[2] -= tau * y2
+        if buf[0][0] - self._t_ref > self.window:  # re-centre: sums of the window only
+            self._rebuild(buf[0][0])
         self._fit = None
 
     def fit(self):
@@ -94,23 +126,30 @@ class BallisticEstimator:
 
     def fit_f(self):
         """:meth:`fit` with r0 and v as 3-tuples of floats (the per-step path)."""
-        if not self.buf:
-            return None
         if self._fit is None:
+            if not self.buf:
+                return None
             t_last, r_last = self.buf[-1]
             if len(self.buf) == 1:
                 self._fit = (t_last, r_last, None)
-            else:
-                n, s1, s2 = self._S
+            else:  # per axis k: b = (n Sty - s1 Sy) / det, a = (Sy - b s1) / n, at t_last
+                s1, s2 = self._S[1], self._S[2]
                 n = float(len(self.buf))  # exact, not a running sum
                 det = n * s2 - s1 * s1
                 tl = t_last - self._t_ref
-                g = self._g
-                b = [(n * self._Sty[k] - s1 * self._Sy[k]) / det for k in range(3)]
-                a = [(self._Sy[k] - b[k] * s1) / n for k in range(3)]
-                r0 = tuple(a[k] + b[k] * tl + 0.5 * g[k] * tl * tl for k in range(3))
-                v = tuple(b[k] + g[k] * tl for k in range(3))
-                self._fit = (t_last, r0, v)
+                g0, g1, g2 = self._g
+                Sy0, Sy1, Sy2 = self._Sy
+                St0, St1, St2 = self._Sty
+                b0 = (n * St0 - s1 * Sy0) / det
+                b1 = (n * St1 - s1 * Sy1) / det
+                b2 = (n * St2 - s1 * Sy2) / det
+                a0, a1, a2 = (Sy0 - b0 * s1) / n, (Sy1 - b1 * s1) / n, (Sy2 - b2 * s1) / n
+                r0 = (
+                    a0 + b0 * tl + 0.5 * g0 * tl * tl,
+                    a1 + b1 * tl + 0.5 * g1 * tl * tl,
+                    a2 + b2 * tl + 0.5 * g2 * tl * tl,
+                )
+                self._fit = (t_last, r0, (b0 + g0 * tl, b1 + g1 * tl, b2 + g2 * tl))
         return self._fit
 
     def state(self, t: float, *, from_fit: bool = False):
@@ -146,7 +185,19 @@ class BallisticEstimator:
         )
 
     def time_to_radius(self, t: float, origin, radius: float):
-        """Absolute time at which the arc first reaches |r - origin| = radius (None if never)."""
+        """Absolute time at which the arc first reaches |r - origin| = radius (None if never):
+        compiled (``_ballistic.time_to_radius``), :meth:`time_to_radius_reference` where
+        Newton's method cannot decide (the same value, to the bit, where it can)."""
+        f = self.fit_f()
+        if f is None or f[2] is None:
+            return None
+        tc = _ballistic.time_to_radius(t, f[0], f[1], f[2], self._g, origin, radius)
+        return tc if tc is not None else self.time_to_radius_reference(t, origin, radius)
+
+    def time_to_radius_reference(self, t: float, origin, radius: float):
+        """:meth:`time_to_radius` in Python floats (the compiled path's reference): the quartic's
+        first root by Newton's method where it provably finds it, else by the eigenvalues of its
+        companion matrix."""
         st = self.state_f(t, from_fit=True)
         if st is None or self.n < 2:
             return None

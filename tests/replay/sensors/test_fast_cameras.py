@@ -355,7 +355,7 @@ def test_compiled_sphere_polygon_equals_the_ellipse_and_its_polygon():
 def test_compiled_stereo_frame_equals_the_step_by_step_measurement(moments, bias):
     """_stereo.frame and _stereo.locate (measure, noise-free) against measure_reference, which
     calls the same kernels from Python: seeded throws, a box behind the ball in a quarter,
-    a second ball beside it in a fifth (spheres only: _stereo.spheres draws them), balls half
+    a second ball beside it in a fifth (spheres only: _stereo.measure draws them), balls half
     out of view, behind a camera or absent in some; the same images, blobs and positions to the
     bit, and None exactly where the reference gives None."""
     p = StereoBallCameraParams(moments=moments, bias_correction=bias)

@@ -196,3 +196,55 @@ def test_time_to_radius_newton_equals_the_eigenvalue_roots():
             assert got == pytest.approx(ref, abs=1e-9)
     print(f"time_to_radius: Newton settled {settled}/{n} arrivals, the rest by eigenvalues")
     assert n >= 60 and settled >= 0.9 * n
+
+
+def test_compiled_time_to_radius_equals_the_python_reference():
+    """_ballistic.time_to_radius (the controller's path) against time_to_radius_reference, the
+    Python it compiles, on seeded noisy throws at, past, away from and over the catch sphere,
+    seen from several times each: the same time to the bit (or None) at every query; the share
+    Newton's method decided in C is printed (the rest fall back to the reference)."""
+    from replay.control.catching import _ballistic
+
+    rng = np.random.default_rng(16)
+    origin, R = (0.0, 0.0, 0.346), 0.48
+    decided = n = found = 0
+    for k in range(200):
+        r0 = np.array([rng.uniform(0.2, 3.5), rng.uniform(-0.5, 0.5), rng.uniform(0.0, 1.5)])
+        aim = np.add(origin, rng.normal(scale=0.4, size=3))
+        speed = rng.uniform(3.0, 12.0) * (1 if k % 4 else -1)  # a quarter thrown away
+        v0 = (aim - r0) / np.linalg.norm(aim - r0) * speed
+        est = BallisticEstimator(G, window=0.05)
+        for i in range(60):
+            t = i * 1e-3
+            est.add(t, r0 + v0 * t + 0.5 * G * t * t + rng.normal(scale=1e-3, size=3))
+            if i % 7 != 3:
+                continue
+            n += 1
+            got, ref = est.time_to_radius(t, origin, R), est.time_to_radius_reference(t, origin, R)
+            assert got == ref
+            found += got is not None
+            f = est.fit_f()
+            decided += _ballistic.time_to_radius(t, f[0], f[1], f[2], G, origin, R) is not None
+    print(f"compiled time_to_radius: {n} queries equal, {found} arrivals, {decided} decided in C")
+    assert found >= 0.2 * n and decided >= 0.9 * found
+
+
+def test_compiled_torque_equals_the_python_reference():
+    """_torque.pd (the controller's per-step torque) against pd_reference on seeded random
+    states of 1-7 joints, a third of them beyond the limits: the same list to the bit."""
+    from replay.control.catching import _torque
+    from replay.control.catching.controller import pd_reference
+
+    rng = np.random.default_rng(17)
+    saturated = 0
+    for k in range(300):
+        n = 1 + k % 7
+        args = [rng.normal(scale=s, size=n).tolist() for s in (20, 900, 0.02, 0.02, 30, 0.5, 0.5)]
+        limit = rng.uniform(1.0, 60.0 if k % 3 else 5.0, size=n).tolist()
+        got, ref = _torque.pd(*args, limit), pd_reference(*args, limit)
+        assert got == ref and all(type(x) is float for x in got)
+        saturated += sum(abs(x) == lim for x, lim in zip(got, limit))
+    print(f"compiled torque: 300 states equal, {saturated} joint torques at their limit")
+    assert 100 < saturated < 0.8 * sum(1 + k % 7 for k in range(300))
+    with pytest.raises(ValueError, match="q_d"):
+        _torque.pd([0.0], [1.0], [0.0, 1.0], [0.0], [1.0], [0.0], [0.0], [1.0])
