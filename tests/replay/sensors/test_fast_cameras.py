@@ -430,7 +430,9 @@ def test_compiled_ball_blob_equals_the_opencv_pipeline(sigma, moments):
 
 def test_the_rendered_window_measures_as_the_whole_image():
     """Noise-free, the stereo camera renders only the box around the silhouettes: the same
-    measurement (to 1e-12) as rendering both whole images, and the same whole images."""
+    measurement (to 1e-12) as rendering both whole images, and the same whole images. On the
+    step-by-step path, whose window is ``_window`` (the compiled one is held equal to it by
+    test_compiled_stereo_frame_equals_the_step_by_step_measurement)."""
     p = StereoBallCameraParams()
     win = StereoBallCamera(p, rng=np.random.default_rng(0))
     whole = StereoBallCamera(p, rng=np.random.default_rng(0))
@@ -438,7 +440,7 @@ def test_the_rendered_window_measures_as_the_whole_image():
     rng = np.random.default_rng(12)
     for k in range(60):
         scene = throw_scene(rng, box=k % 3 == 0)
-        a, b = win.measure(0.0, scene), whole.measure(0.0, scene)
+        a, b = win.measure_reference(0.0, scene), whole.measure_reference(0.0, scene)
         assert (a is None) == (b is None)
         if a is not None:
             np.testing.assert_allclose(a.position, b.position, atol=1e-12)
