@@ -494,6 +494,58 @@ static Moments moments_of(const double *wt, int bw, int bh) {
     return m;
 }
 
+/* Whether the blob b of a window whose first pixel is (ox, oy) touches the fw x fh image's
+ * border (then it is cut by it, and not measured). */
+static int cut_by_border(Blob b, int ox, int oy, int fw, int fh) {
+    return b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh;
+}
+
+/* The box [*x0, *x1) x [*y0, *y1) of the blob b grown by pad px, clipped to the w x h window. */
+static void grown_box(Blob b, int pad, int w, int h, int *x0, int *y0, int *x1, int *y1) {
+    *x0 = b.x - pad > 0 ? b.x - pad : 0, *y0 = b.y - pad > 0 ? b.y - pad : 0;
+    *x1 = b.x + b.w + pad < w ? b.x + b.w + pad : w;
+    *y1 = b.y + b.h + pad < h ? b.y + b.h + pad : h;
+}
+
+/* The marker's background in the w x h uint8 img: the median of 9 pixels 2-4 px beyond each
+ * end (at amax and amin along the axis (ex, ey) from the centroid (cx, cy)), the brighter end
+ * winning. 0 if no such pixel is in the image, else 1 and *background. */
+static int marker_background(const uint8_t *img, int w, int h, double cx, double cy, double ex,
+                             double ey, double amax, double amin, double *background) {
+    const double nx = -ey, ny = ex;
+    int have = 0;
+    double ends[2] = {amax, amin};
+    *background = -INFINITY;
+    for (int e = 0; e < 2; e++) {
+        double sgn = ends[e] > 0 ? 1.0 : -1.0, vals[9];
+        int nv = 0;
+        for (int si = 0; si < 3; si++)
+            for (int oi = 0; oi < 3; oi++) {
+                double s = 2.0 + si, o = -1.0 + oi;
+                double px = cx + (ends[e] + sgn * s) * ex + o * nx;
+                double py = cy + (ends[e] + sgn * s) * ey + o * ny;
+                double ix = rint(px), iy = rint(py);
+                if (ix >= 0 && ix < w && iy >= 0 && iy < h)
+                    vals[nv++] = img[(size_t)iy * w + (size_t)ix];
+            }
+        if (!nv) continue;
+        qsort(vals, nv, sizeof(double), cmp_double);
+        double med = nv % 2 ? vals[nv / 2] : 0.5 * (vals[nv / 2 - 1] + vals[nv / 2]);
+        if (!have || med > *background) *background = med;
+        have = 1;
+    }
+    return have;
+}
+
+/* marker_moments' result from the grey-level moments m of the box whose first pixel is (x0, y0)
+ * of a window whose first pixel is (ox, oy) of the image */
+static PyObject *marker_result(Moments m, int ox, int oy, int x0, int y0, int area,
+                               double background) {
+    return Py_BuildValue("(dddidddddd)", ox + x0 + m.m10 / m.m00, oy + y0 + m.m01 / m.m00,
+                         0.5 * atan2(2.0 * m.mu11, m.mu20 - m.mu02), area, background, m.m00,
+                         m.m10, m.m01, m.mu20, m.mu11, m.mu02);
+}
+
 /* marker_moments(img, w, h, threshold, min_pixels, ox, oy, full_w, full_h): the stick
  * camera's marker measurement (replay/sensors/stick_camera.py StickCamera.marker_moments says
  * what and why) on the uint8 image img (h x w, a window of the full_w x full_h image whose
@@ -518,10 +570,9 @@ static PyObject *py_marker_moments(PyObject *self, PyObject *args) {
     if (!lab || !stack) goto nomem;
     Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1, ey1, lab, stack);
     if (b.area < min_pixels) goto none;
-    if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
-        goto none; /* cut by the image border */
-    int x0 = b.x - 3 > 0 ? b.x - 3 : 0, y0 = b.y - 3 > 0 ? b.y - 3 : 0;
-    int x1 = b.x + b.w + 3 < w ? b.x + b.w + 3 : w, y1 = b.y + b.h + 3 < h ? b.y + b.h + 3 : h;
+    if (cut_by_border(b, ox, oy, fw, fh)) goto none;
+    int x0, y0, x1, y1;
+    grown_box(b, 3, w, h, &x0, &y0, &x1, &y1);
     int bw = x1 - x0, bh = y1 - y0;
     wt = malloc((size_t)bw * bh * sizeof(double) + 2 * (size_t)bw * bh);
     if (!wt) goto nomem;
@@ -533,7 +584,7 @@ static PyObject *py_marker_moments(PyObject *self, PyObject *args) {
             wt[(size_t)r * bw + c] = lab[(size_t)(r + y0) * w + c + x0] == b.label;
     Moments mb = moments_of(wt, bw, bh);
     double a = 0.5 * atan2(2.0 * mb.mu11, mb.mu20 - mb.mu02);
-    double ex = cos(a), ey = sin(a), nx = -ey, ny = ex;
+    double ex = cos(a), ey = sin(a);
     double cx = x0 + mb.m10 / mb.m00, cy = y0 + mb.m01 / mb.m00;
     double amax = -INFINITY, amin = INFINITY;
     for (int r = y0; r < y1; r++)
@@ -543,30 +594,9 @@ static PyObject *py_marker_moments(PyObject *self, PyObject *args) {
                 if (al > amax) amax = al;
                 if (al < amin) amin = al;
             }
-    /* the background: the median of 9 pixels 2-4 px beyond each end along the axis, the
-     * brighter end winning */
-    double background = -INFINITY;
-    int have = 0;
-    double ends[2] = {amax, amin};
-    for (int e = 0; e < 2; e++) {
-        double sgn = ends[e] > 0 ? 1.0 : -1.0, vals[9];
-        int nv = 0;
-        for (int si = 0; si < 3; si++)
-            for (int oi = 0; oi < 3; oi++) {
-                double s = 2.0 + si, o = -1.0 + oi;
-                double px = cx + (ends[e] + sgn * s) * ex + o * nx;
-                double py = cy + (ends[e] + sgn * s) * ey + o * ny;
-                double ix = rint(px), iy = rint(py);
-                if (ix >= 0 && ix < w && iy >= 0 && iy < h)
-                    vals[nv++] = img[(size_t)iy * w + (size_t)ix];
-            }
-        if (!nv) continue;
-        qsort(vals, nv, sizeof(double), cmp_double);
-        double med = nv % 2 ? vals[nv / 2] : 0.5 * (vals[nv / 2 - 1] + vals[nv / 2]);
-        if (!have || med > background) background = med;
-        have = 1;
-    }
-    if (!have) goto none;
+    /* the background beyond the ends */
+    double background;
+    if (!marker_background(img, w, h, cx, cy, ex, ey, amax, amin, &background)) goto none;
     /* moments of the grey level above the background within the blob dilated by 2 px */
     const float bg = (float)background;
     for (int r = 0; r < bh; r++)
@@ -580,9 +610,7 @@ static PyObject *py_marker_moments(PyObject *self, PyObject *args) {
         }
     Moments m = moments_of(wt, bw, bh);
     if (m.m00 <= 0.0) goto none;
-    ret = Py_BuildValue("(dddidddddd)", ox + x0 + m.m10 / m.m00, oy + y0 + m.m01 / m.m00,
-                        0.5 * atan2(2.0 * m.mu11, m.mu20 - m.mu02), b.area, background, m.m00,
-                        m.m10, m.m01, m.mu20, m.mu11, m.mu02);
+    ret = marker_result(m, ox, oy, x0, y0, b.area, background);
     goto done;
 nomem:
     PyErr_NoMemory();
@@ -613,10 +641,9 @@ static int blob_of(const uint8_t *img, int w, int h, double thr, int min_pixels,
     if (!lab || !stack) goto nomem;
     Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1, ey1, lab, stack);
     if (b.area < min_pixels) goto done;
-    if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
-        goto done; /* cut by the image border */
-    int x0 = b.x - 4 > 0 ? b.x - 4 : 0, y0 = b.y - 4 > 0 ? b.y - 4 : 0;
-    int x1 = b.x + b.w + 4 < w ? b.x + b.w + 4 : w, y1 = b.y + b.h + 4 < h ? b.y + b.h + 4 : h;
+    if (cut_by_border(b, ox, oy, fw, fh)) goto done;
+    int x0, y0, x1, y1;
+    grown_box(b, 4, w, h, &x0, &y0, &x1, &y1);
     int bw = x1 - x0, bh = y1 - y0;
     wt = malloc((size_t)bw * bh * sizeof(double) + 2 * (size_t)bw * bh);
     if (!wt) goto nomem;

@@ -74,10 +74,9 @@ static PyObject *marker_moments_fast(const uint8_t *img, int w, int h, double th
     if (!lab || !stack) goto nomem;
     Blob b = largest_component(img, w, h, thr, ex0, ey0, ex1 + 1, ey1 + 1, lab, stack);
     if (b.area < min_pixels) goto none;
-    if (b.x + ox == 0 || b.y + oy == 0 || b.x + ox + b.w == fw || b.y + oy + b.h == fh)
-        goto none; /* cut by the image border */
-    int x0 = b.x - 3 > 0 ? b.x - 3 : 0, y0 = b.y - 3 > 0 ? b.y - 3 : 0;
-    int x1 = b.x + b.w + 3 < w ? b.x + b.w + 3 : w, y1 = b.y + b.h + 3 < h ? b.y + b.h + 3 : h;
+    if (cut_by_border(b, ox, oy, fw, fh)) goto none;
+    int x0, y0, x1, y1;
+    grown_box(b, 3, w, h, &x0, &y0, &x1, &y1);
     int bw = x1 - x0, bh = y1 - y0;
     near = malloc(2 * (size_t)bw * bh);
     wt = malloc((size_t)bw * bh * sizeof(Weight));
@@ -92,7 +91,7 @@ static PyObject *marker_moments_fast(const uint8_t *img, int w, int h, double th
     }
     Moments mb = moments_sparse(wt, n);
     double a = 0.5 * atan2(2.0 * mb.mu11, mb.mu20 - mb.mu02);
-    double ex = cos(a), ey = sin(a), nx = -ey, ny = ex;
+    double ex = cos(a), ey = sin(a);
     double cx = x0 + mb.m10 / mb.m00, cy = y0 + mb.m01 / mb.m00;
     double amax = -INFINITY, amin = INFINITY;
     for (int i = 0; i < n; i++) {
@@ -101,28 +100,8 @@ static PyObject *marker_moments_fast(const uint8_t *img, int w, int h, double th
         if (al < amin) amin = al;
     }
     /* the background: as py_marker_moments */
-    double background = -INFINITY;
-    int have = 0;
-    double ends[2] = {amax, amin};
-    for (int e = 0; e < 2; e++) {
-        double sgn = ends[e] > 0 ? 1.0 : -1.0, vals[9];
-        int nv = 0;
-        for (int si = 0; si < 3; si++)
-            for (int oi = 0; oi < 3; oi++) {
-                double s = 2.0 + si, o = -1.0 + oi;
-                double px = cx + (ends[e] + sgn * s) * ex + o * nx;
-                double py = cy + (ends[e] + sgn * s) * ey + o * ny;
-                double ix = rint(px), iy = rint(py);
-                if (ix >= 0 && ix < w && iy >= 0 && iy < h)
-                    vals[nv++] = img[(size_t)iy * w + (size_t)ix];
-            }
-        if (!nv) continue;
-        qsort(vals, nv, sizeof(double), cmp_double);
-        double med = nv % 2 ? vals[nv / 2] : 0.5 * (vals[nv / 2 - 1] + vals[nv / 2]);
-        if (!have || med > background) background = med;
-        have = 1;
-    }
-    if (!have) goto none;
+    double background;
+    if (!marker_background(img, w, h, cx, cy, ex, ey, amax, amin, &background)) goto none;
     /* the grey level above the background within the blob dilated by 2 px */
     const float bg = (float)background;
     n = 0;
@@ -136,9 +115,7 @@ static PyObject *marker_moments_fast(const uint8_t *img, int w, int h, double th
     }
     Moments m = moments_sparse(wt, n);
     if (m.m00 <= 0.0) goto none;
-    ret = Py_BuildValue("(dddidddddd)", ox + x0 + m.m10 / m.m00, oy + y0 + m.m01 / m.m00,
-                        0.5 * atan2(2.0 * m.mu11, m.mu20 - m.mu02), b.area, background, m.m00,
-                        m.m10, m.m01, m.mu20, m.mu11, m.mu02);
+    ret = marker_result(m, ox, oy, x0, y0, b.area, background);
     goto done;
 nomem:
     PyErr_NoMemory();
