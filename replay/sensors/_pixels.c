@@ -164,6 +164,43 @@ done:
     return ret;
 }
 
+/* composite's blending of one polygon onto the float32 image img (w wide) from the coverage
+ * accumulate left in acc (rows r0..r1, columns c0..c1; acc is zeroed there again, as calloc
+ * left it): img += alpha (grey - img), alpha the running sum along the row clipped to [0, 1],
+ * in float32. */
+static void blend(double *acc, float *img, int w, int r0, int r1, int c0, int c1, float grey) {
+    for (int r = r0; r < r1; r++) {
+        double *row = acc + (size_t)r * (w + 1);
+        float *px = img + (size_t)r * w;
+        double s = 0.0;
+        for (int c = c0; c < c1; c++) {
+            s += row[c];
+            row[c] = 0.0;
+            if (s > 0.0) {
+                float a = (float)(s < 1.0 ? s : 1.0);
+                px[c] += a * (grey - px[c]);
+            }
+        }
+        row[c1] = 0.0; /* the last column accumulate writes */
+    }
+}
+
+/* quantise's core over C arrays: out = clip(rint(in), 0, 255) as uint8, n pixels */
+static void quantise_c(const float *in, uint8_t *out, size_t n) {
+    for (size_t i = 0; i < n; i++) {
+        float v = in[i];
+        /* clip, then round half to even by the float32 magic number (exact below 2^22) */
+        if (!(v > 0.0f)) /* NaN too */
+            out[i] = 0;
+        else if (v >= 255.0f)
+            out[i] = 255;
+        else {
+            float t = v + 12582912.0f; /* 1.5 * 2^23 */
+            out[i] = (uint8_t)(t - 12582912.0f);
+        }
+    }
+}
+
 /* composite(polygons, greys, ox, oy, img, w, h): alpha-composite polygons (a sequence of
  * C-contiguous float64 (n, 2) vertex arrays, pixels of the full image) of grey levels greys (a
  * sequence of floats) onto the float32 image img (h x w, whose first pixel is (ox, oy) of the
@@ -209,21 +246,7 @@ static PyObject *py_composite(PyObject *self, PyObject *args) {
         if (n >= 3) {
             int r0, r1, c0, c1;
             accumulate(P.buf, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1);
-            const float grey = (float)greyd;
-            for (int r = r0; r < r1; r++) {
-                double *row = acc + (size_t)r * (w + 1);
-                float *px = img + (size_t)r * w;
-                double s = 0.0;
-                for (int c = c0; c < c1; c++) {
-                    s += row[c];
-                    row[c] = 0.0;
-                    if (s > 0.0) {
-                        float a = (float)(s < 1.0 ? s : 1.0);
-                        px[c] += a * (grey - px[c]);
-                    }
-                }
-                row[c1] = 0.0; /* the last column accumulate writes */
-            }
+            blend(acc, img, w, r0, r1, c0, c1, (float)greyd);
         }
         PyBuffer_Release(&P);
     }
@@ -247,18 +270,7 @@ static PyObject *py_quantise(PyObject *self, PyObject *args) {
     if (!check(&I, sizeof(float), n, "img")) goto done;
     const float *in = I.buf;
     uint8_t *out = O.buf;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        float v = in[i];
-        /* clip, then round half to even by the float32 magic number (exact below 2^22) */
-        if (!(v > 0.0f)) /* NaN too */
-            out[i] = 0;
-        else if (v >= 255.0f)
-            out[i] = 255;
-        else {
-            float t = v + 12582912.0f; /* 1.5 * 2^23 */
-            out[i] = (uint8_t)(t - 12582912.0f);
-        }
-    }
+    quantise_c(in, out, (size_t)n);
     Py_INCREF(Py_None);
     ret = Py_None;
 done:

@@ -5,7 +5,7 @@
  * background fill, exact-coverage compositing, quantising, the blob's moments, the two
  * triangulations around the sphere's bias correction and the depth checks. They are the kernels
  * of _pixels.c (included here unchanged: accumulate, blob_of and py_triangulate as they are;
- * composite_one and quantise_c are py_composite's and py_quantise's loops over C arrays), so the
+ * composite_one is accumulate and blend, py_composite's core; quantise_c py_quantise's), so the
  * results are those of the Python glue they replace, kept in stereo.py as the reference
  * (measure_reference; tests/replay/sensors/test_fast_cameras.py holds the two together, to the
  * bit). Plain C over the buffer protocol: no NumPy headers.
@@ -22,9 +22,9 @@ static PyObject *call(PyObject *(*kernel)(PyObject *, PyObject *), PyObject *arg
 }
 
 /* py_composite's compositing of one polygon (n vertices xy, full-image pixels) of grey level
- * grey onto img (h x w, first pixel (ox, oy)) over C arrays: the same accumulate and the same
- * float32 operations in the same order. acc: h (w + 1) + 1 zeros, left zero. The rows and
- * columns it may change are added to the box touched (r0, r1, c0, c1; empty when r0 >= r1). */
+ * grey onto img (h x w, first pixel (ox, oy)) over C arrays: the same accumulate and blend.
+ * acc: h (w + 1) + 1 zeros, left zero. The rows and columns it may change are added to the box
+ * touched (r0, r1, c0, c1; empty when r0 >= r1). */
 static void composite_one(const double *xy, Py_ssize_t n, double greyd, int ox, int oy,
                           float *img, int w, int h, double *acc, int touched[4]) {
     if (n < 3) return;
@@ -40,36 +40,7 @@ static void composite_one(const double *xy, Py_ssize_t n, double greyd, int ox, 
             touched[3] = c1 > touched[3] ? c1 : touched[3];
         }
     }
-    const float grey = (float)greyd;
-    for (int r = r0; r < r1; r++) {
-        double *row = acc + (size_t)r * (w + 1);
-        float *px = img + (size_t)r * w;
-        double s = 0.0;
-        for (int c = c0; c < c1; c++) {
-            s += row[c];
-            row[c] = 0.0;
-            if (s > 0.0) {
-                float a = (float)(s < 1.0 ? s : 1.0);
-                px[c] += a * (grey - px[c]);
-            }
-        }
-        row[c1] = 0.0; /* the last column accumulate writes */
-    }
-}
-
-/* py_quantise over C arrays: out = clip(rint(in), 0, 255) as uint8, n pixels */
-static void quantise_c(const float *in, uint8_t *out, size_t n) {
-    for (size_t i = 0; i < n; i++) {
-        float v = in[i];
-        if (!(v > 0.0f)) /* NaN too */
-            out[i] = 0;
-        else if (v >= 255.0f)
-            out[i] = 255;
-        else {
-            float t = v + 12582912.0f; /* 1.5 * 2^23 */
-            out[i] = (uint8_t)(t - 12582912.0f);
-        }
-    }
+    blend(acc, img, w, r0, r1, c0, c1, (float)greyd);
 }
 
 typedef struct {

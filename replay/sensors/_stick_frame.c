@@ -4,9 +4,11 @@
  * silhouette and the window around it, the bounding-sphere test of the other primitives, their
  * silhouettes, far-to-near exact-coverage compositing, quantising and the marker's moments. The
  * kernels are _pixels.c's (included here unchanged: py_project_hull is called as it is from
- * Python, accumulate is composite's core; marker_moments_fast is py_marker_moments with less
- * work), so the pixels and the moments are those of the Python path to the bit; the primitives
- * are read from the scene and the pose worked out from the moments here too (py_measure). Plain C over the buffer protocol: no NumPy headers.
+ * Python; accumulate, blend and quantise_c are composite's and quantise's cores;
+ * marker_moments_fast is py_marker_moments with less work), so the pixels and the moments are
+ * those of the Python path to the bit; the primitives are read from the scene and the pose
+ * worked out from the moments here too (py_measure). Plain C over the buffer protocol: no NumPy
+ * headers.
  */
 #include "_pixels.c"
 
@@ -283,34 +285,10 @@ static PyObject *frame_core(Prim *prims, Py_ssize_t n, int marker, PyObject *R, 
         int r0, r1, c0, c1;
         accumulate(P.buf, p->count, win[0], win[1], acc, w, h, &r0, &r1, &c0, &c1);
         PyBuffer_Release(&P);
-        const float grey = (float)(255.0 * p->albedo);
-        for (int r = r0; r < r1; r++) { /* py_composite's loop */
-            double *row = acc + (size_t)r * (w + 1);
-            float *px = img + (size_t)r * w;
-            double s = 0.0;
-            for (int c = c0; c < c1; c++) {
-                s += row[c];
-                row[c] = 0.0;
-                if (s > 0.0) {
-                    float a = (float)(s < 1.0 ? s : 1.0);
-                    px[c] += a * (grey - px[c]);
-                }
-            }
-            row[c1] = 0.0;
-        }
+        blend(acc, img, w, r0, r1, c0, c1, (float)(255.0 * p->albedo));
     }
     uint8_t *out = (uint8_t *)PyByteArray_AS_STRING(image);
-    for (size_t i = 0; i < (size_t)w * h; i++) { /* py_quantise's loop */
-        float v = img[i];
-        if (!(v > 0.0f))
-            out[i] = 0;
-        else if (v >= 255.0f)
-            out[i] = 255;
-        else {
-            float t = v + 12582912.0f;
-            out[i] = (uint8_t)(t - 12582912.0f);
-        }
-    }
+    quantise_c(img, out, (size_t)w * h);
 
     /* the marker's moments */
     found = marker_moments_fast(out, w, h, thr, min_pixels, win[0], win[1], W, H);
