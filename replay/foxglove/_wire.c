@@ -112,76 +112,112 @@ static const char *utf8(PyObject *s, Py_ssize_t *n) {
     return PyUnicode_AsUTF8AndSize(s, n);
 }
 
-static PyObject *py_frame_transforms(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 2) {
-        PyErr_SetString(PyExc_TypeError, "frame_transforms(frames, ts)");
+/* a length-delimited field: tag, length n, the n bytes of s */
+static uint8_t *put_bytes(uint8_t *p, uint8_t tag, const void *s, size_t n) {
+    *p++ = tag;
+    p = put_varint(p, (uint64_t)n);
+    memcpy(p, s, n);
+    return p + n;
+}
+
+/* a Vector3 (field vtag) of v[0..2] and a Quaternion (field qtag) of v[3..6], every double
+ * written */
+static uint8_t *put_vector_quaternion(uint8_t *p, uint8_t vtag, uint8_t qtag, const double v[7]) {
+    *p++ = vtag;
+    *p++ = 27;
+    p = put_double(p, 9, v[0]);
+    p = put_double(p, 17, v[1]);
+    p = put_double(p, 25, v[2]);
+    *p++ = qtag;
+    *p++ = 36;
+    p = put_double(p, 9, v[3]);
+    p = put_double(p, 17, v[4]);
+    p = put_double(p, 25, v[5]);
+    return put_double(p, 33, v[6]);
+}
+
+/* the bytes written to o (b"" when none) */
+static PyObject *out_bytes(const Out *o) {
+    return PyBytes_FromStringAndSize(o->buf ? (const char *)o->buf : "", (Py_ssize_t)o->len);
+}
+
+/* room in o for a message field tag of body bytes, the first of which are head's, written
+ * up to the end of head: where the rest goes, or NULL out of memory */
+static uint8_t *start_message(Out *o, uint8_t tag, size_t body, const Py_buffer *head) {
+    if (grow(o, 1 + 10 + body) < 0) return NULL;
+    uint8_t *p = o->buf + o->len;
+    *p++ = tag;
+    p = put_varint(p, body);
+    memcpy(p, head->buf, (size_t)head->len);
+    return p + head->len;
+}
+
+/* appends item's message to o after the shared bytes head (a buffer); 0, or -1 with an
+ * exception set. args: the call's arguments. */
+typedef int (*Encoder)(Out *o, PyObject *item, const Py_buffer *head, PyObject *const *args);
+
+/* a call of want arguments (usage: its signature), the first the items (an iterable), the
+ * second head (an object with the buffer protocol): each item encoded by encode after head, one
+ * after another, as bytes; NULL with an exception set */
+static PyObject *encode_each(PyObject *const *args, Py_ssize_t nargs, Py_ssize_t want,
+                             const char *usage, Encoder encode) {
+    if (nargs != want) {
+        PyErr_SetString(PyExc_TypeError, usage);
         return NULL;
     }
-    Py_buffer ts;
-    if (PyObject_GetBuffer(args[1], &ts, PyBUF_SIMPLE) < 0) return NULL;
-    PyObject *it = PyObject_GetIter(args[0]), *f = NULL, *parent = NULL, *child = NULL;
-    PyObject *pos = NULL, *rot = NULL, *ret = NULL;
+    Py_buffer head;
+    if (PyObject_GetBuffer(args[1], &head, PyBUF_SIMPLE) < 0) return NULL;
+    PyObject *it = PyObject_GetIter(args[0]), *item = NULL, *ret = NULL;
     Out o = {NULL, 0, 0};
     if (!it) goto done;
-    while ((f = PyIter_Next(it))) {
-        double v[7];
-        Py_ssize_t np, nc;
-        const char *sp, *sc;
-        if (!(parent = PyObject_GetAttr(f, NAME_PARENT)) ||
-            !(child = PyObject_GetAttr(f, NAME_CHILD)) ||
-            !(pos = PyObject_GetAttr(f, NAME_POSITION)) ||
-            !(rot = PyObject_GetAttr(f, NAME_ORIENTATION)) ||
-            !(sp = utf8(parent, &np)) || !(sc = utf8(child, &nc)) ||
-            doubles(pos, v, 3, "frame position") < 0 ||
-            doubles(rot, v + 3, 4, "frame orientation") < 0)
-            goto done;
-        /* the transform's body: ts, parent, child, translation (2 + 27), rotation (2 + 36) */
-        const size_t body = (size_t)ts.len + 1 + varint_size((uint64_t)np) + (size_t)np + 1 +
-                            varint_size((uint64_t)nc) + (size_t)nc + 29 + 38;
-        if (grow(&o, 1 + 10 + body) < 0) goto done;
-        uint8_t *p = o.buf + o.len;
-        *p++ = 0x0A;
-        p = put_varint(p, body);
-        memcpy(p, ts.buf, (size_t)ts.len);
-        p += ts.len;
-        *p++ = 0x12;
-        p = put_varint(p, (uint64_t)np);
-        memcpy(p, sp, (size_t)np);
-        p += np;
-        *p++ = 0x1A;
-        p = put_varint(p, (uint64_t)nc);
-        memcpy(p, sc, (size_t)nc);
-        p += nc;
-        *p++ = 0x22;
-        *p++ = 27;
-        p = put_double(p, 9, v[0]);
-        p = put_double(p, 17, v[1]);
-        p = put_double(p, 25, v[2]);
-        *p++ = 0x2A;
-        *p++ = 36;
-        p = put_double(p, 9, v[3]);
-        p = put_double(p, 17, v[4]);
-        p = put_double(p, 25, v[5]);
-        p = put_double(p, 33, v[6]);
-        o.len = (size_t)(p - o.buf);
-        Py_CLEAR(parent);
-        Py_CLEAR(child);
-        Py_CLEAR(pos);
-        Py_CLEAR(rot);
-        Py_CLEAR(f);
+    while ((item = PyIter_Next(it))) {
+        if (encode(&o, item, &head, args) < 0) goto done;
+        Py_CLEAR(item);
     }
-    if (!PyErr_Occurred())
-        ret = PyBytes_FromStringAndSize(o.buf ? (const char *)o.buf : "", (Py_ssize_t)o.len);
+    if (!PyErr_Occurred()) ret = out_bytes(&o);
+done:
+    Py_XDECREF(item);
+    Py_XDECREF(it);
+    PyBuffer_Release(&head);
+    free(o.buf);
+    return ret;
+}
+
+/* frame f as a FrameTransform (field 1) of timestamp field ts */
+static int frame_transform(Out *o, PyObject *f, const Py_buffer *ts, PyObject *const *args) {
+    PyObject *parent = NULL, *child = NULL, *pos = NULL, *rot = NULL;
+    int rc = -1;
+    double v[7];
+    Py_ssize_t np, nc;
+    const char *sp, *sc;
+    if (!(parent = PyObject_GetAttr(f, NAME_PARENT)) ||
+        !(child = PyObject_GetAttr(f, NAME_CHILD)) ||
+        !(pos = PyObject_GetAttr(f, NAME_POSITION)) ||
+        !(rot = PyObject_GetAttr(f, NAME_ORIENTATION)) ||
+        !(sp = utf8(parent, &np)) || !(sc = utf8(child, &nc)) ||
+        doubles(pos, v, 3, "frame position") < 0 ||
+        doubles(rot, v + 3, 4, "frame orientation") < 0)
+        goto done;
+    /* the transform's body: ts, parent, child, translation (2 + 27), rotation (2 + 36) */
+    const size_t body = (size_t)ts->len + 1 + varint_size((uint64_t)np) + (size_t)np + 1 +
+                        varint_size((uint64_t)nc) + (size_t)nc + 29 + 38;
+    uint8_t *p = start_message(o, 0x0A, body, ts);
+    if (!p) goto done;
+    p = put_bytes(p, 0x12, sp, (size_t)np);
+    p = put_bytes(p, 0x1A, sc, (size_t)nc);
+    p = put_vector_quaternion(p, 0x22, 0x2A, v);
+    o->len = (size_t)(p - o->buf);
+    rc = 0;
 done:
     Py_XDECREF(parent);
     Py_XDECREF(child);
     Py_XDECREF(pos);
     Py_XDECREF(rot);
-    Py_XDECREF(f);
-    Py_XDECREF(it);
-    PyBuffer_Release(&ts);
-    free(o.buf);
-    return ret;
+    return rc;
+}
+
+static PyObject *py_frame_transforms(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    return encode_each(args, nargs, 2, "frame_transforms(frames, ts)", frame_transform);
 }
 
 static PyObject *py_joint_states(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
@@ -217,16 +253,13 @@ static PyObject *py_joint_states(PyObject *self, PyObject *const *args, Py_ssize
         uint8_t *p = o.buf + o.len;
         *p++ = 0x12;
         p = put_varint(p, joint);
-        *p++ = 0x0A;
-        p = put_varint(p, (uint64_t)nn);
-        memcpy(p, s, (size_t)nn);
-        p += nn;
+        p = put_bytes(p, 0x0A, s, (size_t)nn);
         p = put_double(p, 0x11, v[0]);
         p = put_double(p, 0x19, v[1]);
         p = put_double(p, 0x29, v[2]);
         o.len = (size_t)(p - o.buf);
     }
-    ret = PyBytes_FromStringAndSize(o.buf ? (const char *)o.buf : "", (Py_ssize_t)o.len);
+    ret = out_bytes(&o);
 done:
     for (int k = 0; k < 4; k++) Py_XDECREF(seq[k]);
     PyBuffer_Release(&ts);
@@ -254,62 +287,68 @@ static int primitive_pose(PyObject *p, PyObject *sphere, PyObject **name, double
     return 0;
 }
 
-static uint8_t *put_vector_quaternion(uint8_t *p, uint8_t vtag, uint8_t qtag, const double v[7]) {
-    *p++ = vtag;
-    *p++ = 27;
-    p = put_double(p, 9, v[0]);
-    p = put_double(p, 17, v[1]);
-    p = put_double(p, 25, v[2]);
-    *p++ = qtag;
-    *p++ = 36;
-    p = put_double(p, 9, v[3]);
-    p = put_double(p, 17, v[4]);
-    p = put_double(p, 25, v[5]);
-    return put_double(p, 33, v[6]);
+/* primitive p as a FrameTransform (field 1) of head (its timestamp and parent fields) and its
+ * name as the child; args[2]: the sphere class */
+static int body_transform(Out *o, PyObject *p, const Py_buffer *head, PyObject *const *args) {
+    PyObject *name = NULL;
+    int rc = -1;
+    double v[7];
+    Py_ssize_t nc;
+    const char *sc;
+    if (primitive_pose(p, args[2], &name, v) < 0 || !(sc = utf8(name, &nc))) goto done;
+    const size_t body = (size_t)head->len + 1 + varint_size((uint64_t)nc) + (size_t)nc + 67;
+    uint8_t *q = start_message(o, 0x0A, body, head);
+    if (!q) goto done;
+    q = put_bytes(q, 0x1A, sc, (size_t)nc);
+    q = put_vector_quaternion(q, 0x22, 0x2A, v);
+    o->len = (size_t)(q - o->buf);
+    rc = 0;
+done:
+    Py_XDECREF(name);
+    return rc;
 }
 
 /* body_transforms(primitives, head, sphere): each primitive as a FrameTransform (field 1) of
  * head (its timestamp and parent fields) and its name as the child */
 static PyObject *py_body_transforms(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 3) {
-        PyErr_SetString(PyExc_TypeError, "body_transforms(primitives, head, sphere)");
-        return NULL;
-    }
-    Py_buffer head;
-    if (PyObject_GetBuffer(args[1], &head, PyBUF_SIMPLE) < 0) return NULL;
-    PyObject *it = PyObject_GetIter(args[0]), *p = NULL, *name = NULL, *ret = NULL;
-    Out o = {NULL, 0, 0};
-    if (!it) goto done;
-    while ((p = PyIter_Next(it))) {
+    return encode_each(args, nargs, 3, "body_transforms(primitives, head, sphere)",
+                       body_transform);
+}
+
+/* primitive p, if args[2] (shape_fields) gives it (mid, tail), as an entity (field 2) of head,
+ * mid, its pose and tail; args[3]: the sphere class */
+static int scene_entity(Out *o, PyObject *p, const Py_buffer *head, PyObject *const *args) {
+    PyObject *fields = NULL, *name = NULL;
+    int rc = -1;
+    if (!(fields = PyObject_CallOneArg(args[2], p))) goto done;
+    if (fields != Py_None) {
         double v[7];
-        Py_ssize_t nc;
-        const char *sc;
-        if (primitive_pose(p, args[2], &name, v) < 0 || !(sc = utf8(name, &nc))) goto done;
-        const size_t body = (size_t)head.len + 1 + varint_size((uint64_t)nc) + (size_t)nc + 67;
-        if (grow(&o, 1 + 10 + body) < 0) goto done;
-        uint8_t *q = o.buf + o.len;
+        if (!PyTuple_Check(fields) || PyTuple_GET_SIZE(fields) != 2 ||
+            !PyBytes_Check(PyTuple_GET_ITEM(fields, 0)) ||
+            !PyBytes_Check(PyTuple_GET_ITEM(fields, 1))) {
+            PyErr_SetString(PyExc_TypeError, "scene_update: shape_fields gives (bytes, bytes)");
+            goto done;
+        }
+        if (primitive_pose(p, args[3], &name, v) < 0) goto done;
+        PyObject *mid = PyTuple_GET_ITEM(fields, 0), *tail = PyTuple_GET_ITEM(fields, 1);
+        const size_t nm = (size_t)PyBytes_GET_SIZE(mid), nt = (size_t)PyBytes_GET_SIZE(tail);
+        const size_t body = (size_t)head->len + 69 + nm + nt;
+        uint8_t *q = start_message(o, 0x12, body, head);
+        if (!q) goto done;
+        memcpy(q, PyBytes_AS_STRING(mid), nm);
+        q += nm;
         *q++ = 0x0A;
-        q = put_varint(q, body);
-        memcpy(q, head.buf, (size_t)head.len);
-        q += head.len;
-        *q++ = 0x1A;
-        q = put_varint(q, (uint64_t)nc);
-        memcpy(q, sc, (size_t)nc);
-        q += nc;
-        q = put_vector_quaternion(q, 0x22, 0x2A, v);
-        o.len = (size_t)(q - o.buf);
-        Py_CLEAR(name);
-        Py_CLEAR(p);
+        *q++ = 67;
+        q = put_vector_quaternion(q, 0x0A, 0x12, v);
+        memcpy(q, PyBytes_AS_STRING(tail), nt);
+        q += nt;
+        o->len = (size_t)(q - o->buf);
     }
-    if (!PyErr_Occurred())
-        ret = PyBytes_FromStringAndSize(o.buf ? (const char *)o.buf : "", (Py_ssize_t)o.len);
+    rc = 0;
 done:
     Py_XDECREF(name);
-    Py_XDECREF(p);
-    Py_XDECREF(it);
-    PyBuffer_Release(&head);
-    free(o.buf);
-    return ret;
+    Py_XDECREF(fields);
+    return rc;
 }
 
 /* scene_update(primitives, head, shape_fields, sphere): each primitive of which
@@ -317,59 +356,8 @@ done:
  * timestamp and frame id), mid (its id and primitive field up to the pose), the pose (field 1:
  * position 1, orientation 2), tail */
 static PyObject *py_scene_update(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 4) {
-        PyErr_SetString(PyExc_TypeError, "scene_update(primitives, head, shape_fields, sphere)");
-        return NULL;
-    }
-    Py_buffer head;
-    if (PyObject_GetBuffer(args[1], &head, PyBUF_SIMPLE) < 0) return NULL;
-    PyObject *it = PyObject_GetIter(args[0]), *p = NULL, *name = NULL, *fields = NULL;
-    PyObject *ret = NULL;
-    Out o = {NULL, 0, 0};
-    if (!it) goto done;
-    while ((p = PyIter_Next(it))) {
-        if (!(fields = PyObject_CallOneArg(args[2], p))) goto done;
-        if (fields != Py_None) {
-            double v[7];
-            if (!PyTuple_Check(fields) || PyTuple_GET_SIZE(fields) != 2 ||
-                !PyBytes_Check(PyTuple_GET_ITEM(fields, 0)) ||
-                !PyBytes_Check(PyTuple_GET_ITEM(fields, 1))) {
-                PyErr_SetString(PyExc_TypeError, "scene_update: shape_fields gives (bytes, bytes)");
-                goto done;
-            }
-            if (primitive_pose(p, args[3], &name, v) < 0) goto done;
-            PyObject *mid = PyTuple_GET_ITEM(fields, 0), *tail = PyTuple_GET_ITEM(fields, 1);
-            const size_t nm = (size_t)PyBytes_GET_SIZE(mid), nt = (size_t)PyBytes_GET_SIZE(tail);
-            const size_t body = (size_t)head.len + 69 + nm + nt;
-            if (grow(&o, 1 + 10 + body) < 0) goto done;
-            uint8_t *q = o.buf + o.len;
-            *q++ = 0x12;
-            q = put_varint(q, body);
-            memcpy(q, head.buf, (size_t)head.len);
-            q += head.len;
-            memcpy(q, PyBytes_AS_STRING(mid), nm);
-            q += nm;
-            *q++ = 0x0A;
-            *q++ = 67;
-            q = put_vector_quaternion(q, 0x0A, 0x12, v);
-            memcpy(q, PyBytes_AS_STRING(tail), nt);
-            q += nt;
-            o.len = (size_t)(q - o.buf);
-            Py_CLEAR(name);
-        }
-        Py_CLEAR(fields);
-        Py_CLEAR(p);
-    }
-    if (!PyErr_Occurred())
-        ret = PyBytes_FromStringAndSize(o.buf ? (const char *)o.buf : "", (Py_ssize_t)o.len);
-done:
-    Py_XDECREF(fields);
-    Py_XDECREF(name);
-    Py_XDECREF(p);
-    Py_XDECREF(it);
-    PyBuffer_Release(&head);
-    free(o.buf);
-    return ret;
+    return encode_each(args, nargs, 4, "scene_update(primitives, head, shape_fields, sphere)",
+                       scene_entity);
 }
 
 static PyMethodDef methods[] = {
