@@ -131,6 +131,17 @@ static int step_core(const table_t *t, double *s, const double *tx, const double
     return usual;
 }
 
+/* the arguments step and step_hand share, checked: *dt the float of dt_obj, *t the table of
+ * P, S a state buffer; 1, or 0 with an exception set */
+static int step_args(PyObject *dt_obj, double *dt, Py_buffer *P, table_t *t, Py_buffer *S) {
+    *dt = PyFloat_AsDouble(dt_obj);
+    if (*dt == -1.0 && PyErr_Occurred()) return 0;
+    return unpack(P, t) && state_ok(S);
+}
+
+/* step_core's result (1, 0, or -1 with an exception set) as step's: True, False or NULL */
+static PyObject *step_result(int usual) { return usual >= 0 ? PyBool_FromLong(usual) : NULL; }
+
 /* step(ptrs, state, tx0, ty0, tx1, ty1, dt, space_step, rest_speed, rest_omega, hold_speed,
  *      hold_omega): each tip's velocity set to ((tx - x) / dt, (ty - y) / dt) from its position in
  * state (so that the step's position integration lands it on the target), space_step(dt) called
@@ -150,12 +161,10 @@ static PyObject *py_step(PyObject *self, PyObject *args) {
         return NULL;
     PyObject *ret = NULL;
     table_t t;
-    double dt = PyFloat_AsDouble(dt_obj);
-    if (dt == -1.0 && PyErr_Occurred()) goto done;
-    if (!unpack(&P, &t) || !state_ok(&S)) goto done;
-    int usual = step_core(&t, S.buf, tx, ty, dt_obj, dt, space_step, rest_v, rest_w, hold_v,
-                          hold_w);
-    if (usual >= 0) ret = PyBool_FromLong(usual);
+    double dt;
+    if (!step_args(dt_obj, &dt, &P, &t, &S)) goto done;
+    ret = step_result(
+        step_core(&t, S.buf, tx, ty, dt_obj, dt, space_step, rest_v, rest_w, hold_v, hold_w));
 done:
     PyBuffer_Release(&P);
     PyBuffer_Release(&S);
@@ -218,9 +227,8 @@ static PyObject *py_step_hand(PyObject *self, PyObject *args) {
         return NULL;
     PyObject *ret = NULL;
     table_t t;
-    double dt = PyFloat_AsDouble(dt_obj);
-    if (dt == -1.0 && PyErr_Occurred()) goto done;
-    if (!unpack(&P, &t) || !state_ok(&S)) goto done;
+    double dt;
+    if (!step_args(dt_obj, &dt, &P, &t, &S)) goto done;
     if (Hb.len != H_SIZE * (Py_ssize_t)sizeof(double)) {
         PyErr_SetString(PyExc_ValueError, "hand: 26 float64");
         goto done;
@@ -228,9 +236,8 @@ static PyObject *py_step_hand(PyObject *self, PyObject *args) {
     double *h = Hb.buf;
     advance_hand(h, dt);
     const double tx[2] = {h[H_TIPS], h[H_TIPS + 2]}, ty[2] = {h[H_TIPS + 1], h[H_TIPS + 3]};
-    int usual = step_core(&t, S.buf, tx, ty, dt_obj, dt, space_step, rest_v, rest_w, hold_v,
-                          hold_w);
-    if (usual >= 0) ret = PyBool_FromLong(usual);
+    ret = step_result(
+        step_core(&t, S.buf, tx, ty, dt_obj, dt, space_step, rest_v, rest_w, hold_v, hold_w));
 done:
     PyBuffer_Release(&P);
     PyBuffer_Release(&S);
