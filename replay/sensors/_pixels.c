@@ -858,6 +858,16 @@ done:
     return ret;
 }
 
+/* call a kernel above with a new argument tuple (stolen); NULL with an exception set. For the
+ * modules that include this file (_stereo.c, _stick_frame.c); inline: unused here. */
+static inline PyObject *call_kernel(PyObject *(*kernel)(PyObject *, PyObject *),
+                                    PyObject *args) {
+    if (!args) return NULL;
+    PyObject *ret = kernel(NULL, args);
+    Py_DECREF(args);
+    return ret;
+}
+
 static PyMethodDef methods[] = {
     {"coverage", py_coverage, METH_VARARGS, "exact coverage of one polygon in a block"},
     {"composite", py_composite, METH_VARARGS, "exact-coverage alpha compositing of polygons"},

@@ -13,14 +13,6 @@
 #include "_pixels.c"
 #include "_silhouette.c" /* sphere_outline */
 
-/* call a _pixels kernel with a new argument tuple (stolen); NULL with an exception set */
-static PyObject *call(PyObject *(*kernel)(PyObject *, PyObject *), PyObject *args) {
-    if (!args) return NULL;
-    PyObject *ret = kernel(NULL, args);
-    Py_DECREF(args);
-    return ret;
-}
-
 /* py_composite's compositing of one polygon (n vertices xy, full-image pixels) of grey level
  * grey onto img (h x w, first pixel (ox, oy)) over C arrays: the same accumulate and blend.
  * acc: h (w + 1) + 1 zeros, left zero. The rows and columns it may change are added to the box
@@ -341,7 +333,7 @@ static int locate_c(PyObject *P0, PyObject *P1, double u[2], double v[2], double
         PyObject *a[6] = {Py_NewRef(P0), Py_NewRef(P1), PyFloat_FromDouble(u[0]),
                           PyFloat_FromDouble(v[0]), PyFloat_FromDouble(u[1]),
                           PyFloat_FromDouble(v[1])};
-        PyObject *X = call(py_triangulate, tuple_of(6, a));
+        PyObject *X = call_kernel(py_triangulate, tuple_of(6, a));
         if (!X) return -1;
         if (X == Py_None) {
             Py_DECREF(X);

@@ -12,14 +12,6 @@
  */
 #include "_pixels.c"
 
-/* call a _pixels kernel with a new argument tuple (stolen); NULL with an exception set */
-static PyObject *call_kernel(PyObject *(*kernel)(PyObject *, PyObject *), PyObject *args) {
-    if (!args) return NULL;
-    PyObject *ret = kernel(NULL, args);
-    Py_DECREF(args);
-    return ret;
-}
-
 /* _pixels.c marker_moments on the uint8 window img (w x h, whose first pixel is (ox, oy) of the
  * fw x fh image), the same numbers by the same operations in the same order, with less work:
  * the threshold compared as an integer (for a uint8 v, v > thr is v > floor(thr)), and the sums
