@@ -12,7 +12,7 @@ SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml scenarios/
 .PHONY: install run lint test bench ablations golden-check clean
 
 # (every C source and header of an extension module: a changed kernel is rebuilt by the next make)
-CSOURCES := $(wildcard replay/*/*.[ch] replay/*/*/*.[ch] plants/*/*.[ch])
+CSOURCES := $(wildcard replay/*.h replay/*/*.[ch] replay/*/*/*.[ch] plants/*/*.[ch])
 
 $(STAMP): pyproject.toml setup.py $(CSOURCES)
 	test -x $(PY) || python3 -m venv $(VENV)

@@ -12,10 +12,19 @@ from setuptools import Extension, find_namespace_packages, setup
 FLAGS = ["-O2", "-fexcess-precision=standard", "-ffp-contract=off"]
 
 
+# headers every module may include (replay/ is on the include path): floats between Python
+# sequences and C arrays
+SHARED = ["replay/_pyfloats.h"]
+
+
 def _ext(module: str, depends: tuple[str, ...] = ()) -> Extension:
     """The extension ``module`` built from the one C file of that dotted path."""
     return Extension(
-        module, [module.replace(".", "/") + ".c"], depends=list(depends), extra_compile_args=FLAGS
+        module,
+        [module.replace(".", "/") + ".c"],
+        depends=[*depends, *SHARED],
+        include_dirs=["replay"],
+        extra_compile_args=FLAGS,
     )
 
 

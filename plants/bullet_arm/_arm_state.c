@@ -15,6 +15,8 @@
 #include <Python.h>
 #include <math.h>
 
+#include "_pyfloats.h"
+
 #define MAXJ 64
 
 /* joint_state(states, na, pick, locked) -> ((q, qd), (hq, hqd, heff))
@@ -87,27 +89,6 @@ fail:
     return NULL;
 }
 
-/* the doubles of a list or tuple of n floats (ints too); -1 with an exception otherwise */
-static int doubles(PyObject *obj, double *out, Py_ssize_t n, const char *what) {
-    PyObject *seq = PySequence_Fast(obj, what);
-    if (seq == NULL) return -1;
-    if (PySequence_Fast_GET_SIZE(seq) != n) {
-        PyErr_Format(PyExc_ValueError, "%s: expected %zd values", what, n);
-        Py_DECREF(seq);
-        return -1;
-    }
-    PyObject **items = PySequence_Fast_ITEMS(seq);
-    for (Py_ssize_t i = 0; i < n; i++) {
-        out[i] = PyFloat_AsDouble(items[i]);
-        if (out[i] == -1.0 && PyErr_Occurred()) {
-            Py_DECREF(seq);
-            return -1;
-        }
-    }
-    Py_DECREF(seq);
-    return 0;
-}
-
 /* each element's truth of a list of bools (n of them); -1 with an exception otherwise */
 static int flags(PyObject *obj, int *out, Py_ssize_t n, const char *what) {
     if (!PyList_Check(obj) || PyList_GET_SIZE(obj) != n) {
@@ -146,16 +127,19 @@ static PyObject *py_limit_flags(PyObject *self, PyObject *args) {
     }
     double q[MAXJ], qd[MAXJ], lim[MAXJ], lo[MAXJ], hi[MAXJ], p[3], v[3];
     int over[MAXJ], at[MAXJ], over0[MAXJ], at0[MAXJ];
-    if (doubles(qo, q, n, "q") || doubles(qdo, qd, n, "qd")) return NULL;
+    if (!seq_doubles(qo, q, n, "floats", "q") || !seq_doubles(qdo, qd, n, "floats", "qd"))
+        return NULL;
     int finite = 1;
     for (Py_ssize_t i = 0; i < n; i++) finite = finite && isfinite(q[i]) && isfinite(qd[i]);
     if (po != Py_None) {
-        if (doubles(po, p, 3, "pos") || doubles(vo, v, 3, "v")) return NULL;
+        if (!seq_doubles(po, p, 3, "floats", "pos") || !seq_doubles(vo, v, 3, "floats", "v"))
+            return NULL;
         for (int i = 0; i < 3; i++) finite = finite && isfinite(p[i]) && isfinite(v[i]);
     }
     if (!finite) return Py_BuildValue("(OOO)", Py_False, Py_None, Py_None);
-    if (doubles(limo, lim, n, "vlim") || doubles(loo, lo, n, "lower") ||
-        doubles(hio, hi, n, "upper") || flags(over0o, over0, n, "over0") ||
+    if (!seq_doubles(limo, lim, n, "floats", "vlim") ||
+        !seq_doubles(loo, lo, n, "floats", "lower") ||
+        !seq_doubles(hio, hi, n, "floats", "upper") || flags(over0o, over0, n, "over0") ||
         flags(at0o, at0, n, "at0"))
         return NULL;
     int same = 1;
@@ -178,9 +162,12 @@ static PyObject *py_palm_frame(PyObject *self, PyObject *args) {
     double th;
     if (!PyArg_ParseTuple(args, "OOOOOOd", &oo, &uo, &po, &qo, &vo, &wo, &th)) return NULL;
     double o[3], u[3], pp[3], qq[4], pv[3], w[3];
-    if (doubles(oo, o, 3, "obj_pos") || doubles(uo, u, 3, "obj_vel") ||
-        doubles(po, pp, 3, "palm_pos") || doubles(qo, qq, 4, "palm_quat") ||
-        doubles(vo, pv, 3, "palm_vel") || doubles(wo, w, 3, "palm_omega"))
+    if (!seq_doubles(oo, o, 3, "floats", "obj_pos") ||
+        !seq_doubles(uo, u, 3, "floats", "obj_vel") ||
+        !seq_doubles(po, pp, 3, "floats", "palm_pos") ||
+        !seq_doubles(qo, qq, 4, "floats", "palm_quat") ||
+        !seq_doubles(vo, pv, 3, "floats", "palm_vel") ||
+        !seq_doubles(wo, w, 3, "floats", "palm_omega"))
         return NULL;
     double qx = qq[0], qy = qq[1], qz = qq[2], qw = qq[3];
     double nq = qx * qx + qy * qy + qz * qz + qw * qw;

@@ -13,6 +13,8 @@
 #include <Python.h>
 #include <math.h>
 
+#include "_pyfloats.h"
+
 #define ROW 18
 #define MAXJ 16
 
@@ -47,27 +49,6 @@ static void frames(const double *rows, const double *base, int n, const double *
     }
 }
 
-/* n doubles of a sequence (a list, tuple or 1-D array); 0 with an exception set otherwise */
-static int doubles(PyObject *obj, int n, double *out, const char *what) {
-    PyObject *seq = PySequence_Fast(obj, "joint values: not a sequence");
-    if (!seq) return 0;
-    Py_ssize_t m = PySequence_Fast_GET_SIZE(seq);
-    if (m != n) {
-        PyErr_Format(PyExc_ValueError, "expected %d joint values, got %zd (%s)", n, m, what);
-        Py_DECREF(seq);
-        return 0;
-    }
-    for (int i = 0; i < n; i++) {
-        out[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
-        if (out[i] == -1.0 && PyErr_Occurred()) {
-            Py_DECREF(seq);
-            return 0;
-        }
-    }
-    Py_DECREF(seq);
-    return 1;
-}
-
 /* the chain's rows and base buffers; n joints, 0 with an exception set if they do not fit */
 static int chain_of(Py_buffer *R, Py_buffer *B, int *n) {
     if (R->len % (ROW * (Py_ssize_t)sizeof(double)) || R->len / (ROW * sizeof(double)) > MAXJ ||
@@ -89,7 +70,7 @@ static PyObject *py_point(PyObject *self, PyObject *args) {
     int n;
     double q[MAXJ];
     Frame F[MAXJ + 1];
-    if (!chain_of(&R, &B, &n) || !doubles(qo, n, q, "q")) goto done;
+    if (!chain_of(&R, &B, &n) || !seq_doubles(qo, q, n, "joint values", "q")) goto done;
     frames(R.buf, B.buf, n, q, F);
     const Frame *f = &F[n];
     ret = Py_BuildValue("(ddd)", f->o[0] + u * f->X[0] + v * f->Y[0] + w * f->Z[0],
@@ -113,8 +94,10 @@ static PyObject *py_rnea(PyObject *self, PyObject *args) {
     int n;
     double q[MAXJ], qd[MAXJ], qdd[MAXJ], fw[MAXJ][12];
     Frame F[MAXJ + 1];
-    if (!chain_of(&R, &B, &n) || !doubles(qo, n, q, "q") || !doubles(qdo, n, qd, "qd") ||
-        !doubles(qddo, n, qdd, "qdd"))
+    if (!chain_of(&R, &B, &n) ||
+        !seq_doubles(qo, q, n, "joint values", "q") ||
+        !seq_doubles(qdo, qd, n, "joint values", "qd") ||
+        !seq_doubles(qddo, qdd, n, "joint values", "qdd"))
         goto done;
     const double *rows = R.buf;
     frames(rows, B.buf, n, q, F);

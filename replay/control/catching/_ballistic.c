@@ -10,6 +10,8 @@
 #include <Python.h>
 #include <math.h>
 
+#include "_pyfloats.h"
+
 /* _first_root_newton: 1 and *root = the smallest root s >= 0 of c[0] s^4 + ... + c[4], 0 when
  * Newton's method from 0 does not provably find it. */
 static int first_root_newton(const double c[5], double *root) {
@@ -46,30 +48,14 @@ static int first_root_newton(const double c[5], double *root) {
     return 1;
 }
 
-/* time_to_radius(t, t_last, r0, v, g, origin, radius): the absolute time at which the arc
- * r0 + v (t' - t_last) + g (t' - t_last)^2 / 2 (3-sequences of floats) first reaches
- * |r - origin| = radius, looking from t on: t if it is already inside, else t + the quartic's
- * first root when Newton's method finds it; None when it does not (then the caller takes the
- * companion matrix's eigenvalues). */
-static int three(PyObject *obj, double *out, const char *what) {
-    PyObject *seq = PySequence_Fast(obj, what);
-    if (!seq) return 0;
-    int ok = PySequence_Fast_GET_SIZE(seq) == 3;
-    for (int k = 0; ok && k < 3; k++) {
-        out[k] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, k));
-        if (out[k] == -1.0 && PyErr_Occurred()) ok = 0;
-    }
-    if (!ok && !PyErr_Occurred()) PyErr_Format(PyExc_ValueError, "%s: expected 3 floats", what);
-    Py_DECREF(seq);
-    return ok;
-}
-
 static PyObject *py_time_to_radius(PyObject *self, PyObject *args) {
     double t, t_last, radius, r0[3], v[3], g[3], o[3];
     PyObject *R0, *V, *G, *O;
     if (!PyArg_ParseTuple(args, "ddOOOOd", &t, &t_last, &R0, &V, &G, &O, &radius)) return NULL;
-    if (!three(R0, r0, "r0") || !three(V, v, "v") || !three(G, g, "g") ||
-        !three(O, o, "origin"))
+    if (!seq_doubles(R0, r0, 3, "floats", "r0") ||
+        !seq_doubles(V, v, 3, "floats", "v") ||
+        !seq_doubles(G, g, 3, "floats", "g") ||
+        !seq_doubles(O, o, 3, "floats", "origin"))
         return NULL;
     /* BallisticEstimator.state_f(t, from_fit=True) */
     const double dt = t - t_last;

@@ -14,6 +14,8 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "_pyfloats.h"
+
 #define MAXMONO 256
 #define MAXPOW 32
 
@@ -138,25 +140,6 @@ static void derivatives_one(const double *G, const double *p, double d[3][3], do
     rot_cs(w1, c1, s1, K2R2t, H[4]);
 }
 
-static int three(PyObject *obj, double *out) {
-    PyObject *seq = PySequence_Fast(obj, "expected 3 floats");
-    if (!seq) return 0;
-    if (PySequence_Fast_GET_SIZE(seq) != 3) {
-        PyErr_SetString(PyExc_ValueError, "expected 3 floats");
-        Py_DECREF(seq);
-        return 0;
-    }
-    for (int i = 0; i < 3; i++) {
-        out[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
-        if (out[i] == -1.0 && PyErr_Occurred()) {
-            Py_DECREF(seq);
-            return 0;
-        }
-    }
-    Py_DECREF(seq);
-    return 1;
-}
-
 /* evaluate_one(geo, powers, A, r, rd, rdd): (q_d, qd_d, qdd_d, q_o, in_domain), 3-tuples of
  * floats but in_domain (eqs. 7, 23, 16 for the active joints); raises
  * numpy.linalg.LinAlgError-like ValueError("Singular matrix") if J_c is singular. */
@@ -173,7 +156,8 @@ static PyObject *py_evaluate_one(PyObject *self, PyObject *args) {
         PyErr_SetString(PyExc_ValueError, "geo: float64 24; powers: int32 (n, 3); A: (n, 3)");
         goto done;
     }
-    if (!three(ro, r) || !three(rdo, rd) || !three(rddo, rdd)) goto done;
+    if (!seq_doubles(ro, r, 3, "floats", "r") || !seq_doubles(rdo, rd, 3, "floats", "rd") ||
+        !seq_doubles(rddo, rdd, 3, "floats", "rdd")) goto done;
     const double *G = Gb.buf, *A = Ab.buf;
     const int32_t *pw = Pb.buf;
     double p[3], d[3][3], H[5][3], pd[3], pdd[3];

@@ -7,22 +7,9 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
-#define MAX_JOINTS 64
+#include "_pyfloats.h"
 
-/* n floats of the sequence obj into out; 0 with an exception set */
-static int floats(PyObject *obj, Py_ssize_t n, double *out, const char *what) {
-    PyObject *seq = PySequence_Fast(obj, what);
-    if (!seq) return 0;
-    int ok = PySequence_Fast_GET_SIZE(seq) == n;
-    if (!ok) PyErr_Format(PyExc_ValueError, "%s: expected %zd floats", what, n);
-    PyObject **items = PySequence_Fast_ITEMS(seq);
-    for (Py_ssize_t k = 0; ok && k < n; k++) {
-        out[k] = PyFloat_AsDouble(items[k]);
-        if (out[k] == -1.0 && PyErr_Occurred()) ok = 0;
-    }
-    Py_DECREF(seq);
-    return ok;
-}
+#define MAX_JOINTS 64
 
 /* pd(ff, kp, q_d, q, kd, qd_d, qd, limit): the list of n torques (n = len(ff) <= 64) */
 static PyObject *py_pd(PyObject *self, PyObject *args) {
@@ -36,7 +23,7 @@ static PyObject *py_pd(PyObject *self, PyObject *args) {
     static const char *what[8] = {"ff", "kp", "q_d", "q", "kd", "qd_d", "qd", "limit"};
     double v[8][MAX_JOINTS];
     for (int i = 0; i < 8; i++)
-        if (!floats(o[i], n, v[i], what[i])) return NULL;
+        if (!seq_doubles(o[i], v[i], n, "floats", what[i])) return NULL;
     PyObject *out = PyList_New(n);
     if (!out) return NULL;
     for (Py_ssize_t k = 0; k < n; k++) {

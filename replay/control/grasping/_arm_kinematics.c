@@ -13,27 +13,9 @@
 #include <math.h>
 #include <string.h>
 
-#define MAXJ 16
+#include "_pyfloats.h"
 
-static int read_seq(PyObject *obj, double *out, Py_ssize_t n, const char *what) {
-    PyObject *seq = PySequence_Fast(obj, what);
-    if (seq == NULL) return -1;
-    if (PySequence_Fast_GET_SIZE(seq) < n) {
-        PyErr_Format(PyExc_ValueError, "%s: expected at least %zd values", what, n);
-        Py_DECREF(seq);
-        return -1;
-    }
-    PyObject **items = PySequence_Fast_ITEMS(seq);
-    for (Py_ssize_t i = 0; i < n; i++) {
-        out[i] = PyFloat_AsDouble(items[i]);
-        if (out[i] == -1.0 && PyErr_Occurred()) {
-            Py_DECREF(seq);
-            return -1;
-        }
-    }
-    Py_DECREF(seq);
-    return 0;
-}
+#define MAXJ 16
 
 static int get_buffer(PyObject *obj, Py_buffer *view, Py_ssize_t n, int writable, const char *what) {
     if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | (writable ? PyBUF_WRITABLE : 0)) < 0)
@@ -44,20 +26,6 @@ static int get_buffer(PyObject *obj, Py_buffer *view, Py_ssize_t n, int writable
         return -1;
     }
     return 0;
-}
-
-static PyObject *list_of(const double *x, Py_ssize_t n) {
-    PyObject *out = PyList_New(n);
-    if (out == NULL) return NULL;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        PyObject *f = PyFloat_FromDouble(x[i]);
-        if (f == NULL) {
-            Py_DECREF(out);
-            return NULL;
-        }
-        PyList_SET_ITEM(out, i, f);
-    }
-    return out;
 }
 
 /* T (3 x 4 of a rigid transform) = A B */
@@ -84,7 +52,7 @@ static PyObject *py_chain(PyObject *self, PyObject *args) {
         return NULL;
     }
     double q[MAXJ];
-    if (read_seq(qo, q, n, "chain: q") < 0) return NULL;
+    if (!seq_doubles_head(qo, q, n, "floats", "chain: q")) return NULL;
     Py_buffer vc, vb, vt, vj, vjg;
     if (get_buffer(co, &vc, 5 * n, 0, "chain: consts") < 0) return NULL;
     if (get_buffer(bo, &vb, 16, 0, "chain: base") < 0) goto fail_c;
@@ -157,9 +125,11 @@ static PyObject *py_terms(PyObject *self, PyObject *args) {
         return NULL;
     }
     double b[2][6], f[6], qd[MAXJ], vlim[MAXJ];
-    if (read_seq(b1o, b[0], 6, "terms: b1") < 0 || read_seq(b2o, b[1], 6, "terms: b2") < 0 ||
-        read_seq(fo, f, 6, "terms: F") < 0 || read_seq(qdo, qd, n, "terms: qd") < 0 ||
-        read_seq(vlo, vlim, n, "terms: vlim") < 0)
+    if (!seq_doubles_head(b1o, b[0], 6, "floats", "terms: b1") ||
+        !seq_doubles_head(b2o, b[1], 6, "floats", "terms: b2") ||
+        !seq_doubles_head(fo, f, 6, "floats", "terms: F") ||
+        !seq_doubles_head(qdo, qd, n, "floats", "terms: qd") ||
+        !seq_doubles_head(vlo, vlim, n, "floats", "terms: vlim"))
         return NULL;
     Py_buffer vjg, vj;
     if (get_buffer(jgo, &vjg, 6 * n, 0, "terms: Jg") < 0) return NULL;
@@ -224,7 +194,7 @@ static PyObject *py_terms(PyObject *self, PyObject *args) {
     PyObject *out = PyTuple_New(5);
     if (out == NULL) return NULL;
     for (int m = 0; m < 5; m++) {
-        PyObject *l = list_of(x[m], n);
+        PyObject *l = list_of_doubles(x[m], n);
         if (l == NULL) {
             Py_DECREF(out);
             return NULL;
@@ -245,9 +215,12 @@ static PyObject *py_wrench(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "OOOOOOOdd", &Ro, &fo, &mo, &wo, &co, &bo, &flo, &a, &deadband))
         return NULL;
     double R[9], f[3], m[3], w[3], c[3], b[6], fl[6], ext[6], out[6];
-    if (read_seq(Ro, R, 9, "wrench: R") < 0 || read_seq(fo, f, 3, "wrench: force") < 0 ||
-        read_seq(mo, m, 3, "wrench: torque") < 0 || read_seq(wo, w, 3, "wrench: w_hand") < 0 ||
-        read_seq(co, c, 3, "wrench: com") < 0 || read_seq(flo, fl, 6, "wrench: filtered") < 0)
+    if (!seq_doubles_head(Ro, R, 9, "floats", "wrench: R") ||
+        !seq_doubles_head(fo, f, 3, "floats", "wrench: force") ||
+        !seq_doubles_head(mo, m, 3, "floats", "wrench: torque") ||
+        !seq_doubles_head(wo, w, 3, "floats", "wrench: w_hand") ||
+        !seq_doubles_head(co, c, 3, "floats", "wrench: com") ||
+        !seq_doubles_head(flo, fl, 6, "floats", "wrench: filtered"))
         return NULL;
     double r[3];
     for (int i = 0; i < 3; i++) {
@@ -260,13 +233,14 @@ static PyObject *py_wrench(PyObject *self, PyObject *args) {
         ext[3 + i] = R[3 * i] * m[0] + R[3 * i + 1] * m[1] + R[3 * i + 2] * m[2] - rxw[i];
     if (bo == Py_None) {
         for (int i = 0; i < 6; i++) b[i] = ext[i], fl[i] = 0.0;
-    } else if (read_seq(bo, b, 6, "wrench: bias") < 0) {
+    } else if (!seq_doubles_head(bo, b, 6, "floats", "wrench: bias")) {
         return NULL;
     }
     for (int i = 0; i < 6; i++) fl[i] = fl[i] + a * (ext[i] - b[i] - fl[i]);
     const int quiet = sqrt(fl[0] * fl[0] + fl[1] * fl[1] + fl[2] * fl[2]) < deadband;
     for (int i = 0; i < 6; i++) out[i] = quiet ? 0.0 : fl[i];
-    PyObject *e = list_of(ext, 6), *g = list_of(fl, 6), *F = list_of(out, 6);
+    PyObject *e = list_of_doubles(ext, 6), *g = list_of_doubles(fl, 6);
+    PyObject *F = list_of_doubles(out, 6);
     if (e == NULL || g == NULL || F == NULL) {
         Py_XDECREF(e);
         Py_XDECREF(g);

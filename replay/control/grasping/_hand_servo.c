@@ -7,41 +7,9 @@
 #include <Python.h>
 #include <math.h>
 
+#include "_pyfloats.h"
+
 #define MAXJ 32
-
-static int read_seq(PyObject *obj, double *out, Py_ssize_t n, const char *what) {
-    PyObject *seq = PySequence_Fast(obj, what);
-    if (seq == NULL) return -1;
-    if (PySequence_Fast_GET_SIZE(seq) != n) {
-        PyErr_Format(PyExc_ValueError, "%s: expected %zd values", what, n);
-        Py_DECREF(seq);
-        return -1;
-    }
-    PyObject **items = PySequence_Fast_ITEMS(seq);
-    for (Py_ssize_t i = 0; i < n; i++) {
-        out[i] = PyFloat_AsDouble(items[i]);
-        if (out[i] == -1.0 && PyErr_Occurred()) {
-            Py_DECREF(seq);
-            return -1;
-        }
-    }
-    Py_DECREF(seq);
-    return 0;
-}
-
-static PyObject *list_of(const double *x, Py_ssize_t n) {
-    PyObject *out = PyList_New(n);
-    if (out == NULL) return NULL;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        PyObject *f = PyFloat_FromDouble(x[i]);
-        if (f == NULL) {
-            Py_DECREF(out);
-            return NULL;
-        }
-        PyList_SET_ITEM(out, i, f);
-    }
-    return out;
-}
 
 static Py_ssize_t length(PyObject *obj) {
     Py_ssize_t n = PySequence_Size(obj);
@@ -62,10 +30,11 @@ static PyObject *py_lowpass(PyObject *self, PyObject *args) {
     Py_ssize_t n = length(xo);
     if (n < 0) return NULL;
     double x[MAXJ], tau[MAXJ];
-    if (read_seq(xo, x, n, "lowpass: load") < 0 || read_seq(to, tau, n, "lowpass: torque") < 0)
+    if (!seq_doubles(xo, x, n, "floats", "lowpass: load") ||
+        !seq_doubles(to, tau, n, "floats", "lowpass: torque"))
         return NULL;
     for (Py_ssize_t i = 0; i < n; i++) x[i] = x[i] + a * (-tau[i] - x[i]);
-    return list_of(x, n);
+    return list_of_doubles(x, n);
 }
 
 /* eq4(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax) -> (theta_d, command, deficit):
@@ -81,11 +50,13 @@ static PyObject *py_eq4(PyObject *self, PyObject *args) {
     Py_ssize_t n = length(preo);
     if (n < 0) return NULL;
     double td[MAXJ], grip[MAXJ], q[MAXJ], qd[MAXJ], load[MAXJ], cmd[MAXJ];
-    if (read_seq(preo, td, n, "eq4: pre") < 0 || read_seq(qo, q, n, "eq4: q") < 0 ||
-        read_seq(qdo, qd, n, "eq4: qd") < 0 || read_seq(lo, load, n, "eq4: load") < 0)
+    if (!seq_doubles(preo, td, n, "floats", "eq4: pre") ||
+        !seq_doubles(qo, q, n, "floats", "eq4: q") ||
+        !seq_doubles(qdo, qd, n, "floats", "eq4: qd") ||
+        !seq_doubles(lo, load, n, "floats", "eq4: load"))
         return NULL;
     if (gripo != Py_None) {
-        if (read_seq(gripo, grip, n, "eq4: grip") < 0) return NULL;
+        if (!seq_doubles(gripo, grip, n, "floats", "eq4: grip")) return NULL;
         for (Py_ssize_t i = 0; i < n; i++) td[i] = td[i] + c * (grip[i] - td[i]);
     }
     double deficit = -INFINITY;
@@ -95,9 +66,9 @@ static PyObject *py_eq4(PyObject *self, PyObject *args) {
         const double d = fabs(td[i] - q[i]);
         if (d > deficit) deficit = d;
     }
-    PyObject *a = list_of(td, n);
+    PyObject *a = list_of_doubles(td, n);
     if (a == NULL) return NULL;
-    PyObject *b = list_of(cmd, n);
+    PyObject *b = list_of_doubles(cmd, n);
     if (b == NULL) {
         Py_DECREF(a);
         return NULL;
