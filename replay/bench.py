@@ -1,7 +1,9 @@
 """``make bench``: speed of whole runs, measured so that it can be trusted on a shared machine.
 
-For each benchmarked scenario, in one process: a warm-up run, then ``--runs`` full runs (vision,
-controller and full logging); medians with min-max of CPU time (``time.process_time``: what other
+For each benchmarked scenario, in one process: a warm-up run, then full runs (vision, controller
+and full logging), at least ``--runs`` of them and more until they have taken ``--min-time`` CPU
+seconds (a short scenario's five runs last half a second: one slow spell of a shared host would
+be all of them; more runs spread over seconds make the median the machine's usual speed); medians with min-max of CPU time (``time.process_time``: what other
 users of the machine do not inflate much) and wall time; the real-time factor (simulated seconds
 per second, CPU and wall); the CPU time per simulated second; the ratio of a full run's CPU time
 to the bare engine's stepping the same scene the same number of steps (Pymunk ``space.step``,
@@ -157,6 +159,17 @@ def logging_costs(sc, out: Path) -> dict[str, tuple[float, int]]:
     return result
 
 
+def host_probe(n: int = 20000) -> float:
+    """CPU seconds of a fixed pure-Python loop (~1-2 ms): timed before each run, its spread is
+    how much the shared host's own speed swung while the runs were timed (the code is the same
+    every time, so a slower loop is a slower machine, not slower code)."""
+    c0 = time.process_time()
+    s = 0
+    for i in range(n):
+        s += i * i
+    return time.process_time() - c0
+
+
 def _stats(values: list[float]) -> tuple[float, float, float]:
     return statistics.median(values), min(values), max(values)
 
@@ -184,17 +197,34 @@ def _startup(modules: list[str], repeat: int = 3) -> dict:
 TARGETS = {"stick_3step": 10.0, "catch_optimised": 4.0, "grasp_hexahedron": 3.0}
 
 
-def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True) -> dict:
+# at most this many timed runs of a scenario, whatever ``min_time`` asks
+MAX_RUNS = 200
+
+
+def bench(
+    path: str,
+    runs: int = 5,
+    startup: bool = True,
+    optimiser: bool = True,
+    min_time: float = 0.0,
+) -> dict:
+    """``runs`` timed runs at least, and more (up to ``MAX_RUNS``) until they took ``min_time``
+    CPU seconds in all."""
     sc = load_scenario(path)
     cpu, wall, shares, result, runner = [], [], {c: [] for c in COMPONENTS}, None, None
+    probes = []
     with tempfile.TemporaryDirectory() as tmp:
-        for i in range(runs + 1):  # run 0 warms up (imports, caches, files)
-            runner = Runner(sc)
+        i = 0
+        while i <= runs or (sum(cpu) < min_time and i <= MAX_RUNS):
+            runner = Runner(sc)  # run 0 warms up (imports, caches, files)
+            probe = host_probe()
             c0, w0 = time.process_time(), time.perf_counter()
-            result = runner.run(Path(tmp) / f"run{i}.mcap")
+            result = runner.run(Path(tmp) / f"run{i % 2}.mcap")
             c1, w1 = time.process_time(), time.perf_counter()
-            if i == 0:
+            i += 1
+            if i == 1:
                 continue
+            probes.append(probe)
             cpu.append(c1 - c0)
             wall.append(w1 - w0)
             total = sum(result.timings.values())
@@ -215,7 +245,7 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
         "sim_time": result.t_end,
         "steps": result.steps,
         "messages": result.messages,
-        "runs": runs,
+        "runs": len(cpu),
         "cpu": _stats(cpu),
         "wall": _stats(wall),
         "engine": engine,
@@ -223,6 +253,7 @@ def bench(path: str, runs: int = 5, startup: bool = True, optimiser: bool = True
         "engine_in_run": (engine_cpu / run_cpu, engine_cpu / max(engine_steps, 1)),
         "engine_steps": engine_steps,
         "shares": {c: statistics.median(v) for c, v in shares.items()},
+        "host": _stats(probes),
         "logged": logged,
     }
     for key in ("cpu", "wall"):  # (median, min, max) of simulated s per second
@@ -314,6 +345,13 @@ def report(r: dict) -> str:
     ]
     if "logged" in r:
         lines.append("  " + _logging_line(r))
+    if "host" in r:
+        med, lo, hi = r["host"]
+        lines.append(
+            f"  host speed while timed: a fixed Python loop took {1e3 * med:.2f} "
+            f"({1e3 * lo:.2f}-{1e3 * hi:.2f}) ms CPU before each run, {hi / lo:.2f}x apart (the "
+            "same code each time: the machine's own swings, part of the runs' spread)"
+        )
     target = TARGETS.get(r["scenario"])
     if target is not None:
         rtf = r["rtf_cpu"][0]
@@ -341,7 +379,13 @@ def report(r: dict) -> str:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenarios", nargs="*", default=DEFAULT)
-    ap.add_argument("--runs", type=int, default=5, help="timed runs after the warm-up")
+    ap.add_argument("--runs", type=int, default=5, help="timed runs after the warm-up, at least")
+    ap.add_argument(
+        "--min-time",
+        type=float,
+        default=3.0,
+        help="CPU seconds the timed runs take at least (more runs until they do; default 3)",
+    )
     ap.add_argument("--no-startup", action="store_true", help="skip the start-up timing")
     ap.add_argument(
         "--no-optimiser",
@@ -357,6 +401,7 @@ def main(argv=None) -> None:
                     runs=args.runs,
                     startup=not args.no_startup,
                     optimiser=not args.no_optimiser,
+                    min_time=args.min_time,
                 )
             ),
             flush=True,

@@ -102,3 +102,23 @@ def test_the_logging_costs_count_every_logged_item_and_restore_the_classes(tmp_p
         {**_result("catch_optimised", cpu=1.0), "logged": costs, "sim_time": 0.03}
     ).splitlines()
     assert any(x.startswith("  logging, CPU per item") and "camera image" in x for x in line)
+
+
+def test_short_runs_are_repeated_until_they_took_the_minimum_time(monkeypatch):
+    """A short scenario's few runs would all fall in one slow spell of a shared host: the bench
+    runs more of them until they have taken ``min_time`` CPU seconds."""
+    from replay import bench
+
+    short = load_scenario("scenarios/stick_3step.yaml", sets=["timing.duration=0.02"])
+    monkeypatch.setattr(bench, "load_scenario", lambda path: short)
+    few = bench.bench("stick", runs=2, startup=False, optimiser=False)
+    assert few["runs"] == 2
+    r = bench.bench("stick", runs=2, startup=False, optimiser=False, min_time=0.3)
+    assert r["runs"] > 2
+    assert r["runs"] * r["cpu"][2] >= 0.3  # (the slowest run times the runs: at least the total)
+    text = bench.report(r)
+    assert f"median (min-max) of {r['runs']} runs" in text
+    # the host's speed was probed before each timed run, and the report says how far it swung
+    med, lo, hi = r["host"]
+    assert 0.0 < lo <= med <= hi
+    assert f"{hi / lo:.2f}x apart" in text
