@@ -29,7 +29,7 @@ from replay.foxglove.topics import FoxgloveTopics
 from replay.log import LogWriter
 from replay.resources import scenario_dir
 from replay.runner import COMPONENTS, Runner
-from replay.scenario import load_scenario
+from replay.scenario import ScenarioError, load_scenario
 
 DEFAULT = [
     str(scenario_dir() / f"{name}.yaml")
@@ -393,7 +393,15 @@ def main(argv=None) -> None:
         help="skip timing an offline optimisation from scratch",
     )
     args = ap.parse_args(argv)
+    if args.runs < 1:
+        ap.error(f"--runs {args.runs}: at least 1 timed run")
+    if not args.min_time >= 0.0:  # (NaN too)
+        ap.error(f"--min-time {args.min_time}: CPU seconds, 0 or more")
     for path in args.scenarios:
+        try:
+            load_scenario(path)  # a bad path or scenario: its message, not a traceback
+        except ScenarioError as exc:
+            ap.error(str(exc))
         print(
             report(
                 bench(

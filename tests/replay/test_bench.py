@@ -122,3 +122,21 @@ def test_short_runs_are_repeated_until_they_took_the_minimum_time(monkeypatch):
     med, lo, hi = r["host"]
     assert 0.0 < lo <= med <= hi
     assert f"{hi / lo:.2f}x apart" in text
+
+
+@pytest.mark.parametrize(
+    "argv,says",
+    [
+        (["--runs", "0"], "at least 1 timed run"),
+        (["--min-time", "-1"], "0 or more"),
+        (["--min-time", "nan"], "0 or more"),
+        (["no/such.yaml"], "no such scenario file"),
+    ],
+)
+def test_bad_bench_arguments_are_usage_errors_not_tracebacks(argv, says, capsys):
+    from replay import bench
+
+    with pytest.raises(SystemExit) as exc:
+        bench.main(argv)
+    assert exc.value.code == 2
+    assert says in capsys.readouterr().err
