@@ -3,14 +3,16 @@
 For each benchmarked scenario, in one process: a warm-up run, then full runs (vision, controller
 and full logging), at least ``--runs`` of them and more until they have taken ``--min-time`` CPU
 seconds (a short scenario's five runs last half a second: one slow spell of a shared host would
-be all of them; more runs spread over seconds make the median the machine's usual speed); medians with min-max of CPU time (``time.process_time``: what other
-users of the machine do not inflate much) and wall time; the real-time factor (simulated seconds
-per second, CPU and wall); the CPU time per simulated second; the ratio of a full run's CPU time
-to the bare engine's stepping the same scene the same number of steps (Pymunk ``space.step``,
-PyBullet ``stepSimulation``, nothing else); the share of each part of the loop (the runner's own
-timers: sensors, controller, plant, logging, runner); what a JSON message, a camera image, a
-3-D frame and a /log line cost each (one more run, each such call timed); and, apart, the interpreter's start-up and
-the imports a run needs. Nothing here is a test: it prints, it does not judge.
+be all of them; runs spread over seconds make the median the machine's usual speed), with a
+fixed Python loop timed before each as a probe of the host's own speed; medians with min-max of
+CPU time (``time.process_time``: what other users of the machine do not inflate much) and wall
+time; the real-time factor (simulated seconds per second, CPU and wall); the CPU time per
+simulated second; the ratio of a full run's CPU time to the bare engine's stepping the same scene
+the same number of steps (Pymunk ``space.step``, PyBullet ``stepSimulation``, nothing else); the
+share of each part of the loop (the runner's own timers: sensors, controller, plant, logging,
+runner); what a JSON message, a camera image, a 3-D frame and a /log line cost each (one more
+run, each such call timed); whether issue #10's target is met; and, apart, the interpreter's
+start-up and the imports a run needs. Nothing here is a test: it prints, it does not fail.
 """
 
 from __future__ import annotations
@@ -397,11 +399,12 @@ def main(argv=None) -> None:
         ap.error(f"--runs {args.runs}: at least 1 timed run")
     if not args.min_time >= 0.0:  # (NaN too)
         ap.error(f"--min-time {args.min_time}: CPU seconds, 0 or more")
-    for path in args.scenarios:
+    for path in args.scenarios:  # a bad path or scenario: its message, before any run
         try:
-            load_scenario(path)  # a bad path or scenario: its message, not a traceback
+            load_scenario(path)
         except ScenarioError as exc:
             ap.error(str(exc))
+    for path in args.scenarios:
         print(
             report(
                 bench(
