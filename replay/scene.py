@@ -9,10 +9,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 
-# Box and Cylinder store their fields straight into the instance's dict: a frozen dataclass's
-# generated __init__ sets each through object.__setattr__ (~1 us a field on Python 3.11; the
-# air table makes ~800 primitives a simulated second); tests/replay/test_scene_inits.py holds
-# them to the generated signature and result.
+# Box, Sphere, Cylinder and Frame store their fields straight into the instance's dict: a frozen
+# dataclass's generated __init__ sets each through object.__setattr__ (~1 us a field on Python
+# 3.11; the air table makes ~800 primitives a simulated second, the catching arm a Sphere a step
+# and ~1000 link Frames); tests/replay/test_scene_inits.py holds them to the generated signature
+# and result.
 @dataclass(frozen=True, init=False)
 class Box:
     name: str
@@ -27,12 +28,16 @@ class Box:
         d["size"], d["albedo"] = size, albedo
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Sphere:
     name: str
     position: tuple[float, float, float]
     radius: float
     albedo: float = 0.5
+
+    def __init__(self, name: str, position, radius: float, albedo: float = 0.5) -> None:
+        d = self.__dict__
+        d["name"], d["position"], d["radius"], d["albedo"] = name, position, radius, albedo
 
 
 @dataclass(frozen=True, init=False)
@@ -55,7 +60,7 @@ class Cylinder:
 Primitive = Box | Sphere | Cylinder
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Frame:
     """A moving body's or robot link's frame ``child`` in frame ``parent`` (for 3-D viewers:
     ``/tf``): translation (m) and rotation [qx, qy, qz, qw] of ``child`` in ``parent``."""
@@ -64,6 +69,15 @@ class Frame:
     child: str
     position: tuple[float, float, float]
     orientation: tuple[float, float, float, float]
+
+    def __init__(self, parent: str, child: str, position, orientation) -> None:
+        d = self.__dict__
+        d["parent"], d["child"], d["position"], d["orientation"] = (
+            parent,
+            child,
+            position,
+            orientation,
+        )
 
 
 @dataclass
