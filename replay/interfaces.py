@@ -69,7 +69,8 @@ class Plant(ABC):
 
     @abstractmethod
     def truth(self, t: float) -> dict[str, Any]:
-        """Ground truth to log now: topic -> payload dataclass."""
+        """Ground truth to log now: topic -> payload dataclass (or a list of them, as in
+        ``Controller.telemetry``)."""
 
     @abstractmethod
     def scene(self) -> Scene:

@@ -197,6 +197,7 @@ class Runner:
             controller.pop_events,
         )
         write = self._emitter(log)
+        write_all = self._emitter_all(log)
         sensors = [
             (s.measure, s.topic, div, latency, (name, s) if name in viz.imaging else None)
             for name, s, div, latency in self.sensors
@@ -271,20 +272,14 @@ class Runner:
                             stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
                         c0 = clock()
                     if telemetry:
-                        for topic, payload in telemetry.items():
-                            if isinstance(payload, list):
-                                for item in payload:
-                                    write(topic, item, t_ns)
-                            else:
-                                write(topic, payload, t_ns)
+                        write_all(telemetry, t_ns)
                         t_log += clock() - c0
                 c0 = clock()
                 if k % log_div == 0:
                     truth = truth_of(t)
                     c1 = clock()
                     t_plant += c1 - c0
-                    for topic, payload in truth.items():
-                        write(topic, payload, t_ns)
+                    write_all(truth, t_ns)
                     c0 = clock()
                     t_log += c0 - c1
                 if frame_div and k % frame_div == 0:  # the 3-D topics (replay/foxglove)
@@ -398,6 +393,20 @@ class Runner:
                 observe(topic, payload, t_ns)
 
         return write
+
+    def _emitter_all(self, log: LogWriter) -> Callable[[dict, int], None]:
+        """``write_all(messages, t_ns)``: each (topic, payload) of a dict written, a list payload
+        as its items' messages; the log's own compiled write_all without observers."""
+        if not self.observers:
+            return log.write_all
+        write = self._emitter(log)
+
+        def write_all(messages: dict, t_ns: int) -> None:
+            for topic, payload in messages.items():
+                for item in payload if isinstance(payload, list) else (payload,):
+                    write(topic, item, t_ns)
+
+        return write_all
 
     def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:
         """A message outside the loop's hot path (scenario, events, outcome), timed as logging."""

@@ -7,7 +7,8 @@
  * channel's count so far, log time u64, publish time u64, data; little endian) and calls
  * on_full() when the chunk has grown beyond chunk_size; append(record) adds other records
  * (schemas, channels); take() returns the chunk and its indexes and starts a new one;
- * json(topic, payload, t_ns) is a JSON message encoded and appended in one call (below).
+ * json(topic, payload, t_ns) is a JSON message encoded and appended in one call (below), json_all
+ * those of a dict.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -133,57 +134,95 @@ static PyObject *Chunk_message(Chunk *c, PyObject *const *args, Py_ssize_t nargs
     Py_RETURN_NONE;
 }
 
-/* json(topic, payload, t_ns): the JSON message of a topic whose channel is known, in one call
- * (replay/log/writer.py's LogWriter.write and encode are the reference): the channel from the
- * `json_channels` dict, the bytes from `dumps(payload)`, and when they hold "null" (orjson's NaN and
- * infinity) `finite(payload)` must say True; then one Message record at log and publish time
- * t_ns. True when written; False, with nothing written, for the Python path to decide (a topic
- * without a channel yet, a TypeError of dumps, a "null" not known finite). */
-static PyObject *Chunk_json(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 3) {
-        PyErr_SetString(PyExc_TypeError, "json(topic, payload, t_ns)");
-        return NULL;
-    }
-    if (!c->json_channels || !c->dumps || !c->finite) {
-        PyErr_SetString(PyExc_RuntimeError, "json(): use_json(channels, dumps, finite) first");
-        return NULL;
-    }
-    unsigned long long t = PyLong_AsUnsignedLongLong(args[2]);
-    if (t == (unsigned long long)-1 && PyErr_Occurred()) return NULL;
-    PyObject *channel = PyDict_GetItemWithError(c->json_channels, args[0]); /* borrowed */
-    if (!channel) {
-        if (PyErr_Occurred()) return NULL;
-        Py_RETURN_FALSE;
-    }
+/* One JSON message of a topic whose channel is known (replay/log/writer.py's LogWriter.write and
+ * encode are the reference): the channel from the `json_channels` dict, the bytes from
+ * `dumps(payload)`, and when they hold "null" (orjson's NaN and infinity) `finite(payload)` must
+ * say True; then one Message record at log and publish time t. 1 when written; 0, with nothing
+ * written, for the Python path to decide (a topic without a channel yet, a TypeError of dumps, a
+ * "null" not known finite); -1 with an exception set. */
+static int json_one(Chunk *c, PyObject *topic, PyObject *payload, unsigned long long t) {
+    PyObject *channel = PyDict_GetItemWithError(c->json_channels, topic); /* borrowed */
+    if (!channel) return PyErr_Occurred() ? -1 : 0;
     unsigned long long ch = PyLong_AsUnsignedLongLong(channel);
-    if (ch == (unsigned long long)-1 && PyErr_Occurred()) return NULL;
-    PyObject *data = PyObject_CallOneArg(c->dumps, args[1]);
+    if (ch == (unsigned long long)-1 && PyErr_Occurred()) return -1;
+    PyObject *data = PyObject_CallOneArg(c->dumps, payload);
     if (!data) {
-        if (!PyErr_ExceptionMatches(PyExc_TypeError)) return NULL;
+        if (!PyErr_ExceptionMatches(PyExc_TypeError)) return -1;
         PyErr_Clear();
-        Py_RETURN_FALSE;
+        return 0;
     }
     if (!PyBytes_Check(data)) {
         Py_DECREF(data);
         PyErr_SetString(PyExc_TypeError, "json(): dumps must return bytes");
-        return NULL;
+        return -1;
     }
     const char *buf = PyBytes_AS_STRING(data);
     size_t len = (size_t)PyBytes_GET_SIZE(data);
     if (len >= 4 && memmem(buf, len, "null", 4)) {
-        PyObject *ok = PyObject_CallOneArg(c->finite, args[1]);
+        PyObject *ok = PyObject_CallOneArg(c->finite, payload);
         if (ok != Py_True) {
             Py_DECREF(data);
-            if (!ok) return NULL;
+            if (!ok) return -1;
             Py_DECREF(ok);
-            Py_RETURN_FALSE;
+            return 0;
         }
         Py_DECREF(ok);
     }
     int r = append_message(c, ch, t, t, buf, len);
     Py_DECREF(data);
+    return r < 0 ? -1 : 1;
+}
+
+static int json_ready(Chunk *c) {
+    if (c->json_channels && c->dumps && c->finite) return 0;
+    PyErr_SetString(PyExc_RuntimeError, "json(): use_json(channels, dumps, finite) first");
+    return -1;
+}
+
+/* json(topic, payload, t_ns): json_one in one call; True when written, False for Python. */
+static PyObject *Chunk_json(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "json(topic, payload, t_ns)");
+        return NULL;
+    }
+    if (json_ready(c) < 0) return NULL;
+    unsigned long long t = PyLong_AsUnsignedLongLong(args[2]);
+    if (t == (unsigned long long)-1 && PyErr_Occurred()) return NULL;
+    int r = json_one(c, args[0], args[1], t);
     if (r < 0) return NULL;
-    Py_RETURN_TRUE;
+    return PyBool_FromLong(r);
+}
+
+/* json_all(messages, start, t_ns): json_one of each (topic, payload) of the dict `messages`, in
+ * its order, from its item `start` on; stops at the first that is a list or that json_one leaves
+ * to Python and returns that item's index (the caller writes it and calls again from the next),
+ * -1 when all were written. The same records, in the same order, as json() of each. */
+static PyObject *Chunk_json_all(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3 || !PyDict_Check(args[0])) {
+        PyErr_SetString(PyExc_TypeError, "json_all(messages: dict, start, t_ns)");
+        return NULL;
+    }
+    if (json_ready(c) < 0) return NULL;
+    Py_ssize_t start = PyLong_AsSsize_t(args[1]);
+    if (start == -1 && PyErr_Occurred()) return NULL;
+    unsigned long long t = PyLong_AsUnsignedLongLong(args[2]);
+    if (t == (unsigned long long)-1 && PyErr_Occurred()) return NULL;
+    Py_ssize_t pos = 0, i = 0;
+    PyObject *topic, *payload; /* borrowed */
+    while (PyDict_Next(args[0], &pos, &topic, &payload)) {
+        if (i >= start) {
+            if (PyList_Check(payload)) return PyLong_FromSsize_t(i);
+            Py_INCREF(topic); /* (on_full runs Python: keep them alive) */
+            Py_INCREF(payload);
+            int r = json_one(c, topic, payload, t);
+            Py_DECREF(topic);
+            Py_DECREF(payload);
+            if (r < 0) return NULL;
+            if (r == 0) return PyLong_FromSsize_t(i);
+        }
+        i++;
+    }
+    return PyLong_FromLong(-1);
 }
 
 static PyObject *Chunk_use_json(Chunk *c, PyObject *const *args, Py_ssize_t nargs) {
@@ -307,6 +346,8 @@ static void Chunk_dealloc(Chunk *c) {
 static PyMethodDef Chunk_methods[] = {
     {"message", (PyCFunction)(void (*)(void))Chunk_message, METH_FASTCALL,
      "append one Message record"},
+    {"json_all", (PyCFunction)(void (*)(void))Chunk_json_all, METH_FASTCALL,
+     "json() of a dict's (topic, payload) items from one on; where it stopped or -1"},
     {"json", (PyCFunction)(void (*)(void))Chunk_json, METH_FASTCALL,
      "a JSON message of a known topic in one call (False: not written, the caller decides)"},
     {"use_json", (PyCFunction)(void (*)(void))Chunk_use_json, METH_FASTCALL,

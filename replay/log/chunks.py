@@ -129,6 +129,14 @@ class McapFile:
         return self._chunk.json
 
     @property
+    def json_all(self) -> Callable[[dict[str, Any], int, int], int]:
+        """``json_all(messages, start, t_ns)``, compiled: ``json_messages``' call for each
+        (topic, payload) of the dict ``messages`` from its item ``start`` on, in order; the index
+        of the first it leaves to the caller (a list, or one ``json`` would say False of), or -1
+        when all were written."""
+        return self._chunk.json_all
+
+    @property
     def message_count(self) -> int:
         return self._chunk.total
 

@@ -91,3 +91,51 @@ def test_compiled_json_path_leaves_a_new_topic_and_a_bad_payload_to_python(tmp_p
         assert log.count == count
         with pytest.raises(OverflowError):
             log._json("/x", {"t": 1.0}, -1)
+
+
+def _write_dicts(path, groups, compiled: bool):
+    """Each group (a dict of topic -> payload or list of payloads, one time) written by
+    write_all (compiled) or by write one message at a time; the refusals and the file."""
+    refused = []
+    with LogWriter(path, chunk_size=4096) as log:
+        for messages, t_ns in groups:
+            try:
+                if compiled:
+                    log.write_all(messages, t_ns)
+                else:
+                    for topic, payload in messages.items():
+                        for item in payload if isinstance(payload, list) else [payload]:
+                            log.write(topic, item, t_ns)
+                refused.append(None)
+            except NonFiniteValueError as exc:  # the rest of that group is not written
+                refused.append((exc.topic, exc.fields))
+    return refused, path.read_bytes()
+
+
+@pytest.mark.parametrize("seed", [5, 6])
+def test_write_all_writes_what_a_loop_of_write_does(tmp_path, seed):
+    """A dict's messages in one compiled call: new topics, lists, payloads only Python takes and
+    non-finite refusals where they come, the same records in the same order."""
+    rng = np.random.default_rng(seed)
+    topics = [f"/t{i}" for i in range(8)] + ["/stick/state", "/events"]
+    groups = []
+    for i in range(600):
+        messages = {}
+        for topic in rng.choice(topics, size=int(rng.integers(1, 6)), replace=False):
+            n = int(rng.integers(0, 4))
+            messages[str(topic)] = (
+                [_payload(rng) for _ in range(n)] if rng.random() < 0.2 else _payload(rng)
+            )
+        groups.append((messages, 1_000_000 * i))
+    refused, data = _write_dicts(tmp_path / "all.mcap", groups, compiled=True)
+    refused_ref, data_ref = _write_dicts(tmp_path / "loop.mcap", groups, compiled=False)
+    assert refused == refused_ref and any(r is not None for r in refused)
+    assert data == data_ref
+
+
+def test_write_all_rejects_what_is_not_a_dict(tmp_path):
+    with LogWriter(tmp_path / "x.mcap") as log:
+        with pytest.raises(TypeError, match="json_all"):
+            log._json_all([("/x", {"t": 1.0})], 0, 0)
+        log.write_all({}, 0)  # nothing to write
+    assert log.count == 0
