@@ -22,7 +22,11 @@ def run(tmp_path, name, sets=(), seed=None):
 
 @pytest.fixture(scope="module")
 def hexahedron(tmp_path_factory, project_root_module):
-    return run(tmp_path_factory.mktemp("grasp"), "grasp_hexahedron", ["timing.duration=1.6"])
+    """The scenario as it is (2 s: tracking, reach, then the hold). The grasp's moment moves with
+    the low bits of the machine's BLAS kernels (the contacts are chaotic): first grasp at 1.005-1.134
+    s over OpenBLAS's Prescott, Sandybridge, Haswell, Zen and SkylakeX kernels, so a run cut at
+    1.6 s held 0.47 s on one machine and 0.6 s on another; at 2 s each holds 0.87-1.0 s."""
+    return run(tmp_path_factory.mktemp("grasp"), "grasp_hexahedron")
 
 
 @pytest.fixture(scope="module")
@@ -45,7 +49,8 @@ def test_the_box_is_grasped_with_the_rectangle_preshape_and_held_while_it_moves(
     o = result.outcome
     assert o["success"], o["reason"]
     assert o["shape"] == "rectangle" and o["preshape_at_grasp"] == ["rectangle"]
-    assert 0.5 < o["first_grasp_t"] < 1.1  # reaching starts at 0.5 s (Fig. 7)
+    # reaching 0.5-0.8 s (Fig. 7); the fingers close and settle after it (1.0-1.13 s measured)
+    assert 0.8 < o["first_grasp_t"] < 1.3
     assert o["held_path"] > 0.01  # the human kept moving it, m
     grasp = events(log, "grasp")
     assert len(grasp) == 1 and len(grasp[0]["data"]["parts"]) >= 3
@@ -55,7 +60,7 @@ def test_the_box_is_grasped_with_the_rectangle_preshape_and_held_while_it_moves(
 def test_every_loop_ticks_each_ms_with_latency_under_1_5_ms(hexahedron):
     _, log = hexahedron
     loops = log.series("/tasks/loops")
-    assert len(loops) == 1600
+    assert len(loops) == 2000
     assert all(all(m["ticked"]) for m in loops)
     names = loops[0]["names"]
     assert all(x is None for m in loops for x, n in zip(m["latency"], names) if n == "schedule")
@@ -138,3 +143,34 @@ def test_same_seed_same_log(tmp_path, project_root):
         "/wrist/wrench",
     ):
         assert logs[0].series(topic) == logs[1].series(topic), topic
+
+
+@pytest.mark.parametrize("kernels", ["Haswell", "Prescott"])
+def test_the_box_is_grasped_with_another_machines_blas_kernels(kernels, tmp_path, project_root):
+    """Another CPU's BLAS (OpenBLAS's kernels for it, chosen by OPENBLAS_CORETYPE at start-up)
+    changes the low bits of the arm's damped pseudo-inverse and from there the contacts: the
+    grasp must not depend on them."""
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / "grasp.mcap"
+    env = {**os.environ, "OPENBLAS_CORETYPE": kernels}
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "replay.cli",
+            "run",
+            "scenarios/grasp_hexahedron.yaml",
+            "-o",
+            str(out),
+        ],
+        check=True,
+        env=env,
+        capture_output=True,
+    )
+    o = [e for e in LogReader(out).events() if e["kind"] == "outcome"][-1]["data"]
+    print(f"{kernels}: {o['reason']}, first grasp {o['first_grasp_t']:.3f} s")
+    assert o["success"], o["reason"]
+    assert 0.8 < o["first_grasp_t"] < 1.3
