@@ -306,7 +306,8 @@ class Runner:
             # the final state, so the log ends where the run ended
             t_end = k / rate
             for topic, payload in self.plant.truth(t_end).items():
-                self._write(log, topic, payload, self.t_ns(k))
+                for item in payload if isinstance(payload, list) else (payload,):
+                    self._write(log, topic, item, self.t_ns(k))
             if frame_div:
                 viz.frame(self.plant.scene(), self.t_ns(k))
             self._outcome(log, result, k, self._verdict(k / rate))

@@ -362,3 +362,25 @@ def test_resolved_yaml_tree_is_the_representers_on_random_plain_data():
         data = {"root": value(0)}
         want = yaml.dump(data, Dumper=_DUMPER, sort_keys=False, default_flow_style=None, width=100)
         assert yaml.serialize(_node(data), Dumper=_DUMPER, width=100) == want
+
+
+def test_a_list_in_truth_is_its_items_messages_with_and_without_observers(
+    toy_yaml, tmp_path, monkeypatch
+):
+    """Truth and telemetry go through the log's write_all (one compiled call a dict); a list
+    payload is one message an item, as a loop of write would log it, observers or not."""
+    import toy_plugins
+
+    def truth(self, t):
+        return {"/toy/state": {"t": t, "x": self.x}, "/toy/pair": [{"i": 0}, {"i": 1}]}
+
+    monkeypatch.setattr(toy_plugins.ToyPlant, "truth", truth)
+    seen = []
+    for observers, name in (((), "plain.mcap"), ((lambda *m: seen.append(m[0]),), "obs.mcap")):
+        sc = load_scenario(toy_yaml, sets=["timing.duration=0.01"])
+        result = Runner(sc, observers=observers).run(tmp_path / name)
+        counts = LogReader(result.path).topic_counts()
+        assert counts["/toy/pair"] == 2 * counts["/toy/state"] == 2 * (result.steps + 1)
+    assert seen.count("/toy/pair") == 2 * seen.count("/toy/state")
+    plain = list(LogReader(tmp_path / "plain.mcap").messages("/toy/pair"))
+    assert [m.data["i"] for m in plain[:4]] == [0, 1, 0, 1]
