@@ -268,6 +268,7 @@ def bench(
         "steps": result.steps,
         "messages": result.messages,
         "runs": len(cpu),
+        "capped": len(cpu) >= MAX_RUNS and sum(cpu) < min_time,  # min_time not reached
         "cpu": _stats(cpu),
         "wall": _stats(wall),
         "engine": engine,
@@ -350,7 +351,8 @@ def report(r: dict) -> str:
     sim = r["sim_time"]
     lines = [
         f"{r['scenario']}: {sim:.3f} s simulated, {r['steps']} physics steps, "
-        f"{r['messages']} log messages; median (min-max) of {r['runs']} runs after a warm-up",
+        f"{r['messages']} log messages; median (min-max) of {r['runs']} runs after a warm-up"
+        + (f" (stopped at {MAX_RUNS} runs before --min-time)" if r.get("capped") else ""),
         f"  CPU time:  {_range(r['cpu'], '.3f')} s = {r['cpu'][0] / sim:.3f} s per simulated s; "
         f"real-time factor {_range(r['rtf_cpu'], '.1f')}x",
         f"  wall time: {_range(r['wall'], '.3f')} s; real-time factor "

@@ -121,7 +121,10 @@ def test_short_runs_are_repeated_until_they_took_the_minimum_time(monkeypatch):
     # the host's speed was probed before each timed run, and the report says how far it swung
     med, lo, hi = r["host"]
     assert 0.0 < lo <= med <= hi
-    assert f"{hi / lo:.2f}x apart" in text
+    assert f"{hi / lo:.2f}x apart" in text and "stopped at" not in text
+    monkeypatch.setattr(bench, "MAX_RUNS", 3)  # a --min-time the runs cannot reach: said so
+    capped = bench.bench("stick", runs=1, startup=False, optimiser=False, min_time=1e6)
+    assert capped["runs"] == 3 and "(stopped at 3 runs before --min-time)" in bench.report(capped)
 
 
 @pytest.mark.parametrize(
