@@ -64,8 +64,10 @@ def test_the_report_says_whether_each_target_is_met():
     met = report(_result("stick_3step", cpu=0.15))  # 13.3x real time
     assert "target (issue #10): >= 10x real time (<= 0.100 CPU s per simulated s): met" in met
     missed = report(_result("catch_optimised", cpu=1.0))  # 2x
-    assert ">= 4x real time" in missed and "NOT met: needs 2.0x less CPU" in missed
+    assert ">= 4x real time" in missed and "NOT met: needs 2.00x less CPU (50 % less)" in missed
     assert "target" not in report(_result("stick_2step", cpu=1.0))  # no target for it
+    close = report(_result("catch_optimised", cpu=0.51))  # 3.92x: 2 % short, not "1.0x"
+    assert "NOT met: needs 1.02x less CPU (2 % less)" in close
     # the components add up to the run's CPU time per simulated second (500 ms here)
     line = next(x for x in missed.splitlines() if "where the time goes" in x)
     ms = [int(x.split()[-1]) for x in line.split("[")[1].split(" ms")[0].split(", ")]
