@@ -305,9 +305,10 @@ class Runner:
                     progress(k / rate, sc.timing.duration)
             # the final state, so the log ends where the run ended
             t_end = k / rate
-            for topic, payload in self.plant.truth(t_end).items():
-                for item in payload if isinstance(payload, list) else (payload,):
-                    self._write(log, topic, item, self.t_ns(k))
+            truth = self.plant.truth(t_end)
+            c0 = clock()
+            write_all(truth, self.t_ns(k))  # (as in the loop)
+            t_log += clock() - c0
             if frame_div:
                 viz.frame(self.plant.scene(), self.t_ns(k))
             self._outcome(log, result, k, self._verdict(k / rate))
