@@ -1,8 +1,26 @@
-"""The claims table: each number a paper states against the same quantity measured in a run."""
+"""The claims table: each number a paper states against the same quantity measured in a run.
+
+A row has a kind (what decides it):
+
+- ``measured``: read from the run's truth topics; only these count toward "N of M reproduced",
+  and only when a falsifier (a named variant under which the paper's claim is false in the
+  simulation) is declared for the row: a row that cannot be shown to fail proves nothing.
+- ``configuration``: what the scenario sets (a rate, a resolution, a release speed): shown, never
+  counted.
+- ``paper``: the paper's own numbers checked against each other; the verdict is computed.
+
+A paper's claims module (the ``paper_replay.claims`` entry point's module) lists its falsifiers
+in ``FALSIFIERS``; ``replay falsify`` runs each variant and checks that its row then "differs".
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import inspect
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+KINDS = ("measured", "configuration", "paper")
 
 
 @dataclass
@@ -10,15 +28,74 @@ class Claim:
     quantity: str
     stated: str  # as the paper states it (with its unit)
     measured: str  # from the run's log, or a computation from the paper's own numbers
-    status: str  # reproduced | differs | inconsistent (the paper's numbers disagree)
+    status: str  # reproduced | differs | tie | inconsistent | consistent | note | not run
     note: str = ""
+    kind: str = "measured"  # measured | configuration | paper (see the module docstring)
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"claim {self.quantity!r}: kind {self.kind!r} is not one of {KINDS}")
+
+
+@dataclass(frozen=True)
+class Falsifier:
+    """A variant under which a measured row's claim is false in the simulation.
+
+    ``replaces`` names the log (by scenario name) that the variant's run stands in for when the
+    paper's rows are evaluated; the variant is that scenario (or ``scenario``, if given) with
+    ``overrides`` (``--set`` paths to values) applied."""
+
+    row: str  # the Claim.quantity it must turn to "differs"
+    name: str  # a short name for the variant
+    replaces: str  # the scenario name of the log it replaces
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+    why: str = ""  # why the paper's claim is false under it
+    scenario: str | None = None  # the scenario run (default: ``replaces``)
 
 
 def within(measured: float, stated: float, rel: float = 0.0, abs_: float = 0.0) -> str:
     return "reproduced" if abs(measured - stated) <= abs_ + rel * abs(stated) else "differs"
 
 
-def format_table(title: str, rows: list[Claim], partial: dict[str, list[str]] | None = None) -> str:
+def falsifiers_of(evaluate: Callable) -> tuple[Falsifier, ...]:
+    """The falsifiers declared beside a paper's ``evaluate`` (its module's ``FALSIFIERS``)."""
+    return tuple(getattr(inspect.getmodule(evaluate), "FALSIFIERS", ()))
+
+
+def counted(rows: Iterable[Claim], falsifiers: Iterable[Falsifier]) -> tuple[int, int]:
+    """(reproduced, of): measured rows only; a reproduced row counts only with a falsifier."""
+    rows = [r for r in rows if r.kind == "measured"]
+    covered = {f.row for f in falsifiers}
+    n_ok = sum(r.status == "reproduced" and r.quantity in covered for r in rows)
+    return n_ok, len(rows)
+
+
+def summary(rows: list[Claim], falsifiers: Iterable[Falsifier] = ()) -> str:
+    """One line: the measured count and how many rows of each other kind there are."""
+    falsifiers = tuple(falsifiers)
+    n_ok, n = counted(rows, falsifiers)
+    covered = {f.row for f in falsifiers}
+    bare = sum(
+        r.kind == "measured" and r.status == "reproduced" and r.quantity not in covered
+        for r in rows
+    )
+    ties = sum(r.kind == "measured" and r.status == "tie" for r in rows)
+    other = {k: sum(r.kind == k for r in rows) for k in KINDS[1:]}
+    parts = [f"{n_ok} of {n} measured rows reproduced"]
+    if bare:
+        parts.append(f"{bare} more agree but have no falsifier (not counted)")
+    if ties:
+        parts.append(f"{ties} tie{'s' if ties > 1 else ''}")
+    parts += [f"{v} {k} row{'s' if v != 1 else ''}" for k, v in other.items() if v]
+    return "; ".join(parts) + "."
+
+
+def format_table(
+    title: str,
+    rows: list[Claim],
+    partial: dict[str, list[str]] | None = None,
+    falsifiers: Iterable[Falsifier] = (),
+) -> str:
     """The table in Markdown; ``partial`` (log name -> notes) lists the logs that are not
     finished runs, so their rows are never read as a finished run's."""
     lines = [f"## {title}", ""]
@@ -29,9 +106,13 @@ def format_table(title: str, rows: list[Claim], partial: dict[str, list[str]] | 
         )
     if partial:
         lines.append("")
-    lines += ["| quantity | paper states | this run | status | note |", "|---|---|---|---|---|"]
+    lines += [
+        "| quantity | kind | paper states | this run | status | note |",
+        "|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        lines.append(f"| {r.quantity} | {r.stated} | {r.measured} | **{r.status}** | {r.note} |")
-    n_ok = sum(r.status == "reproduced" for r in rows)
-    lines += ["", f"{n_ok} of {len(rows)} reproduced."]
+        lines.append(
+            f"| {r.quantity} | {r.kind} | {r.stated} | {r.measured} | **{r.status}** | {r.note} |"
+        )
+    lines += ["", summary(rows, falsifiers)]
     return "\n".join(lines)

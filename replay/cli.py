@@ -625,7 +625,7 @@ def figures(logs, out):
 @click.option("--markdown", type=click.Path(dir_okay=False), help="also write the table here")
 def claims(logs, markdown):
     """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
-    from analysis.claims import format_table
+    from analysis.claims import falsifiers_of, format_table
 
     sections = []
     by_paper = _logs_by_paper(logs)
@@ -645,7 +645,9 @@ def claims(logs, markdown):
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("claims", paper, readers, exc)
         title = PAPERS[paper].title if paper in PAPERS else paper
-        sections.append(format_table(title, rows, partial=_partial(readers)))
+        sections.append(
+            format_table(title, rows, partial=_partial(readers), falsifiers=falsifiers_of(evaluate))
+        )
     text = "\n\n".join(sections)
     click.echo(text)
     if markdown:

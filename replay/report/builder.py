@@ -68,6 +68,8 @@ class PaperSection:
     figures: list = field(default_factory=list)
     claims: list = field(default_factory=list)
     claims_md: str = ""
+    claims_summary: str = ""
+    falsifiers: tuple = ()
     ablations: list = field(default_factory=list)
     notes: list = field(default_factory=list)
 
@@ -129,9 +131,11 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
             try:
                 evaluate = registry.load("claims", key)
                 sec.claims = evaluate(readers)
-                from analysis.claims import format_table
+                from analysis.claims import falsifiers_of, format_table, summary
 
-                sec.claims_md = format_table(paper.title, sec.claims)
+                sec.falsifiers = falsifiers_of(evaluate)
+                sec.claims_md = format_table(paper.title, sec.claims, falsifiers=sec.falsifiers)
+                sec.claims_summary = summary(sec.claims, sec.falsifiers)
             except registry.UnknownPlugin:
                 sec.notes.append("No claims table defined yet.")
         for name in ablations.names():
@@ -322,17 +326,16 @@ def _html(sections, info, commands) -> str:
         if sec.claims:
             h += [
                 "<h3>Claims</h3>",
-                "<table><tr><th>quantity</th><th>paper states</th>"
+                "<table><tr><th>quantity</th><th>kind</th><th>paper states</th>"
                 "<th>this run</th><th>status</th><th>note</th></tr>",
             ]
             for c in sec.claims:
                 h.append(
-                    f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.stated)}</td>"
+                    f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.kind)}</td><td>{_e(c.stated)}</td>"
                     f"<td>{_e(c.measured)}</td><td class='{_e(c.status)}'><b>"
                     f"{_e(c.status)}</b></td><td>{_e(c.note)}</td></tr>"
                 )
-            n_ok = sum(c.status == "reproduced" for c in sec.claims)
-            h += ["</table>", f"<p>{n_ok} of {len(sec.claims)} reproduced.</p>"]
+            h += ["</table>", f"<p>{_e(sec.claims_summary)}</p>"]
         if sec.ablations:
             h.append("<h3>Ablations</h3>")
             for a in sec.ablations:
