@@ -25,10 +25,11 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+from replay.resources import scenario_dir
+
 SCENARIO = {
-    "stick_2step": ROOT / "scenarios" / "stick_2step.yaml",
-    "stick_3step": ROOT / "scenarios" / "stick_3step.yaml",
+    "stick_2step": scenario_dir() / "stick_2step.yaml",
+    "stick_3step": scenario_dir() / "stick_3step.yaml",
 }
 PASS_Y = 0.12  # m, where the paper's first collision happens (Sec. IV-B)
 # s, per strategy: a run stops 0.1 s after the capture; the 3-step's clamped second contact

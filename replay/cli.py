@@ -14,6 +14,7 @@ import numpy as np
 from replay import completion as complete
 from replay import registry
 from replay.console import RunProgress, bar, bars_on, fail, note, warn
+from replay.foxglove.layouts import PAPERS as LAYOUT_PAPERS
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
 from replay.log.writer import check_output
@@ -353,7 +354,8 @@ def list_(plugins):
     """The scenarios (name, paper, description), or the plug-ins."""
     if plugins:
         for kind in registry.GROUPS:
-            click.echo(f"{kind}s: {', '.join(registry.names(kind)) or '-'}")
+            label = kind if kind.endswith("s") else f"{kind}s"  # figures, claims: already plural
+            click.echo(f"{label}: {', '.join(registry.names(kind)) or '-'}")
         return
     for p in sorted(scenario_dir().glob("*.yaml")):
         try:
@@ -801,6 +803,55 @@ def urdf(scenario, out, sets):
     if not text:
         fail(f"{scenario}: plant {sc.plant.type!r} has no URDF")
     _write_output(Path(out), text, kind="URDF", magic=b"<?xml")
+    click.echo(f"wrote {out}")
+
+
+@main.command()
+@click.argument("name", shell_complete=complete.scenario)
+@click.option(
+    "-o", "--out", type=click.Path(dir_okay=False), help="copy it to this file (default: stdout)"
+)
+def show(name, out):
+    """Print the scenario NAME (a shipped one by name, e.g. stick_3step, or a file), or copy it
+    to FILE as a start for your own. A copy's ``extends:`` of a shipped scenario still resolves
+    (a bare name is a shipped scenario), so ``extends: stick_3step`` and one changed value is a
+    complete scenario."""
+    path = Path(find_scenario(name))
+    if not path.is_file():
+        fail(f"no scenario {name!r}: `replay list` names the shipped ones")
+    text = path.read_text(encoding="utf-8")
+    if not out:
+        click.echo(text, nl=False)
+        return
+    target = Path(out)
+    if target.exists() or target.is_symlink():
+        fail(f"will not overwrite {target}: it exists (remove it or give another -o)")
+    if target.resolve() == path.resolve():
+        fail(f"{target} is the scenario itself")
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with open(target, "x", encoding="utf-8") as f:
+            f.write(text)
+    except OSError as exc:
+        fail(f"cannot write {target}: {exc.strerror or exc}")
+    click.echo(f"wrote {target} (from {path.name}); run it with: replay run {target}")
+
+
+@main.command()
+@click.argument("paper", type=click.Choice(LAYOUT_PAPERS))
+@click.option(
+    "-o", "--out", type=click.Path(dir_okay=False), help="write it to this file (default: stdout)"
+)
+def layout(paper, out):
+    """A Foxglove layout for PAPER's logs (Layout -> Import from file; docs/foxglove.md): 3-D
+    scene, camera images, the paper's quantities plotted, the events."""
+    from replay.foxglove.layouts import layout_json  # noqa: PLC0415
+
+    text = layout_json(paper)
+    if not out:
+        click.echo(text, nl=False)
+        return
+    _write_output(Path(out), text, kind="Foxglove layout", magic=b"{")
     click.echo(f"wrote {out}")
 
 

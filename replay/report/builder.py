@@ -210,7 +210,7 @@ def _commands(sections, logs) -> list[str]:
     cmds = []
     for sec in sections:
         for name, seed, _ in sec.runs:
-            cmds.append(f"replay run scenarios/{name}.yaml --seed {seed} -o out/logs/{name}.mcap")
+            cmds.append(f"replay run {name} --seed {seed} -o out/logs/{name}.mcap")
     if logs:
         cmds += [
             "replay figures out/logs/*.mcap -o out/figures",

@@ -78,7 +78,7 @@ def _compose_file(
     if not (isinstance(base_node, yaml.ScalarNode) and base_node.tag == _STR and base_node.value):
         raise ScenarioError("expected a file name", node=base_node, path="extends")
     try:
-        base_path = (path.parent / base_node.value).resolve()
+        base_path = _base_file(path, base_node.value, seen)
     except (OSError, RuntimeError, ValueError):
         raise ScenarioError(
             f"bad file name {show(base_node.value)}", node=base_node, path="extends"
@@ -93,9 +93,32 @@ def _compose_file(
         )
     if not base_path.is_file():
         raise ScenarioError(
-            f"no such scenario file {show(base_node.value)}", node=base_node, path="extends"
+            f"no such scenario file {show(base_node.value)} (neither beside this file nor a "
+            "shipped scenario: `replay list` names them)",
+            node=base_node,
+            path="extends",
         )
     return _merge(_compose_file(base_path, seen + (path.resolve(),), inputs=inputs), node)
+
+
+def _base_file(path: Path, value: str, seen: tuple[Path, ...]) -> Path:
+    """What ``extends: value`` in ``path`` names: a file beside ``path`` wins (for a bare name,
+    ``NAME`` or ``NAME.yaml``), unless it is ``path`` itself or already in the chain; else a
+    bare name (``stick_3step`` or ``stick_3step.yaml``) is the shipped scenario of that name, so
+    a user's own file can build on one after ``pip install``."""
+    local = (path.parent / value).resolve()
+    bare = "/" not in value and "\\" not in value and not value.endswith((".yaml", ".yml"))
+    for candidate in (local, local.with_name(f"{local.name}.yaml")) if bare else (local,):
+        if candidate.is_file() and candidate != path.resolve() and candidate not in seen:
+            return candidate
+    if "/" not in value and "\\" not in value:
+        from replay.resources import scenario_dir
+
+        name = value if value.endswith((".yaml", ".yml")) else f"{value}.yaml"
+        shipped = (scenario_dir() / name).resolve()
+        if shipped.is_file() and shipped != path.resolve():
+            return shipped
+    return local
 
 
 def _pop(mapping: yaml.MappingNode, key: str) -> yaml.Node | None:
@@ -504,14 +527,28 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
         if not isinstance(raw, yaml.Node):  # no params given: all defaults
             raw = yaml.MappingNode(_MAP, [], _nearest(root, path).start_mark, None)
         spec.params = build_dataclass(raw, cls.Params, f"{path}.params")
-    # a plug-in whose Params declare an internal ``scenario_dir`` field gets the scenario file's
-    # directory, so that its file parameters resolve relative to the scenario, not the cwd
+    # a plug-in whose Params declare an internal ``scenario_dir`` field gets the directory of the
+    # file that wrote its file parameters (fields named ``*_file``), so that they resolve relative
+    # to that file, not the cwd: a user's file that extends a shipped scenario keeps the shipped
+    # scenario's data files (by default: the scenario file's own directory)
     src = Path(str(sc.source)) if sc.source else None
     if src is not None and src.is_file():
-        for _, spec, _ in plugin_sections(sc):
+        for _, spec, path in plugin_sections(sc):
             if hasattr(spec.params, "scenario_dir"):
-                spec.params.scenario_dir = str(src.resolve().parent)
+                spec.params.scenario_dir = str(_files_dir(root, path, spec.params, src))
     return sc
+
+
+def _files_dir(root: yaml.Node, path: str, params: Any, src: Path) -> Path:
+    """The directory of the file that set ``params``' first ``*_file`` field (else ``src``'s)."""
+    for f in dataclasses.fields(params):
+        if not f.name.endswith("_file"):
+            continue
+        node = node_at(root, f"{path}.params.{f.name}")
+        name = getattr(getattr(node, "start_mark", None), "name", "")
+        if node is not None and name and Path(name).is_file():
+            return Path(name).resolve().parent
+    return src.resolve().parent
 
 
 def check_timing(sc: Scenario, root: yaml.Node) -> None:
