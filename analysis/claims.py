@@ -35,6 +35,11 @@ class Claim:
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"claim {self.quantity!r}: kind {self.kind!r} is not one of {KINDS}")
+        if self.kind != "measured" and self.status == "reproduced":
+            raise ValueError(
+                f"claim {self.quantity!r}: a {self.kind} row is never 'reproduced' (only a "
+                "measured one is; say 'consistent' or 'differs')"
+            )
 
 
 @dataclass(frozen=True)
@@ -55,6 +60,19 @@ class Falsifier:
 
 def within(measured: float, stated: float, rel: float = 0.0, abs_: float = 0.0) -> str:
     return "reproduced" if abs(measured - stated) <= abs_ + rel * abs(stated) else "differs"
+
+
+def agrees(ok: bool) -> str:
+    """A configuration or paper row's verdict: 'consistent' or 'differs'."""
+    return "consistent" if ok else "differs"
+
+
+def smaller(a: float, b: float, tol: float) -> str:
+    """'a is smaller than b' with a tolerance: "reproduced" when b - a > tol, "tie" when
+    |a - b| <= tol (what the paper's figure cannot tell apart), else "differs"."""
+    if abs(a - b) <= tol:
+        return "tie"
+    return "reproduced" if a < b else "differs"
 
 
 def falsifiers_of(evaluate: Callable) -> tuple[Falsifier, ...]:
