@@ -693,7 +693,7 @@ def falsify(papers, logs_dir, keep):
                     paper,
                     work / paper,
                     Path(logs_dir) if logs_dir else None,
-                    progress=lambda s: click.echo(s, err=True),
+                    progress=note,
                 )
             except (LogError, ScenarioError) as exc:
                 fail(f"{paper}: {one_line(str(exc))}", code=1)
