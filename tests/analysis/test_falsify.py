@@ -6,6 +6,7 @@ import pytest
 
 from analysis.claims import Claim, Falsifier, agrees, smaller, summary
 from analysis.falsify import _sets, check
+from replay.log import LogReader
 
 
 def _evaluate(logs):
@@ -70,3 +71,30 @@ def test_only_measured_rows_are_reproduced_and_counted():
     text = summary(rows, [Falsifier("a small", "big", "run")])
     assert text.startswith("1 of 2 measured rows reproduced")
     assert "1 more agree but have no falsifier" in text and "1 configuration row" in text
+
+
+def test_replay_falsify_flips_every_reproduced_row_of_the_stick_and_catch_tables(tmp_path):
+    """The whole check, as CI runs it: the papers' default scenarios, then every falsifier."""
+    from click.testing import CliRunner
+
+    from replay.cli import main
+
+    res = CliRunner().invoke(
+        main, ["falsify", "higashimori2007", "namiki2003", "--keep", str(tmp_path)]
+    )
+    assert res.exit_code == 0, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.startswith(("ok", "FAIL"))]
+    assert lines and not [ln for ln in lines if ln.startswith("FAIL")]
+    assert any("catch_optimised: ball caught | enforced_limits" in ln for ln in lines)
+    assert any("translation after collision 1 | width10" in ln for ln in lines)
+    # every measured row reproduced at baseline has its falsifier line, flipped to "differs"
+    from analysis import catch_claims, stick_claims
+
+    for paper, module in (("higashimori2007", stick_claims), ("namiki2003", catch_claims)):
+        logs = {p.stem: LogReader(p) for p in (tmp_path / paper / "baseline").glob("*.mcap")}
+        rows = module.evaluate(logs)
+        for r in rows:
+            if r.kind == "measured" and r.status == "reproduced":
+                assert any(
+                    ln.startswith(f"ok    {r.quantity} |") and "-> differs" in ln for ln in lines
+                ), r.quantity
