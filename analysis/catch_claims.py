@@ -802,7 +802,7 @@ def _feedback_row(runs: dict[str, CatchRun]) -> list[Claim]:
     """Sec. IV-B: 'it is difficult to catch it only using simple feedback control', against the
     feedback-only baseline on the same arm, vision and throw."""
     q = "difficult to catch only using simple feedback control (Sec. IV-B)"
-    stated = "at about 8 ~ 10 m/s, simple feedback control hardly catches"
+    stated = _stated()["statements"]["feedback_difficult"]["value"]
     run = runs.get(FEEDBACK)
     if run is None:
         return [Claim(q, stated, f"(no {FEEDBACK} log)", "not run")]
@@ -853,7 +853,7 @@ def _delay_row(runs: dict[str, CatchRun]) -> list[Claim]:
     return [
         Claim(
             "catch_optimised: the arm follows its trajectory with very little delay (Sec. IV-B)",
-            "smooth, very little delay in the arm motion (Fig. 7, Sec. IV-B)",
+            f"{_stated()['statements']['little_delay']['value']} (Fig. 7, Sec. IV-B)",
             f"tool velocity lags d/dt l(q_d) by {1000 * best[0]:.0f} ms (RMS difference "
             f"{best[1]:.2f} m/s of {scale:.2f} m/s RMS) from t0 to the first touch",
             "reproduced" if best[0] <= DELAY_TOL else "differs",

@@ -314,7 +314,7 @@ def _reversal_row(log: LogReader, name: str, first: int) -> Claim:
     ok = max(dev) <= ANGLE_RES and max(spin) <= W_RES
     return Claim(
         quantity,
-        "v_i/‖v_i‖ = −v_{i−1}/‖v_{i−1}‖, pure translation (eqs. 32, 33)",
+        _stated()["statements"]["reversal"]["value"],
         f"{len(cs)} collisions: direction off the reversal by at most {max(dev):.1f}°, "
         f"‖ω_i‖ ≤ {max(spin):.2f} rad/s",
         "reproduced" if ok else "differs",
@@ -365,7 +365,7 @@ def _captured_row(log: LogReader, name: str, st: dict) -> Claim:
     w = _params(log).stick.collision_width
     return Claim(
         f"{name}: captured",
-        "the stick is stopped between the fingertips (Sec. IV-B, Fig. 6(f))",
+        f"{st['statements']['captured']['value']} (Sec. IV-B, Fig. 6(f))",
         measured,
         status,
         f"plant: both fingertips touching, stick at rest, held; W = {1000 * w:g} mm",
@@ -397,7 +397,7 @@ def _three_step_rows(log: LogReader, st: dict) -> list[Claim]:
         rows.append(
             Claim(
                 "spin reversed at collision 1 (eq. 35)",
-                "ω_1/‖ω_1‖ = −ω_0/‖ω_0‖ (eq. 35; clockwise after, Fig. 6(c))",
+                st["statements"]["sign_rule"]["value"],
                 f"ω_0 = {w0:.2f} → ω_1 = {w1:.2f} rad/s",
                 "reproduced" if w0 * w1 < 0 and abs(w1) > W_RES else "differs",
                 f"‖ω_1‖ must exceed {W_RES:g} rad/s (1 px at the tip over 0.1 s) to have a sign",
@@ -537,7 +537,7 @@ def _friction_rows(logs: dict[str, LogReader]) -> list[Claim]:
         rows.append(
             Claim(
                 q2,
-                "the strategy is independent of the contact friction (conclusion 2)",
+                f"{_stated()['statements']['friction_independent']['value']} (conclusion 2)",
                 f"{_runs_text(runs)}: {text}",
                 "reproduced" if all(o.get("captured") for o in got.values()) else "differs",
                 "plant's capture check in each run",
