@@ -35,6 +35,11 @@ class Claim:
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"claim {self.quantity!r}: kind {self.kind!r} is not one of {KINDS}")
+        if self.kind != "measured" and self.status == "reproduced":
+            raise ValueError(
+                f"claim {self.quantity!r}: a {self.kind} row is never 'reproduced' (only a "
+                "measured one is; say 'consistent' or 'differs')"
+            )
 
 
 @dataclass(frozen=True)
@@ -55,6 +60,19 @@ class Falsifier:
 
 def within(measured: float, stated: float, rel: float = 0.0, abs_: float = 0.0) -> str:
     return "reproduced" if abs(measured - stated) <= abs_ + rel * abs(stated) else "differs"
+
+
+def agrees(ok: bool) -> str:
+    """A configuration or paper row's verdict: 'consistent' or 'differs'."""
+    return "consistent" if ok else "differs"
+
+
+def smaller(a: float, b: float, tol: float) -> str:
+    """'a is smaller than b' with a tolerance: "reproduced" when b - a > tol, "tie" when
+    |a - b| <= tol (what the paper's figure cannot tell apart), else "differs"."""
+    if abs(a - b) <= tol:
+        return "tie"
+    return "reproduced" if a < b else "differs"
 
 
 def falsifiers_of(evaluate: Callable) -> tuple[Falsifier, ...]:
@@ -110,9 +128,34 @@ def format_table(
         "| quantity | kind | paper states | this run | status | note |",
         "|---|---|---|---|---|---|",
     ]
+    falsifiers = tuple(falsifiers)
     for r in rows:
         lines.append(
-            f"| {r.quantity} | {r.kind} | {r.stated} | {r.measured} | **{r.status}** | {r.note} |"
+            f"| {r.quantity} | {r.kind} | {r.stated} | {r.measured} | **{r.status}** | "
+            f"{row_note(r, falsifiers)} |"
         )
     lines += ["", summary(rows, falsifiers)]
+    return "\n".join(lines)
+
+
+def row_note(r: Claim, falsifiers: Iterable[Falsifier]) -> str:
+    """The row's note, and for a reproduced measured row the falsifier(s) that must flip it
+    (`replay falsify`), or that it has none and is not counted."""
+    if r.kind != "measured" or r.status != "reproduced":
+        return r.note
+    names = [f.name for f in falsifiers if f.row == r.quantity]
+    tag = f"falsifier: {', '.join(names)}" if names else "no falsifier: not counted"
+    return f"{r.note} [{tag}]" if r.note else f"[{tag}]"
+
+
+def format_falsifiers(falsifiers: Iterable[Falsifier]) -> str:
+    """The declared falsifiers as a Markdown table (what `replay falsify` runs)."""
+    lines = [
+        "| row | variant | replaces | overrides | why the claim is false under it |",
+        "|---|---|---|---|---|",
+    ]
+    for f in falsifiers:
+        sets = ", ".join(f"`{k}={v}`" for k, v in f.overrides.items())
+        run = f"{f.scenario} " if f.scenario else ""
+        lines.append(f"| {f.row} | {f.name} | {f.replaces} | {run}{sets} | {f.why} |")
     return "\n".join(lines)

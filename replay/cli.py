@@ -660,6 +660,64 @@ def claims(logs, markdown):
             fail(f"cannot write {markdown}: {exc.strerror or exc}")
 
 
+@main.command()
+@click.argument("papers", nargs=-1)
+@click.option(
+    "--logs",
+    "logs_dir",
+    type=click.Path(file_okay=False, exists=True),
+    help="baseline logs from this folder (e.g. out/logs) instead of fresh runs",
+)
+@click.option(
+    "--keep",
+    type=click.Path(file_okay=False),
+    help="write the runs here and keep them (default: a temporary folder)",
+)
+def falsify(papers, logs_dir, keep):
+    """Run each claims row's falsifier (a variant under which the paper's claim is false) and
+    require its row to read "differs"; one line per falsifier (row | variant | verdict). Exits 1
+    if a measured reproduced row has no falsifier or is not flipped by it. PAPERS default to
+    every paper with a claims table."""
+    import tempfile
+
+    from analysis.falsify import falsify_paper
+
+    names = list(papers) or [p for p in PAPERS if _has_claims(p)]
+    for p in names:
+        if not _has_claims(p):
+            fail(f"{p}: no claims table (known: {', '.join(q for q in PAPERS if _has_claims(q))})")
+    failed = 0
+    with tempfile.TemporaryDirectory(prefix="replay-falsify-") as tmp:
+        work = Path(keep) if keep else Path(tmp)
+        for paper in names:
+            try:
+                verdicts = falsify_paper(
+                    paper,
+                    work / paper,
+                    Path(logs_dir) if logs_dir else None,
+                    progress=note,
+                )
+            except (LogError, ScenarioError) as exc:
+                fail(f"{paper}: {one_line(str(exc))}", code=1)
+            click.echo(f"## {paper}")
+            for v in verdicts:
+                click.echo(v.line())
+            bad = sum(not v.ok for v in verdicts)
+            ran = sum(bool(v.status) for v in verdicts)
+            click.echo(f"{paper}: {ran} falsifiers run, {bad} failing")
+            failed += bad
+    if failed:
+        sys.exit(1)
+
+
+def _has_claims(paper: str) -> bool:
+    try:
+        registry.load("claims", paper)
+    except registry.UnknownPlugin:
+        return False
+    return True
+
+
 @main.group()
 def golden():
     """Golden-log regression: `check` compares fresh runs, `update` rewrites them."""

@@ -216,6 +216,9 @@ def _commands(sections, logs) -> list[str]:
             "replay figures out/logs/*.mcap -o out/figures",
             "replay claims out/logs/*.mcap --markdown out/claims.md",
         ]
+    papers = [sec.key for sec in sections if sec.falsifiers]
+    if papers:
+        cmds.append(f"replay falsify {' '.join(papers)} --logs out/logs")
     for sec in sections:
         for a in sec.ablations:
             cmds.append(f"{a.command} --store   # table: {a.source}")
@@ -246,6 +249,19 @@ def _markdown(sections, info, commands) -> str:
                 lines += [f"![{f.caption}]({f.png})", "", f"*{f.caption}*", ""]
         if sec.claims_md:
             lines += ["### Claims", "", sec.claims_md.split("\n", 2)[2], ""]
+        if sec.falsifiers:
+            from analysis.claims import format_falsifiers
+
+            lines += [
+                "#### Falsifiers",
+                "",
+                "Each reproduced measured row counts only with a variant under which the paper's "
+                "claim is false in the simulation; `replay falsify` runs them and requires the "
+                "row to read *differs*.",
+                "",
+                format_falsifiers(sec.falsifiers),
+                "",
+            ]
         if sec.ablations:
             lines += ["### Ablations", ""]
             for a in sec.ablations:
@@ -329,13 +345,32 @@ def _html(sections, info, commands) -> str:
                 "<table><tr><th>quantity</th><th>kind</th><th>paper states</th>"
                 "<th>this run</th><th>status</th><th>note</th></tr>",
             ]
+            from analysis.claims import row_note
+
             for c in sec.claims:
                 h.append(
                     f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.kind)}</td><td>{_e(c.stated)}</td>"
                     f"<td>{_e(c.measured)}</td><td class='{_e(c.status)}'><b>"
-                    f"{_e(c.status)}</b></td><td>{_e(c.note)}</td></tr>"
+                    f"{_e(c.status)}</b></td><td>{_e(row_note(c, sec.falsifiers))}</td></tr>"
                 )
             h += ["</table>", f"<p>{_e(sec.claims_summary)}</p>"]
+            if sec.falsifiers:
+                h += [
+                    "<h4>Falsifiers</h4>",
+                    "<p>Each reproduced measured row counts only with a variant under which the "
+                    "paper's claim is false in the simulation; <code>replay falsify</code> runs "
+                    "them and requires the row to read <i>differs</i>.</p>",
+                    "<table><tr><th>row</th><th>variant</th><th>replaces</th><th>overrides</th>"
+                    "<th>why the claim is false under it</th></tr>",
+                ]
+                for f in sec.falsifiers:
+                    sets = ", ".join(f"{k}={v}" for k, v in f.overrides.items())
+                    run = f"{f.scenario} " if f.scenario else ""
+                    h.append(
+                        f"<tr><td>{_e(f.row)}</td><td>{_e(f.name)}</td><td>{_e(f.replaces)}</td>"
+                        f"<td>{_e(run + sets)}</td><td>{_e(f.why)}</td></tr>"
+                    )
+                h.append("</table>")
         if sec.ablations:
             h.append("<h3>Ablations</h3>")
             for a in sec.ablations:

@@ -81,7 +81,9 @@ def test_catch_scenarios_state_the_papers_setup():
         assert pp.arm == "wam4" and pp.locked_joints == ["J3"]
         assert np.allclose(pp.initial_q, [0.0, math.pi / 4, 0.0, 0.0], atol=1e-9)  # Sec. IV-A
         assert cp.selected_joint == "J4" and cp.q_alpha == pytest.approx(math.pi / 2, abs=1e-9)
-        assert cp.order == 4
+        direct = sc.controller.type == "catching"  # else catch_feedback, the feedback baseline
+        assert direct or (sc.controller.type == "feedback" and path.stem == "catch_feedback")
+        assert not direct or cp.order == 4
         assert pp.hand_closing_speed == pytest.approx((math.pi / 2) / 0.020, rel=1e-6)
         assert sc.timing.physics_rate == 1000 and sc.controller.rate == 1000
         stereo = sc.sensors["stereo"]
@@ -90,7 +92,7 @@ def test_catch_scenarios_state_the_papers_setup():
         assert (stereo.params.width, stereo.params.height) == (128, 128)
         assert sc.sensors["encoders"].type == "joint_encoders"
         assert {"catch", "miss"} <= set(sc.stop.on_events) and sc.stop.after > 0
-        assert (cp.mapping == "initial") == (path.stem == "catch_initial")
+        assert not direct or (cp.mapping == "initial") == (path.stem == "catch_initial")
 
 
 @pytest.mark.parametrize(
@@ -296,10 +298,18 @@ def test_claims_from_the_logs(runs):
     rows = evaluate(logs)
     by = {r.quantity: r for r in rows}
     assert all(
-        r.status in {"reproduced", "differs", "inconsistent", "note", "not run"} for r in rows
+        r.status
+        in {"reproduced", "differs", "tie", "inconsistent", "consistent", "note", "not run"}
+        for r in rows
     )
-    assert by["catch_initial: ball caught"].status == "reproduced"
+    assert all(r.kind == "measured" for r in rows if r.status in ("reproduced", "tie"))
+    # the paper never says the unoptimised mapping catches (Figs. 10, 11 are the optimised one)
+    assert by["catch_initial: ball caught"].status == "note"
+    assert "not stated" in by["catch_initial: ball caught"].stated
     assert by["catch_optimised: ball caught"].status == "reproduced"
+    # scenario echoes are configuration rows, never counted
+    assert by["catch_optimised: throw speed"].kind == "configuration"
+    assert by["stereo vision rate and resolution"].kind == "configuration"
     out = runs["catch_optimised"]["result"].outcome
     assert f"{out['approach_angle']:.0f}°" in by["catch_optimised: ball caught"].measured
     # the cost rows quote the logged first and last iterates
@@ -315,20 +325,28 @@ def test_claims_from_the_logs(runs):
     # Figs. 8-9 comparison: the row's verdict agrees with the numbers computed here
     a = motion_effort(load_run(logs["catch_optimised"]))
     b = motion_effort(load_run(logs["catch_initial"]))
-    travel = by["desired joint travel Σ‖Δq_d‖, t0 → t_c (Fig. 8)"]
-    assert travel.status == (
-        "reproduced" if a["travel_desired"].sum() < b["travel_desired"].sum() else "differs"
-    )
+    for key, q in (("travel_desired", "desired"), ("travel", "actual")):
+        ta, tb = a[key].sum(), b[key].sum()
+        want = (
+            "tie" if abs(ta - tb) <= 0.01 * max(ta, tb) else "reproduced" if ta < tb else "differs"
+        )
+        assert (
+            by[f"{q} joint travel Σ‖Δq{'_d' if q == 'desired' else ''}‖, t0 → t_c (Fig. 8)"].status
+            == want
+        )
     rms = by["command torque RMS, t0 → t_c (Fig. 9)"]
     assert rms.status == ("reproduced" if a["tau_rms_all"] < b["tau_rms_all"] else "differs")
     # the arm's stated 5 m/s against eq. 4 and the model: the paper's numbers disagree
-    assert by["hand speed eq. 4 demands at t_c vs the arm's 5 m/s"].status == "inconsistent"
+    eq4_speed = by["hand speed eq. 4 demands at t_c vs the arm's 5 m/s"]
+    assert eq4_speed.kind == "paper" and eq4_speed.status == "inconsistent"
     speed = by["end-effector maximum speed (model)"]
     assert speed.status == "differs" and "3.56 rad/s" in speed.measured
-    assert (
-        by["catch_optimised: terminal constraint eq. 4 (r_e = l(q_d) − r_o)"].status == "reproduced"
-    )
-    assert by["catch_optimised: initial constraint eq. 9 at t0"].status == "reproduced"
+    # eq. 4 judged at the hand by the plant's contact: the ball arrives metres per second fast
+    eq4 = by["catch_optimised: terminal constraint eq. 4 at the hand (first touch)"]
+    assert eq4.kind == "measured" and eq4.status == "differs"
+    assert "by construction" in eq4.measured
+    eq9 = by["catch_optimised: initial constraint eq. 9 at t0 (the mapping's q_d)"]
+    assert eq9.kind == "configuration" and eq9.status == "consistent"
     # what eq. 25 leaves out, from the outcome events; eq. 22 as the runs met it
     app = by["approach of the ball at first touch (angle off the palm axis, offset from it)"]
     for name, r in runs.items():
@@ -338,7 +356,11 @@ def test_claims_from_the_logs(runs):
             in app.measured
         )
     assert by["torque limits (eq. 22) during the throw, t0 → t_c"].status == "differs"
-    assert by["joint speed limits (eq. 24) at the catch, given eq. 4"].status == "reproduced"
+    eq24 = by["joint speed limits (eq. 24) at the catch, given eq. 4"]
+    assert eq24.kind == "configuration" and eq24.status == "consistent"
+    # the catch needs the arm beyond the stated 5 m/s (no catch_enforced_limits log here)
+    limits = by["catch within the stated arm speed (5 m/s, Sec. IV-A)"]
+    assert limits.status == "differs" and "no catch_enforced_limits log" in limits.measured
 
 
 def test_claims_command_prints_the_table(runs):

@@ -1,0 +1,158 @@
+"""``replay falsify``: show that every measured "reproduced" row of a paper's claims table can fail.
+
+For a paper, the baseline logs are its default scenarios (those ``make run`` runs:
+``scenarios/{stick,catch,grasp}_*.yaml`` whose ``paper`` is it) run into a folder, or the logs
+already in ``--logs DIR``. Each :class:`~analysis.claims.Falsifier` the paper's claims module
+declares is then run (its scenario with its overrides) and stands in for the log it
+``replaces``; the paper's rows are evaluated again and the falsifier's row must read "differs".
+
+A measured row that is "reproduced" at baseline and has no falsifier, or whose falsifier leaves
+it anything but "differs", fails the check.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import sys
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from analysis.claims import Claim, Falsifier, falsifiers_of
+from replay import registry
+from replay.log import LogReader
+from replay.resources import find_scenario, scenario_dir
+from replay.scenario import load_scenario
+
+DEFAULT_GLOBS = ("stick_*.yaml", "catch_*.yaml", "grasp_*.yaml")  # as the Makefile's SCENARIOS
+
+
+@dataclass
+class Verdict:
+    row: str
+    variant: str  # the falsifier's name, or "" for a row that has none
+    replaces: str
+    baseline: str  # the row's status at baseline ("" when the row is not in the table)
+    status: str  # the row's status with the variant in place ("" when not run)
+    ok: bool
+    why: str = ""
+
+    def line(self) -> str:
+        if not self.variant:
+            return f"FAIL  {self.row}: reproduced, but no falsifier is declared"
+        mark = "ok  " if self.ok else "FAIL"
+        got = f"{self.baseline} -> {self.status}" if self.status else self.baseline or "(no row)"
+        return f"{mark}  {self.row} | {self.variant} (replaces {self.replaces}) | {got}"
+
+
+def default_scenarios(paper: str) -> list[Path]:
+    """The paper's default scenarios, as ``make run`` runs them."""
+    out = []
+    for pattern in DEFAULT_GLOBS:
+        for path in sorted(scenario_dir().glob(pattern)):
+            if load_scenario(path).paper == paper:
+                out.append(path)
+    return out
+
+
+def _sets(overrides) -> list[str]:
+    return [
+        f"{k}={yaml.safe_dump(v, default_flow_style=True).strip().removesuffix('...').strip()}"
+        for k, v in overrides.items()
+    ]
+
+
+def run_scenario(path: str | Path, out: Path, sets: Iterable[str] = ()) -> LogReader:
+    from replay.runner import Runner
+
+    sc = load_scenario(find_scenario(str(path)), sets=list(sets))
+    Runner(sc).run(out)
+    return LogReader(out)
+
+
+def _row(rows: list[Claim], quantity: str) -> Claim | None:
+    return next((r for r in rows if r.quantity == quantity), None)
+
+
+def check(
+    evaluate: Callable[[dict[str, LogReader]], list[Claim]],
+    baseline: dict[str, LogReader],
+    falsifiers: Iterable[Falsifier],
+    run_variant: Callable[[Falsifier], LogReader],
+    progress: Callable[[str], None] = lambda s: None,
+) -> list[Verdict]:
+    """Run each falsifier of a reproduced measured row in place of its log and re-evaluate.
+
+    Returns one verdict per falsifier (of a row that is reproduced at baseline; others are
+    reported, not run) and one failing verdict per reproduced measured row without any."""
+    rows = evaluate(baseline)
+    falsifiers = tuple(falsifiers)
+    out: list[Verdict] = []
+    for f in falsifiers:
+        base = _row(rows, f.row)
+        if base is None or base.kind != "measured" or base.status != "reproduced":
+            # nothing to flip: a row that is missing (its log not run) or does not agree
+            out.append(Verdict(f.row, f.name, f.replaces, base.status if base else "", "", True))
+            continue
+        if f.replaces not in baseline:
+            out.append(
+                Verdict(
+                    f.row, f.name, f.replaces, base.status, "", False, "no baseline log to replace"
+                )
+            )
+            continue
+        progress(f"{f.name} (for {f.row})")
+        variant = run_variant(f)
+        logs = dict(baseline)
+        logs[f.replaces] = variant
+        now = _row(evaluate(logs), f.row)
+        status = now.status if now is not None else "(row gone)"
+        out.append(Verdict(f.row, f.name, f.replaces, base.status, status, status == "differs"))
+    covered = {f.row for f in falsifiers}
+    for r in rows:
+        if r.kind == "measured" and r.status == "reproduced" and r.quantity not in covered:
+            out.append(Verdict(r.quantity, "", "", r.status, "", False))
+    return out
+
+
+def falsify_paper(
+    paper: str,
+    work: Path,
+    logs_dir: Path | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> list[Verdict]:
+    """The whole check for one paper; runs go under ``work`` (baseline/ and variants/)."""
+    say = progress or (lambda s: print(s, file=sys.stderr))
+    evaluate = registry.load("claims", paper)
+    baseline: dict[str, LogReader] = {}
+    if logs_dir is not None:
+        for p in sorted(Path(logs_dir).glob("*.mcap")):
+            r = LogReader(p)
+            sc = r.scenario()
+            if yaml.safe_load(sc["yaml"]).get("paper") == paper:
+                baseline[sc["name"]] = r
+    else:
+        (work / "baseline").mkdir(parents=True, exist_ok=True)
+        for path in default_scenarios(paper):
+            say(f"{paper}: baseline {path.stem}")
+            baseline[path.stem] = run_scenario(path, work / "baseline" / f"{path.stem}.mcap")
+    (work / "variants").mkdir(parents=True, exist_ok=True)
+
+    def run_variant(f: Falsifier) -> LogReader:
+        scenario = f.scenario or f.replaces
+        sets = _sets(f.overrides)
+        key = hashlib.sha1("\n".join([scenario, *sets]).encode()).hexdigest()[:8]
+        out = work / "variants" / f"{f.replaces}--{f.name}-{key}.mcap"
+        if out.is_file():
+            return LogReader(out)  # the same variant for another row: run once
+        return run_scenario(scenario, out, sets)
+
+    return check(
+        evaluate,
+        baseline,
+        falsifiers_of(evaluate),
+        run_variant,
+        progress=lambda s: say(f"{paper}: variant {s}"),
+    )
