@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import tempfile
 import time
 import traceback
@@ -31,9 +32,8 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         return row
     log: str = task.get("log") or ""
     tmp = ""
-    if not log:
-        fd, tmp = tempfile.mkstemp(suffix=".mcap", prefix="sweep-")
-        os.close(fd)
+    if not log:  # a folder of its own: the log is made there (an empty file is no output)
+        tmp = str(Path(tempfile.mkdtemp(prefix="sweep-")) / "variant.mcap")
     cwd = task.get("cwd")
     if cwd and Path(cwd).is_dir() and os.getcwd() != cwd:
         os.chdir(cwd)  # relative data paths (alpha files) as in the scenario
@@ -69,7 +69,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         ).replace("\n", " ")
     finally:
         if tmp:
-            Path(tmp).unlink(missing_ok=True)
+            shutil.rmtree(Path(tmp).parent, ignore_errors=True)
     row["wall_time"] = round(time.perf_counter() - wall0, 4)
     row["cpu_time"] = round(time.process_time() - cpu0, 4)
     row["log"] = log if log and Path(log).is_file() else ""
