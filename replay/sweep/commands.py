@@ -11,7 +11,9 @@ import click
 from replay import completion as complete
 from replay.console import fail, note
 from replay.sweep.executors import EXECUTORS, ExecutorError
+from replay.sweep.lock import SweepOutputError
 from replay.sweep.spec import SweepSpecError
+from replay.sweep.table import TableError
 
 DEFAULT_SWEEP_OUT = Path("out/sweeps")
 
@@ -120,7 +122,7 @@ def sweep(
     )
     click.echo(summary.line())
     if summary.interrupted:
-        sys.exit(130)
+        sys.exit(143 if summary.terminated else 130)
 
 
 def _run(
@@ -166,6 +168,8 @@ def _run(
         )
     except ExecutorError as exc:
         fail(str(exc))
+    except (SweepOutputError, TableError) as exc:
+        fail(str(exc), code=exc.code)
 
 
 @click.command()
@@ -223,7 +227,7 @@ def ablate(
             )
             click.echo(f"{sf.name}: {summary.line()}")
             if summary.interrupted:
-                sys.exit(130)
+                sys.exit(143 if summary.terminated else 130)
             table = summary.table
             if store:
                 click.echo(f"stored: {ablations.store(sf.name, table)}")
