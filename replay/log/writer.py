@@ -500,7 +500,9 @@ class LogWriter:
         return self._message
 
     def write_error(self, exc: OSError) -> LogError:
-        """The LogError of a failed write."""
+        """The LogError of a failed write (after which the run stops: Ctrl-C is Python's
+        again)."""
+        self._held.uninstall()
         return LogWriteError(f"cannot write log {self.part_path}: {exc.strerror}", exc.errno)
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
@@ -541,16 +543,6 @@ class LogWriter:
                     f"run's finished log is kept as {final}"
                 )
         return self.path
-
-    def discard(self) -> None:
-        """Remove this run's unfinished ``.part`` (a run that cannot go on, e.g. a full disk)."""
-        if not self.closed:
-            self.closed = True
-            self._held.uninstall()
-            with contextlib.suppress(OSError):
-                self.part_path.unlink()
-            with contextlib.suppress(OSError):
-                self._file.close()
 
     def __enter__(self) -> "LogWriter":
         return self
