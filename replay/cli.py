@@ -14,7 +14,7 @@ import numpy as np
 
 from replay import completion as complete
 from replay import registry
-from replay.console import RunProgress, bar, bars_on, fail, note, warn
+from replay.console import RunProgress, bar, bars_on, fail, note, printable_streams, warn
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
 from replay.log.writer import (
@@ -53,6 +53,7 @@ class _Group(click.Group):
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        printable_streams()  # (ω, … on a latin-1 or ASCII terminal: fallbacks, no traceback)
         try:
             code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except _NoArgsIsHelp as exc:  # `replay` or `replay golden` alone: the help

@@ -62,6 +62,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     except (RunInterrupted, KeyboardInterrupt):
         row.update(success=False, reason=INTERRUPTED)  # not a result: the engine drops it
     except Exception as exc:  # noqa: BLE001 - a failed variant is a row
+        _drop_part_on_full_disk(exc, log)
         row["success"] = False
         last = traceback.extract_tb(exc.__traceback__)[-1]
         row["reason"] = (
@@ -74,6 +75,19 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     row["cpu_time"] = round(time.process_time() - cpu0, 4)
     row["log"] = log if log and Path(log).is_file() else ""
     return row
+
+
+def _drop_part_on_full_disk(exc: BaseException, log: str) -> None:
+    """A run stopped by a full disk leaves no ``.part`` (as ``replay run`` does): what it holds
+    is not worth the disk it fills."""
+    import errno
+
+    from replay.log.writer import LogWriteError, own_part
+
+    if log and isinstance(exc, LogWriteError) and exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        part = own_part(Path(log))
+        if part is not None:
+            part.unlink(missing_ok=True)
 
 
 def load_function(ref: str):
