@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import ipaddress
 import logging
 import sys
@@ -13,11 +14,18 @@ import numpy as np
 
 from replay import completion as complete
 from replay import registry
-from replay.console import RunProgress, bar, bars_on, fail, note, warn
+from replay.console import RunProgress, bar, bars_on, fail, note, printable_streams, warn
 from replay.foxglove.layouts import PAPERS as LAYOUT_PAPERS
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
-from replay.log.writer import check_output
+from replay.log.writer import (
+    LogWriteError,
+    OutputConflictError,
+    check_output,
+    live_writers,
+    own_part,
+    part_pid,
+)
 from replay.papers import PAPERS
 from replay.resources import find_scenario, scenario_dir
 from replay.scenario import ScenarioError, load_scenario
@@ -46,6 +54,7 @@ class _Group(click.Group):
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        printable_streams()  # (ω, … on a latin-1 or ASCII terminal: fallbacks, no traceback)
         try:
             code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except _NoArgsIsHelp as exc:  # `replay` or `replay golden` alone: the help
@@ -116,6 +125,20 @@ def run(scenario, out, sets, seed, quiet, view):
             err=True,
         )
         sys.exit(130)
+    except LogWriteError as exc:  # a full disk, an I/O error: a system fault, exit 1
+        progress.done()
+        if live:
+            live.stop()
+        part = own_part(out)
+        if part is not None and exc.errno in (errno.ENOSPC, errno.EDQUOT):
+            part.unlink(missing_ok=True)  # what it holds is not worth the disk it fills
+            fail(f"{exc}; the run stopped and its partial log is removed", code=1)
+        fail(f"{exc}; the run stopped" + (f", partial log: {part}" if part else ""), code=1)
+    except OutputConflictError as exc:
+        progress.done()
+        if live:
+            live.stop()
+        fail(str(exc), code=1)
     except LogError as exc:
         progress.done()
         if live:
@@ -125,7 +148,7 @@ def run(scenario, out, sets, seed, quiet, view):
         progress.done()
         if live:
             live.stop()
-        part = out.with_name(out.name + ".part")
+        part = own_part(out)
         fail(f"the run failed: {type(exc).__name__}: {exc}; partial log: {part}", code=1)
     progress.done()
     failed = result.stopped_by == "error"
@@ -161,6 +184,13 @@ def _check_log_path(out: Path, sc) -> None:
         check_output(out)
     except LogError as exc:
         fail(str(exc))
+    busy = live_writers(out)
+    if busy:  # (LogWriter refuses it too, under a lock: this says it before the plug-ins load)
+        fail(
+            f"will not write log {out}: another run (process {part_pid(busy[0], out)}) is "
+            f"writing it "
+            f"({busy[0].name}); wait for it or give another -o"
+        )
 
 
 _REFUSED = (ValueError, TypeError, KeyError, IndexError, ArithmeticError, OSError, LogError)

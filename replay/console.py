@@ -8,6 +8,7 @@ per runner callback and nothing more.
 
 from __future__ import annotations
 
+import codecs
 import sys
 import time
 from typing import IO, Any, NoReturn
@@ -17,6 +18,86 @@ import click
 from replay.scenario.yamlio import one_line
 
 REDRAW = 0.1  # s of wall time between redraws of a bar
+
+# what a character becomes on a terminal whose encoding lacks it (latin-1, ASCII): the units and
+# symbols the papers' tables and the summaries print, else "?"
+FALLBACK = {
+    "…": "...",
+    "ω": "w",
+    "θ": "theta",
+    "α": "alpha",
+    "β": "beta",
+    "γ": "gamma",
+    "δ": "delta",
+    "Δ": "D",
+    "μ": "u",
+    "π": "pi",
+    "σ": "sigma",
+    "τ": "tau",
+    "φ": "phi",
+    "ψ": "psi",
+    "λ": "lambda",
+    "ε": "eps",
+    "ρ": "rho",
+    "η": "eta",
+    "ζ": "zeta",
+    "ν": "nu",
+    "κ": "kappa",
+    "χ": "chi",
+    "Ω": "Ohm",
+    "°": " deg",
+    "±": "+/-",
+    "×": "x",
+    "·": ".",
+    "−": "-",
+    "–": "-",
+    "—": "--",
+    "≤": "<=",
+    "≥": ">=",
+    "≈": "~",
+    "≠": "!=",
+    "→": "->",
+    "←": "<-",
+    "²": "^2",
+    "³": "^3",
+    "½": "1/2",
+    "√": "sqrt",
+    "✓": "ok",
+    "✗": "x",
+    "‘": "'",
+    "’": "'",
+    "“": '"',
+    "”": '"',
+}
+_ERRORS = "replay-fallback"
+
+
+def _fallback(exc: UnicodeError) -> tuple[str, int]:
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    text = exc.object[exc.start : exc.end]
+    out = "".join(FALLBACK.get(ch, "?") for ch in text)
+    try:
+        out.encode(exc.encoding)
+    except (UnicodeEncodeError, LookupError):
+        out = "?" * len(text)
+    return out, exc.end
+
+
+codecs.register_error(_ERRORS, _fallback)
+
+
+def printable_streams() -> None:
+    """stdout and stderr print in any terminal encoding: a character it cannot encode becomes
+    its :data:`FALLBACK` (ω -> w, … -> ...) or ``?``, instead of a UnicodeEncodeError."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is None or getattr(stream, "errors", None) in (_ERRORS, "surrogateescape"):
+            continue
+        try:
+            reconfigure(errors=_ERRORS)
+        except (ValueError, OSError):  # (a stream that cannot be reconfigured: left alone)
+            pass
 
 
 def fail(message: str, code: int = 2) -> NoReturn:

@@ -1,5 +1,6 @@
 """The ``replay`` executable: Ctrl-C at any moment exits 130 quietly, even while Python is still
-importing the command line (numpy, PyBullet, ... take a while)."""
+importing the command line (numpy, PyBullet, ... take a while); a command line that cannot load
+(an address-space limit, ``ulimit -v``, too low for the libraries) is one ``error:`` line, exit 1."""
 
 import os
 import signal
@@ -12,12 +13,46 @@ def _while_importing(signum, frame) -> None:
     os._exit(130)  # nothing is written yet: nothing to keep
 
 
+def _address_space_limit() -> int | None:
+    """The soft RLIMIT_AS in bytes, None when there is none."""
+    try:
+        import resource
+    except ImportError:  # (Windows)
+        return None
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    return None if soft == resource.RLIM_INFINITY else soft
+
+
+def _cannot_load(exc: BaseException, limit: int | None) -> None:
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    why = f"{type(exc).__name__}: {text}"
+    if limit is not None:
+        why += (
+            f"; the address-space limit (ulimit -v) is {limit >> 20} MB, too little for "
+            "NumPy, OpenCV and PyBullet: raise it"
+        )
+    sys.stderr.write(f"error: paper-replay cannot load: {why}\n")
+    sys.stderr.flush()
+    os._exit(1)
+
+
 def main() -> None:
     signal.signal(signal.SIGINT, _while_importing)
-    from replay.cli import main as cli
+    limit = _address_space_limit()
+    if limit is not None:
+        # each OpenBLAS thread reserves its buffers at import: under a limit (ulimit -v) one
+        # thread, else the import fails (500 MB on 2 cores) or crashes in C (400 MB)
+        os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    try:
+        from replay.cli import main as cli
+    except (ImportError, MemoryError, OSError) as exc:
+        _cannot_load(exc, limit)
 
     signal.signal(signal.SIGINT, signal.default_int_handler)
-    cli()
+    try:
+        cli()
+    except (ImportError, MemoryError) as exc:  # a plug-in's libraries, loaded by the command
+        _cannot_load(exc, limit)
 
 
 if __name__ == "__main__":

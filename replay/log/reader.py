@@ -3,29 +3,99 @@
 A finished log is read through its index. A log whose summary is missing (a run killed mid-way,
 a ``.part`` file, a file cut short) is read record by record up to its last whole record and is
 ``truncated``. A log whose bytes are wrong (a chunk whose CRC does not match, a record that does
-not parse, a message that is not a JSON object) is ``damaged``: what can be read is read, and
-:attr:`LogReader.problems` says what was not. Nothing a log's bytes hold raises anything but
-:class:`LogError`.
+not parse, a message that is not a JSON object, bytes after its end) is ``damaged``: what can be
+read is read, and :attr:`LogReader.problems` says what was not and where. A damaged chunk of an
+indexed log costs its own messages only: the others are read through the index (the summary
+holds every channel). Zeros or garbage after the last whole record (a file extended, a disk
+block) are found by walking the records' headers, in time proportional to the real content.
+Nothing a log's bytes hold raises anything but :class:`LogError`.
 """
 
 from __future__ import annotations
 
+import io
 import json
 import os
+import struct
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
+from mcap.data_stream import ReadDataStream
 from mcap.reader import make_reader
-from mcap.records import Channel, Message, Schema
-from mcap.stream_reader import StreamReader
+from mcap.records import Channel, Chunk, Message, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk
 
 from replay.log.chunks import MAGIC
 from replay.log.errors import LogError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
+_OPCODES = range(0x01, 0x10)  # MCAP's record opcodes (0x00 is none: zeros are not records)
+_HEAD = struct.Struct("<BQ")  # a record's opcode and length
+
+
+def content_end(f, size: int) -> tuple[int, bool]:
+    """Where the records of an MCAP file end, and whether a record cut short is what ends them
+    (else zeros, garbage or nothing follow): past its last record whose header is an MCAP opcode
+    and whose length fits in the file (and the closing magic, if it follows). Walks the
+    records' 9-byte headers only, seeking over their bodies."""
+    pos = len(MAGIC)
+    while pos + _HEAD.size <= size:
+        f.seek(pos)
+        head = f.read(_HEAD.size)
+        opcode, length = _HEAD.unpack(head)
+        if opcode not in _OPCODES:
+            if head[: len(MAGIC)] == MAGIC[: len(head)] and pos + len(MAGIC) <= size:
+                return pos + len(MAGIC), False
+            return pos, False
+        if length > min(_RECORD_LIMIT, size - pos - _HEAD.size):
+            return pos, length <= _RECORD_LIMIT
+        pos += _HEAD.size + length
+    return pos, pos < size
+
+
+class _Bounded:
+    """The first ``end`` bytes of a binary file, seekable (what the ``mcap`` reader is given
+    when zeros or garbage follow the records)."""
+
+    def __init__(self, f, end: int) -> None:
+        self._f = f
+        self._end = end
+        self._pos = 0
+
+    def readable(self) -> bool:
+        return True
+
+    def seekable(self) -> bool:
+        return True
+
+    def tell(self) -> int:
+        return self._pos
+
+    def seek(self, offset: int, whence: int = io.SEEK_SET) -> int:
+        base = {io.SEEK_SET: 0, io.SEEK_CUR: self._pos, io.SEEK_END: self._end}[whence]
+        self._pos = max(0, base + offset)
+        return self._pos
+
+    def read(self, n: int | None = -1) -> bytes:
+        n = self._end - self._pos if n is None or n < 0 else min(n, self._end - self._pos)
+        if n <= 0:
+            return b""
+        self._f.seek(self._pos)
+        data = self._f.read(n)
+        self._pos += len(data)
+        return data
+
+    def close(self) -> None:
+        self._f.close()
+
+    def __enter__(self) -> "_Bounded":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
 
 @dataclass(frozen=True)
@@ -63,6 +133,10 @@ def _decode(data: bytes) -> dict | None:
     return value if isinstance(value, dict) else None
 
 
+class _IndexUnusable(Exception):
+    """The index of a log points at bytes that are not its chunks."""
+
+
 class LogReader:
     def __init__(self, path: str | os.PathLike) -> None:
         self.path = Path(path)
@@ -83,13 +157,12 @@ class LogReader:
         self.damaged = False
         self.problems: list[str] = []
         self._bad_messages: Counter = Counter()
+        self._bad_chunks: dict[int, str] = {}  # chunk offset -> why it does not read
         self._checked = False
-        self._summary = None
-        try:
-            with open(self.path, "rb") as f:
-                self._summary = make_reader(f).get_summary()
-        except Exception:  # noqa: BLE001 - mcap raises many kinds on bad bytes
-            self._summary = None
+        self._end = self.size  # where the records end (before zeros or garbage)
+        self._summary = self._read_summary() if tail == MAGIC else None
+        if self._summary is None:
+            self._find_end()
         if self._summary is None:
             self.truncated = True
             if tail == MAGIC and self.size > 2 * len(MAGIC):
@@ -99,6 +172,35 @@ class LogReader:
                     "truncated: the file ends mid-run (no summary): read up "
                     "to its last whole record"
                 )
+
+    def _open(self):
+        """The file, cut at the end of its records."""
+        f = open(self.path, "rb")
+        return f if self._end == self.size else _Bounded(f, self._end)
+
+    def _read_summary(self):
+        try:
+            with self._open() as f:
+                return make_reader(f).get_summary()
+        except Exception:  # noqa: BLE001 - mcap raises many kinds on bad bytes
+            return None
+
+    def _find_end(self) -> None:
+        """Zeros or garbage after the last record: cut off (and said), the summary looked for
+        before them."""
+        try:
+            with open(self.path, "rb") as f:
+                end, torn = content_end(f, self.size)
+                f.seek(end)
+                sample = f.read(4096)
+        except OSError:
+            return
+        if end >= self.size or torn:
+            return  # (a record cut short: a truncated log, said as such)
+        self._end = end
+        what = "zeros" if not sample.strip(b"\0") else "not MCAP records"
+        self._damage(f"its last {self.size - end} bytes (from byte {end} on) are {what}: ignored")
+        self._summary = self._read_summary()
 
     def _damage(self, what: str) -> None:
         self.damaged = True
@@ -113,14 +215,18 @@ class LogReader:
 
     def check(self) -> "LogReader":
         """Read every record once with CRCs checked (a few ms per MB), so that ``damaged`` and
-        ``problems`` are known before the log is used; a damaged log is then read record by
-        record (the index may point into the damage)."""
+        ``problems`` are known before the log is used: an indexed log chunk by chunk through its
+        index (a damaged chunk is then skipped, the rest read), another record by record."""
         if self._checked:
             return self
         self._checked = True
+        if self._summary is not None:
+            self._check_chunks()
+            self._check_records()
+            return self
         n = 0
         try:
-            with open(self.path, "rb") as f:
+            with self._open() as f:
                 for _ in StreamReader(
                     f, validate_crcs=True, record_size_limit=_RECORD_LIMIT
                 ).records:
@@ -135,34 +241,125 @@ class LogReader:
             self.truncated = True
         return self
 
+    def _chunk_indexes(self) -> list:
+        assert self._summary is not None
+        return sorted(self._summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
+
+    def _read_chunk(self, f, index) -> list:
+        """A chunk's records (schemas, channels, messages), its CRC checked."""
+        f.seek(index.chunk_start_offset + _HEAD.size)
+        return breakup_chunk(Chunk.read(ReadDataStream(f)), validate_crc=True)
+
+    def _check_chunks(self) -> None:
+        indexes = self._chunk_indexes()
+        try:
+            with self._open() as f:
+                for i, c in enumerate(indexes):
+                    try:
+                        self._read_chunk(f, c)
+                    except Exception as exc:  # noqa: BLE001 - any damage of its bytes
+                        self._bad_chunk(i, len(indexes), c, exc)
+        except OSError as exc:
+            self._damage(f"cannot be read ({exc.strerror})")
+
+    def _check_records(self) -> None:
+        """The records outside the chunks (header, metadata, summary), parsed once."""
+        n = 0
+        try:
+            with self._open() as f:
+                reader = StreamReader(f, emit_chunks=True, record_size_limit=_RECORD_LIMIT)
+                for _ in reader.records:
+                    n += 1
+        except Exception as exc:  # noqa: BLE001
+            if not self._bad_chunks:
+                self._damage(
+                    f"a record after {n} whole ones does not read ({type(exc).__name__}); "
+                    "the chunks are read through the index"
+                )
+
+    def _bad_chunk(self, i: int, n: int, c, exc: BaseException) -> None:
+        self._bad_chunks[c.chunk_start_offset] = type(exc).__name__
+        end = c.chunk_start_offset + c.chunk_length
+        self._damage(
+            f"chunk {i + 1} of {n} (bytes {c.chunk_start_offset}-{end}, t = "
+            f"{c.message_start_time * 1e-9:.4f}-{c.message_end_time * 1e-9:.4f} s) does not "
+            f"read ({type(exc).__name__}): its messages are missing, the other chunks are read"
+        )
+
+    def _salvaged(self, wanted) -> Iterator[tuple[Channel, Message]]:
+        """(channel, message) of every chunk that reads, in log-time order (a chunk that does
+        not read skipped and said); channels from the summary, which holds them all."""
+        assert self._summary is not None
+        channels = self._summary.channels
+        out: list[tuple[int, int, Channel, Message]] = []
+        indexes = self._chunk_indexes()
+        with self._open() as f:
+            for i, c in enumerate(indexes):
+                if c.chunk_start_offset in self._bad_chunks:
+                    continue
+                try:
+                    records = self._read_chunk(f, c)
+                except Exception as exc:  # noqa: BLE001
+                    self._bad_chunk(i, len(indexes), c, exc)
+                    continue
+                for record in records:
+                    if isinstance(record, Message) and record.channel_id in channels:
+                        channel = channels[record.channel_id]
+                        if wanted is None or channel.topic in wanted:
+                            out.append((record.log_time, len(out), channel, record))
+        out.sort(key=lambda item: (item[0], item[1]))
+        for _, _, channel, msg in out:
+            yield channel, msg
+
+    def _indexed(self, wanted) -> Iterator[tuple[Any, Channel, Message]]:
+        """(schema, channel, message) through the index; a chunk found damaged on the way
+        makes the rest come from :meth:`_salvaged` (what was yielded not yielded again)."""
+        if not self._bad_chunks:
+            done = 0
+            try:
+                with self._open() as f:
+                    for schema, channel, msg in make_reader(f, validate_crcs=True).iter_messages(
+                        topics=wanted
+                    ):
+                        done += 1
+                        yield schema, channel, msg
+                return
+            except Exception:  # noqa: BLE001 - a chunk that does not read: which one, below
+                self._checked = False
+                self.check()
+                if not self._bad_chunks:  # (not a chunk: the index itself is wrong)
+                    self._damage("the index points at bad bytes; read record by record")
+                    raise _IndexUnusable from None
+        else:
+            done = 0
+        assert self._summary is not None
+        schemas = self._summary.schemas
+        for i, (channel, msg) in enumerate(self._salvaged(wanted)):
+            if i >= done:
+                yield schemas.get(channel.schema_id), channel, msg
+
     # -- messages -------------------------------------------------------------------------
     def messages(self, topics: Iterable[str] | str | None = None) -> Iterator[LogMessage]:
         """Messages in log-time order (file order for a truncated log), optionally by topic.
         Only channels of JSON messages are read (others, e.g. protobuf, are for other tools);
         messages on them that are not JSON objects are skipped (and counted in ``problems``)."""
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
+        skip = 0
         if self._summary is not None:
             done = 0
             try:
-                with open(self.path, "rb") as f:
-                    for _, channel, msg in make_reader(f).iter_messages(topics=wanted):
-                        if channel.message_encoding != "json":
-                            continue  # e.g. Foxglove's protobuf channels: not JSON payloads
-                        item = self._message(channel.topic, msg.log_time, msg.data)
-                        if item is not None:
-                            done += 1
-                            yield item
+                for _, channel, msg in self._indexed(wanted):
+                    if channel.message_encoding != "json":
+                        continue  # e.g. Foxglove's protobuf channels: not JSON payloads
+                    item = self._message(channel.topic, msg.log_time, msg.data)
+                    if item is not None:
+                        done += 1
+                        yield item
                 return
-            except Exception as exc:  # noqa: BLE001
-                self._damage(
-                    f"the index points at bad bytes ({type(exc).__name__}); "
-                    "read record by record instead"
-                )
+            except _IndexUnusable:
                 self._summary = None
                 self.truncated = True
                 skip = done
-        else:
-            skip = 0
         for i, item in enumerate(self._stream(wanted)):
             if i >= skip:
                 yield item
@@ -179,7 +376,7 @@ class LogReader:
 
     def _records(self) -> Iterator[Any]:
         """The file's records in order, CRCs checked, ending quietly at a torn or damaged tail."""
-        with open(self.path, "rb") as f:
+        with self._open() as f:
             records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
             while True:
                 try:
@@ -208,21 +405,15 @@ class LogReader:
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
         if self._summary is not None:
             try:
-                with open(self.path, "rb") as f:
-                    for schema, channel, msg in make_reader(f).iter_messages(topics=wanted):
-                        if channel.message_encoding != "json":
-                            name = schema.name if schema is not None else ""
-                            yield RawMessage(
-                                channel.topic,
-                                msg.log_time,
-                                name,
-                                channel.message_encoding,
-                                msg.data,
-                            )
-                return
-            except Exception as exc:  # noqa: BLE001
-                self._damage(f"the index points at bad bytes ({type(exc).__name__})")
-                return
+                for schema, channel, msg in self._indexed(wanted):
+                    if channel.message_encoding != "json":
+                        name = schema.name if schema is not None else ""
+                        yield RawMessage(
+                            channel.topic, msg.log_time, name, channel.message_encoding, msg.data
+                        )
+            except _IndexUnusable:
+                pass  # (said in problems)
+            return
         yield from self._stream_raw(wanted)
 
     def _stream_raw(self, wanted) -> Iterator[RawMessage]:
@@ -257,7 +448,12 @@ class LogReader:
 
     # -- summary --------------------------------------------------------------------------
     def topic_counts(self) -> dict[str, int]:
-        if self._summary is not None and self._summary.statistics is not None:
+        """Messages per topic: the statistics' counts, or what was read where chunks are lost."""
+        if (
+            self._summary is not None
+            and self._summary.statistics is not None
+            and not self._bad_chunks
+        ):
             stats = self._summary.statistics.channel_message_counts
             channels = self._summary.channels
             return {
@@ -278,7 +474,7 @@ class LogReader:
         if self._summary is None:
             return out
         try:
-            with open(self.path, "rb") as f:
+            with self._open() as f:
                 for record in make_reader(f).iter_metadata():
                     out[record.name] = dict(record.metadata)
         except Exception:  # noqa: BLE001

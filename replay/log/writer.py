@@ -2,32 +2,45 @@
 
 Crash safety:
 
-- the file is written under ``NAME.part`` and renamed to ``NAME`` only when it is closed as a
-  finished run, so an old log at ``NAME`` stays untouched until a new one is complete; a run
-  closed as failed or interrupted is renamed ``STEM.failed.mcap`` / ``STEM.interrupted.mcap``
-  instead, and a run killed mid-way leaves ``NAME.part``, readable up to its last chunk
-  (``LogReader`` reads it);
+- the file is written under a name of its own, ``NAME.PID.part`` (PID: the writing process),
+  and renamed to ``NAME`` only when it is closed as a finished run, so an old log at ``NAME``
+  stays untouched until a new one is complete; a run closed as failed or interrupted is renamed
+  ``STEM.failed.mcap`` / ``STEM.interrupted.mcap`` instead, and a run killed mid-way leaves its
+  ``.part``, readable up to its last chunk (``LogReader`` reads it);
+- one writer per output: a ``.part`` is locked (``flock``) while its run lives, and a second run
+  onto the same ``NAME`` is refused before it starts, naming the first one's process; a finished
+  log replaces ``NAME`` only if no other log got there after this run started (else it is kept as
+  ``STEM.conflict-PID.mcap`` and :class:`OutputConflictError` says so);
 - a record is written whole or not at all: Ctrl-C (SIGINT) arriving while a message or the
   summary is being written is held until that write is done, then raised;
-- a log never overwrites a file that is not an MCAP log (a scenario, say) nor a folder.
+- a log never overwrites a file that is not an MCAP log (a scenario, say), an empty file, a
+  folder, nor anything that is not a regular file (a device, a FIFO, a socket).
 
 Same messages in the same order give the same bytes.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
+import glob
 import json
 import math
 import os
 import signal
+import stat
 import tempfile
 import threading
 from pathlib import Path
 from typing import Any, Callable
 
 import orjson
+
+try:
+    import fcntl
+except ImportError:  # (Windows: no flock; one writer per output is then up to the user)
+    fcntl = None  # type: ignore[assignment]
 
 from replay import __version__
 from replay.log._finite import finite
@@ -185,20 +198,46 @@ def failed_path(path: Path, status: str) -> Path:
     return path.with_name(f"{path.stem}.{status}{path.suffix or '.mcap'}")
 
 
+def _what(mode: int) -> str | None:
+    """What a file that is neither a regular file nor a folder is, or None."""
+    for test, name in (
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return name
+    return None if stat.S_ISREG(mode) or stat.S_ISDIR(mode) else "not a regular file"
+
+
 def check_output(path: Path, *, kind: str = "log", magic: bytes | None = MAGIC) -> None:
     """Raise :class:`LogError` when ``path`` cannot take a log (or another ``kind`` of output):
-    a folder, an existing file that does not start with ``magic``, a parent that is not a
-    folder, cannot be made or takes no files."""
-    if path.is_dir():
+    a folder, anything but a regular file (a device, a FIFO, a socket: checked without opening
+    it, which would block on a FIFO), an existing file that does not start with ``magic`` or is
+    empty, a parent that is not a folder, cannot be made or takes no files."""
+    try:
+        st = os.stat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        st = None  # (a parent that is a file: said below)
+    except OSError as exc:
+        raise LogError(f"cannot write {kind} {path}: {exc.strerror}") from None
+    if st is not None and stat.S_ISDIR(st.st_mode):
         raise LogError(f"cannot write {kind} {path}: it is a folder (give a file name)")
-    if path.exists() and magic is not None:
+    if st is not None and _what(st.st_mode):
+        raise LogError(
+            f"will not write {kind} {path}: it is {_what(st.st_mode)}, not a regular file"
+        )
+    if st is not None and magic is not None:
+        what = "an MCAP log" if magic == MAGIC else f"an earlier {kind} (JSON)"
+        if st.st_size == 0:
+            raise LogError(f"will not overwrite {path}: it is an empty file, not {what}")
         try:
             with open(path, "rb") as f:
                 head = f.read(len(magic))
         except OSError as exc:
             raise LogError(f"cannot write {kind} {path}: {exc.strerror}") from None
-        if head != magic and path.stat().st_size > 0:
-            what = "an MCAP log" if magic == MAGIC else f"an earlier {kind} (JSON)"
+        if head != magic:
             raise LogError(f"will not overwrite {path}: it is not {what}")
     parent = path.parent
     for p in (parent, *parent.parents):
@@ -220,6 +259,88 @@ def check_output(path: Path, *, kind: str = "log", magic: bytes | None = MAGIC) 
         ) from None
 
 
+def _identity(path: Path) -> tuple[int, int, int, int] | None:
+    """What is at ``path`` (device, inode, size, mtime), None when nothing: a log that another
+    run put there changes it."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
+
+
+@contextlib.contextmanager
+def _folder_lock(folder: Path):
+    """The folder ``flock``-ed for a moment, so that looking for other writers and making a
+    ``.part``, or checking the target and replacing it, is one step among runs (no-op where
+    ``fcntl`` is missing)."""
+    if fcntl is None:
+        yield
+        return
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # (releases the lock)
+
+
+def _locked(path: Path) -> bool:
+    """Whether another live process holds ``path`` (a ``.part``) locked."""
+    if fcntl is None:
+        return False
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError:
+        return True
+    finally:
+        os.close(fd)
+    return False
+
+
+def part_paths(path: Path) -> list[Path]:
+    """The ``.part`` files of runs onto ``path`` (live or killed), oldest first."""
+    found = path.parent.glob(f"{glob.escape(path.name)}.*{PART_SUFFIX}")
+    return sorted((p for p in found if p.is_file()), key=lambda p: p.stat().st_mtime_ns)
+
+
+def part_pid(part: Path, path: Path) -> str:
+    """The process that made ``part`` (``NAME.PID.part`` or ``NAME.PID-N.part``) onto ``path``."""
+    return part.name[len(path.name) + 1 : -len(PART_SUFFIX)].split("-")[0]
+
+
+def live_writers(path: Path) -> list[Path]:
+    """The ``.part`` files of runs still writing ``path`` (locked by a live process)."""
+    return [p for p in part_paths(path) if _locked(p)]
+
+
+class LogWriteError(LogError):
+    """Writing or finishing a log failed (a full disk, an I/O error): a system fault, not bad
+    input; ``errno`` says which."""
+
+    def __init__(self, message: str, errno: int | None = None) -> None:
+        super().__init__(message)
+        self.errno = errno
+
+
+def own_part(path: Path) -> Path | None:
+    """The newest ``.part`` of this process onto ``path`` (what a failed run leaves)."""
+    mine = [p for p in part_paths(path) if part_pid(p, path) == str(os.getpid())]
+    return mine[-1] if mine else None
+
+
+class OutputConflictError(LogError):
+    """Another run finished a log at the same path while this one ran: this one kept aside."""
+
+
 class LogWriter:
     """``with LogWriter(path) as log: log.write("/events", Event(...), t_ns)``.
 
@@ -236,12 +357,8 @@ class LogWriter:
         if compression not in ("zstd", "none"):
             raise LogError(f"log compression {compression!r}: zstd or none")
         self.path = Path(path)
-        self.part_path = self.path.with_name(self.path.name + PART_SUFFIX)
         check_output(self.path)
-        try:
-            self._file = _FlushedFile(open(self.part_path, "wb"))
-        except OSError as exc:
-            raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from exc
+        self.part_path, self._file, self._found = self._open_part(self.path)
         self._held = _HeldSigint()
         self._held.install()
         self._mcap = McapFile(
@@ -252,12 +369,46 @@ class LogWriter:
             guard=self._held,
         )
         self._message = self._mcap.message
-        self._mcap.start(profile="", library=f"paper-replay {__version__}")
+        try:
+            self._mcap.start(profile="", library=f"paper-replay {__version__}")
+        except OSError as exc:
+            raise self.write_error(exc) from None
         self._json_channels: dict[str, int] = {}  # topic -> channel id
         self._json = self._mcap.json_messages(self._json_channels, _dumps, finite)
         self._json_all = self._mcap.json_all
         self._topics: set[str] = set()  # every channel's topic
         self.closed = False
+
+    @staticmethod
+    def _open_part(path: Path) -> tuple[Path, _FlushedFile, tuple | None]:
+        """This run's own ``NAME.PID.part``, made and locked while no other live run writes
+        ``path`` (else :class:`LogError` naming it), and what was at ``path`` then."""
+        with _folder_lock(path.parent):
+            others = live_writers(path)
+            if others:
+                pid = part_pid(others[0], path)
+                raise LogError(
+                    f"will not write log {path}: another run (process {pid}) is writing it "
+                    f"({others[0].name}); wait for it or give another -o"
+                )
+            found = _identity(path)
+            for n in range(1000):
+                tag = f"{os.getpid()}" + (f"-{n}" if n else "")
+                part = path.with_name(f"{path.name}.{tag}{PART_SUFFIX}")
+                try:
+                    fd = os.open(part, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+                except FileExistsError:
+                    continue  # a killed run's .part of a recycled pid: kept
+                except OSError as exc:
+                    raise LogWriteError(
+                        f"cannot write log {part}: {exc.strerror}", exc.errno
+                    ) from None
+                break
+            else:
+                raise LogError(f"cannot write log {path}: 1000 .part files of this pid")
+            if fcntl is not None:
+                fcntl.flock(fd, fcntl.LOCK_EX)  # (made under the folder's lock: free)
+        return part, _FlushedFile(os.fdopen(fd, "wb")), found
 
     @property
     def count(self) -> int:
@@ -271,7 +422,7 @@ class LogWriter:
             try:
                 return self._mcap.schema(name, encoding, bytes(data))
             except OSError as exc:
-                raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+                raise self.write_error(exc) from None
 
     def register_channel(
         self,
@@ -289,7 +440,7 @@ class LogWriter:
             try:
                 channel = self._mcap.channel(topic, message_encoding, schema_id, metadata)
             except OSError as exc:
-                raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+                raise self.write_error(exc) from None
         self._topics.add(topic)
         return channel
 
@@ -349,15 +500,17 @@ class LogWriter:
         return self._message
 
     def write_error(self, exc: OSError) -> LogError:
-        """The LogError of a failed write."""
-        return LogError(f"cannot write log {self.part_path}: {exc.strerror}")
+        """The LogError of a failed write (after which the run stops: Ctrl-C is Python's
+        again)."""
+        self._held.uninstall()
+        return LogWriteError(f"cannot write log {self.part_path}: {exc.strerror}", exc.errno)
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         with self._held:
             try:
                 self._mcap.metadata(name, {k: str(v) for k, v in data.items()})
             except OSError as exc:
-                raise LogError(f"cannot write log {self.part_path}: {exc.strerror}") from None
+                raise self.write_error(exc) from None
 
     def close(self, status: str = "") -> Path:
         """Finish the file (summary, index) and give it its final name: ``path`` for a
@@ -365,18 +518,30 @@ class LogWriter:
         ended with ``status`` ("failed", "interrupted"). Returns where the log is."""
         if not self.closed:
             final = failed_path(self.path, status) if status else self.path
+            conflict = None
             with self._held:
                 try:
                     self._mcap.finish()
                     os.fsync(self._file.fileno())
-                    self._file.close()
-                    os.replace(self.part_path, final)
+                    with _folder_lock(final.parent):
+                        if final == self.path and _identity(final) != self._found:
+                            conflict = final  # another log got there after this run started
+                            final = failed_path(self.path, f"conflict-{os.getpid()}")
+                        os.replace(self.part_path, final)
+                    self._file.close()  # (the .part's lock held until it has its name)
                 except OSError as exc:
-                    raise LogError(f"cannot finish log {self.part_path}: {exc.strerror}") from None
+                    raise LogWriteError(
+                        f"cannot finish log {self.part_path}: {exc.strerror}", exc.errno
+                    ) from None
                 finally:
                     self._held.uninstall()
                 self.closed = True
                 self.path = final
+            if conflict is not None:
+                raise OutputConflictError(
+                    f"another run wrote {conflict} while this one ran: not replaced; this "
+                    f"run's finished log is kept as {final}"
+                )
         return self.path
 
     def __enter__(self) -> "LogWriter":

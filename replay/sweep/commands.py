@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import errno
 import sys
 from pathlib import Path
 
@@ -11,7 +12,9 @@ import click
 from replay import completion as complete
 from replay.console import fail, note
 from replay.sweep.executors import EXECUTORS, ExecutorError
+from replay.sweep.lock import SweepOutputError
 from replay.sweep.spec import SweepSpecError
+from replay.sweep.table import TableError
 
 DEFAULT_SWEEP_OUT = Path("out/sweeps")
 
@@ -120,7 +123,7 @@ def sweep(
     )
     click.echo(summary.line())
     if summary.interrupted:
-        sys.exit(130)
+        sys.exit(143 if summary.terminated else 130)
 
 
 def _run(
@@ -166,6 +169,8 @@ def _run(
         )
     except ExecutorError as exc:
         fail(str(exc))
+    except (SweepOutputError, TableError) as exc:
+        fail(str(exc), code=exc.code)
 
 
 @click.command()
@@ -223,11 +228,18 @@ def ablate(
             )
             click.echo(f"{sf.name}: {summary.line()}")
             if summary.interrupted:
-                sys.exit(130)
+                sys.exit(143 if summary.terminated else 130)
             table = summary.table
             if store:
-                click.echo(f"stored: {ablations.store(sf.name, table)}")
-        for path in ablations.plot(sf, table, out):
+                try:
+                    click.echo(f"stored: {ablations.store(sf.name, table)}")
+                except OSError as exc:
+                    fail(f"cannot store {sf.name}'s table: {exc.strerror or exc}", code=_code(exc))
+        try:
+            plots = ablations.plot(sf, table, out)
+        except OSError as exc:
+            fail(f"cannot write {sf.name}'s plots to {out}: {exc.strerror or exc}", code=_code(exc))
+        for path in plots:
             click.echo(f"plot: {path}")
 
 
@@ -249,8 +261,17 @@ def report(out, logs):
 
     if not Path(logs).is_dir():
         note(f"no {logs}/: the report has no figures or claims (run `make run`)")
-    path = build_report(out, logs)
+    try:
+        path = build_report(out, logs)
+    except OSError as exc:  # a read-only or full disk: one line (1: the disk, 2: the folder)
+        where = f" ({exc.filename})" if exc.filename else ""
+        fail(f"cannot write the report to {out}{where}: {exc.strerror or exc}", code=_code(exc))
     click.echo(f"report: {path} (and {path.with_suffix('.md')})")
+
+
+def _code(exc: OSError) -> int:
+    """Exit code of a failed write: 1 for the disk (full, I/O error), 2 for the place given."""
+    return 1 if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO) else 2
 
 
 def register(group: click.Group) -> None:

@@ -2,24 +2,35 @@
 
 ``run_sweep`` writes ``DIR/table.csv`` (and ``DIR/logs/KEY.mcap`` per variant unless
 ``keep_logs=False``), rewriting the table after every finished variant, so a killed or interrupted
-sweep resumes where it stopped and a rerun of a finished one runs nothing (``retry_failed``: except
-the variants that failed to run at all, e.g. after installing a missing plug-in).
+sweep resumes where it stopped and a rerun of a finished one runs nothing but the variants that
+did not finish (a worker died under it, its log is gone); ``retry_failed``: also the variants
+that failed to run at all, e.g. after installing a missing plug-in.
+
+The folder is one sweep's at a time (``DIR/sweep.lock``, held by the sweep and its workers); rows
+of other sweeps of the same code into it stay in the table (after this sweep's rows), rows of
+another code version are added to ``DIR/table.stale.csv``. SIGTERM stops a sweep as Ctrl-C does.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
-from replay.sweep.executors import default_workers, run_local, run_ray
-from replay.sweep.table import as_bool, read_table, write_table
+from replay.sweep.executors import WORKER_DIED, default_workers, run_local, run_ray
+from replay.sweep.lock import FolderLock, SweepOutputError
+from replay.sweep.table import as_bool, param_columns, read_table, write_table
 from replay.sweep.variants import Variant
 from replay.sweep.worker import INTERRUPTED
 
 TABLE = "table.csv"
+STALE = "table.stale.csv"
 
 
 @dataclass
@@ -34,6 +45,7 @@ class SweepSummary:
     rows: list = field(default_factory=list)
     interrupted: bool = False
     stale: int = 0
+    terminated: bool = False  # by SIGTERM (exit 143), not Ctrl-C (130)
 
     @property
     def rate(self) -> float:
@@ -47,7 +59,7 @@ class SweepSummary:
         )
         if self.stale:
             text += (
-                f" ({self.stale} rows of another code or scenario version moved to table.stale.csv)"
+                f" ({self.stale} rows of another code or scenario version added to table.stale.csv)"
             )
         return ("interrupted: " if self.interrupted else "") + text
 
@@ -79,22 +91,87 @@ def run_sweep(
     metrics: str = "",
     retry_failed: bool = False,
 ) -> SweepSummary:
+    """Run the variants the table of ``out_dir`` does not hold yet (see the module); the folder
+    is locked for the sweep (:class:`SweepOutputError` naming the sweep that holds it)."""
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SweepOutputError(
+            f"cannot make sweep folder {out_dir}: {exc.strerror or exc}"
+        ) from None
+    with FolderLock(out_dir), _sigterm_as_interrupt() as terminated:
+        summary = _run_locked(
+            variants,
+            out_dir,
+            workers=workers,
+            executor=executor,
+            address=address,
+            keep_logs=keep_logs,
+            progress=progress,
+            metrics=metrics,
+            retry_failed=retry_failed,
+        )
+    summary.terminated = bool(terminated)
+    return summary
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt():
+    """SIGTERM (``kill``, a scheduler's stop) ends the sweep as Ctrl-C does: workers stopped,
+    their logs closed as interrupted, the table whole; the list it yields says whether it came."""
+    came: list[bool] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield came
+        return
+
+    def handler(signum, frame) -> None:
+        came.append(True)
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield came
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+def _run_locked(
+    variants: list[Variant],
+    out_dir: Path,
+    *,
+    workers,
+    executor,
+    address,
+    keep_logs,
+    progress,
+    metrics,
+    retry_failed,
+) -> SweepSummary:
     table = out_dir / TABLE
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
+    versions = {v.version for v in variants}
     old = read_table(table)
-    rows: dict[str, dict] = {
-        r["key"]: dict(r)
-        for r in old
-        if r.get("key") in by_key and not (retry_failed and is_error(r))
-    }
-    for key, r in rows.items():  # the index follows this sweep's order
-        r["index"] = by_key[key].index
-    stale = len(old) - len(rows)
-    if stale:  # rows of another code or scenario version: kept aside
-        table.replace(out_dir / "table.stale.csv")
+    rows: dict[str, dict[str, Any]] = {}
+    others: list[dict[str, Any]] = []  # rows of other sweeps of this code into this folder: kept
+    stale: list[dict[str, Any]] = []  # rows of another code or scenario version: set aside
+    for r in old:
+        key = r.get("key", "")
+        if key in by_key:
+            if not (retry_failed and is_error(r)) and not unfinished(r):
+                rows[key] = dict(r)
+        elif r.get("version") and r.get("version") in versions:
+            others.append(dict(r))
+        else:
+            stale.append(r)
+    for key, row in rows.items():  # the index follows this sweep's order
+        row["index"] = by_key[key].index
+    for i, row in enumerate(others):  # the other sweeps' rows after this one's
+        row["index"] = len(variants) + i
+    columns = list(dict.fromkeys(params + [c for r in others for c in param_columns(r)]))
+    if stale:
+        _set_aside(out_dir / STALE, stale)
     todo = [v for v in variants if v.key not in rows]
     workers = workers or default_workers()
     tasks = [
@@ -111,12 +188,17 @@ def run_sweep(
         }
         for v in todo
     ]
+
+    def save() -> None:
+        write_table(table, [*_with_params(rows.values(), by_key), *others], columns)
+
     t0 = time.perf_counter()
     ran = failed_now = 0
     interrupted = False
     bar = _progress(len(todo), progress)
-    if stale or (old and not todo) or todo:
-        write_table(table, _with_params(rows.values(), by_key), params)
+    if stale or old or todo:
+        save()
+    stream: Any = None  # (a generator: closed below)
     try:
         stream = (
             run_local(tasks, workers) if executor == "local" else run_ray(tasks, workers, address)
@@ -128,13 +210,15 @@ def run_sweep(
             rows[row["key"]] = row
             ran += 1
             failed_now += not as_bool(row.get("success"))
-            write_table(table, _with_params(rows.values(), by_key), params)
+            save()
             bar.update(1)
             if failed_now:
                 bar.set_postfix_str(f" {failed_now} failed", refresh=False)
     except KeyboardInterrupt:
         interrupted = True
     finally:
+        if stream is not None:
+            stream.close()  # (its workers stopped before the folder is let go)
         bar.close()
     done = list(_with_params(rows.values(), by_key))
     ok = sum(as_bool(r.get("success")) for r in done)
@@ -148,7 +232,29 @@ def run_sweep(
         table=table,
         rows=sorted(done, key=lambda r: int(r["index"])),
         interrupted=interrupted,
-        stale=stale,
+        stale=len(stale),
+    )
+
+
+def _set_aside(path: Path, stale: list[dict[str, Any]]) -> None:
+    """Add ``stale`` rows to ``path`` (table.stale.csv), a row of the same key replaced: the
+    rows set aside by every earlier sweep stay."""
+    kept: dict[str, dict[str, Any]] = {r.get("key", ""): dict(r) for r in read_table(path)}
+    kept.update({r.get("key", ""): r for r in stale})
+    merged = list(kept.values())
+    for r in merged:
+        if not str(r.get("index", "")).strip().lstrip("-").isdigit():
+            r["index"] = -1
+    columns = list(dict.fromkeys(c for r in merged for c in param_columns(r)))
+    write_table(path, merged, columns)
+
+
+def unfinished(row: dict) -> bool:
+    """A row of a variant that did not finish: its worker died under it, or the log it names
+    is gone. A plain rerun runs it again."""
+    log = str(row.get("log") or "")
+    return str(row.get("reason", "")).startswith(WORKER_DIED) or bool(
+        log and not Path(log).is_file()
     )
 
 
@@ -161,4 +267,4 @@ def is_error(row: dict) -> bool:
 def _with_params(rows, by_key):
     for r in rows:
         v = by_key[r["key"]]
-        yield {**r, **v.params, "index": v.index, "seed": v.seed}
+        yield {**r, **v.params, "index": v.index, "seed": v.seed, "version": v.version}

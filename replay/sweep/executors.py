@@ -8,10 +8,14 @@ local instance (127.0.0.1, ``workers`` CPUs, no dashboard) and shuts it down at 
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing as mp
 import os
+import signal
+import sys
+import threading
 import time
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from multiprocessing.connection import wait as mp_wait
 from typing import Iterator
 
 from replay.sweep.worker import run_variant
@@ -23,18 +27,26 @@ class ExecutorError(Exception):
     """The executor cannot start (Ray missing, no cluster at the address)."""
 
 
-def crashed(task: dict, exc: BaseException) -> dict:
+def crashed(task: dict, exc: BaseException | str) -> dict:
     """The row of a variant whose worker died under it."""
-    text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+    if isinstance(exc, str):
+        why = exc
+    else:
+        text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        why = f"{type(exc).__name__}{': ' + text if text else ''}"
     return {
         "key": task["key"],
         "index": task["index"],
         "success": False,
-        "reason": f"error: worker died: {type(exc).__name__}{': ' + text if text else ''}",
+        "reason": f"{WORKER_DIED}{why}",
         "wall_time": "",
         "cpu_time": "",
         "log": "",
     }
+
+
+WORKER_DIED = "error: worker died: "  # a row's reason: the variant did not finish (rerun it)
+STOP_GRACE = 5.0  # s a worker has to close its log as interrupted before it is killed
 
 
 def default_workers() -> int:
@@ -44,28 +56,141 @@ def default_workers() -> int:
     )
 
 
+def _died(exitcode: int | None) -> str:
+    if exitcode is not None and exitcode < 0:
+        try:
+            name = signal.Signals(-exitcode).name
+        except ValueError:
+            name = f"signal {-exitcode}"
+        hint = " (out of memory?)" if -exitcode == signal.SIGKILL else ""
+        return f"killed by {name}{hint}"
+    return f"exited with code {exitcode}"
+
+
+def _die_with(parent: int) -> None:
+    """In a worker: SIGTERM when the sweep's process dies (Linux ``PR_SET_PDEATHSIG``, and a
+    watchdog thread wherever that is missing or was set too late), SIGTERM being a Ctrl-C here
+    (the variant's log closed as interrupted); killed outright if that does not end it."""
+    signal.signal(signal.SIGTERM, _as_interrupt)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(STOP_GRACE)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="die-with-parent").start()
+
+
+def _as_interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
+def _serve(conn, parent: int) -> None:
+    """A worker: variants in, rows out, until the pipe closes."""
+    _die_with(parent)
+    try:
+        while True:
+            try:
+                task = conn.recv()
+            except EOFError:
+                return
+            conn.send(run_variant(task))
+    except (KeyboardInterrupt, BrokenPipeError, EOFError):
+        return
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)  # (a late stop ends it quietly)
+
+
 def run_local(tasks: list[dict], workers: int) -> Iterator[dict]:
-    """A pool of ``workers`` processes (forked: the imports are already paid for)."""
+    """``workers`` processes (forked: the imports are already paid for), each given one variant
+    at a time, so the variant a worker was running when it died (the OOM killer, a crash in C
+    code) is the only one that fails: the worker is replaced and the rest go on. Workers die
+    with this process (SIGTERM, SIGKILL), and are stopped when the consumer stops (Ctrl-C)."""
     if not tasks:
         return
-    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
-    pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(tasks))), mp_context=ctx)
+    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else mp.get_context()
+    queue = list(reversed(tasks))
+    n = max(1, min(workers, len(tasks)))
+    procs: dict = {}  # conn -> process
+    running: dict = {}  # conn -> its task
+
+    def start() -> None:
+        ours, theirs = ctx.Pipe()
+        proc = ctx.Process(target=_serve, args=(theirs, os.getpid()), daemon=True)
+        proc.start()
+        theirs.close()
+        procs[ours] = proc
+
+    def give(conn) -> None:
+        if queue:
+            running[conn] = queue.pop()
+            conn.send(running[conn])
+
     try:
-        of = {pool.submit(run_variant, t): t for t in tasks}
-        pending = set(of)
-        while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for f in done:
+        for _ in range(n):
+            start()
+        for conn in list(procs):
+            give(conn)
+        while running:
+            by_sentinel = {procs[c].sentinel: c for c in running}
+            ready = mp_wait(list(running) + list(by_sentinel))
+            seen = set()
+            for item in ready:
+                conn = by_sentinel.get(item, item)
+                if conn in seen or conn not in running:
+                    continue
+                seen.add(conn)
+                row = None
                 try:
-                    yield f.result()
-                except Exception as exc:  # noqa: BLE001 - a dead worker (a crash in C code)
-                    yield crashed(of[f], exc)
-    except BaseException:  # Ctrl-C, or the consumer stopped: do not wait for them
-        for proc in list(getattr(pool, "_processes", {}).values()):
-            proc.terminate()
-        pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    pool.shutdown(wait=True)
+                    if conn.poll():
+                        row = conn.recv()
+                except (EOFError, OSError):
+                    row = None
+                if row is not None:
+                    del running[conn]
+                    yield row
+                    give(conn)
+                    continue
+                if procs[conn].is_alive():
+                    continue  # (woken by the other one of its pair)
+                task = running.pop(conn)
+                procs[conn].join()
+                why = _died(procs.pop(conn).exitcode)
+                conn.close()
+                yield crashed(task, why)
+                if queue:  # a new worker for the rest
+                    start()
+                    give(list(procs)[-1])
+    finally:  # done, Ctrl-C, SIGTERM or the consumer stopped: no worker outlives this
+        _stop(procs)
+
+
+def _stop(procs: dict) -> None:
+    for conn in procs:
+        conn.close()  # an idle worker ends at once
+    busy = []
+    for p in procs.values():
+        p.join(0.2)
+        if p.is_alive():
+            with contextlib.suppress(OSError):
+                p.terminate()  # a running one closes its log as interrupted
+            busy.append(p)
+    deadline = time.monotonic() + STOP_GRACE
+    for p in busy:
+        p.join(max(0.0, deadline - time.monotonic()))
+        if p.is_alive():
+            p.kill()
+            p.join()
 
 
 def ray_available() -> bool:

@@ -2,21 +2,24 @@
 
 Columns: ``index``, ``key``, the varied parameters, ``seed``, ``success``, ``reason``, the
 ``outcome`` event's metrics (``m.NAME``), the sweep's own metrics read from each log
-(``x.NAME``), the count of each event kind (``e.KIND``), ``stopped_by``, ``t_end``, ``wall_time``, ``cpu_time`` and ``log``. The
-file is the sweep's memory: rows whose key is still a variant of the sweep are done; a killed sweep
-loses at most the variants that were running.
+(``x.NAME``), the count of each event kind (``e.KIND``), ``stopped_by``, ``t_end``,
+``wall_time``, ``cpu_time``, ``log`` and ``version`` (the code version that ran it). The file is
+the sweep's memory: rows whose key is still a variant of the sweep are done; a killed sweep loses
+at most the variants that were running; rows of other sweeps into the same folder stay.
 """
 
 from __future__ import annotations
 
 import csv
+import errno
 import os
+import tempfile
 from pathlib import Path
 from typing import Any, Iterable
 
 FIRST = ["index", "key"]
 LAST = ["seed", "success", "reason"]
-TAIL = ["stopped_by", "t_end", "wall_time", "cpu_time", "log"]
+TAIL = ["stopped_by", "t_end", "wall_time", "cpu_time", "log", "version"]
 
 
 def read_table(path: str | Path) -> list[dict[str, str]]:
@@ -27,20 +30,48 @@ def read_table(path: str | Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
+class TableError(Exception):
+    """The table cannot be written (a full disk, a folder that takes no files); ``code`` is the
+    exit code (1: a system fault, 2: the folder given)."""
+
+    def __init__(self, message: str, code: int = 1) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+def param_columns(row: dict[str, Any]) -> list[str]:
+    """The varied parameters' columns of a row read back (everything but the fixed columns and
+    the metrics)."""
+    fixed = set(FIRST + LAST + TAIL)
+    return [k for k in row if k not in fixed and str(k)[:2] not in ("m.", "x.", "e.")]
+
+
 def write_table(path: str | Path, rows: Iterable[dict[str, Any]], params: list[str]) -> None:
+    """Write ``rows`` to ``path`` atomically (a temporary file of this writer's own, replacing
+    ``path`` only once whole); :class:`TableError` when it cannot, nothing left behind."""
     path = Path(path)
     rows = sorted(rows, key=lambda r: int(r["index"]))
     metrics = sorted({k for r in rows for k in r if str(k)[:2] in ("m.", "x.", "e.")})
-    columns = FIRST + [p for p in params if p not in LAST] + LAST + metrics + TAIL
+    columns = FIRST + [p for p in params if p not in LAST + TAIL] + LAST + metrics + TAIL
     extra = sorted({k for r in rows for k in r} - set(columns))
-    tmp = path.with_name(path.name + ".tmp")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with tmp.open("w", newline="", encoding="utf-8") as f:
-        w = csv.DictWriter(f, fieldnames=columns + extra, extrasaction="ignore")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: _text(v) for k, v in r.items()})
-    os.replace(tmp, path)
+    tmp = None
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        with os.fdopen(fd, "w", newline="", encoding="utf-8") as f:
+            w = csv.DictWriter(f, fieldnames=columns + extra, extrasaction="ignore")
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: _text(v) for k, v in r.items()})
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except OSError as exc:
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+        full = exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO)
+        raise TableError(
+            f"cannot write table {path}: {exc.strerror or exc}", 1 if full else 2
+        ) from None
 
 
 def _text(v: Any) -> Any:

@@ -30,6 +30,7 @@ class Variant:
     resolved: str = ""  # the resolved YAML ("" when it failed to load)
     error: str = ""  # why it failed to load
     name: str = ""  # the scenario's name
+    version: str = ""  # the code version it is keyed by (the table's version column)
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -83,7 +84,15 @@ def expand(
         all_sets = list(sets) + point_sets
         vseed = seed if point_seed is None else point_seed
         cells = {k: spec.label(k, v) for k, v in point.items()}
-        v = Variant(index=i, key="", params=cells, scenario_path=path, sets=all_sets, seed=vseed)
+        v = Variant(
+            index=i,
+            key="",
+            params=cells,
+            scenario_path=path,
+            sets=all_sets,
+            seed=vseed,
+            version=version,
+        )
         try:
             sc = load_scenario(path, sets=all_sets, seed=vseed)
             v.resolved = resolved_yaml(sc)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import tempfile
 import time
 import traceback
@@ -31,9 +32,8 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         return row
     log: str = task.get("log") or ""
     tmp = ""
-    if not log:
-        fd, tmp = tempfile.mkstemp(suffix=".mcap", prefix="sweep-")
-        os.close(fd)
+    if not log:  # a folder of its own: the log is made there (an empty file is no output)
+        tmp = str(Path(tempfile.mkdtemp(prefix="sweep-")) / "variant.mcap")
     cwd = task.get("cwd")
     if cwd and Path(cwd).is_dir() and os.getcwd() != cwd:
         os.chdir(cwd)  # relative data paths (alpha files) as in the scenario
@@ -62,6 +62,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     except (RunInterrupted, KeyboardInterrupt):
         row.update(success=False, reason=INTERRUPTED)  # not a result: the engine drops it
     except Exception as exc:  # noqa: BLE001 - a failed variant is a row
+        _drop_part_on_full_disk(exc, log)
         row["success"] = False
         last = traceback.extract_tb(exc.__traceback__)[-1]
         row["reason"] = (
@@ -69,11 +70,24 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         ).replace("\n", " ")
     finally:
         if tmp:
-            Path(tmp).unlink(missing_ok=True)
+            shutil.rmtree(Path(tmp).parent, ignore_errors=True)
     row["wall_time"] = round(time.perf_counter() - wall0, 4)
     row["cpu_time"] = round(time.process_time() - cpu0, 4)
     row["log"] = log if log and Path(log).is_file() else ""
     return row
+
+
+def _drop_part_on_full_disk(exc: BaseException, log: str) -> None:
+    """A run stopped by a full disk leaves no ``.part`` (as ``replay run`` does): what it holds
+    is not worth the disk it fills."""
+    import errno
+
+    from replay.log.writer import LogWriteError, own_part
+
+    if log and isinstance(exc, LogWriteError) and exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        part = own_part(Path(log))
+        if part is not None:
+            part.unlink(missing_ok=True)
 
 
 def load_function(ref: str):

@@ -162,7 +162,7 @@ def test_killed_run_leaves_a_readable_part_file(toy_yaml, tmp_path):
         proc.send_signal(signal.SIGKILL)
         proc.wait(timeout=30)
     assert not out.exists()
-    part = tmp_path / "killed.mcap.part"
+    part = tmp_path / f"killed.mcap.{proc.pid}.part"  # the run's own name: its pid
     r = LogReader(part)
     assert r.truncated
     states = r.series("/toy/state")
