@@ -229,7 +229,7 @@ def check_output(path: Path, *, kind: str = "log", magic: bytes | None = MAGIC) 
             f"will not write {kind} {path}: it is {_what(st.st_mode)}, not a regular file"
         )
     if st is not None and magic is not None:
-        what = "an MCAP log" if magic == MAGIC else f"an earlier {kind} (JSON)"
+        what = "an MCAP log" if magic == MAGIC else f"an earlier {kind} (a file starting {magic!r})"
         if st.st_size == 0:
             raise LogError(f"will not overwrite {path}: it is an empty file, not {what}")
         try:
