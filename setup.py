@@ -62,8 +62,6 @@ setup(
         _ext("replay.control.stick._sweep"),
         _ext("replay.control.stick._contacts"),
         _ext("replay.control.stick._fit"),
-        _ext("replay.foxglove._png"),
-        _ext("replay.foxglove._wire"),
         _ext("replay.control.grasping._arm_kinematics"),
         _ext("replay.control.grasping._chip_target"),
         _ext("replay.control.grasping._hand_servo"),

@@ -25,7 +25,7 @@ import signal
 import tempfile
 import threading
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import orjson
 
@@ -333,14 +333,6 @@ class LogWriter:
         if held.pending and not held.depth:
             held.pending = False
             raise KeyboardInterrupt
-
-    @property
-    def raw_message(self) -> Callable[[int, int, int, bytes], None]:
-        """``message(channel_id, log_time, publish_time, data)``: :meth:`write_raw` with both
-        times (the camera frames' batch writer calls it)."""
-        return lambda channel_id, log_time, publish_time, data: self.write_raw(
-            channel_id, data, log_time
-        )
 
     def write_error(self, exc: OSError) -> LogError:
         """The LogError of a failed write."""

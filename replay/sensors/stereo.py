@@ -75,7 +75,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.foxglove.png import WindowedImage
+from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import ParamError, param
@@ -188,8 +188,8 @@ class StereoBallCameraParams:
     )
     log_images: bool = param(
         True,
-        doc="write both cameras' images to the log (PNG, /camera/SENSOR/cam0 and cam1) at the "
-        "camera rate: ~0.2 KiB and ~0.1 ms a frame pair",
+        doc="write both cameras' images to the log (foxglove.RawImage, /camera/SENSOR/cam0 and "
+        "cam1) at the camera rate: ~0.3 KiB after the log's zstd and ~0.04 ms a frame pair",
     )
 
     def __post_init__(self) -> None:

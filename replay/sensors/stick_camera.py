@@ -58,7 +58,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.foxglove.png import WindowedImage
+from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_STICK, VisionStick
 from replay.params import ParamError, param
@@ -315,7 +315,7 @@ class StickCameraParams:
     marker: str = param("marker", max_length=100, doc="name of the Box the camera tracks")
     log_images: bool = param(
         False,
-        doc="write each whole frame to the log (PNG, /camera/SENSOR/image) at the camera rate; "
+        doc="write each whole frame to the log (RawImage mono8, /camera/SENSOR/image) at the camera rate; "
         "off by default: a 512 px frame costs ~1 ms to build and encode",
     )
 

@@ -63,7 +63,7 @@ class VisionChipParams:
     reading: str = param("head", doc="the plant's reading with the camera pose")
     log_images: bool = param(
         True,
-        doc="write the binary image to the log (PNG, 0/255, /camera/SENSOR/image) at the "
+        doc="write the binary image to the log (RawImage mono8, 0/255, /camera/SENSOR/image) at the "
         "camera rate",
     )
 
@@ -101,7 +101,7 @@ class VisionChipSensor(Sensor):
         return img > self.level
 
     def frame_images(self) -> list[tuple[str, np.ndarray]]:
-        """The last frame: ``[("image", bool HxW)]`` (its PNG is 0 / 255)."""
+        """The last frame: ``[("image", bool HxW)]`` (its RawImage is 0 / 255)."""
         return [] if self.last_image is None else [("image", self.last_image)]
 
     def measure(self, t: float, scene: Scene) -> VisionChip | None:
