@@ -21,7 +21,7 @@ static void composite_one(const double *xy, Py_ssize_t n, double greyd, int ox, 
                           float *img, int w, int h, double *acc, int touched[4]) {
     if (n < 3) return;
     int r0, r1, c0, c1;
-    accumulate(xy, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1);
+    if (accumulate(xy, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1) < 0) return; /* (error set) */
     if (r0 < r1 && c0 < c1) {
         if (touched[0] >= touched[1]) {
             touched[0] = r0, touched[1] = r1, touched[2] = c0, touched[3] = c1;
@@ -93,6 +93,11 @@ static int frame_c(const double *const *xy, const Py_ssize_t *nv, const double *
         memset(acc, 0, nacc * sizeof(double));
         for (Py_ssize_t i = 0; i < nb; i++)
             composite_one(xy[i], nv[i], greys[i], x0, y0, img, w, h, acc, box);
+        if (PyErr_Occurred()) { /* a vertex accumulate refused */
+            free(img);
+            Py_CLEAR(f->image);
+            return -1;
+        }
     }
     /* quantised: the background's level outside the box (its pixels are g there, unchanged) */
     uint8_t *img8 = (uint8_t *)PyByteArray_AS_STRING(f->image), qg;

@@ -275,8 +275,9 @@ static PyObject *frame_core(Prim *prims, Py_ssize_t n, int marker, PyObject *R, 
         Py_buffer P;
         if (PyObject_GetBuffer(p->out, &P, PyBUF_C_CONTIGUOUS) < 0) goto done;
         int r0, r1, c0, c1;
-        accumulate(P.buf, p->count, win[0], win[1], acc, w, h, &r0, &r1, &c0, &c1);
+        int bad = accumulate(P.buf, p->count, win[0], win[1], acc, w, h, &r0, &r1, &c0, &c1);
         PyBuffer_Release(&P);
+        if (bad) goto done; /* a vertex it refused: ValueError set */
         blend(acc, img, w, r0, r1, c0, c1, (float)(255.0 * p->albedo));
     }
     uint8_t *out = (uint8_t *)PyByteArray_AS_STRING(image);
