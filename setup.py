@@ -57,7 +57,6 @@ setup(
         _ext("replay.control.catching._mapping"),
         _ext("replay.control.catching._ballistic"),
         _ext("replay.control.catching._torque"),
-        _ext("replay.robot._chain"),
         _ext("plants.airtable._bodies"),
         _ext("replay.control.stick._sweep"),
         _ext("replay.control.stick._contacts"),
