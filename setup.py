@@ -58,7 +58,6 @@ setup(
         _ext("replay.control.catching._mapping"),
         _ext("replay.control.catching._ballistic"),
         _ext("replay.control.catching._torque"),
-        _ext("plants.airtable._bodies"),
         _ext("replay.control.grasping._arm_kinematics"),
         _ext("replay.control.grasping._chip_target"),
         _ext("replay.control.grasping._hand_servo"),
