@@ -81,8 +81,8 @@ from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.sensors import _pixels, _stereo
-from replay.sensors.raster import quantise
+from replay.accel import accelerator
+from replay.sensors.raster import composite, quantise
 from replay.sensors.silhouette import (
     _AREA_SCALE,
     _COS,
@@ -91,6 +91,11 @@ from replay.sensors.silhouette import (
     drawables,
     render_views,
 )
+
+import cv2  # (the blob's and the triangulation's pure-Python path: the OpenCV they replaced)
+
+_pixels = accelerator("replay.sensors._pixels")
+_stereo = accelerator("replay.sensors._stereo")
 
 _VIEWS = ("cam0", "cam1")  # the two cameras' image views (frame_images)
 
@@ -351,13 +356,12 @@ class StereoBallCamera(Sensor):
         p = params if params is not None else StereoBallCameraParams()
         img = np.ascontiguousarray(image, dtype=np.uint8)
         h, w = img.shape
-        found = _pixels.ball_blob(
+        args = (float(p.threshold), int(p.min_pixels), int(p.moments == "binary"))
+        found = _ball_blob(
             img,
             w,
             h,
-            float(p.threshold),
-            int(p.min_pixels),
-            int(p.moments == "binary"),
+            *args,
             255.0 * float(p.background),
             int(origin[0]),
             int(origin[1]),
@@ -379,7 +383,7 @@ class StereoBallCamera(Sensor):
     def triangulate(self, uv0, uv1) -> np.ndarray:
         """World point (3,) from a pixel in each image: the linear (DLT) triangulation of
         ``cv2.triangulatePoints`` (compiled: ``_pixels.triangulate``; NaN at infinity)."""
-        X = _pixels.triangulate(
+        X = _triangulate(
             self._P[0], self._P[1], float(uv0[0]), float(uv0[1]), float(uv1[0]), float(uv1[1])
         )
         return np.full(3, np.nan) if X is None else np.array(X)
@@ -448,7 +452,7 @@ class StereoBallCamera(Sensor):
         """:meth:`locate` on floats: (x, y, z), or None at infinity. The bias correction as
         :func:`~replay.sensors.silhouette.correct_sphere_centroid` computes it."""
         P0, P1 = self._P
-        X = _pixels.triangulate(P0, P1, uv0[0], uv0[1], uv1[0], uv1[1])
+        X = _triangulate(P0, P1, uv0[0], uv0[1], uv1[0], uv1[1])
         if X is None or radius is None or radius <= 0.0 or not all(map(math.isfinite, X)):
             return X
         fixed = []
@@ -461,7 +465,7 @@ class StereoBallCamera(Sensor):
             s = (z * z - r2) / (z * z)
             fixed.append((cx + (u - cx) * s, cy + (v - cy) * s))
         (a, b), (c, d) = fixed
-        return _pixels.triangulate(P0, P1, a, b, c, d)
+        return _triangulate(P0, P1, a, b, c, d)
 
     def measure(self, t: float, scene: Scene) -> VisionObject | None:
         """The module doc's pipeline: noise-free, a scene of spheres in one compiled call (both
@@ -482,6 +486,8 @@ class StereoBallCamera(Sensor):
             if self.params.bias_correction and isinstance(tracked, Sphere)
             else 0.0
         )
+        if _stereo is None:
+            return self.measure_reference(t, scene)
         # a scene of spheres: both cameras' silhouettes drawn in C (None: not only spheres)
         got = _stereo.measure(prims, Sphere, tracked is not None, radius, *self._measure_args)
         if got is not None:
@@ -530,15 +536,14 @@ class StereoBallCamera(Sensor):
             w, h = x1 - x0, y1 - y0
             img = np.full((h, w), grey, np.float32)
             if drawn and w and h:
-                _pixels.composite([d[0] for d in drawn], [d[1] for d in drawn], x0, y0, img, w, h)
+                composite(img, [d[0] for d in drawn], [d[1] for d in drawn], (x0, y0))
             if noise:
                 img += np.float32(p.noise_sigma) * self.rng.standard_normal(
                     img.shape, dtype=np.float32
                 )
-            img8 = np.empty((h, w), np.uint8)
-            _pixels.quantise(img, img8)
+            img8 = quantise(img)
             last.append((img8, window))
-            found = _pixels.ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
+            found = _ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
             founds.append(found)
             blobs.append(_blob(found, blob_args[2]))
         self._last = last
@@ -564,3 +569,63 @@ class StereoBallCamera(Sensor):
             position=list(X),
             features={"centroids": [list(uv0), list(uv1)], "areas": [b0["area"], b1["area"]]},
         )
+
+
+# --- the blob and the triangulation: the accelerator's, or OpenCV's ----------------------
+
+
+def _ball_blob(img, w, h, threshold, min_pixels, binary, default_bg, ox, oy, W, H):
+    """(u, v, area, background) of the largest 8-connected blob above ``threshold`` in a
+    window (first pixel (ox, oy)) of a W x H image, or None (:meth:`StereoBallCamera.blob`):
+    the accelerator (``_pixels.ball_blob``) where built, else the OpenCV pipeline it replaced
+    (equal to 1e-9 px: test_fast_cameras.py)."""
+    if _pixels is not None:
+        return _pixels.ball_blob(img, w, h, threshold, min_pixels, binary, default_bg, ox, oy, W, H)
+    _, mask = cv2.threshold(img, threshold, 1, cv2.THRESH_BINARY)
+    ex, ey, ew, eh = cv2.boundingRect(mask)
+    if ew == 0:
+        return None
+    ex0, ey0 = max(ex - 4, 0), max(ey - 4, 0)
+    ex1, ey1 = min(ex + ew + 4, w), min(ey + eh + 4, h)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask[ey0:ey1, ex0:ex1], connectivity=8)
+    i = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    bx, by, bw, bh, area = (int(v) for v in stats[i])
+    bx, by = bx + ex0, by + ey0
+    if area < min_pixels or bx + ox == 0 or by + oy == 0 or bx + ox + bw == W or by + oy + bh == H:
+        return None
+    x0, y0 = max(bx - 4, 0), max(by - 4, 0)
+    x1, y1 = min(bx + bw + 4, w), min(by + bh + 4, h)
+    labels = labels[y0 - ey0 : y1 - ey0, x0 - ex0 : x1 - ex0]
+    blob = (labels == i).astype(np.uint8)
+    if binary:
+        m = cv2.moments(blob, binaryImage=True)
+        return (ox + x0 + m["m10"] / m["m00"], oy + y0 + m["m01"] / m["m00"], area, 0.0)
+    roi = img[y0:y1, x0:x1].astype(np.float32)
+    free = labels == 0
+    region = cv2.dilate(blob, np.ones((5, 5), np.uint8)).astype(bool) & (free | blob.astype(bool))
+    ring = roi[~region & free]
+    if ring.size:
+        background = float(np.partition(ring, ring.size // 2)[ring.size // 2])
+    else:
+        background = default_bg
+    weight = np.where(region, roi - np.float32(background), np.float32(0.0))
+    m = cv2.moments(weight)
+    if m["m00"] <= 0.0:
+        return None
+    return (ox + x0 + m["m10"] / m["m00"], oy + y0 + m["m01"] / m["m00"], area, background)
+
+
+def _triangulate(P0, P1, u0, v0, u1, v1):
+    """The linear (DLT) two-view triangulation of ``cv2.triangulatePoints``: (x, y, z), or None
+    at infinity (the accelerator's ``_pixels.triangulate`` where built)."""
+    if _pixels is not None:
+        return _pixels.triangulate(P0, P1, u0, v0, u1, v1)
+    X = cv2.triangulatePoints(
+        np.asarray(P0, dtype=np.float64).reshape(3, 4),
+        np.asarray(P1, dtype=np.float64).reshape(3, 4),
+        np.array([[u0], [v0]], dtype=np.float64),
+        np.array([[u1], [v1]], dtype=np.float64),
+    ).ravel()
+    if X[3] == 0.0:
+        return None
+    return (float(X[0] / X[3]), float(X[1] / X[3]), float(X[2] / X[3]))

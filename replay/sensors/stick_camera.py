@@ -65,9 +65,14 @@ from replay.params import ParamError, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
-from replay.sensors import _pixels, _stick_frame
+from replay.accel import accelerator
 from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
+
+import cv2  # (the moments' pure-Python path: the OpenCV pipeline the accelerator replaced)
+
+_pixels = accelerator("replay.sensors._pixels")
+_stick_frame = accelerator("replay.sensors._stick_frame")
 
 _RIM = 48  # vertices of a polygon standing in for a circle
 
@@ -419,21 +424,24 @@ class StickCamera(Sensor):
 
     @staticmethod
     def _moments(image: np.ndarray, params: StickCameraParams, origin: tuple[int, int]):
-        """:meth:`marker_moments` as the compiled kernel returns it: (u, v, angle, pixels,
-        background, m00, m10, m01, mu20, mu11, mu02) or None."""
+        """:meth:`marker_moments` as a tuple: (u, v, angle, pixels, background, m00, m10, m01,
+        mu20, mu11, mu02) or None. The accelerator (``_pixels.marker_moments``, one pass) where
+        built, else the OpenCV pipeline it replaced (equal to 1e-9 px: test_fast_cameras.py)."""
         img = np.ascontiguousarray(image, dtype=np.uint8)
         h, w = img.shape
-        return _pixels.marker_moments(
-            img,
-            w,
-            h,
-            float(params.threshold),
-            int(params.min_pixels),
-            int(origin[0]),
-            int(origin[1]),
-            int(params.width),
-            int(params.height),
-        )
+        if _pixels is not None:
+            return _pixels.marker_moments(
+                img,
+                w,
+                h,
+                float(params.threshold),
+                int(params.min_pixels),
+                int(origin[0]),
+                int(origin[1]),
+                int(params.width),
+                int(params.height),
+            )
+        return _moments_opencv(img, params, origin)
 
     # --- the sensor ---------------------------------------------------------------------------
     @property
@@ -463,7 +471,11 @@ class StickCamera(Sensor):
         (:meth:`_frame`, the same pixels, moments and pose as :meth:`measure_reference`), the
         rest (noise, a scene with spheres, no marker in view: the whole image) by the
         reference."""
-        framed = self._frame(scene) if self.params.noise_sigma == 0.0 else None
+        framed = (
+            self._frame(scene)
+            if self.params.noise_sigma == 0.0 and _stick_frame is not None
+            else None
+        )
         if framed is None:
             return self.measure_reference(t, scene)
         img, window, pose = framed
@@ -575,3 +587,91 @@ class StickCamera(Sensor):
         if not (abs(dz / n) > 1e-12 and s > 0.0):
             return None
         return ox + s * dx, oy + s * dy
+
+
+# --- the marker's moments without the accelerator: OpenCV -----------------------------------
+
+_END_SAMPLES = np.array([[s, o] for s in (2.0, 3.0, 4.0) for o in (-1.0, 0.0, 1.0)])
+
+
+def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> float | None:
+    """The median of 9 pixels 2-4 px beyond each end of the blob along its long axis, the
+    brighter end's (:meth:`StickCamera.marker_moments`)."""
+    m = cv2.moments(blob, binaryImage=True)
+    if m["m00"] <= 0.0:
+        return None
+    a = 0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"])
+    e = np.array([math.cos(a), math.sin(a)])
+    n = np.array([-e[1], e[0]])
+    c = np.array([origin[0] + m["m10"] / m["m00"], origin[1] + m["m01"] / m["m00"]])
+    rows, cols = np.nonzero(blob)
+    along = (np.column_stack([cols + origin[0], rows + origin[1]]) - c) @ e
+    h, w = image.shape
+    levels = []
+    for end in (along.max(), along.min()):
+        sign = 1.0 if end > 0 else -1.0
+        pts = c + (end + sign * _END_SAMPLES[:, :1]) * e + _END_SAMPLES[:, 1:] * n
+        ij = np.rint(pts).astype(int)
+        ok = (ij[:, 0] >= 0) & (ij[:, 0] < w) & (ij[:, 1] >= 0) & (ij[:, 1] < h)
+        if ok.any():
+            levels.append(float(np.median(image[ij[ok, 1], ij[ok, 0]])))
+    return max(levels) if levels else None
+
+
+def _moments_opencv(image: np.ndarray, params: StickCameraParams, origin) -> tuple | None:
+    """:meth:`StickCamera._moments` with OpenCV: threshold, the largest 8-connected blob (none
+    touching the image's border), the background beyond its ends, grey-level moments over the
+    blob dilated by 2 px."""
+    h, w = image.shape
+    ox, oy = int(origin[0]), int(origin[1])
+    mask = (image > params.threshold).astype(np.uint8)
+    bright = cv2.findNonZero(mask)
+    if bright is None:
+        return None
+    cx, cy, cw, ch = cv2.boundingRect(bright)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(
+        mask[cy : cy + ch, cx : cx + cw], connectivity=8
+    )
+    if n <= 1:
+        return None
+    i = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    bx, by, bw, bh, area = (int(v) for v in stats[i])
+    bx, by = bx + cx, by + cy
+    if area < params.min_pixels:
+        return None
+    if (
+        bx + ox == 0
+        or by + oy == 0
+        or bx + ox + bw == params.width
+        or by + oy + bh == params.height
+    ):
+        return None
+    x0, y0 = max(bx - 3, 0), max(by - 3, 0)
+    x1, y1 = min(bx + bw + 3, w), min(by + bh + 3, h)
+    roi = image[y0:y1, x0:x1].astype(np.float32)
+    blob = np.zeros((y1 - y0, x1 - x0), np.uint8)
+    lx0, ly0 = bx - cx, by - cy
+    blob[by - y0 : by - y0 + bh, bx - x0 : bx - x0 + bw] = (
+        labels[ly0 : ly0 + bh, lx0 : lx0 + bw] == i
+    )
+    background = _background_beyond_ends(image, blob, (x0, y0))
+    if background is None:
+        return None
+    region = cv2.dilate(blob, np.ones((5, 5), np.uint8)).astype(bool)
+    weight = np.where(region, np.maximum(roi - np.float32(background), 0.0), 0.0)
+    m = cv2.moments(weight.astype(np.float32))
+    if m["m00"] <= 0.0:
+        return None
+    return (
+        ox + x0 + m["m10"] / m["m00"],
+        oy + y0 + m["m01"] / m["m00"],
+        0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"]),
+        area,
+        background,
+        m["m00"],
+        m["m10"],
+        m["m01"],
+        m["mu20"],
+        m["mu11"],
+        m["mu02"],
+    )

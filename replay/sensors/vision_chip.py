@@ -30,8 +30,10 @@ from replay.interfaces import Sensor
 from replay.params import param
 from replay.scene import Scene
 from replay.sensors.pinhole import Intrinsics, PinholeCamera
-from replay.sensors import _pixels
+from replay.accel import accelerator
 from replay.sensors.silhouette import render
+
+_pixels = accelerator("replay.sensors._pixels")
 
 
 @dataclass
@@ -108,7 +110,7 @@ class VisionChipSensor(Sensor):
         bits = self.image(scene)
         self.last_image = bits
         h, w = bits.shape
-        if w <= 63:  # pack_rows, compiled
+        if w <= 63 and _pixels is not None:  # pack_rows, by the accelerator
             rows, count = _pixels.pack_rows(bits, w, h)
         else:
             rows, count = pack_rows(bits), int(bits.sum())

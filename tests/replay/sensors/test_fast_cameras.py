@@ -1,4 +1,5 @@
-"""The cameras' compiled kernels (replay/sensors/_pixels.c) against the NumPy/OpenCV pipelines
+"""The cameras' optional compiled kernels (replay/sensors/_pixels.c) and their pure-Python paths
+against the NumPy/OpenCV pipelines
 they replaced, kept here as references, and the stated accuracy of the stick camera.
 
 Each comparison runs over seeded random poses (with and without pixel noise) and reports the
@@ -13,7 +14,8 @@ import pytest
 
 from replay.messages import pack_rows, unpack_rows
 from replay.scene import Box, Cylinder, Scene, Sphere
-from replay.sensors import _pixels
+from replay.sensors.raster import _pixels  # the accelerator, or None where not built
+from replay.sensors.stereo import _stereo
 from replay.sensors.silhouette import _body_points, project_hull, sphere_ellipse, sphere_polygon
 from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 from replay.sensors.stick_camera import (
@@ -351,6 +353,7 @@ def test_compiled_sphere_polygon_equals_the_ellipse_and_its_polygon():
     assert drawn > 300 and behind > 20
 
 
+@pytest.mark.skipif(_stereo is None, reason="the _stereo accelerator is not built")
 @pytest.mark.parametrize("moments,bias", [("grey", True), ("binary", True), ("grey", False)])
 def test_compiled_stereo_frame_equals_the_step_by_step_measurement(moments, bias):
     """_stereo.frame and _stereo.locate (measure, noise-free) against measure_reference, which
@@ -465,6 +468,7 @@ def test_triangulation_equals_opencv():
 # --- the vision chip ------------------------------------------------------------------------
 
 
+@pytest.mark.skipif(_pixels is None, reason="the _pixels accelerator is not built")
 def test_compiled_pack_rows_equals_pack_rows():
     rng = np.random.default_rng(1)
     for w in (1, 2, 16, 62, 63):
@@ -491,6 +495,7 @@ def test_window_of_a_box_on_the_stick_camera_is_clipped_to_the_image():
     assert hull_window(cam, (600.0, 5.0, 700.0, 9.5)) is None
 
 
+@pytest.mark.skipif(_pixels is None, reason="the _pixels accelerator is not built")
 def test_kernels_refuse_bad_buffers_and_see_nothing_in_empty_images():
     assert StereoBallCamera.blob(np.zeros((0, 0), np.uint8)) is None
     assert StickCamera.marker_moments(np.zeros((0, 5), np.uint8), StickCameraParams()) is None
