@@ -71,22 +71,7 @@ setup(
     packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
     package_dir=SHIPPED,
     ext_modules=[
-        _ext("replay.sensors._pixels", ("replay/sensors/_ellipse.h",)),
-        # includes _pixels.c's kernels, unchanged, and _silhouette.c's sphere outline
-        _ext(
-            "replay.sensors._stereo",
-            (
-                "replay/sensors/_pixels.c",
-                "replay/sensors/_silhouette.c",
-                "replay/sensors/_ellipse.h",
-            ),
-        ),
-        _ext("replay.sensors._silhouette", ("replay/sensors/_ellipse.h",)),
-        # includes _pixels.c's kernels, unchanged
-        _ext(
-            "replay.sensors._stick_frame",
-            ("replay/sensors/_pixels.c", "replay/sensors/_ellipse.h"),
-        ),
+        _ext("replay.sensors._pixels"),
         _ext("replay.control.stick._sweep"),
         _ext("replay.control.catching._mapping"),
         _ext("replay.control.catching._ballistic"),

@@ -1,5 +1,7 @@
-/* Per-pixel kernels of the cameras (replay/sensors/pixels.py documents them; that module is the
- * only caller). Plain C over the buffer protocol: no NumPy headers, no start-up cost.
+/* Per-pixel kernels of the cameras: the optional accelerator of replay/sensors/raster.py,
+ * silhouette.py, stick_camera.py and stereo.py (their Python paths are the algorithms, which
+ * these repeat and the tests hold them to; replay.accel loads this module where it is built).
+ * Plain C over the buffer protocol: no NumPy headers, no start-up cost.
  *
  * Image conventions (replay/sensors/pinhole.py): integer pixel coordinates are pixel centres,
  * pixel (i, j) spans [i - 0.5, i + 0.5] x [j - 0.5, j + 0.5].
@@ -11,7 +13,23 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "_ellipse.h"
+/* An ellipse's n-gon and its box: out[k] = (u + a c cos_k - b s sin_k, v + a s cos_k + b c sin_k)
+ * for the tables ct, st (n each) into out (2n); box = (umin, vmin, umax, vmax). The operations
+ * and order of replay/sensors/silhouette.py Ellipse.polygon_and_box. */
+static void ellipse_ngon(const double *ct, const double *st, Py_ssize_t n, double u, double v,
+                         double a, double b, double c, double s, double *out, double *box) {
+    double ac = a * c, bs = b * s, as = a * s, bc = b * c;
+    double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double pu = u + ac * ct[k] - bs * st[k], pv = v + as * ct[k] + bc * st[k];
+        out[2 * k] = pu, out[2 * k + 1] = pv;
+        if (pu < umin) umin = pu;
+        if (pu > umax) umax = pu;
+        if (pv < vmin) vmin = pv;
+        if (pv > vmax) vmax = pv;
+    }
+    box[0] = umin, box[1] = vmin, box[2] = umax, box[3] = vmax;
+}
 
 /* Signed-area accumulation of one polygon (n vertices xy[2n], pixels of the full image) into
  * acc (h rows of w + 1) of the block whose first pixel is (ox, oy): each edge is cut where it
@@ -888,16 +906,6 @@ static PyObject *py_triangulate(PyObject *self, PyObject *args) {
 done:
     PyBuffer_Release(&B0);
     PyBuffer_Release(&B1);
-    return ret;
-}
-
-/* call a kernel above with a new argument tuple (stolen); NULL with an exception set. For the
- * modules that include this file (_stereo.c, _stick_frame.c); inline: unused here. */
-static inline PyObject *call_kernel(PyObject *(*kernel)(PyObject *, PyObject *),
-                                    PyObject *args) {
-    if (!args) return NULL;
-    PyObject *ret = kernel(NULL, args);
-    Py_DECREF(args);
     return ret;
 }
 

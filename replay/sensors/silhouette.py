@@ -38,7 +38,6 @@ from replay.accel import accelerator
 from replay.sensors.raster import composite
 
 _pixels = accelerator("replay.sensors._pixels")
-_silhouette = accelerator("replay.sensors._silhouette")
 
 ELLIPSE_VERTICES = 48  # vertices of the polygon standing in for an ellipse
 _NEAR = 1e-6  # m: nearest depth drawn
@@ -261,31 +260,9 @@ def silhouette(
 
 def sphere_polygon(camera: PinholeCamera, centre, radius: float):
     """(polygon (N, 2), box) of a sphere's silhouette, or None if it reaches behind the camera:
-    :func:`sphere_ellipse` and :meth:`Ellipse.polygon_and_box` (the optional accelerator
-    ``_silhouette.sphere_polygon`` does both in one call, the same operations, equal to 1e-12 px:
-    test_fast_cameras.py)."""
-    if _silhouette is None:
-        e = sphere_ellipse(camera, centre, radius)
-        return None if e is None else e.polygon_and_box()
-    k = camera.intrinsics
-    poly = np.empty((ELLIPSE_VERTICES, 2))
-    box = _silhouette.sphere_polygon(
-        camera.rotation,
-        camera.position,
-        k.fx,
-        k.fy,
-        k.cx,
-        k.cy,
-        float(centre[0]),
-        float(centre[1]),
-        float(centre[2]),
-        float(radius),
-        _COS,
-        _SIN,
-        _AREA_SCALE,
-        poly,
-    )
-    return None if box is None else (poly, box)
+    :func:`sphere_ellipse` and :meth:`Ellipse.polygon_and_box`."""
+    e = sphere_ellipse(camera, centre, radius)
+    return None if e is None else e.polygon_and_box()
 
 
 def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float, tuple]]:

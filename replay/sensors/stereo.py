@@ -56,16 +56,9 @@ the image is exactly the background, below the threshold, and the blob's moments
 4 px around the blob), filled in only when the whole images are asked for (:attr:`last_images`);
 with pixel noise the whole images are rendered, every pixel drawn from the rng as before. The
 per-pixel work (ellipse polygon, exact-coverage compositing, quantising, segmentation and
-moments) and the triangulation are compiled kernels (``_pixels.c``) of the same algorithms the
-NumPy/OpenCV code used (kept as references in tests/replay/sensors/test_fast_cameras.py; equal
-to 1e-9 px there, positions of a recorded catch_optimised run equal to 2e-15 m): ~0.1 ms a
-pair noise-free instead of ~1 ms. Noise-free, a scene of spheres (the catch's) is measured in one
-compiled call (``_stereo.measure``: both cameras' windows, images and blobs and the
-triangulation with its bias correction, on C arrays; the same kernels, the blob's background
-median from a histogram, only the pixels a silhouette may change quantised), other scenes one
-call a camera and one for the triangulation; :meth:`StereoBallCamera.measure_reference` keeps
-the step-by-step path (equal to the bit, test_fast_cameras.py). A catch_optimised frame: ~100 k
-instructions (callgrind), ~157 k on the earlier step-by-step frames.
+moments) and the triangulation run in the optional accelerator (``_pixels.c``) where it is
+built, else as NumPy/OpenCV (the same algorithms, equal to 1e-9 px: tests/replay/sensors/
+test_fast_cameras.py): ~0.2 ms a noise-free pair compiled, ~2 ms in Python.
 """
 
 from __future__ import annotations
@@ -83,19 +76,11 @@ from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
 from replay.accel import accelerator
 from replay.sensors.raster import composite, quantise
-from replay.sensors.silhouette import (
-    _AREA_SCALE,
-    _COS,
-    _SIN,
-    correct_sphere_centroid,
-    drawables,
-    render_views,
-)
+from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
 
 import cv2  # (the blob's and the triangulation's pure-Python path: the OpenCV they replaced)
 
 _pixels = accelerator("replay.sensors._pixels")
-_stereo = accelerator("replay.sensors._stereo")
 
 _VIEWS = ("cam0", "cam1")  # the two cameras' image views (frame_images)
 
@@ -256,39 +241,6 @@ class StereoBallCamera(Sensor):
             255.0 * float(params.background),
         )
         self._centres = [(c.intrinsics.cx, c.intrinsics.cy) for c in self.cameras]
-        self._axes_c = np.array([x for axis in self._axes for v in axis for x in v], float)
-        self._centres_c = np.array([x for c in self._centres for x in c], float)
-        self._cams_c = np.array(
-            [
-                x
-                for c in self.cameras
-                for x in (
-                    *c.rotation.ravel().tolist(),
-                    *c.position.tolist(),
-                    c.intrinsics.fx,
-                    c.intrinsics.fy,
-                    c.intrinsics.cx,
-                    c.intrinsics.cy,
-                )
-            ],
-            float,
-        )
-        # noise-free with a background below the threshold: the compiled frame (_stereo.c)
-        self._compiled = params.noise_sigma == 0.0 and self._background_level <= params.threshold
-        grey, W, H = 255.0 * params.background, int(params.width), int(params.height)
-        self._frame_args = (grey, W, H, *self._blob_args)
-        self._measure_args = (  # _stereo.measure's after (prims, locate, radius), buffers as
-            self._cams_c.tobytes(),  # bytes (the cheapest to take a buffer of, per call)
-            _COS.tobytes(),
-            _SIN.tobytes(),
-            _AREA_SCALE,
-            *self._frame_args,
-            self._P[0].tobytes(),
-            self._P[1].tobytes(),
-            self._axes_c.tobytes(),
-            self._centres_c.tobytes(),
-        )
-        self._u8 = np.dtype(np.uint8)
         self._last: list = [None, None]
         self._found: tuple = (None, None)  # the blob kernels' tuples of the last frame
 
@@ -468,59 +420,8 @@ class StereoBallCamera(Sensor):
         return _triangulate(P0, P1, a, b, c, d)
 
     def measure(self, t: float, scene: Scene) -> VisionObject | None:
-        """The module doc's pipeline: noise-free, a scene of spheres in one compiled call (both
-        cameras' windows, images and blobs and the triangulation with its bias correction:
-        ``_stereo.measure``), other scenes each camera's frame in one (``_stereo.frame``) and the
-        triangulation in another (``_stereo.locate``): the kernels :meth:`measure_reference`
-        calls, in the same order; with pixel noise :meth:`measure_reference` itself."""
-        if not self._compiled:
-            return self.measure_reference(t, scene)
-        name, prims = self.params.tracked, scene.primitives
-        tracked = None
-        for q in prims:
-            if q.name == name:
-                tracked = q
-                break
-        radius = (  # for the bias correction: the tracked Sphere's, else 0 (none)
-            float(tracked.radius)
-            if self.params.bias_correction and isinstance(tracked, Sphere)
-            else 0.0
-        )
-        if _stereo is None:
-            return self.measure_reference(t, scene)
-        # a scene of spheres: both cameras' silhouettes drawn in C (None: not only spheres)
-        got = _stereo.measure(prims, Sphere, tracked is not None, radius, *self._measure_args)
-        if got is not None:
-            img0, win0, f0, img1, win1, f1, X = got
-        else:
-            (img0, win0, f0), (img1, win1, f1) = [
-                _stereo.frame(*self._drawn(camera, scene), *self._frame_args)
-                for camera in self.cameras
-            ]
-            X = None
-            if tracked is not None and f0 is not None and f1 is not None:
-                X = _stereo.locate(*self._P, *f0[:2], *f1[:2], radius, *self._measure_args[-2:])
-        u8 = self._u8
-        self._last = [
-            (np.ndarray((win0[3] - win0[1], win0[2] - win0[0]), u8, img0), win0),
-            (np.ndarray((win1[3] - win1[1], win1[2] - win1[0]), u8, img1), win1),
-        ]
-        self._found = (f0, f1)
-        if X is None:
-            return None
-        return VisionObject(
-            t, list(X), {"centroids": [[f0[0], f0[1]], [f1[0], f1[1]]], "areas": [f0[2], f1[2]]}
-        )
-
-    @staticmethod
-    def _drawn(camera: PinholeCamera, scene: Scene) -> tuple[list, list, list]:
-        """The polygons, grey levels and boxes of a scene's silhouettes in a camera, far first."""
-        drawn = drawables(camera, scene)
-        return [d[0] for d in drawn], [d[1] for d in drawn], [d[2] for d in drawn]
-
-    def measure_reference(self, t: float, scene: Scene) -> VisionObject | None:
-        """:meth:`measure` step by step, each kernel called from Python (the compiled
-        frame's reference, and the path with pixel noise)."""
+        """The module doc's pipeline: each camera's window, image and blob, then the
+        triangulation with its bias correction."""
         p = self.params
         noise = p.noise_sigma > 0.0
         grey = 255.0 * p.background

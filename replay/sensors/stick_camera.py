@@ -32,11 +32,11 @@ Cost: a frame renders only the window around the marker's silhouette (plus 8 px;
 the image is exactly the dark table, which never passes the threshold, and is filled in only
 when the whole image is asked for, :attr:`StickCamera.last_image`), draws only the primitives
 whose bounding sphere's image meets that window, and does the per-pixel work in compiled
-kernels (``_pixels.c``: outline projection and hull, exact-coverage compositing, 8-bit
-quantising, segmentation and moments in one pass) with the same algorithms the NumPy/OpenCV code used (kept as references in
-tests/replay/sensors/test_fast_cameras.py and test_raster.py): ~0.1 ms a frame of stick_3step
-instead of ~1.9 ms (tools/bench_cameras.py), measurements equal to 1e-14 m and a stick_3step
-run equal to what it was (the outlines' pixels are NumPy's to the bit: ``project_hull``).
+kernels where the optional accelerator is built (``_pixels.c``: outline projection and hull,
+exact-coverage compositing, 8-bit quantising, segmentation and moments in one pass; without
+it the same algorithms in NumPy/OpenCV, held together in tests/replay/sensors/
+test_fast_cameras.py and test_raster.py): ~0.2 ms a frame of stick_3step, ~1 ms in Python
+(docs/DESIGN.md, "Compiled code"), measurements equal to 1e-14 m either way.
 
 Accuracy (test_fast_cameras.py, noise-free, 200 random poses of the stick_3step geometry, 1.8 mm
 per pixel, no fingertips), the same before and after the kernels: bias (mean error) x -0.17,
@@ -72,7 +72,6 @@ from replay.sensors.raster import composite, quantise
 import cv2  # (the moments' pure-Python path: the OpenCV pipeline the accelerator replaced)
 
 _pixels = accelerator("replay.sensors._pixels")
-_stick_frame = accelerator("replay.sensors._stick_frame")
 
 _RIM = 48  # vertices of a polygon standing in for a circle
 
@@ -346,17 +345,6 @@ class StickCamera(Sensor):
         self.camera = self.make_camera(params)
         self._R = tuple(tuple(float(v) for v in row) for row in self.camera.rotation)
         self._o = tuple(float(v) for v in self.camera.position)
-        k = self.camera.intrinsics
-        self._frame_camera = (  # _stick_frame.measure's camera, made once
-            np.ascontiguousarray(self.camera.rotation, dtype=np.float64),
-            np.ascontiguousarray(self.camera.position, dtype=np.float64),
-            float(k.fx), float(k.fy), float(k.cx), float(k.cy),
-            int(params.width), int(params.height), float(params.background),
-            float(params.threshold), int(params.min_pixels), str(params.marker),
-            Box, Cylinder, self._o, math.dist,
-            float(params.position_offset[0]), float(params.position_offset[1]),
-        )  # fmt: skip
-        self._shapes: dict = {}  # _frame's (body points, bounding radius, hull buffer) by shape
         self._last = None
 
     # --- helpers usable without a sensor instance -------------------------------------------
@@ -467,54 +455,7 @@ class StickCamera(Sensor):
         ]
 
     def measure(self, t: float, scene: Scene) -> VisionStick | None:
-        """The marker's pose in a frame of ``scene``: noise-free frames in one compiled call
-        (:meth:`_frame`, the same pixels, moments and pose as :meth:`measure_reference`), the
-        rest (noise, a scene with spheres, no marker in view: the whole image) by the
-        reference."""
-        framed = (
-            self._frame(scene)
-            if self.params.noise_sigma == 0.0 and _stick_frame is not None
-            else None
-        )
-        if framed is None:
-            return self.measure_reference(t, scene)
-        img, window, pose = framed
-        self._last = (img, window)
-        return None if pose is None else VisionStick(t, *pose)
-
-    def _frame(self, scene: Scene):
-        """(image window, window, pose (x, y, theta) or None) of a noise-free frame in one
-        compiled call (``_stick_frame.measure``: the steps of :meth:`measure_reference`, its
-        kernels and :meth:`_pose`), or None when the reference path must do it."""
-        prims, shapes = scene.primitives, self._shapes
-        while True:
-            framed = _stick_frame.measure(prims, shapes, self._frame_camera)
-            if framed is None or framed[0] is not None:
-                break
-            _, i, key = framed  # a shape not seen yet: its outline points, once
-            shapes[key] = self._shape(prims[i])
-        if framed is None:
-            return None
-        data, window, _, pose = framed
-        img = np.frombuffer(data, np.uint8).reshape(window[3] - window[1], window[2] - window[0])
-        return img, window, pose
-
-    @staticmethod
-    def _shape(prim: Box | Cylinder) -> tuple[np.ndarray, float, np.ndarray]:
-        """(body outline points, bounding-sphere radius as :func:`_misses` takes it, a hull
-        buffer) of a box or cylinder, for :meth:`_frame`."""
-        body = _body_points(prim)
-        if isinstance(prim, Box):
-            sx, sy, sz = prim.size
-            rb = 0.5 * math.sqrt(sx * sx + sy * sy + sz * sz)
-        else:
-            rb = math.hypot(prim.radius, 0.5 * prim.length)
-        return body, rb, np.empty((len(body), 2))
-
-    def measure_reference(self, t: float, scene: Scene) -> VisionStick | None:
-        """:meth:`measure` in Python between the compiled kernels (the reference of
-        ``_stick_frame.frame``, tests/replay/sensors/test_stick_frame.py, and the path of frames
-        with noise)."""
+        """The marker's pose in a frame of ``scene`` (the module doc's pipeline)."""
         p = self.params
         cam = self.camera
         # Only a window around the marker is rendered (and given noise): the moments use
