@@ -40,9 +40,11 @@ def installed(tmp_path_factory):
         cwd=base,
     )
     wheel = next(dist.glob("paper_replay-*.whl"))
-    _sh([sys.executable, "-m", "venv", venv], cwd=base)
-    _sh([venv / "bin" / "python", "-m", "pip", "install", "-q", wheel], cwd=base)
+    # (no PYTHONPATH: a checkout on it, with the egg-info the wheel build leaves there, would
+    # make pip take the package as installed already)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    _sh([sys.executable, "-m", "venv", venv], cwd=base, env=env)
+    _sh([venv / "bin" / "python", "-m", "pip", "install", "-q", wheel], cwd=base, env=env)
     return venv / "bin" / "replay", work, env
 
 
