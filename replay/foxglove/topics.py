@@ -231,7 +231,7 @@ class FoxgloveTopics:
             )
         self.log.write_raw(channel, encode_string(urdf), t_ns)
 
-    def _wire(self, topic: str, cls: type[Message]) -> int:
+    def _proto_channel(self, topic: str, cls: type[Message]) -> int:
         """The channel of a topic of ``cls`` messages (made on first use)."""
         channel = self._channels.get(topic)
         if channel is None:
@@ -244,23 +244,23 @@ class FoxgloveTopics:
     def transforms(self, frames: Iterable[Frame], t_ns: int, bodies: Sequence = ()) -> None:
         """``frames``, after each of ``bodies`` (scene primitives) as a frame of its own name in
         ``world``."""
-        channel = self._channels.get(TOPIC_TF) or self._wire(TOPIC_TF, FrameTransforms)
+        channel = self._channels.get(TOPIC_TF) or self._proto_channel(TOPIC_TF, FrameTransforms)
         self.log.write_raw(channel, frame_transforms(frames, t_ns, bodies), t_ns)
 
     def scene(self, primitives: Sequence, t_ns: int) -> None:
         """The primitives as one entity each (id = name) at their world poses."""
-        channel = self._channels.get(TOPIC_SCENE) or self._wire(TOPIC_SCENE, SceneUpdate)
+        channel = self._channels.get(TOPIC_SCENE) or self._proto_channel(TOPIC_SCENE, SceneUpdate)
         self.log.write_raw(channel, scene_update(primitives, WORLD, t_ns), t_ns)
 
     def joint_states(self, names, position, velocity, effort, t_ns: int) -> None:
-        channel = self._channels.get(TOPIC_JOINT_STATES) or self._wire(
+        channel = self._channels.get(TOPIC_JOINT_STATES) or self._proto_channel(
             TOPIC_JOINT_STATES, JointStates
         )
         self.log.write_raw(channel, joint_states(names, position, velocity, effort, t_ns), t_ns)
 
     def event(self, kind: str, data: dict, text: str, t_ns: int) -> None:
         """One ``/events`` message as a log line: ``KIND {data as JSON}``."""
-        channel = self._channels.get(TOPIC_LOG) or self._wire(TOPIC_LOG, Log)
+        channel = self._channels.get(TOPIC_LOG) or self._proto_channel(TOPIC_LOG, Log)
         line = log_line(log_level(kind, data), f"{kind} {text}", "paper-replay", t_ns)
         self.log.write_raw(channel, line, t_ns)
 
@@ -275,6 +275,6 @@ class FoxgloveTopics:
         for view, image in frames:
             got = views.get(view)
             if got is None:
-                channel = self._wire(camera_topic(sensor, view), RawImage)
+                channel = self._proto_channel(camera_topic(sensor, view), RawImage)
                 got = views[view] = (channel, f"{sensor}/{view}")
             self.log.write_raw(got[0], raw_image(image, got[1], t_ns), t_ns)

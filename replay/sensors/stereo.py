@@ -303,8 +303,8 @@ class StereoBallCamera(Sensor):
         image border). Grey moments weigh the grey level above the local background (the median
         of the free pixels 3-4 px around the blob grown by 2 px, signed, so that zero-mean noise
         leaves the centroid unbiased) within the blob grown by 2 px (5 x 5). Computed in one
-        compiled pass (``_pixels.ball_blob``; the OpenCV pipeline it replaced is the reference
-        in tests/replay/sensors/test_stereo_vision.py)."""
+        pass by the optional accelerator (``_pixels.ball_blob``), else the OpenCV pipeline it
+        replaced (:func:`_ball_blob`)."""
         p = params if params is not None else StereoBallCameraParams()
         img = np.ascontiguousarray(image, dtype=np.uint8)
         h, w = img.shape
@@ -334,7 +334,7 @@ class StereoBallCamera(Sensor):
 
     def triangulate(self, uv0, uv1) -> np.ndarray:
         """World point (3,) from a pixel in each image: the linear (DLT) triangulation of
-        ``cv2.triangulatePoints`` (compiled: ``_pixels.triangulate``; NaN at infinity)."""
+        ``cv2.triangulatePoints`` (:func:`_triangulate`; NaN at infinity)."""
         X = _triangulate(
             self._P[0], self._P[1], float(uv0[0]), float(uv0[1]), float(uv1[0]), float(uv1[1])
         )

@@ -395,8 +395,8 @@ class StickCamera(Sensor):
         half a pixel along the axis): the level is the median of 9 pixels 2-4 px beyond each end
         of the blob along its long axis (so the stick must extend that far beyond the marker,
         ~5 mm at 1.25 mm/px), the brighter end winning (a dark fingertip may cover one end).
-        Computed in one compiled pass (``_pixels.marker_moments``; the OpenCV pipeline it
-        replaced is the reference in tests/replay/sensors/test_stick_camera.py)."""
+        Computed in one pass by the optional accelerator (``_pixels.marker_moments``), else by
+        the OpenCV pipeline it replaced (:func:`_moments_opencv`)."""
         found = StickCamera._moments(image, params, origin)
         if found is None:
             return None

@@ -5,7 +5,7 @@ array of photodetectors, each with its own processing element, read as a **binar
 Each frame: the camera's pose comes from the head's joint angles (``Scene.readings["head"]``,
 the plant's ``replay.robot.head.camera_pose``); the scene's silhouettes are rendered through that
 pinhole camera (:func:`replay.sensors.silhouette.render`: exact projected outlines, each pixel's
-exact coverage, compiled), Gaussian grey-level noise is
+exact coverage), Gaussian grey-level noise is
 added, and each pixel is thresholded into one bit. What happens to the bits (Self Windowing,
 moments) is the method's (``replay.control.grasping``): the chip's PEs run the paper's
 algorithm, so it is not part of this sensor.
