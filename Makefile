@@ -9,9 +9,10 @@ OUT    ?= out
 # the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md
 SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml scenarios/grasp_*.yaml)
 
-.PHONY: install run lint test bench ablations golden-check clean
+.PHONY: install run lint test test-pure bench ablations golden-check clean
 
-# (every C source and header of an extension module: a changed kernel is rebuilt by the next make)
+# (every C source and header of an optional accelerator: a changed kernel is rebuilt by the next
+# make; one that does not build is left out and its pure-Python path runs: setup.py)
 CSOURCES := $(wildcard replay/*.h replay/*/*.[ch] replay/*/*/*.[ch] plants/*/*.[ch])
 
 $(STAMP): pyproject.toml setup.py $(CSOURCES)
@@ -44,6 +45,11 @@ lint: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q
+
+# the same suite on the pure-Python paths (replay.accel: the accelerators built but not used),
+# what an install without a C compiler runs
+test-pure: $(STAMP)
+	REPLAY_NO_ACCEL=1 $(PY) -m pytest -q
 
 bench: $(STAMP)
 	$(PY) -m replay.bench

@@ -1,15 +1,47 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
-the hot paths are small C extensions, one ``_name.c`` beside the Python module it speeds (plain C
-over the buffer protocol, no NumPy headers, each with a ``.pyi`` stub and a test holding it to its
-Python reference): the list is ``ext_modules`` below."""
+a few hot paths have optional C accelerators, one ``_name.c`` beside the Python module it speeds
+(plain C over the buffer protocol, no NumPy headers, a ``.pyi`` stub, a test holding it to the
+Python path): ``ext_modules`` below. Each is optional: where it does not build (no C compiler,
+``CC=/bin/false``, a compiler that rejects it) the install goes on without it and the pure-Python
+path runs (replay.accel); docs/DESIGN.md, "Compiled code", says what each one gains."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
+import os
+import sys
+
+from setuptools.command.build_ext import build_ext
+
 # -fexcess-precision=standard and -ffp-contract=off: every double operation rounds once, as in
 # Python and NumPy (no fused multiply-adds where a CPU has them: the kernels' tests compare with
-# their Python references to the bit)
-FLAGS = ["-O2", "-fexcess-precision=standard", "-ffp-contract=off"]
+# their Python references to the bit). GCC's options: other compilers get their own below.
+GCC_FLAGS = ["-O2", "-fexcess-precision=standard", "-ffp-contract=off"]
+CLANG_FLAGS = ["-O2", "-ffp-contract=off"]  # (clang has no excess precision on x86-64 SSE)
+MSVC_FLAGS = ["/O2", "/fp:precise"]
+
+
+class OptionalBuildExt(build_ext):
+    """Each extension with its compiler's flags; one that fails to build is left out (its
+    pure-Python path runs), said once on stderr."""
+
+    def build_extension(self, ext):
+        kind = self.compiler.compiler_type
+        cc = " ".join(getattr(self.compiler, "compiler_so", None) or [os.environ.get("CC", "")])
+        if kind == "msvc":
+            ext.extra_compile_args = MSVC_FLAGS
+        elif "clang" in cc:
+            ext.extra_compile_args = CLANG_FLAGS
+        else:
+            ext.extra_compile_args = GCC_FLAGS
+        try:
+            super().build_extension(ext)
+        except Exception as exc:  # (CompileError, LinkError, a missing compiler)
+            print(
+                f"paper-replay: optional accelerator {ext.name} not built ({exc}); "
+                "its pure-Python path will run",
+                file=sys.stderr,
+            )
 
 
 # headers every module may include (replay/ is on the include path): floats between Python
@@ -24,7 +56,7 @@ def _ext(module: str, depends: tuple[str, ...] = ()) -> Extension:
         [module.replace(".", "/") + ".c"],
         depends=[*depends, *SHARED],
         include_dirs=["replay"],
-        extra_compile_args=FLAGS,
+        optional=True,
     )
 
 
@@ -35,37 +67,15 @@ SHIPPED = {
 }
 
 setup(
+    cmdclass={"build_ext": OptionalBuildExt},
     packages=find_namespace_packages(include=["replay*", "plants*", "analysis*"]) + list(SHIPPED),
     package_dir=SHIPPED,
     ext_modules=[
-        _ext("replay.sensors._pixels", ("replay/sensors/_ellipse.h",)),
-        # includes _pixels.c's kernels, unchanged, and _silhouette.c's sphere outline
-        _ext(
-            "replay.sensors._stereo",
-            (
-                "replay/sensors/_pixels.c",
-                "replay/sensors/_silhouette.c",
-                "replay/sensors/_ellipse.h",
-            ),
-        ),
-        _ext("replay.sensors._silhouette", ("replay/sensors/_ellipse.h",)),
-        # includes _pixels.c's kernels, unchanged
-        _ext(
-            "replay.sensors._stick_frame",
-            ("replay/sensors/_pixels.c", "replay/sensors/_ellipse.h"),
-        ),
+        _ext("replay.sensors._pixels"),
+        _ext("replay.control.stick._sweep"),
         _ext("replay.control.catching._mapping"),
         _ext("replay.control.catching._ballistic"),
         _ext("replay.control.catching._torque"),
-        _ext("replay.robot._chain"),
-        _ext("plants.airtable._bodies"),
-        _ext("replay.control.stick._sweep"),
-        _ext("replay.control.stick._contacts"),
-        _ext("replay.control.stick._fit"),
-        _ext("replay.foxglove._png"),
-        _ext("replay.foxglove._wire"),
-        _ext("replay.log._chunk"),
-        _ext("replay.log._finite"),
         _ext("replay.control.grasping._arm_kinematics"),
         _ext("replay.control.grasping._chip_target"),
         _ext("replay.control.grasping._hand_servo"),

@@ -2,9 +2,8 @@
 
 Each axis (base x, base y, each joint) moves toward its target by at most ``speed * dt`` per step,
 independently (paper Sec. IV-A: 1.0 m/s per slider axis, 14.0 rad/s per joint). Targets outside
-the workspace or the joint ranges are clamped. The plant's compiled step advances the servo
-(``_bodies.step_hand``); :meth:`HandServo.advance` and :meth:`HandServo.tip_list` are its
-reference.
+the workspace or the joint ranges are clamped. The plant's step advances the servo
+(:meth:`HandServo.advance`) and aims the tips at :meth:`HandServo.tip_list`.
 """
 
 from __future__ import annotations
@@ -30,7 +29,7 @@ def _toward(current: list, target: list, max_delta: float) -> bool:
     return done
 
 
-# HandServo.state: its layout (plants/airtable/_bodies.c step_hand reads and writes it)
+# HandServo.state: its layout
 BASE, JOINTS, BASE_TARGET, JOINT_TARGETS = slice(0, 2), slice(2, 6), slice(6, 8), slice(8, 12)
 SETTLED, TIPS, TIPS_VALID = 12, slice(13, 17), 17
 ROOTS, LINKS, BASE_SPEED, JOINT_SPEED, STATE_SIZE = slice(18, 22), slice(22, 24), 24, 25, 26
@@ -40,10 +39,8 @@ class HandServo:
     """Base position and joint angles of the two fingers, and their (clamped) targets.
 
     The state is one float64 array (``state``, the layout above: base, joints, their targets,
-    whether on them, the tips' cache and the spec's kinematics and speeds), so that the plant's
-    compiled step (``_bodies.step_hand``) advances the servo as :meth:`advance` and
-    :meth:`tip_list` do here, its reference (tests/plants/airtable/test_bodies_kernel.py);
-    ``base``, ``joints``, ``base_target`` and ``joint_targets`` give it as arrays."""
+    whether on them, the tips' cache and the spec's kinematics and speeds); ``base``,
+    ``joints``, ``base_target`` and ``joint_targets`` give it as arrays."""
 
     def __init__(self, spec: HandSpec, base, joints) -> None:
         self.spec = spec

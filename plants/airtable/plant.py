@@ -43,7 +43,6 @@ from replay.spatial import yaw_quaternion
 
 from plants.airtable import body_state, settings
 from plants.airtable.hand import HandServo
-from plants.airtable.lean_space import LeanSpace
 from plants.airtable.params import Params
 
 STICK_TYPE = 1
@@ -77,7 +76,7 @@ class AirTablePlant(Plant):
         self._hand_spec = settings.hand_spec(p)
         self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
 
-        space = LeanSpace()
+        space = pymunk.Space()
         space.gravity = (0.0, 0.0)
         space.damping = 1.0  # no velocity damping
         space.iterations = int(p.solver.iterations)
@@ -133,11 +132,9 @@ class AirTablePlant(Plant):
         self._nan_reported = False
         self._collisions = 0
         self._held_since: float | None = None  # the stick held between the tips since
-        self._io = body_state.TableIO(self.stick_body, self.tip_bodies, space)
+        self._io = body_state.TableIO(self.stick_body, self.tip_bodies)
         self._rest_speed, self._rest_omega = p.rest_speed, p.rest_omega
         self._hold_speed, self._hold_omega = p.hold_speed, p.hold_omega
-        self._limits = tuple(map(float, (p.rest_speed, p.rest_omega, p.hold_speed, p.hold_omega)))
-        self._lean_step = self._io.lean_stepper(self.hand, self.dt, self._limits)
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
         # scene(): the boxes' centre heights and sizes, and the fingertips' last primitives
@@ -168,18 +165,11 @@ class AirTablePlant(Plant):
             self._events.append(Occurrence("limit", clamped))
 
     def step(self) -> None:
-        io, space = self._io, self.space
+        io = self._io
         # Hand: rate-limited servo, then tip velocities that integrate onto the kinematics, the
-        # engine's step and the state after it (one compiled call: TableIO.step_hand)
-        # (a collision's velocity before is read in _on_begin, during the engine's step). The
-        # engine is called from C when LeanSpace.step would only call it (no body added since
-        # the last step: the collision callback adds nothing, LeanSpace's contract) and nothing
-        # wraps space.step (a timer: replay.bench)
-        lean = self._lean_step
-        if lean is not None and not space._bodies_to_check and "step" not in space.__dict__:
-            usual = lean()  # io.step_hand(self.hand, self.dt, None, self._limits)
-        else:
-            usual = io.step_hand(self.hand, self.dt, space.step, self._limits)
+        # engine's step and the state after it (TableIO.step_hand) (a collision's velocity
+        # before is read in _on_begin, during the engine's step)
+        io.step_hand(self.hand, self.dt, self.space.step)
         self._steps += 1
         if self._pending:
             _, _, vx, vy, _, omega = io.state[:6]
@@ -188,13 +178,6 @@ class AirTablePlant(Plant):
                 self._events.append(Occurrence("collision", c))
             self._collisions += len(self._pending)
             self._pending = []
-        if usual:  # certainly finite and too fast to rest or be held (TableIO.step)
-            self._rest_since = None
-            self._rest_reported = False  # moving: a later rest is a new event
-            if not self._reached:
-                self._reached = self._in_reach()
-            self._held_since = None
-            return
         # the checks' usual case in line (a finite stick moving too fast to rest or be held);
         # anything else is _check_state's and _check_held's
         x, y, vx, vy, angle, omega, t0x, t0y, t1x, t1y = io.state

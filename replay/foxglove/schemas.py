@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import struct
 
-from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
 from foxglove_schemas_protobuf.Log_pb2 import Log
+from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from google.protobuf import json_format
 from google.protobuf.descriptor_pb2 import FileDescriptorSet
@@ -29,7 +29,7 @@ _CDR_HEADER = b"\x00\x01\x00\x00"  # CDR_LE, no options
 # the classes our logs use, by schema name
 CLASSES: dict[str, type[Message]] = {
     cls.DESCRIPTOR.full_name: cls
-    for cls in (FrameTransforms, SceneUpdate, JointStates, Log, CompressedImage)
+    for cls in (FrameTransforms, SceneUpdate, JointStates, Log, RawImage)
 }
 
 

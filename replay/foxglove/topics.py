@@ -10,26 +10,39 @@
   (CDR): the one schema Foxglove's URDF layer reads from a topic, and the one Rerun's MCAP
   importer turns into the robot's geometry;
 - ``/log`` (``foxglove.Log``): each ``/events`` message as a log line;
-- ``/camera/SENSOR/VIEW`` (``foxglove.CompressedImage``, PNG): each camera frame.
+- ``/camera/SENSOR/VIEW`` (``foxglove.RawImage``, mono8: :mod:`replay.foxglove.image`): each
+  camera frame.
 
-Every message is stamped with simulated time (header ``timestamp`` = log time) and serialised
-deterministically, so the same run gives the same bytes.
+Every message is built with the ``foxglove_schemas_protobuf`` classes, stamped with simulated
+time (header ``timestamp`` = log time) and serialised deterministically, so the same run gives
+the same bytes.
 """
 
 from __future__ import annotations
 
+import functools
 from typing import Iterable, Sequence
 
 import numpy as np
-from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage
+from foxglove_schemas_protobuf.Color_pb2 import Color
+from foxglove_schemas_protobuf.CubePrimitive_pb2 import CubePrimitive
+from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
+from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
+from foxglove_schemas_protobuf.JointState_pb2 import JointState
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
 from foxglove_schemas_protobuf.Log_pb2 import Log
+from foxglove_schemas_protobuf.Pose_pb2 import Pose
+from foxglove_schemas_protobuf.Quaternion_pb2 import Quaternion
+from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
+from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
+from foxglove_schemas_protobuf.SpherePrimitive_pb2 import SpherePrimitive
+from foxglove_schemas_protobuf.Vector3_pb2 import Vector3
 from google.protobuf.message import Message
+from google.protobuf.timestamp_pb2 import Timestamp
 
-from replay.foxglove import wire
-from replay.foxglove.png import WindowedImage, png_messages
+from replay.foxglove.image import WindowedImage, raw_image
 from replay.foxglove.schemas import (
     MESSAGE_ENCODING,
     SCHEMA_ENCODING,
@@ -44,7 +57,7 @@ from replay.messages import (
     TOPIC_SCENE,
     TOPIC_TF,
 )
-from replay.scene import Frame
+from replay.scene import Box, Cylinder, Frame, Sphere
 
 WORLD = "world"  # the fixed frame every pose hangs from
 
@@ -84,6 +97,113 @@ def log_level(kind: str, data: dict) -> Log.Level.ValueType:
     return Log.INFO
 
 
+def timestamp(t_ns: int) -> Timestamp:
+    sec, nsec = divmod(t_ns, 1_000_000_000)
+    return Timestamp(seconds=sec, nanos=nsec)
+
+
+def _transform(ts: Timestamp, parent: str, child: str, position, orientation) -> FrameTransform:
+    (x, y, z), (qx, qy, qz, qw) = position, orientation
+    return FrameTransform(
+        timestamp=ts,
+        parent_frame_id=parent,
+        child_frame_id=child,
+        translation=Vector3(x=x, y=y, z=z),
+        rotation=Quaternion(x=qx, y=qy, z=qz, w=qw),
+    )
+
+
+_IDENTITY = (0.0, 0.0, 0.0, 1.0)
+
+
+def frame_transforms(
+    frames: Iterable[Frame], t_ns: int, bodies: Iterable = (), parent: str = WORLD
+) -> bytes:
+    """``foxglove.FrameTransforms``: each of ``bodies`` (scene primitives) as a frame of its own
+    name in ``parent`` (a sphere unrotated), then each frame's pose in its parent, at ``t_ns``."""
+    ts = timestamp(t_ns)
+    out = [
+        _transform(
+            ts, parent, p.name, p.position, _IDENTITY if isinstance(p, Sphere) else p.orientation
+        )
+        for p in bodies
+    ]
+    out += [_transform(ts, f.parent, f.child, f.position, f.orientation) for f in frames]
+    return FrameTransforms(transforms=out).SerializeToString()
+
+
+def _grey(albedo: float) -> float:
+    """The albedo as a grey, lifted so that a black body still shows on a dark background."""
+    return 0.25 + 0.75 * min(max(float(albedo), 0.0), 1.0)
+
+
+@functools.lru_cache(maxsize=4096)
+def _color(albedo: float) -> Color:
+    v = _grey(albedo)
+    return Color(r=v, g=v, b=v, a=1.0)
+
+
+def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
+    """``foxglove.SceneUpdate``: each box, sphere and cylinder as one entity (id = its name) of
+    one primitive at its pose in ``frame_id``, grey by albedo (others are left out); a
+    cylinder's axis is its body z."""
+    ts = timestamp(t_ns)
+    entities = []
+    for p in primitives:
+        if not isinstance(p, (Sphere, Box, Cylinder)):
+            continue
+        entity = SceneEntity(timestamp=ts, frame_id=frame_id, id=p.name)
+        (x, y, z) = p.position
+        position = Vector3(x=x, y=y, z=z)
+        color = _color(p.albedo)
+        if isinstance(p, Sphere):
+            d = 2.0 * p.radius
+            entity.spheres.append(
+                SpherePrimitive(
+                    pose=Pose(position=position, orientation=Quaternion(w=1.0)),
+                    size=Vector3(x=d, y=d, z=d),
+                    color=color,
+                )
+            )
+        else:
+            qx, qy, qz, qw = p.orientation
+            pose = Pose(position=position, orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))
+            if isinstance(p, Box):
+                sx, sy, sz = p.size
+                entity.cubes.append(
+                    CubePrimitive(pose=pose, size=Vector3(x=sx, y=sy, z=sz), color=color)
+                )
+            else:
+                d = 2.0 * p.radius
+                entity.cylinders.append(
+                    CylinderPrimitive(
+                        pose=pose,
+                        size=Vector3(x=d, y=d, z=p.length),
+                        bottom_scale=1.0,
+                        top_scale=1.0,
+                        color=color,
+                    )
+                )
+        entities.append(entity)
+    return SceneUpdate(entities=entities).SerializeToString()
+
+
+def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
+    """``foxglove.JointStates``: each joint's name, position, velocity and effort."""
+    joints = [
+        JointState(name=n, position=q, velocity=v, effort=e)
+        for n, q, v, e in zip(names, position, velocity, effort)
+    ]
+    return JointStates(timestamp=timestamp(t_ns), joints=joints).SerializeToString()
+
+
+def log_line(level: Log.Level.ValueType, message: str, name: str, t_ns: int) -> bytes:
+    """``foxglove.Log``: a line of ``level`` from ``name``."""
+    return Log(
+        timestamp=timestamp(t_ns), level=level, message=message, name=name
+    ).SerializeToString()
+
+
 class FoxgloveTopics:
     """The Foxglove topics of one log: ``FoxgloveTopics(log_writer)``, then one call a message."""
 
@@ -91,9 +211,9 @@ class FoxgloveTopics:
         self.log = log  # a replay.log.LogWriter
         self._channels: dict[str, int] = {}  # topic -> channel id
         self._schemas: dict[str, int] = {}  # schema name -> id (each stored once)
-        # sensor -> view -> (channel id, the image messages' fields after the PNG)
-        self._images: dict[str, dict[str, tuple[int, bytes]]] = {}
-        self._record = log.raw_message  # the log's compiled record writer
+        self._images: dict[
+            str, dict[str, tuple[int, str]]
+        ] = {}  # sensor -> view -> (channel id, frame id)
 
     def _channel(self, topic: str, schema: str, encoding: str, data: bytes, message: str) -> int:
         if schema not in self._schemas:
@@ -111,7 +231,7 @@ class FoxgloveTopics:
             )
         self.log.write_raw(channel, encode_string(urdf), t_ns)
 
-    def _wire(self, topic: str, cls: type[Message]) -> int:
+    def _proto_channel(self, topic: str, cls: type[Message]) -> int:
         """The channel of a topic of ``cls`` messages (made on first use)."""
         channel = self._channels.get(topic)
         if channel is None:
@@ -121,56 +241,40 @@ class FoxgloveTopics:
             )
         return channel
 
-    # The messages at the frame and camera rates are written straight in the wire format
-    # (replay.foxglove.wire: ~5x cheaper than filling the protobuf classes, same messages).
     def transforms(self, frames: Iterable[Frame], t_ns: int, bodies: Sequence = ()) -> None:
         """``frames``, after each of ``bodies`` (scene primitives) as a frame of its own name in
         ``world``."""
-        channel = self._channels.get(TOPIC_TF) or self._wire(TOPIC_TF, FrameTransforms)
-        data = wire.body_transforms(bodies, WORLD, t_ns) + wire.frame_transforms(frames, t_ns)
-        self.log.write_raw(channel, data, t_ns)
+        channel = self._channels.get(TOPIC_TF) or self._proto_channel(TOPIC_TF, FrameTransforms)
+        self.log.write_raw(channel, frame_transforms(frames, t_ns, bodies), t_ns)
 
     def scene(self, primitives: Sequence, t_ns: int) -> None:
         """The primitives as one entity each (id = name) at their world poses."""
-        channel = self._channels.get(TOPIC_SCENE) or self._wire(TOPIC_SCENE, SceneUpdate)
-        self.log.write_raw(channel, wire.scene_update(primitives, WORLD, t_ns), t_ns)
+        channel = self._channels.get(TOPIC_SCENE) or self._proto_channel(TOPIC_SCENE, SceneUpdate)
+        self.log.write_raw(channel, scene_update(primitives, WORLD, t_ns), t_ns)
 
     def joint_states(self, names, position, velocity, effort, t_ns: int) -> None:
-        channel = self._channels.get(TOPIC_JOINT_STATES) or self._wire(
+        channel = self._channels.get(TOPIC_JOINT_STATES) or self._proto_channel(
             TOPIC_JOINT_STATES, JointStates
         )
-        self.log.write_raw(
-            channel, wire.joint_states(names, position, velocity, effort, t_ns), t_ns
-        )
+        self.log.write_raw(channel, joint_states(names, position, velocity, effort, t_ns), t_ns)
 
     def event(self, kind: str, data: dict, text: str, t_ns: int) -> None:
         """One ``/events`` message as a log line: ``KIND {data as JSON}``."""
-        channel = self._channels.get(TOPIC_LOG) or self._wire(TOPIC_LOG, Log)
-        self.log.write_raw(
-            channel,
-            wire.log_line(int(log_level(kind, data)), f"{kind} {text}", "paper-replay", t_ns),
-            t_ns,
-        )
+        channel = self._channels.get(TOPIC_LOG) or self._proto_channel(TOPIC_LOG, Log)
+        line = log_line(log_level(kind, data), f"{kind} {text}", "paper-replay", t_ns)
+        self.log.write_raw(channel, line, t_ns)
 
     def images(
         self, sensor: str, frames: Sequence[tuple[str, np.ndarray | WindowedImage]], t_ns: int
     ) -> None:
-        """A sensor's frame: each (view, image) on its ``/camera/SENSOR/VIEW`` topic, one
-        timestamp for all, in one compiled call (``_png.messages``: each image's PNG message
-        to the log's record writer) but for a view's first image, which makes its channel."""
+        """A sensor's frame: each (view, image) as a ``foxglove.RawImage`` on its
+        ``/camera/SENSOR/VIEW`` topic (frame ``SENSOR/VIEW``), one timestamp for all."""
         views = self._images.get(sensor)
         if views is None:
             views = self._images[sensor] = {}
-        if not isinstance(frames, (list, tuple)):
-            frames = list(frames)
-        ts, start = wire.timestamp(t_ns), 0
-        while True:
-            try:
-                start = png_messages(self._record, views, frames, start, ts, t_ns)
-            except OSError as exc:
-                raise self.log.write_error(exc) from None
-            if start < 0:
-                return
-            view = frames[start][0]
-            channel = self._wire(camera_topic(sensor, view), CompressedImage)
-            views[view] = (channel, wire.image_tail(f"{sensor}/{view}", "png"))
+        for view, image in frames:
+            got = views.get(view)
+            if got is None:
+                channel = self._proto_channel(camera_topic(sensor, view), RawImage)
+                got = views[view] = (channel, f"{sensor}/{view}")
+            self.log.write_raw(got[0], raw_image(image, got[1], t_ns), t_ns)

@@ -2,10 +2,10 @@
 
 The messages of a short run of each scenario are kept (deep copies, as the observers saw them),
 then written again and again, CPU time (``time.process_time``), best of ``--repeat``: the JSON
-encoding alone; the MCAP records of the encoded bytes through our chunk builder
-(``replay.log.chunks``) and, for reference, through the ``mcap`` library's ``Writer`` (same zstd
-chunks); and the whole ``LogWriter.write`` as the runner calls it (a log's opening and closing,
-once a run, apart). Nothing here is a test.
+encoding alone; the MCAP records of the encoded bytes through the ``mcap`` library's ``Writer``
+as the log configures it (``replay.log.chunks``: zstd chunks); and the whole ``LogWriter.write``
+as the runner calls it (a log's opening and closing, once a run, apart). Nothing here is a
+test.
 """
 
 from __future__ import annotations
@@ -17,10 +17,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from mcap.writer import CompressionType, Writer
-
-from replay.log.chunks import McapFile
-from replay.log.writer import ZSTD_LEVEL, LogWriter, encode
+from replay.log.chunks import mcap_writer
+from replay.log.writer import LogWriter, encode
 from replay.resources import scenario_dir
 
 DEFAULT = ["stick_3step", "catch_optimised", "grasp_hexahedron"]
@@ -60,19 +58,8 @@ def costs(messages: list[tuple[str, object, int]], repeat: int = 5) -> dict[str,
         for topic, p, _ in messages:
             encode(topic, p)
 
-    def ours() -> None:
-        f = McapFile(io.BytesIO(), chunk_size=CHUNK, level=ZSTD_LEVEL)
-        f.start()
-        channels: dict[str, int] = {}
-        for topic, data, t in encoded:
-            c = channels.get(topic)
-            if c is None:
-                c = channels[topic] = f.channel(topic, "json", f.schema(topic, "jsonschema", b"{}"))
-            f.message(c, t, t, data)
-        f.finish()
-
-    def library() -> None:
-        w = Writer(io.BytesIO(), chunk_size=CHUNK, compression=CompressionType.ZSTD)
+    def records() -> None:
+        w = mcap_writer(io.BytesIO(), chunk_size=CHUNK)
         w.start()
         channels: dict[str, int] = {}
         sequence: dict[str, int] = {}
@@ -104,8 +91,7 @@ def costs(messages: list[tuple[str, object, int]], repeat: int = 5) -> dict[str,
             name: _best(fn, repeat) / n
             for name, fn in (
                 ("encode", encoding),
-                ("records", ours),
-                ("records_mcap_library", library),
+                ("records", records),
                 ("write", whole),
             )
         }
@@ -127,8 +113,8 @@ def main(argv=None) -> None:
         print(
             f"log messages of {scenario} ({len(messages)} in {args.duration:g} s, {size:.0f} B "
             f"of JSON each), CPU us a message: LogWriter.write {1e6 * c['write']:.2f} = JSON "
-            f"{1e6 * c['encode']:.2f} + MCAP records and zstd {1e6 * c['records']:.2f} (the mcap "
-            f"library's Writer, zstd level 3: {1e6 * c['records_mcap_library']:.2f}) + the rest; "
+            f"{1e6 * c['encode']:.2f} + MCAP records and zstd (the mcap library's Writer) "
+            f"{1e6 * c['records']:.2f} + the rest; "
             f"opening and closing a log: {1e3 * c['open_close']:.1f} ms",
             flush=True,
         )

@@ -1,5 +1,5 @@
-"""A serial chain of revolute joints in standard (Spong) Denavit–Hartenberg form. NumPy, with one
-configuration's point and RNEA compiled (``_chain.c``; the Python float forms are the reference).
+"""A serial chain of revolute joints in standard (Spong) Denavit–Hartenberg form: NumPy for many
+configurations, Python floats for one (its point and RNEA: cheaper than NumPy on 3-vectors).
 
 Conventions (Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control*, Sec. 3.2):
 
@@ -21,8 +21,6 @@ from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
-
-from replay.robot import _chain
 
 
 def dh_transform(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
@@ -131,11 +129,6 @@ class SerialChain:
             tuple(B[:3, 2].tolist()),
             tuple(B[:3, 3].tolist()),
         )
-        # the same rows and base as flat float64 buffers for the compiled path (_chain.c)
-        self._rows_c = np.array(
-            [[*r[:6], *r[6], *(x for row in r[7] for x in row)] for r in self._rows_f], float
-        ).ravel()
-        self._base_c = np.array([x for axis in self._base_f for x in axis], float)
         self._g_f = tuple(float(x) for x in self.gravity)
 
     # ------------------------------------------------------------------ variants
@@ -152,6 +145,13 @@ class SerialChain:
         )
 
     # ------------------------------------------------------------------ kinematics
+    def _floats(self, q) -> list[float]:
+        """n joint values (a list, tuple or array) as a list of Python floats."""
+        out = q.tolist() if isinstance(q, np.ndarray) else [float(x) for x in q]
+        if len(out) != self.n or (out and isinstance(out[0], list)):
+            out = self._q(q).tolist()  # (the shape check and its message)
+        return out
+
     def _q(self, q) -> np.ndarray:
         q = np.asarray(q, dtype=float).reshape(-1)
         if q.shape[0] != self.n:
@@ -170,8 +170,8 @@ class SerialChain:
         """Frames 0..n as (X, Y, Z, o): the world axes and origin of each, 3-tuples of floats.
 
         The same products as :meth:`frames` (T_i = T_{i-1} Rz(q_i + offset) Tz(d) Tx(a) Rx(alpha),
-        Spong Sec. 3.2) written per column, for one configuration: the reference of the
-        compiled frames in ``_chain.c`` (:meth:`point`, :meth:`rnea`)."""
+        Spong Sec. 3.2) written per column, for one configuration (:meth:`point`,
+        :meth:`rnea`)."""
         key = tuple(q)
         (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._base_f
         out = [self._base_f]
@@ -196,26 +196,18 @@ class SerialChain:
 
     def point(self, q, point_in_last=(0.0, 0.0, 0.0)) -> np.ndarray:
         """World position of a point given in the last DH frame (for a tool point: ``tool`` @
-        the point), one configuration: compiled (``_chain.point``), :meth:`point_floats`'s
-        operations in the same order."""
+        the point), one configuration."""
         return np.array(self.point_tuple(q, point_in_last))
 
     def point_tuple(self, q, point_in_last=(0.0, 0.0, 0.0)) -> tuple[float, float, float]:
-        """:meth:`point` as a 3-tuple of floats (q: n floats, a list, tuple or array)."""
-        return _chain.point(self._rows_c, self._base_c, q, point_in_last)
-
-    def point_floats(self, q, point_in_last=(0.0, 0.0, 0.0)) -> np.ndarray:
-        """:meth:`point` in Python floats on :meth:`_frames_f` (the compiled one's reference)."""
-        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._frames_f(
-            self._q(q).tolist()
-        )[-1]
+        """:meth:`point` as a 3-tuple of floats (q: n floats, a list, tuple or array), on the
+        frames of :meth:`_frames_f`."""
+        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._frames_f(self._floats(q))[-1]
         u, v, w = point_in_last
-        return np.array(
-            [
-                px + u * xx + v * yx + w * zx,
-                py + u * xy + v * yy + w * zy,
-                pz + u * xz + v * yz + w * zz,
-            ]
+        return (
+            px + u * xx + v * yx + w * zx,
+            py + u * xy + v * yy + w * zy,
+            pz + u * xz + v * yz + w * zz,
         )
 
     def fk(self, q) -> np.ndarray:
@@ -262,17 +254,12 @@ class SerialChain:
 
     # ------------------------------------------------------------------ dynamics
     def rnea(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> np.ndarray:
-        """Inverse dynamics tau = M qdd + H qd + g (n,): :meth:`rnea_floats` compiled
-        (``_chain.rnea``, the same operations in the same order)."""
+        """Inverse dynamics tau = M qdd + H qd + g (n,): :meth:`rnea_tuple` as an array."""
         return np.array(self.rnea_tuple(q, qd, qdd, gravity))
 
     def rnea_tuple(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> tuple:
-        """:meth:`rnea` as a tuple of n floats (q, qd, qdd: n floats each, lists or arrays)."""
-        g = self._g_f if gravity is None else tuple(float(x) for x in gravity)
-        return _chain.rnea(self._rows_c, self._base_c, q, qd, qdd, g)
-
-    def rnea_floats(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> np.ndarray:
-        """Inverse dynamics tau = M qdd + H qd + g: recursive Newton–Euler in world coordinates.
+        """Inverse dynamics tau = M qdd + H qd + g as a tuple of n floats (q, qd, qdd: n floats
+        each, lists or arrays): recursive Newton–Euler in world coordinates.
 
         Forward pass: angular velocity/acceleration of link i and linear acceleration of o_{i-1}
         (on joint i's axis, fixed in links i-1 and i); gravity enters as a base acceleration -g.
@@ -281,14 +268,13 @@ class SerialChain:
         as R I R^T v without forming R I R^T); :meth:`rnea_batch` is the same recursion in NumPy
         over many states, and the tests hold the two together.
         """
-        q, qd, qdd = self._q(q), self._q(qd), self._q(qdd)
-        g = self.gravity if gravity is None else np.asarray(gravity, dtype=float)
-        F = self._frames_f(q.tolist())
-        gx, gy, gz = g.tolist()
+        qf, qdf, qddf = self._floats(q), self._floats(qd), self._floats(qdd)
+        gx, gy, gz = self._g_f if gravity is None else (float(x) for x in gravity)
+        F = self._frames_f(qf)
         wx = wy = wz = dwx = dwy = dwz = 0.0
         ax, ay, az = -gx, -gy, -gz  # acceleration of o_{i-1}
         fwd = []
-        for i, (qdi, qddi) in enumerate(zip(qd.tolist(), qdd.tolist())):
+        for i, (qdi, qddi) in enumerate(zip(qdf, qddf)):
             (zx, zy, zz), (ox, oy, oz) = F[i][2], F[i][3]
             X, Y, Z, (o1x, o1y, o1z) = F[i + 1]
             row = self._rows_f[i]
@@ -356,7 +342,7 @@ class SerialChain:
             )
             fx, fy, fz = max_ + fx, may + fy, maz + fz
             tau[i] = zx * nx + zy * ny + zz * nz
-        return np.array(tau)
+        return tuple(tau)
 
     def _link_jacobians(self, q):
         """Per link i: COM Jacobian Jv (n, n, 3), angular Jw (n, n, 3), world inertia (n, 3, 3)."""

@@ -1,5 +1,7 @@
-/* Per-pixel kernels of the cameras (replay/sensors/pixels.py documents them; that module is the
- * only caller). Plain C over the buffer protocol: no NumPy headers, no start-up cost.
+/* Per-pixel kernels of the cameras: the optional accelerator of replay/sensors/raster.py,
+ * silhouette.py, stick_camera.py and stereo.py (their Python paths are the algorithms, which
+ * these repeat and the tests hold them to; replay.accel loads this module where it is built).
+ * Plain C over the buffer protocol: no NumPy headers, no start-up cost.
  *
  * Image conventions (replay/sensors/pinhole.py): integer pixel coordinates are pixel centres,
  * pixel (i, j) spans [i - 0.5, i + 0.5] x [j - 0.5, j + 0.5].
@@ -11,7 +13,23 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "_ellipse.h"
+/* An ellipse's n-gon and its box: out[k] = (u + a c cos_k - b s sin_k, v + a s cos_k + b c sin_k)
+ * for the tables ct, st (n each) into out (2n); box = (umin, vmin, umax, vmax). The operations
+ * and order of replay/sensors/silhouette.py Ellipse.polygon_and_box. */
+static void ellipse_ngon(const double *ct, const double *st, Py_ssize_t n, double u, double v,
+                         double a, double b, double c, double s, double *out, double *box) {
+    double ac = a * c, bs = b * s, as = a * s, bc = b * c;
+    double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double pu = u + ac * ct[k] - bs * st[k], pv = v + as * ct[k] + bc * st[k];
+        out[2 * k] = pu, out[2 * k + 1] = pv;
+        if (pu < umin) umin = pu;
+        if (pu > umax) umax = pu;
+        if (pv < vmin) vmin = pv;
+        if (pv > vmax) vmax = pv;
+    }
+    box[0] = umin, box[1] = vmin, box[2] = umax, box[3] = vmax;
+}
 
 /* Signed-area accumulation of one polygon (n vertices xy[2n], pixels of the full image) into
  * acc (h rows of w + 1) of the block whose first pixel is (ox, oy): each edge is cut where it
@@ -21,8 +39,24 @@
  * of the winding number over the pixel). Pieces left of the block count at its left edge, pieces
  * right of it or outside its rows are dropped. *r0, *r1, *c0, *c1: the rows and columns outside
  * which the polygon covers nothing in the block (acc is written only there, columns c0..c1). */
-static void accumulate(const double *xy, Py_ssize_t n, double ox, double oy, double *acc,
-                       int w, int h, int *r0, int *r1, int *c0, int *c1) {
+/* (the largest |coordinate|, px, a vertex may have: every cut stays in int range) */
+#define COORD_MAX 1e9
+
+static int accumulate(const double *xy, Py_ssize_t n, double ox, double oy, double *acc,
+                      int w, int h, int *r0, int *r1, int *c0, int *c1) {
+    /* a NaN or infinite vertex would make the cut loops below run for ever, a huge one
+     * overflow their ints: refused, nothing accumulated, ValueError set, -1 */
+    for (Py_ssize_t i = 0; i < 2 * n; i++)
+        if (!(fabs(xy[i]) <= COORD_MAX)) { /* NaN too */
+            char *text = PyOS_double_to_string(xy[i], 'r', 0, 0, NULL);
+            PyErr_Format(PyExc_ValueError,
+                         "polygon vertex %zd: %s = %s is not a finite pixel coordinate "
+                         "within +-1e9",
+                         i / 2, i % 2 ? "y" : "x", text ? text : "?");
+            PyMem_Free(text);
+            *r0 = *r1 = *c0 = *c1 = 0;
+            return -1;
+        }
     const double bx = ox - 0.5, by = oy - 0.5; /* block coordinates: pixel (c, r) = [c, c+1] x [r, r+1] */
     const int stride = w + 1;
     double area2 = 0.0, xmin = INFINITY, xmax = -INFINITY;
@@ -115,6 +149,7 @@ static void accumulate(const double *xy, Py_ssize_t n, double ox, double oy, dou
     *r1 = rhi;
     *c0 = cl;
     *c1 = ch;
+    return 0;
 }
 
 static int sizes_ok(int w, int h) {
@@ -149,7 +184,10 @@ static PyObject *py_coverage(PyObject *self, PyObject *args) {
         goto done;
     }
     int r0, r1, c0, c1;
-    if (n >= 3) accumulate(P.buf, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1);
+    if (n >= 3 && accumulate(P.buf, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1) < 0) {
+        free(acc);
+        goto done;
+    }
     double *out = O.buf;
     for (int r = 0; r < h; r++) {
         double s = 0.0;
@@ -245,7 +283,10 @@ static PyObject *py_composite(PyObject *self, PyObject *args) {
         Py_ssize_t n = P.len / (2 * (Py_ssize_t)sizeof(double));
         if (n >= 3) {
             int r0, r1, c0, c1;
-            accumulate(P.buf, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1);
+            if (accumulate(P.buf, n, ox, oy, acc, w, h, &r0, &r1, &c0, &c1) < 0) {
+                PyBuffer_Release(&P);
+                goto done;
+            }
             blend(acc, img, w, r0, r1, c0, c1, (float)greyd);
         }
         PyBuffer_Release(&P);
@@ -349,6 +390,12 @@ static PyObject *py_project_hull(PyObject *self, PyObject *args) {
         /* rounded to float32 for real (a plain cast may be elided: GCC's default
          * -fexcess-precision=fast) */
         volatile float fu = (float)(fx * X / Z + cx), fv = (float)(fy * Y / Z + cy);
+        if (!(isfinite(fu) && isfinite(fv))) { /* NaN or beyond float32: no hull of it (the
+                                                * chain below would outgrow out) */
+            PyErr_Format(PyExc_ValueError, "project_hull: body point %zd projects to a pixel "
+                         "that is not finite (a non-finite or huge pose)", i);
+            goto done;
+        }
         pts[2 * i] = fu;
         pts[2 * i + 1] = fv;
     }
@@ -365,6 +412,10 @@ static PyObject *py_project_hull(PyObject *self, PyObject *args) {
         hull[2 * k] = pts[2 * i], hull[2 * k + 1] = pts[2 * i + 1], k++;
     }
     if (k > 1) k--; /* the first point is repeated at the end */
+    if (k > n) { /* cannot happen for finite points; never written past out */
+        PyErr_SetString(PyExc_RuntimeError, "project_hull: hull longer than its points");
+        goto done;
+    }
     memcpy(O.buf, hull, (size_t)k * 2 * sizeof(double));
     double umin = INFINITY, vmin = INFINITY, umax = -INFINITY, vmax = -INFINITY;
     for (Py_ssize_t i = 0; i < k; i++) {
@@ -855,16 +906,6 @@ static PyObject *py_triangulate(PyObject *self, PyObject *args) {
 done:
     PyBuffer_Release(&B0);
     PyBuffer_Release(&B1);
-    return ret;
-}
-
-/* call a kernel above with a new argument tuple (stolen); NULL with an exception set. For the
- * modules that include this file (_stereo.c, _stick_frame.c); inline: unused here. */
-static inline PyObject *call_kernel(PyObject *(*kernel)(PyObject *, PyObject *),
-                                    PyObject *args) {
-    if (!args) return NULL;
-    PyObject *ret = kernel(NULL, args);
-    Py_DECREF(args);
     return ret;
 }
 

@@ -91,7 +91,7 @@ class PinholeCamera:
     """
 
     def __init__(self, intrinsics: Intrinsics, rotation=None, position=(0.0, 0.0, 0.0)) -> None:
-        # C-contiguous: the compiled silhouettes read them as buffers
+        # C-contiguous: the optional accelerator reads them as buffers
         R = np.eye(3) if rotation is None else np.ascontiguousarray(rotation, dtype=float)
         if (
             R.shape != (3, 3)

@@ -33,8 +33,11 @@ import numpy as np
 
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.sensors.pinhole import PinholeCamera
-from replay.sensors import _pixels, _silhouette
+from replay.spatial import quaternion_matrix
+from replay.accel import accelerator
 from replay.sensors.raster import composite
+
+_pixels = accelerator("replay.sensors._pixels")
 
 ELLIPSE_VERTICES = 48  # vertices of the polygon standing in for an ellipse
 _NEAR = 1e-6  # m: nearest depth drawn
@@ -68,15 +71,20 @@ class Ellipse:
         return self.polygon_and_box(inset, area_exact)[0]
 
     def polygon_and_box(self, inset: float = 0.0, area_exact: bool = True):
-        """:meth:`polygon` and its box (umin, vmin, umax, vmax), in one compiled call."""
+        """:meth:`polygon` and its box (umin, vmin, umax, vmax) (the accelerator's
+        ``ellipse_polygon`` where built: the same operations)."""
         k = _AREA_SCALE if area_exact else 1.0
         a = max(self.a - inset, 0.05 * self.a) * k
         b = max(self.b - inset, 0.05 * self.b) * k
+        c, s = math.cos(self.angle), math.sin(self.angle)
         out = np.empty((ELLIPSE_VERTICES, 2))
-        box = _pixels.ellipse_polygon(
-            _COS, _SIN, self.u, self.v, a, b, math.cos(self.angle), math.sin(self.angle), out
-        )
-        return out, box
+        if _pixels is not None:
+            box = _pixels.ellipse_polygon(_COS, _SIN, self.u, self.v, a, b, c, s, out)
+            return out, box
+        out[:, 0] = self.u + (a * c) * _COS - (b * s) * _SIN
+        out[:, 1] = self.v + (a * s) * _COS + (b * c) * _SIN
+        lo, hi = out.min(axis=0).tolist(), out.max(axis=0).tolist()
+        return out, (lo[0], lo[1], hi[0], hi[1])
 
 
 def sphere_ellipse(camera: PinholeCamera, centre, radius: float) -> Ellipse | None:
@@ -165,28 +173,66 @@ def _body_points(prim: Box | Cylinder) -> np.ndarray:
 def project_hull(camera: PinholeCamera, body: np.ndarray, orientation, position):
     """(convex hull (N, 2) in pixels, its box (umin, vmin, umax, vmax)) of body-frame points
     (n, 3) of a rigid body at ``position`` with quaternion ``orientation``, or None if a point
-    is not in front of the camera (depth <= 1 um). One compiled call
-    (``_pixels.project_hull``): the products as NumPy's matmul computes them (fused
-    multiply-adds in ascending order: the same pixels to the bit, test_fast_cameras.py), the
-    projections rounded to float32, as ``cv2.convexHull`` of float32 points took them, and the
-    hull is Andrew's monotone chain."""
+    is not in front of the camera (depth <= 1 um): the points projected with NumPy (world =
+    body R^T + p, then (world - o) R), rounded to float32 as ``cv2.convexHull`` of float32
+    points took them, and Andrew's monotone chain (counter-clockwise in image axes, no
+    collinear vertices). The optional accelerator (``_pixels.project_hull``) computes the
+    products as NumPy's matmul does (fused multiply-adds in ascending order: the same pixels
+    to the bit, test_fast_cameras.py). ValueError for a pose whose projection is not finite."""
     k = camera.intrinsics
-    hull = np.empty((len(body), 2))
-    found = _pixels.project_hull(
-        body,
-        orientation,
-        position,
-        np.ascontiguousarray(camera.rotation, dtype=np.float64),
-        np.ascontiguousarray(camera.position, dtype=np.float64),
-        k.fx,
-        k.fy,
-        k.cx,
-        k.cy,
-        hull,
+    if _pixels is not None:
+        hull = np.empty((len(body), 2))
+        found = _pixels.project_hull(
+            body,
+            orientation,
+            position,
+            np.ascontiguousarray(camera.rotation, dtype=np.float64),
+            np.ascontiguousarray(camera.position, dtype=np.float64),
+            k.fx,
+            k.fy,
+            k.cx,
+            k.cy,
+            hull,
+        )
+        if found is None:
+            return None
+        return hull[: found[0]], found[1:]
+    if not any(orientation):
+        raise ValueError("zero quaternion")
+    world = np.asarray(body, dtype=float) @ quaternion_matrix(orientation).T + np.asarray(
+        position, dtype=float
     )
-    if found is None:
+    pc = (world - camera.position) @ camera.rotation
+    z = pc[:, 2]
+    if not (z > _NEAR).all():
         return None
-    return hull[: found[0]], found[1:]
+    uv = np.empty((len(pc), 2), np.float32)
+    uv[:, 0] = k.fx * pc[:, 0] / z + k.cx
+    uv[:, 1] = k.fy * pc[:, 1] / z + k.cy
+    if not np.isfinite(uv).all():
+        raise ValueError(
+            "project_hull: a body point projects to a pixel that is not finite (a non-finite "
+            "or huge pose)"
+        )
+    pts = sorted(map(tuple, uv.astype(np.float64).tolist()))
+
+    def cross(o, a, b) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    chain: list = []
+    for p in pts:
+        while len(chain) >= 2 and cross(chain[-2], chain[-1], p) <= 0.0:
+            chain.pop()
+        chain.append(p)
+    lower = len(chain) + 1
+    for p in reversed(pts[:-1]):
+        while len(chain) >= lower and cross(chain[-2], chain[-1], p) <= 0.0:
+            chain.pop()
+        chain.append(p)
+    if len(chain) > 1:
+        chain.pop()  # the first point is repeated at the end
+    hull = np.array(chain, dtype=np.float64).reshape(-1, 2)
+    return hull, (*hull.min(axis=0).tolist(), *hull.max(axis=0).tolist())
 
 
 def silhouette(
@@ -214,27 +260,9 @@ def silhouette(
 
 def sphere_polygon(camera: PinholeCamera, centre, radius: float):
     """(polygon (N, 2), box) of a sphere's silhouette, or None if it reaches behind the camera:
-    :func:`sphere_ellipse` and :meth:`Ellipse.polygon_and_box` in one compiled call
-    (``_silhouette.sphere_polygon``, the same operations; test_fast_cameras.py)."""
-    k = camera.intrinsics
-    poly = np.empty((ELLIPSE_VERTICES, 2))
-    box = _silhouette.sphere_polygon(
-        camera.rotation,
-        camera.position,
-        k.fx,
-        k.fy,
-        k.cx,
-        k.cy,
-        float(centre[0]),
-        float(centre[1]),
-        float(centre[2]),
-        float(radius),
-        _COS,
-        _SIN,
-        _AREA_SCALE,
-        poly,
-    )
-    return None if box is None else (poly, box)
+    :func:`sphere_ellipse` and :meth:`Ellipse.polygon_and_box`."""
+    e = sphere_ellipse(camera, centre, radius)
+    return None if e is None else e.polygon_and_box()
 
 
 def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float, tuple]]:

@@ -56,16 +56,9 @@ the image is exactly the background, below the threshold, and the blob's moments
 4 px around the blob), filled in only when the whole images are asked for (:attr:`last_images`);
 with pixel noise the whole images are rendered, every pixel drawn from the rng as before. The
 per-pixel work (ellipse polygon, exact-coverage compositing, quantising, segmentation and
-moments) and the triangulation are compiled kernels (``_pixels.c``) of the same algorithms the
-NumPy/OpenCV code used (kept as references in tests/replay/sensors/test_fast_cameras.py; equal
-to 1e-9 px there, positions of a recorded catch_optimised run equal to 2e-15 m): ~0.1 ms a
-pair noise-free instead of ~1 ms. Noise-free, a scene of spheres (the catch's) is measured in one
-compiled call (``_stereo.measure``: both cameras' windows, images and blobs and the
-triangulation with its bias correction, on C arrays; the same kernels, the blob's background
-median from a histogram, only the pixels a silhouette may change quantised), other scenes one
-call a camera and one for the triangulation; :meth:`StereoBallCamera.measure_reference` keeps
-the step-by-step path (equal to the bit, test_fast_cameras.py). A catch_optimised frame: ~100 k
-instructions (callgrind), ~157 k on the earlier step-by-step frames.
+moments) and the triangulation run in the optional accelerator (``_pixels.c``) where it is
+built, else as NumPy/OpenCV (the same algorithms, equal to 1e-9 px: tests/replay/sensors/
+test_fast_cameras.py): ~0.2 ms a noise-free pair compiled, ~2 ms in Python.
 """
 
 from __future__ import annotations
@@ -75,22 +68,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.foxglove.png import WindowedImage
+from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_OBJECT, VisionObject
 from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
-from replay.sensors import _pixels, _stereo
-from replay.sensors.raster import quantise
-from replay.sensors.silhouette import (
-    _AREA_SCALE,
-    _COS,
-    _SIN,
-    correct_sphere_centroid,
-    drawables,
-    render_views,
-)
+from replay.accel import accelerator
+from replay.sensors.raster import composite, quantise
+from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
+
+import cv2  # (the blob's and the triangulation's pure-Python path: the OpenCV they replaced)
+
+_pixels = accelerator("replay.sensors._pixels")
 
 _VIEWS = ("cam0", "cam1")  # the two cameras' image views (frame_images)
 
@@ -188,8 +178,8 @@ class StereoBallCameraParams:
     )
     log_images: bool = param(
         True,
-        doc="write both cameras' images to the log (PNG, /camera/SENSOR/cam0 and cam1) at the "
-        "camera rate: ~0.2 KiB and ~0.1 ms a frame pair",
+        doc="write both cameras' images to the log (foxglove.RawImage, /camera/SENSOR/cam0 and "
+        "cam1) at the camera rate: ~0.3 KiB after the log's zstd and ~0.04 ms a frame pair",
     )
 
     def __post_init__(self) -> None:
@@ -251,39 +241,6 @@ class StereoBallCamera(Sensor):
             255.0 * float(params.background),
         )
         self._centres = [(c.intrinsics.cx, c.intrinsics.cy) for c in self.cameras]
-        self._axes_c = np.array([x for axis in self._axes for v in axis for x in v], float)
-        self._centres_c = np.array([x for c in self._centres for x in c], float)
-        self._cams_c = np.array(
-            [
-                x
-                for c in self.cameras
-                for x in (
-                    *c.rotation.ravel().tolist(),
-                    *c.position.tolist(),
-                    c.intrinsics.fx,
-                    c.intrinsics.fy,
-                    c.intrinsics.cx,
-                    c.intrinsics.cy,
-                )
-            ],
-            float,
-        )
-        # noise-free with a background below the threshold: the compiled frame (_stereo.c)
-        self._compiled = params.noise_sigma == 0.0 and self._background_level <= params.threshold
-        grey, W, H = 255.0 * params.background, int(params.width), int(params.height)
-        self._frame_args = (grey, W, H, *self._blob_args)
-        self._measure_args = (  # _stereo.measure's after (prims, locate, radius), buffers as
-            self._cams_c.tobytes(),  # bytes (the cheapest to take a buffer of, per call)
-            _COS.tobytes(),
-            _SIN.tobytes(),
-            _AREA_SCALE,
-            *self._frame_args,
-            self._P[0].tobytes(),
-            self._P[1].tobytes(),
-            self._axes_c.tobytes(),
-            self._centres_c.tobytes(),
-        )
-        self._u8 = np.dtype(np.uint8)
         self._last: list = [None, None]
         self._found: tuple = (None, None)  # the blob kernels' tuples of the last frame
 
@@ -346,18 +303,17 @@ class StereoBallCamera(Sensor):
         image border). Grey moments weigh the grey level above the local background (the median
         of the free pixels 3-4 px around the blob grown by 2 px, signed, so that zero-mean noise
         leaves the centroid unbiased) within the blob grown by 2 px (5 x 5). Computed in one
-        compiled pass (``_pixels.ball_blob``; the OpenCV pipeline it replaced is the reference
-        in tests/replay/sensors/test_stereo_vision.py)."""
+        pass by the optional accelerator (``_pixels.ball_blob``), else the OpenCV pipeline it
+        replaced (:func:`_ball_blob`)."""
         p = params if params is not None else StereoBallCameraParams()
         img = np.ascontiguousarray(image, dtype=np.uint8)
         h, w = img.shape
-        found = _pixels.ball_blob(
+        args = (float(p.threshold), int(p.min_pixels), int(p.moments == "binary"))
+        found = _ball_blob(
             img,
             w,
             h,
-            float(p.threshold),
-            int(p.min_pixels),
-            int(p.moments == "binary"),
+            *args,
             255.0 * float(p.background),
             int(origin[0]),
             int(origin[1]),
@@ -378,8 +334,8 @@ class StereoBallCamera(Sensor):
 
     def triangulate(self, uv0, uv1) -> np.ndarray:
         """World point (3,) from a pixel in each image: the linear (DLT) triangulation of
-        ``cv2.triangulatePoints`` (compiled: ``_pixels.triangulate``; NaN at infinity)."""
-        X = _pixels.triangulate(
+        ``cv2.triangulatePoints`` (:func:`_triangulate`; NaN at infinity)."""
+        X = _triangulate(
             self._P[0], self._P[1], float(uv0[0]), float(uv0[1]), float(uv1[0]), float(uv1[1])
         )
         return np.full(3, np.nan) if X is None else np.array(X)
@@ -448,7 +404,7 @@ class StereoBallCamera(Sensor):
         """:meth:`locate` on floats: (x, y, z), or None at infinity. The bias correction as
         :func:`~replay.sensors.silhouette.correct_sphere_centroid` computes it."""
         P0, P1 = self._P
-        X = _pixels.triangulate(P0, P1, uv0[0], uv0[1], uv1[0], uv1[1])
+        X = _triangulate(P0, P1, uv0[0], uv0[1], uv1[0], uv1[1])
         if X is None or radius is None or radius <= 0.0 or not all(map(math.isfinite, X)):
             return X
         fixed = []
@@ -461,60 +417,11 @@ class StereoBallCamera(Sensor):
             s = (z * z - r2) / (z * z)
             fixed.append((cx + (u - cx) * s, cy + (v - cy) * s))
         (a, b), (c, d) = fixed
-        return _pixels.triangulate(P0, P1, a, b, c, d)
+        return _triangulate(P0, P1, a, b, c, d)
 
     def measure(self, t: float, scene: Scene) -> VisionObject | None:
-        """The module doc's pipeline: noise-free, a scene of spheres in one compiled call (both
-        cameras' windows, images and blobs and the triangulation with its bias correction:
-        ``_stereo.measure``), other scenes each camera's frame in one (``_stereo.frame``) and the
-        triangulation in another (``_stereo.locate``): the kernels :meth:`measure_reference`
-        calls, in the same order; with pixel noise :meth:`measure_reference` itself."""
-        if not self._compiled:
-            return self.measure_reference(t, scene)
-        name, prims = self.params.tracked, scene.primitives
-        tracked = None
-        for q in prims:
-            if q.name == name:
-                tracked = q
-                break
-        radius = (  # for the bias correction: the tracked Sphere's, else 0 (none)
-            float(tracked.radius)
-            if self.params.bias_correction and isinstance(tracked, Sphere)
-            else 0.0
-        )
-        # a scene of spheres: both cameras' silhouettes drawn in C (None: not only spheres)
-        got = _stereo.measure(prims, Sphere, tracked is not None, radius, *self._measure_args)
-        if got is not None:
-            img0, win0, f0, img1, win1, f1, X = got
-        else:
-            (img0, win0, f0), (img1, win1, f1) = [
-                _stereo.frame(*self._drawn(camera, scene), *self._frame_args)
-                for camera in self.cameras
-            ]
-            X = None
-            if tracked is not None and f0 is not None and f1 is not None:
-                X = _stereo.locate(*self._P, *f0[:2], *f1[:2], radius, *self._measure_args[-2:])
-        u8 = self._u8
-        self._last = [
-            (np.ndarray((win0[3] - win0[1], win0[2] - win0[0]), u8, img0), win0),
-            (np.ndarray((win1[3] - win1[1], win1[2] - win1[0]), u8, img1), win1),
-        ]
-        self._found = (f0, f1)
-        if X is None:
-            return None
-        return VisionObject(
-            t, list(X), {"centroids": [[f0[0], f0[1]], [f1[0], f1[1]]], "areas": [f0[2], f1[2]]}
-        )
-
-    @staticmethod
-    def _drawn(camera: PinholeCamera, scene: Scene) -> tuple[list, list, list]:
-        """The polygons, grey levels and boxes of a scene's silhouettes in a camera, far first."""
-        drawn = drawables(camera, scene)
-        return [d[0] for d in drawn], [d[1] for d in drawn], [d[2] for d in drawn]
-
-    def measure_reference(self, t: float, scene: Scene) -> VisionObject | None:
-        """:meth:`measure` step by step, each kernel called from Python (the compiled
-        frame's reference, and the path with pixel noise)."""
+        """The module doc's pipeline: each camera's window, image and blob, then the
+        triangulation with its bias correction."""
         p = self.params
         noise = p.noise_sigma > 0.0
         grey = 255.0 * p.background
@@ -530,15 +437,14 @@ class StereoBallCamera(Sensor):
             w, h = x1 - x0, y1 - y0
             img = np.full((h, w), grey, np.float32)
             if drawn and w and h:
-                _pixels.composite([d[0] for d in drawn], [d[1] for d in drawn], x0, y0, img, w, h)
+                composite(img, [d[0] for d in drawn], [d[1] for d in drawn], (x0, y0))
             if noise:
                 img += np.float32(p.noise_sigma) * self.rng.standard_normal(
                     img.shape, dtype=np.float32
                 )
-            img8 = np.empty((h, w), np.uint8)
-            _pixels.quantise(img, img8)
+            img8 = quantise(img)
             last.append((img8, window))
-            found = _pixels.ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
+            found = _ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
             founds.append(found)
             blobs.append(_blob(found, blob_args[2]))
         self._last = last
@@ -564,3 +470,63 @@ class StereoBallCamera(Sensor):
             position=list(X),
             features={"centroids": [list(uv0), list(uv1)], "areas": [b0["area"], b1["area"]]},
         )
+
+
+# --- the blob and the triangulation: the accelerator's, or OpenCV's ----------------------
+
+
+def _ball_blob(img, w, h, threshold, min_pixels, binary, default_bg, ox, oy, W, H):
+    """(u, v, area, background) of the largest 8-connected blob above ``threshold`` in a
+    window (first pixel (ox, oy)) of a W x H image, or None (:meth:`StereoBallCamera.blob`):
+    the accelerator (``_pixels.ball_blob``) where built, else the OpenCV pipeline it replaced
+    (equal to 1e-9 px: test_fast_cameras.py)."""
+    if _pixels is not None:
+        return _pixels.ball_blob(img, w, h, threshold, min_pixels, binary, default_bg, ox, oy, W, H)
+    _, mask = cv2.threshold(img, threshold, 1, cv2.THRESH_BINARY)
+    ex, ey, ew, eh = cv2.boundingRect(mask)
+    if ew == 0:
+        return None
+    ex0, ey0 = max(ex - 4, 0), max(ey - 4, 0)
+    ex1, ey1 = min(ex + ew + 4, w), min(ey + eh + 4, h)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask[ey0:ey1, ex0:ex1], connectivity=8)
+    i = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    bx, by, bw, bh, area = (int(v) for v in stats[i])
+    bx, by = bx + ex0, by + ey0
+    if area < min_pixels or bx + ox == 0 or by + oy == 0 or bx + ox + bw == W or by + oy + bh == H:
+        return None
+    x0, y0 = max(bx - 4, 0), max(by - 4, 0)
+    x1, y1 = min(bx + bw + 4, w), min(by + bh + 4, h)
+    labels = labels[y0 - ey0 : y1 - ey0, x0 - ex0 : x1 - ex0]
+    blob = (labels == i).astype(np.uint8)
+    if binary:
+        m = cv2.moments(blob, binaryImage=True)
+        return (ox + x0 + m["m10"] / m["m00"], oy + y0 + m["m01"] / m["m00"], area, 0.0)
+    roi = img[y0:y1, x0:x1].astype(np.float32)
+    free = labels == 0
+    region = cv2.dilate(blob, np.ones((5, 5), np.uint8)).astype(bool) & (free | blob.astype(bool))
+    ring = roi[~region & free]
+    if ring.size:
+        background = float(np.partition(ring, ring.size // 2)[ring.size // 2])
+    else:
+        background = default_bg
+    weight = np.where(region, roi - np.float32(background), np.float32(0.0))
+    m = cv2.moments(weight)
+    if m["m00"] <= 0.0:
+        return None
+    return (ox + x0 + m["m10"] / m["m00"], oy + y0 + m["m01"] / m["m00"], area, background)
+
+
+def _triangulate(P0, P1, u0, v0, u1, v1):
+    """The linear (DLT) two-view triangulation of ``cv2.triangulatePoints``: (x, y, z), or None
+    at infinity (the accelerator's ``_pixels.triangulate`` where built)."""
+    if _pixels is not None:
+        return _pixels.triangulate(P0, P1, u0, v0, u1, v1)
+    X = cv2.triangulatePoints(
+        np.asarray(P0, dtype=np.float64).reshape(3, 4),
+        np.asarray(P1, dtype=np.float64).reshape(3, 4),
+        np.array([[u0], [v0]], dtype=np.float64),
+        np.array([[u1], [v1]], dtype=np.float64),
+    ).ravel()
+    if X[3] == 0.0:
+        return None
+    return (float(X[0] / X[3]), float(X[1] / X[3]), float(X[2] / X[3]))

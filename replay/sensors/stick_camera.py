@@ -32,11 +32,11 @@ Cost: a frame renders only the window around the marker's silhouette (plus 8 px;
 the image is exactly the dark table, which never passes the threshold, and is filled in only
 when the whole image is asked for, :attr:`StickCamera.last_image`), draws only the primitives
 whose bounding sphere's image meets that window, and does the per-pixel work in compiled
-kernels (``_pixels.c``: outline projection and hull, exact-coverage compositing, 8-bit
-quantising, segmentation and moments in one pass) with the same algorithms the NumPy/OpenCV code used (kept as references in
-tests/replay/sensors/test_fast_cameras.py and test_raster.py): ~0.1 ms a frame of stick_3step
-instead of ~1.9 ms (tools/bench_cameras.py), measurements equal to 1e-14 m and a stick_3step
-run equal to what it was (the outlines' pixels are NumPy's to the bit: ``project_hull``).
+kernels where the optional accelerator is built (``_pixels.c``: outline projection and hull,
+exact-coverage compositing, 8-bit quantising, segmentation and moments in one pass; without
+it the same algorithms in NumPy/OpenCV, held together in tests/replay/sensors/
+test_fast_cameras.py and test_raster.py): ~0.2 ms a frame of stick_3step, ~1 ms in Python
+(docs/DESIGN.md, "Compiled code"), measurements equal to 1e-14 m either way.
 
 Accuracy (test_fast_cameras.py, noise-free, 200 random poses of the stick_3step geometry, 1.8 mm
 per pixel, no fingertips), the same before and after the kernels: bias (mean error) x -0.17,
@@ -58,16 +58,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.foxglove.png import WindowedImage
+from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_STICK, VisionStick
 from replay.params import ParamError, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
-from replay.sensors import _pixels, _stick_frame
+from replay.accel import accelerator
 from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
+
+import cv2  # (the moments' pure-Python path: the OpenCV pipeline the accelerator replaced)
+
+_pixels = accelerator("replay.sensors._pixels")
 
 _RIM = 48  # vertices of a polygon standing in for a circle
 
@@ -315,7 +319,7 @@ class StickCameraParams:
     marker: str = param("marker", max_length=100, doc="name of the Box the camera tracks")
     log_images: bool = param(
         False,
-        doc="write each whole frame to the log (PNG, /camera/SENSOR/image) at the camera rate; "
+        doc="write each whole frame to the log (RawImage mono8, /camera/SENSOR/image) at the camera rate; "
         "off by default: a 512 px frame costs ~1 ms to build and encode",
     )
 
@@ -341,17 +345,6 @@ class StickCamera(Sensor):
         self.camera = self.make_camera(params)
         self._R = tuple(tuple(float(v) for v in row) for row in self.camera.rotation)
         self._o = tuple(float(v) for v in self.camera.position)
-        k = self.camera.intrinsics
-        self._frame_camera = (  # _stick_frame.measure's camera, made once
-            np.ascontiguousarray(self.camera.rotation, dtype=np.float64),
-            np.ascontiguousarray(self.camera.position, dtype=np.float64),
-            float(k.fx), float(k.fy), float(k.cx), float(k.cy),
-            int(params.width), int(params.height), float(params.background),
-            float(params.threshold), int(params.min_pixels), str(params.marker),
-            Box, Cylinder, self._o, math.dist,
-            float(params.position_offset[0]), float(params.position_offset[1]),
-        )  # fmt: skip
-        self._shapes: dict = {}  # _frame's (body points, bounding radius, hull buffer) by shape
         self._last = None
 
     # --- helpers usable without a sensor instance -------------------------------------------
@@ -402,8 +395,8 @@ class StickCamera(Sensor):
         half a pixel along the axis): the level is the median of 9 pixels 2-4 px beyond each end
         of the blob along its long axis (so the stick must extend that far beyond the marker,
         ~5 mm at 1.25 mm/px), the brighter end winning (a dark fingertip may cover one end).
-        Computed in one compiled pass (``_pixels.marker_moments``; the OpenCV pipeline it
-        replaced is the reference in tests/replay/sensors/test_stick_camera.py)."""
+        Computed in one pass by the optional accelerator (``_pixels.marker_moments``), else by
+        the OpenCV pipeline it replaced (:func:`_moments_opencv`)."""
         found = StickCamera._moments(image, params, origin)
         if found is None:
             return None
@@ -419,21 +412,24 @@ class StickCamera(Sensor):
 
     @staticmethod
     def _moments(image: np.ndarray, params: StickCameraParams, origin: tuple[int, int]):
-        """:meth:`marker_moments` as the compiled kernel returns it: (u, v, angle, pixels,
-        background, m00, m10, m01, mu20, mu11, mu02) or None."""
+        """:meth:`marker_moments` as a tuple: (u, v, angle, pixels, background, m00, m10, m01,
+        mu20, mu11, mu02) or None. The accelerator (``_pixels.marker_moments``, one pass) where
+        built, else the OpenCV pipeline it replaced (equal to 1e-9 px: test_fast_cameras.py)."""
         img = np.ascontiguousarray(image, dtype=np.uint8)
         h, w = img.shape
-        return _pixels.marker_moments(
-            img,
-            w,
-            h,
-            float(params.threshold),
-            int(params.min_pixels),
-            int(origin[0]),
-            int(origin[1]),
-            int(params.width),
-            int(params.height),
-        )
+        if _pixels is not None:
+            return _pixels.marker_moments(
+                img,
+                w,
+                h,
+                float(params.threshold),
+                int(params.min_pixels),
+                int(origin[0]),
+                int(origin[1]),
+                int(params.width),
+                int(params.height),
+            )
+        return _moments_opencv(img, params, origin)
 
     # --- the sensor ---------------------------------------------------------------------------
     @property
@@ -459,50 +455,7 @@ class StickCamera(Sensor):
         ]
 
     def measure(self, t: float, scene: Scene) -> VisionStick | None:
-        """The marker's pose in a frame of ``scene``: noise-free frames in one compiled call
-        (:meth:`_frame`, the same pixels, moments and pose as :meth:`measure_reference`), the
-        rest (noise, a scene with spheres, no marker in view: the whole image) by the
-        reference."""
-        framed = self._frame(scene) if self.params.noise_sigma == 0.0 else None
-        if framed is None:
-            return self.measure_reference(t, scene)
-        img, window, pose = framed
-        self._last = (img, window)
-        return None if pose is None else VisionStick(t, *pose)
-
-    def _frame(self, scene: Scene):
-        """(image window, window, pose (x, y, theta) or None) of a noise-free frame in one
-        compiled call (``_stick_frame.measure``: the steps of :meth:`measure_reference`, its
-        kernels and :meth:`_pose`), or None when the reference path must do it."""
-        prims, shapes = scene.primitives, self._shapes
-        while True:
-            framed = _stick_frame.measure(prims, shapes, self._frame_camera)
-            if framed is None or framed[0] is not None:
-                break
-            _, i, key = framed  # a shape not seen yet: its outline points, once
-            shapes[key] = self._shape(prims[i])
-        if framed is None:
-            return None
-        data, window, _, pose = framed
-        img = np.frombuffer(data, np.uint8).reshape(window[3] - window[1], window[2] - window[0])
-        return img, window, pose
-
-    @staticmethod
-    def _shape(prim: Box | Cylinder) -> tuple[np.ndarray, float, np.ndarray]:
-        """(body outline points, bounding-sphere radius as :func:`_misses` takes it, a hull
-        buffer) of a box or cylinder, for :meth:`_frame`."""
-        body = _body_points(prim)
-        if isinstance(prim, Box):
-            sx, sy, sz = prim.size
-            rb = 0.5 * math.sqrt(sx * sx + sy * sy + sz * sz)
-        else:
-            rb = math.hypot(prim.radius, 0.5 * prim.length)
-        return body, rb, np.empty((len(body), 2))
-
-    def measure_reference(self, t: float, scene: Scene) -> VisionStick | None:
-        """:meth:`measure` in Python between the compiled kernels (the reference of
-        ``_stick_frame.frame``, tests/replay/sensors/test_stick_frame.py, and the path of frames
-        with noise)."""
+        """The marker's pose in a frame of ``scene`` (the module doc's pipeline)."""
         p = self.params
         cam = self.camera
         # Only a window around the marker is rendered (and given noise): the moments use
@@ -575,3 +528,91 @@ class StickCamera(Sensor):
         if not (abs(dz / n) > 1e-12 and s > 0.0):
             return None
         return ox + s * dx, oy + s * dy
+
+
+# --- the marker's moments without the accelerator: OpenCV -----------------------------------
+
+_END_SAMPLES = np.array([[s, o] for s in (2.0, 3.0, 4.0) for o in (-1.0, 0.0, 1.0)])
+
+
+def _background_beyond_ends(image: np.ndarray, blob: np.ndarray, origin) -> float | None:
+    """The median of 9 pixels 2-4 px beyond each end of the blob along its long axis, the
+    brighter end's (:meth:`StickCamera.marker_moments`)."""
+    m = cv2.moments(blob, binaryImage=True)
+    if m["m00"] <= 0.0:
+        return None
+    a = 0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"])
+    e = np.array([math.cos(a), math.sin(a)])
+    n = np.array([-e[1], e[0]])
+    c = np.array([origin[0] + m["m10"] / m["m00"], origin[1] + m["m01"] / m["m00"]])
+    rows, cols = np.nonzero(blob)
+    along = (np.column_stack([cols + origin[0], rows + origin[1]]) - c) @ e
+    h, w = image.shape
+    levels = []
+    for end in (along.max(), along.min()):
+        sign = 1.0 if end > 0 else -1.0
+        pts = c + (end + sign * _END_SAMPLES[:, :1]) * e + _END_SAMPLES[:, 1:] * n
+        ij = np.rint(pts).astype(int)
+        ok = (ij[:, 0] >= 0) & (ij[:, 0] < w) & (ij[:, 1] >= 0) & (ij[:, 1] < h)
+        if ok.any():
+            levels.append(float(np.median(image[ij[ok, 1], ij[ok, 0]])))
+    return max(levels) if levels else None
+
+
+def _moments_opencv(image: np.ndarray, params: StickCameraParams, origin) -> tuple | None:
+    """:meth:`StickCamera._moments` with OpenCV: threshold, the largest 8-connected blob (none
+    touching the image's border), the background beyond its ends, grey-level moments over the
+    blob dilated by 2 px."""
+    h, w = image.shape
+    ox, oy = int(origin[0]), int(origin[1])
+    mask = (image > params.threshold).astype(np.uint8)
+    bright = cv2.findNonZero(mask)
+    if bright is None:
+        return None
+    cx, cy, cw, ch = cv2.boundingRect(bright)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(
+        mask[cy : cy + ch, cx : cx + cw], connectivity=8
+    )
+    if n <= 1:
+        return None
+    i = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    bx, by, bw, bh, area = (int(v) for v in stats[i])
+    bx, by = bx + cx, by + cy
+    if area < params.min_pixels:
+        return None
+    if (
+        bx + ox == 0
+        or by + oy == 0
+        or bx + ox + bw == params.width
+        or by + oy + bh == params.height
+    ):
+        return None
+    x0, y0 = max(bx - 3, 0), max(by - 3, 0)
+    x1, y1 = min(bx + bw + 3, w), min(by + bh + 3, h)
+    roi = image[y0:y1, x0:x1].astype(np.float32)
+    blob = np.zeros((y1 - y0, x1 - x0), np.uint8)
+    lx0, ly0 = bx - cx, by - cy
+    blob[by - y0 : by - y0 + bh, bx - x0 : bx - x0 + bw] = (
+        labels[ly0 : ly0 + bh, lx0 : lx0 + bw] == i
+    )
+    background = _background_beyond_ends(image, blob, (x0, y0))
+    if background is None:
+        return None
+    region = cv2.dilate(blob, np.ones((5, 5), np.uint8)).astype(bool)
+    weight = np.where(region, np.maximum(roi - np.float32(background), 0.0), 0.0)
+    m = cv2.moments(weight.astype(np.float32))
+    if m["m00"] <= 0.0:
+        return None
+    return (
+        ox + x0 + m["m10"] / m["m00"],
+        oy + y0 + m["m01"] / m["m00"],
+        0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"]),
+        area,
+        background,
+        m["m00"],
+        m["m10"],
+        m["m01"],
+        m["mu20"],
+        m["mu11"],
+        m["mu02"],
+    )

@@ -5,7 +5,7 @@ array of photodetectors, each with its own processing element, read as a **binar
 Each frame: the camera's pose comes from the head's joint angles (``Scene.readings["head"]``,
 the plant's ``replay.robot.head.camera_pose``); the scene's silhouettes are rendered through that
 pinhole camera (:func:`replay.sensors.silhouette.render`: exact projected outlines, each pixel's
-exact coverage, compiled), Gaussian grey-level noise is
+exact coverage), Gaussian grey-level noise is
 added, and each pixel is thresholded into one bit. What happens to the bits (Self Windowing,
 moments) is the method's (``replay.control.grasping``): the chip's PEs run the paper's
 algorithm, so it is not part of this sensor.
@@ -30,8 +30,10 @@ from replay.interfaces import Sensor
 from replay.params import param
 from replay.scene import Scene
 from replay.sensors.pinhole import Intrinsics, PinholeCamera
-from replay.sensors import _pixels
+from replay.accel import accelerator
 from replay.sensors.silhouette import render
+
+_pixels = accelerator("replay.sensors._pixels")
 
 
 @dataclass
@@ -63,7 +65,7 @@ class VisionChipParams:
     reading: str = param("head", doc="the plant's reading with the camera pose")
     log_images: bool = param(
         True,
-        doc="write the binary image to the log (PNG, 0/255, /camera/SENSOR/image) at the "
+        doc="write the binary image to the log (RawImage mono8, 0/255, /camera/SENSOR/image) at the "
         "camera rate",
     )
 
@@ -101,14 +103,14 @@ class VisionChipSensor(Sensor):
         return img > self.level
 
     def frame_images(self) -> list[tuple[str, np.ndarray]]:
-        """The last frame: ``[("image", bool HxW)]`` (its PNG is 0 / 255)."""
+        """The last frame: ``[("image", bool HxW)]`` (its RawImage is 0 / 255)."""
         return [] if self.last_image is None else [("image", self.last_image)]
 
     def measure(self, t: float, scene: Scene) -> VisionChip | None:
         bits = self.image(scene)
         self.last_image = bits
         h, w = bits.shape
-        if w <= 63:  # pack_rows, compiled
+        if w <= 63 and _pixels is not None:  # pack_rows, by the accelerator
             rows, count = _pixels.pack_rows(bits, w, h)
         else:
             rows, count = pack_rows(bits), int(bits.sum())

@@ -1,4 +1,4 @@
-"""The viewer's camera panel: each logged camera image (``/camera/SENSOR/VIEW``, PNG:
+"""The viewer's camera panel: each logged camera image (``/camera/SENSOR/VIEW``, ``foxglove.RawImage``:
 docs/foxglove.md) at the shown time, with the centroid the vision measured in it drawn as a red
 ring (stereo: ``/vision/object`` ``features.centroids``; the vision chip: the recognition's
 ``/grasping/object`` ``xi``), matched to the image by its capture time. The mark is a ring
@@ -12,6 +12,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from replay.foxglove.image import pixels
 from replay.foxglove.schemas import decode
 from replay.log import LogReader
 from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_VISION_OBJECT
@@ -32,7 +33,7 @@ class ImageTrack:
     sensor: str
     view: str
     t_ns: np.ndarray  # capture times
-    png: list[bytes]
+    images: list[np.ndarray]  # (h, w) uint8
     marks: dict[int, tuple[float, float]] = field(default_factory=dict)  # t_ns -> (u, v) px
 
     def index(self, t: float) -> int | None:
@@ -42,9 +43,7 @@ class ImageTrack:
 
     def frame(self, k: int) -> np.ndarray:
         """Image ``k`` as RGB, scaled to :data:`SIZE` px wide, its centroid marked."""
-        grey = cv2.imdecode(np.frombuffer(self.png[k], np.uint8), cv2.IMREAD_GRAYSCALE)
-        if grey is None:
-            raise ValueError(f"{self.topic}: image {k} is not a readable PNG")
+        grey = self.images[k]
         h, w = grey.shape
         s = SIZE / w
         interp = cv2.INTER_NEAREST if s >= 1 else cv2.INTER_AREA
@@ -80,15 +79,15 @@ def load_image_tracks(path: str | Path, sensors: dict) -> list[ImageTrack]:
     reader = LogReader(path)
     found: dict[str, tuple[list, list]] = {}
     for m in reader.raw():
-        if m.topic.startswith(CAMERA_PREFIX) and m.schema == "foxglove.CompressedImage":
-            ts, pngs = found.setdefault(m.topic, ([], []))
+        if m.topic.startswith(CAMERA_PREFIX) and m.schema == "foxglove.RawImage":
+            ts, images = found.setdefault(m.topic, ([], []))
             ts.append(m.t_ns)
-            pngs.append(decode(m.schema, m.data).data)
+            images.append(pixels(decode(m.schema, m.data)))
     tracks = []
-    for topic, (ts, pngs) in sorted(found.items()):
+    for topic, (ts, images) in sorted(found.items()):
         sensor, _, view = topic[len(CAMERA_PREFIX) :].partition("/")
         spec = sensors.get(sensor) or {}
-        tr = ImageTrack(topic, sensor, view, np.asarray(ts, np.int64), pngs)
+        tr = ImageTrack(topic, sensor, view, np.asarray(ts, np.int64), images)
         tr.marks = _marks(reader, str(spec.get("type", "")), spec, view)
         tracks.append(tr)
     return tracks

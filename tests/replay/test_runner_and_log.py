@@ -218,21 +218,21 @@ def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
 
 def test_sigint_mid_record_is_held_until_the_record_is_whole(tmp_path):
     """Ctrl-C while a record is written is raised only once the write is done, so the log never
-    holds a torn record; after close the default handler is back. (A message is appended by
-    compiled code, where no handler runs; the Python it runs is writing a chunk it filled.)"""
+    holds a torn record; after close the default handler is back. (The signal arrives while the
+    mcap writer writes the chunk the message filled to the file.)"""
     w = LogWriter(tmp_path / "x.mcap", chunk_size=100)
-    add, reached = w._mcap._write, []
+    add, reached = w._file.write, []
 
     def interrupted_mid_chunk(data):  # Ctrl-C arrives while the chunk is being written
         os.kill(os.getpid(), signal.SIGINT)
         add(data)
         reached.append(True)
 
-    w._mcap._write = interrupted_mid_chunk
+    w._file.write = interrupted_mid_chunk
     with pytest.raises(KeyboardInterrupt):
         w.write("/events", Event(0.0, "a"), 0)  # the schema, channel and it fill the chunk
     assert reached
-    w._mcap._write = add
+    w._file.write = add
     w.write("/events", Event(0.001, "interrupted"), 1_000_000)
     assert w.close("interrupted") == tmp_path / "x.interrupted.mcap"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

@@ -41,9 +41,11 @@ def installed(tmp_path_factory):
         cwd=base,
     )
     wheel = next(dist.glob("paper_replay-*.whl"))
-    _sh([sys.executable, "-m", "venv", venv], cwd=base)
-    _sh([venv / "bin" / "python", "-m", "pip", "install", "-q", wheel], cwd=base)
+    # (no PYTHONPATH: a checkout on it, with the egg-info the wheel build leaves there, would
+    # make pip take the package as installed already)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    _sh([sys.executable, "-m", "venv", venv], cwd=base, env=env)
+    _sh([venv / "bin" / "python", "-m", "pip", "install", "-q", wheel], cwd=base, env=env)
     return venv / "bin" / "replay", work, env
 
 
@@ -102,3 +104,47 @@ def test_a_user_scenario_builds_on_a_shipped_one(installed):
         out = _sh([replay, "run", f, "--quiet", "-o", work / f"{f}.mcap"], cwd=work, env=env)
         assert (work / f"{f}.mcap").is_file(), out
     assert "seed 5" in _sh([replay, "info", work / "mine.yaml.mcap"], cwd=work, env=env)
+
+
+def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_path):
+    """``CC=/bin/false``: every accelerator fails to build and is left out (setup.py), the
+    wheel still builds, holds no compiled module, and the stick run works on the pure-Python
+    paths. (The catching and grasping runs still need modules outside issue #22's part.)"""
+    import shutil
+    import zipfile
+
+    dist, venv, work = tmp_path / "dist", tmp_path / "venv", tmp_path / "empty"
+    work.mkdir()
+    # the sources alone (no build/ of an earlier build, no in-place .so files)
+    src = tmp_path / "src"
+    skip = shutil.ignore_patterns(
+        ".git", ".venv", "build", "out", "*.egg-info", "*.so", "*.pyd", "__pycache__"
+    )
+    shutil.copytree(ROOT, src, ignore=skip)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    out = _sh(
+        [sys.executable, "-m", "pip", "wheel", "-v", "--no-deps", "--no-build-isolation"]
+        + ["-w", dist, src],
+        cwd=tmp_path,
+        env={**env, "CC": "/bin/false", "CXX": "/bin/false"},
+    )
+    assert "not built" in out  # the accelerators said they were left out
+    wheel = next(dist.glob("paper_replay-*.whl"))
+    compiled = [n for n in zipfile.ZipFile(wheel).namelist() if n.endswith((".so", ".pyd"))]
+    assert compiled == []
+    # the dependencies from this interpreter's site-packages: only the package is new
+    _sh([sys.executable, "-m", "venv", "--without-pip", venv], cwd=tmp_path)
+    site = next((venv / "lib").glob("python3*/site-packages"))
+    here = next(p for p in sys.path if p.endswith("site-packages"))
+    (site / "deps.pth").write_text(here + "\n")
+    _sh([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", site, wheel], work)
+    code = (
+        "import sys; from replay.entry import main; "
+        "sys.argv = ['replay', 'run', 'stick_3step', '--quiet', '--set', "
+        f"'timing.duration=0.3', '-o', {str(work / 'stick.mcap')!r}]; main()"
+    )
+    _sh([venv / "bin" / "python", "-c", code], cwd=work, env=env)
+    assert (work / "stick.mcap").is_file()
+    probe = "import replay.sensors.raster as r, replay.accel as a; print(r._pixels, a.__file__)"
+    out = _sh([venv / "bin" / "python", "-c", probe], cwd=work, env=env)
+    assert out.startswith("None") and str(site) in out

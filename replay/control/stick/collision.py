@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.stick import _contacts
 from replay.robot.stick_impact import quadratic_roots as _roots
 
 
@@ -229,38 +228,7 @@ def contact_options(
     Both roots of one side can pass eq. 26 (e.g. F_V,1(0) for the Fig. 7 numbers: r_x = -25.8 mm
     gives omega_1 = -10 rad/s, r_x = +10.5 mm gives +18 rad/s): the strategy's own rule (eq. 31,
     35 or 37) then chooses. Roots beyond the stick (|r_x| > L/2) are kept, ``within`` False.
-    The roots, J_i u and C_i are solved compiled (``_contacts.options``: the operations of
-    :func:`contact_options_reference`, its reference).
     """
-    if (omega is None) == (speed is None):
-        raise ValueError("give exactly one of omega, speed")
-    u = _u3(u_prev)
-    if omega is not None:
-        target, by_speed, v = float(omega), False, 0.0
-    else:
-        target, by_speed, v = float(speed), True, math.hypot(u[0], u[1])  # type: ignore[arg-type]
-    return [
-        ContactSolution(theta, side, r, u, after, roots, condition, length)
-        for side, r, after, roots, condition in _contacts.options(
-            m, inertia, e, theta, u[0], u[1], u[2], target, by_speed, v, sides
-        )
-    ]
-
-
-def contact_options_reference(
-    m: float,
-    inertia: float,
-    e: float,
-    theta: float,
-    u_prev,
-    *,
-    omega: float | None = None,
-    speed: float | None = None,
-    length: float | None = None,
-    sides=(1, -1),
-) -> list[ContactSolution]:
-    """:func:`contact_options` in Python (f_omega, f_v, _terms, _after, approach_speed): the
-    reference of its compiled kernel (``_contacts.options``, tests/.../test_contacts_kernel.py)."""
     if (omega is None) == (speed is None):
         raise ValueError("give exactly one of omega, speed")
     u = _u3(u_prev)

@@ -18,8 +18,7 @@ outlier is dropped); the fit then restarts from the deviating samples, and
 :meth:`StickEstimator.add` returns True.
 
 Defaults (SI): window 30 samples (0.1 s at 300 fps), ready after 6 samples (20 ms), pos_tol
-0.002 m, theta_tol 0.03 rad, confirm 2. Pure Python; the running sums and the fit are compiled
-(``_fit.c``, with their Python references).
+0.002 m, theta_tol 0.03 rad, confirm 2. Pure Python (running sums, a closed-form fit).
 """
 
 from __future__ import annotations
@@ -27,8 +26,6 @@ from __future__ import annotations
 import math
 from array import array
 from dataclasses import dataclass
-
-from replay.control.stick import _fit
 
 
 REANCHOR = 1.0  # s, the running sums are rebuilt from the window once their anchor is this old
@@ -195,12 +192,7 @@ class StickEstimator:
             self._sum(sample, 1.0)
 
     def _sum(self, sample, sign: float) -> None:
-        """Add ``sign`` times the sample's terms to the running sums (compiled: ``_fit.add``,
-        the operations of :meth:`_sum_reference`)."""
-        _fit.add(self._sums, self._anchor, sample, sign)
-
-    def _sum_reference(self, sample, sign: float) -> None:
-        """:meth:`_sum` in Python (its reference, test_fit_kernel.py)."""
+        """Add ``sign`` times the sample's terms to the running sums."""
         t0, x0, y0, th0 = self._anchor
         ts, xs, ys, ths = sample
         t = ts - t0
@@ -224,20 +216,7 @@ class StickEstimator:
 
     def _refit(self) -> None:
         """Least squares of (x, y, theta) = value at t_ref + rate (t - t_ref), in closed form
-        from the running sums (rate = S_tv / S_tt of the centred sums; compiled: ``_fit.fit``,
-        the operations of :meth:`_refit_reference`)."""
-        samples = self._samples
-        n = len(samples)
-        t_ref = samples[-1][0]
-        if n == 1:
-            _, x, y, th = samples[0]
-            self._fit = StickEstimate(t_ref, x, y, th, 0.0, 0.0, 0.0, 1, 0.0, 0.0)
-            return
-        x, vx, y, vy, th, w, rms_xy, rms_th = _fit.fit(self._sums, self._anchor, n, t_ref)
-        self._fit = StickEstimate(t_ref, x, y, th, vx, vy, w, n, rms_xy, rms_th)
-
-    def _refit_reference(self) -> None:
-        """:meth:`_refit` in Python (its reference, test_fit_kernel.py)."""
+        from the running sums (rate = S_tv / S_tt of the centred sums)."""
         samples = self._samples
         n = len(samples)
         t_ref = samples[-1][0]

@@ -9,9 +9,8 @@ gives no equations for them; the kinematics are ``replay.robot.hand2d``'s (``fin
 The controllers have no hand feedback. They track their own commands with the plant's motion
 model: every axis moves toward its target at its speed limit, from where the spec says the hand
 was homed. :class:`HandModel` follows it in time; :func:`route_configs` and :func:`route_tips`
-sample it along a planned route of waypoints [(t_start, Config)] (:func:`route_target`): the
-NumPy reference of the route check the planner runs compiled (``_sweep.route_hit``, compared
-with them in tests/replay/control/stick/test_sweep_kernel.py).
+sample it along a planned route of waypoints [(t_start, Config)] (:func:`route_target`) for the
+planner's route check (``ContactPlanner.route_clear``).
 
 Pure NumPy.
 """

@@ -23,7 +23,7 @@ The result is a :class:`ContactPlan` (the approach phase's plan; its ``intent`` 
 event's data). :class:`Shortfall` keeps the best time needed vs available of failed attempts
 (the ``unreachable`` report).
 
-Pure NumPy; the sampled sweep checks are compiled (``_sweep.c``, see ``sweep``).
+NumPy (the sampled sweep checks: ``sweep``, with its optional accelerator).
 """
 
 from __future__ import annotations
@@ -39,16 +39,25 @@ from replay.robot.hand2d import HandSpec
 from replay.spatial import wrap_half_pi
 from replay.control.stick import collision as sc
 from replay.control.stick.estimator import StickEstimate
-from replay.control.stick import _sweep
 from replay.control.stick.hand_model import (
     Config,
     HandModel,
     base_candidates,
     posture_grid,
+    route_configs,
     route_target,
+    route_tips,
     travel,
 )
-from replay.control.stick.sweep import Motion, Sweep, first_covered, sample_count
+from replay.control.stick import sweep as _sweeps
+from replay.control.stick.sweep import (
+    Motion,
+    Sweep,
+    covered_along,
+    first_covered,
+    sample_count,
+    sample_times,
+)
 
 CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
 GO_DELAY = 0.003  # s, a staged tip moves in this long after the stick's last pass
@@ -145,7 +154,7 @@ class ContactPlanner:
         )
         self._grid_reach_lists = tuple(a.tolist() for a in self._grid_reach)  # (_passive)
         (r0x, r0y), (r1x, r1y) = hand.root_offsets
-        self._geometry = tuple(map(float, (l1, l2, r0x, r0y, r1x, r1y)))
+        self._geometry = tuple(map(float, (l1, l2, r0x, r0y, r1x, r1y)))  # (the accelerator's)
         self._speeds = (float(hand.base_speed), float(hand.joint_speed))
 
     def crossings(
@@ -330,6 +339,61 @@ class ContactPlanner:
         last before t_c - arrive_margin, and no fingertip is hit by the predicted sweep: on the
         way (both tips) and, once arrived, finger k's tip until just before t_c and the idle
         tip (``sweep_margin`` clear) until t_c + post_horizon. Else None."""
+        if _sweeps._sweep is not None:
+            return self._route_clear_compiled(t, now, route, k, motion, t_c, check_idle)
+        p, st, hand = self.params, self.stick, self.hand
+        starts, frm, to = [], [], []
+        prev = now
+        for i, (t_start, cfg) in enumerate(route):
+            if i + 1 < len(route):
+                if t_start + travel(hand, prev, cfg) > route[i + 1][0] + 1e-9:
+                    return None
+            starts.append(t_start)
+            frm.append(prev)
+            to.append(cfg)
+            prev = cfg
+        arrival = starts[-1] + travel(hand, frm[-1], to[-1])
+        if arrival > t_c - p.arrive_margin:
+            return None
+        # sampled every SAMPLE_DT from t: the hand along the route (route_configs, route_tips);
+        # finger k's tip must stay out of the sweep (sweep.covered_along) until CONTACT_GUARD
+        # before t_c; the idle tip, with check_idle, until t_c + post_horizon, keeping
+        # sweep_margin, or on the way at least the clearance it has now (it may start at the
+        # stick it just hit: a route grazing the stick at speed is a hit)
+        times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
+        base, joints = route_configs(hand, starts, frm, to, times)
+        tips = route_tips(hand, base, joints)
+        half_l, half_w = 0.5 * st.length, 0.5 * st.width
+        act = times <= t_c - CONTACT_GUARD
+        c, th = poses = motion.poses(times)
+        tip_r = hand.tip_radius - 5e-4
+        if covered_along(
+            motion, times[act], tips[act, k], half_l, half_w, tip_r, poses=(c[act], th[act])
+        ).any():
+            return None
+        if check_idle:
+            x0, y0, th0 = motion.pose_floats(t)
+            dx, dy = float(tips[0, 1 - k, 0]) - x0, float(tips[0, 1 - k, 1]) - y0
+            cs, sn = math.cos(th0), math.sin(th0)
+            xb, yb = dx * cs + dy * sn, -dx * sn + dy * cs
+            gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
+            on_way = max(tip_r, min(hand.tip_radius + p.sweep_margin, gap))
+            grow = np.where(times < arrival, on_way, hand.tip_radius + p.sweep_margin)
+            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow, poses).any():
+                return None
+        return arrival
+
+    def _route_clear_compiled(
+        self,
+        t: float,
+        now: Config,
+        route: list,
+        k: int,
+        motion: Motion,
+        t_c: float,
+        check_idle: bool,
+    ) -> float | None:
+        """:meth:`route_clear` by the accelerator (``_sweep.route_hit``: the same operations)."""
         p, st, hand = self.params, self.stick, self.hand
         rows = array("d")
         prev = last = now
@@ -352,7 +416,7 @@ class ContactPlanner:
         # sweep_margin, or on the way at least the clearance it has now (it may start at the
         # stick it just hit: a route grazing the stick at speed is a hit)
         t1 = t_c + (p.post_horizon if check_idle else 0.0)
-        hit = _sweep.route_hit(
+        hit = _sweeps._sweep.route_hit(
             motion.packed,
             float(t),
             float(t1),

@@ -6,9 +6,11 @@ velocities the contact solution predicts, u_i = J_i u_{i-1} (eq. 22). A point is
 stick when it lies within a margin of the spec's L x W rectangle (W may be 0, the paper's
 Assumption 5). The planners sample the sweep every ``SAMPLE_DT``.
 
-Pure NumPy, with the sampled checks compiled (``_sweep.c``: the same operations, element by
-element; :func:`covered` and :func:`covered_along` are their NumPy references, which
-tests/replay/control/stick/test_sweep_kernel.py compares with them).
+NumPy: each check one vectorised pass over the samples (:func:`covered`, :func:`covered_along`).
+The sampled checks the planners repeat most (:func:`first_covered`, ``ContactPlanner
+.route_clear``) have an optional compiled accelerator (``_sweep.c``, ``replay.accel``: the same
+operations element by element, held to these NumPy paths by
+tests/replay/control/stick/test_sweep_kernel.py): ~20 % of a stick_3step run.
 """
 
 from __future__ import annotations
@@ -19,8 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.stick import _sweep
+from replay.accel import accelerator
 from replay.control.stick.estimator import StickEstimate
+
+_sweep = accelerator("replay.control.stick._sweep")
 
 SAMPLE_DT = 0.001  # s, time step of the predicted-sweep checks
 
@@ -58,7 +62,7 @@ class Motion:
 
     @functools.cached_property
     def packed(self) -> tuple:
-        """(x, y, theta, vx, vy, omega, t_ref, t_switch, u0, u1, u2): the compiled checks' motion."""
+        """(x, y, theta, vx, vy, omega, t_ref, t_switch, u0, u1, u2): the accelerator's motion."""
         e, u = self.est, self.u_after
         return (
             float(e.x),
@@ -145,19 +149,25 @@ def first_covered(
 ) -> float | None:
     """The first (``last``: the last) of :func:`sample_times` (t0, t1) at which the fixed
     ``point`` is within ``grow`` of the stick rectangle (:func:`covered`), or None."""
-    found = _sweep.covered_index(
-        motion.packed,
-        float(t0),
-        float(t1),
-        sample_count(t0, t1),
-        float(point[0]),
-        float(point[1]),
-        half_length,
-        half_width,
-        grow,
-        last,
-    )
-    return None if found is None else found[1]
+    if _sweep is not None:
+        found = _sweep.covered_index(
+            motion.packed,
+            float(t0),
+            float(t1),
+            sample_count(t0, t1),
+            float(point[0]),
+            float(point[1]),
+            half_length,
+            half_width,
+            grow,
+            last,
+        )
+        return None if found is None else found[1]
+    times = sample_times(t0, t1)
+    hit = np.flatnonzero(covered(motion, times, [point], half_length, half_width, grow)[:, 0])
+    if not hit.size:
+        return None
+    return float(times[hit[-1] if last else hit[0]])
 
 
 class Sweep:

@@ -40,7 +40,6 @@ def test_rerun_converts_a_catch_log_into_transforms_images_and_the_robot(tmp_pat
     rows: Counter = Counter()
     columns: dict[str, set] = defaultdict(set)
     children: set = set()
-    media: set = set()
     for chunk in RrdReader(rrd).store().stream():
         batch = chunk.to_record_batch()
         names = set(batch.schema.names)
@@ -50,10 +49,8 @@ def test_rerun_converts_a_catch_log_into_transforms_images_and_the_robot(tmp_pat
             rows[path, "Transform3D"] += chunk.num_rows
             for cell in batch.column("Transform3D:child_frame").to_pylist():
                 children.update(cell or [])
-        if "EncodedImage:blob" in names:
-            rows[path, "EncodedImage"] += chunk.num_rows
-            for cell in batch.column("EncodedImage:media_type").to_pylist():
-                media.update(cell or [])
+        if "Image:buffer" in names:
+            rows[path, "Image"] += chunk.num_rows
         if "TextLog:text" in names:
             rows[path, "TextLog"] += chunk.num_rows
 
@@ -64,8 +61,7 @@ def test_rerun_converts_a_catch_log_into_transforms_images_and_the_robot(tmp_pat
     assert {"wam_base", "wam_tool", "palm", "ball"} <= children
     for view in ("cam0", "cam1"):
         topic = f"/camera/stereo/{view}"
-        assert rows[topic, "EncodedImage"] == counts[topic] == 50
-    assert media == {"image/png"}
+        assert rows[topic, "Image"] == counts[topic] == 50
     assert rows[TOPIC_LOG, "TextLog"] == counts[TOPIC_LOG]
     robot = [p for p in columns if "/visual_geometries/" in p]  # the URDF on /robot_description
     assert any("wam_link1" in p for p in robot), sorted(columns)[:20]

@@ -1,71 +1,14 @@
-"""The log's own MCAP chunk builder (replay/log/chunks.py): the ``mcap`` library's bytes, an
-index the library's readers follow, CRCs that check, and channels of any encoding."""
-
-import io
-import random
+"""The log's MCAP file (the ``mcap`` library's Writer, replay/log/chunks.py): an index the
+library's readers follow, CRCs that check, sequence numbers per channel, and channels of any
+encoding."""
 
 import pytest
 
 from mcap.reader import make_reader
 from mcap.stream_reader import StreamReader
-from mcap.writer import CompressionType, Writer
 
 from replay.log import LogError, LogReader, LogWriter
-from replay.log.chunks import McapFile
 from replay.messages import Event, StickState
-
-
-def _script(seed: int):
-    """A random sequence of calls: channels registered mid-run, metadata between messages,
-    messages of random sizes at times that sometimes go back (so min/max are exercised)."""
-    rng = random.Random(seed)
-    calls = [("schema", "s1", "jsonschema", b'{"type":"object"}'), ("channel", "/a", "json", 1)]
-    channels, t = 1, 0
-    for i in range(3000):
-        r = rng.random()
-        if r < 0.003:
-            calls.append(("metadata", f"m{i}", {"k": str(i)}))
-        elif r < 0.006:
-            calls.append(
-                ("schema", f"s{i}", "protobuf", bytes(rng.randrange(256) for _ in range(9)))
-            )
-            calls.append(("channel", f"/c{i}", "protobuf", 2))
-            channels += 1
-        else:
-            t = max(0, t + rng.randrange(-2_000, 1_000_000))
-            data = bytes(rng.randrange(97, 123) for _ in range(rng.randrange(0, 400)))
-            calls.append(("message", rng.randrange(1, channels + 1), t, data))
-    return calls
-
-
-def test_same_bytes_as_the_mcap_writer_for_the_same_calls():
-    for seed in range(3):
-        ours, theirs = io.BytesIO(), io.BytesIO()
-        a = McapFile(ours, chunk_size=8_000, level=3)
-        b = Writer(theirs, chunk_size=8_000, compression=CompressionType.ZSTD)
-        a.start(profile="p", library="lib")
-        b.start(profile="p", library="lib")
-        sequence: dict[int, int] = {}
-        for call in _script(seed):
-            kind, args = call[0], call[1:]
-            if kind == "schema":
-                assert a.schema(*args) == b.register_schema(*args)
-            elif kind == "channel":
-                topic, encoding, schema = args
-                assert a.channel(topic, encoding, schema) == b.register_channel(
-                    topic, encoding, schema
-                )
-            elif kind == "metadata":
-                a.metadata(*args)
-                b.add_metadata(*args)
-            else:
-                channel, t, data = args
-                a.message(channel, t, t, data)
-                n = sequence[channel] = sequence.get(channel, -1) + 1
-                b.add_message(channel, log_time=t, data=data, publish_time=t, sequence=n)
-        a.finish()
-        b.finish()
-        assert ours.getvalue() == theirs.getvalue()
 
 
 def test_a_log_reads_through_its_index_and_its_crcs_check(tmp_path):

@@ -1,11 +1,12 @@
-"""The compiled JSON message path (replay/log/_chunk.c ``json``, LogWriter.write's first try):
-the same file as the Python path (encode, the channel, the record) for the same writes, and the
-same non-finite refusals, on seeded random payloads and topics."""
+"""LogWriter's JSON messages on seeded random payloads and topics: refusals of non-finite
+numbers that write nothing, sequence numbers per channel, and ``write_all`` writing what a loop of
+``write`` does."""
 
 import math
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
 
 from replay.log import LogWriter, NonFiniteValueError
 from replay.messages import Event, JointState, StickState
@@ -29,68 +30,30 @@ def _payload(rng):
     return {"t": 0.5, "v": _random_payload(rng)}
 
 
-def _write_all(path, writes, compiled: bool):
-    """The writes' outcome (written or refused, by field) and the file's bytes."""
-    refused = []
-    with LogWriter(path, chunk_size=4096) as log:
-        if not compiled:
-            log._json = lambda topic, payload, t_ns: False  # the Python path alone
-        for topic, payload, t_ns in writes:
-            try:
-                log.write(topic, payload, t_ns)
-                refused.append(None)
-            except NonFiniteValueError as exc:
-                refused.append((exc.topic, exc.fields))
-    return refused, path.read_bytes()
-
-
-@pytest.mark.parametrize("seed", [3, 4])
-def test_compiled_json_path_writes_the_python_paths_bytes(tmp_path, seed):
-    rng = np.random.default_rng(seed)
+def test_a_refused_payload_writes_nothing_and_sequences_count_per_channel(tmp_path):
+    """Seeded random payloads of what runs log: each is written or refused whole (a refusal
+    leaves the count as it was), and each channel's messages are numbered 0, 1, 2, ..."""
+    rng = np.random.default_rng(3)
     topics = [f"/t{i}" for i in range(6)] + ["/stick/state", "/events"]
-    writes = [
-        (topics[int(rng.integers(0, len(topics)))], _payload(rng), 1_000_000 * i)
-        for i in range(1500)
-    ]
-    fast_log, slow_log = tmp_path / "fast.mcap", tmp_path / "slow.mcap"
-    counted = {"compiled": 0}
-    refused, data = _write_all(fast_log, writes, compiled=True)
-    refused_ref, data_ref = _write_all(slow_log, writes, compiled=False)
-    # how many writes the compiled call took whole (the rest fell back to Python)
-    with LogWriter(tmp_path / "count.mcap") as log:
-        json = log._json
-        for topic, payload, t_ns in writes:
+    written: dict[str, int] = {}
+    refused = 0
+    with LogWriter(tmp_path / "a.mcap", chunk_size=4096) as log:
+        for i in range(1500):
+            topic = topics[int(rng.integers(0, len(topics)))]
+            count = log.count
             try:
-                if json(topic, payload, t_ns):
-                    counted["compiled"] += 1
-                else:
-                    log.write(topic, payload, t_ns)
+                log.write(topic, _payload(rng), 1_000_000 * i)
+                written[topic] = written.get(topic, 0) + 1
             except NonFiniteValueError:
-                pass
-    n_refused = sum(r is not None for r in refused)
-    print(
-        f"seed {seed}: {counted['compiled']}/{len(writes)} writes compiled whole, "
-        f"{n_refused} refused as non-finite; files equal: {data == data_ref}"
-    )
-    assert refused == refused_ref and 0 < n_refused < len(writes)
-    assert data == data_ref
-    assert len(writes) // 4 < counted["compiled"] < len(writes)
-
-
-def test_compiled_json_path_leaves_a_new_topic_and_a_bad_payload_to_python(tmp_path):
-    with LogWriter(tmp_path / "a.mcap") as log:
-        assert log._json("/x", {"t": 1.0}, 0) is False  # no channel yet
-        log.write("/x", {"t": 1.0}, 0)
-        assert log._json("/x", {"t": 2.0}, 1) is True
-        assert log._json("/x", {"t": np.float64(2.0)}, 2) is False  # orjson's TypeError
-        assert log._json("/x", {"t": math.nan}, 3) is False  # null: finite() says no
-        assert log._json("/x", {"t": None}, 4) is True  # a real null
-        count = log.count
-        with pytest.raises(NonFiniteValueError):
-            log.write("/x", {"t": math.inf}, 5)
-        assert log.count == count
-        with pytest.raises(OverflowError):
-            log._json("/x", {"t": 1.0}, -1)
+                refused += 1
+                assert log.count == count
+    assert 0 < refused < 1500 and log.count == 1500 - refused
+    with open(tmp_path / "a.mcap", "rb") as f:
+        seqs: dict[str, list[int]] = {}
+        for _, channel, message in make_reader(f).iter_messages(log_time_order=False):
+            seqs.setdefault(channel.topic, []).append(message.sequence)
+    assert {t: len(v) for t, v in seqs.items()} == written
+    assert all(v == list(range(len(v))) for v in seqs.values())
 
 
 def _write_dicts(path, groups, compiled: bool):
@@ -114,8 +77,8 @@ def _write_dicts(path, groups, compiled: bool):
 
 @pytest.mark.parametrize("seed", [5, 6])
 def test_write_all_writes_what_a_loop_of_write_does(tmp_path, seed):
-    """A dict's messages in one compiled call: new topics, lists, payloads only Python takes and
-    non-finite refusals where they come, the same records in the same order."""
+    """A dict's messages in one call: new topics, lists, payloads only the standard encoder
+    takes and non-finite refusals where they come, the same records in the same order."""
     rng = np.random.default_rng(seed)
     topics = [f"/t{i}" for i in range(8)] + ["/stick/state", "/events"]
     groups = []
@@ -133,9 +96,7 @@ def test_write_all_writes_what_a_loop_of_write_does(tmp_path, seed):
     assert data == data_ref
 
 
-def test_write_all_rejects_what_is_not_a_dict(tmp_path):
+def test_write_all_of_nothing_writes_nothing(tmp_path):
     with LogWriter(tmp_path / "x.mcap") as log:
-        with pytest.raises(TypeError, match="json_all"):
-            log._json_all([("/x", {"t": 1.0})], 0, 0)
-        log.write_all({}, 0)  # nothing to write
+        log.write_all({}, 0)
     assert log.count == 0

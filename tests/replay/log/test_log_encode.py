@@ -84,18 +84,3 @@ def _random_payload(rng, depth=0):
     if kind == 7:
         return {f"k{i}": v for i, v in enumerate(items)}
     return Event(0.1, "x", {"v": items})
-
-
-def test_compiled_finiteness_check_equals_the_python_reference():
-    from replay.log._finite import finite
-    from replay.log.writer import _finite
-
-    rng = np.random.default_rng(21)
-    n, agree, non_finite = 2000, 0, 0
-    for _ in range(n):
-        payload = _random_payload(rng)
-        agree += finite(payload) is _finite(payload)
-        non_finite += not _finite(payload)
-    print(f"compiled finite() = _finite() for {agree}/{n} payloads ({non_finite} non-finite)")
-    assert agree == n and 0 < non_finite < n
-    assert finite(np.float64("inf")) is False and finite(StickState(0, 1, 2, 3, 4, 5, 6)) is True

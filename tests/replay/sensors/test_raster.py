@@ -128,3 +128,65 @@ def test_quantise_is_clip_of_rint():
         [rng.uniform(-20, 280, 5000), np.arange(-2, 258, 0.5), [0.0, -0.0, 255.0, 1e30, -1e30]]
     ).astype(np.float32)
     np.testing.assert_array_equal(quantise(img), np.clip(np.rint(img), 0, 255).astype(np.uint8))
+
+
+# each case in a child process with a time limit: a kernel that loops for ever (as these did on
+# a NaN x coordinate, uninterruptibly) fails the test instead of hanging the suite
+_BAD_CHILD = r"""
+import sys
+import numpy as np
+from replay.scene import Box, Scene
+from replay.sensors.raster import composite, coverage
+bad = float(sys.argv[1])
+which = int(sys.argv[2])
+poly = np.array([[1.0, 1.0], [6.0, 1.5], [5.0, 6.0], [1.5, 5.0]])
+poly[which % 4, which % 2] = bad
+def kernel_error(call):
+    try:
+        call()
+    except ValueError as exc:
+        return str(exc)
+    return "no error"
+print(kernel_error(lambda: coverage([poly], 0, 0, 8, 8)))
+print(kernel_error(lambda: composite(np.zeros((8, 8), np.float32), [poly], [200.0])))
+if which == 0:  # the stick camera's compiled frame, the stick and its marker at a bad place
+    from replay.sensors.stick_camera import StickCamera, StickCameraParams
+    cam = StickCamera(StickCameraParams(), rng=np.random.default_rng(0))
+    marker = Box("marker", (bad, 0.0, 0.01), (0.0, 0.0, 0.0, 1.0), (0.08, 0.006, 0.002), 1.0)
+    near = Box("stick", (bad, 0.0, 0.005), (0.0, 0.0, 0.0, 1.0), (0.2, 0.02, 0.01), 0.5)
+    try:
+        print("measured", cam.measure(0.0, Scene([near, marker])))
+    except (ValueError, OverflowError) as exc:
+        print("refused", exc)
+if which == 1:  # the stereo camera's compiled frame, a ball and a box at a bad place
+    from replay.scene import Sphere
+    from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
+    cam = StereoBallCamera(StereoBallCameraParams(), rng=np.random.default_rng(0))
+    box = Box("box", (0.0, bad, 1.0), (0.0, 0.0, 0.0, 1.0), (0.1, 0.1, 0.1), 0.5)
+    try:
+        print("measured", cam.measure(0.0, Scene([Sphere("ball", (bad, 0.0, 1.0), 0.02), box])))
+    except (ValueError, OverflowError) as exc:
+        print("refused", exc)
+"""
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "-inf", "1e300"])
+@pytest.mark.parametrize("which", [0, 1, 2, 3])
+def test_a_non_finite_or_huge_vertex_is_refused_not_looped_on(bad, which, project_root):
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-c", _BAD_CHILD, bad, str(which)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=project_root,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    lines = done.stdout.splitlines()
+    assert len(lines) == (3 if which < 2 else 2), done.stdout
+    for line in lines[:2]:
+        assert "not a finite pixel coordinate" in line, line
+    if which < 2:  # the cameras: unseen (None) or refused, and returned (no hang, no crash)
+        assert lines[2] == "measured None" or lines[2].startswith("refused"), lines[2]

@@ -1,8 +1,9 @@
-"""The stick planners' compiled sweep checks (replay/control/stick/_sweep.c) against their NumPy
-references: sweep.covered for a fixed point (first / last covered sample; Sweep.hits is that too,
-tests/.../test_stick_fast_paths.py) and ContactPlanner.route_clear as it was written in NumPy before the kernel (kept here). The kernel
-repeats the NumPy operations in the same order, so the answers agree exactly on seeded random
-motions, points and routes, and the random cases exercise both answers."""
+"""The stick planners' optional sweep accelerator (replay/control/stick/_sweep.c) against their
+NumPy paths (what runs without it): sweep.covered for a fixed point (first / last covered
+sample; Sweep.hits is that too, tests/.../test_stick_fast_paths.py) and ContactPlanner
+.route_clear. The kernel repeats the NumPy operations in the same order, so the answers agree
+exactly on seeded random motions, points and routes, and the random cases exercise both
+answers. Skipped where the accelerator is not built (a pure-Python install, REPLAY_NO_ACCEL)."""
 
 from __future__ import annotations
 
@@ -11,19 +12,22 @@ import math
 import numpy as np
 import pytest
 
-from replay.control.stick.hand_model import Config, HandModel, route_configs, route_tips, travel
-from replay.control.stick.plan import CONTACT_GUARD, ContactPlanner
+from replay.control.stick import sweep as sweeps
+from replay.control.stick.hand_model import Config, HandModel, travel
+from replay.control.stick.plan import ContactPlanner
 from replay.control.stick.estimator import StickEstimate
 from replay.control.stick.strategy import ThreeStepParams
 from replay.control.stick.sweep import (
     Motion,
     covered,
-    covered_along,
     first_covered,
     sample_times,
 )
 
 from tests.replay.control.stick.test_stick_method import air_spec
+
+if sweeps._sweep is None:
+    pytest.skip("the sweep accelerator is not built (or REPLAY_NO_ACCEL)", allow_module_level=True)
 
 
 def random_motion(rng) -> Motion:
@@ -82,49 +86,12 @@ def test_first_and_last_covered_sample_are_numpys():
 
 
 def route_clear_reference(planner, t, now, route, k, motion, t_c, check_idle=True):
-    """ContactPlanner.route_clear in NumPy, as it was before the compiled kernel."""
-    p, st, hand = planner.params, planner.stick, planner.hand
-    starts, frm, to = [], [], []
-    prev = now
-    for i, (t_start, cfg) in enumerate(route):
-        if i + 1 < len(route):
-            if t_start + travel(hand, prev, cfg) > route[i + 1][0] + 1e-9:
-                return None
-        starts.append(t_start)
-        frm.append(prev)
-        to.append(cfg)
-        prev = cfg
-    arrival = starts[-1] + travel(hand, frm[-1], to[-1])
-    if arrival > t_c - p.arrive_margin:
-        return None
-    times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
-    base, joints = route_configs(hand, starts, frm, to, times)
-    tips = route_tips(hand, base, joints)
-    half_l, half_w = 0.5 * st.length, 0.5 * st.width
-    moving = times < arrival
-    act = times <= t_c - CONTACT_GUARD
-    c, th = poses = motion.poses(times)
-    if covered_along(
-        motion,
-        times[act],
-        tips[act, k],
-        half_l,
-        half_w,
-        hand.tip_radius - 5e-4,
-        poses=(c[act], th[act]),
-    ).any():
-        return None
-    if check_idle:
-        c0, th0 = motion.pose(t)
-        d = np.asarray(tips[0, 1 - k], dtype=float) - c0
-        cs, sn = math.cos(th0), math.sin(th0)
-        xb, yb = float(d[0] * cs + d[1] * sn), float(-d[0] * sn + d[1] * cs)
-        gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
-        on_way = max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
-        grow = np.where(moving, on_way, hand.tip_radius + p.sweep_margin)
-        if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow, poses).any():
-            return None
-    return arrival
+    """ContactPlanner.route_clear's NumPy path (the accelerator switched off)."""
+    kernel, sweeps._sweep = sweeps._sweep, None
+    try:
+        return planner.route_clear(t, now, route, k, motion, t_c, check_idle)
+    finally:
+        sweeps._sweep = kernel
 
 
 def random_config(rng, hand) -> Config:
