@@ -99,3 +99,17 @@ def test_the_falsifier_turns_the_4_5_ms_rows_to_differs(logs, tmp_path):
         variant = _run(f.scenario or f.replaces, tmp_path, sets)
         rows = {r.quantity: r for r in C.rows({**logs, f.replaces: variant})}
         assert rows[f.row].status == "differs", rows[f.row].measured
+
+
+def test_figures_8_9_end_at_first_contact_and_exist_for_the_slow_pair(logs, tmp_path):
+    from analysis.catch_claims import first_contact, load_run
+    from analysis.catch_figures import _joint_figure, make_figures
+
+    names = {p.name for p in make_figures(logs, tmp_path)}
+    for k in (6, 8, 9):
+        assert f"catch_5ms_fig{k}.png" in names and f"catch_fig{k}.png" in names
+    for pair in (("catch_optimised", "catch_initial"), C.PAIRS[1][1:]):
+        runs = [load_run(logs[n], n) for n in pair]
+        fig = _joint_figure(runs, "", "torques")
+        end = max(first_contact(r)["t"] for r in runs)
+        assert fig.axes[0].get_xlim()[1] == pytest.approx(end, abs=1e-9)
