@@ -215,6 +215,33 @@ def _model_rows(regime: str, name_opt: str, opt: LogReader, ini: LogReader) -> l
     ]
 
 
+EXTENSION = "catch_optimised_clamped"  # clamp-aware eq. 25 (not in the paper)
+
+
+def _extension_rows(ext: LogReader, ini: LogReader) -> list[Claim]:
+    a, b = window_effort(ext), window_effort(ini)
+    if a is None or b is None:
+        return []
+    return [
+        Claim(
+            f"EXTENSION (not in the paper), 8-10 m/s: clamp-aware eq. 25 vs initial, {what} "
+            "before first contact",
+            "(not stated: the extension's question)",
+            f"clamp-aware {a[key]:.3f} vs initial {b[key]:.3f} {unit} ({_pct(a[key], b[key])}); "
+            f"{'caught' if a['caught'] else 'not caught'} (initial "
+            f"{'caught' if b['caught'] else 'not caught'})",
+            compare(a[key], b[key]),
+            "cost Σ sat(τ)ᵀK_τ sat(τ) + 0.1 Σ (τ − sat τ)ᵀK_τ (τ − sat τ) + eq. 25's ω term "
+            "(scenarios/catch_optimised_clamped.yaml); plant truth; "
+            f"tie if within {100 * TIE:g} %",
+        )
+        for key, what, unit in (
+            ("travel_sum", "joint travel Σ‖Δq‖", "rad"),
+            ("tau_sq_dt_sum", "Σ τ² dt", "N²·m²·s"),
+        )
+    ]
+
+
 def rows(logs: dict[str, LogReader]) -> list[Claim]:
     """The thesis rows for whichever pairs of ``PAIRS`` are among ``logs`` (by scenario name)."""
     out: list[Claim] = []
@@ -225,6 +252,8 @@ def rows(logs: dict[str, LogReader]) -> list[Claim]:
         out.append(_cost_row(opt, regime))
         out += _pair_rows(regime, opt, ini)
         out += _model_rows(regime, name_opt, opt, ini)
+    if EXTENSION in logs and PAIRS[0][2] in logs:
+        out += _extension_rows(logs[EXTENSION], logs[PAIRS[0][2]])
     return out
 
 

@@ -13,7 +13,13 @@ from analysis.series import events
 from replay.log import LogReader
 
 ROOT = Path(__file__).resolve().parents[2]
-NAMES = ("catch_optimised", "catch_initial", "catch_5ms_optimised", "catch_5ms_initial")
+NAMES = (
+    "catch_optimised",
+    "catch_initial",
+    "catch_5ms_optimised",
+    "catch_5ms_initial",
+    C.EXTENSION,
+)
 
 
 def _run(name: str, out: Path, sets=()) -> LogReader:
@@ -113,3 +119,14 @@ def test_figures_8_9_end_at_first_contact_and_exist_for_the_slow_pair(logs, tmp_
         fig = _joint_figure(runs, "", "torques")
         end = max(first_contact(r)["t"] for r in runs)
         assert fig.axes[0].get_xlim()[1] == pytest.approx(end, abs=1e-9)
+
+
+def test_the_extension_rows_follow_their_numbers(logs, table):
+    """The clamp-aware extension (not in the paper) against the initial mapping at 9 m/s: its
+    alpha file is current, and its rows' statuses are the tie-band comparison of the numbers."""
+    assert not events(logs[C.EXTENSION], "warning"), "stale alpha: `replay optimise`"
+    a, b = C.window_effort(logs[C.EXTENSION]), C.window_effort(logs["catch_initial"])
+    ext = [r for q, r in table.items() if q.startswith("EXTENSION")]
+    assert len(ext) == 2
+    for row, key in zip(ext, ("travel_sum", "tau_sq_dt_sum")):
+        assert row.status == C.compare(a[key], b[key])
