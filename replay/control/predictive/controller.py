@@ -68,7 +68,10 @@ class PredictiveParams:
     accel_sigma: float = param(
         2.0, unit="m/s^2", gt=0.0, doc="Kalman process noise: unmodelled acceleration (drag, kicks)"
     )
-    min_measurements: int = param(10, ge=1, doc="frames before the first plan")
+    min_measurements: int = param(3, ge=1, doc="frames before the first plan, and ...")
+    min_track_time: float = param(
+        0.009, unit="s", ge=0.0, doc="... at least this long between the first and newest frame"
+    )
     search_step: float = param(
         0.004, unit="s", gt=0.0, doc="arrival times tried along the predicted arc, this apart"
     )
@@ -178,6 +181,7 @@ class PredictiveController(Controller):
         self.t_catch: float | None = None
         self.replans = 0
         self._t_plan = 0.0
+        self._t_first: float | None = None
         self.closing = False
         self._events: list[Occurrence] = []
 
@@ -189,7 +193,13 @@ class PredictiveController(Controller):
                 self.kf.add(m.t, m.position)
             elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
                 self._joint_state(m)
-        if self.kf.n >= P.min_measurements:
+        if self.kf.n == 1 and self._t_first is None:
+            self._t_first = self.kf.t
+        if (
+            self.kf.n >= P.min_measurements
+            and self._t_first is not None
+            and self.kf.t - self._t_first >= P.min_track_time - 1e-9
+        ):
             self._maybe_replan(t)
         if self.plan is not None:
             self.q_d, self.qd_d, self.qdd_d = self.plan(t)
