@@ -238,13 +238,17 @@ def summary_direct_vs_predictive(rows: list[dict]) -> str:
             f"with the direct mapping and {sp:.1f} m/s with the predictor ({hi:g} Hz, no "
             "kick). "
         )
+    per_cell = min(len(v) for v in _split(rows, "scenario", "kick", "camera").values())
+    if per_cell < 20:  # a rate from a throw or two is no evidence either way
+        return text + (
+            f"With {per_cell} throw{'s' if per_cell > 1 else ''} a cell this sweep supports no "
+            "conclusion; the shared throw set (python -m analysis.ablation_catch, "
+            "data/ablations/catch_shared_throws.md: 20 throws a cell, Wilson intervals) does."
+        )
     fast_gap = np.nanmean([d[0] - p[0], d[2] - p[2]])
     slow_gap = np.nanmean([d[1] - p[1], d[3] - p[3]])
     if np.isnan(fast_gap) or (max(np.nanmax(d), np.nanmax(p)) == 0):
-        text += (
-            "Neither method caught in this sweep, so it cannot test the claim yet (the "
-            "catching mapping misses on this code base)."
-        )
+        text += "Neither method caught in this sweep, so it cannot test the claim."
     elif fast_gap > 0 and fast_gap > slow_gap:
         text += "The direct mapping's advantage grows with the camera rate, as the paper argues."
     elif fast_gap > 0:
