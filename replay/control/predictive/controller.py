@@ -1,22 +1,21 @@
 """A predict-then-intercept baseline for the catching arm (not in Namiki & Ishikawa: the classic
-approach their direct mapping is set against, built here for the ablation).
+approach their direct mapping is set against, built here for the ablation; docs/catching.md).
 
 Each control step it
 
-1. filters the stereo positions with a Kalman filter (:mod:`.kalman`: state (r, v), known gravity);
-2. predicts the ballistic arc from the estimate and its first crossing of the catch surface
-   |r - O| = |c| (the same surface as the direct mapping's eq. 4: where q4 = q_alpha and the ball
-   meets the palm): the catch point p_c and time t_c;
-3. inverse kinematics of p_c on that surface (closed form, ``CatchGeometry.inverse``; q3 held);
-4. a quintic joint trajectory from the current desired state to (q_c, 0, 0), ending ``margin``
-   before t_c (at least ``min_duration`` long), **re-planned** whenever the predicted catch point
-   moves by more than ``replan_distance`` or t_c by more than ``replan_time`` (the estimates
-   improve, or the ball was disturbed), until ``freeze_time`` before t_c;
-5. tracks it with the same PD + inverse-dynamics law and torque saturation as the direct
-   controller, and closes the hand so that its closing ends at t_c.
-
-So the arm goes to where the ball will be and waits there, open-palmed toward the shoulder's
-outward normal, instead of moving with the ball as the direct mapping does.
+1. filters the stereo positions with a Kalman filter (:mod:`.kalman`: state (r, v), known
+   gravity); the first plan waits ``min_measurements`` frames spanning ``min_track_time``;
+2. chooses an intercept on the predicted ballistic arc (:func:`.intercept.choose_intercept`):
+   reachable (IK on J1, J2, J4, q3 held, inside the joint limits), the palm's inward normal
+   aligned with the incoming ball, the hand on the ball's centre at arrival;
+3. plans move -> glide -> brake (:class:`.trajectory.InterceptPlan`, velocity matching beta)
+   and makes it torque-feasible: the reference is the arm model driven along it by this
+   controller's own saturated law (:class:`.intercept.Rollout`), aimed by shooting so that it
+   lands on the ball; **re-planned** (from the desired state) when the prediction at the
+   planned arrival moves by more than ``replan_distance`` (at most every ``replan_interval``),
+   until ``freeze_time`` before the arrival;
+4. tracks it with the same PD + inverse-dynamics law and torque saturation as the direct
+   controller, and starts closing the hand at the planned arrival (+ ``close_delay``).
 """
 
 from __future__ import annotations

@@ -53,9 +53,6 @@ class Quintic:
         """(q, qd, qdd) at n instants evenly spread over [t0, t1]."""
         return [self(t) for t in np.linspace(self.t0, self.t1 - 1e-12, n)]
 
-    def peak_speed(self, n: int = 50) -> np.ndarray:
-        return np.max(np.abs([s[1] for s in self.samples(n)]), axis=0)
-
 
 class InterceptPlan:
     """Move, glide, brake (module doc). ``t_catch`` is the planned arrival t_c of the ball."""

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from replay.control.predictive import BallKalman, PredictiveController, Quintic, first_crossing
+from replay.control.predictive import BallKalman, PredictiveController, Quintic
 from replay.messages import TOPIC_ARM_ENCODERS, TOPIC_VISION_OBJECT, JointState, VisionObject
 
 ROOT = Path(__file__).resolve().parents[4]
@@ -30,15 +30,6 @@ def test_kalman_recovers_velocity_from_noisy_positions():
     assert np.linalg.norm(r - _arc(r0, v0, 0.099)) < 0.003
     assert np.linalg.norm(v - (v0 + G * 0.099)) < 0.15
     assert kf.velocity_sigma() < 0.2
-
-
-def test_first_crossing_lands_on_the_sphere():
-    r, v, o = np.array([2.0, 0.1, 0.8]), np.array([-9.0, 0.0, -1.0]), np.zeros(3)
-    s = first_crossing(r, v, G, o, 0.8)
-    assert s is not None and s > 0
-    assert np.linalg.norm(_arc(r, v, s) - o) == pytest.approx(0.8, abs=1e-9)
-    assert first_crossing(r, np.array([9.0, 0.0, 0.0]), np.zeros(3), o, 0.8) is None
-    assert first_crossing(np.array([0.1, 0, 0]), v, G, o, 0.8) == 0.0
 
 
 def test_quintic_meets_its_boundary_conditions():
@@ -140,3 +131,23 @@ def test_rollout_stays_within_the_torque_limits_and_obeys_the_model(spec):
         for k in (0, 40, 100):
             tau = m.inverse_dynamics_full(ro.q[k], ro.qd[k], ro.qdd[k])
             np.testing.assert_allclose(tau[act], ro.tau[k, act], atol=1e-6)
+
+
+def test_ik_round_trip_and_palm_angle(spec):
+    """solve_ik recovers seeded postures of the elbow-positive branch from their catch point
+    (from the method's seed), and the palm angle is 0 for a ball coming down -z_tool, 180 for
+    one leaving along it."""
+    from replay.control.predictive.intercept import palm_angle, solve_ik
+
+    arm, params = spec
+    ctrl = PredictiveController(params, spec=arm)
+    m = ctrl.model
+    rng = np.random.default_rng(8)
+    for _ in range(10):
+        p = np.array([rng.uniform(-0.3, 0.3), rng.uniform(0.6, 1.2), rng.uniform(0.5, 2.0)])
+        got, err = solve_ik(m, m.point(p), np.asarray(params.ik_seed, float))
+        assert err < 1e-7
+        np.testing.assert_allclose(got, p, atol=1e-5)
+        z = m.tool_axis(p)
+        assert palm_angle(m, p, -3.0 * z) == pytest.approx(0.0, abs=1e-6)
+        assert palm_angle(m, p, 2.0 * z) == pytest.approx(180.0, abs=1e-6)
