@@ -238,13 +238,17 @@ def summary_direct_vs_predictive(rows: list[dict]) -> str:
             f"with the direct mapping and {sp:.1f} m/s with the predictor ({hi:g} Hz, no "
             "kick). "
         )
+    per_cell = min(len(v) for v in _split(rows, "scenario", "kick", "camera").values())
+    if per_cell < 20:  # a rate from a throw or two is no evidence either way
+        return text + (
+            f"With {per_cell} throw{'s' if per_cell > 1 else ''} a cell this sweep supports no "
+            "conclusion; the shared throw set (python -m analysis.ablation_catch, "
+            "data/ablations/catch_shared_throws.md: 20 throws a cell, Wilson intervals) does."
+        )
     fast_gap = np.nanmean([d[0] - p[0], d[2] - p[2]])
     slow_gap = np.nanmean([d[1] - p[1], d[3] - p[3]])
     if np.isnan(fast_gap) or (max(np.nanmax(d), np.nanmax(p)) == 0):
-        text += (
-            "Neither method caught in this sweep, so it cannot test the claim yet (the "
-            "catching mapping misses on this code base)."
-        )
+        text += "Neither method caught in this sweep, so it cannot test the claim."
     elif fast_gap > 0 and fast_gap > slow_gap:
         text += "The direct mapping's advantage grows with the camera rate, as the paper argues."
     elif fast_gap > 0:
@@ -252,3 +256,127 @@ def summary_direct_vs_predictive(rows: list[dict]) -> str:
     else:
         text += "The direct mapping is not ahead of the predictor here: the claim is not borne out."
     return text
+
+
+# -- the shared throw set (issue #21): every controller on the same throws ---------------------
+
+SHARED_CONTROLLERS = {
+    "initial": "catch_initial",
+    "optimised": "catch_optimised",
+    "extension (clamp-aware)": "catch_optimised_clamped",
+    "predictor": "predictive_catch",
+}
+KICK = [[0.18, 0.0, 0.02, 0.0]]  # t (s), impulse (N*s): +y, 0.8 m/s on the 25 g ball (assumed)
+SHARED_CELLS: dict[str, dict] = {
+    # name: (throw-set arguments, scenario overrides); the base cell is the robustness test's
+    "base (8-10 m/s, 1 kHz)": {"throws": {}, "set": {}},
+    "arrival spread +-0.1 m": {"throws": {"spread": 0.1}, "set": {}},
+    "10-11 m/s": {"throws": {"speeds": (10.0, 11.0)}, "set": {}},
+    "camera 250 Hz": {
+        "throws": {},
+        "set": {"sensors.stereo.rate": 250, "sensors.stereo.latency": 0.004},
+    },
+    "camera 100 Hz": {
+        "throws": {},
+        "set": {"sensors.stereo.rate": 100, "sensors.stereo.latency": 0.01},
+    },
+    "latency 5 ms (1 kHz)": {"throws": {}, "set": {"sensors.stereo.latency": 0.005}},
+    "mid-flight kick": {"throws": {}, "set": {"plant.params.object_impulses": KICK}},
+}
+
+
+def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
+    """The Wilson score 95 % interval of a rate k/n (Wilson 1927)."""
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    den = 1.0 + z * z / n
+    mid = (p + z * z / (2 * n)) / den
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return float(max(0.0, mid - half)), float(min(1.0, mid + half))
+
+
+def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, out=None):
+    """Every controller on every cell's n seeded throws (the same throws for all): one row per
+    run with the plant's outcome (success, reason). ``out``: a CSV path to write."""
+    import csv
+    import json
+    import tempfile
+    from pathlib import Path
+
+    from analysis.ablation_throws import perturbed_throws, throw_overrides
+    from replay.runner import Runner
+    from replay.scenario import load_scenario
+
+    root = Path(__file__).resolve().parents[1]
+    cells = cells or list(SHARED_CELLS)
+    controllers = controllers or SHARED_CONTROLLERS
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="catch-shared-") as tmp:
+        for cell in cells:
+            spec = SHARED_CELLS[cell]
+            throws = perturbed_throws(n, seed, **spec["throws"])
+            sets = [f"{k}={json.dumps(v)}" for k, v in spec["set"].items()]
+            for label, name in controllers.items():
+                for i, th in enumerate(throws):
+                    sc = load_scenario(
+                        root / "scenarios" / f"{name}.yaml",
+                        throw_overrides(th) + sets + ["timing.duration=0.45", "stop.after=0.0"],
+                    )
+                    o = Runner(sc).run(Path(tmp) / "run.mcap").outcome
+                    rows.append(
+                        {
+                            "cell": cell,
+                            "controller": label,
+                            "throw": i,
+                            "speed": round(th["speed"], 4),
+                            "success": bool(o["success"]),
+                            "reason": o["reason"],
+                            "approach_angle": round(float(o.get("approach_angle", np.nan)), 1),
+                            "contact_speed": round(float(o.get("contact_speed", np.nan)), 2),
+                        }
+                    )
+    if out is not None:
+        with open(out, "w", newline="", encoding="utf-8") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    return rows
+
+
+def shared_table(rows: list[dict]) -> str:
+    """Markdown: per cell and controller the catch rate with its Wilson 95 % interval and the
+    failures' reasons."""
+    from collections import Counter
+
+    cells = list(dict.fromkeys(r["cell"] for r in rows))
+    ctrls = list(dict.fromkeys(r["controller"] for r in rows))
+    lines = ["| cell | " + " | ".join(ctrls) + " |", "|---" * (len(ctrls) + 1) + "|"]
+    for cell in cells:
+        parts = []
+        for c in ctrls:
+            sub = [r for r in rows if r["cell"] == cell and r["controller"] == c]
+            k = sum(str(r["success"]) in ("True", "true", "1") for r in sub)
+            lo, hi = wilson(k, len(sub))
+            why = Counter(r["reason"] for r in sub if str(r["success"]) not in ("True", "true"))
+            fails = "; ".join(f"{v}× {k_}" for k_, v in why.most_common())
+            parts.append(
+                f"{k}/{len(sub)} [{100 * lo:.0f}–{100 * hi:.0f} %]"
+                + (f" ({fails})" if fails else "")
+            )
+        lines.append(f"| {cell} | " + " | ".join(parts) + " |")
+    return "\n".join(lines)
+
+
+if (
+    __name__ == "__main__"
+):  # python -m analysis.ablation_catch [n]: data/ablations/catch_shared_throws.*
+    import sys
+    from pathlib import Path
+
+    n_throws = int(sys.argv[1]) if len(sys.argv) > 1 else 20
+    dest = Path(__file__).resolve().parents[1] / "data" / "ablations"
+    table_rows = run_shared(n_throws, out=dest / "catch_shared_throws.csv")
+    text = shared_table(table_rows)
+    (dest / "catch_shared_throws.md").write_text(text + "\n", encoding="utf-8")
+    print(text)

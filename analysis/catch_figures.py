@@ -47,6 +47,15 @@ def _span(run: CatchRun, after: float = 0.08) -> tuple[float, float]:
     return start, min(end, run.t_ctrl[-1])
 
 
+def _to_contact(run: CatchRun) -> tuple[float, float]:
+    """Figs. 8, 9's window: from 20 ms before t0 to the first ball-robot contact (the plant's
+    event; the optimisation's claim is about the motion before the ball is met), else t_c."""
+    start = (run.t0 if run.t0 is not None else run.t_ctrl[0]) - 0.02
+    c = first_contact(run)
+    end = c["t"] if c is not None else (run.t_c if run.t_c is not None else run.t_ctrl[-1])
+    return start, min(end, run.t_ctrl[-1])
+
+
 def _marks(ax, run: CatchRun, style: dict, text: bool = False) -> None:
     """t0 (mapping starts), t_c (catch surface), first contact and catch/miss, within the axes'
     time span (labels staggered so that close instants stay readable)."""
@@ -202,10 +211,10 @@ def fig7(runs: list[CatchRun], title: str):
 
 def _joint_figure(runs: list[CatchRun], title: str, what: str):
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.6, 6.4))
-    axes[0].set_xlim(min(_span(r, 0.1)[0] for r in runs), max(_span(r, 0.1)[1] for r in runs))
+    axes[0].set_xlim(min(_to_contact(r)[0] for r in runs), max(_to_contact(r)[1] for r in runs))
     for run in runs:
         st = STYLE["optimised" if run.mapping == "optimised" else "initial"]
-        t0, t1 = _span(run, after=0.1)
+        t0, t1 = _to_contact(run)
         wa = run.window(run.t_arm, t0, t1)
         wc = run.window(run.t_ctrl, t0, t1)
         for ax, j, name in zip(axes, ACTIVE, JOINTS):
@@ -254,7 +263,7 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
     fig.text(
         0.01,
         0.005,
-        note + "; vertical lines: t₀, t_c, contact, catch/miss",
+        note + "; t₀ → first contact; vertical lines: t₀, t_c, contact",
         fontsize=7,
         color="0.35",
     )
@@ -262,28 +271,43 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
     return fig
 
 
+def _pair_figures(pair: list[CatchRun], out: Path, prefix: str, note: str = "") -> list[Path]:
+    opt = next((r for r in pair if r.mapping == "optimised"), None)
+    ini = next((r for r in pair if r.mapping != "optimised"), None)
+    what = " vs ".join(r.name for r in pair) + note
+    paths = save(fig6(opt, ini), out, f"{prefix}_fig6")
+    paths += save(fig7(pair, f"Catching trajectory: {what} (cf. Fig. 7)"), out, f"{prefix}_fig7")
+    paths += save(
+        _joint_figure(pair, f"Joint angles: {what} (cf. Fig. 8)", "angles"), out, f"{prefix}_fig8"
+    )
+    paths += save(
+        _joint_figure(pair, f"Command torques: {what} (cf. Fig. 9)", "torques"),
+        out,
+        f"{prefix}_fig9",
+    )
+    return paths
+
+
+SLOW_PAIR = ("catch_5ms_optimised", "catch_5ms_initial")  # 4.5 m/s, outside the paper's speeds
+
+
 def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
-    """Figs. 6-9 for the optimised / unoptimised pair, and Fig. 7 for every other run."""
+    """Figs. 6-9 for the optimised / unoptimised pair, again for the 4.5 m/s pair
+    (``catch_5ms_fig*``, outside the paper's 8-10 m/s), and Fig. 7 for every other run."""
     out = Path(out)
     runs = {name: load_run(log, name) for name, log in sorted(logs.items())}
     if not runs:
         return []
-    opt, ini = _pair(runs)
+    slow = [runs[n] for n in SLOW_PAIR if n in runs]
+    rest = {n: r for n, r in runs.items() if n not in SLOW_PAIR}
+    opt, ini = _pair(rest) if rest else (None, None)
     pair = [r for r in (opt, ini) if r is not None]
     paths: list[Path] = []
     if pair:
-        what = " vs ".join(r.name for r in pair)
-        paths += save(fig6(opt, ini), out, "catch_fig6")
-        paths += save(fig7(pair, f"Catching trajectory: {what} (cf. Fig. 7)"), out, "catch_fig7")
-        paths += save(
-            _joint_figure(pair, f"Joint angles: {what} (cf. Fig. 8)", "angles"), out, "catch_fig8"
-        )
-        paths += save(
-            _joint_figure(pair, f"Command torques: {what} (cf. Fig. 9)", "torques"),
-            out,
-            "catch_fig9",
-        )
-    for name, run in runs.items():
+        paths += _pair_figures(pair, out, "catch")
+    if slow:
+        paths += _pair_figures(slow, out, "catch_5ms", " (4.5 m/s, not the paper's)")
+    for name, run in rest.items():
         if run in pair:
             continue
         paths += save(

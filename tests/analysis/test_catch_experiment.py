@@ -92,7 +92,9 @@ def test_catch_scenarios_state_the_papers_setup():
         assert (stereo.params.width, stereo.params.height) == (128, 128)
         assert sc.sensors["encoders"].type == "joint_encoders"
         assert {"catch", "miss"} <= set(sc.stop.on_events) and sc.stop.after > 0
-        assert not direct or (cp.mapping == "initial") == (path.stem == "catch_initial")
+        assert not direct or (cp.mapping == "initial") == (
+            path.stem in ("catch_initial", "catch_5ms_initial")
+        )
 
 
 @pytest.mark.parametrize(

@@ -171,6 +171,15 @@ class Params:
         doc="weight of the approach-direction term (not in the paper, "
         "approach.py): the ball down the palm axis; 0 = eq. 25 only",
     )
+    torque_cost: str = param(
+        "eq25",
+        choices=("eq25", "clamped"),
+        doc="'eq25': the paper's unclamped eq.-17 torque; 'clamped': an EXTENSION (not in the "
+        "paper): sat(tau) at the limits plus excess_weight times the undeliverable rest",
+    )
+    excess_weight: float = param(
+        0.1, unit="1", ge=0.0, le=1e6, doc="weight of tau - sat(tau) in the 'clamped' extension"
+    )
     max_iterations: int = param(40, ge=0, le=1000, doc="Levenberg-Marquardt iterations at most")
     kp: list[float] = param(
         [900.0, 1500.0, 300.0, 150.0],
@@ -325,6 +334,8 @@ class CatchingController(Controller):
             torque_penalty=P.torque_limit_penalty,
             approach_weight=P.approach_weight,
             max_iter=P.max_iterations,
+            torque_cost=P.torque_cost,
+            excess_weight=P.excess_weight,
         )
         self.problem = build_problem(model, self.config)
         self.history: list[CostRecord] = []

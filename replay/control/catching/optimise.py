@@ -78,6 +78,8 @@ class Objective:
         penalty: float = 100.0,
         approach=None,
         torque_penalty: float | None = None,
+        clamped: bool = False,
+        excess_weight: float = 0.1,
     ) -> None:
         self.mp, self.model, self.f = mapping, model, feats
         self.approach = approach  # ApproachTerm or None (eq. 25 as stated)
@@ -88,6 +90,11 @@ class Objective:
         self.wp = penalty  # hinge weight of eq. 24 (omega)
         self.wpt = penalty if torque_penalty is None else torque_penalty  # of eq. 22 (tau)
         self.nm, self.m = mapping.poly.n_mono, mapping.poly.m
+        # The extension (not in the paper): weigh the torque the arm can deliver, sat(tau) at
+        # +-tau_max, plus excess_weight times the undeliverable rest tau - sat(tau) (the
+        # saturated tracking error's cause), instead of eq. 25's unclamped tau.
+        self.clamped = clamped
+        self.we = excess_weight
 
     def trajectory(self, alpha):
         A = np.asarray(alpha).reshape(self.nm, self.m)
@@ -98,6 +105,17 @@ class Objective:
         q, qd, qdd = self.trajectory(alpha)
         return np.array([self.model.tau(a, b, c) for a, b, c in zip(q, qd, qdd)])  # eq. 17
 
+    def _split(self, tau):
+        """(sat(tau), tau - sat(tau)) at +-tau_max."""
+        sat = np.clip(tau, -self.tau_max, self.tau_max)
+        return sat, tau - sat
+
+    def _torque_residuals(self, tau) -> list:
+        if not self.clamped:
+            return [(np.sqrt(self.kt) * tau).ravel()]
+        sat, exc = self._split(tau)
+        return [(np.sqrt(self.kt) * sat).ravel(), (np.sqrt(self.we * self.kt) * exc).ravel()]
+
     def _parts(self, tau, omega):
         ht = np.maximum(np.abs(tau) / self.tau_max - 1.0, 0.0)
         hw = np.maximum(np.abs(omega) / self.omega_max - 1.0, 0.0)
@@ -106,17 +124,21 @@ class Objective:
     def record(self, it: int, alpha, tau=None) -> CostRecord:
         tau = self.torques(alpha) if tau is None else tau
         _, omega, _ = self.trajectory(alpha)
-        tc = float(np.sum(self.kt * tau**2))
+        tc = float(np.sum(self.kt * tau**2))  # eq. 25's torque cost, also for the extension
         vc = float(np.sum(self.kw * omega**2))
         ht, hw = self._parts(tau, omega)
         pen = float(self.wpt * np.sum(ht**2) + self.wp * np.sum(hw**2))
         ac = self.approach.cost(alpha) if self.approach is not None else 0.0
+        obj_t = tc
+        if self.clamped:
+            sat, exc = self._split(tau)
+            obj_t = float(np.sum(self.kt * sat**2) + self.we * np.sum(self.kt * exc**2))
         return CostRecord(
             it,
             tc,
             vc,
             pen,
-            tc + vc + pen + ac,
+            obj_t + vc + pen + ac,
             float(np.max(np.abs(tau) / self.tau_max)),
             float(np.max(np.abs(omega) / self.omega_max)),
             ac,
@@ -127,8 +149,7 @@ class Objective:
         _, omega, _ = self.trajectory(alpha)
         ht, hw = self._parts(tau, omega)
         sp, spt = np.sqrt(self.wp), np.sqrt(self.wpt)
-        parts = [
-            (np.sqrt(self.kt) * tau).ravel(),
+        parts = self._torque_residuals(tau) + [
             (np.sqrt(self.kw) * omega).ravel(),
             spt * ht.ravel(),
             sp * hw.ravel(),
@@ -159,9 +180,17 @@ class Objective:
         sp, spt = np.sqrt(self.wp), np.sqrt(self.wpt)
         Jht = (ht > 0)[..., None] * (np.sign(tau) / self.tau_max)[..., None] * Jt
         Jhw = (hw > 0)[..., None] * (np.sign(omega) / self.omega_max)[..., None] * Jw
+        if self.clamped:
+            inside = (np.abs(tau) <= self.tau_max)[..., None]
+            Jtau = [
+                (np.sqrt(self.kt)[:, None] * (inside * Jt)).reshape(-1, Jt.shape[-1]),
+                (np.sqrt(self.we * self.kt)[:, None] * (~inside * Jt)).reshape(-1, Jt.shape[-1]),
+            ]
+        else:
+            Jtau = [(np.sqrt(self.kt)[:, None] * Jt).reshape(-1, Jt.shape[-1])]
         J = np.concatenate(
-            [
-                (np.sqrt(self.kt)[:, None] * Jt).reshape(-1, Jt.shape[-1]),
+            Jtau
+            + [
                 (np.sqrt(self.kw)[:, None] * Jw).reshape(-1, Jw.shape[-1]),
                 spt * Jht.reshape(-1, Jt.shape[-1]),
                 sp * Jhw.reshape(-1, Jw.shape[-1]),

@@ -36,11 +36,20 @@ class ProblemConfig:
     torque_penalty: float = -1.0  # of eq. 22's alone; < 0 = ``penalty``
     approach_weight: float = 0.0  # w_app of the extension (approach.py); 0 = off
     max_iter: int = 40
+    # the extension (not in the paper, optimise.Objective): "eq25" weighs the unclamped eq.-17
+    # torque as the paper states; "clamped" weighs sat(tau) + excess_weight (tau - sat(tau))
+    torque_cost: str = "eq25"
+    excess_weight: float = 0.1
+
+    _KEY_DEFAULTS = {"torque_cost": "eq25", "excess_weight": 0.1}  # not keyed at these values
 
     def key(self, model: ArmModel | None = None) -> str:
         """A short hash of everything the optimum depends on: this config and, if given, the
         model (its catch point and mass matrix at two postures, rounded)."""
         data = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
+        if self.torque_cost == "eq25":  # keys of eq.-25 configurations as before the extension
+            for k in self._KEY_DEFAULTS:
+                data.pop(k)
         if model is not None:
             probe = []
             for p in ((0.0, math.pi / 4, 0.0), (0.3, 0.5, 1.2)):
@@ -126,6 +135,8 @@ def build_problem(model: ArmModel, cfg: ProblemConfig | None = None) -> Catching
         cfg.penalty,
         approach,
         cfg.torque_penalty if cfg.torque_penalty >= 0 else None,
+        clamped=cfg.torque_cost == "clamped",
+        excess_weight=cfg.excess_weight,
     )
     return CatchingProblem(
         cfg, model, geo, poly, mapping, throws, catch_point, nominal_v, C, rhs, obj

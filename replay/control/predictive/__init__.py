@@ -1,8 +1,18 @@
-"""A predict-then-intercept baseline for the catching arm (Kalman filter, ballistic catch point,
-inverse kinematics, a re-planned time-parameterised joint trajectory). Pure NumPy."""
+"""A predict-then-intercept baseline for the catching arm (Kalman filter, an intercept chosen for
+reach and palm alignment, a torque-feasible rollout plan). Pure NumPy."""
 
 from replay.control.predictive.controller import Params, PredictiveController
-from replay.control.predictive.kalman import BallKalman, first_crossing
-from replay.control.predictive.trajectory import Quintic
+from replay.control.predictive.intercept import Rollout, choose_intercept, solve_ik
+from replay.control.predictive.kalman import BallKalman
+from replay.control.predictive.trajectory import InterceptPlan, Quintic
 
-__all__ = ["Params", "PredictiveController", "BallKalman", "first_crossing", "Quintic"]
+__all__ = [
+    "Params",
+    "PredictiveController",
+    "Rollout",
+    "choose_intercept",
+    "solve_ik",
+    "BallKalman",
+    "InterceptPlan",
+    "Quintic",
+]

@@ -1,22 +1,21 @@
 """A predict-then-intercept baseline for the catching arm (not in Namiki & Ishikawa: the classic
-approach their direct mapping is set against, built here for the ablation).
+approach their direct mapping is set against, built here for the ablation; docs/catching.md).
 
 Each control step it
 
-1. filters the stereo positions with a Kalman filter (:mod:`.kalman`: state (r, v), known gravity);
-2. predicts the ballistic arc from the estimate and its first crossing of the catch surface
-   |r - O| = |c| (the same surface as the direct mapping's eq. 4: where q4 = q_alpha and the ball
-   meets the palm): the catch point p_c and time t_c;
-3. inverse kinematics of p_c on that surface (closed form, ``CatchGeometry.inverse``; q3 held);
-4. a quintic joint trajectory from the current desired state to (q_c, 0, 0), ending ``margin``
-   before t_c (at least ``min_duration`` long), **re-planned** whenever the predicted catch point
-   moves by more than ``replan_distance`` or t_c by more than ``replan_time`` (the estimates
-   improve, or the ball was disturbed), until ``freeze_time`` before t_c;
-5. tracks it with the same PD + inverse-dynamics law and torque saturation as the direct
-   controller, and closes the hand so that its closing ends at t_c.
-
-So the arm goes to where the ball will be and waits there, open-palmed toward the shoulder's
-outward normal, instead of moving with the ball as the direct mapping does.
+1. filters the stereo positions with a Kalman filter (:mod:`.kalman`: state (r, v), known
+   gravity); the first plan waits ``min_measurements`` frames spanning ``min_track_time``;
+2. chooses an intercept on the predicted ballistic arc (:func:`.intercept.choose_intercept`):
+   reachable (IK on J1, J2, J4, q3 held, inside the joint limits), the palm's inward normal
+   aligned with the incoming ball, the hand on the ball's centre at arrival;
+3. plans move -> glide -> brake (:class:`.trajectory.InterceptPlan`, velocity matching beta)
+   and makes it torque-feasible: the reference is the arm model driven along it by this
+   controller's own saturated law (:class:`.intercept.Rollout`), aimed by shooting so that it
+   lands on the ball; **re-planned** (from the desired state) when the prediction at the
+   planned arrival moves by more than ``replan_distance`` (at most every ``replan_interval``),
+   until ``freeze_time`` before the arrival;
+4. tracks it with the same PD + inverse-dynamics law and torque saturation as the direct
+   controller, and starts closing the hand at the planned arrival (+ ``close_delay``).
 """
 
 from __future__ import annotations
@@ -26,10 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.catching.mapping import CatchGeometry
 from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
-from replay.control.predictive.kalman import BallKalman, first_crossing
-from replay.control.predictive.trajectory import Quintic
+from replay.control.predictive.intercept import FeasiblePlan, Intercept, choose_intercept
+from replay.control.predictive.kalman import BallKalman
 from replay.interfaces import Controller, Occurrence
 from replay.messages import (
     TOPIC_ARM_ENCODERS,
@@ -46,20 +44,14 @@ from replay.robot.arm_types import ArmCommand, ArmSpec
 
 @dataclass
 class PredictiveParams:
-    q_alpha: float = param(
-        math.pi / 2,
+    ik_seed: list = param(
+        [0.0, math.pi / 4, math.pi / 2],
         unit="rad",
-        doc="joint angle of the selected joint at the catch (the catch "
-        "surface), as the direct mapping's",
+        length=3,
+        doc="(q1, q2, q4) the inverse kinematics starts from (the elbow branch: q4 > 0)",
     )
-    selected_joint: str = param("J4", doc="the joint at q_alpha on the catch surface")
     held_joints: list = param(["J3"], doc="joints held at their initial angle")
-    catch_q: list = param(
-        [0.0, math.pi / 4],
-        unit="rad",
-        length=2,
-        doc="(q1, q2) the inverse kinematics prefers (branch choice)",
-    )
+    selected_joint: str = param("J4", doc="the last active joint (as the direct mapping's)")
     catch_offset: float = param(
         -1.0,
         unit="m",
@@ -75,21 +67,50 @@ class PredictiveParams:
     accel_sigma: float = param(
         2.0, unit="m/s^2", gt=0.0, doc="Kalman process noise: unmodelled acceleration (drag, kicks)"
     )
-    min_measurements: int = param(3, ge=1, doc="frames before the first plan")
-    margin: float = param(
-        0.02, unit="s", ge=0.0, doc="reach the catch posture this long before the predicted arrival"
+    min_measurements: int = param(3, ge=1, doc="frames before the first plan, and ...")
+    min_track_time: float = param(
+        0.009, unit="s", ge=0.0, doc="... at least this long between the first and newest frame"
     )
-    min_duration: float = param(
-        0.03, unit="s", gt=0.0, doc="a re-planned trajectory lasts at least this long"
+    search_step: float = param(
+        0.004, unit="s", gt=0.0, doc="arrival times tried along the predicted arc, this apart"
+    )
+    max_lead: float = param(0.4, unit="s", gt=0.0, doc="the latest arrival tried")
+    settle: float = param(
+        0.008,
+        unit="s",
+        ge=0.001,
+        doc="the move ends this long before the arrival; then the hand glides at the matched "
+        "velocity (holds still if beta = 0)",
+    )
+    brake: float = param(0.06, unit="s", gt=0.0, doc="after arrival, stop the glide over this long")
+    match_max: float = param(
+        0.25, unit="1", ge=0.0, le=1.0, doc="largest fraction of the ball's velocity matched"
+    )
+    match_levels: int = param(2, ge=1, doc="beta values tried, match_max down to 0")
+    position_weight: float = param(
+        1.0, unit="deg/mm", ge=0.0, doc="cost of the rollout's hand missing the ball's centre"
+    )
+    speed_weight: float = param(
+        3.0, unit="deg/(m/s)", ge=0.0, doc="cost of the ball's speed relative to the hand"
+    )
+    switch_weight: float = param(
+        200.0, unit="deg/s", ge=0.0, doc="cost of moving the planned arrival on a re-plan"
+    )
+    shoot_iterations: int = param(
+        2, ge=0, doc="corrections of the target posture so that the rollout lands on the ball"
+    )
+    refine: int = param(6, ge=1, doc="best-aligned candidates whose rollouts are computed")
+    replan_interval: float = param(
+        0.005, unit="s", ge=0.0, doc="at least this long between two plans"
     )
     replan_distance: float = param(
-        0.005, unit="m", ge=0.0, doc="re-plan when the predicted catch point moves this far"
-    )
-    replan_time: float = param(
-        0.003, unit="s", ge=0.0, doc="re-plan when the predicted catch time moves this much"
+        0.003,
+        unit="m",
+        ge=0.0,
+        doc="re-plan when the prediction at the planned arrival moves this far",
     )
     freeze_time: float = param(
-        0.01, unit="s", ge=0.0, doc="no re-planning this close to the predicted catch"
+        0.01, unit="s", ge=0.0, doc="no re-planning this close to the planned arrival"
     )
     kp: list = param(
         [900.0, 1500.0, 300.0, 150.0],
@@ -103,8 +124,10 @@ class PredictiveParams:
         ge=0.0,
         doc="PD damping per arm joint (as the direct controller's)",
     )
-    close_lead: float = param(
-        0.0, unit="s", doc="start closing this much earlier than (t_c - closing time)"
+    close_delay: float = param(
+        0.0,
+        unit="s",
+        doc="start closing the hand this long after the planned arrival (negative: before)",
     )
 
 
@@ -117,8 +140,9 @@ class PredictiveController(Controller):
     command_type = ArmCommand
     reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)
     description = (
-        "predict-then-intercept baseline: Kalman filter, ballistic catch point, IK, "
-        "re-planned quintic joint trajectory, PD + dynamics"
+        "predict-then-intercept baseline: Kalman filter, intercept chosen for reach, palm "
+        "alignment and torque feasibility, move-glide-brake plan with velocity matching, PD + "
+        "dynamics"
     )
 
     def __init__(self, params: PredictiveParams, *, spec) -> None:
@@ -132,36 +156,31 @@ class PredictiveController(Controller):
         )
         self.q_init = np.asarray(spec.initial_q, float).copy()
         self.tau_limit = np.asarray(spec.torque_limits, float)
+        self.lower, self.upper = np.asarray(spec.lower, float), np.asarray(spec.upper, float)
         self.gravity = np.array([0.0, 0.0, -float(spec.gravity)])
         off = catch_point_offset(spec, P.catch_offset)
         self.model = ArmModel.from_chain(
             spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)
         )
-        self.geo = CatchGeometry.from_fk(self.model.fk, P.q_alpha, p_ref=tuple(P.catch_q))
         self.kp = np.asarray(P.kp, dtype=float)
         self.kd = np.asarray(P.kd, dtype=float)
         if self.kp.shape != (self.n,) or self.kd.shape != (self.n,):
             raise ValueError(f"kp and kd need {self.n} values")
         self.kf = BallKalman(self.gravity, meas_sigma=P.meas_sigma, accel_sigma=P.accel_sigma)
         self.hand = spec.hand
-        if self.hand is not None:
-            self.hand_open = np.asarray(self.hand.open_posture, float)
-            self.hand_closed = np.asarray(self.hand.closed_posture, float)
-            self.close_time = float(
-                np.max(np.abs(self.hand_closed - self.hand_open)) / self.hand.closing_speed
-            )
-        else:
-            self.close_time = 0.0
         self.q: np.ndarray | None = None
         self.qd: np.ndarray | None = None
         self.q_d = self.q_init.copy()
         self.qd_d = np.zeros(self.n)
         self.qdd_d = np.zeros(self.n)
         self.tau = np.zeros(self.n)
-        self.plan: Quintic | None = None
+        self.plan: FeasiblePlan | None = None
+        self.intercept: Intercept | None = None
         self.p_catch: np.ndarray = np.zeros(3)
         self.t_catch: float | None = None
         self.replans = 0
+        self._t_plan = 0.0
+        self._t_first: float | None = None
         self.closing = False
         self._events: list[Occurrence] = []
 
@@ -173,7 +192,13 @@ class PredictiveController(Controller):
                 self.kf.add(m.t, m.position)
             elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
                 self._joint_state(m)
-        if self.kf.n >= P.min_measurements:
+        if self.kf.n == 1 and self._t_first is None:
+            self._t_first = self.kf.t
+        if (
+            self.kf.n >= P.min_measurements
+            and self._t_first is not None
+            and self.kf.t - self._t_first >= P.min_track_time - 1e-9
+        ):
             self._maybe_replan(t)
         if self.plan is not None:
             self.q_d, self.qd_d, self.qdd_d = self.plan(t)
@@ -181,19 +206,14 @@ class PredictiveController(Controller):
             self.hand is not None
             and not self.closing
             and self.t_catch is not None
-            and t >= self.t_catch - self.close_time - P.close_lead - 1e-9
+            and t >= self.t_catch + P.close_delay - 1e-9
         ):
-            self.closing = True
-            self._events.append(
-                Occurrence(
-                    "hand_close",
-                    {"predicted_catch_time": self.t_catch, "closing_time": self.close_time},
-                )
-            )
+            self.closing = True  # closure on arrival (close_delay after it)
+            self._events.append(Occurrence("hand_close", {"predicted_catch_time": self.t_catch}))
         self.tau = self._torque()
         hand = None
         if self.hand is not None:
-            hand = (self.hand_closed if self.closing else self.hand_open).tolist()
+            hand = list(self.hand.closed_posture if self.closing else self.hand.open_posture)
         return ArmCommand(torque=self.tau.tolist(), hand=hand)
 
     def _maybe_replan(self, t: float) -> None:
@@ -201,33 +221,60 @@ class PredictiveController(Controller):
         if self.t_catch is not None and t >= self.t_catch - P.freeze_time:
             return
         r, v = self.kf.state(t)
-        s = first_crossing(r, v, self.gravity, self.geo.origin, self.geo.catch_radius)
-        if s is None:
+        start = (self.q_d, self.qd_d, self.qdd_d)
+        if self.t_catch is not None:  # has the prediction at the planned arrival moved?
+            s = self.t_catch - t
+            x = r + v * s + 0.5 * self.gravity * s * s
+            if np.linalg.norm(x - self.p_catch) <= P.replan_distance:
+                return
+            if t < self._t_plan + P.replan_interval - 1e-9:
+                return
+        ic = choose_intercept(
+            self.model,
+            t,
+            r,
+            v,
+            self.gravity,
+            start,
+            seed=np.asarray(P.ik_seed, float),
+            lower=self.lower,
+            upper=self.upper,
+            kp=self.kp,
+            kd=self.kd,
+            tau_limit=self.tau_limit,
+            s_min=P.settle + 0.005,
+            s_max=P.max_lead,
+            step=P.search_step,
+            settle=P.settle,
+            brake=P.brake,
+            match_max=P.match_max,
+            match_levels=P.match_levels,
+            position_weight=P.position_weight,
+            speed_weight=P.speed_weight,
+            switch_weight=P.switch_weight,
+            t_prev=self.t_catch,
+            shoot_iterations=P.shoot_iterations,
+            refine=P.refine,
+        )
+        if ic is None:
             return
-        t_c = t + s
-        p_c = r + v * s + 0.5 * self.gravity * s * s
-        if (
-            self.plan is not None
-            and self.t_catch is not None
-            and np.linalg.norm(p_c - self.p_catch) <= P.replan_distance
-            and abs(t_c - self.t_catch) <= P.replan_time
-        ):
-            return
-        inv = self.geo.inverse(p_c)
-        q_goal = self.model.full(inv.p[0])
-        t_end = max(t_c - P.margin, t + P.min_duration)
-        self.plan = Quintic(t, t_end, self.q_d, self.qd_d, self.qdd_d, q_goal)
-        self.t_catch, self.p_catch = t_c, p_c
+        self.intercept, self.plan = ic, ic.plan
+        self.t_catch, self.p_catch = ic.t_catch, ic.point
+        self._t_plan = t
         self.replans += 1
         self._events.append(
             Occurrence(
                 "plan",
                 {
-                    "catch_time": t_c,
-                    "catch_point": p_c.tolist(),
-                    "q_goal": q_goal.tolist(),
-                    "arrive": t_end,
-                    "in_domain": bool(inv.in_domain[0]),
+                    "catch_time": ic.t_catch,
+                    "catch_point": ic.point.tolist(),
+                    "q_goal": self.model.full(ic.p).tolist(),
+                    "palm_angle_deg": ic.angle_deg,
+                    "velocity_match": ic.beta,
+                    "target_torque_ratio": ic.torque_ratio,
+                    "rollout_error": ic.error,
+                    "rollout_relative_speed": ic.relative_speed,
+                    "candidates": ic.candidates,
                     "index": self.replans,
                     "position_sigma": self.kf.position_sigma(),
                     "velocity_sigma": self.kf.velocity_sigma(),

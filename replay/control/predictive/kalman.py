@@ -75,17 +75,3 @@ class BallKalman:
 
     def velocity_sigma(self) -> float:
         return float(np.sqrt(np.trace(self.P[3:, 3:]) / 3.0)) if self.n else float("inf")
-
-
-def first_crossing(r, v, g, origin, radius: float) -> float | None:
-    """Smallest s >= 0 with |r + v s + g s^2 / 2 - origin| = radius (None if the arc never gets
-    there): the quartic |d + v s + g s^2/2|^2 = R^2, d = r - origin."""
-    d = np.asarray(r, float) - np.asarray(origin, float)
-    v, g = np.asarray(v, float), np.asarray(g, float)
-    if d @ d <= radius * radius:
-        return 0.0
-    coeffs = [0.25 * (g @ g), v @ g, v @ v + d @ g, 2.0 * (d @ v), d @ d - radius * radius]
-    roots = np.roots(coeffs)
-    real = roots[np.abs(roots.imag) < 1e-9].real
-    real = real[real >= 0.0]
-    return float(real.min()) if real.size else None

@@ -472,3 +472,36 @@ def test_approach_jacobian_and_the_extension_lowers_it(approach_problem):
     assert res.history[-1].approach_cost < res.history[0].approach_cost
     assert res.history[-1].objective < res.history[0].objective
     assert res.constraint_residual < 1e-9
+
+
+# ------------------------------------------- the clamp-aware extension (not in the paper, #21)
+def test_clamped_cost_jacobian_and_its_reduction_to_eq25():
+    """The 'clamped' torque cost's Jacobian matches central differences at a random alpha near
+    alpha0 (away from the clamp's kinks), and with limits no sample reaches it is eq. 25."""
+    from dataclasses import replace
+
+    model = _model()
+    base = ProblemConfig(tau_max=(60.0, 60.0, 30.0), omega_max=(3.0, 13.5, 37.0), max_iter=3)
+    pb = build_problem(model, replace(base, torque_cost="clamped", excess_weight=0.1))
+    obj = pb.objective
+    rng = np.random.default_rng(21)
+    a = initial_alpha(pb.C, pb.rhs) + rng.standard_normal(pb.C.shape[1]) * 1e-3
+    r, tau, J = obj.jacobian(a)
+    d = rng.standard_normal(a.shape) * 1e-6
+    fd = (obj.residuals(a + d)[0] - obj.residuals(a - d)[0]) / 2
+    # rows whose torque sample crosses a limit within +-d are kinks: leave them out
+    tp, tm = obj.torques(a + d), obj.torques(a - d)
+    lim = obj.tau_max
+    kink = ((np.abs(tp) > lim) != (np.abs(tm) > lim)).ravel()
+    n = tau.size
+    keep = np.ones(len(r), bool)
+    for k in (0, 1, 3):  # sat, excess and the eq.-22 hinge rows kink at the limits
+        keep[k * n : (k + 1) * n][kink] = False
+    assert np.any(np.abs(tau) > lim)  # the 9 m/s set saturates: the test sees both branches
+    np.testing.assert_allclose((J @ d)[keep], fd[keep], rtol=1e-3, atol=1e-9)
+    big = replace(base, tau_max=(1e5, 1e5, 1e5))
+    e25 = build_problem(model, big).objective
+    ext = build_problem(model, replace(big, torque_cost="clamped")).objective
+    assert ext.record(0, a).objective == pytest.approx(e25.record(0, a).objective, rel=1e-12)
+    assert ProblemConfig().key() == replace(ProblemConfig(), excess_weight=0.1).key()
+    assert ProblemConfig().key() != replace(ProblemConfig(), torque_cost="clamped").key()
