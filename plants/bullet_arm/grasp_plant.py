@@ -64,24 +64,20 @@ class BulletGraspPlant(BulletArmPlant):
         assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
-        # the servos: every arm and hand joint's own inertia at the initial posture
+        # the hand joints: no PyBullet default motor (their VelocityMotors drive them)
         bc.setJointMotorControlArray(
             self.robot, self._hand_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._hand_j)
         )
-        dofs = [j for j in self._dofs]
+        # the servos are inertia-decoupled (servo.VelocityServos): the arm joints' block of the
+        # mass matrix (hand joints held by their drives) at the posture of each step
+        dofs = list(self._dofs)
+        read = self._arm_j + self._hand_j
+        self._dof_from_read = [read.index(j) for j in dofs]
+        self._arm_rows = [dofs.index(j) for j in self._arm_j]
+        self._mass_matrix = bc.calculateMassMatrix
         pos = [s[0] for s in bc.getJointStates(self.robot, dofs)]
-        Minv = np.linalg.inv(np.array(bc.calculateMassMatrix(self.robot, pos)))
-        # each joint's effective inertia with the others free (1 / (M^-1)_jj), divided by the
-        # largest eigenvalue of M^-1 diag(1 / (M^-1)_jj) (~2.7: the joints' coupling), so that
-        # the fastest mode of all loops acting together has the stated bandwidth
-        d = 1.0 / np.diag(Minv)
-        coupling = float(np.max(np.linalg.eigvals(Minv * d[None, :]).real))
-        inertia = {j: d[i] / coupling for i, j in enumerate(dofs)}
         self.arm_servos = VelocityServos(
-            [inertia[j] for j in self._arm_j],
-            self.torque_limits[list(self.active)],
-            P.arm_servo_bandwidth,
-            dt,
+            self.torque_limits[list(self.active)], P.arm_servo_bandwidth, dt
         )
         self.hand_servos = VelocityMotors(
             bc, self.robot, self._hand_j, [P.hand_max_torque] * len(self._hand_j)
@@ -91,7 +87,8 @@ class BulletGraspPlant(BulletArmPlant):
         # static torques (gravity) at the initial posture
         g = bc.calculateInverseDynamics(self.robot, pos, [0.0] * len(dofs), [0.0] * len(dofs))
         tau0 = {j: g[i] for i, j in enumerate(dofs)}
-        self.arm_servos.preload([tau0[j] for j in self._arm_j])
+        self._dof_pos = pos
+        self.arm_servos.preload([tau0[j] for j in self._arm_j], self.arm_mass_matrix())
         # the head
         self.head = HeadSpec(
             position=tuple(P.head_position),
@@ -174,6 +171,7 @@ class BulletGraspPlant(BulletArmPlant):
         """The base's state cache (plain floats) from one getJointStates of arm, hand and palm
         joint, with the servos' torques, the wrist's wrench and the object's state."""
         states = self._get_joint_states(self.robot, self._all_j)  # arm, hand, palm joint
+        self._dof_pos = [states[k][0] for k in self._dof_from_read]
         (q, qd), (hq, hqd, heff) = joint_state(states[:-1], self._na, self._pick, self._q_locked_l)
         servos = self.arm_servos
         if self._all_active:
@@ -200,6 +198,11 @@ class BulletGraspPlant(BulletArmPlant):
             self._read()
             assert self._cache is not None
         return self._cache
+
+    def arm_mass_matrix(self) -> np.ndarray:
+        """The arm joints' block of the joint-space mass matrix now (kg m^2)."""
+        M = np.asarray(self._mass_matrix(self.robot, self._dof_pos))
+        return M[np.ix_(self._arm_rows, self._arm_rows)]
 
     def _link_point_velocity(self, link: int, point) -> tuple[float, float, float]:
         if link != self._palm_link:
@@ -233,7 +236,8 @@ class BulletGraspPlant(BulletArmPlant):
             self._servo_j,
             p.TORQUE_CONTROL,
             forces=self.arm_servos.torques(
-                qd if self._all_active else [qd[i] for i in self.active]
+                qd if self._all_active else [qd[i] for i in self.active],
+                self.arm_mass_matrix(),
             ),
         )
         self.hand_servos.actuate()

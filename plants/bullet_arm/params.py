@@ -252,8 +252,8 @@ class GraspParams(Params):
         unit="rad/s",
         gt=0.0,
         le=1500.0,
-        doc="velocity-loop bandwidth of the arm's AC servo amplifiers (assumed ~80 Hz; the "
-        "explicit 1 kHz loop needs bandwidth * dt well below 2)",
+        doc="closed-loop bandwidth of the arm's AC servo velocity loops (inertia-decoupled, "
+        "plants/bullet_arm/servo.py: every joint's; assumed ~80 Hz)",
     )
     plane_normal: list = param(
         [1.0, 0.0, 0.0],
