@@ -8,7 +8,8 @@ What it adds to :class:`BulletArmPlant` (same URDF builder, same object, same co
   gauges' F^h);
 - a 2-axis pan/tilt **head** (``head.HeadServo``) carrying the vision chip's camera;
 - the wrist's 6-axis **force/torque sensor** on the fixed flange-palm joint (``ft_sensor``);
-- a **human hand** moving the object on its constraint plane (``human_hand``);
+- a **human hand** moving the object on its constraint plane, a compliant spring-damper coupling
+  to its seeded path (``human_hand``);
 - events ``grasp`` (the base's hold event under this name), ``release`` (with how long it was
   held), ``slip``, and the run's outcome: grasped, held while the human kept moving the object.
 
@@ -29,7 +30,7 @@ from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.head import HeadServo
 from plants.bullet_arm.human_hand import HumanHand
 from plants.bullet_arm.params import GraspParams
-from plants.bullet_arm.payloads import HeadState, HumanState, ServoState, Wrench
+from plants.bullet_arm.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
 from plants.bullet_arm.plant import BulletArmPlant
 from plants.bullet_arm.servo import VelocityMotors, VelocityServos
 from replay.interfaces import Occurrence
@@ -141,6 +142,13 @@ class BulletGraspPlant(BulletArmPlant):
             components=P.human_components,
             max_force=P.human_max_force,
             start=P.human_start,
+            mass=P.object_mass,
+            gravity=P.gravity,
+            stiffness=P.human_stiffness,
+            damping=P.human_damping,
+            rot_stiffness=P.human_rot_stiffness,
+            rot_damping=P.human_rot_damping,
+            max_torque=P.human_max_torque,
         )
         # bookkeeping of the verdict
         self._grasps: list[dict] = []
@@ -229,8 +237,8 @@ class BulletGraspPlant(BulletArmPlant):
             self.head_servo.set_command(command.head)
 
     def step(self) -> None:
-        self.human.drive(self._t)
         (_, qd), _, obj = self._state()
+        self.human.drive(self._t, *obj)
         self._set_motors(
             self.robot,
             self._servo_j,
@@ -383,6 +391,14 @@ class BulletGraspPlant(BulletArmPlant):
         human = self.human
         out["/human/state"] = HumanState(
             t, human.target_l[:], float(human.roll), human.force(), human.max_force
+        )
+        pos = self._state()[2][0]
+        out["/human/wrench"] = HumanWrench(
+            t,
+            human.force(),
+            human.torque_l[:],
+            [a - b for a, b in zip(pos, human.target_l)],
+            human.limited,
         )
         w = self._wrench
         out["/wrist/wrench_truth"] = Wrench(t, w[:3], w[3:])

@@ -272,7 +272,30 @@ class GraspParams(Params):
     human_f_max: float = param(1.0, unit="Hz", gt=0.0, doc="band limit of the path")
     human_components: int = param(6, ge=1, doc="sinusoids per path axis")
     human_max_force: float = param(
-        30.0, unit="N", gt=0.0, doc="force limit of the human's hold (grip and arm strength)"
+        30.0,
+        unit="N",
+        gt=0.0,
+        doc="limit on the magnitude of the human hand's total force on the object (grip and "
+        "arm strength)",
+    )
+    human_stiffness: float = param(
+        500.0,
+        unit="N/m",
+        gt=0.0,
+        doc="stiffness of the human hand's hold about its path (assumed: a human arm's "
+        "endpoint stiffness is ~200-1000 N/m)",
+    )
+    human_damping: float = param(
+        10.0, unit="N*s/m", ge=0.0, doc="damping of the human hand's hold about its path"
+    )
+    human_rot_stiffness: float = param(
+        0.5, unit="N*m/rad", ge=0.0, doc="rotational stiffness of the human's hold (assumed)"
+    )
+    human_rot_damping: float = param(
+        0.01, unit="N*m*s/rad", ge=0.0, doc="rotational damping of the human's hold"
+    )
+    human_max_torque: float = param(
+        1.0, unit="N*m", gt=0.0, doc="limit on the magnitude of the human hand's torque"
     )
     human_start: float = param(0.0, unit="s", ge=0.0, doc="the human starts moving at this time")
     head_position: list = param(
