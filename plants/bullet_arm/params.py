@@ -326,12 +326,35 @@ class GraspParams(Params):
     head_servo_bandwidth: float = param(
         300.0, unit="rad/s", gt=0.0, doc="velocity-loop bandwidth of the head's DC servos"
     )
-    slip_speed: float = param(
-        0.05,
-        unit="m/s",
+    slip_distance: float = param(
+        0.001,
+        unit="m",
         gt=0.0,
-        doc="while grasped, object speed relative to the palm above this "
-        "starts a slip (a slip event), below half of it ends it",
+        doc="while grasped, the object moving this far in the hand's frame within slip_time "
+        "starts a slip (a slip event: sustained relative motion, not one step's solver "
+        "chatter); under half of it over slip_time ends it",
+    )
+    slip_time: float = param(0.01, unit="s", gt=0.0, doc="the window of slip_distance")
+    grasp_max_drift: float = param(
+        0.010,
+        unit="m",
+        gt=0.0,
+        doc="held: during a grasp the object stays within this of where it sat in the hand "
+        "(the hand's frame) when the grasp began",
+    )
+    grasp_max_human_offset: float = param(
+        0.020,
+        unit="m",
+        gt=0.0,
+        doc="with the human: during a grasp the object stays within this of the human hand's "
+        "path (not carried away)",
+    )
+    grasp_max_off_plane: float = param(
+        0.010,
+        unit="m",
+        gt=0.0,
+        doc="on its plane: over the whole run the object stays within this of its constraint "
+        "plane (the reach did not shove it off)",
     )
     grasp_min_grasps: int = param(1, ge=1, doc="grasps a successful run has")
     grasp_min_hold: float = param(

@@ -96,7 +96,12 @@ class HandParams:
         _CIRC_GRIP, unit="rad", length=14, doc="theta_d^h fully closed on a circle"
     )
     close_from: float = param(
-        0.8, unit="1", ge=0.0, lt=1.0, doc="reach progress (x_d^a) from which theta_d^h closes"
+        0.9,
+        unit="1",
+        ge=0.0,
+        lt=1.0,
+        doc="reach progress (x_d^a) from which theta_d^h closes (the arm lags x_d^a by ~1-2 cm: "
+        "0.8 closed the fingers on the ball before the palm was there, shoving it off its plane)",
     )
     load_filter: float = param(
         0.005,
