@@ -350,11 +350,12 @@ class GraspParams(Params):
         "path (not carried away)",
     )
     grasp_max_off_plane: float = param(
-        0.010,
+        0.020,
         unit="m",
         gt=0.0,
         doc="on its plane: over the whole run the object stays within this of its constraint "
-        "plane (the reach did not shove it off)",
+        "plane (the reach did not shove it off; the human's own tolerance, "
+        "grasp_max_human_offset: 10 N on its 500 N/m hold)",
     )
     grasp_min_grasps: int = param(1, ge=1, doc="grasps a successful run has")
     grasp_min_hold: float = param(

@@ -53,7 +53,7 @@ S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
 class ArmParams:
     K_ap: float = param(1.0, unit="1", ge=0.0, doc="eq. 2's K^ap (a scalar times I)")
     K_a1: list = param(
-        [0.0, 40.0, 40.0, 20.0, 0.0, 0.0],
+        [0.0, 60.0, 60.0, 30.0, 0.0, 0.0],
         unit="1/s",
         length=6,
         ge=0.0,
@@ -68,11 +68,11 @@ class ArmParams:
     )
     K_av: float = param(0.05, unit="1", ge=0.0, doc="eq. 2's K^av (scalar times I)")
     K_af: float = param(
-        0.15,
+        0.3,
         unit="rad/(s*N*m)",
         ge=0.0,
         doc="eq. 2's K^af (scalar times I): compliance to the external wrench on the hand "
-        "(assumed; checked 0, 0.05 and 0.15 in the ablation: data/ablations/grasp_force.*)",
+        "(assumed; the ablation analysis/ablation_grasp.py compares 0, 0.3 and 0.6)",
     )
     grasp_point: float = param(
         0.045,
