@@ -313,6 +313,9 @@ class BulletGraspPlant(BulletArmPlant):
                         "in_hand": self._in_hand_position(pos),
                         "drift": 0.0,
                         "human": 0.0,
+                        "force_sq": 0.0,
+                        "force_max": 0.0,
+                        "n": 0,
                     }
                 )
                 self._in_hand.clear()
@@ -340,6 +343,11 @@ class BulletGraspPlant(BulletArmPlant):
             r0 = g["in_hand"]
             g["drift"] = max(g["drift"], math.dist(h, r0))
             g["human"] = max(g["human"], math.dist(pos, self.human.target_l))
+            fx, fy, fz = self.human.force_l  # the human's force on the object (last step)
+            f2 = fx * fx + fy * fy + fz * fz
+            g["force_sq"] += f2
+            g["force_max"] = max(g["force_max"], math.sqrt(f2))
+            g["n"] += 1
             # a slip: the object moved >= slip_distance in the hand within slip_time
             # (sustained relative motion); over when it moves less than half of that
             buf = self._in_hand
@@ -377,6 +385,7 @@ class BulletGraspPlant(BulletArmPlant):
         holds = [(g["held_for"] if g["held_for"] is not None else t - g["t"]) for g in self._grasps]
         drift = max((g["drift"] for g in self._grasps), default=0.0)
         human = max((g["human"] for g in self._grasps), default=0.0)
+        n_held = sum(g["n"] for g in self._grasps)
         out = {
             "success": True,
             "reason": "grasped and held with the human",
@@ -389,6 +398,10 @@ class BulletGraspPlant(BulletArmPlant):
             "hold_drift_max": drift,
             "hold_human_offset_max": human,
             "off_plane_max": self._off_plane,
+            "hold_human_force_rms": (
+                math.sqrt(sum(g["force_sq"] for g in self._grasps) / n_held) if n_held else None
+            ),
+            "hold_human_force_max": max((g["force_max"] for g in self._grasps), default=None),
             "tracking_error_rms": (
                 math.sqrt(self._track_sq / self._track_n) if self._track_n else None
             ),
