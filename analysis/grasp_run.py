@@ -94,6 +94,7 @@ class GraspRun:
     human_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # N, world
     t_contacts: np.ndarray = field(default_factory=lambda: np.zeros(0))
     grip_force: np.ndarray = field(default_factory=lambda: np.zeros(0))  # N, summed normals
+    arm_task: list = field(default_factory=list)  # T_ARM_TASK messages (x_a, wrench, terms)
 
     # ---------------------------------------------------------------- helpers
     @property
@@ -250,6 +251,7 @@ def load_run(log: LogReader, name: str | None = None) -> GraspRun:
         tasks=log.series(T_TASKS),
         events=events(log),
     )
+    run.arm_task = eff
     ef = [m for m in log.series(T_EFFECTOR) if m.get("position")]
     run.t_tool, run.tool = _vec(ef, "t"), _vec(ef, "position", 3)
     run.tool_orn = _vec(ef, "orientation", 4)
