@@ -27,7 +27,7 @@ import math
 import numpy as np
 import pybullet as p
 
-from replay.spatial import matrix_to_quaternion, quaternion_matrix, rpy_to_matrix
+from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 
 
 def band_limited_path(
@@ -164,47 +164,40 @@ class HumanHand:
         self.velocity_l = [ru * a + rv * b for a, b in zip(self._u, self._v)]
         self.roll, self.roll_rate = dr, rr
         k, c = self.k, self.c
-        F = np.array(
-            [
-                k * (x_h - x) + c * (v_h - v)
-                for x_h, x, v_h, v in zip(self.target_l, pos, self.velocity_l, vel)
-            ]
-        )
+        F = [
+            k * (x_h - x) + c * (v_h - v)
+            for x_h, x, v_h, v in zip(self.target_l, pos, self.velocity_l, vel)
+        ]
         F[2] += self.weight
-        # rotation: the error R_h R^T as a rotation vector (world), the roll rate about n
-        R_h = quaternion_matrix(self.target_orientation())
-        R = quaternion_matrix(list(orn))
-        E = R_h @ R.T
-        T = self.k_r * _rotvec(E) + self.c_r * (rr * self.n - np.asarray(omega, float))
+        # rotation: the error q_h q^-1 (world) as a rotation vector, the roll rate about n
+        hx, hy, hz, hw = self.target_orientation()
+        bx, by, bz, bw = -orn[0], -orn[1], -orn[2], orn[3]  # q^-1 (unit q)
+        ex = hw * bx + hx * bw + hy * bz - hz * by
+        ey = hw * by - hx * bz + hy * bw + hz * bx
+        ez = hw * bz + hx * by - hy * bx + hz * bw
+        ew = hw * bw - hx * bx - hy * by - hz * bz
+        if ew < 0.0:  # the shorter way round
+            ex, ey, ez, ew = -ex, -ey, -ez, -ew
+        sn = math.sqrt(ex * ex + ey * ey + ez * ez)
+        g = 2.0 * math.atan2(sn, ew) / sn if sn > 1e-12 else 2.0
+        kr, cr, n = self.k_r, self.c_r, self._n
+        T = [kr * g * e + cr * (rr * nn - w) for e, nn, w in zip((ex, ey, ez), n, omega)]
         self.limited = False
-        f, tq = float(np.linalg.norm(F)), float(np.linalg.norm(T))
+        f = math.sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2])
+        tq = math.sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2])
         if f > self.max_force:
-            F *= self.max_force / f
+            F = [x * (self.max_force / f) for x in F]
             self.limited = True
         if tq > self.max_torque:
-            T *= self.max_torque / tq
+            T = [x * (self.max_torque / tq) for x in T]
             self.limited = True
-        self.force_l, self.torque_l = F.tolist(), T.tolist()
+        self.force_l, self.torque_l = F, T
         self.bc.applyExternalForce(self.obj, -1, self.force_l, list(pos), p.WORLD_FRAME)
         self.bc.applyExternalTorque(self.obj, -1, self.torque_l, p.WORLD_FRAME)
 
     def force(self) -> list[float]:
         """The hand's force on the object (N, world), applied in the last step."""
         return self.force_l[:]
-
-
-def _rotvec(E: np.ndarray) -> np.ndarray:
-    """The rotation vector (axis * angle, rad) of the rotation matrix ``E``."""
-    cos = min(1.0, max(-1.0, (float(np.trace(E)) - 1.0) / 2.0))
-    ang = math.acos(cos)
-    w = np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
-    if ang < 1e-9:
-        return 0.5 * w
-    s = math.sin(ang)
-    if s < 1e-6:  # near pi: the axis from the symmetric part
-        axis = np.sqrt(np.maximum((np.diag(E) + 1.0) / 2.0, 0.0))
-        return ang * axis
-    return ang / (2.0 * s) * w
 
 
 def numpy_row_sum(xs: list) -> float:
