@@ -111,3 +111,27 @@ def test_a_carried_away_object_fails_both_verdicts(tmp_path):
     )
     assert not ok and "off the human's path" in why
     assert not flag["success"] and "carried away from the human" in flag["reason"]
+
+
+def test_the_hand_holds_still_tracking_a_still_object(tmp_path):
+    """Issue #20: with the object still (no human motion) the tracking hand's true position
+    wobbles by far less than 1 mm in the plane (the former J1 limit cycle: +-15 mm in Y)."""
+    from replay.log import LogReader
+    from replay.runner import Runner
+    from replay.scenario import load_scenario
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.chdir(ROOT)
+        sc = load_scenario(
+            ROOT / "scenarios" / "grasp_hexahedron.yaml",
+            sets=[
+                "plant.params.human_speed=0.0",
+                "plant.params.human_roll_rate=0.0",
+                "timing.duration=0.5",
+            ],
+        )
+        log = LogReader(Runner(sc).run(tmp_path / "still.mcap").path)
+    tool = np.array([m["position"] for m in log.series("/effector/motion") if m["t"] >= 0.1])
+    wobble = np.std(tool[:, 1:], axis=0)
+    print("hand wobble (std, y z):", wobble)
+    assert wobble.max() < 1e-3
