@@ -1,5 +1,7 @@
-"""The grasping ablation (sweeps/grasp_loops.yaml): grasp rate and tracking error against the loop
-period of every task and the vision chip, one line per speed of the human hand."""
+"""The grasping ablations: grasp rate and tracking error against the loop period of every task and
+the vision chip, one line per speed of the human hand (sweeps/grasp_loops.yaml); the wrist force
+term K^af of eq. 2 against the human's force and the object's drift in the hand during the hold
+(sweeps/grasp_force.yaml)."""
 
 from __future__ import annotations
 
@@ -70,3 +72,46 @@ def summary_loops(rows: list[dict]) -> str:
         + "; ".join(parts)
         + "."
     )
+
+
+KAF = "tasks.arm.params.K_af"
+FORCE = "m.hold_human_force_max"  # N: the human's largest force on the held object
+HUMAN = "m.hold_human_offset_max"  # m: the held object's largest distance from the human's path
+DRIFT = "m.hold_drift_max"  # m: its largest motion in the hand
+
+
+def plot_force(rows: list[dict], out: Path, stem: str) -> list[Path]:
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.4, 7.0))
+    for col, ax, label, scale in (
+        (FORCE, axes[0], "the human's largest force\non the held object [N]", 1.0),
+        (HUMAN, axes[1], "held object from the\nhuman's path, max [mm]", 1e3),
+        (DRIFT, axes[2], "object's drift in\nthe hand, max [mm]", 1e3),
+    ):
+        for i, (speed, (xs, ys)) in enumerate(sorted(mean_by(rows, KAF, SPEED, col).items())):
+            ax.plot(xs, np.asarray(ys) * scale, marker="osD^v"[i % 5], label=f"human {speed} m/s")
+        ax.set_ylabel(label, fontsize=8)
+        ax.grid(True, alpha=0.3)
+    axes[1].axhline(20.0, color="0.5", ls=":", lw=0.8, label="success limit")
+    axes[2].axhline(10.0, color="0.5", ls=":", lw=0.8)
+    axes[0].legend(fontsize=8)
+    axes[2].set_xlabel("eq. 2's K^af [rad/(s N m)]")
+    axes[0].set_title("Grasping: the wrist force term during the hold", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out, stem)
+
+
+def summary_force(rows: list[dict]) -> str:
+    parts = []
+    force, human, drift = (mean_by(rows, KAF, SPEED, c) for c in (FORCE, HUMAN, DRIFT))
+    rates = rate_by(rows, KAF, SPEED, grasped)
+    for speed in sorted(force, key=float):
+        xs, fs = force[speed]
+        parts.append(
+            f"at {float(speed):g} m/s, K^af "
+            + ", ".join(
+                f"{x:g}: human {f:.1f} N, {1e3 * h:.0f} mm off its path, drift {1e3 * d:.1f} mm"
+                f" ({pct(r)} held with the human)"
+                for x, f, h, d, r in zip(xs, fs, human[speed][1], drift[speed][1], rates[speed][1])
+            )
+        )
+    return "The wrist force term during the hold (means over seeds): " + "; ".join(parts) + "."

@@ -1,8 +1,10 @@
 """Namiki, Nakabo, Ishii & Ishikawa 1999, Figs. 6-9, drawn from runs' logs.
 
 - Fig. 9 ("Feedback Response"): the hand x^a and the object along Y (the tracking of eq. 2's
-  first term) and the hand and the reaching target x_d^a along X (its second term), against time,
-  with the schedule's grasp phases (reaching and holding) and releasing phases shaded.
+  first term; with the human's path) and the hand and the reaching target x_d^a along X (its
+  second term), against time, and the forces of the hold: the human's force on the object
+  (truth) and the wrist's external force F^a that eq. 2's K^af term acts on; the schedule's
+  grasp phases (reaching and holding) and releasing phases shaded.
 - Figs. 6-8 (the grasp as a sequence of pictures, the close-up, the sphere): a filmstrip of the
   first grasp cycle drawn from the log: the WAM-7 from its kinematics (``replay.robot.wam``) at the
   logged joint angles, the 14-joint hand (``replay.robot.hand``) at the logged hand angles, the
@@ -72,7 +74,11 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> None:
 
 
 def fig9(run: GraspRun):
-    fig, (ax_y, ax_x) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 5.2))
+    fig, (ax_y, ax_x, ax_f) = plt.subplots(
+        3, 1, sharex=True, figsize=(7.0, 6.8), gridspec_kw={"height_ratios": [3, 3, 2]}
+    )
+    if len(run.t_human):
+        ax_y.plot(run.t_human, run.human[:, 1], color="0.55", lw=0.9, ls=":", label="human's path")
     ax_y.plot(run.t_obj, run.obj[:, 1], color=C_OBJ, lw=1.4, label="object (truth)")
     ax_y.plot(run.t_eff, run.hand[:, 1], color=C_HAND, lw=1.2, label="hand x^a")
     ax_x.plot(
@@ -80,13 +86,30 @@ def fig9(run: GraspRun):
     )
     ax_x.plot(run.t_eff, run.hand[:, 0], color=C_HAND, lw=1.2, label="hand x^a")
     ax_x.plot(run.t_obj, run.obj[:, 0], color=C_OBJ, lw=0.8, alpha=0.7, label="object (truth)")
-    for ax, name in ((ax_y, "Y"), (ax_x, "X")):
-        ax.set_ylabel(f"{name} [m]")
+    if len(run.t_human):
+        ax_f.plot(
+            run.t_human,
+            np.linalg.norm(run.human_force, axis=1),
+            color=C_OBJ,
+            lw=1.0,
+            label="the human's force on the object",
+        )
+    wr = [m for m in run.arm_task if m.get("wrench")] if run.arm_task else []
+    if wr:
+        ax_f.plot(
+            [m["t"] for m in wr],
+            [float(np.linalg.norm(m["wrench"][:3])) for m in wr],
+            color=C_HAND,
+            lw=0.9,
+            label="F^a: external force at the wrist (eq. 2)",
+        )
+    for ax, name in ((ax_y, "Y [m]"), (ax_x, "X [m]"), (ax_f, "force [N]")):
+        ax.set_ylabel(name)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        ax.legend(fontsize=7, loc="lower right" if ax is not ax_f else "upper right")
         ax.set_xlim(0.0, run.t_end)
         _shade(ax, run, labels=ax is ax_y)
-    ax_x.set_xlabel("time [s]")
+    ax_f.set_xlabel("time [s]")
     ax_y.set_title(f"Feedback response: {run.name} (cf. Fig. 9)", fontsize=10)
     fig.text(
         0.01,

@@ -30,6 +30,10 @@ T_CHIP = "/vision/chip"  # the 16 x 16 binary images
 T_HAND_TASK = "/grasping/hand"  # preshape, theta_d, load, command (eq. 4)
 T_STATE = "/grasping/state"  # the schedule: phase, cycle, x_d, grasp
 T_TASKS = "/tasks/loops"  # runner: names, ticked, latency per task, every step
+T_EFFECTOR = "/effector/motion"  # the tool (= hand) frame's true pose
+T_HUMAN = "/human/state"  # the human hand's path (target) and its force on the object
+T_CONTACTS = "/object/contacts"  # parts touching the object and their normal force
+T_HEAD_CMD = "/grasping/head"  # eq. 1: image error and command
 
 # the schedule's phases: what the hand does (the arm tracks in all of them)
 TRACKING, REACHING, HOLDING, RELEASING = "track", "reach", "hold", "release"
@@ -82,6 +86,15 @@ class GraspRun:
     tasks: list = field(default_factory=list)  # T_TASKS messages
     events: list = field(default_factory=list)
     phases: list = field(default_factory=list)  # [Phase]
+    t_tool: np.ndarray = field(default_factory=lambda: np.zeros(0))  # true tool frame
+    tool: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    tool_orn: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # xyzw
+    t_human: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    human: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # the path's point
+    human_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # N, world
+    t_contacts: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    grip_force: np.ndarray = field(default_factory=lambda: np.zeros(0))  # N, summed normals
+    arm_task: list = field(default_factory=list)  # T_ARM_TASK messages (x_a, wrench, terms)
 
     # ---------------------------------------------------------------- helpers
     @property
@@ -101,6 +114,23 @@ class GraspRun:
     def t_end(self) -> float:
         ts = [a[-1] for a in (self.t_eff, self.t_obj, self.t_arm) if len(a)]
         return float(max(ts)) if ts else 0.0
+
+    def in_hand(self) -> np.ndarray:
+        """The object's centre in the true tool (= hand) frame at the object's samples (m):
+        R^T (x - p), from /object/state and /effector/motion (truth only)."""
+        n = min(len(self.t_obj), len(self.t_tool))
+        out = np.zeros((n, 3))
+        for i in range(n):
+            x, y, z, w = self.tool_orn[i]
+            R = np.array(
+                [
+                    [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                    [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                    [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+                ]
+            )
+            out[i] = R.T @ (self.obj[i] - self.tool[i])
+        return out
 
     def kinds(self, kind: str) -> list[dict]:
         return [e for e in self.events if e["kind"] == kind]
@@ -221,6 +251,15 @@ def load_run(log: LogReader, name: str | None = None) -> GraspRun:
         tasks=log.series(T_TASKS),
         events=events(log),
     )
+    run.arm_task = eff
+    ef = [m for m in log.series(T_EFFECTOR) if m.get("position")]
+    run.t_tool, run.tool = _vec(ef, "t"), _vec(ef, "position", 3)
+    run.tool_orn = _vec(ef, "orientation", 4)
+    hu = log.series(T_HUMAN)
+    run.t_human, run.human = _vec(hu, "t"), _vec(hu, "target", 3)
+    run.human_force = _vec(hu, "force", 3)
+    co = log.series(T_CONTACTS)
+    run.t_contacts, run.grip_force = _vec(co, "t"), _vec(co, "normal_force")
     run.phases = _phases_from_state(st) or _phases_from_events(run.events, run.t_end)
     return run
 

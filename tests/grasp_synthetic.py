@@ -228,6 +228,20 @@ def write_grasp_log(
                 ObjectState(t, o.tolist(), [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
                 ns,
             )
+            # the truth of the hand (the tool frame), the human's path (the object's own, off
+            # which a slipping object slides) and the grip
+            log.write(
+                "/effector/motion",
+                {"t": t, "position": hand.tolist(), "orientation": [0.0, 0.0, 0.0, 1.0]},
+                ns,
+            )
+            log.write(
+                "/human/state",
+                {"t": t, "target": object_path(t).tolist(), "force": [0.0, 0.0, 1.0]},
+                ns,
+            )
+            held = ph == HOLDING and (slip_at is None or t < slip_at)
+            log.write("/object/contacts", {"t": t, "normal_force": 20.0 if held else 0.0}, ns)
             log.write(
                 T_CHIP,
                 {

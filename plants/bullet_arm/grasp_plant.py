@@ -8,7 +8,8 @@ What it adds to :class:`BulletArmPlant` (same URDF builder, same object, same co
   gauges' F^h);
 - a 2-axis pan/tilt **head** (``head.HeadServo``) carrying the vision chip's camera;
 - the wrist's 6-axis **force/torque sensor** on the fixed flange-palm joint (``ft_sensor``);
-- a **human hand** moving the object on its constraint plane (``human_hand``);
+- a **human hand** moving the object on its constraint plane, a compliant spring-damper coupling
+  to its seeded path (``human_hand``);
 - events ``grasp`` (the base's hold event under this name), ``release`` (with how long it was
   held), ``slip``, and the run's outcome: grasped, held while the human kept moving the object.
 
@@ -20,6 +21,7 @@ effector's motion, the grasp point and the palm's point velocity.
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import numpy as np
 import pybullet as p
@@ -29,7 +31,7 @@ from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.head import HeadServo
 from plants.bullet_arm.human_hand import HumanHand
 from plants.bullet_arm.params import GraspParams
-from plants.bullet_arm.payloads import HeadState, HumanState, ServoState, Wrench
+from plants.bullet_arm.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
 from plants.bullet_arm.plant import BulletArmPlant
 from plants.bullet_arm.servo import VelocityMotors, VelocityServos
 from replay.interfaces import Occurrence
@@ -64,24 +66,20 @@ class BulletGraspPlant(BulletArmPlant):
         assert self.hand_table is not None
         self.ft = WristFT(bc, self.robot, self._palm_j, palm_body(self.hand_table).com)
         self._all_j = self._arm_j + self._hand_j + [self._palm_j]
-        # the servos: every arm and hand joint's own inertia at the initial posture
+        # the hand joints: no PyBullet default motor (their VelocityMotors drive them)
         bc.setJointMotorControlArray(
             self.robot, self._hand_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._hand_j)
         )
-        dofs = [j for j in self._dofs]
+        # the servos are inertia-decoupled (servo.VelocityServos): the arm joints' block of the
+        # mass matrix (hand joints held by their drives) at the posture of each step
+        dofs = list(self._dofs)
+        read = self._arm_j + self._hand_j
+        self._dof_from_read = [read.index(j) for j in dofs]
+        self._arm_rows = [dofs.index(j) for j in self._arm_j]
+        self._mass_matrix = bc.calculateMassMatrix
         pos = [s[0] for s in bc.getJointStates(self.robot, dofs)]
-        Minv = np.linalg.inv(np.array(bc.calculateMassMatrix(self.robot, pos)))
-        # each joint's effective inertia with the others free (1 / (M^-1)_jj), divided by the
-        # largest eigenvalue of M^-1 diag(1 / (M^-1)_jj) (~2.7: the joints' coupling), so that
-        # the fastest mode of all loops acting together has the stated bandwidth
-        d = 1.0 / np.diag(Minv)
-        coupling = float(np.max(np.linalg.eigvals(Minv * d[None, :]).real))
-        inertia = {j: d[i] / coupling for i, j in enumerate(dofs)}
         self.arm_servos = VelocityServos(
-            [inertia[j] for j in self._arm_j],
-            self.torque_limits[list(self.active)],
-            P.arm_servo_bandwidth,
-            dt,
+            self.torque_limits[list(self.active)], P.arm_servo_bandwidth, dt
         )
         self.hand_servos = VelocityMotors(
             bc, self.robot, self._hand_j, [P.hand_max_torque] * len(self._hand_j)
@@ -91,7 +89,8 @@ class BulletGraspPlant(BulletArmPlant):
         # static torques (gravity) at the initial posture
         g = bc.calculateInverseDynamics(self.robot, pos, [0.0] * len(dofs), [0.0] * len(dofs))
         tau0 = {j: g[i] for i, j in enumerate(dofs)}
-        self.arm_servos.preload([tau0[j] for j in self._arm_j])
+        self._dof_pos = pos
+        self.arm_servos.preload([tau0[j] for j in self._arm_j], self.arm_mass_matrix())
         # the head
         self.head = HeadSpec(
             position=tuple(P.head_position),
@@ -144,6 +143,13 @@ class BulletGraspPlant(BulletArmPlant):
             components=P.human_components,
             max_force=P.human_max_force,
             start=P.human_start,
+            mass=P.object_mass,
+            gravity=P.gravity,
+            stiffness=P.human_stiffness,
+            damping=P.human_damping,
+            rot_stiffness=P.human_rot_stiffness,
+            rot_damping=P.human_rot_damping,
+            max_torque=P.human_max_torque,
         )
         # bookkeeping of the verdict
         self._grasps: list[dict] = []
@@ -151,6 +157,10 @@ class BulletGraspPlant(BulletArmPlant):
         self._slipping = False
         self._slips = 0
         self._held_path = 0.0
+        self._in_hand: deque = deque(maxlen=max(1, round(P.slip_time / dt)) + 1)
+        self._off_plane = 0.0  # m, the largest |(x - plane point) . n| of the run
+        self._off_plane_t = 0.0
+        self._n_l = [float(x) for x in n]
         self._max_parts = 0
         self._touched: set = set()
         self._track_sq = 0.0
@@ -174,6 +184,7 @@ class BulletGraspPlant(BulletArmPlant):
         """The base's state cache (plain floats) from one getJointStates of arm, hand and palm
         joint, with the servos' torques, the wrist's wrench and the object's state."""
         states = self._get_joint_states(self.robot, self._all_j)  # arm, hand, palm joint
+        self._dof_pos = [states[k][0] for k in self._dof_from_read]
         (q, qd), (hq, hqd, heff) = joint_state(states[:-1], self._na, self._pick, self._q_locked_l)
         servos = self.arm_servos
         if self._all_active:
@@ -201,6 +212,11 @@ class BulletGraspPlant(BulletArmPlant):
             assert self._cache is not None
         return self._cache
 
+    def arm_mass_matrix(self) -> np.ndarray:
+        """The arm joints' block of the joint-space mass matrix now (kg m^2)."""
+        M = np.asarray(self._mass_matrix(self.robot, self._dof_pos))
+        return M[np.ix_(self._arm_rows, self._arm_rows)]
+
     def _link_point_velocity(self, link: int, point) -> tuple[float, float, float]:
         if link != self._palm_link:
             return super()._link_point_velocity(link, point)
@@ -226,14 +242,15 @@ class BulletGraspPlant(BulletArmPlant):
             self.head_servo.set_command(command.head)
 
     def step(self) -> None:
-        self.human.drive(self._t)
         (_, qd), _, obj = self._state()
+        self.human.drive(self._t, *obj)
         self._set_motors(
             self.robot,
             self._servo_j,
             p.TORQUE_CONTROL,
             forces=self.arm_servos.torques(
-                qd if self._all_active else [qd[i] for i in self.active]
+                qd if self._all_active else [qd[i] for i in self.active],
+                self.arm_mass_matrix(),
             ),
         )
         self.hand_servos.actuate()
@@ -264,13 +281,44 @@ class BulletGraspPlant(BulletArmPlant):
         self._check_events()
         self._grasp_bookkeeping(was_held, n_before)
 
+    def _in_hand_position(self, pos) -> list[float]:
+        """The object's centre in the tool (= hand) frame (m): R^T (x - p)."""
+        (px, py, pz), (qx, qy, qz, qw), _, _ = self._frames_now()[0]
+        dx, dy, dz = pos[0] - px, pos[1] - py, pos[2] - pz
+        # the columns of R(q) dotted with d
+        return [
+            (1 - 2 * (qy * qy + qz * qz)) * dx
+            + 2 * (qx * qy + qz * qw) * dy
+            + 2 * (qx * qz - qy * qw) * dz,
+            2 * (qx * qy - qz * qw) * dx
+            + (1 - 2 * (qx * qx + qz * qz)) * dy
+            + 2 * (qy * qz + qx * qw) * dz,
+            2 * (qx * qz + qy * qw) * dx
+            + 2 * (qy * qz - qx * qw) * dy
+            + (1 - 2 * (qx * qx + qy * qy)) * dz,
+        ]
+
     def _grasp_bookkeeping(self, was_held: bool, n_before: int) -> None:
+        """The physical verdict's record, from the truth of this step: each grasp's drift in
+        the hand, its distance to the human's path, the run's distance off the plane, slips."""
         pos, _, v, _ = self._state()[2]
         for ev in self._events[n_before:]:
             if ev.kind == "grasp":
                 self._grasp_start = self._t - ev.data.get("hold_time", 0.0)
                 ev.data["normal_force"] = float(sum(c[9] for c in self._contacts))
-                self._grasps.append({"t": self._grasp_start, "held_for": None})
+                self._grasps.append(
+                    {
+                        "t": self._grasp_start,
+                        "held_for": None,
+                        "in_hand": self._in_hand_position(pos),
+                        "drift": 0.0,
+                        "human": 0.0,
+                        "force_sq": 0.0,
+                        "force_max": 0.0,
+                        "n": 0,
+                    }
+                )
+                self._in_hand.clear()
             elif ev.kind == "release" and self._grasps:
                 held = self._t - self._grasp_start
                 self._grasps[-1]["held_for"] = held
@@ -280,24 +328,42 @@ class BulletGraspPlant(BulletArmPlant):
         if n_hand:
             self._touched.update(x for x in parts if x != "arm")
         self._max_parts = max(self._max_parts, n_hand)
-        # 3-vectors in floats (sums and products in np.dot's / np.linalg.norm's order)
+        # 3-vectors in floats
         ox, oy, oz = pos
-        if self.caught:
+        (cx, cy, cz), (nx, ny, nz) = self.plane.point, self._n_l
+        off = abs((ox - cx) * nx + (oy - cy) * ny + (oz - cz) * nz)
+        if off > self._off_plane:
+            self._off_plane, self._off_plane_t = off, self._t
+        if self.caught and self._grasps:
             if self._last_pos is not None:
                 lx, ly, lz = ox - self._last_pos[0], oy - self._last_pos[1], oz - self._last_pos[2]
                 self._held_path += math.sqrt(lx * lx + ly * ly + lz * lz)
-            px, py, pz = self._link_point_velocity(self._palm_link or -1, pos)
-            rx, ry, rz = v[0] - px, v[1] - py, v[2] - pz
-            rel = math.sqrt(rx * rx + ry * ry + rz * rz)
-            # a slip episode: faster than slip_speed on the hand, over when below half of it
-            if rel > self.params.slip_speed and not self._slipping:
-                self._slips += 1
-                self._slipping = True
-                self._events.append(Occurrence("slip", {"speed": rel, "position": list(pos)}))
-            elif self._slipping and rel < 0.5 * self.params.slip_speed:
-                self._slipping = False
+            g = self._grasps[-1]
+            h = self._in_hand_position(pos)
+            r0 = g["in_hand"]
+            g["drift"] = max(g["drift"], math.dist(h, r0))
+            g["human"] = max(g["human"], math.dist(pos, self.human.target_l))
+            fx, fy, fz = self.human.force_l  # the human's force on the object (last step)
+            f2 = fx * fx + fy * fy + fz * fz
+            g["force_sq"] += f2
+            g["force_max"] = max(g["force_max"], math.sqrt(f2))
+            g["n"] += 1
+            # a slip: the object moved >= slip_distance in the hand within slip_time
+            # (sustained relative motion); over when it moves less than half of that
+            buf = self._in_hand
+            buf.append(h)
+            if len(buf) == buf.maxlen:
+                d = math.dist(h, buf[0])
+                P = self.params
+                if d >= P.slip_distance and not self._slipping:
+                    self._slips += 1
+                    self._slipping = True
+                    self._events.append(Occurrence("slip", {"distance": d, "position": list(pos)}))
+                elif self._slipping and d < 0.5 * P.slip_distance:
+                    self._slipping = False
         else:
             self._slipping = False
+            self._in_hand.clear()
             ex, ey, ez = self._frames_now()[0][0]
             dx, dy, dz = ox - ex, oy - ey, oz - ez
             (ux, uy, uz), (vx, vy, vz) = self._u_l, self._v_l
@@ -309,44 +375,76 @@ class BulletGraspPlant(BulletArmPlant):
 
     # ------------------------------------------------------------------ verdict
     def outcome(self, t: float) -> dict:
+        """The physical verdict (truth only): success needs the object grasped and **held**
+        (within ``grasp_max_drift`` of where it sat in the hand, every grasp), **with the
+        human** (within ``grasp_max_human_offset`` of the human's path while grasped, every
+        grasp), **on its plane** (within ``grasp_max_off_plane`` all run), one grasp at least
+        ``grasp_min_hold`` long and the object moved while held; a failure names every
+        criterion it missed."""
         P = self.params
         holds = [(g["held_for"] if g["held_for"] is not None else t - g["t"]) for g in self._grasps]
+        drift = max((g["drift"] for g in self._grasps), default=0.0)
+        human = max((g["human"] for g in self._grasps), default=0.0)
+        n_held = sum(g["n"] for g in self._grasps)
         out = {
             "success": True,
-            "reason": "grasped",
+            "reason": "grasped and held with the human",
             "grasps": len(self._grasps),
             "first_grasp_t": self._grasps[0]["t"] if self._grasps else None,
             "hold_time": float(sum(holds)),
             "longest_hold": max(holds, default=0.0),
             "held_path": self._held_path,
             "slips": self._slips,
+            "hold_drift_max": drift,
+            "hold_human_offset_max": human,
+            "off_plane_max": self._off_plane,
+            "hold_human_force_rms": (
+                math.sqrt(sum(g["force_sq"] for g in self._grasps) / n_held) if n_held else None
+            ),
+            "hold_human_force_max": max((g["force_max"] for g in self._grasps), default=None),
             "tracking_error_rms": (
                 math.sqrt(self._track_sq / self._track_n) if self._track_n else None
             ),
             "hand_parts_touched": sorted(self._touched),
         }
+        why: list[str] = []
         if not self._grasps:
-            out["success"] = False
             if not self._touched:
-                out["reason"] = "no grasp: the hand never touched the object"
+                why.append("no grasp: the hand never touched the object")
             else:
-                out["reason"] = (
+                why.append(
                     f"no grasp: touched by {', '.join(sorted(self._touched))} "
                     f"(at most {self._max_parts} parts at once, "
                     f"{P.catch_min_parts} needed) but never held still against "
                     "the palm"
                 )
-        elif len(self._grasps) < P.grasp_min_grasps:
-            out["success"] = False
-            out["reason"] = f"only {len(self._grasps)} of {P.grasp_min_grasps} grasps"
-        elif max(holds) < P.grasp_min_hold - 1e-9:
-            out["success"] = False
-            out["reason"] = (
-                f"grasp not held: longest hold {max(holds):.3f} s < {P.grasp_min_hold:g} s"
+        else:
+            if len(self._grasps) < P.grasp_min_grasps:
+                why.append(f"only {len(self._grasps)} of {P.grasp_min_grasps} grasps")
+            if max(holds) < P.grasp_min_hold - 1e-9:
+                why.append(
+                    f"grasp not held: longest hold {max(holds):.3f} s < {P.grasp_min_hold:g} s"
+                )
+            if drift > P.grasp_max_drift:
+                why.append(
+                    f"not held: the object moved {1e3 * drift:.1f} mm in the hand "
+                    f"(> {1e3 * P.grasp_max_drift:g} mm)"
+                )
+            if human > P.grasp_max_human_offset:
+                why.append(
+                    f"carried away from the human: {1e3 * human:.1f} mm off the human's path "
+                    f"(> {1e3 * P.grasp_max_human_offset:g} mm)"
+                )
+            if self._held_path <= 1e-3:
+                why.append("held, but the object did not move while grasped")
+        if self._off_plane > P.grasp_max_off_plane:
+            why.append(
+                f"off its plane: {1e3 * self._off_plane:.1f} mm at {self._off_plane_t:.3f} s "
+                f"(> {1e3 * P.grasp_max_off_plane:g} mm)"
             )
-        elif self._held_path <= 1e-3:
+        if why:
             out["success"] = False
-            out["reason"] = "held, but the object did not move while grasped"
+            out["reason"] = "; ".join(why)
         return out
 
     # ------------------------------------------------------------------ log and scene
@@ -379,6 +477,14 @@ class BulletGraspPlant(BulletArmPlant):
         human = self.human
         out["/human/state"] = HumanState(
             t, human.target_l[:], float(human.roll), human.force(), human.max_force
+        )
+        pos = self._state()[2][0]
+        out["/human/wrench"] = HumanWrench(
+            t,
+            human.force(),
+            human.torque_l[:],
+            [a - b for a, b in zip(pos, human.target_l)],
+            human.limited,
         )
         w = self._wrench
         out["/wrist/wrench_truth"] = Wrench(t, w[:3], w[3:])

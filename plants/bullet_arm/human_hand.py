@@ -1,5 +1,5 @@
 """A human hand moving the object on its constraint plane: a seeded, band-limited random path
-applied through a force-limited constraint.
+and a compliant coupling to it.
 
 The path (in the plane's two in-plane axes u, v and the roll about its normal) is a sum of
 ``components`` sinusoids per axis with frequencies drawn uniformly in ``[f_min, f_max]`` Hz,
@@ -8,9 +8,16 @@ RMS in-plane speed over time is ``speed`` (m/s) and the RMS roll rate is ``roll_
 It starts at the object's initial pose. Irregular and not known to the robot (Sec. 5: "moved by
 a human hand, its trajectory is irregular and difficult to predict").
 
-The hand holds the object with a PyBullet fixed constraint to the path's pose whose force is
-limited to ``max_force`` (a human's grip-and-arm strength): the object follows the path unless
-something (the robot's grasp) resists harder; the constraint force is read back.
+The hand holds the object compliantly (issue #20; the paper gives no model of the human): a
+spring-damper to the path's pose plus the object's weight, applied at its centre of mass as an
+external force and torque each step,
+
+    F = m g_up + k (x_h - x) + c (v_h - v),     |F| <= max_force (the vector's magnitude),
+    T = k_r rotvec(R_h R^T) + c_r (w_h - w),    |T| <= max_torque,
+
+so the object follows the path unless something (the robot's grasp) holds it elsewhere, and
+then the human pulls with ``k`` times the offset: a force the robot's wrist sensor feels. The
+force and torque applied are read back for the log (``/human/state``, ``/human/wrench``).
 """
 
 from __future__ import annotations
@@ -62,6 +69,13 @@ class HumanHand:
         components: int,
         max_force: float,
         start: float,
+        mass: float,
+        gravity: float,
+        stiffness: float,
+        damping: float,
+        rot_stiffness: float,
+        rot_damping: float,
+        max_torque: float,
     ) -> None:
         self.bc, self.obj = bc, obj
         self.origin = np.asarray(origin, float)
@@ -69,14 +83,17 @@ class HumanHand:
         self._n = self.n.tolist()
         self.start = float(start)
         self.max_force = float(max_force)
+        self.max_torque = float(max_torque)
+        self.k, self.c = float(stiffness), float(damping)
+        self.k_r, self.c_r = float(rot_stiffness), float(rot_damping)
+        self.weight = float(mass) * float(gravity)  # N, carried by the hand (world +z)
         self.w, self.a, self.phi = band_limited_path(
             rng, components=components, f_min=f_min, f_max=f_max, rms_rate=speed, axes=2
         )
         self.rw, self.ra, self.rphi = band_limited_path(
             rng, components=components, f_min=f_min, f_max=f_max, rms_rate=roll_rate, axes=1
         )
-        # the three axes' sinusoids stacked (u, v, roll rows): one sin a step; each row's sum is
-        # the same reduction as the separate ones
+        # the three axes' sinusoids stacked (u, v, roll rows)
         self._W = np.concatenate([self.w, self.rw])
         self._A = np.concatenate([self.a, self.ra])
         self._PHI = np.concatenate([self.phi, self.rphi])
@@ -92,19 +109,12 @@ class HumanHand:
         self.q0 = _quat(self.R0)
         self._origin, self._u, self._v = self.origin.tolist(), self.u.tolist(), self.v.tolist()
         self.target_l = self.origin.tolist()
+        self.velocity_l = [0.0, 0.0, 0.0]
         self.roll = 0.0
-        self.cid = bc.createConstraint(
-            obj,
-            -1,
-            -1,
-            -1,
-            p.JOINT_FIXED,
-            [0.0, 0.0, 0.0],
-            [0.0, 0.0, 0.0],
-            self.origin.tolist(),
-            childFrameOrientation=_quat(self.R0),
-        )
-        bc.changeConstraint(self.cid, maxForce=self.max_force)
+        self.roll_rate = 0.0
+        self.force_l = [0.0, 0.0, 0.0]  # N, world: the hand's force on the object (last step)
+        self.torque_l = [0.0, 0.0, 0.0]  # N m, world
+        self.limited = False  # the force (or torque) was at its limit in the last step
 
     def offset(self, t: float) -> tuple[float, float, float]:
         """(du, dv, droll) of the path from the start pose at time ``t``."""
@@ -118,37 +128,76 @@ class HumanHand:
         )
         return du, dv, r
 
+    def rate(self, t: float) -> tuple[float, float, float]:
+        """d/dt of :meth:`offset` (m/s, m/s, rad/s)."""
+        if t < self.start:
+            return 0.0, 0.0, 0.0
+        tt = t - self.start
+        cos = math.cos
+        du, dv, r = (sum(a * w * cos(w * tt + phi) for w, a, phi, _ in row) for row in self._rows)
+        return du, dv, r
+
     @property
     def target(self) -> np.ndarray:
-        """Where the hand pulls the object now (m, world)."""
+        """Where the hand's path is now (m, world)."""
         return np.array(self.target_l)
 
-    def drive(self, t: float) -> None:
-        du, dv, dr = self.offset(t)
-        # origin + du u + dv v per axis in floats (the vector form's operations and order)
-        self.target_l = [o + du * a + dv * b for o, a, b in zip(self._origin, self._u, self._v)]
-        self.roll = dr
-        # the start orientation turned by dr about the plane normal: q = q_n(dr) q0
-        s, c = math.sin(dr / 2.0), math.cos(dr / 2.0)
+    def target_orientation(self) -> list[float]:
+        """The path's orientation now: the start orientation turned by ``roll`` about the
+        plane normal, q = q_n(roll) q0 ([qx, qy, qz, qw])."""
+        s, c = math.sin(self.roll / 2.0), math.cos(self.roll / 2.0)
         ax, ay, az = (x * s for x in self._n)
         bx, by, bz, bw = self.q0
-        q = [
+        return [
             c * bx + ax * bw + ay * bz - az * by,
             c * by - ax * bz + ay * bw + az * bx,
             c * bz + ax * by - ay * bx + az * bw,
             c * bw - ax * bx - ay * by - az * bz,
         ]
-        self.bc.changeConstraint(
-            self.cid,
-            jointChildPivot=self.target_l,
-            jointChildFrameOrientation=q,
-            maxForce=self.max_force,
-        )
+
+    def drive(self, t: float, pos, orn, vel, omega) -> None:
+        """The path at ``t`` and the hand's force and torque on the object in state (pos, orn,
+        vel, omega), applied for the next physics step."""
+        du, dv, dr = self.offset(t)
+        ru, rv, rr = self.rate(t)
+        self.target_l = [o + du * a + dv * b for o, a, b in zip(self._origin, self._u, self._v)]
+        self.velocity_l = [ru * a + rv * b for a, b in zip(self._u, self._v)]
+        self.roll, self.roll_rate = dr, rr
+        k, c = self.k, self.c
+        F = [
+            k * (x_h - x) + c * (v_h - v)
+            for x_h, x, v_h, v in zip(self.target_l, pos, self.velocity_l, vel)
+        ]
+        F[2] += self.weight
+        # rotation: the error q_h q^-1 (world) as a rotation vector, the roll rate about n
+        hx, hy, hz, hw = self.target_orientation()
+        bx, by, bz, bw = -orn[0], -orn[1], -orn[2], orn[3]  # q^-1 (unit q)
+        ex = hw * bx + hx * bw + hy * bz - hz * by
+        ey = hw * by - hx * bz + hy * bw + hz * bx
+        ez = hw * bz + hx * by - hy * bx + hz * bw
+        ew = hw * bw - hx * bx - hy * by - hz * bz
+        if ew < 0.0:  # the shorter way round
+            ex, ey, ez, ew = -ex, -ey, -ez, -ew
+        sn = math.sqrt(ex * ex + ey * ey + ez * ez)
+        g = 2.0 * math.atan2(sn, ew) / sn if sn > 1e-12 else 2.0
+        kr, cr, n = self.k_r, self.c_r, self._n
+        T = [kr * g * e + cr * (rr * nn - w) for e, nn, w in zip((ex, ey, ez), n, omega)]
+        self.limited = False
+        f = math.sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2])
+        tq = math.sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2])
+        if f > self.max_force:
+            F = [x * (self.max_force / f) for x in F]
+            self.limited = True
+        if tq > self.max_torque:
+            T = [x * (self.max_torque / tq) for x in T]
+            self.limited = True
+        self.force_l, self.torque_l = F, T
+        self.bc.applyExternalForce(self.obj, -1, self.force_l, list(pos), p.WORLD_FRAME)
+        self.bc.applyExternalTorque(self.obj, -1, self.torque_l, p.WORLD_FRAME)
 
     def force(self) -> list[float]:
-        """The constraint's force on the object (N, world), from the last step."""
-        st = self.bc.getConstraintState(self.cid)
-        return [float(st[0]), float(st[1]), float(st[2])]
+        """The hand's force on the object (N, world), applied in the last step."""
+        return self.force_l[:]
 
 
 def numpy_row_sum(xs: list) -> float:

@@ -252,8 +252,8 @@ class GraspParams(Params):
         unit="rad/s",
         gt=0.0,
         le=1500.0,
-        doc="velocity-loop bandwidth of the arm's AC servo amplifiers (assumed ~80 Hz; the "
-        "explicit 1 kHz loop needs bandwidth * dt well below 2)",
+        doc="closed-loop bandwidth of the arm's AC servo velocity loops (inertia-decoupled, "
+        "plants/bullet_arm/servo.py: every joint's; assumed ~80 Hz)",
     )
     plane_normal: list = param(
         [1.0, 0.0, 0.0],
@@ -272,7 +272,30 @@ class GraspParams(Params):
     human_f_max: float = param(1.0, unit="Hz", gt=0.0, doc="band limit of the path")
     human_components: int = param(6, ge=1, doc="sinusoids per path axis")
     human_max_force: float = param(
-        30.0, unit="N", gt=0.0, doc="force limit of the human's hold (grip and arm strength)"
+        30.0,
+        unit="N",
+        gt=0.0,
+        doc="limit on the magnitude of the human hand's total force on the object (grip and "
+        "arm strength)",
+    )
+    human_stiffness: float = param(
+        500.0,
+        unit="N/m",
+        gt=0.0,
+        doc="stiffness of the human hand's hold about its path (assumed: a human arm's "
+        "endpoint stiffness is ~200-1000 N/m)",
+    )
+    human_damping: float = param(
+        10.0, unit="N*s/m", ge=0.0, doc="damping of the human hand's hold about its path"
+    )
+    human_rot_stiffness: float = param(
+        0.5, unit="N*m/rad", ge=0.0, doc="rotational stiffness of the human's hold (assumed)"
+    )
+    human_rot_damping: float = param(
+        0.01, unit="N*m*s/rad", ge=0.0, doc="rotational damping of the human's hold"
+    )
+    human_max_torque: float = param(
+        1.0, unit="N*m", gt=0.0, doc="limit on the magnitude of the human hand's torque"
     )
     human_start: float = param(0.0, unit="s", ge=0.0, doc="the human starts moving at this time")
     head_position: list = param(
@@ -303,12 +326,36 @@ class GraspParams(Params):
     head_servo_bandwidth: float = param(
         300.0, unit="rad/s", gt=0.0, doc="velocity-loop bandwidth of the head's DC servos"
     )
-    slip_speed: float = param(
-        0.05,
-        unit="m/s",
+    slip_distance: float = param(
+        0.001,
+        unit="m",
         gt=0.0,
-        doc="while grasped, object speed relative to the palm above this "
-        "starts a slip (a slip event), below half of it ends it",
+        doc="while grasped, the object moving this far in the hand's frame within slip_time "
+        "starts a slip (a slip event: sustained relative motion, not one step's solver "
+        "chatter); under half of it over slip_time ends it",
+    )
+    slip_time: float = param(0.01, unit="s", gt=0.0, doc="the window of slip_distance")
+    grasp_max_drift: float = param(
+        0.010,
+        unit="m",
+        gt=0.0,
+        doc="held: during a grasp the object stays within this of where it sat in the hand "
+        "(the hand's frame) when the grasp began",
+    )
+    grasp_max_human_offset: float = param(
+        0.020,
+        unit="m",
+        gt=0.0,
+        doc="with the human: during a grasp the object stays within this of the human hand's "
+        "path (not carried away)",
+    )
+    grasp_max_off_plane: float = param(
+        0.020,
+        unit="m",
+        gt=0.0,
+        doc="on its plane: over the whole run the object stays within this of its constraint "
+        "plane (the reach did not shove it off; the human's own tolerance, "
+        "grasp_max_human_offset: 10 N on its 500 N/m hold)",
     )
     grasp_min_grasps: int = param(1, ge=1, doc="grasps a successful run has")
     grasp_min_hold: float = param(

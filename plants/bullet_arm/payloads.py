@@ -72,8 +72,20 @@ class HumanState:
     t: float
     target: Vec3  # m, world
     roll: float  # rad, about the plane normal, from the start pose
-    force: Vec3  # N, the constraint's force on the object
+    force: Vec3  # N, world: the hand's force on the object (its spring-damper and weight)
     max_force: float  # N
+
+
+@dataclass
+class HumanWrench:
+    """``/human/wrench``: the human hand's coupling to the object (world): the force and torque
+    it applies, the offset of the object from the hand's path, and whether a limit cut it."""
+
+    t: float
+    force: Vec3  # N
+    torque: Vec3  # N*m
+    offset: Vec3  # m: object centre - the path's point
+    limited: bool
 
 
 @dataclass

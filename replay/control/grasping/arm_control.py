@@ -53,14 +53,14 @@ S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
 class ArmParams:
     K_ap: float = param(1.0, unit="1", ge=0.0, doc="eq. 2's K^ap (a scalar times I)")
     K_a1: list = param(
-        [0.0, 40.0, 40.0, 20.0, 0.0, 0.0],
+        [0.0, 60.0, 60.0, 30.0, 0.0, 0.0],
         unit="1/s",
         length=6,
         ge=0.0,
         doc="eq. 2's K^a1 (tracking; only the S components act; assumed)",
     )
     K_a2: list = param(
-        [15.0, 0.0, 0.0, 0.0, 10.0, 10.0],
+        [60.0, 0.0, 0.0, 0.0, 20.0, 20.0],
         unit="1/s",
         length=6,
         ge=0.0,
@@ -68,10 +68,11 @@ class ArmParams:
     )
     K_av: float = param(0.05, unit="1", ge=0.0, doc="eq. 2's K^av (scalar times I)")
     K_af: float = param(
-        0.005,
+        0.3,
         unit="rad/(s*N*m)",
         ge=0.0,
-        doc="eq. 2's K^af (scalar times I): compliance to the wrist wrench",
+        doc="eq. 2's K^af (scalar times I): compliance to the external wrench on the hand "
+        "(assumed; the ablation analysis/ablation_grasp.py compares 0, 0.3 and 0.6)",
     )
     grasp_point: float = param(
         0.045,
@@ -86,6 +87,15 @@ class ArmParams:
         unit="N",
         ge=0.0,
         doc="external forces below this are taken as zero (sensor noise and the hand's inertia)",
+    )
+    hold_offset_filter: float = param(
+        0.0,
+        unit="s",
+        ge=0.0,
+        doc="hold: eq. 2's errors (x^o - x^a on S, x_d^a - x^a on I - S) are taken from where "
+        "the object sat in the hand when the hold began, that offset following them with this "
+        "time constant (0: latched): the arm keeps the grasp instead of chasing a ball that "
+        "sits off the grasp point (assumed)",
     )
     force_filter: float = param(
         0.01,
@@ -136,7 +146,7 @@ class ArmControlTask(Controller):
         self._n_plane = [float(x) for x in self.n_plane]
         self.hand = hand_body(spec.hand.table)
         self.g = np.array([0.0, 0.0, -spec.gravity])
-        self._w_hand = (self.hand.mass * self.g).tolist()
+        self._g = self.g.tolist()
         self._com = [float(x) for x in self.hand.com]
         self.vlim = np.asarray(spec.velocity_limits, float)
         self._vlim = self.vlim.tolist()
@@ -150,8 +160,12 @@ class ArmControlTask(Controller):
         self.obj: Any = None
         self.state: Any = None
         self.wrench_raw: Any = None
-        self.bias: list[float] | None = None
+        # the sensor's offset: the simulated sensor has none (replay/sensors/force.py: noise
+        # only), and a tare at the first reading took in the hand's start-up transient
+        self.bias: list[float] | None = [0.0] * 6
         self.filtered = [0.0] * 6
+        self._v_com: list[float] | None = None  # the hand's centre of mass velocity (world)
+        self._hold: tuple | None = None  # (cycle, offset on x^o - x^a, offset on x_d - x^a)
         self._out: ArmLoop | None = None
         self.track_sq: dict[str, list] = {}
 
@@ -184,24 +198,45 @@ class ArmControlTask(Controller):
         J = np.vstack([cross3(Z, p[:, None] - O), Z])
         return T, J
 
+    def hand_acceleration(self, R) -> list[float]:
+        """The hand's centre-of-mass acceleration (world, m/s^2) from the arm's kinematics:
+        v_com = v_tool + w x (R com) with (v_tool, w) = J theta_dot (the tool Jacobian of this
+        step's chain), differenced over the task's period."""
+        J, qd = self._J, self.qd
+        tw = [sum(J[i, j] * qd[j] for j in range(self._n)) for i in range(6)]
+        c = self._com
+        r = [R[3 * i] * c[0] + R[3 * i + 1] * c[1] + R[3 * i + 2] * c[2] for i in range(3)]
+        wx, wy, wz = tw[3], tw[4], tw[5]
+        v = [
+            tw[0] + wy * r[2] - wz * r[1],
+            tw[1] + wz * r[0] - wx * r[2],
+            tw[2] + wx * r[1] - wy * r[0],
+        ]
+        prev, self._v_com = self._v_com, v
+        if prev is None or self.dt <= 0.0:
+            return [0.0, 0.0, 0.0]
+        return [(a - b) / self.dt for a, b in zip(v, prev)]
+
     def external_wrench(self, R) -> list[float]:
-        """F^a (world, about the flange): the sensor's wrench minus the hand's weight and bias
-        (the first reading: tare), low-passed, zero within the deadband (compiled). ``R``: the
-        tool's rotation, row-major 9 floats."""
+        """F^a (world, about the flange): the sensor's wrench minus the hand's gravity and
+        inertial load m (g - a_com) (the sensor reads m g - m a + F_ext; a_com from the arm's
+        kinematics: :meth:`hand_acceleration`), low-passed, zero within the deadband (compiled). ``R``: the tool's rotation, row-major
+        9 floats."""
         a = self.dt / (self.params.force_filter + self.dt)
+        acc = self.hand_acceleration(R)
+        m = self.hand.mass
+        load = [m * (g - x) for g, x in zip(self._g, acc)]
         ext, self.filtered, F = _arm_kinematics.wrench(
             R,
             self.wrench_raw.force,
             self.wrench_raw.torque,
-            self._w_hand,
+            load,
             self._com,
             self.bias,
             self.filtered,
             a,
             self.params.force_deadband,
         )
-        if self.bias is None:
-            self.bias = ext  # tare at start: the sensor's offset
         return F
 
     def update(self, t: float, measurements) -> ServoCommand | None:
@@ -246,6 +281,7 @@ class ArmControlTask(Controller):
             n_palm[2] * npl[0] - n_palm[0] * npl[2],
             n_palm[0] * npl[1] - n_palm[1] * npl[0],
         ]
+        self._hold_offsets(e_track, e_reach)
         F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
         track, reach, damp, force, cmd = _arm_kinematics.terms(
             self._Jg,
@@ -278,6 +314,25 @@ class ArmControlTask(Controller):
         acc[0] += e_track[1] ** 2 + e_track[2] ** 2
         acc[1] += 1
         return ServoCommand(arm=cmd)
+
+    def _hold_offsets(self, e_track: list, e_reach: list) -> None:
+        """In the hold phase the translational errors count from where the object sat in the
+        hand when the hold began (the offsets then follow them with ``hold_offset_filter``):
+        holding, not chasing (issue #20). Changes ``e_track``, ``e_reach`` in place."""
+        st = self.state
+        if st.phase != "hold" or self.obj is None:
+            self._hold = None
+            return
+        if self._hold is None or self._hold[0] != st.cycle:
+            self._hold = (st.cycle, e_track[:3], e_reach[:3])
+        _, dt_, dr_ = self._hold
+        tau = self.params.hold_offset_filter
+        b = self.dt / (tau + self.dt) if tau > 0.0 else 0.0
+        for i in range(3):
+            dt_[i] += b * (e_track[i] - dt_[i])
+            dr_[i] += b * (e_reach[i] - dr_[i])
+            e_track[i] -= dt_[i]
+            e_reach[i] -= dr_[i]
 
     def reference_command(self, q, qd, obj, state, F) -> dict[str, np.ndarray]:
         """Eq. 2's terms the NumPy way (the reference of the compiled path in :meth:`update`):

@@ -2,7 +2,8 @@
 
     theta_dot_d^h = K^hg (theta_d^h - theta^h) - K^hv theta_dot^h + K^hf F^h          (4)
 
-- F^h (N m): the load on each joint, minus the strain gauge's actuator torque (the gauge reads
+- F^h (N m): the load on each joint (tared by the first reading: the fingers' own weight), minus
+  the strain gauge's actuator torque (the gauge reads
   the torque the drive puts on the joint; the object pushes back with its opposite). At rest
   against an object eq. 4 balances at F^h = -(K^hg / K^hf) (theta_d - theta): the grip torque
   grows with how far theta_d^h closes past the contact, a compliance.
@@ -74,7 +75,7 @@ class HandParams:
     K_hg: float = param(25.0, unit="1/s", ge=0.0, doc="eq. 4's K^hg (scalar times I, assumed)")
     K_hv: float = param(0.02, unit="1", ge=0.0, doc="eq. 4's K^hv (scalar times I)")
     K_hf: float = param(
-        40.0,
+        10.0,
         unit="rad/(s*N*m)",
         ge=0.0,
         doc="eq. 4's K^hf (scalar times I): grip torque = K^hg/K^hf x overclosure",
@@ -95,7 +96,12 @@ class HandParams:
         _CIRC_GRIP, unit="rad", length=14, doc="theta_d^h fully closed on a circle"
     )
     close_from: float = param(
-        0.8, unit="1", ge=0.0, lt=1.0, doc="reach progress (x_d^a) from which theta_d^h closes"
+        0.9,
+        unit="1",
+        ge=0.0,
+        lt=1.0,
+        doc="reach progress (x_d^a) from which theta_d^h closes (the arm lags x_d^a by ~1-2 cm: "
+        "0.8 closed the fingers on the ball before the palm was there, shoving it off its plane)",
     )
     load_filter: float = param(
         0.005,
@@ -104,6 +110,13 @@ class HandParams:
         doc="time constant of the first-order low-pass on F^h: the gauge "
         "reads the drive's own torque, so unfiltered feedback through "
         "a stiff servo chatters",
+    )
+    aperture_margin: float = param(
+        0.02,
+        unit="m",
+        ge=0.0,
+        doc="preshape aperture: the thumb's and fingers' tips this far clear of the object's "
+        "measured width on each side (the vision chip's pixel is ~1 cm at the object; assumed)",
     )
     free_closure: float = param(
         0.1,
@@ -153,8 +166,23 @@ class HandControlTask(Controller):
         self.q: list[float] = list(self._open)
         self.qd = [0.0] * n
         self.load = [0.0] * n  # F^h, low-passed (a new list each step: logged as is)
+        self._tare: list[float] | None = None
         self.shape = "unknown"
         self.preshape = "none"
+        # the aperture: per finger its first flex joint (index in the 14), the half-span of
+        # its root's inner face from the palm centre (across the thumb-finger axis) and its
+        # length; the measured width (smaller in-plane size) averaged while tracking
+        self._flex: list[tuple[int, list[int], float, float]] = []
+        k = 0
+        for finger in hand.table.fingers:
+            idx = list(range(k, k + len(finger.joints)))
+            k += len(finger.joints)
+            flex = [i for i, j in zip(idx, finger.joints) if j.kind == "flex"]
+            half = abs(finger.root[0]) - finger.joints[-1].width / 2.0
+            length = sum(j.length for j in finger.joints)
+            self._flex.append((flex[0], flex[1:], half, length))
+        self._width_sum, self._width_n = 0.0, 0
+        self.width: float | None = None
         self.dt = spec.dt
         self._t_last: float | None = None
         self.state: Any = None
@@ -174,9 +202,18 @@ class HandControlTask(Controller):
                     if self.params.load_filter <= 0.0
                     else min(1.0, self.dt / (self.params.load_filter + self.dt))
                 )
-                self.load = _hand_servo.lowpass(self.load, m.torque, a)
+                # the first reading is the tare: the fingers' own weight on the open hand (else
+                # eq. 4 balances it by sagging ~0.15 rad off theta_d, closing the aperture)
+                if self._tare is None:
+                    self._tare = list(m.torque)
+                tau = [x - x0 for x, x0 in zip(m.torque, self._tare)]
+                self.load = _hand_servo.lowpass(self.load, tau, a)
             elif topic == TOPIC_GRASP_OBJECT:
                 self.shape = m.shape
+                if m.found and m.size and self.state is not None and self.state.phase == "track":
+                    self._width_sum += min(m.size)
+                    self._width_n += 1
+                    self.width = self._width_sum / self._width_n
             elif topic == TOPIC_GRASP_STATE:
                 self.state = m
         if self._t_last is not None and t > self._t_last:
@@ -198,6 +235,8 @@ class HandControlTask(Controller):
                 self.preshape = self.shape
                 self._events.append(Occurrence("preshape", {"shape": self.shape}))
         pre, grip = self._postures.get(self.preshape, (self._open, None))
+        if grip is not None and self.width is not None:
+            pre = self.aperture(pre, self.width)
         P = self.params
         theta_d, cmd, deficit = _hand_servo.eq4(
             pre, grip, c, self.q, self.qd, self.load, P.K_hg, P.K_hv, P.K_hf, self.vmax
@@ -207,6 +246,19 @@ class HandControlTask(Controller):
             self._holds[st.cycle] = min(self._holds.get(st.cycle, math.inf), deficit)
         self._out = HandLoop(t, self.preshape, c, theta_d, self.load, cmd)
         return ServoCommand(hand=cmd)
+
+    def aperture(self, pre: list[float], width: float) -> list[float]:
+        """The preshape opened for an object ``width`` wide (m): each finger straight, turned
+        out at its first flex joint so that its tip clears the object by ``aperture_margin``
+        on its side (never closed further than ``pre``), within the joint's limits."""
+        out = list(pre)
+        need = width / 2.0 + self.params.aperture_margin
+        for j1, rest, half, length in self._flex:
+            s = min(max((need - half) / length, 0.0), 1.0)
+            out[j1] = max(min(-math.asin(s), pre[j1]), float(self.lo[j1]))
+            for i in rest:
+                out[i] = 0.0
+        return out
 
     def telemetry(self, t: float) -> dict:
         return {TOPIC_GRASP_HAND: self._out} if self._out is not None else {}

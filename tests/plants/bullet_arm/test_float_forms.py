@@ -13,39 +13,54 @@ from plants.bullet_arm.servo import VelocityServos
 from replay.spatial import cross3
 
 
-def _servo_reference(command, integral, qd, K, wi, lim, dt):
-    """The PI velocity servos on arrays (plants/bullet_arm/servo.py's docstring)."""
-    e = command - qd
-    acc = integral + e * dt
-    raw = K * (e + wi * acc)
-    sat = np.abs(raw) > lim
-    return np.where(sat, integral, acc), np.clip(raw, -lim, lim), sat
-
-
-def test_velocity_servos_equal_the_vector_form_over_random_commands():
+def test_velocity_servos_are_decoupled_and_limited_over_random_commands():
+    """Seeded random mass matrices, commands within and far beyond the torque limits: below
+    the limits the torque is M k (e + w_i integral) (servo.py); past them every torque is
+    within its limit, at least one joint at it, and the proportional part keeps its direction
+    (a scale in [0, 1] of M k e), the integral held."""
     rng = np.random.default_rng(11)
     n, steps = 7, 400
-    inertia = rng.uniform(0.05, 2.0, n)
+    A = rng.normal(0.0, 0.5, (n, n))
+    M = A @ A.T + np.diag(rng.uniform(0.05, 1.0, n))  # a mass matrix: symmetric, positive
     lim = rng.uniform(5.0, 60.0, n)
-    servos = VelocityServos(inertia, lim, 60.0, 1e-3)
-    servos.preload(rng.normal(0.0, 2.0, n))
-    same = saturated = 0
+    servos = VelocityServos(lim, 60.0, 1e-3)
+    servos.preload(rng.normal(0.0, 2.0, n), M)
+    linear = saturated = scaled = 0
     for k in range(steps):
         servos.set_command(rng.normal(0.0, 0.2 if k % 40 else 200.0, n))
         qd = rng.normal(0.0, 0.2, n)
-        want = _servo_reference(
-            servos.command, servos.integral, qd, servos.K, servos.wi, servos.limits, servos.dt
-        )
-        got_tau = servos.torques(qd.tolist())
-        got = (servos.integral, np.array(got_tau), servos.saturated)
-        same += all(np.array_equal(a, b) for a, b in zip(got, want))
-        saturated += bool(want[2].any())
-    print(f"servo step: {same}/{steps} equal, {saturated} with a joint at its torque limit")
-    assert same == steps and 0 < saturated < steps
+        e = servos.command - qd
+        acc = servos.integral + e * servos.dt
+        tau_i, tau_p = M @ (servos.k * servos.wi * acc), M @ (servos.k * e)
+        before = servos.integral
+        tau = np.array(servos.torques(qd.tolist(), M))
+        if not servos.saturated.any():
+            linear += 1
+            np.testing.assert_allclose(tau, tau_i + tau_p, rtol=1e-12, atol=1e-12)
+            np.testing.assert_allclose(servos.integral, acc, rtol=1e-12, atol=1e-15)
+        else:
+            saturated += 1
+            assert np.all(np.abs(tau) <= lim * (1 + 1e-12))
+            if np.all(np.abs(tau_i) <= lim):  # else the integral alone is past a limit
+                s = np.dot(tau - tau_i, tau_p) / np.dot(tau_p, tau_p)
+                assert -1e-9 <= s <= 1.0 + 1e-9
+                np.testing.assert_allclose(tau, tau_i + s * tau_p, rtol=1e-9, atol=1e-9)
+                scaled += 1
+            np.testing.assert_array_equal(servos.integral, before)
+    print(f"servo step: {linear} linear, {saturated} at a torque limit ({scaled} scaled)")
+    assert linear > 0 and scaled > 0
+
+
+def test_velocity_servos_preload_holds_the_torque_at_zero_error():
+    M = np.diag([1.0, 0.3]) + 0.1
+    servos = VelocityServos([50.0, 50.0], 500.0, 1e-3)
+    tau = np.array([12.0, -3.0])
+    servos.preload(tau, M)
+    np.testing.assert_allclose(servos.torques([0.0, 0.0], M), tau, rtol=1e-9)
 
 
 def test_velocity_servos_stop_on_a_non_finite_command():
-    servos = VelocityServos([1.0, 1.0], [10.0, 10.0], 50.0, 1e-3)
+    servos = VelocityServos([10.0, 10.0], 50.0, 1e-3)
     servos.set_command([math.nan, 1.0])
     assert servos.command.tolist() == [0.0, 1.0]
 

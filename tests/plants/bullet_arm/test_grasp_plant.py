@@ -330,3 +330,84 @@ def test_kept_pybullet_calls_stay_bound_to_each_rigs_own_client():
     finally:
         a.close()
         b.close()
+
+
+class _Recorder:
+    """A stand-in PyBullet client that keeps the forces and torques applied to the object."""
+
+    def __init__(self):
+        self.force = self.torque = None
+
+    def applyExternalForce(self, obj, link, force, pos, frame):  # noqa: N802
+        self.force = np.array(force)
+
+    def applyExternalTorque(self, obj, link, torque, frame):  # noqa: N802
+        self.torque = np.array(torque)
+
+
+def _still_human(bc, **kw):
+    from plants.bullet_arm.human_hand import HumanHand
+
+    base = dict(
+        origin=[0.75, 0.0, 0.55],
+        rpy0=[0.0, 0.0, 0.0],
+        u=[0.0, 1.0, 0.0],
+        v=[0.0, 0.0, 1.0],
+        n=[1.0, 0.0, 0.0],
+        speed=0.0,
+        roll_rate=0.0,
+        f_min=0.1,
+        f_max=1.0,
+        components=6,
+        max_force=30.0,
+        start=0.0,
+        mass=0.1,
+        gravity=9.81,
+        stiffness=500.0,
+        damping=10.0,
+        rot_stiffness=0.5,
+        rot_damping=0.01,
+        max_torque=1.0,
+    )
+    base.update(kw)
+    return HumanHand(bc, 0, np.random.default_rng(0), **base)
+
+
+def test_human_hand_is_a_spring_damper_with_a_total_force_limit():
+    """Issue #20: the human holds the object compliantly: at its path's pose it carries the
+    weight; 10 mm off it pulls back with k x 10 mm; far off, the force's magnitude (not each
+    axis) stops at its limit, pointing the same way; a moving object is damped."""
+    bc = _Recorder()
+    h = _still_human(bc)
+    q = [0.0, 0.0, 0.0, 1.0]
+    h.drive(0.0, [0.75, 0.0, 0.55], q, [0.0] * 3, [0.0] * 3)
+    np.testing.assert_allclose(bc.force, [0.0, 0.0, 0.981], atol=1e-12)
+    np.testing.assert_allclose(bc.torque, 0.0, atol=1e-12)
+    h.drive(0.0, [0.75, 0.01, 0.55], q, [0.0] * 3, [0.0] * 3)
+    np.testing.assert_allclose(bc.force, [0.0, -5.0, 0.981], atol=1e-9)
+    h.drive(0.0, [0.75, 0.01, 0.55], q, [0.0, 0.2, 0.0], [0.0] * 3)
+    np.testing.assert_allclose(bc.force, [0.0, -7.0, 0.981], atol=1e-9)
+    h.drive(0.0, [0.80, 0.10, 0.55], q, [0.0] * 3, [0.0] * 3)  # 25 N and 50 N per axis
+    assert np.linalg.norm(bc.force) == pytest.approx(30.0, rel=1e-12) and h.limited
+    want = np.array([-25.0, -50.0, 0.981])
+    np.testing.assert_allclose(bc.force / 30.0, want / np.linalg.norm(want), atol=1e-12)
+    # turned 0.1 rad about the plane normal: turned back with k_r x 0.1 rad
+    s = math.sin(0.05)
+    h.drive(0.0, [0.75, 0.0, 0.55], [s, 0.0, 0.0, math.cos(0.05)], [0.0] * 3, [0.0] * 3)
+    np.testing.assert_allclose(bc.torque, [-0.05, 0.0, 0.0], atol=1e-9)
+
+
+def test_human_force_is_logged_and_follows_a_pull():
+    """On the rig: with nothing touching, the object hangs on the human's spring at its path
+    (within 1 mm; the logged force carries its weight); /human/wrench is in the truth."""
+    plant = rig(human_speed=0.05)
+    try:
+        for _ in range(300):
+            plant.step()
+        truth = plant.truth(plant._t)
+        hw = truth["/human/wrench"]
+        assert np.linalg.norm(hw.offset) < 1e-3
+        assert hw.force[2] == pytest.approx(0.1 * 9.81, abs=0.6)
+        assert not hw.limited
+    finally:
+        plant.close()
