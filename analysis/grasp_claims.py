@@ -16,7 +16,6 @@ Quantities (all from the log):
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import yaml
@@ -32,8 +31,9 @@ from analysis.grasp_run import (
     load_run,
 )
 from replay.log import LogReader
+from replay.resources import data_path
 
-STATED = Path(__file__).resolve().parents[1] / "data" / "claims" / "namiki1999.yaml"
+STATED = data_path("claims", "namiki1999.yaml")
 ROUND = {"box": "rectangle", "ball": "circle"}  # the rig's object -> its image's shape
 HOLD_DRIFT = 0.01  # m: a grasp "holds" while the object stays within this of the palm
 TRACK_RATIO = 0.2  # tracking is "responsive" if RMS error < this x the object's excursion

@@ -24,7 +24,7 @@ import math
 from collections import deque
 
 import numpy as np
-import pybullet as p
+from plants.bullet_arm.engine import pybullet as p
 
 from plants.bullet_arm._arm_state import joint_state
 from plants.bullet_arm.ft_sensor import WristFT

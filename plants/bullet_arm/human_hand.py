@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet as p
+from plants.bullet_arm.engine import pybullet as p
 
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 

@@ -44,9 +44,8 @@ from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
 from replay.scene import Box, Frame, Scene, Sphere
 
-with quiet_c_output():  # PyBullet's import prints a build banner
-    import pybullet as p
-    from pybullet_utils import bullet_client
+from plants.bullet_arm.engine import bullet_client
+from plants.bullet_arm.engine import pybullet as p
 
 
 # the PyBullet calls made every step through the client (the plant, the grasp rig's helpers, the

@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet as p
+from plants.bullet_arm.engine import pybullet as p
 
 INTEGRAL_RATIO = 10.0  # bandwidth / w_i
 
