@@ -71,9 +71,8 @@ class Params(ArmParams):
         doc="velocity gain of each hand joint's servo (integrated implicitly), its torque "
         "capped at hand_max_torque: stiff, as PyBullet's velocity motor (a constraint). "
         "Assumed: gain * dt is 2000 times a finger's inertia (~5e-5 kg*m^2), so the fingers "
-        "follow the palm within 1e-4 of a step's acceleration (1 N*m*s/rad: 0.5 %); at 1000 "
-        "the implicit damping upsets MuJoCo's contact solve (a ball on the palm is kicked off "
-        "as the fingers start to close)",
+        "follow the palm within 1e-4 of a step's acceleration (1 N*m*s/rad: 0.5 %); 30 and "
+        "1000 catch the same throws (docs/mujoco.md)",
     )
 
     def __post_init__(self) -> None:

@@ -26,7 +26,7 @@ from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.settings import resolve
 from plants.mujoco_arm.params import Params as MujocoParams
-from plants.mujoco_arm.world import build_world, free_velocity
+from plants.mujoco_arm.world import NEAR, build_world, free_velocity
 from replay.interfaces import Occurrence, Plant
 from replay.messages import (
     TOPIC_ARM_APPLIED_TORQUE,
@@ -140,6 +140,24 @@ class MujocoArmPlant(Plant):
         self._hand_i_dt = [float(m.dof_M0[i]) / dt for i in W.hand_dof]
         self._hand_body = [W.body_names.index(f"{n}_link") for n in self.hand_names]
         self._hand_capped: list | None = None
+        # each hand link's geoms, the object's, and how near the palm the object must be
+        # before a link can be NEAR it: the hand's size (links' geoms about the palm, bounded by
+        # their bodies' bounding spheres at rest) + the object's + NEAR
+        self._hand_geoms = [
+            list(range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]))
+            for b in self._hand_body
+        ]
+        self._obj_geom = int(m.body_geomadr[self._ob]) if self._ob >= 0 else -1
+        self._fromto = np.zeros(6)
+        if self._palm >= 0 and self._ob >= 0:
+            ext = max(
+                float(np.linalg.norm(d.geom_xpos[g] - d.xpos[self._palm])) + m.geom_rbound[g]
+                for gs in self._hand_geoms
+                + [[g for g in range(m.ngeom) if m.geom_bodyid[g] == self._palm]]
+                for g in gs
+            )
+            reach = ext + float(m.geom_rbound[self._obj_geom]) + NEAR
+            self._hand_reach2 = reach * reach
         self._hand_kv = float(P.hand_servo_gain)
         # MuJoCo resets the state where it diverges (a warning count): those are the "nan"
         self._bad = (
@@ -339,24 +357,34 @@ class MujocoArmPlant(Plant):
         f, u = d.actuator_force[self._hand_act].tolist(), d.ctrl[self._hand_act].tolist()
         return [a if c else kv * (x - y) for a, c, x, y in zip(f, self._hand_capped, u, v)]
 
+    def _near_links(self) -> list[bool]:
+        """Per hand joint: its link is within ``NEAR`` of the object now (it may touch it in the
+        coming step); the distances are asked only with the object near the palm."""
+        n = len(self._hand_geoms)
+        if self._ob < 0 or self._palm < 0:
+            return [False] * n
+        d = self.md
+        r = d.xpos[self._ob] - d.xpos[self._palm]
+        if float(r @ r) > self._hand_reach2:
+            return [False] * n
+        m, og, fromto = self.mj, self._obj_geom, self._fromto
+        return [
+            any(mujoco.mj_geomDistance(m, d, og, g, NEAR, fromto) < NEAR for g in gs)
+            for gs in self._hand_geoms
+        ]
+
     def _hand_caps(self, v_cmd: list, v: list) -> None:
         """PyBullet's hand motor is a velocity constraint whose force is capped; MuJoCo clips an
         actuator's force before its implicit step (a clipped servo is explicit and overshoots
         its target). So each joint's stiff servo is left unclipped (rigid, as the constraint)
         while a free finger needs less than the cap to reach ``v_cmd`` in a step (I dv / dt),
         and clipped to the cap (the constraint's force then) when it needs more or its link
-        touches the object in the coming step (the contacts mj_step1 found at this state)."""
-        d = self.md
-        touching = (
-            {int(b) for b in self.mj.geom_bodyid[np.r_[d.contact.geom1, d.contact.geom2]]}
-            if d.ncon
-            else ()
-        )
+        may touch the object in the coming step (``_near_links``). (PyBullet caps the motor in
+        the same solve as the impact; a stiff servo hitting the ball unclipped for a step kicks
+        it off.)"""
+        near = self._near_links()
         cap = self._hand_cap
-        capped = [
-            k * abs(x - y) > cap or b in touching
-            for x, y, k, b in zip(v_cmd, v, self._hand_i_dt, self._hand_body)
-        ]
+        capped = [k * abs(x - y) > cap or n for x, y, k, n in zip(v_cmd, v, self._hand_i_dt, near)]
         if capped != self._hand_capped:
             big = 1e6 * cap
             self.mj.actuator_forcerange[self._hand_act] = [
@@ -407,8 +435,9 @@ class MujocoArmPlant(Plant):
 
     # ------------------------------------------------------------------ events
     def _read_contacts(self) -> None:
-        """The step's object-robot contacts (the robot touches nothing else): body, point,
-        normal from the robot towards the object, normal force (N)."""
+        """The step's object-robot contacts (the robot touches nothing else) that were in its
+        constraint solve (the nearer-than-margin ones are not: world.py): body, point, normal
+        from the robot towards the object, normal force (N)."""
         d = self.md
         out = []
         n = d.ncon
@@ -417,7 +446,7 @@ class MujocoArmPlant(Plant):
             con = d.contact
             for i in range(n):
                 b1, b2 = int(bodyid[con.geom1[i]]), int(bodyid[con.geom2[i]])
-                if ob not in (b1, b2) or con.dist[i] > 1e-4:
+                if ob not in (b1, b2) or con.efc_address[i] < 0:  # not in the solve: near
                     continue
                 mujoco.mj_contactForce(m, d, i, self._f6)
                 nrm = con.frame[i, :3]  # from geom1 to geom2

@@ -11,7 +11,10 @@ MuJoCo facts used (MuJoCo 4.0, checked by tests/plants/mujoco_arm):
 - PyBullet combines two bodies' friction coefficients by their product, MuJoCo by their maximum:
   both the robot's and the object's geoms get the product, so the pair has the same mu;
 - the hand joints are velocity servos (``set_to_velocity``) with their torque clipped to
-  ``hand_max_torque``, the PyBullet plant's rate-limited velocity motors.
+  ``hand_max_torque``, the PyBullet plant's rate-limited velocity motors (plant.py
+  ``_hand_caps``: when the clip applies);
+- a hand servo is clipped while its link is within ``NEAR`` of the object (``mj_geomDistance``):
+  the object may touch it within the step.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 
 ROBOT_BITS, OBJECT_BITS = 2, 1  # contype of each; conaffinity the other's: robot-robot never
 OBJECT_BODY = "object"
+NEAR = 0.02  # m: an object this near a link may touch it within a 1 ms step (20 m/s relative)
 INTEGRATORS = {
     "Euler": mujoco.mjtIntegrator.mjINT_EULER,
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
