@@ -43,15 +43,19 @@ from replay.robot.hand import hand_mass
 from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
 from replay.scene import Box, Frame, Scene, Sphere
 
-_XBODY = mujoco.mjtObj.mjOBJ_XBODY
-
 
 def _xyzw(q) -> tuple[float, float, float, float]:
-    w, x, y, z = (float(v) for v in q)
-    return (x, y, z, w)
+    w, x, y, z = q
+    return (float(x), float(y), float(z), float(w))
 
 
 def _floats(values, n: int, what: str) -> list[float]:
+    """A flat list of ``n`` floats: a list or tuple of numbers by ``float()``, else NumPy's."""
+    if type(values) in (list, tuple) and len(values) == n:
+        try:
+            return list(map(float, values))
+        except (TypeError, ValueError):
+            pass
     a = np.asarray(values, dtype=float).reshape(-1)
     if a.shape != (n,):
         raise ValueError(f"{what} needs {n} values, got {a.shape[0]}")
@@ -109,7 +113,10 @@ class MujocoArmPlant(Plant):
             d.qvel[b : b + 6] = free_velocity(R, P.object_velocity, P.object_angular_velocity)
         mujoco.mj_forward(m, d)
         self._q_locked = [float(self.locked.get(n, 0.0)) for n in self.joint_names]
-        self._vel6 = np.zeros(6)
+        # (arm joint index, qpos address, dof address) of each active joint
+        self._arm_slots = [(i, W.arm_qpos[k], W.arm_dof[k]) for k, i in enumerate(self.active)]
+        self._root = m.body_rootid.tolist()
+        self._motions: dict = {}  # (step, body) -> _body_motion
         self._f6 = np.zeros(6)
         # ---- bookkeeping (as the PyBullet plant's)
         dof = self.dof
@@ -245,22 +252,25 @@ class MujocoArmPlant(Plant):
         plain floats, read once after each step; shared, never mutated."""
         if self._cache is None:
             d = self.md
-            qa, va = d.qpos[self._arm_qpos].tolist(), d.qvel[self._arm_dof].tolist()
-            if len(qa) == self.dof:
-                q, qd = qa, va
-            else:
-                q, qd = self._q_locked[:], [0.0] * self.dof
-                for k, i in enumerate(self.active):
-                    q[i], qd[i] = qa[k], va[k]
-            hv = d.qvel[self._hand_dof].tolist()
-            hand = (d.qpos[self._hand_qpos].tolist(), hv, self._hand_effort(hv))
+            qp, qv = d.qpos.tolist(), d.qvel.tolist()  # one read each: lists beat fancy indexing
+            q, qd = self._q_locked[:], [0.0] * self.dof
+            for i, a, b in self._arm_slots:
+                q[i], qd[i] = qp[a], qv[b]
+            hv = [qv[b] for b in self._hand_dof]
+            hand = ([qp[a] for a in self._hand_qpos], hv, self._hand_effort(hv))
             obj = None
             if self._ob >= 0:
                 a, b = self.world.object_qpos, self.world.object_dof
-                qp, qv = d.qpos[a : a + 7].tolist(), d.qvel[b : b + 6]
-                R = d.xmat[self._ob].reshape(3, 3)
-                w = (R @ qv[3:6]).tolist()  # the free joint's spin is in the body frame
-                obj = (tuple(qp[:3]), _xyzw(qp[3:7]), tuple(qv[:3].tolist()), tuple(w))
+                # the free joint's spin is in the body frame: w = R w_local
+                r = d.xmat[self._ob].tolist()
+                lx, ly, lz = qv[b + 3 : b + 6]
+                w = (
+                    r[0] * lx + r[1] * ly + r[2] * lz,
+                    r[3] * lx + r[4] * ly + r[5] * lz,
+                    r[6] * lx + r[7] * ly + r[8] * lz,
+                )
+                qw, qx, qy, qz = qp[a + 3 : a + 7]
+                obj = (tuple(qp[a : a + 3]), (qx, qy, qz, qw), tuple(qv[b : b + 3]), w)
             self._cache = ((q, qd), hand, obj)
         return self._cache
 
@@ -268,6 +278,7 @@ class MujocoArmPlant(Plant):
         """Forget the state read (after setting qpos/qvel other than by stepping)."""
         mujoco.mj_step1(self.mj, self.md)
         self._cache = None
+        self._motions.clear()
 
     def arm_state(self) -> tuple[np.ndarray, np.ndarray]:
         q, qd = self._state()[0]
@@ -281,11 +292,24 @@ class MujocoArmPlant(Plant):
         return tuple(np.array(a) for a in self._state()[2])
 
     def _body_motion(self, body: int) -> tuple:
-        """(position, orientation xyzw, v, w) of a body's frame (world)."""
+        """(position, orientation xyzw, v, w) of a body's frame (world), from MuJoCo's cvel
+        (rotation; translation of the point at the subtree centre of mass of the body's root,
+        moving with the body), read once a step per body."""
+        key = (self._steps, body)
+        got = self._motions.get(key)
+        if got is not None:
+            return got
+        if len(self._motions) > 8:
+            self._motions.clear()
         d = self.md
-        mujoco.mj_objectVelocity(self.mj, d, _XBODY, body, self._vel6, 0)
-        w, v = self._vel6[:3].tolist(), self._vel6[3:].tolist()
-        return (tuple(d.xpos[body].tolist()), _xyzw(d.xquat[body]), tuple(v), tuple(w))
+        wx, wy, wz, ux, uy, uz = d.cvel[body].tolist()
+        px, py, pz = d.xpos[body].tolist()
+        cx, cy, cz = d.subtree_com[self._root[body]].tolist()
+        rx, ry, rz = px - cx, py - cy, pz - cz
+        v = (ux + wy * rz - wz * ry, uy + wz * rx - wx * rz, uz + wx * ry - wy * rx)
+        got = ((px, py, pz), _xyzw(d.xquat[body].tolist()), v, (wx, wy, wz))
+        self._motions[key] = got
+        return got
 
     def effector_state(self):
         """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity."""

@@ -302,7 +302,8 @@ def test_miss_event_when_ball_falls_past(engine):
     assert plant.outcome(0.4)["reason"] == "ball passed below the hand"
 
 
-def test_nan_event_on_non_finite_state():
+def test_nan_event_on_non_finite_state(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warning to ./MUJOCO_LOG.TXT
     plant = make("mujoco", **CATCHING)
     plant.md.qvel[plant.world.object_dof] = float("nan")
     plant.invalidate_state()
