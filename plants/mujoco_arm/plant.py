@@ -372,9 +372,9 @@ class MujocoArmPlant(Plant):
         self._clamped = self._torque_episode = clamped
 
     def _hand_effort(self, v: list) -> list[float]:
-        """The hand servos' torques of the last step (N*m): the cap where clipped (MuJoCo's
-        actuator_force), else the implicit step's kv (v_cmd - v after it); MuJoCo's
-        actuator_force is then the force before the step, kv (v_cmd - v before it)."""
+        """The hand servos' torques of the last step (N*m): where clipped, MuJoCo's
+        actuator_force; else the implicit step's kv (v_cmd - v after it) (actuator_force is
+        then the force before the step, kv (v_cmd - v before it))."""
         if self._hand_capped is None:
             return [0.0] * len(v)
         kv, d = self._hand_kv, self.md
@@ -398,21 +398,22 @@ class MujocoArmPlant(Plant):
         ]
 
     def _hand_caps(self, v_cmd: list, v: list) -> None:
-        """PyBullet's hand motor is a velocity constraint whose force is capped; MuJoCo clips an
-        actuator's force before its implicit step (a clipped servo is explicit and overshoots
-        its target). So each joint's stiff servo is left unclipped (rigid, as the constraint)
+        """PyBullet's hand motor is a velocity constraint whose force is capped. MuJoCo clips an
+        actuator's force before its implicit step, and a clipped servo is integrated
+        explicitly. So each joint's stiff servo is left unclipped (rigid, as the constraint)
         while a free finger needs less than the cap to reach ``v_cmd`` in a step (I dv / dt),
-        and clipped to the cap (the constraint's force then) when it needs more or its link
-        may touch the object in the coming step (``_near_links``). (PyBullet caps the motor in
-        the same solve as the impact; a stiff servo hitting the ball unclipped for a step kicks
-        it off.)"""
+        and is clipped to the force that would (at most the cap) when it needs more or its
+        link may touch the object in the coming step (``_near_links``): explicit then, with no
+        overshoot. (PyBullet caps the motor in the impact's own solve; a stiff servo hitting
+        the ball unclipped for a step kicks it off.)"""
         near = self._near_links()
         cap = self._hand_cap
-        capped = [k * abs(x - y) > cap or n for x, y, k, n in zip(v_cmd, v, self._hand_i_dt, near)]
-        if capped != self._hand_capped:
+        need = [k * abs(x - y) for x, y, k in zip(v_cmd, v, self._hand_i_dt)]
+        capped = [f > cap or n for f, n in zip(need, near)]
+        if capped != self._hand_capped or True in capped:
             big = 1e6 * cap
             self.mj.actuator_forcerange[self._hand_act] = [
-                (-cap, cap) if c else (-big, big) for c in capped
+                (-min(f, cap), min(f, cap)) if c else (-big, big) for c, f in zip(capped, need)
             ]
             self._hand_capped = capped
 
