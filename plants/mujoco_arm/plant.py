@@ -117,6 +117,12 @@ class MujocoArmPlant(Plant):
         self._arm_slots = [(i, W.arm_qpos[k], W.arm_dof[k]) for k, i in enumerate(self.active)]
         self._root = m.body_rootid.tolist()
         self._motions: dict = {}  # (step, body) -> _body_motion
+        # frames(): per robot body (body, parent, parent's name, its name)
+        self._frame_rows = [
+            (i, int(m.body_parentid[i]), W.body_names[int(m.body_parentid[i])], W.body_names[i])
+            for i in range(1, m.nbody)
+            if W.part_of_body[i] is not None
+        ]
         self._f6 = np.zeros(6)
         # ---- bookkeeping (as the PyBullet plant's)
         dof = self.dof
@@ -155,7 +161,11 @@ class MujocoArmPlant(Plant):
             for b in self._hand_body
         ]
         self._obj_geom = int(m.body_geomadr[self._ob]) if self._ob >= 0 else -1
-        self._fromto = np.zeros(6)
+        # _near_links: each hand geom, its joint, (its bounding radius + the object's + NEAR)^2
+        self._near_geoms = [g for gs in self._hand_geoms for g in gs]
+        self._near_joint = [k for k, gs in enumerate(self._hand_geoms) for _ in gs]
+        r_obj = float(m.geom_rbound[self._obj_geom]) if self._ob >= 0 else 0.0
+        self._near_lim2 = [(float(m.geom_rbound[g]) + r_obj + NEAR) ** 2 for g in self._near_geoms]
         if self._palm >= 0 and self._ob >= 0:
             ext = max(
                 float(np.linalg.norm(d.geom_xpos[g] - d.xpos[self._palm])) + m.geom_rbound[g]
@@ -382,20 +392,24 @@ class MujocoArmPlant(Plant):
         return [a if c else kv * (x - y) for a, c, x, y in zip(f, self._hand_capped, u, v)]
 
     def _near_links(self) -> list[bool]:
-        """Per hand joint: its link is within ``NEAR`` of the object now (it may touch it in the
-        coming step); the distances are asked only with the object near the palm."""
-        n = len(self._hand_geoms)
+        """Per hand joint: its link may touch the object in the coming step: a geom's bounding
+        sphere within ``NEAR`` of the object's (conservative: a sphere bounds a box); asked
+        only with the object near the palm."""
+        n = len(self._hand_body)
         if self._ob < 0 or self._palm < 0:
             return [False] * n
         d = self.md
         r = d.xpos[self._ob] - d.xpos[self._palm]
         if float(r @ r) > self._hand_reach2:
             return [False] * n
-        m, og, fromto = self.mj, self._obj_geom, self._fromto
-        return [
-            any(mujoco.mj_geomDistance(m, d, og, g, NEAR, fromto) < NEAR for g in gs)
-            for gs in self._hand_geoms
-        ]
+        x, y, z = d.xpos[self._ob].tolist()
+        near = [False] * n
+        for (gx, gy, gz), k, lim2 in zip(
+            d.geom_xpos[self._near_geoms].tolist(), self._near_joint, self._near_lim2
+        ):
+            if (gx - x) ** 2 + (gy - y) ** 2 + (gz - z) ** 2 < lim2:
+                near[k] = True
+        return near
 
     def _hand_caps(self, v_cmd: list, v: list) -> None:
         """PyBullet's hand motor is a velocity constraint whose force is capped. MuJoCo clips an
@@ -648,18 +662,34 @@ class MujocoArmPlant(Plant):
         return self.model.urdf
 
     def frames(self) -> list[Frame]:
-        """Every URDF link (a body of the same name) in its parent link, the base in ``world``."""
-        d, W = self.md, self.world
+        """Every URDF link (a body of the same name) in its parent link, the base in ``world``
+        (the robot's bodies; the free object is the scene's), in plain floats."""
+        d = self.md
+        X, R, Q = d.xpos.tolist(), d.xmat.tolist(), d.xquat.tolist()
         out = []
-        for b in range(1, self.mj.nbody):
-            if W.part_of_body[b] is None:
-                continue  # the free object: the scene's
-            p = int(self.mj.body_parentid[b])
-            Rp = d.xmat[p].reshape(3, 3)
-            rel = Rp.T @ (d.xpos[b] - d.xpos[p])
-            q = np.zeros(4)
-            mujoco.mju_mulQuat(q, _conj(d.xquat[p]), d.xquat[b])
-            out.append(Frame(W.body_names[p], W.body_names[b], tuple(rel.tolist()), _xyzw(q)))
+        for b, p, pn, bn in self._frame_rows:
+            (px, py, pz), r = X[p], R[p]
+            x, y, z = X[b][0] - px, X[b][1] - py, X[b][2] - pz
+            w1, x1, y1, z1 = Q[p]
+            x1, y1, z1 = -x1, -y1, -z1  # the parent's conjugate times the child's (wxyz)
+            w2, x2, y2, z2 = Q[b]
+            out.append(
+                Frame(
+                    pn,
+                    bn,
+                    (  # R_p^T (x_b - x_p)
+                        r[0] * x + r[3] * y + r[6] * z,
+                        r[1] * x + r[4] * y + r[7] * z,
+                        r[2] * x + r[5] * y + r[8] * z,
+                    ),
+                    (
+                        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+                        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                    ),
+                )
+            )
         return out
 
     def joints(self) -> tuple[list, list, list, list]:
@@ -691,7 +721,3 @@ class MujocoArmPlant(Plant):
                 )
         encoders = {"name": list(self.joint_names), "position": q[:], "velocity": qd[:]}
         return Scene(prims, readings={"arm": encoders})
-
-
-def _conj(q) -> np.ndarray:
-    return np.array([q[0], -q[1], -q[2], -q[3]], float)

@@ -13,8 +13,8 @@ MuJoCo facts used (MuJoCo 4.0, checked by tests/plants/mujoco_arm):
 - the hand joints are velocity servos (``set_to_velocity``) with their torque clipped to
   ``hand_max_torque``, the PyBullet plant's rate-limited velocity motors (plant.py
   ``_hand_caps``: when the clip applies);
-- a hand servo is clipped while its link is within ``NEAR`` of the object (``mj_geomDistance``):
-  the object may touch it within the step.
+- a hand servo is clipped while its link's geoms' bounding spheres are within ``NEAR`` of the
+  object's: the object may touch it within the step.
 """
 
 from __future__ import annotations
