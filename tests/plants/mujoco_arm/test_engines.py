@@ -1,0 +1,67 @@
+"""Claims per engine (analysis/engines.py): the catch rows of the PyBullet and the MuJoCo runs of
+the same scenarios side by side, each decided by the paper's own rows on each engine's truth."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from analysis.claims import Claim
+from analysis.engines import closing_note, engine_rows, join, rate_row, split_logs
+
+ROOT = Path(__file__).resolve().parents[3]
+NAMES = ("catch_optimised", "catch_initial")
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    from replay.log import LogReader
+    from replay.runner import Runner
+    from replay.scenario import load_scenario
+
+    out = tmp_path_factory.mktemp("engines")
+    res = {}
+    for name in NAMES + tuple(n + "_mujoco" for n in NAMES):
+        path = out / f"{name}.mcap"
+        Runner(load_scenario(ROOT / "scenarios" / f"{name}.yaml")).run(path)
+        res[name] = LogReader(str(path))
+    return res
+
+
+def test_every_catch_row_shows_both_engines(logs):
+    from analysis.catch_claims import evaluate
+
+    pb, mj = split_logs(logs)
+    assert set(pb) == set(mj) == set(NAMES)
+    rows = engine_rows(evaluate, logs)
+    assert {r.quantity for r in rows} == {r.quantity for r in evaluate(pb)}
+    for r in rows:
+        assert r.measured.startswith("PyBullet: ") and " ‖ MuJoCo: " in r.measured, r.quantity
+        assert "not run" not in r.measured, r.quantity
+    caught = {r.quantity: r for r in rows if r.quantity.endswith("ball caught")}
+    assert set(caught) == {f"{n}: ball caught" for n in NAMES}
+    for r in caught.values():  # the plants' own verdict, in each engine
+        assert r.status == "reproduced", r
+    note = closing_note(rows)
+    assert "catch_optimised: ball caught" in note.splitlines()[0]
+
+
+def test_rows_that_part_say_so():
+    a = [Claim("q", "1", "1.0", "reproduced", "n"), Claim("only", "x", "y", "note")]
+    b = [Claim("q", "1", "2.0", "differs", "n")]
+    rows = join(a, b)
+    assert rows[0].status == "differs" and rows[0].note.startswith(
+        "engines part: PyBullet reproduced, MuJoCo differs"
+    )
+    assert rows[0].measured == "PyBullet: 1.0 ‖ MuJoCo: 2.0"
+    assert rows[1].measured.endswith("MuJoCo: not run")
+    assert "q (PyBullet reproduced, MuJoCo differs)" in closing_note(rows)
+
+
+def test_rate_row():
+    ok, bad = {"success": True, "reason": "caught"}, {"success": False, "reason": "x"}
+    r = rate_row("rate", "≥ 90 %", {"PyBullet": [ok] * 10, "MuJoCo": [ok] * 9 + [bad]})
+    assert r.status == "reproduced" and "MuJoCo: 9/10 = 90 %" in r.measured
+    r = rate_row("rate", "≥ 90 %", {"PyBullet": [ok] * 10, "MuJoCo": [ok] * 8 + [bad] * 2})
+    assert r.status == "differs" and "MuJoCo failures: x" in r.note
