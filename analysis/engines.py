@@ -55,8 +55,10 @@ def _pair(a: Claim | None, b: Claim | None) -> Claim:
     sb = b.status if b else "not run"
     if sa == sb:
         status, parted = sa, ""
+    elif "not run" in (sa, sb):  # one engine has no run for it: the other's verdict stands
+        status, parted = (sb if sa == "not run" else sa), ""
     else:
-        status = "differs" if "reproduced" in (sa, sb) else (sa if sb == "not run" else sb)
+        status = "differs" if "reproduced" in (sa, sb) else sb
         parted = f"engines part: PyBullet {sa}, MuJoCo {sb}"
     note = "; ".join(x for x in (parted, ref.note) if x)
     return Claim(
@@ -73,6 +75,17 @@ def engine_rows(evaluate: Callable[[dict], list[Claim]], logs: Mapping[str, Any]
     """The paper's rows per engine, joined (``join``)."""
     pb, mj = split_logs(logs)
     return join(evaluate(pb) if pb else [], evaluate(mj) if mj else [])
+
+
+def evaluate_runs(
+    evaluate: Callable[[dict], list[Claim]], logs: Mapping[str, Any]
+) -> tuple[list[Claim], str]:
+    """(rows, note) as the claims table and the report show them: with MuJoCo runs among
+    ``logs`` both engines side by side and the closing note; else the paper's rows alone."""
+    if not any(n.endswith(SUFFIX) for n in logs):
+        return evaluate(dict(logs)), ""
+    rows = engine_rows(evaluate, logs)
+    return rows, closing_note(rows)
 
 
 def rate_row(label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]]) -> Claim:
@@ -103,7 +116,7 @@ def closing_note(rows: Sequence[Claim]) -> str:
             both.append(r.quantity)
         elif "engines part" in r.note:
             one.append(f"{r.quantity} ({r.note.split(';')[0].removeprefix('engines part: ')})")
-        else:
+        elif r.status == "differs":  # (ties, notes and rows not run in either: no verdict)
             neither.append(r.quantity)
     lines = [f"Hold in both engines ({len(both)}): {', '.join(both) or 'none'}."]
     lines.append(f"Hold in one engine only ({len(one)}): {', '.join(one) or 'none'}.")

@@ -658,6 +658,7 @@ def figures(logs, out):
 def claims(logs, markdown):
     """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
     from analysis.claims import falsifiers_of, format_table
+    from analysis.engines import evaluate_runs
 
     sections = []
     by_paper = _logs_by_paper(logs)
@@ -673,13 +674,14 @@ def claims(logs, markdown):
             warn(f"{paper}: no claims defined yet")
             continue
         try:
-            rows = evaluate(readers)
+            rows, engines_note = evaluate_runs(evaluate, readers)  # both engines, if both ran
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("claims", paper, readers, exc)
         title = PAPERS[paper].title if paper in PAPERS else paper
-        sections.append(
-            format_table(title, rows, partial=_partial(readers), falsifiers=falsifiers_of(evaluate))
+        table = format_table(
+            title, rows, partial=_partial(readers), falsifiers=falsifiers_of(evaluate)
         )
+        sections.append(table + (f"\n\n{engines_note}" if engines_note else ""))
     text = "\n\n".join(sections)
     click.echo(text)
     if markdown:

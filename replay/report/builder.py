@@ -130,8 +130,12 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
                 )
             try:
                 evaluate = registry.load("claims", key)
-                sec.claims = evaluate(readers)
                 from analysis.claims import falsifiers_of, format_table, summary
+                from analysis.engines import evaluate_runs
+
+                sec.claims, engines_note = evaluate_runs(evaluate, readers)
+                if engines_note:
+                    sec.notes.append("Both physics engines (docs/mujoco.md): " + engines_note)
 
                 sec.falsifiers = falsifiers_of(evaluate)
                 sec.claims_md = format_table(paper.title, sec.claims, falsifiers=sec.falsifiers)
