@@ -58,7 +58,7 @@ def arm_urdf(
     return path
 
 
-FOCUS_REACH = 0.3  # m: the object this near the hand's path is framed with it
+FOCUS_REACH = 0.2  # m: the object this near the hand's path is framed with it
 
 
 class ArmScene(RunScene):
