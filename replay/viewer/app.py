@@ -182,16 +182,16 @@ class Viewer:
         for client in self.server.get_clients().values():
             cam = client.camera
             offset = np.asarray(cam.position, float) - np.asarray(cam.look_at, float)
-            with client.atomic():
-                cam.look_at = tuple(p)
+            with client.atomic():  # viser: position moves look_at along; then look_at
                 cam.position = tuple(p + offset)
+                cam.look_at = tuple(p)
 
     def _home(self) -> None:
         pos, look = self.camera_home
         for client in self.server.get_clients().values():
             with client.atomic():
+                client.camera.position = pos  # moves look_at along: set it after
                 client.camera.look_at = look
-                client.camera.position = pos
                 client.camera.up_direction = (0.0, 0.0, 1.0)
 
     def load(self, runs: list[RunData]) -> None:
