@@ -123,7 +123,7 @@ class ArmScene(RunScene):
         if self.run.track(TOPIC_ARM_JOINT_STATE) is not None or self.run.plant_type:
             try:
                 path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
-                opacity = 0.45 if self.ghost else 0.7  # overlaid: every run in its colour
+                opacity = 0.5 if self.ghost else 1.0  # overlaid: every run in its colour
                 override = None if not self.tint else (*(c / 255 for c in self.color), opacity)
                 self.urdf_color = override
                 self.urdf = ViserUrdf(

@@ -163,9 +163,10 @@ def test_follow_object_turns_the_camera_to_the_object(served, tmp_path):
 
 def test_two_overlaid_catch_runs_in_their_own_colours_with_a_legend(served, tmp_path):
     a = write_arm_log(tmp_path / "a.mcap", name="catch_a")
-    b = write_arm_log(tmp_path / "b.mcap", name="catch_b", swing=0.5)
+    b = write_arm_log(tmp_path / "b.mcap", name="catch_b", swing=0.25)
     viewer, page = served([a, b])
     deadline = time.monotonic() + PAGE_DEADLINE
+    viewer.seek(0.3)  # mid-swing: the arms apart (at 0 they coincide)
     img = _poll(
         page,
         lambda img: _near(img, run_color(0)) > RUN_FILL and _near(img, run_color(1)) > RUN_FILL,
