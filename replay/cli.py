@@ -945,6 +945,28 @@ def layout(paper, out):
     click.echo(f"wrote {out}")
 
 
+@main.command()
+@click.argument("log", type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--web", is_flag=True, help="Rerun's web viewer on 127.0.0.1 instead of the native one"
+)
+@click.option(
+    "--port", type=int, default=9090, show_default=True, help="web viewer port (+1: data)"
+)
+@click.option("--at", type=float, help="convert the log only up to T seconds")
+@click.option("--shot", type=click.Path(dir_okay=False), help="with --web: screenshot to FILE")
+def rerun(log, web, port, at, shot):
+    """Open LOG in Rerun's viewer with a ready layout, its timeline in simulated seconds (needs
+    the extra: pip install 'paper-replay[rerun]'). Every process it starts is stopped when it
+    ends (docs/foxglove.md)."""
+    from replay.foxglove.rerun_view import RerunError, view  # noqa: PLC0415
+
+    try:
+        view(Path(log), web=web, port=port, at=at, shot=Path(shot) if shot else None)
+    except RerunError as exc:
+        fail(str(exc))
+
+
 from replay.sweep.commands import register  # noqa: E402  (replay sweep, ablate, report)
 
 register(main)

@@ -103,7 +103,7 @@ class AirTableScene(RunScene):
                 )
             )
         self.stick = self._add(sc.add_frame(f"{r}/stick", show_axes=False))
-        body_color = (55, 55, 60) if not self.ghost else self.color
+        body_color = (55, 55, 60) if not self.tint else self.color
         self._add(
             sc.add_box(
                 f"{r}/stick/body",
@@ -131,7 +131,7 @@ class AirTableScene(RunScene):
                 visible=False,
             )
         )
-        tip_color = (30, 30, 30) if not self.ghost else self.color
+        tip_color = (30, 30, 30) if not self.tint else self.color
         self.tips = [
             self._add(
                 sc.add_cylinder(
@@ -189,6 +189,12 @@ class AirTableScene(RunScene):
         lo, hi = p.min(axis=0) - 0.06, p.max(axis=0) + 0.06
         return np.append(lo, 0.0), np.append(hi, 0.02)
 
+    def focus(self, run: RunData, t: float):
+        st = run.track(TOPIC_STICK_STATE)
+        if st is None or st.index(t) < 0:
+            return None
+        return np.array([st.at("x", t), st.at("y", t), 0.0], float)
+
     def update(self, run: RunData, t: float) -> None:
         g = self.geo
         st = run.track(TOPIC_STICK_STATE)
@@ -231,7 +237,7 @@ class AirTableScene(RunScene):
             segs = [[(*pts[f, s], z), (*pts[f, s + 1], z)] for f in range(2) for s in range(2)]
             segs.append([(*pts[0, 0], z), (*pts[1, 0], z)])  # the palm
             self.base.position = (float(base[0]), float(base[1]), 0.005)
-            color = (90, 90, 100) if not self.ghost else self.color
+            color = (90, 90, 100) if not self.tint else self.color
             self.fingers = self.scene.add_line_segments(
                 f"{self.root}/fingers",
                 np.asarray(segs, dtype=np.float32),

@@ -58,6 +58,9 @@ def arm_urdf(
     return path
 
 
+FOCUS_REACH = 0.2  # m: the object this near the hand's path is framed with it
+
+
 class ArmScene(RunScene):
     """Namiki & Ishikawa 2003 (catching), Namiki et al. 1999 (grasping): arm and hand from the
     plant's URDF, the free object (ball / hexahedron) and its path, cameras."""
@@ -106,6 +109,7 @@ class ArmScene(RunScene):
                 )
             )
         self.urdf = None
+        self.urdf_color: tuple | None = None  # the arm's colour override (RGBA, 0-1)
         self._names: tuple[str, ...] = ()
         self._maps: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._add(
@@ -119,7 +123,9 @@ class ArmScene(RunScene):
         if self.run.track(TOPIC_ARM_JOINT_STATE) is not None or self.run.plant_type:
             try:
                 path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
-                override = None if not self.ghost else (*(c / 255 for c in self.color), 0.45)
+                opacity = 0.5 if self.ghost else 1.0  # overlaid: every run in its colour
+                override = None if not self.tint else (*(c / 255 for c in self.color), opacity)
+                self.urdf_color = override
                 self.urdf = ViserUrdf(
                     self.server, path, root_node_name=f"{r}/arm", mesh_color_override=override
                 )
@@ -131,7 +137,7 @@ class ArmScene(RunScene):
                 self.notes.append(
                     f"arm not drawn: URDF unreadable ({exc.__class__.__name__}: {exc})"
                 )
-        color = (240, 120, 30) if not self.ghost else self.color
+        color = (240, 120, 30) if not self.tint else self.color
         if p.object == "box":
             self.body = self._add(
                 sc.add_box(
@@ -191,6 +197,42 @@ class ArmScene(RunScene):
         p = np.concatenate(pts)
         p = p[np.all(np.isfinite(p), axis=1)]
         return p.min(axis=0) - 0.2, p.max(axis=0) + 0.2
+
+    def hand_path(self) -> np.ndarray | None:
+        """The hand's logged positions (n, 3): the effector (``/effector/state``, else
+        ``/effector/motion``), else the grasping task's x^a; None if the log has none."""
+        for topic, field in (
+            (TOPIC_EFFECTOR_STATE, "position"),
+            ("/effector/motion", "position"),
+            ("/grasping/arm", "x_a"),
+        ):
+            tr = self.run.track(topic)
+            if tr is not None and tr.has(field) and tr.fields[field].shape[1:2] >= (3,):
+                return np.asarray(tr.fields[field][:, :3], float)
+        return None
+
+    def focus_points(self):
+        """The hand and the object where it comes near the hand (within ``FOCUS_REACH`` of the
+        hand's path's box): a thrown ball's far flight is left out, so that the hand and the
+        ball fill the view. Without a logged hand: the object's whole path."""
+        ob = self.run.track(TOPIC_OBJECT_STATE)
+        obj = ob.fields["position"] if ob is not None and ob.has("position") else np.zeros((0, 3))
+        obj = obj[np.all(np.isfinite(obj), axis=1)]
+        hand = self.hand_path()
+        if hand is None:
+            return obj if len(obj) else None
+        hand = hand[np.all(np.isfinite(hand), axis=1)]
+        if not len(hand):
+            return obj if len(obj) else None
+        lo, hi = hand.min(axis=0) - FOCUS_REACH, hand.max(axis=0) + FOCUS_REACH
+        near = obj[np.all((obj >= lo) & (obj <= hi), axis=1)]
+        return np.concatenate([hand, near])
+
+    def focus(self, run: RunData, t: float):
+        ob = run.track(TOPIC_OBJECT_STATE)
+        if ob is None or not ob.has("position") or ob.index(t) < 0:
+            return None
+        return np.asarray(ob.at("position", t), float)
 
     def _map(self, track: Track) -> tuple[np.ndarray, np.ndarray]:
         """(columns in the track, slots in the URDF configuration) for joints in both."""

@@ -28,6 +28,7 @@ DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8080
 PORT_TRIES = 50
 PLOT_PERIOD = 0.1  # s between plot-cursor updates while playing
+FIT_DISTANCE = 1.1  # the camera's distance from the fitted box's centre, in box sizes
 
 
 def _can_bind(host: str, port: int) -> OSError | None:
@@ -98,6 +99,8 @@ class Viewer:
         self.images: ImagePanel | None = None
         self.notes: list[str] = []
         self.run_toggles: list = []
+        self.follow = None  # the "follow object" checkbox
+        self.camera_home: tuple = ((1.0, 1.0, 1.0), (0.0, 0.0, 0.0))
         self.time = 0.0
         self._lock = threading.RLock()
         self._last_plot = 0.0
@@ -132,30 +135,64 @@ class Viewer:
         self.server.scene.reset()  # every node, the runs' and the shared ones
         self.server.gui.reset()
         self.scenes, self.timeline, self.plots, self._status = [], None, None, None
-        self.images = None
+        self.images = self.follow = None
 
     def _build_scenes(self, runs: list[RunData]) -> None:
         self.runs = list(runs)
         self.notes = []
         for k, run in enumerate(self.runs):
             cls = scene_class(run)
-            s = cls(self.server, run, k, urdf_for=self.urdf_for)
+            s = cls(self.server, run, k, urdf_for=self.urdf_for, overlaid=len(self.runs) > 1)
             s.root_frame = self.server.scene.add_frame(s.root, show_axes=False)
-            s.build()
+            s.setup()
             self.scenes.append(s)
             prefix = f"{run.label}: " if len(self.runs) > 1 else ""
             self.notes += [f"{prefix}{n}" for n in run.notes + s.notes]
         self._frame_camera()
 
+    def fitted(self) -> tuple[np.ndarray, np.ndarray]:
+        """The box the camera fits at load: every run's moving parts (``RunScene.fit``)."""
+        boxes = [s.fit() for s in self.scenes]
+        return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+
     def _frame_camera(self) -> None:
-        lo = np.min([s.bounds()[0] for s in self.scenes], axis=0)
-        hi = np.max([s.bounds()[1] for s in self.scenes], axis=0)
+        lo, hi = self.fitted()
         c = (lo + hi) / 2.0
         size = float(max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.2))
+        d = np.array(self.scenes[0].view_direction, float)
         cam = self.server.initial_camera
-        cam.position = tuple(c + np.array(self.scenes[0].view_direction) * size)
+        cam.position = tuple(c + d / np.linalg.norm(d) * size * FIT_DISTANCE)
         cam.look_at = tuple(c)
         cam.up = (0.0, 0.0, 1.0)
+        self.camera_home = (tuple(cam.position), tuple(cam.look_at))
+
+    def follow_point(self, t: float) -> np.ndarray | None:
+        """Where the camera looks when following: the first run's object at ``t``."""
+        for s in self.scenes:
+            p = s.focus(s.run, t)
+            if p is not None and np.all(np.isfinite(p)):
+                return np.asarray(p, float)
+        return None
+
+    def _follow(self, t: float) -> None:
+        """Keep every browser's camera on the object: look at it, keep the camera's offset."""
+        p = self.follow_point(t)
+        if p is None:
+            return
+        for client in self.server.get_clients().values():
+            cam = client.camera
+            offset = np.asarray(cam.position, float) - np.asarray(cam.look_at, float)
+            with client.atomic():  # viser: position moves look_at along; then look_at
+                cam.position = tuple(p + offset)
+                cam.look_at = tuple(p)
+
+    def _home(self) -> None:
+        pos, look = self.camera_home
+        for client in self.server.get_clients().values():
+            with client.atomic():
+                client.camera.position = pos  # moves look_at along: set it after
+                client.camera.look_at = look
+                client.camera.up_direction = (0.0, 0.0, 1.0)
 
     def load(self, runs: list[RunData]) -> None:
         """Show ``runs`` (replacing what is shown): scenes, timeline, events, plots."""
@@ -171,12 +208,7 @@ class Viewer:
                 f"{title}  \n{', '.join(papers) or 'no scenario'} · {t1 - t0:.3f} s simulated"
             )
             if len(self.runs) > 1:
-                legend = " · ".join(
-                    f"<span style='color:rgb{run_color(k)}'>■</span> {r.label}"
-                    + (" (natural colours)" if k == 0 else "")
-                    for k, r in enumerate(self.runs)
-                )
-                gui.add_markdown(legend)
+                gui.add_markdown(self.legend())
             if self.notes:
                 gui.add_markdown("\n".join(f"- ⚠ {n}" for n in self.notes))
             frames = np.unique(np.concatenate([s.frame_times() for s in self.scenes]))
@@ -185,6 +217,16 @@ class Viewer:
             self.timeline = Timeline(
                 self.server, (t0, t1), frames, events, self.show, speed=self.speed
             )
+            with gui.add_folder("Camera"):
+                if self.follow_point(t0) is not None or any(
+                    s.focus(s.run, t1) is not None for s in self.scenes
+                ):
+                    self.follow = gui.add_checkbox(
+                        "follow object", False, hint="keep the camera on the object"
+                    )
+                    self.follow.on_update(lambda _: self.show(self.time))
+                home = gui.add_button("fit view", hint="back to the fitted view at load")
+                home.on_click(lambda _: self._home())
             self.run_toggles = []
             if len(self.runs) > 1:
                 with gui.add_folder("Runs"):
@@ -205,13 +247,22 @@ class Viewer:
                     self.plots = PlotPanel(self.server, specs, self.runs, (t0, t1))
             self.show(t0)
 
+    def legend(self) -> str:
+        """Overlaid runs: each run's colour (its arm or stick, object and path) and label."""
+        return "  \n".join(
+            f"<span style='color:rgb{run_color(k)}'>■</span> {r.label}"
+            for k, r in enumerate(self.runs)
+        )
+
     # -- showing a time -----------------------------------------------------------------------
     def show(self, t: float) -> None:
         with self._lock:
             self.time = float(t)
             with self.server.atomic():
                 for s in self.scenes:
-                    s.update(s.run, t)
+                    s.draw(s.run, t)
+            if self.follow is not None and self.follow.value:
+                self._follow(t)
             tl = self.timeline
             playing = tl is not None and tl.playing
             now = time.perf_counter()
@@ -312,7 +363,7 @@ class LiveSession:
                     v._status = v.server.gui.add_markdown("")
                 with v.server.atomic():
                     for s in v.scenes:
-                        s.update(run, t)
+                        s.draw(run, t)
                 v._status.content = f"**live** · {run.label} · t = {t:.4f} s (running)"
                 self.refreshes += 1
         except Exception as exc:  # noqa: BLE001

@@ -1,8 +1,14 @@
 """Scene builders, one per kind of experiment: handles created once, moved to a time ``t``.
 
-A builder owns the scene nodes of one run under ``/runK`` (several runs overlay: run 0 in its
-natural colours, later runs tinted and see-through). It draws from the run's tracks and the
-scenario's geometry only, and says in ``notes`` what it could not draw and why.
+A builder owns the scene nodes of one run under ``/runK``. A run alone is drawn in its natural
+colours; overlaid runs are each drawn in their own colour (``run_color``; later runs also
+see-through), so that near-identical runs stay told apart. It draws from the run's tracks and
+the scenario's geometry only, and says in ``notes`` what it could not draw and why.
+
+The camera fits the run's moving parts at load (``focus_points``: for an arm, the hand and the
+object near it, not the whole static scene) and can follow the object (``focus``). A builder
+may expose extra bodies (``bodies``: e.g. the human hand moving a grasped object); the base
+class draws and moves them, and the framing counts them.
 
 Builders are plug-ins: a subclass of :class:`RunScene`, found through the entry-point group
 ``paper_replay.viewer_scenes`` under the plant type it draws (``replay.registry``, kind
@@ -13,7 +19,7 @@ builder shares; it imports no plug-in (docs/viewer.md says how to add one).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import viser
@@ -26,10 +32,43 @@ from replay.viewer.geometry import cameras
 
 RUN_COLORS = [(225, 95, 30), (35, 110, 220), (40, 160, 70), (150, 60, 180), (200, 160, 20)]
 PATH_POINTS = 600  # a path so far is drawn with at most this many points
+FIT_MARGIN = 0.08  # m added around the moving parts when the camera is fitted
+FIT_MIN_SIZE = 0.3  # m: the smallest scene the camera fits (a still object is not a speck)
+FIT_SAMPLES = 200  # times at which the extra bodies' poses are sampled for the fit
+
+
+def fit_bounds(
+    points: np.ndarray, margin: float = FIT_MARGIN, min_size: float = FIT_MIN_SIZE
+) -> tuple[np.ndarray, np.ndarray]:
+    """The box (lo, hi) the camera fits: the finite ``points`` (n, 3) with ``margin`` around,
+    each side at least ``min_size`` long (about the same centre)."""
+    p = np.asarray(points, float).reshape(-1, 3)
+    p = p[np.all(np.isfinite(p), axis=1)]
+    if len(p) == 0:
+        p = np.zeros((1, 3))
+    lo, hi = p.min(axis=0) - margin, p.max(axis=0) + margin
+    c, half = (lo + hi) / 2.0, np.maximum((hi - lo) / 2.0, min_size / 2.0)
+    return c - half, c + half
 
 
 def run_color(k: int) -> tuple[int, int, int]:
     return RUN_COLORS[k % len(RUN_COLORS)]
+
+
+@dataclass
+class Body:
+    """A body a scene draws besides its own (e.g. the human hand that moves the grasped object).
+
+    ``shape``: "box" (``size`` = its three dimensions), "sphere" (``size`` = (radius,)) or
+    "cylinder" (``size`` = (radius, height), along its z). ``pose(run, t)``: its (position xyz,
+    orientation wxyz) at simulated time t, or None where it is not shown."""
+
+    name: str
+    shape: str
+    size: tuple[float, ...]
+    pose: Callable[[RunData, float], tuple[Sequence[float], Sequence[float]] | None]
+    color: tuple[int, int, int] = (225, 180, 150)
+    label: str = ""
 
 
 @dataclass
@@ -59,7 +98,8 @@ class RunScene:
         self.k = index
         self.root = f"/run{index}"
         self.color = run_color(index)
-        self.ghost = index > 0
+        self.ghost = index > 0  # see-through
+        self.tint = bool(options.get("overlaid", index > 0))  # drawn in self.color
         self.options = options
         self.notes: list[str] = []
         self.handles: list = []
@@ -152,6 +192,79 @@ class RunScene:
         for name in missing:
             self.notes.append(f"camera '{name}': no pose in its scenario params; frustum not drawn")
 
+    def _make_body(self, b: Body):
+        name, opacity = f"{self.root}/bodies/{b.name}", 0.55 if self.ghost else None
+        color = self.color if self.tint else b.color
+        if b.shape == "box":
+            return self.scene.add_box(
+                name,
+                color=color,
+                dimensions=np.asarray(b.size, float),
+                opacity=opacity,
+                visible=False,
+            )
+        if b.shape == "sphere":
+            return self.scene.add_icosphere(
+                name, radius=b.size[0], color=color, opacity=opacity, visible=False
+            )
+        if b.shape == "cylinder":
+            return self.scene.add_cylinder(
+                name,
+                radius=b.size[0],
+                height=b.size[1],
+                color=color,
+                opacity=opacity,
+                visible=False,
+            )
+        raise ValueError(f"body {b.name!r}: unknown shape {b.shape!r}")
+
+    def setup(self) -> None:
+        """``build`` the scene, then its extra ``bodies``."""
+        self.build()
+        self._bodies = []
+        for b in self.bodies():
+            try:
+                h = self._add(self._make_body(b))
+            except ValueError as exc:
+                self.notes.append(f"{exc}: not drawn")
+                continue
+            if b.label:
+                self._add(self.scene.add_label(f"{self.root}/bodies/{b.name}/label", b.label))
+            self._bodies.append((b, h))
+
+    def draw(self, run: RunData, t: float) -> None:
+        """Show time ``t``: ``update`` the scene, then move its extra bodies."""
+        self.update(run, t)
+        for b, h in getattr(self, "_bodies", ()):
+            pose = b.pose(run, t)
+            ok = pose is not None and bool(np.all(np.isfinite(np.r_[pose[0], pose[1]])))
+            h.visible = ok
+            if pose is not None and ok:
+                h.position = tuple(float(v) for v in pose[0])
+                h.wxyz = tuple(float(v) for v in pose[1])
+
+    def body_points(self) -> np.ndarray:
+        """The extra bodies' positions at up to ``FIT_SAMPLES`` of the run's frame times."""
+        times = self.frame_times()
+        if len(times) > FIT_SAMPLES:
+            times = times[np.linspace(0, len(times) - 1, FIT_SAMPLES).astype(int)]
+        pts = []
+        for b in self.bodies():
+            for t in times:
+                pose = b.pose(self.run, float(t))
+                if pose is not None:
+                    pts.append(np.asarray(pose[0], float)[:3])
+        return np.asarray(pts, float).reshape(-1, 3)
+
+    def fit(self) -> tuple[np.ndarray, np.ndarray]:
+        """The box the camera fits at load: the moving parts (``focus_points``) and the extra
+        bodies; the scene's ``bounds`` when it names no moving part."""
+        pts = self.focus_points()
+        if pts is None or not len(pts):
+            lo, hi = self.bounds()
+            pts = np.array([lo, hi], float)
+        return fit_bounds(np.concatenate([np.asarray(pts, float), self.body_points()]))
+
     # -- interface --------------------------------------------------------------------------
     def build(self) -> None:
         raise NotImplementedError
@@ -164,6 +277,19 @@ class RunScene:
 
     def plots(self) -> list[PlotSpec]:
         return []
+
+    def bodies(self) -> list[Body]:
+        """Extra bodies to draw (none by default); see :class:`Body`."""
+        return []
+
+    def focus_points(self) -> np.ndarray | None:
+        """Points (n, 3) of the parts the experiment is about (the hand, the object), which the
+        camera fits at load; None: the whole ``bounds``."""
+        return None
+
+    def focus(self, run: RunData, t: float) -> np.ndarray | None:
+        """The point the camera follows (the object) at time t, or None."""
+        return None
 
     def frame_times(self) -> np.ndarray:
         for topic in self.needs:

@@ -199,10 +199,14 @@ def write_arm_log(
     arm: str = "wam4",
     hand: str = "catch3",
     obj: str = "ball",
+    limit_events: int = 0,
+    outcome: bool = False,
 ) -> Path:
     """An arm log like the PyBullet arm plant's: a WAM (4 axes with J3 locked, as for catching,
     or 7), its hand closing (``catch3`` / ``grasp4``), a ball or a spinning box that flies into
-    the hand (``obj="none"``: no object)."""
+    the hand (``obj="none"``: no object). ``limit_events``: that many ``torque_limit`` /
+    ``velocity_limit`` events (alternating, one a step from the first), as a plant at its limits
+    floods the log; ``outcome``: an ``outcome`` event at the end."""
     from replay.robot.hand import HANDS
     from replay.robot.wam import wam_chain, wam_joint_names
 
@@ -323,4 +327,9 @@ def write_arm_log(
                     Event(t, kind, {"parts": ["palm", "f1", "f2"], "position": pos.tolist()}),
                     t_ns,
                 )
+            if 1 <= k <= limit_events:
+                limit = ("torque_limit", "velocity_limit")[k % 2]
+                log.write(TOPIC_EVENTS, Event(t, limit, {"joint": names[k % dof]}), t_ns)
+            if outcome and k == n:
+                log.write(TOPIC_EVENTS, Event(t, "outcome", {"success": True}), t_ns)
     return Path(path)

@@ -1,5 +1,8 @@
 """The timeline: a slider over simulated time, play/pause, playback speed (down to 1/100),
-one frame back and forth, and the log's events as buttons that jump there.
+one frame back and forth, and the log's events as buttons that jump there: the paper's
+milestones (``MILESTONES``: capture, catch, grasp, release, outcome, ...) always listed, the
+others grouped by kind with their counts and found through a kind dropdown and a text filter
+(a flood of ``torque_limit`` events cannot push a milestone out of the list).
 
 The slider is the single source of truth: every way of moving in time (dragging, playing,
 stepping, an event button) sets the slider's value, and its update callback shows that time.
@@ -10,13 +13,16 @@ from __future__ import annotations
 import threading
 import time
 from fractions import Fraction
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
 SPEEDS = ("1/100", "1/50", "1/20", "1/10", "1/5", "1/4", "1/2", "1", "2")
 DEFAULT_SPEED = "1/10"
-MAX_EVENT_BUTTONS = 40  # per run; the rest are counted, not listed
+MAX_EVENT_BUTTONS = 40  # listed for the filter's choice; the rest are counted, not listed
+# the experiment's milestones, by event kind: always listed as buttons, whatever else happened
+MILESTONES = ("capture", "catch", "grasp", "release", "drop", "miss", "outcome", "interrupted")
+ALL_KINDS = "all kinds"
 TICK = 1.0 / 30.0  # playback refresh period (s, wall clock)
 
 
@@ -32,6 +38,46 @@ def _event_brief(e: dict) -> str:
             v = "+".join(map(str, v)) if isinstance(v, list) else v
             return f" ({key} {v})"
     return ""
+
+
+def event_label(e: dict, who: str = "") -> str:
+    """A button's label: ``[run: ]t s  kind (detail)``."""
+    prefix = f"{who}: " if who else ""
+    return f"{prefix}{e['t']:.4f} s  {e.get('kind', '?')}{_event_brief(e)}"
+
+
+def kind_counts(events: list[tuple[str, dict]]) -> dict[str, int]:
+    """Events per kind, kinds in the order they first happen."""
+    counts: dict[str, int] = {}
+    for _, e in events:
+        k = str(e.get("kind", "?"))
+        counts[k] = counts.get(k, 0) + 1
+    return counts
+
+
+def milestones(events: list[tuple[str, dict]]) -> list[tuple[str, dict]]:
+    """The events whose kind is one of the paper's milestones (``MILESTONES``), in time order."""
+    return [(label, e) for label, e in events if e.get("kind") in MILESTONES]
+
+
+def kind_option(kind: str, n: int) -> str:
+    return f"{kind} ({n})"
+
+
+def select_events(
+    events: list[tuple[str, dict]], kind: str | None = None, text: str = "", multi: bool = False
+) -> list[tuple[str, dict]]:
+    """The events of ``kind`` (None: every kind) whose button label contains ``text`` (any
+    case; several words: all of them)."""
+    words = text.lower().split()
+    out = []
+    for label, e in events:
+        if kind is not None and str(e.get("kind", "?")) != kind:
+            continue
+        name = event_label(e, label if multi else "").lower()
+        if all(w in name for w in words):
+            out.append((label, e))
+    return out
 
 
 class Timeline:
@@ -61,7 +107,9 @@ class Timeline:
         dt = float(np.median(np.diff(self.frames))) if len(self.frames) > 1 else 1e-3
         self.dt = dt if dt > 0 else 1e-3
         step = 10.0 ** np.floor(np.log10(self.dt))  # a decade at or below a frame
-        marks = [(round(e.get("t", 0.0), 6), "") for _, e in events[:12]]
+        marked = milestones(events)[:12]  # the slider marks the milestones first
+        marked += [le for le in events if le[1].get("kind") not in MILESTONES][: 12 - len(marked)]
+        marks = sorted({(round(e.get("t", 0.0), 6), "") for _, e in marked})
         self.slider = gui.add_slider(
             "time (s)",
             min=self.t0,
@@ -88,29 +136,79 @@ class Timeline:
         self.play.on_click(lambda _: self.toggle())
         self.back.on_click(lambda _: self.step(-1))
         self.fwd.on_click(lambda _: self.step(+1))
-        self.event_buttons = []
-        if events:
+        self.events = list(events)
+        self.multi = len({label for label, _ in self.events}) > 1
+        self.counts = kind_counts(self.events)
+        self.milestone_buttons: list = []  # (t, button): always listed
+        self.event_buttons: list = []  # (t, button): the filter's choice
+        self._listed: list = []  # the filter's handles (buttons, the "more" note)
+        self.kind: Any = None  # the kind dropdown, the filter text box, the "N more" note
+        self.filter: Any = None
+        self.more: Any = None
+        if self.events:
             with gui.add_folder("Events", expand_by_default=True):
-                per_run: dict[str, int] = {}
-                for label, e in events:
-                    per_run[label] = per_run.get(label, 0) + 1
-                    if per_run[label] > MAX_EVENT_BUTTONS:
-                        continue
-                    who = f"{label}: " if len({l for l, _ in events}) > 1 else ""
-                    b = gui.add_button(
-                        f"{who}{e['t']:.4f} s  {e.get('kind', '?')}{_event_brief(e)}",
-                        hint="jump to this event",
-                    )
-                    b.on_click(lambda _, t=float(e["t"]): self.seek(t))
-                    self.event_buttons.append((float(e["t"]), b))
-                for label, n in per_run.items():
-                    if n > MAX_EVENT_BUTTONS:
-                        gui.add_markdown(
-                            f"*{label}: {n - MAX_EVENT_BUTTONS} more events not "
-                            "listed (`replay info LOG` lists all)*"
-                        )
+                gui.add_markdown(
+                    f"{len(self.events)} events: "
+                    + " · ".join(f"{k} × {n}" for k, n in self.counts.items())
+                )
+                stones = milestones(self.events)
+                if stones:
+                    gui.add_markdown("**milestones**")
+                for label, e in stones:
+                    self.milestone_buttons.append(self._button(label, e, icon=viser.Icon.FLAG))
+                self.kind = gui.add_dropdown(
+                    "kind",
+                    (ALL_KINDS, *(kind_option(k, n) for k, n in self.counts.items())),
+                    initial_value=ALL_KINDS,
+                    hint="list the events of one kind",
+                )
+                self.filter = gui.add_text(
+                    "filter", "", hint="list the events whose label holds these words"
+                )
+                self._list_folder = gui.add_folder("listed", expand_by_default=True)
+                self.kind.on_update(lambda _: self.relist())
+                self.filter.on_update(lambda _: self.relist())
+                self.relist()
         self._thread = threading.Thread(target=self._run, name="replay-viewer-player", daemon=True)
         self._thread.start()
+
+    def _button(self, label: str, e: dict, icon=None):
+        b = self.server.gui.add_button(
+            event_label(e, label if self.multi else ""), icon=icon, hint="jump to this event"
+        )
+        b.on_click(lambda _, t=float(e["t"]): self.seek(t))
+        return float(e["t"]), b
+
+    def selected_kind(self) -> str | None:
+        value = self.kind.value if self.kind is not None else ALL_KINDS
+        for k, n in self.counts.items():
+            if value == kind_option(k, n):
+                return k
+        return None
+
+    def relist(self) -> None:
+        """List (at most ``MAX_EVENT_BUTTONS`` of) the events the kind and the filter choose."""
+        if self.kind is None or self.filter is None:
+            return
+        for h in self._listed:
+            h.remove()
+        chosen = select_events(self.events, self.selected_kind(), self.filter.value, self.multi)
+        self._listed, self.event_buttons = [], []
+        with self._list_folder:
+            for label, e in chosen[:MAX_EVENT_BUTTONS]:
+                t, b = self._button(label, e)
+                self.event_buttons.append((t, b))
+                self._listed.append(b)
+            rest = len(chosen) - MAX_EVENT_BUTTONS
+            self.more = None
+            if rest > 0:
+                self.more = self.server.gui.add_markdown(
+                    f"*{rest} more not listed: choose a kind or filter "
+                    "(`replay info LOG` lists all)*"
+                )
+                self._listed.append(self.more)
+            elif not chosen:
+                self._listed.append(self.server.gui.add_markdown("*no event matches*"))
 
     # -- moving in time ---------------------------------------------------------------------
     @property
