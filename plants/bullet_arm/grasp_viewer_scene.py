@@ -20,12 +20,14 @@ from plants.bullet_arm.params import GraspParams
 from plants.bullet_arm.viewer_scene import ArmScene
 from replay.spatial import xyzw_to_wxyz
 from replay.viewer.data import RunData
-from replay.viewer.scenes import PlotSeries, PlotSpec
+from replay.viewer.scenes import Body, PlotSeries, PlotSpec
 
 T_HEAD = "/head/state"
 T_CHIP = "/vision/chip"
 T_RECOGNISED = "/grasping/object"
 T_ARM_TASK = "/grasping/arm"
+T_HUMAN = "/human/state"  # where the human hand holds the object (its target on the path)
+HUMAN_HAND = (0.03, 0.09, 0.10)  # m: a palm drawn behind the object (thickness along the normal)
 # the topics a grasping run has (a missing one is noted in the view)
 EXPECTED = (
     "/arm/joint_state",
@@ -114,7 +116,7 @@ class GraspScene(ArmScene):
                 )
             )
         self.fov, self.chip_w, self.chip_h = chip_fov(self.run.sensors)
-        color = (60, 60, 60) if not self.ghost else self.color
+        color = (60, 60, 60) if not self.tint else self.color
         self.head = self._add(sc.add_frame(f"{r}/head", show_axes=False, visible=False))
         self._add(
             sc.add_box(
@@ -155,6 +157,29 @@ class GraspScene(ArmScene):
         ]
         self.phase_label = self._add(sc.add_label(f"{r}/phase", "", visible=False))
         self._chip_i = -1
+
+    def bodies(self) -> list[Body]:
+        """The human hand that moves the object: a palm on the far side of the object from the
+        robot, at the hand's logged target (``/human/state``), facing along the plane normal."""
+        p = self.params
+        n = np.asarray(p.plane_normal, float)
+        n /= np.linalg.norm(n) or 1.0
+        axis = np.cross([1.0, 0.0, 0.0], n)
+        angle = math.atan2(np.linalg.norm(axis), n[0])
+        axis = axis / (np.linalg.norm(axis) or 1.0)
+        wxyz = (math.cos(angle / 2), *(math.sin(angle / 2) * axis))
+        depth = max(p.object_size) if p.object_size else 2.0 * p.object_radius
+        behind = 0.5 * float(depth) + 0.5 * HUMAN_HAND[0] + 0.01
+
+        def pose(run: RunData, t: float):
+            target = _row(run, T_HUMAN, t, "target")
+            if target is None or not np.all(np.isfinite(target[0])):
+                return None
+            x = np.asarray(target[0], float)
+            side = 1.0 if float(np.dot(n, x)) >= 0 else -1.0  # away from the arm's base
+            return tuple(x + side * behind * n), wxyz
+
+        return [Body("human_hand", "box", HUMAN_HAND, pose, label="human hand")]
 
     def update(self, run: RunData, t: float) -> None:
         super().update(run, t)

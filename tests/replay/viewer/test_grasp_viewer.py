@@ -71,3 +71,34 @@ def test_fig9_plots_are_offered(viewer):
     assert titles[0].startswith("Y (m)") and titles[1].startswith("X (m)")
     y = viewer.scenes[0].plots()[0].series[0].signal(viewer.runs[0])
     assert y is not None and len(y[0]) == len(viewer.runs[0].track("/grasping/arm"))
+
+
+def test_the_human_hand_is_drawn_behind_the_object_and_moves_with_it(tmp_path):
+    """The human hand that moves the object (/human/state's target): a body of the grasp scene,
+    on the far side of the constraint plane from the arm, in the camera's fitted view."""
+    from replay.resources import scenario_dir
+    from replay.runner import Runner
+    from replay.scenario import load_scenario
+
+    sc = load_scenario(scenario_dir() / "grasp_hexahedron.yaml", ["timing.duration=0.15"])
+    log = Runner(sc).run(tmp_path / "grasp.mcap").path
+    v = Viewer.open([log], port=0)
+    try:
+        scene = v.scenes[0]
+        (hand,) = [b for b in scene.bodies() if b.name == "human_hand"]
+        run = v.runs[0]
+        human = run.track("/human/state")
+        n = np.asarray(scene.params.plane_normal, float) / np.linalg.norm(scene.params.plane_normal)
+        seen = []
+        for t in (0.05, 0.14):
+            pos, _ = hand.pose(run, t)
+            target = np.asarray(human.fields["target"][human.index(t)], float)
+            off = np.asarray(pos) - target
+            assert np.linalg.norm(off - np.dot(off, n) * n) < 1e-9  # on the normal through it
+            assert abs(np.dot(pos, n)) > abs(np.dot(target, n))  # farther from the arm's base
+            seen.append(pos)
+        assert np.linalg.norm(np.subtract(seen[1], seen[0])) > 1e-3  # it moves with the path
+        lo, hi = v.fitted()
+        assert np.all(np.asarray(seen[0]) >= lo - 0.05) and np.all(np.asarray(seen[0]) <= hi + 0.05)
+    finally:
+        v.stop()
