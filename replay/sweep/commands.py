@@ -226,9 +226,13 @@ def ablate(
                 metrics=sf.metrics,
                 retry_failed=retry_failed,
             )
-            click.echo(f"{sf.name}: {summary.line()}")
+            click.echo(f"{sf.name}: {summary.line(outcomes=not sf.summary)}")
             if summary.interrupted:
                 sys.exit(143 if summary.terminated else 130)
+            if sf.summary and summary.rows:  # the ablation's own measure
+                from replay.sweep.worker import load_function
+
+                click.echo(f"{sf.name}: {load_function(sf.summary)(summary.rows)}")
             table = summary.table
             if store:
                 try:

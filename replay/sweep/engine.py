@@ -51,10 +51,26 @@ class SweepSummary:
     def rate(self) -> float:
         return self.ran / self.wall_time if self.wall_time > 0 else 0.0
 
-    def line(self) -> str:
+    @property
+    def not_run(self) -> int:
+        """Variants that did not run to their end (an error, an invalid variant, a dead
+        worker), as opposed to runs whose outcome was a failure of the method."""
+        return sum(
+            str(r.get("reason", "")).startswith(("error", "invalid", "worker died"))
+            for r in self.rows
+        )
+
+    def line(self, outcomes: bool = True) -> str:
+        """The summary; ``outcomes=False`` (an ablation that states its own measure) counts
+        only the variants that could not run, not the runs' success flags: variants that stop
+        before the paper's end by design are not failures."""
+        if outcomes:
+            verdicts = f"{self.ok} succeeded, {self.failed} failed"
+        else:
+            verdicts = f"{self.not_run} could not run" if self.not_run else "all ran"
         text = (
             f"sweep: {self.total} variants: {self.ran} ran, {self.skipped} skipped (done "
-            f"before); {self.ok} succeeded, {self.failed} failed; {self.wall_time:.1f} s "
+            f"before); {verdicts}; {self.wall_time:.1f} s "
             f"({self.rate:.2f} variants/s); table: {self.table}"
         )
         if self.stale:
