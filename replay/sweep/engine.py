@@ -146,10 +146,14 @@ def _sigterm_as_interrupt():
         raise KeyboardInterrupt
 
     old = signal.signal(signal.SIGTERM, handler)
+    # a sweep started in the background of a script inherits SIGINT ignored (the shell's rule
+    # for `cmd &`) and would run to its end: Ctrl-C / `kill -INT` stop it however it started
+    old_int = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         yield came
     finally:
         signal.signal(signal.SIGTERM, old)
+        signal.signal(signal.SIGINT, old_int)
 
 
 def _run_locked(

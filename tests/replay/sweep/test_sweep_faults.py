@@ -256,3 +256,25 @@ def test_workers_die_with_their_parent_and_a_rerun_races_none(toy_yaml, tmp_path
     )
     with FolderLock(out):  # free: no survivor holds it
         pass
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_sweep_started_with_sigint_ignored_still_stops_on_sigint(toy_yaml, tmp_path):
+    """A sweep started in the background of a script inherits SIGINT ignored (``cmd &``): a
+    Ctrl-C / ``kill -INT`` must stop it all the same (exit 130), its workers with it."""
+    out = tmp_path / "D"
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)  # inherited by the child, as `&` does
+    try:
+        proc, workers = _start_slow_sweep(toy_yaml, out)
+    finally:
+        signal.signal(signal.SIGINT, before)
+    try:
+        os.kill(proc.pid, signal.SIGINT)
+        proc.wait(timeout=60)
+        assert proc.returncode == 130, proc.stderr.read()[-2000:]
+        assert _gone_within(workers, 15), "a worker outlived the sweep"
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
