@@ -17,12 +17,12 @@ import tempfile
 import time
 from pathlib import Path
 
-from replay.log.chunks import CHUNK_SIZE, mcap_writer
+from replay.log.chunks import mcap_writer
 from replay.log.writer import LogWriter, encode
 from replay.resources import scenario_dir
 
 DEFAULT = ["stick_3step", "catch_optimised", "grasp_hexahedron"]
-CHUNK = CHUNK_SIZE  # LogWriter's
+CHUNK = 256 * 1024  # LogWriter's
 
 
 def capture(scenario: str, duration: float) -> list[tuple[str, object, int]]:

@@ -14,11 +14,6 @@ from typing import Any
 from mcap.writer import CompressionType, IndexType, Writer
 
 MAGIC = b"\x89MCAP0\r\n"  # the MCAP file's leading and trailing magic (the MCAP spec)
-# A log's chunk size. 1 MiB, not 256 KiB: whole catch_optimised runs (2000 16 KiB camera images
-# per simulated s) take ~7 % less CPU (0.191 -> 0.178 s a run, alternated in one process),
-# stick_3step the same (its log is one or two chunks either way); the price is what a killed
-# run loses: up to its last chunk (~1 s of a stick run's messages, ~30 ms of a catch's).
-CHUNK_SIZE = 1024 * 1024
 
 
 def mcap_writer(stream: Any, *, chunk_size: int, compression: str = "zstd") -> Writer:

@@ -43,7 +43,7 @@ except ImportError:  # (Windows: no flock; one writer per output is then up to t
     fcntl = None  # type: ignore[assignment]
 
 from replay import __version__
-from replay.log.chunks import CHUNK_SIZE, MAGIC, mcap_writer
+from replay.log.chunks import MAGIC, mcap_writer
 from replay.log.errors import LogError, NonFiniteValueError
 from replay.messages import TOPICS, json_schema, to_dict
 
@@ -349,7 +349,7 @@ class LogWriter:
     """
 
     def __init__(
-        self, path: str | os.PathLike, *, chunk_size: int = CHUNK_SIZE, compression: str = "zstd"
+        self, path: str | os.PathLike, *, chunk_size: int = 256 * 1024, compression: str = "zstd"
     ) -> None:
         if compression not in ("zstd", "none"):
             raise LogError(f"log compression {compression!r}: zstd or none")
