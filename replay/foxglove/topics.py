@@ -25,19 +25,13 @@ from typing import Iterable, Sequence
 
 import numpy as np
 from foxglove_schemas_protobuf.Color_pb2 import Color
-from foxglove_schemas_protobuf.CubePrimitive_pb2 import CubePrimitive
-from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
-from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 from foxglove_schemas_protobuf.JointState_pb2 import JointState
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
 from foxglove_schemas_protobuf.Log_pb2 import Log
-from foxglove_schemas_protobuf.Pose_pb2 import Pose
 from foxglove_schemas_protobuf.Quaternion_pb2 import Quaternion
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
-from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
-from foxglove_schemas_protobuf.SpherePrimitive_pb2 import SpherePrimitive
 from foxglove_schemas_protobuf.Vector3_pb2 import Vector3
 from google.protobuf.message import Message
 from google.protobuf.timestamp_pb2 import Timestamp
@@ -102,15 +96,18 @@ def timestamp(t_ns: int) -> Timestamp:
     return Timestamp(seconds=sec, nanos=nsec)
 
 
-def _transform(ts: Timestamp, parent: str, child: str, position, orientation) -> FrameTransform:
-    (x, y, z), (qx, qy, qz, qw) = position, orientation
-    return FrameTransform(
-        timestamp=ts,
-        parent_frame_id=parent,
-        child_frame_id=child,
-        translation=Vector3(x=x, y=y, z=z),
-        rotation=Quaternion(x=qx, y=qy, z=qz, w=qw),
-    )
+# /tf and /scene are built in place (``repeated.add()``, then each field set on the
+# submessage), not from nested constructors: the same bytes (setting a field, even to its
+# default, makes its submessage present, as passing it does) in about half the time (6
+# transforms: 18 -> 8.5 us), as a nested constructor builds each submessage and then copies it.
+
+
+def _vector(v: Vector3, x: float, y: float, z: float) -> None:
+    v.x, v.y, v.z = x, y, z
+
+
+def _quaternion(q: Quaternion, x: float, y: float, z: float, w: float) -> None:
+    q.x, q.y, q.z, q.w = x, y, z, w
 
 
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -122,14 +119,19 @@ def frame_transforms(
     """``foxglove.FrameTransforms``: each of ``bodies`` (scene primitives) as a frame of its own
     name in ``parent`` (a sphere unrotated), then each frame's pose in its parent, at ``t_ns``."""
     ts = timestamp(t_ns)
-    out = [
-        _transform(
-            ts, parent, p.name, p.position, _IDENTITY if isinstance(p, Sphere) else p.orientation
-        )
+    msg = FrameTransforms()
+    add = msg.transforms.add
+    poses = [
+        (parent, p.name, p.position, _IDENTITY if isinstance(p, Sphere) else p.orientation)
         for p in bodies
     ]
-    out += [_transform(ts, f.parent, f.child, f.position, f.orientation) for f in frames]
-    return FrameTransforms(transforms=out).SerializeToString()
+    poses += [(f.parent, f.child, f.position, f.orientation) for f in frames]
+    for parent_id, child_id, position, orientation in poses:
+        tf = add(parent_frame_id=parent_id, child_frame_id=child_id)
+        tf.timestamp.CopyFrom(ts)
+        _vector(tf.translation, *position)
+        _quaternion(tf.rotation, *orientation)
+    return msg.SerializeToString()
 
 
 def _grey(albedo: float) -> float:
@@ -148,48 +150,39 @@ def scene_update(primitives: Sequence, frame_id: str, t_ns: int) -> bytes:
     one primitive at its pose in ``frame_id``, grey by albedo (others are left out); a
     cylinder's axis is its body z."""
     ts = timestamp(t_ns)
-    entities = []
+    msg = SceneUpdate()
+    add = msg.entities.add
     for p in primitives:
-        if not isinstance(p, (Sphere, Box, Cylinder)):
-            continue
-        entity = SceneEntity(timestamp=ts, frame_id=frame_id, id=p.name)
-        (x, y, z) = p.position
-        position = Vector3(x=x, y=y, z=z)
-        color = _color(p.albedo)
         if isinstance(p, Sphere):
+            entity = add(frame_id=frame_id, id=p.name)
+            prim = entity.spheres.add()
             d = 2.0 * p.radius
-            entity.spheres.append(
-                SpherePrimitive(
-                    pose=Pose(position=position, orientation=Quaternion(w=1.0)),
-                    size=Vector3(x=d, y=d, z=d),
-                    color=color,
-                )
-            )
+            _vector(prim.size, d, d, d)
+            orientation = _IDENTITY
+        elif isinstance(p, Box):
+            entity = add(frame_id=frame_id, id=p.name)
+            prim = entity.cubes.add()
+            _vector(prim.size, *p.size)
+            orientation = p.orientation
+        elif isinstance(p, Cylinder):
+            entity = add(frame_id=frame_id, id=p.name)
+            prim = entity.cylinders.add(bottom_scale=1.0, top_scale=1.0)
+            d = 2.0 * p.radius
+            _vector(prim.size, d, d, p.length)
+            orientation = p.orientation
         else:
-            qx, qy, qz, qw = p.orientation
-            pose = Pose(position=position, orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))
-            if isinstance(p, Box):
-                sx, sy, sz = p.size
-                entity.cubes.append(
-                    CubePrimitive(pose=pose, size=Vector3(x=sx, y=sy, z=sz), color=color)
-                )
-            else:
-                d = 2.0 * p.radius
-                entity.cylinders.append(
-                    CylinderPrimitive(
-                        pose=pose,
-                        size=Vector3(x=d, y=d, z=p.length),
-                        bottom_scale=1.0,
-                        top_scale=1.0,
-                        color=color,
-                    )
-                )
-        entities.append(entity)
-    return SceneUpdate(entities=entities).SerializeToString()
+            continue
+        entity.timestamp.CopyFrom(ts)
+        pose = prim.pose
+        _vector(pose.position, *p.position)
+        _quaternion(pose.orientation, *orientation)
+        prim.color.CopyFrom(_color(p.albedo))
+    return msg.SerializeToString()
 
 
 def joint_states(names, position, velocity, effort, t_ns: int) -> bytes:
-    """``foxglove.JointStates``: each joint's name, position, velocity and effort."""
+    """``foxglove.JointStates``: each joint's name, position, velocity and effort (built from
+    constructors: in place measured no faster here)."""
     joints = [
         JointState(name=n, position=q, velocity=v, effort=e)
         for n, q, v, e in zip(names, position, velocity, effort)
