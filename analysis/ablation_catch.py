@@ -372,10 +372,11 @@ if (
     __name__ == "__main__"
 ):  # python -m analysis.ablation_catch [n]: data/ablations/catch_shared_throws.*
     import sys
-    from pathlib import Path
+
+    from replay.resources import data_path
 
     n_throws = int(sys.argv[1]) if len(sys.argv) > 1 else 20
-    dest = Path(__file__).resolve().parents[1] / "data" / "ablations"
+    dest = data_path("ablations")
     table_rows = run_shared(n_throws, out=dest / "catch_shared_throws.csv")
     text = shared_table(table_rows)
     (dest / "catch_shared_throws.md").write_text(text + "\n", encoding="utf-8")

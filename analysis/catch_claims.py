@@ -118,6 +118,20 @@ FALSIFIERS: tuple[Falsifier, ...] = (
         "no gravity): it catches, so the row turns on the catch, not on the controller's name",
     ),
     Falsifier(
+        "catch_optimised_clamped: ball caught",
+        "enforced_limits",
+        "catch_optimised_clamped",
+        _ENFORCED,
+        _WHY_ENFORCED,
+    ),
+    Falsifier(
+        "catch_5ms_optimised: ball caught",
+        "half_speed_fingers",
+        "catch_5ms_optimised",
+        {"plant.params.hand_closing_speed": 39.27},
+        "fingers at half the stated speed (90° in 40 ms): the ball bounces off a finger",
+    ),
+    Falsifier(
         "hand closing, free (no ball in the way)",
         "half_speed_fingers",
         "catch_eq24_infeasible",
