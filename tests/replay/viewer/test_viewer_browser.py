@@ -126,6 +126,24 @@ def _set_time(page, viewer: Viewer, t: float, deadline: float) -> None:
     _wait_for(lambda: abs(viewer.time - t) < 1e-3, deadline, f"the server to show t = {t}")
 
 
+def _moved_to(page, viewer: Viewer, ref: np.ndarray, fractions, least: float, deadline: float):
+    """Move the slider to the first of ``fractions`` of the run at which the scene differs from
+    ``ref`` (more than ``least`` of its pixels); the screenshot there."""
+    t0, t1 = viewer.timeline.t0, viewer.timeline.t1
+    for k, f in enumerate(fractions):
+        last = k == len(fractions) - 1
+        share = deadline if last else min(deadline, time.monotonic() + 30.0)
+        _set_time(page, viewer, t0 + f * (t1 - t0), deadline)
+        try:
+            return _poll(
+                page, lambda img: _changed(img, ref) > least, share, f"the scene to move (t at {f})"
+            )
+        except AssertionError:
+            if last:
+                raise
+    raise AssertionError("no slider position to try")
+
+
 CASES = _cases()
 
 
@@ -142,24 +160,13 @@ def test_viewer_draws_and_moves_in_a_browser(browser, name, make, tmp_path):
         deadline = time.monotonic() + PAGE_DEADLINE
         first = _poll(page, lambda img: _colours(img) > 60, deadline, "the scene to be drawn")
         _close_toasts(page)
-        t0, t1 = viewer.timeline.t0, viewer.timeline.t1
-        ta, tb = t0 + 0.15 * (t1 - t0), t0 + 0.85 * (t1 - t0)
-        _set_time(page, viewer, ta, deadline)
-        a = _poll(
-            page,
-            lambda img: _changed(img, first) > 0.0005,
-            deadline,
-            "the scene to move to the first slider position",
-        )
+        # the view is fitted to the moving parts (the hand, the object near it): in a catch log
+        # the arm waits still until the ball is seen (0.1 s of 0.3), so where nothing in view
+        # moves yet, the next time is tried
+        a = _moved_to(page, viewer, first, (0.15, 0.5, 0.75), 0.0005, deadline)
         time.sleep(1.0)  # let the frame settle, then take it
         a = _image(page.screenshot(path=str(tmp_path / f"{name}_a.png"), timeout=SHOT_TIMEOUT))
-        _set_time(page, viewer, tb, deadline)
-        b = _poll(
-            page,
-            lambda img: _changed(img, a) > 0.001,
-            deadline,
-            "the scene to change between the two slider positions",
-        )
+        b = _moved_to(page, viewer, a, (0.85, 0.95, 0.3), 0.001, deadline)
         time.sleep(1.0)
         b = _image(page.screenshot(path=str(tmp_path / f"{name}_b.png"), timeout=SHOT_TIMEOUT))
         assert _colours(a) > 60 and _colours(b) > 60, "the canvas is not drawn"
