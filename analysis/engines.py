@@ -108,9 +108,12 @@ def rate_row(label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]])
 
 def closing_note(rows: Sequence[Claim]) -> str:
     """Which measured claims hold in both engines, which in one (and why: the row's note)."""
-    both, one, neither = [], [], []
+    both, one, neither, single = [], [], [], 0
     for r in rows:
         if r.kind != "measured":
+            continue
+        if r.measured.startswith("PyBullet: not run") or r.measured.endswith("MuJoCo: not run"):
+            single += 1  # run in one engine only: no cross-engine verdict
             continue
         if r.status == "reproduced":
             both.append(r.quantity)
@@ -121,4 +124,6 @@ def closing_note(rows: Sequence[Claim]) -> str:
     lines = [f"Hold in both engines ({len(both)}): {', '.join(both) or 'none'}."]
     lines.append(f"Hold in one engine only ({len(one)}): {', '.join(one) or 'none'}.")
     lines.append(f"Hold in neither ({len(neither)}): {', '.join(neither) or 'none'}.")
+    if single:
+        lines.append(f"Run in one engine only, not compared: {single} measured rows.")
     return "\n".join(lines)
