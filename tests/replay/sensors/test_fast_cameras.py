@@ -20,6 +20,7 @@ from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 from replay.sensors.stick_camera import (
     StickCamera,
     StickCameraParams,
+    _moments_opencv,
     _projected_items,
     hull_window,
     render_scene,
@@ -30,80 +31,14 @@ from test_raster import polygon_coverage  # the closed-form reference, beside th
 
 # --- references: the OpenCV pipelines the kernels replaced ------------------------------------
 
-_END_SAMPLES = np.array([[s, o] for s in (2.0, 3.0, 4.0) for o in (-1.0, 0.0, 1.0)])
-
-
-def _background_beyond_ends(image, blob, origin):
-    m = cv2.moments(blob, binaryImage=True)
-    if m["m00"] <= 0.0:
-        return None
-    a = 0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"])
-    e = np.array([math.cos(a), math.sin(a)])
-    n = np.array([-e[1], e[0]])
-    c = np.array([origin[0] + m["m10"] / m["m00"], origin[1] + m["m01"] / m["m00"]])
-    rows, cols = np.nonzero(blob)
-    along = (np.column_stack([cols + origin[0], rows + origin[1]]) - c) @ e
-    h, w = image.shape
-    levels = []
-    for end in (along.max(), along.min()):
-        sign = 1.0 if end > 0 else -1.0
-        pts = c + (end + sign * _END_SAMPLES[:, :1]) * e + _END_SAMPLES[:, 1:] * n
-        ij = np.rint(pts).astype(int)
-        ok = (ij[:, 0] >= 0) & (ij[:, 0] < w) & (ij[:, 1] >= 0) & (ij[:, 1] < h)
-        if ok.any():
-            levels.append(float(np.median(image[ij[ok, 1], ij[ok, 0]])))
-    return max(levels) if levels else None
-
 
 def reference_marker_moments(image, params, origin=(0, 0)):
-    """The stick camera's marker moments as OpenCV computed them before _pixels.marker_moments."""
-    h, w = image.shape
-    ox, oy = origin
-    mask = (image > params.threshold).astype(np.uint8)
-    bright = cv2.findNonZero(mask)
-    if bright is None:
+    """The stick camera's marker moments by the OpenCV pipeline _pixels.marker_moments replaced:
+    the camera's own pure-Python path (``_moments_opencv``), as a dict."""
+    m = _moments_opencv(image, params, origin)
+    if m is None:
         return None
-    cx, cy, cw, ch = cv2.boundingRect(bright)
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(
-        mask[cy : cy + ch, cx : cx + cw], connectivity=8
-    )
-    if n <= 1:
-        return None
-    i = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    bx, by, bw, bh, area = (int(v) for v in stats[i])
-    bx, by = bx + cx, by + cy
-    if area < params.min_pixels:
-        return None
-    if (
-        bx + ox == 0
-        or by + oy == 0
-        or bx + ox + bw == params.width
-        or by + oy + bh == params.height
-    ):
-        return None
-    x0, y0 = max(bx - 3, 0), max(by - 3, 0)
-    x1, y1 = min(bx + bw + 3, w), min(by + bh + 3, h)
-    roi = image[y0:y1, x0:x1].astype(np.float32)
-    blob = np.zeros((y1 - y0, x1 - x0), np.uint8)
-    lx0, ly0 = bx - cx, by - cy
-    blob[by - y0 : by - y0 + bh, bx - x0 : bx - x0 + bw] = (
-        labels[ly0 : ly0 + bh, lx0 : lx0 + bw] == i
-    )
-    background = _background_beyond_ends(image, blob, (x0, y0))
-    if background is None:
-        return None
-    region = cv2.dilate(blob, np.ones((5, 5), np.uint8)).astype(bool)
-    weight = np.where(region, np.maximum(roi - np.float32(background), 0.0), 0.0)
-    m = cv2.moments(weight.astype(np.float32))
-    if m["m00"] <= 0.0:
-        return None
-    return {
-        "u": ox + x0 + m["m10"] / m["m00"],
-        "v": oy + y0 + m["m01"] / m["m00"],
-        "angle": 0.5 * math.atan2(2.0 * m["mu11"], m["mu20"] - m["mu02"]),
-        "pixels": area,
-        "background": background,
-    }
+    return {"u": m[0], "v": m[1], "angle": m[2], "pixels": m[3], "background": m[4]}
 
 
 def reference_ball_blob(image, p):
