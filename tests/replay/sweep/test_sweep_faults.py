@@ -221,6 +221,34 @@ def _start_slow_sweep(toy_yaml, out: Path):
     pytest.fail("the sweep's workers did not start")
 
 
+def _session(sid: int) -> set[int]:
+    """Every live process of session ``sid`` (the sweep, its workers and anything they
+    started): a survivor the workers' list taken at the start would miss is found here."""
+    found = set()
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if fields[0] != "Z" and int(fields[3]) == sid:  # (state, ppid, pgrp, session)
+            found.add(int(stat.parent.name))
+    return found
+
+
+def _lock_free_within(out: Path, seconds: float) -> None:
+    """The folder's lock is free once every process that shared it has ended; the kernel may
+    release it a moment after the last one reads as gone, so allow a short wait."""
+    deadline = time.monotonic() + seconds
+    while True:
+        try:
+            with FolderLock(out):
+                return
+        except SweepOutputError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.1)
+
+
 def _gone_within(pids: set[int], seconds: float) -> bool:
     deadline = time.monotonic() + seconds
     while time.monotonic() < deadline:
@@ -239,6 +267,7 @@ def test_workers_die_with_their_parent_and_a_rerun_races_none(toy_yaml, tmp_path
         os.kill(proc.pid, sig)
         proc.wait(timeout=30)
         assert _gone_within(workers, 15), "a worker outlived the sweep"
+        assert _gone_within(_session(proc.pid), 15), f"outlived the sweep: {_session(proc.pid)}"
         if sig == signal.SIGTERM:
             assert proc.returncode == 143
             assert "Traceback" not in proc.stderr.read()
@@ -254,8 +283,7 @@ def test_workers_die_with_their_parent_and_a_rerun_races_none(toy_yaml, tmp_path
     assert not list(out.glob("logs/*.mcap.*.part")) or all(
         not _alive(int(p.name.split(".")[-2].split("-")[0])) for p in out.glob("logs/*.part")
     )
-    with FolderLock(out):  # free: no survivor holds it
-        pass
+    _lock_free_within(out, 5)  # free: no survivor holds it
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
