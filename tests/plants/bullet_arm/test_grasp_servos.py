@@ -4,7 +4,6 @@ leaves the others (nearly) where they were: the loops are inertia-decoupled."""
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
