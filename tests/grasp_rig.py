@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from plants.bullet_arm.grasp_plant import BulletGraspPlant
@@ -27,3 +29,16 @@ def rig(**kw) -> BulletGraspPlant:
     )
     base.update(kw)
     return BulletGraspPlant(GraspParams(**base), dt=DT, rng=np.random.default_rng(0))
+
+
+def rise_bandwidth(w: np.ndarray, target: float, dt: float) -> float:
+    """1 / t63 (rad/s): the time to 63 % of the step, interpolated between samples (sample k
+    at (k + 1) dt, the response starting from 0 at t = 0)."""
+    level = (1.0 - math.exp(-1.0)) * target
+    prev_t, prev_w = 0.0, 0.0
+    for k, x in enumerate(w):
+        t = (k + 1) * dt
+        if x >= level:
+            return 1.0 / (prev_t + (level - prev_w) / (x - prev_w) * (t - prev_t))
+        prev_t, prev_w = t, x
+    return 0.0

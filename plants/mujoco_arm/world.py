@@ -14,7 +14,11 @@ MuJoCo facts used (MuJoCo 4.0, checked by tests/plants/mujoco_arm):
   ``hand_max_torque``, the PyBullet plant's rate-limited velocity motors (plant.py
   ``_hand_caps``: when the clip applies);
 - a hand servo is clipped while its link's geoms' bounding spheres are within ``NEAR`` of the
-  object's: the object may touch it within the step.
+  object's: the object may touch it within the step;
+- the wrist F/T sensor: MuJoCo's ``force``/``torque`` sensors on a site at the palm's origin give
+  the flange's wrench on the palm about that point in the palm frame (``wrist_wrench`` negates it
+  to the PyBullet rig's convention; tests/plants/mujoco_arm/test_wrist_mujoco.py: the same static
+  loads as PyBullet's).
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 
 ROBOT_BITS, OBJECT_BITS = 2, 1  # contype of each; conaffinity the other's: robot-robot never
 OBJECT_BODY = "object"
+WRIST_SITE = "wrist_ft"
 NEAR = 0.02  # m: an object this near a link may touch it within a 1 ms step (20 m/s relative)
 INTEGRATORS = {
     "Euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -61,6 +66,7 @@ class World:
     object_body: int  # -1: none
     object_qpos: int
     object_dof: int
+    wrist_adr: int = -1  # sensordata address of the wrist's force (3) then torque (3); -1: none
 
 
 def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
@@ -92,6 +98,19 @@ def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
         a.set_to_velocity(kv=float(P.hand_servo_gain))
         a.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
         a.forcerange = [-float(P.hand_max_torque), float(P.hand_max_torque)]
+    if arm.palm_link is not None:
+        # the wrist's 6-axis F/T sensor on the flange-palm joint (fixed, identity: the palm
+        # frame is the tool frame): a site at the palm body's origin, MuJoCo's force and torque
+        # sensors there (the palm's interaction with its parent, wam_tool; wrist_wrench)
+        site = spec.body(arm.palm_link).add_site(name=WRIST_SITE)
+        spec.add_sensor(
+            name="wrist_force", type=mujoco.mjtSensor.mjSENS_FORCE,
+            objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name,
+        )  # fmt: skip
+        spec.add_sensor(
+            name="wrist_torque", type=mujoco.mjtSensor.mjSENS_TORQUE,
+            objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name,
+        )  # fmt: skip
     if P.object != "none":
         body = spec.worldbody.add_body(
             name=OBJECT_BODY,
@@ -145,6 +164,15 @@ def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
         object_body=ob,
         object_qpos=int(model.jnt_qposadr[oj]) if oj >= 0 else -1,
         object_dof=int(model.jnt_dofadr[oj]) if oj >= 0 else -1,
+        wrist_adr=(
+            int(
+                model.sensor_adr[
+                    mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, "wrist_force")
+                ]
+            )
+            if arm.palm_link is not None
+            else -1
+        ),
     )
 
 
@@ -152,3 +180,12 @@ def free_velocity(R: np.ndarray, v, w) -> list[float]:
     """A free joint's qvel: linear velocity (world), angular velocity in the body frame
     (MuJoCo's convention), from world ``v`` and ``w`` with the body's rotation ``R``."""
     return [float(x) for x in v] + (R.T @ np.asarray(w, float)).tolist()
+
+
+def wrist_wrench(world: World, data: mujoco.MjData) -> list[float]:
+    """The wrist sensor's reading, as the PyBullet plant's (bullet_arm/ft_sensor.py): the force
+    and torque the hand exerts on the flange, moment about the joint origin, palm frame
+    [Fx, Fy, Fz, Mx, My, Mz]. MuJoCo's force/torque sensors give the parent's (the flange's)
+    wrench on the site's body, about the site, in the site frame: negated here."""
+    a = world.wrist_adr
+    return [-float(x) for x in data.sensordata[a : a + 6]]

@@ -4,13 +4,12 @@ leaves the others (nearly) where they were: the loops are inertia-decoupled."""
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
 
 from replay.robot.arm_types import ServoCommand
-from grasp_rig import rig
+from grasp_rig import rig, rise_bandwidth
 
 STEP = 0.05  # rad/s: small enough that no joint reaches its torque limit (a linear step)
 
@@ -30,19 +29,6 @@ def _step_response(plant, j: int, steps: int = 100) -> np.ndarray:
         assert not any(plant.arm_servos.saturated_l)
         out.append(np.array(plant.arm_state()[1]) - w0)
     return np.array(out)
-
-
-def rise_bandwidth(w: np.ndarray, target: float, dt: float) -> float:
-    """1 / t63 (rad/s): the time to 63 % of the step, interpolated between samples (sample k
-    at (k + 1) dt, the response starting from 0 at t = 0)."""
-    level = (1.0 - math.exp(-1.0)) * target
-    prev_t, prev_w = 0.0, 0.0
-    for k, x in enumerate(w):
-        t = (k + 1) * dt
-        if x >= level:
-            return 1.0 / (prev_t + (level - prev_w) / (x - prev_w) * (t - prev_t))
-        prev_t, prev_w = t, x
-    return 0.0
 
 
 @pytest.mark.parametrize("joint", range(7))
