@@ -83,6 +83,14 @@ def _falsifiers(name: str) -> tuple[Falsifier, ...]:
             mis_why,
         ),
         Falsifier(
+            f"{name}: the hand meets the object without impact (first contact speed)",
+            "fingers slam shut",
+            name,
+            {"tasks.hand.params.touch_speed": 78.5},
+            "the fingers cross the last clearance at the drives' full speed (78.5 rad/s, the "
+            "hand's limit) instead of 4 rad/s: they strike the object",
+        ),
+        Falsifier(
             f"{name}: the grasp holds while the human keeps moving the object",
             "no force feedback",
             name,
@@ -414,6 +422,48 @@ def _preshape_rows(run: GraspRun, st: dict) -> list[Claim]:
             "reproduced" if ok else "differs",
             "the recognition task's shape (moments of the binarised 16 × 16 image) over "
             "the frames it found the object in",
+        )
+    ]
+
+
+# ------------------------------------------------------------------------------- contact
+def first_contact(run: GraspRun) -> dict | None:
+    """The plant's first ``contact`` event of the run (the physics: the touching link's point
+    velocity against the object's just before), with the time each hand part first touched the
+    object (``/object/contacts``)."""
+    e = next((e for e in run.events if e["kind"] == "contact"), None)
+    if e is None:
+        return None
+    return {"t": float(e["t"]), "speed": float(e["data"]["speed"]), "parts": e["data"]["parts"]}
+
+
+def knock_speed(run: GraspRun) -> float:
+    """The contact speed (m/s) that would knock the object a hold's tolerance out of the
+    human's hand: a 1-D impulse m v on the object held by the human's spring k displaces it by
+    v sqrt(m / k) (undamped), so v = grasp_max_drift sqrt(k / m)."""
+    P = run.params
+    return float(P.grasp_max_drift * np.sqrt(P.human_stiffness / P.object_mass))
+
+
+def _contact_rows(run: GraspRun, st: dict) -> list[Claim]:
+    q = f"{run.name}: the hand meets the object without impact (first contact speed)"
+    stated = "reaching and grasping a moving object without knocking it away (Figs. 7, 8)"
+    c = first_contact(run)
+    if c is None:
+        return [Claim(q, stated, "(the hand never touched the object)", "not run")]
+    bound = knock_speed(run)
+    return [
+        Claim(
+            q,
+            stated,
+            f"first contact ({', '.join(c['parts'])}) at {c['t']:.3f} s, "
+            f"{c['speed']:.2f} m/s relative to the object (bound {bound:.2f} m/s)",
+            "reproduced" if c["speed"] <= bound else "differs",
+            "the plant's first contact event (the touching link's point velocity against the "
+            "object's, from the physics). Bound: the speed whose impulse would push the object "
+            f"{1000 * run.params.grasp_max_drift:.0f} mm (the hold's tolerance) against the "
+            f"human's {run.params.human_stiffness:.0f} N/m, v = d sqrt(k/m); the paper gives no "
+            "number, its figures show the object not knocked away",
         )
     ]
 
@@ -830,6 +880,7 @@ def evaluate(logs: dict[str, LogReader]) -> list[Claim]:
             rows += _vision_rows(run, st)
         rows += _timing_rows(run, st)
         rows += _preshape_rows(run, st)
+        rows += _contact_rows(run, st)
         rows += _hold_rows(run, st)
         rows += _compliance_rows(run, st)
         rows += _tracking_rows(run, st)
