@@ -99,10 +99,10 @@ def test_the_ball_gets_the_circle_preshape_and_is_grasped(tmp_path, project_root
 
 
 def test_a_grasp_that_stops_short_says_why(tmp_path, project_root):
-    """The reach ends 12 cm before the object (x_grasp = 0.12 m): the fingers close on nothing;
-    the run fails and says so."""
+    """The reach ends 12 cm before the object (x_grasp = 0.12 m): the fingers close on nothing
+    (at touch_speed, ~0.25 s from the touch posture to the grip); the run fails and says so."""
     result, _ = run(
-        tmp_path, "grasp_hexahedron", ["timing.duration=1.0", "tasks.schedule.params.x_grasp=0.12"]
+        tmp_path, "grasp_hexahedron", ["timing.duration=1.3", "tasks.schedule.params.x_grasp=0.12"]
     )
     o = result.outcome
     assert o["success"] is False

@@ -224,3 +224,31 @@ def test_every_falsifier_names_a_measured_row_and_the_new_rows_are_there(rows):
         ):
             assert table[f"{name}: {q}"].status in ("reproduced", "differs", "note"), q
     assert not [r for r in rows.values() if r.kind == "configuration" and r.status == "reproduced"]
+
+
+def test_every_reproduced_measured_row_has_a_falsifier(rows):
+    """What `replay falsify` requires: no measured row of these runs reads "reproduced" without
+    a declared variant that must turn it to "differs"."""
+    from analysis.grasp_claims import FALSIFIERS
+
+    covered = {f.row for f in FALSIFIERS}
+    bare = [q for q, r in rows.items() if r.kind == "measured" and r.status == "reproduced"]
+    assert bare and not [q for q in bare if q not in covered]
+
+
+def test_look_then_move_breaks_eq3s_partition(rows, tmp_path):
+    """The partition row's falsifier, run: without S K^a1 while reaching (a sequential
+    controller) the hand leaves the moving box behind in the plane during the reach."""
+    from analysis.grasp_claims import FALSIFIERS, evaluate
+    from replay.log import LogReader
+    from replay.runner import Runner
+    from replay.scenario import load_scenario
+
+    q = "grasp_hexahedron: eq. 3's partition: tracking unaffected by reaching"
+    assert rows[q].status == "reproduced"
+    (f,) = [f for f in FALSIFIERS if f.row == q]
+    sets = [f"{k}={v}" for k, v in f.overrides.items()] + ["timing.duration=0.9"]
+    sc = load_scenario(ROOT / "scenarios" / "grasp_hexahedron.yaml", sets=sets)
+    res = Runner(sc).run(tmp_path / "v.mcap")
+    row = next(r for r in evaluate({"grasp_hexahedron": LogReader(res.path)}) if r.quantity == q)
+    assert row.status == "differs", row.measured

@@ -9,7 +9,7 @@ run's outcome flag:
 - on its plane: within 20 mm of the constraint plane over the whole run.
 
 The outcome flag may never say success where this rejects. (A 30-run batch over seeds 101-105
-and speeds 0.05, 0.15, 0.3 m/s, docs/grasping.md, gave 29 of 30; here 6 runs keep the suite
+and speeds 0.05, 0.15, 0.3 m/s, docs/grasping.md, gave 30 of 30; here 6 runs keep the suite
 quick.)"""
 
 from __future__ import annotations

@@ -66,6 +66,15 @@ class ArmParams:
         ge=0.0,
         doc="eq. 2's K^a2 (reaching; only the I - S components act; assumed)",
     )
+    reach_tracking: float = param(
+        1.0,
+        unit="1",
+        ge=0.0,
+        le=1.0,
+        doc="the share of eq. 2's tracking term S K^a1 (x^o - x^a) kept while reaching: 1 is "
+        "eq. 3's partition, tracking and reaching at once; 0 a sequential look-then-move "
+        "controller that stops tracking to reach (a falsifier of eq. 3's row)",
+    )
     K_av: float = param(0.05, unit="1", ge=0.0, doc="eq. 2's K^av (scalar times I)")
     K_af: float = param(
         0.3,
@@ -155,6 +164,7 @@ class ArmControlTask(Controller):
         self.K_a1, self.K_a2 = np.asarray(params.K_a1, float), np.asarray(params.K_a2, float)
         self._g_track = (S_DIAG * self.K_a1).tolist()  # eq. 2's S K^a1 and (I - S) K^a2
         self._g_reach = ((1.0 - S_DIAG) * self.K_a2).tolist()
+        self._g_track_reach = [params.reach_tracking * g for g in self._g_track]
         self.q: list[float] = [float(x) for x in spec.initial_q]
         self.qd = [0.0] * len(self.q)
         self.obj: Any = None
@@ -288,7 +298,12 @@ class ArmControlTask(Controller):
             self._J,
             n,
             P.damping**2,
-            [g * e for g, e in zip(self._g_track, e_track)],
+            [
+                g * e
+                for g, e in zip(
+                    self._g_track_reach if self.state.phase == "reach" else self._g_track, e_track
+                )
+            ],
             [g * e for g, e in zip(self._g_reach, e_reach)],
             self.qd,
             F,
@@ -354,8 +369,9 @@ class ArmControlTask(Controller):
         e_reach[3:] = cross3(R[:, 2], self._n_plane)
         JJt = Jg @ Jg.T + P.damping**2 * np.eye(6)
         Jpinv = Jg.T @ np.linalg.solve(JJt, np.eye(6))
+        share = P.reach_tracking if state.phase == "reach" else 1.0
         out = {
-            "track": P.K_ap * Jpinv @ (S_DIAG * self.K_a1 * e_track),
+            "track": P.K_ap * Jpinv @ (share * S_DIAG * self.K_a1 * e_track),
             "reach": P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach),
             "damp": -P.K_av * np.asarray(qd, float),
             "force": P.K_af * (J.T @ np.asarray(F, float)),

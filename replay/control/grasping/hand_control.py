@@ -8,8 +8,10 @@
   against an object eq. 4 balances at F^h = -(K^hg / K^hf) (theta_d - theta): the grip torque
   grows with how far theta_d^h closes past the contact, a compliance.
 - theta_d^h = preshape + c (grip - preshape): ``c`` (0..1) follows the reaching motion x_d^a
-  (the schedule's reach progress: closing from ``close_from`` to the grasp position, held
-  closed, opened on release). Preshape and grip postures are chosen by the recognised shape
+  (the schedule's reach progress: from ``close_from`` to the grasp position it closes to the
+  touch posture, where the fingers clear the measured width by ``touch_clearance``, arriving
+  as x_d^a comes to rest; in the hold it is the grip posture, closed at most ``touch_speed``
+  per joint, so the fingers meet the object gently; opened on release). Preshape and grip postures are chosen by the recognised shape
   (Fig. 5(b)): a rectangle gets straight fingers side by side (a flat hand, closing like a
   parallel gripper on the box's faces), a circle a cupped hand: the fingers opened wide at the
   knuckle and curled at their distal joints, the index and ring turned in towards the middle
@@ -96,12 +98,13 @@ class HandParams:
         _CIRC_GRIP, unit="rad", length=14, doc="theta_d^h fully closed on a circle"
     )
     close_from: float = param(
-        0.9,
+        0.7,
         unit="1",
         ge=0.0,
         lt=1.0,
-        doc="reach progress (x_d^a) from which theta_d^h closes (the arm lags x_d^a by ~1-2 cm: "
-        "0.8 closed the fingers on the ball before the palm was there, shoving it off its plane)",
+        doc="reach progress (x_d^a) from which theta_d^h closes towards the touch posture "
+        "(closing to the full grip from 0.8 shoved the ball off its plane before the palm was "
+        "there; to the touch it stays clear of the measured width)",
     )
     load_filter: float = param(
         0.005,
@@ -117,6 +120,21 @@ class HandParams:
         ge=0.0,
         doc="preshape aperture: the thumb's and fingers' tips this far clear of the object's "
         "measured width on each side (the vision chip's pixel is ~1 cm at the object; assumed)",
+    )
+    touch_clearance: float = param(
+        0.005,
+        unit="m",
+        ge=0.0,
+        doc="the reach closes theta_d^h only to where the fingers clear the measured width by "
+        "this much on each side (the touch posture), arriving as x_d^a comes to rest; the hold "
+        "then closes on to the grip posture (assumed)",
+    )
+    touch_speed: float = param(
+        4.0,
+        unit="rad/s",
+        gt=0.0,
+        doc="in the hold each hand joint closes at most this fast (eq. 4's command clipped): "
+        "the last clearance is crossed slowly, so the fingers meet the object gently (assumed)",
     )
     free_closure: float = param(
         0.1,
@@ -173,6 +191,8 @@ class HandControlTask(Controller):
         # its root's inner face from the palm centre (across the thumb-finger axis) and its
         # length; the measured width (smaller in-plane size) averaged while tracking
         self._flex: list[tuple[int, list[int], float, float]] = []
+        self._chains: list[tuple[int, list[int], float, float, float, list]] = []
+        self._touch: float | None = None
         k = 0
         for finger in hand.table.fingers:
             idx = list(range(k, k + len(finger.joints)))
@@ -181,6 +201,10 @@ class HandControlTask(Controller):
             half = abs(finger.root[0]) - finger.joints[-1].width / 2.0
             length = sum(j.length for j in finger.joints)
             self._flex.append((flex[0], flex[1:], half, length))
+            # the flex chain in the closing plane: the root's distance from the palm centre
+            # and each flex link's (length, width), for touch_closure
+            links = [(j.length, j.width) for j in finger.joints if j.kind == "flex"]
+            self._chains.append((flex[0], flex, half, length, abs(finger.root[0]), links))
         self._width_sum, self._width_n = 0.0, 0
         self.width: float | None = None
         self.dt = spec.dt
@@ -222,12 +246,6 @@ class HandControlTask(Controller):
         if self.state is None:
             return None
         st = self.state
-        c = 0.0
-        if st.phase == "reach":
-            f = self.params.close_from
-            c = min(max((st.reach_progress - f) / (1.0 - f), 0.0), 1.0)
-        elif st.phase == "hold":
-            c = 1.0
         if self.shape in self.postures and (
             st.phase in ("track", "release") or self.preshape == "none"
         ):
@@ -235,11 +253,28 @@ class HandControlTask(Controller):
                 self.preshape = self.shape
                 self._events.append(Occurrence("preshape", {"shape": self.shape}))
         pre, grip = self._postures.get(self.preshape, (self._open, None))
+        P = self.params
+        touch = 1.0
         if grip is not None and self.width is not None:
             pre = self.aperture(pre, self.width)
-        P = self.params
+            if st.phase in ("track", "release") or self._touch is None:
+                self._touch = self.touch_closure(
+                    pre, grip, self.width + 2.0 * P.touch_clearance, self.preshape
+                )
+            touch = self._touch
+        # theta_d^h by the reach (Sec. 4.3): from close_from of x_d^a's progress to the touch,
+        # reached as x_d^a comes to rest (its min-jerk progress has zero rate at 1); in the hold
+        # the grip posture, closed at most touch_speed
+        c = 0.0
+        vmax = self.vmax
+        if st.phase == "reach":
+            f = P.close_from
+            c = touch * min(max((st.reach_progress - f) / (1.0 - f), 0.0), 1.0)
+        elif st.phase == "hold":
+            c = 1.0
+            vmax = min(vmax, P.touch_speed)
         theta_d, cmd, deficit = _hand_servo.eq4(
-            pre, grip, c, self.q, self.qd, self.load, P.K_hg, P.K_hv, P.K_hf, self.vmax
+            pre, grip, c, self.q, self.qd, self.load, P.K_hg, P.K_hv, P.K_hf, vmax
         )
         if st.phase == "hold":
             self._shape_at_grasp.setdefault(st.cycle, self.preshape)
@@ -259,6 +294,40 @@ class HandControlTask(Controller):
             for i in rest:
                 out[i] = 0.0
         return out
+
+    def touch_closure(self, pre: list[float], grip: list[float], width: float, shape: str) -> float:
+        """The closure c (theta_d^h = pre + c (grip - pre)) at which the first finger's joints
+        or tip (on their inner face) meet an object ``width`` wide (the measured size), by bisection over c on each
+        finger's flex chain in its closing plane: a rectangle as a slab |d| <= width/2 in front
+        of the palm (its depth is not measured), a circle as a disc of diameter ``width`` resting
+        on the palm face. 1 if the grip posture never meets it."""
+        r = width / 2.0
+
+        def inside(c: float) -> bool:
+            for _j1, flex, half, _length, a, links in self._chains:
+                phi, u, h = 0.0, 0.0, 0.0  # toward the centre, along the palm normal
+                for i, (length, w) in zip(flex, links):
+                    phi += pre[i] + c * (grip[i] - pre[i])
+                    s, co = math.sin(phi), math.cos(phi)
+                    u += length * s
+                    h += length * co
+                    # the link's end (the next joint, or the tip), on its inner face
+                    d = a - (u + 0.5 * w * co)
+                    z = h - 0.5 * w * s
+                    if shape == "circle":
+                        if d * d + (z - r) * (z - r) <= r * r:
+                            return True
+                    elif abs(d) <= r and z >= 0.0:
+                        return True
+            return False
+
+        if not inside(1.0):
+            return 1.0
+        lo, hi = 0.0, 1.0
+        for _ in range(20):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if inside(mid) else (mid, hi)
+        return lo
 
     def telemetry(self, t: float) -> dict:
         return {TOPIC_GRASP_HAND: self._out} if self._out is not None else {}

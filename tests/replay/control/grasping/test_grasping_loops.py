@@ -373,3 +373,42 @@ def test_preshape_aperture_opens_for_the_measured_width(spec):
         if wide[j1] > task.lo[j1] + 1e-9:
             assert tip == pytest.approx(0.035 + task.params.aperture_margin, abs=1e-9)
         assert all(wide[i] == 0.0 for i in rest)
+
+
+def test_touch_posture_clears_the_measured_width_and_closes_less_on_a_wider_object(spec):
+    """touch_closure: at its closure the first finger's joints or tips reach the width (a
+    little more closure crosses it), a wider object is met sooner, and the preshape opened for
+    that width by aperture() is clear of it; an object too narrow to meet gives 1."""
+    task = HandControlTask(HandParams(), spec=spec)
+    for shape in ("rectangle", "circle"):
+        pre0, grip = (list(x) for x in task.postures[shape])
+        closures = []
+        for width in (0.05, 0.07):
+            pre = task.aperture(pre0, width)
+            c = task.touch_closure(pre, grip, width, shape)
+            assert 0.0 < c < 1.0, (shape, width, c)
+            # the bisection's bound: just past it the posture is inside the object
+            assert task.touch_closure(pre, grip, width + 0.002, shape) <= c
+            closures.append(c)
+        assert closures[1] < closures[0], (shape, closures)  # wider: met sooner
+    pre = task.aperture(list(task.postures["rectangle"][0]), 0.05)
+    assert task.touch_closure(pre, list(task.postures["rectangle"][0]), 0.001, "rectangle") == 1.0
+
+
+def test_the_hold_closes_the_hand_no_faster_than_touch_speed(spec):
+    """In the hold eq. 4's command is clipped to touch_speed (the gentle last gap); in the
+    reach it may use the drive's full speed."""
+    P = HandParams(touch_speed=3.0)
+    task = HandControlTask(P, spec=spec)
+    # every joint 0.2 rad more open than any posture: eq. 4 asks > 5 rad/s of each
+    enc = JointState(0.0, list(spec.hand.joint_names), [-0.2] * 14, [0.0] * 14, [0.0] * 14)
+    task.shape = "rectangle"
+    task.width = 0.05
+    hold = GraspState(0.0, "hold", 0, [0.0] * 6, 1.0, True, 0.01)
+    cmd = task.update(0.0, [(TOPIC_HAND_ENCODERS, enc), (TOPIC_GRASP_STATE, hold)])
+    assert cmd is not None and max(abs(v) for v in cmd.hand) == pytest.approx(3.0)
+    reach = GraspState(0.001, "reach", 0, [0.0] * 6, 0.95, True, 0.29)
+    fresh = HandControlTask(P, spec=spec)
+    fresh.shape, fresh.width = "rectangle", 0.05
+    cmd = fresh.update(0.001, [(TOPIC_HAND_ENCODERS, enc), (TOPIC_GRASP_STATE, reach)])
+    assert cmd is not None and max(abs(v) for v in cmd.hand) > 3.0
