@@ -144,3 +144,35 @@ def test_contact_stiffness_neighbours_still_grasp(tmp_path, stiffness):
     )
     print(stiffness, tc, ok, why)
     assert ok and flag["success"], (why, flag["reason"])
+
+
+def test_every_grasp_row_shows_both_engines(tmp_path):
+    """analysis/engines.py joins the grasp claims (analysis.grasp_claims) of both engines' runs
+    of the same scenarios, each decided on its own engine's truth; the hold holds in both."""
+    from analysis.engines import closing_note, engine_rows, split_logs
+    from analysis.grasp_claims import evaluate
+    from replay.log import LogReader
+    from replay.runner import Runner
+    from replay.scenario import load_scenario
+
+    logs = {}
+    with pytest.MonkeyPatch.context() as mp:
+        mp.chdir(ROOT)
+        for name in ("grasp_hexahedron", "grasp_sphere"):
+            for n in (name, name + "_mujoco"):
+                Runner(load_scenario(ROOT / "scenarios" / f"{n}.yaml")).run(tmp_path / f"{n}.mcap")
+                logs[n] = LogReader(str(tmp_path / f"{n}.mcap"))
+    pb, mj = split_logs(logs)
+    assert set(pb) == set(mj) == {"grasp_hexahedron", "grasp_sphere"}
+    rows = engine_rows(evaluate, logs)
+    assert {r.quantity for r in rows} == {r.quantity for r in evaluate(pb)}
+    for r in rows:
+        assert r.measured.startswith("PyBullet: ") and " ‖ MuJoCo: " in r.measured, r.quantity
+    held = [
+        r
+        for r in rows
+        if r.quantity.endswith("the grasp holds while the human keeps moving the object")
+    ]
+    assert len(held) == 2 and all(r.status == "reproduced" for r in held), held
+    both = closing_note(rows).splitlines()[0]
+    assert all(r.quantity in both for r in held)
