@@ -1,11 +1,13 @@
 """Claims per physics engine: each arm claim's row with the PyBullet and the MuJoCo value side by
-side (docs/mujoco.md), the catch rates of both engines on the same throws, and the closing note
-(which claims hold in both engines, which in one).
+side (docs/mujoco.md), the catch (or grasp) rates of both engines on the same throws (or human
+paths), and the closing note (which claims hold in both engines, which in one).
 
 A MuJoCo run is the scenario of the same name with ``_mujoco`` appended
-(``catch_optimised_mujoco`` is ``catch_optimised`` with ``plant.type: mujoco_arm``). The paper's
-own ``evaluate`` (e.g. ``analysis.catch_claims.evaluate``) is run once on each engine's logs,
-named without the suffix, so both give the same rows; the rows are then joined by quantity.
+(``catch_optimised_mujoco`` is ``catch_optimised`` with ``plant.type: mujoco_arm``,
+``grasp_hexahedron_mujoco`` is ``grasp_hexahedron`` with ``mujoco_grasp``). The paper's own
+``evaluate`` (``analysis.catch_claims.evaluate``, ``analysis.grasp_claims.evaluate``: a MuJoCo
+log's typed params are the MuJoCo rig's, analysis/grasp_run.py) is run once on each engine's
+logs, named without the suffix, so both give the same rows; the rows are then joined by quantity.
 Every verdict stays the paper module's, from each engine's truth topics.
 
 Wiring (for the claims table and the report): ``engine_rows(evaluate, logs)`` in place of

@@ -104,11 +104,15 @@ class GraspRun:
     @cached_property
     def params(self):
         """The rig's typed ``GraspParams``, rebuilt from the log's resolved scenario (every
-        default the plant's own)."""
+        default the plant's own): the PyBullet rig's, or the MuJoCo rig's (its contact settings
+        added) for a ``mujoco_grasp`` run."""
         from plants.bullet_arm.params import GraspParams
+        from plants.mujoco_arm.params import GraspParams as MujocoGraspParams
         from replay.scenario import params_from_data
 
-        return params_from_data(GraspParams, self.plant_params, "plant.params")
+        mujoco = (self.scenario.get("plant") or {}).get("type") == "mujoco_grasp"
+        cls = MujocoGraspParams if mujoco else GraspParams
+        return params_from_data(cls, self.plant_params, "plant.params")
 
     @property
     def t_end(self) -> float:

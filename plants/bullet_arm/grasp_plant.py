@@ -25,6 +25,7 @@ from plants.bullet_arm.engine import pybullet as p
 
 from plants.bullet_arm._arm_state import joint_state
 from plants.bullet_arm.ft_sensor import WristFT
+from plants.bullet_arm.grasp_setup import head_setup, human_args, plane_setup
 from plants.bullet_arm.grasp_verdict import GraspVerdict
 from plants.bullet_arm.head import HeadServo
 from plants.bullet_arm.human_hand import HumanHand
@@ -34,9 +35,9 @@ from plants.bullet_arm.plant import BulletArmPlant
 from plants.bullet_arm.servo import VelocityMotors, VelocityServos
 from replay.interfaces import Occurrence
 from replay.messages import JointState
-from replay.robot.arm_types import GraspSpec, PlaneSpec, ServoCommand
+from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.hand import palm_body
-from replay.robot.head import HeadSpec, camera_pose, look_angles
+from replay.robot.head import camera_pose
 from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
@@ -89,66 +90,14 @@ class BulletGraspPlant(GraspVerdict, BulletArmPlant):
         tau0 = {j: g[i] for i, j in enumerate(dofs)}
         self._dof_pos = pos
         self.arm_servos.preload([tau0[j] for j in self._arm_j], self.arm_mass_matrix())
-        # the head
-        self.head = HeadSpec(
-            position=tuple(P.head_position),
-            yaw=float(P.head_yaw),
-            camera_offset=float(P.head_camera_offset),
-            lower=tuple(P.head_lower),
-            upper=tuple(P.head_upper),
-            inertia=tuple(P.head_inertia),
-            torque_limit=tuple(P.head_torque_limit),
-            velocity_limit=tuple(P.head_velocity_limit),
-        )
-        h0 = (
-            list(P.head_initial)
-            if P.head_initial
-            else list(look_angles(self.head, P.object_position))
-        )
-        if len(h0) != 2:
-            raise ValueError("head_initial needs 2 values (pan, tilt)")
+        # the head, the constraint plane and the human (grasp_setup: shared with MuJoCo's rig)
+        self.head, h0 = head_setup(P)
         self.head_servo = HeadServo(self.head, P.head_servo_bandwidth, dt, h0)
-        # the constraint plane and the human
-        n = np.asarray(P.plane_normal, float)
-        if np.linalg.norm(n) == 0.0:
-            raise ValueError("plane_normal must not be zero")
-        n = n / np.linalg.norm(n)
-        u = np.cross([0.0, 0.0, 1.0], n)
-        if np.linalg.norm(u) < 1e-9:
-            u = np.array([0.0, 1.0, 0.0])
-        u = u / np.linalg.norm(u)
-        v = np.cross(n, u)
-        op = [float(x) for x in P.object_position]
-        self.plane = PlaneSpec(
-            point=(op[0], op[1], op[2]), normal=(float(n[0]), float(n[1]), float(n[2]))
-        )
+        self.plane, u, v, n = plane_setup(P)
         self._u, self._v = u, v
         self._u_l, self._v_l = u.tolist(), v.tolist()
         assert self.obj is not None and self._palm_link is not None
-        self.human = HumanHand(
-            bc,
-            self.obj,
-            rng,
-            origin=P.object_position,
-            rpy0=P.object_rpy,
-            u=u,
-            v=v,
-            n=n,
-            speed=P.human_speed,
-            roll_rate=P.human_roll_rate,
-            f_min=P.human_f_min,
-            f_max=P.human_f_max,
-            components=P.human_components,
-            max_force=P.human_max_force,
-            start=P.human_start,
-            mass=P.object_mass,
-            gravity=P.gravity,
-            stiffness=P.human_stiffness,
-            damping=P.human_damping,
-            rot_stiffness=P.human_rot_stiffness,
-            rot_damping=P.human_rot_damping,
-            max_torque=P.human_max_torque,
-        )
+        self.human = HumanHand(bc, self.obj, rng, **human_args(P, u, v, n))
         # bookkeeping of the verdict
         self._n_l = [float(x) for x in n]
         self._start_verdict(P.slip_time, dt)

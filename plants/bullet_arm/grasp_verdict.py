@@ -6,9 +6,9 @@ by the same criterion.
 
 The host plant provides: ``params`` (GraspParams), ``plane`` (PlaneSpec), ``_n_l``, ``_u_l``,
 ``_v_l`` (the plane's normal and in-plane axes), ``human`` (human_path.HumanPath), ``caught``,
-``_t``, ``_events``, ``_contacts`` (rows with the normal force at [9]), ``_state()`` (its [2]:
-the object's (pos, orn, v, w)), ``_frames_now()`` (its [0]: the tool frame's (pos, [x, y, z, w],
-...)) and ``_contact_summary_now()`` (its [0]: the sorted parts touching the object).
+``_t``, ``_events``, ``_state()`` (its [2]: the object's (pos, orn, v, w)), ``_frames_now()``
+(its [0]: the tool frame's (pos, [x, y, z, w], ...)) and ``_contact_summary_now()`` (the sorted
+parts touching the object, their links, the total normal force in N).
 """
 
 from __future__ import annotations
@@ -28,7 +28,6 @@ class GraspVerdict:
     caught: bool
     _t: float
     _events: list
-    _contacts: list
     _n_l: list
     _u_l: list
     _v_l: list
@@ -76,7 +75,7 @@ class GraspVerdict:
         for ev in self._events[n_before:]:
             if ev.kind == "grasp":
                 self._grasp_start = self._t - ev.data.get("hold_time", 0.0)
-                ev.data["normal_force"] = float(sum(c[9] for c in self._contacts))
+                ev.data["normal_force"] = float(self._contact_summary_now()[2])
                 self._grasps.append(
                     {
                         "t": self._grasp_start,

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from plants.bullet_arm.params import GraspParams as BulletGraspParams
 from plants.bullet_arm.params import Params as ArmParams
 from replay.params import ParamError, param
 
@@ -82,3 +83,10 @@ class Params(ArmParams):
                 # MuJoCo advises >= 2 steps; the plant runs at 1 ms (a finer step allows less,
                 # but no scenario uses one)
                 raise ParamError(name, "the time constant must be >= 0.002 s (2 physics steps)")
+
+
+@dataclass
+class GraspParams(BulletGraspParams, Params):
+    """The grasping rig's parameters (plants/bullet_arm/params.py ``GraspParams``: servos, head,
+    human, verdict) with MuJoCo's contact and solver settings (``Params`` above), so a grasp
+    scenario changes only ``plant.type``."""

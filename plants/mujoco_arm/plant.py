@@ -116,6 +116,7 @@ class MujocoArmPlant(Plant):
         # (arm joint index, qpos address, dof address) of each active joint
         self._arm_slots = [(i, W.arm_qpos[k], W.arm_dof[k]) for k, i in enumerate(self.active)]
         self._root = m.body_rootid.tolist()
+        self._geom_body = m.geom_bodyid.tolist()
         self._motions: dict = {}  # (step, body) -> _body_motion
         # frames(): per robot body (body, parent, parent's name, its name)
         self._frame_rows = [
@@ -481,17 +482,22 @@ class MujocoArmPlant(Plant):
         out = []
         n = d.ncon
         if n and self._ob >= 0:
-            m, bodyid, ob = self.mj, self.mj.geom_bodyid, self._ob
+            m, ob, f6 = self.mj, self._ob, self._f6
             con = d.contact
+            # each array read once as a list (indexing the contact struct per item is slow)
+            bodyid = self._geom_body
+            g1, g2, adr = con.geom1.tolist(), con.geom2.tolist(), con.efc_address.tolist()
+            pos, frame = con.pos.tolist(), con.frame.tolist()
             for i in range(n):
-                b1, b2 = int(bodyid[con.geom1[i]]), int(bodyid[con.geom2[i]])
-                if ob not in (b1, b2) or con.efc_address[i] < 0:  # not in the solve: near
+                b1, b2 = bodyid[g1[i]], bodyid[g2[i]]
+                if ob not in (b1, b2) or adr[i] < 0:  # not in the solve: near
                     continue
-                mujoco.mj_contactForce(m, d, i, self._f6)
-                nrm = con.frame[i, :3]  # from geom1 to geom2
-                robot = b2 if b1 == ob else b1
-                sign = 1.0 if b2 == ob else -1.0
-                out.append((robot, con.pos[i].tolist(), (sign * nrm).tolist(), float(self._f6[0])))
+                mujoco.mj_contactForce(m, d, i, f6)
+                nx, ny, nz = frame[i][:3]  # from geom1 to geom2
+                if b2 == ob:
+                    out.append((b1, pos[i], [nx, ny, nz], float(f6[0])))
+                else:
+                    out.append((b2, pos[i], [-nx, -ny, -nz], float(f6[0])))
         self._contacts = out
 
     def _contact_summary(self) -> tuple[list, list, float]:

@@ -1,7 +1,7 @@
 """Issue #20: the grasp judged by its physics on inputs it was not tuned to. Box and sphere, on
 seeds the scenarios do not use (they use 0) and human speeds across 0.05-0.3 m/s (the
-scenarios': 0.10), judged from the truth topics alone by this test's own criterion, not by the
-run's outcome flag:
+scenarios': 0.10), judged from the truth topics alone by the test's own criterion
+(tests/grasp_judge.py, shared with the MuJoCo rig's test), not by the run's outcome flag:
 
 - grasped: the plant's grasp event (contacts) and the object held for >= 0.5 s after it;
 - held: during that hold the object stays within 10 mm of where it sat in the true hand frame;
@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from grasp_judge import physical_verdict
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = [
@@ -25,39 +26,6 @@ CASES = [
     for scenario in ("grasp_hexahedron", "grasp_sphere")
     for seed, speed in ((211, 0.05), (212, 0.15), (213, 0.3))
 ]
-
-
-def physical_verdict(log) -> tuple[bool, str]:
-    from analysis.grasp_run import load_run
-
-    run = load_run(log)
-    grasps = run.kinds("grasp")
-    if not grasps:
-        return False, "never grasped"
-    t0 = grasps[0]["t"]
-    held_until = next((e["t"] for e in run.kinds("release") if e["t"] > t0), run.t_end)
-    if held_until - t0 < 0.5 - 1e-9:
-        return False, f"held {held_until - t0:.3f} s"
-    w = run.window(run.t_obj, t0, held_until)
-    rel = run.in_hand()[w]
-    drift = float(np.max(np.linalg.norm(rel - rel[0], axis=1)))
-    target = np.column_stack(
-        [np.interp(run.t_obj[w], run.t_human, run.human[:, i]) for i in range(3)]
-    )
-    human = float(np.max(np.linalg.norm(run.obj[w] - target, axis=1)))
-    plane_x = float(run.plant_params["object_position"][0])  # the plane's normal is world x
-    off = float(np.max(np.abs(run.obj[:, 0] - plane_x)))
-    why = []
-    if drift > 0.010:
-        why.append(f"moved {1e3 * drift:.1f} mm in the hand")
-    if human > 0.020:
-        why.append(f"{1e3 * human:.1f} mm off the human's path")
-    if off > 0.020:
-        why.append(f"{1e3 * off:.1f} mm off its plane")
-    return not why, "; ".join(why) or (
-        f"held {held_until - t0:.2f} s, {1e3 * drift:.1f} mm in the hand, "
-        f"{1e3 * human:.1f} mm from the human, {1e3 * off:.1f} mm off the plane"
-    )
 
 
 @pytest.fixture(scope="module")
