@@ -1,10 +1,16 @@
-"""The arm plant's once-a-step state arithmetic in Python: the references of the compiled
-``_arm_state`` functions the plant runs (a seeded test holds them equal to the bit).
-``_arm_state.palm_frame``'s reference is ``outcome.palm_frame_reference`` (the catch watch's)."""
+"""The arm plant's once-a-step state arithmetic in Python floats: ``joint_state`` and
+``limit_flags`` the plants run are these ``*_reference`` functions, or the optional compiled
+``_arm_state`` (the same operations; a seeded test holds them equal to the bit) where it is
+built. ``_arm_state.palm_frame``'s Python is ``outcome.palm_frame_reference`` (the catch
+watch's)."""
 
 from __future__ import annotations
 
 import math
+
+from replay.accel import accelerator
+
+_ARM_STATE = accelerator("plants.bullet_arm._arm_state")
 
 
 def joint_state_reference(states: tuple, na: int, pick: tuple, locked: list) -> tuple:
@@ -32,3 +38,7 @@ def limit_flags_reference(q, qd, pos, v, vlim, lower, upper, over0, at0):
     if over == over0 and at == at0:
         return None
     return (True, over, at)
+
+
+joint_state = _ARM_STATE.joint_state if _ARM_STATE is not None else joint_state_reference
+limit_flags = _ARM_STATE.limit_flags if _ARM_STATE is not None else limit_flags_reference

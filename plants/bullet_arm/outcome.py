@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from plants.bullet_arm._arm_state import palm_frame
+from replay.accel import accelerator
 
 
 @dataclass
@@ -76,7 +76,8 @@ class CatchWatch:
         caught: bool,
     ) -> None:
         """One step: the object's and the palm's state (world) and the parts touching now.
-        The geometry compiled (``palm_frame``; ``palm_frame_reference`` below is its Python)."""
+        The geometry: ``palm_frame_reference`` below (compiled ``_arm_state.palm_frame`` where
+        built)."""
         lx, ly, lz, speed, angle, d, dist2 = palm_frame(
             obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, self.palm_thickness
         )
@@ -156,8 +157,8 @@ def palm_frame_reference(
 ) -> tuple:
     """(lx, ly, lz, speed, angle, d, |d|^2): the object centre from the palm face centre d
     (world) and in the palm frame, its speed relative to the palm point under it and that
-    velocity's angle (deg) from the palm's inward normal; in floats (3-vectors as tuples), the
-    reference of the compiled ``_arm_state.palm_frame``."""
+    velocity's angle (deg) from the palm's inward normal; in floats (3-vectors as tuples); the
+    optional compiled ``_arm_state.palm_frame`` repeats its operations."""
     qx, qy, qz, qw = palm_quat  # the palm frame's z axis and in-plane axes (world)
     n = qx * qx + qy * qy + qz * qz + qw * qw
     k = 2.0 / n  # (quaternion_matrix's columns, normalised there too)
@@ -184,3 +185,7 @@ def palm_frame_reference(
     angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
     dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
     return lx, ly, lz, speed, angle, d, dist2
+
+
+_ARM_STATE = accelerator("plants.bullet_arm._arm_state")
+palm_frame = _ARM_STATE.palm_frame if _ARM_STATE is not None else palm_frame_reference

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from plants.bullet_arm._arm_state import joint_state, limit_flags
+from plants.bullet_arm.arm_state import joint_state, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params

@@ -14,7 +14,9 @@ from collections import deque
 
 import numpy as np
 
-from replay.control.catching import _ballistic
+from replay.accel import accelerator
+
+_BALLISTIC = accelerator("replay.control.catching._ballistic")
 
 
 class BallisticEstimator:
@@ -186,12 +188,15 @@ class BallisticEstimator:
 
     def time_to_radius(self, t: float, origin, radius: float):
         """Absolute time at which the arc first reaches |r - origin| = radius (None if never):
-        compiled (``_ballistic.time_to_radius``), :meth:`time_to_radius_reference` where
-        Newton's method cannot decide (the same value, to the bit, where it can)."""
+        :meth:`time_to_radius_reference`; where the compiled ``_ballistic`` is built it runs
+        first and that method only where Newton's method cannot decide (the same value, to the
+        bit, where it can)."""
         f = self.fit_f()
         if f is None or f[2] is None:
             return None
-        tc = _ballistic.time_to_radius(t, f[0], f[1], f[2], self._g, origin, radius)
+        if _BALLISTIC is None:
+            return self.time_to_radius_reference(t, origin, radius)
+        tc = _BALLISTIC.time_to_radius(t, f[0], f[1], f[2], self._g, origin, radius)
         return tc if tc is not None else self.time_to_radius_reference(t, origin, radius)
 
     def time_to_radius_reference(self, t: float, origin, radius: float):

@@ -1,7 +1,8 @@
 """The direct mapping q_d = f(r_o) = g o l_c^-1(r_o) of Namiki & Ishikawa (eqs. 6-8, 12-14, 16, 23).
 
 NumPy, batched: every function takes arrays with a leading sample axis ``(n, ...)``; the
-controller's one-sample path (``*_one``) is in Python floats, compiled in ``_mapping.c``.
+controller's one-sample path (``*_one``) is in Python floats (``_mapping.c`` repeats it where
+that optional accelerator is built).
 
 Coordinates. The arm has four joints; the paper uses axes 1, 2 and 4 and holds axis 3 at 0
 (Sec. IV-A). The mapping works in the *active* coordinates ``p = (q1, q2, q4)`` (m_q = 3); the
@@ -34,7 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.catching import _mapping
+from replay.accel import accelerator
+
+_MAPPING = accelerator("replay.control.catching._mapping")
 
 ACTIVE = (0, 1, 3)  # active joints of the 4-DOF arm (axes 1, 2, 4); axis 3 held at 0
 
@@ -533,19 +536,23 @@ class DirectMapping:
 
     def evaluate_one(self, r, rd, rdd):
         """:meth:`evaluate` of one object state (r_o, r_o', r_o'' each (3,)): (q_d, qd_d,
-        qdd_d, q_o, in_domain), arrays (3,) but in_domain. Compiled (``_mapping.c``:
-        :meth:`evaluate_one_floats`' operations in the same order); tests hold the two and the
-        batched :meth:`evaluate` together."""
+        qdd_d, q_o, in_domain), arrays (3,) but in_domain: :meth:`evaluate_one_floats`, or the
+        compiled ``_mapping.c`` (its operations in the same order) where that is built; tests
+        hold the two and the batched :meth:`evaluate` together."""
         q, qd, qdd, p, ok = self.evaluate_one_tuple(r, rd, rdd)
         return np.array(q), np.array(qd), np.array(qdd), np.array(p), ok
 
     def evaluate_one_tuple(self, r, rd, rdd) -> tuple[tuple, tuple, tuple, tuple, bool]:
         """:meth:`evaluate_one` with 3-tuples of floats (the controller's per-step path: ~1 us,
-        ~60x less than :meth:`evaluate_one_floats`)."""
+        with the compiled ``_mapping``, ~60x less than :meth:`evaluate_one_floats`, which runs
+        without it)."""
         if self.poly.m != 3 or self.poly.i != 2:
             raise ValueError("evaluate_one is written for 3 active joints, the last selected")
+        if _MAPPING is None:
+            q, qd, qdd, p, ok = self.evaluate_one_floats(r, rd, rdd)
+            return tuple(q.tolist()), tuple(qd.tolist()), tuple(qdd.tolist()), tuple(p.tolist()), ok
         try:
-            return _mapping.evaluate_one(self.geo._c, self.poly._powers_c, self._A, r, rd, rdd)
+            return _MAPPING.evaluate_one(self.geo._c, self.poly._powers_c, self._A, r, rd, rdd)
         except ValueError as exc:
             if str(exc) == "Singular matrix":  # as np.linalg.solve
                 raise np.linalg.LinAlgError("Singular matrix") from None

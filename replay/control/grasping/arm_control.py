@@ -18,9 +18,10 @@
   mass and centre of mass, open posture) and the sensor's bias at start (tare), about the
   flange: the external wrench on the hand (N, N m).
 - No prediction of the object's motion: x^o is the latest measurement.
-- Per step in floats: the chain, Jg, eq. 2's terms and F^a are one compiled module
-  (``_arm_kinematics.c``); :meth:`ArmControlTask.kinematics` and :meth:`reference_command` are
-  the NumPy reference a seeded test holds it to.
+- Per step: the chain and Jg (:meth:`ArmControlTask.kinematics`, NumPy), eq. 2's terms
+  (:func:`eq2_terms`) and F^a (:func:`wrench_reference`, floats); the optional compiled
+  ``_arm_kinematics.c`` repeats them where it is built, and :meth:`reference_command` is the
+  NumPy formula a seeded test holds the task's command to.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from replay.control.grasping import _arm_kinematics
+from replay.accel import accelerator
 from replay.control.grasping.payloads import ArmLoop
 from replay.interfaces import Controller
 from replay.messages import (
@@ -47,6 +48,50 @@ from replay.robot.hand import hand_body
 from replay.spatial import cross3, wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
+
+_ARM_KINEMATICS = accelerator("replay.control.grasping._arm_kinematics")
+
+
+def eq2_terms(Jg, J, n, lam2, b1, b2, qd, F, K_ap, K_av, K_af, vlim) -> tuple[list, ...]:
+    """Eq. 2's joint-velocity terms (track, reach, damp, force, command): track = K_ap Jg+ b1,
+    reach = K_ap Jg+ b2 with the damped pseudo-inverse Jg+ = Jg^T (Jg Jg^T + lam2 I)^-1 (b1 =
+    S K^a1 e_track, b2 = (I - S) K^a2 e_reach), damp = -K_av qd, force = K_af J^T F; command =
+    their sum clipped to +-vlim (``_arm_kinematics.terms``' formula; ``n`` its joint count)."""
+    A = Jg @ Jg.T + lam2 * np.eye(6)
+    y = np.linalg.solve(A, np.array([b1, b2], float).T)
+    tr = K_ap * (Jg.T @ y)
+    damp = -K_av * np.asarray(qd, float)
+    force = K_af * (J.T @ np.asarray(F, float))
+    cmd = np.clip(tr[:, 0] + tr[:, 1] + damp + force, -np.asarray(vlim), np.asarray(vlim))
+    return tr[:, 0].tolist(), tr[:, 1].tolist(), damp.tolist(), force.tolist(), cmd.tolist()
+
+
+def wrench_reference(R, force, torque, w_hand, com, bias, filtered, a, deadband):
+    """(ext, filtered, F): the wrist sensor's wrench turned into the world (R: the tool's
+    rotation, row-major 9 floats) minus the hand's weight ``w_hand`` acting at R com, ext = (R f
+    - w, R m - (R com) x w); ``bias`` None: this ext is the tare (the filter restarts at 0);
+    filtered += a ((ext - bias) - filtered); F = filtered, or 0 while its force is below the
+    deadband (``_arm_kinematics.wrench`` repeats these operations)."""
+    r = [R[3 * i] * com[0] + R[3 * i + 1] * com[1] + R[3 * i + 2] * com[2] for i in range(3)]
+    w = w_hand
+    rxw = (r[1] * w[2] - r[2] * w[1], r[2] * w[0] - r[0] * w[2], r[0] * w[1] - r[1] * w[0])
+    ext = [
+        R[3 * i] * force[0] + R[3 * i + 1] * force[1] + R[3 * i + 2] * force[2] - w[i]
+        for i in range(3)
+    ]
+    ext += [
+        R[3 * i] * torque[0] + R[3 * i + 1] * torque[1] + R[3 * i + 2] * torque[2] - rxw[i]
+        for i in range(3)
+    ]
+    if bias is None:
+        bias, filtered = ext, [0.0] * 6
+    fl = [f + a * (e - b - f) for f, e, b in zip(filtered, ext, bias)]
+    quiet = math.sqrt(fl[0] * fl[0] + fl[1] * fl[1] + fl[2] * fl[2]) < deadband
+    return ext, fl, ([0.0] * 6 if quiet else list(fl))
+
+
+_terms = _ARM_KINEMATICS.terms if _ARM_KINEMATICS is not None else eq2_terms
+_wrench = _ARM_KINEMATICS.wrench if _ARM_KINEMATICS is not None else wrench_reference
 
 
 @dataclass
@@ -198,6 +243,28 @@ class ArmControlTask(Controller):
         J = np.vstack([cross3(Z, p[:, None] - O), Z])
         return T, J
 
+    def _chain(self, grasp_point: float) -> tuple[float, ...]:
+        """(R row-major, p, grasp point g = p + grasp_point R[:, 2]) of the tool at ``self.q``;
+        fills ``self._J`` (the tool's geometric Jacobian) and ``self._Jg`` (the grasp point's:
+        v_g = v + w x (g - p)). :meth:`kinematics`, or ``_arm_kinematics.chain`` where built."""
+        if _ARM_KINEMATICS is not None:
+            return _ARM_KINEMATICS.chain(
+                self.q,
+                self._n,
+                self._consts,
+                self._base,
+                self._tool,
+                grasp_point,
+                self._J,
+                self._Jg,
+            )
+        T, J = self.kinematics(self.q)
+        p, r = T[:3, 3], grasp_point * T[:3, 2]
+        self._J[:] = J
+        self._Jg[:] = J
+        self._Jg[:3] -= cross3(r[:, None], J[3:])
+        return (*T[:3, :3].ravel().tolist(), *p.tolist(), *(p + r).tolist())
+
     def hand_acceleration(self, R) -> list[float]:
         """The hand's centre-of-mass acceleration (world, m/s^2) from the arm's kinematics:
         v_com = v_tool + w x (R com) with (v_tool, w) = J theta_dot (the tool Jacobian of this
@@ -226,7 +293,7 @@ class ArmControlTask(Controller):
         acc = self.hand_acceleration(R)
         m = self.hand.mass
         load = [m * (g - x) for g, x in zip(self._g, acc)]
-        ext, self.filtered, F = _arm_kinematics.wrench(
+        ext, self.filtered, F = _wrench(
             R,
             self.wrench_raw.force,
             self.wrench_raw.torque,
@@ -257,9 +324,7 @@ class ArmControlTask(Controller):
             return None
         P, n = self.params, self._n
         # tool pose, grasp point x^a, J (tool) and Jg (grasp point: v_gp = v_tool + w x (gp - p))
-        k = _arm_kinematics.chain(
-            self.q, n, self._consts, self._base, self._tool, P.grasp_point, self._J, self._Jg
-        )
+        k = self._chain(P.grasp_point)
         R = k[:9]
         gp = k[12:15]
         n_palm, row = (R[2], R[5], R[8]), (R[1], R[4], R[7])
@@ -283,7 +348,7 @@ class ArmControlTask(Controller):
         ]
         self._hold_offsets(e_track, e_reach)
         F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
-        track, reach, damp, force, cmd = _arm_kinematics.terms(
+        track, reach, damp, force, cmd = _terms(
             self._Jg,
             self._J,
             n,

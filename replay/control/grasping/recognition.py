@@ -11,9 +11,9 @@ pixel extents at that depth give the size; the fill of the smallest bounding box
 the image border) and then kept. The image Jacobian of the head (d xi / d(pan, tilt), for eq. 1)
 is that of the same model at the estimated point. Nothing here predicts motion.
 
-Per frame the task runs compiled kernels (``_chip_target.c``: Self Windowing and the moments on
-the packed rows, the plane geometry); ``self_window``, ``features`` and :class:`Camera` are their
-references.
+Per frame the task runs ``self_window``'s Self Windowing and ``features``' moments on the packed
+rows, and :class:`Camera`'s plane geometry; the optional compiled ``_chip_target.c`` repeats
+them where it is built.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.grasping import _chip_target
+from replay.accel import accelerator
 from replay.control.grasping.features import DIR_TABLE, Blob, blob_rows
 from replay.control.grasping.payloads import GraspObject
 from replay.control.grasping.self_window import track_rows
@@ -33,6 +33,8 @@ from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import HeadSpec, camera_pose
 from replay.spatial import wrap_half_pi
+
+_CHIP_TARGET = accelerator("replay.control.grasping._chip_target")
 
 
 @dataclass
@@ -197,8 +199,8 @@ class RecognitionTask(Controller):
         if angles is None:
             return None
         fill = self.shape == "unknown"
-        if chip.width <= 63 and len(chip.rows) <= 64:  # track_rows and blob_rows, compiled
-            target, reacquired, feats = _chip_target.target_blob(
+        if _CHIP_TARGET is not None and chip.width <= 63 and len(chip.rows) <= 64:
+            target, reacquired, feats = _CHIP_TARGET.target_blob(  # track_rows and blob_rows
                 self._target, chip.rows, chip.width, fill, DIR_TABLE
             )
             b = None if feats is None else Blob(*feats)
@@ -234,24 +236,8 @@ class RecognitionTask(Controller):
             self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
         self._had_target = True
         # x_o on the constraint plane, the target's axis there and the image Jacobian, from the
-        # camera pose at capture (Camera.ray / meet_plane / Camera.jacobian, compiled)
-        head = self.camera.head
-        g = _chip_target.plane_geometry(
-            head.yaw,
-            angles[0],
-            angles[1],
-            self._head_position,
-            head.camera_offset,
-            self.camera.f,
-            *self._c,
-            self._plane_point,
-            self._pn,
-            self._pu,
-            self._pv,
-            b.u,
-            b.v,
-            b.phi,
-        )
+        # camera pose at capture
+        g = self._plane_geometry(angles, b)
         if g is None:
             return None
         X0, X1, X2, axis, dist, J00, J01, J10, J11 = g
@@ -278,6 +264,46 @@ class RecognitionTask(Controller):
             [[J00, J01], [J10, J11]],
             list(angles),
         )
+
+    def _plane_geometry(self, angles, b) -> tuple[float, ...] | None:
+        """None (the ray through the target's centre misses the plane) or (X0, X1, X2, axis,
+        distance, J00, J01, J10, J11): X where that ray meets the constraint plane, axis =
+        atan2(e . pv, e . pu) of e = X' - X, X' that of (u + cos phi, v + sin phi) (NaN if it
+        misses), distance = |X - o|, J = d (u, v) / d (pan, tilt) of X: Camera.ray, meet_plane
+        and Camera.jacobian (``_chip_target.plane_geometry`` where built)."""
+        cam = self.camera
+        if _CHIP_TARGET is not None:
+            head = cam.head
+            return _CHIP_TARGET.plane_geometry(
+                head.yaw,
+                angles[0],
+                angles[1],
+                self._head_position,
+                head.camera_offset,
+                cam.f,
+                *self._c,
+                self._plane_point,
+                self._pn,
+                self._pu,
+                self._pv,
+                b.u,
+                b.v,
+                b.phi,
+            )
+        pose = camera_pose(cam.head, *angles)
+        o, d = cam.ray(angles, (b.u, b.v), pose)
+        X = meet_plane(o, d, self.plane_point, self.pn)
+        if X is None:
+            return None
+        axis = math.nan
+        o2, d2 = cam.ray(angles, (b.u + math.cos(b.phi), b.v + math.sin(b.phi)), pose)
+        X2 = meet_plane(o2, d2, self.plane_point, self.pn)
+        if X2 is not None:
+            e = X2 - X
+            axis = math.atan2(float(e @ self.pv), float(e @ self.pu))
+        J = cam.jacobian(angles, X, pose)
+        dist = float(np.linalg.norm(X - o))
+        return (*X.tolist(), axis, dist, *J.ravel().tolist())
 
     def _vote(self, b) -> None:
         kind = shape_of(b, self.params)
