@@ -1,19 +1,12 @@
-"""The arm plant's once-a-step state arithmetic in Python floats: ``joint_state`` and
-``limit_flags`` the plants run are these ``*_reference`` functions, or the optional compiled
-``_arm_state`` (the same operations; a seeded test holds them equal to the bit) where it is
-built. ``_arm_state.palm_frame``'s Python is ``outcome.palm_frame_reference`` (the catch
-watch's)."""
+"""The arm plant's once-a-step state arithmetic in Python floats (``joint_state``,
+``limit_flags``: the PyBullet and MuJoCo arm plants run them)."""
 
 from __future__ import annotations
 
 import math
 
-from replay.accel import accelerator
 
-_ARM_STATE = accelerator("plants.bullet_arm._arm_state")
-
-
-def joint_state_reference(states: tuple, na: int, pick: tuple, locked: list) -> tuple:
+def joint_state(states: tuple, na: int, pick: tuple, locked: list) -> tuple:
     """((q, qd), (hand q, qd, applied torque)) from getJointStates' tuple ``states`` (the arm's
     ``na`` read joints, then the hand's): per arm joint ``pick`` gives its read joint, or -1
     for a locked joint (q ``locked[i]``, qd 0.0)."""
@@ -23,7 +16,7 @@ def joint_state_reference(states: tuple, na: int, pick: tuple, locked: list) -> 
     return (q, qd), (list(pos[na:]), list(vel[na:]), list(eff[na:]))
 
 
-def limit_flags_reference(q, qd, pos, v, vlim, lower, upper, over0, at0):
+def limit_flags(q, qd, pos, v, vlim, lower, upper, over0, at0):
     """None when the state is finite and no joint's flags changed since ``over0``, ``at0``;
     else (finite, over, at): over[i] |qd| > vlim, at[i] q <= lower or q >= upper (None, None
     when not finite). ``pos``, ``v``: the object's (None without one)."""
@@ -38,7 +31,3 @@ def limit_flags_reference(q, qd, pos, v, vlim, lower, upper, over0, at0):
     if over == over0 and at == at0:
         return None
     return (True, over, at)
-
-
-joint_state = _ARM_STATE.joint_state if _ARM_STATE is not None else joint_state_reference
-limit_flags = _ARM_STATE.limit_flags if _ARM_STATE is not None else limit_flags_reference

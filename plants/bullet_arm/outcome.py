@@ -26,8 +26,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.accel import accelerator
-
 
 @dataclass
 class PalmSample:
@@ -76,8 +74,7 @@ class CatchWatch:
         caught: bool,
     ) -> None:
         """One step: the object's and the palm's state (world) and the parts touching now.
-        The geometry: ``palm_frame_reference`` below (compiled ``_arm_state.palm_frame`` where
-        built)."""
+        The geometry: :func:`palm_frame`."""
         lx, ly, lz, speed, angle, d, dist2 = palm_frame(
             obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, self.palm_thickness
         )
@@ -152,13 +149,10 @@ def _first_part(parts: list) -> str:
     return "palm" if "palm" in parts else (parts[0] if parts else "arm")
 
 
-def palm_frame_reference(
-    obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, th: float
-) -> tuple:
+def palm_frame(obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, th: float) -> tuple:
     """(lx, ly, lz, speed, angle, d, |d|^2): the object centre from the palm face centre d
     (world) and in the palm frame, its speed relative to the palm point under it and that
-    velocity's angle (deg) from the palm's inward normal; in floats (3-vectors as tuples); the
-    optional compiled ``_arm_state.palm_frame`` repeats its operations."""
+    velocity's angle (deg) from the palm's inward normal; in floats (3-vectors as tuples)."""
     qx, qy, qz, qw = palm_quat  # the palm frame's z axis and in-plane axes (world)
     n = qx * qx + qy * qy + qz * qz + qw * qw
     k = 2.0 / n  # (quaternion_matrix's columns, normalised there too)
@@ -185,7 +179,3 @@ def palm_frame_reference(
     angle = math.degrees(math.acos(max(-1.0, min(1.0, inward / speed)))) if speed > 0 else 0.0
     dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
     return lx, ly, lz, speed, angle, d, dist2
-
-
-_ARM_STATE = accelerator("plants.bullet_arm._arm_state")
-palm_frame = _ARM_STATE.palm_frame if _ARM_STATE is not None else palm_frame_reference

@@ -30,7 +30,6 @@ from pathlib import Path
 
 import numpy as np
 
-from replay.accel import accelerator
 from replay.control.catching.estimator import BallisticEstimator
 from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
 from replay.control.catching.optimise import (
@@ -252,8 +251,7 @@ def _saturated(tau, limit) -> list[float]:
 
 
 def pd_reference(ff, kp, q_d, q, kd, qd_d, qd, limit) -> list[float]:
-    """tau = ff + Kp (q_d - q) + Kd (qd_d - qd), saturated (step 4 above); the
-    compiled ``_torque.pd`` repeats these operations where it is built."""
+    """tau = ff + Kp (q_d - q) + Kd (qd_d - qd), saturated (step 4 above)."""
     return _saturated(
         [
             f + p * (a - b) + d * (c - e)
@@ -261,10 +259,6 @@ def pd_reference(ff, kp, q_d, q, kd, qd_d, qd, limit) -> list[float]:
         ],
         limit,
     )
-
-
-_TORQUE = accelerator("replay.control.catching._torque")
-_pd = _TORQUE.pd if _TORQUE is not None else pd_reference
 
 
 @dataclass
@@ -555,7 +549,7 @@ class CatchingController(Controller):
             ff = self._zeros
         q, qd = self.q, self.qd
         if q is not None:
-            return _pd(ff, self._kp, self.q_d, q, self._kd, self.qd_d, qd, self._tau_limit)
+            return pd_reference(ff, self._kp, self.q_d, q, self._kd, self.qd_d, qd, self._tau_limit)
         if not self._warned_state:
             self._warned_state = True
             self._events.append(

@@ -19,9 +19,8 @@
   flange: the external wrench on the hand (N, N m).
 - No prediction of the object's motion: x^o is the latest measurement.
 - Per step: the chain and Jg (:meth:`ArmControlTask.kinematics`, NumPy), eq. 2's terms
-  (:func:`eq2_terms`) and F^a (:func:`wrench_reference`, floats); the optional compiled
-  ``_arm_kinematics.c`` repeats them where it is built, and :meth:`reference_command` is the
-  NumPy formula a seeded test holds the task's command to.
+  (:func:`eq2_terms`) and F^a (:func:`wrench_reference`, floats); :meth:`reference_command` is
+  eq. 2 written out in NumPy, the formula a seeded test holds the task's command to.
 """
 
 from __future__ import annotations
@@ -32,7 +31,6 @@ from typing import Any
 
 import numpy as np
 
-from replay.accel import accelerator
 from replay.control.grasping.payloads import ArmLoop
 from replay.interfaces import Controller
 from replay.messages import (
@@ -49,14 +47,12 @@ from replay.spatial import cross3, wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
 
-_ARM_KINEMATICS = accelerator("replay.control.grasping._arm_kinematics")
-
 
 def eq2_terms(Jg, J, n, lam2, b1, b2, qd, F, K_ap, K_av, K_af, vlim) -> tuple[list, ...]:
     """Eq. 2's joint-velocity terms (track, reach, damp, force, command): track = K_ap Jg+ b1,
     reach = K_ap Jg+ b2 with the damped pseudo-inverse Jg+ = Jg^T (Jg Jg^T + lam2 I)^-1 (b1 =
     S K^a1 e_track, b2 = (I - S) K^a2 e_reach), damp = -K_av qd, force = K_af J^T F; command =
-    their sum clipped to +-vlim (``_arm_kinematics.terms``' formula; ``n`` its joint count)."""
+    their sum clipped to +-vlim."""
     A = Jg @ Jg.T + lam2 * np.eye(6)
     y = np.linalg.solve(A, np.array([b1, b2], float).T)
     tr = K_ap * (Jg.T @ y)
@@ -71,7 +67,7 @@ def wrench_reference(R, force, torque, w_hand, com, bias, filtered, a, deadband)
     rotation, row-major 9 floats) minus the hand's weight ``w_hand`` acting at R com, ext = (R f
     - w, R m - (R com) x w); ``bias`` None: this ext is the tare (the filter restarts at 0);
     filtered += a ((ext - bias) - filtered); F = filtered, or 0 while its force is below the
-    deadband (``_arm_kinematics.wrench`` repeats these operations)."""
+    deadband."""
     r = [R[3 * i] * com[0] + R[3 * i + 1] * com[1] + R[3 * i + 2] * com[2] for i in range(3)]
     w = w_hand
     rxw = (r[1] * w[2] - r[2] * w[1], r[2] * w[0] - r[0] * w[2], r[0] * w[1] - r[1] * w[0])
@@ -88,10 +84,6 @@ def wrench_reference(R, force, torque, w_hand, com, bias, filtered, a, deadband)
     fl = [f + a * (e - b - f) for f, e, b in zip(filtered, ext, bias)]
     quiet = math.sqrt(fl[0] * fl[0] + fl[1] * fl[1] + fl[2] * fl[2]) < deadband
     return ext, fl, ([0.0] * 6 if quiet else list(fl))
-
-
-_terms = _ARM_KINEMATICS.terms if _ARM_KINEMATICS is not None else eq2_terms
-_wrench = _ARM_KINEMATICS.wrench if _ARM_KINEMATICS is not None else wrench_reference
 
 
 @dataclass
@@ -175,14 +167,8 @@ class ArmControlTask(Controller):
         self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
         self._M[:, 2, 3] = [r[2] for r in self.dh]
         self._M[:, 3, 3] = 1.0
-        # the compiled chain's constants (cos alpha, sin alpha, a, d, theta offset) per joint,
-        # its base and tool, the Jacobians it fills, and eq. 2's gains on the task vectors
+        # the Jacobians a step fills (tool, grasp point) and eq. 2's gains on the task vectors
         n = self._n = len(self.dh)
-        self._consts = np.ascontiguousarray(
-            np.column_stack([self._ca, self._sa, self._a, self._M[:, 2, 3], self._off])
-        )
-        self._base = np.ascontiguousarray(self.chain.base, float)
-        self._tool = np.ascontiguousarray(self.chain.tool, float)
         self._J, self._Jg = np.zeros((6, n)), np.zeros((6, n))
         self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
@@ -246,18 +232,7 @@ class ArmControlTask(Controller):
     def _chain(self, grasp_point: float) -> tuple[float, ...]:
         """(R row-major, p, grasp point g = p + grasp_point R[:, 2]) of the tool at ``self.q``;
         fills ``self._J`` (the tool's geometric Jacobian) and ``self._Jg`` (the grasp point's:
-        v_g = v + w x (g - p)). :meth:`kinematics`, or ``_arm_kinematics.chain`` where built."""
-        if _ARM_KINEMATICS is not None:
-            return _ARM_KINEMATICS.chain(
-                self.q,
-                self._n,
-                self._consts,
-                self._base,
-                self._tool,
-                grasp_point,
-                self._J,
-                self._Jg,
-            )
+        v_g = v + w x (g - p)), from :meth:`kinematics`."""
         T, J = self.kinematics(self.q)
         p, r = T[:3, 3], grasp_point * T[:3, 2]
         self._J[:] = J
@@ -293,7 +268,7 @@ class ArmControlTask(Controller):
         acc = self.hand_acceleration(R)
         m = self.hand.mass
         load = [m * (g - x) for g, x in zip(self._g, acc)]
-        ext, self.filtered, F = _wrench(
+        ext, self.filtered, F = wrench_reference(
             R,
             self.wrench_raw.force,
             self.wrench_raw.torque,
@@ -348,7 +323,7 @@ class ArmControlTask(Controller):
         ]
         self._hold_offsets(e_track, e_reach)
         F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
-        track, reach, damp, force, cmd = _terms(
+        track, reach, damp, force, cmd = eq2_terms(
             self._Jg,
             self._J,
             n,

@@ -24,7 +24,6 @@ from typing import Any
 
 import numpy as np
 
-from replay.accel import accelerator
 from replay.control.grasping.payloads import HandLoop
 from replay.interfaces import Controller, Occurrence
 from replay.messages import (
@@ -62,8 +61,7 @@ _CIRC_GRIP = [-0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, 0.20, 1.20, 0.90, 0.80,
 
 def eq4_reference(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax):
     """(theta_d^h, eq. 4's command clipped to +-vmax, max |theta_d^h - theta^h|) in floats, the
-    task's per-step path (``grip`` None: theta_d^h = ``pre``); the optional compiled
-    ``_hand_servo.eq4`` repeats its operations."""
+    task's per-step path (``grip`` None: theta_d^h = ``pre``)."""
     theta_d = list(pre) if grip is None else [p + c * (g - p) for p, g in zip(pre, grip)]
     cmd = [K_hg * (td - x) - K_hv * v + K_hf * f for td, x, v, f in zip(theta_d, q, qd, load)]
     cmd = [vmax if x > vmax else (-vmax if x < -vmax else x) for x in cmd]  # np.clip's
@@ -72,13 +70,8 @@ def eq4_reference(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax):
 
 def lowpass_reference(load, torque, a) -> list[float]:
     """F^h (minus the drive's torque) first-order low-passed with gain ``a``: x + a (-tau - x)
-    per joint (the optional compiled ``_hand_servo.lowpass`` repeats it)."""
+    per joint."""
     return [x + a * (-t - x) for x, t in zip(load, torque)]
-
-
-_HAND_SERVO = accelerator("replay.control.grasping._hand_servo")
-_eq4 = _HAND_SERVO.eq4 if _HAND_SERVO is not None else eq4_reference
-_lowpass = _HAND_SERVO.lowpass if _HAND_SERVO is not None else lowpass_reference
 
 
 @dataclass
@@ -218,7 +211,7 @@ class HandControlTask(Controller):
                 if self._tare is None:
                     self._tare = list(m.torque)
                 tau = [x - x0 for x, x0 in zip(m.torque, self._tare)]
-                self.load = _lowpass(self.load, tau, a)
+                self.load = lowpass_reference(self.load, tau, a)
             elif topic == TOPIC_GRASP_OBJECT:
                 self.shape = m.shape
                 if m.found and m.size and self.state is not None and self.state.phase == "track":
@@ -249,7 +242,7 @@ class HandControlTask(Controller):
         if grip is not None and self.width is not None:
             pre = self.aperture(pre, self.width)
         P = self.params
-        theta_d, cmd, deficit = _eq4(
+        theta_d, cmd, deficit = eq4_reference(
             pre, grip, c, self.q, self.qd, self.load, P.K_hg, P.K_hv, P.K_hf, self.vmax
         )
         if st.phase == "hold":

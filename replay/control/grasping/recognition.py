@@ -12,8 +12,7 @@ the image border) and then kept. The image Jacobian of the head (d xi / d(pan, t
 is that of the same model at the estimated point. Nothing here predicts motion.
 
 Per frame the task runs ``self_window``'s Self Windowing and ``features``' moments on the packed
-rows, and :class:`Camera`'s plane geometry; the optional compiled ``_chip_target.c`` repeats
-them where it is built.
+rows, and :class:`Camera`'s plane geometry.
 """
 
 from __future__ import annotations
@@ -23,8 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.accel import accelerator
-from replay.control.grasping.features import DIR_TABLE, Blob, blob_rows
+from replay.control.grasping.features import blob_rows
 from replay.control.grasping.payloads import GraspObject
 from replay.control.grasping.self_window import track_rows
 from replay.interfaces import Controller, Occurrence
@@ -33,8 +31,6 @@ from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import HeadSpec, camera_pose
 from replay.spatial import wrap_half_pi
-
-_CHIP_TARGET = accelerator("replay.control.grasping._chip_target")
 
 
 @dataclass
@@ -157,14 +153,6 @@ class RecognitionTask(Controller):
         self.pu, self.pv, self.pn = plane_basis(spec.plane.normal)
         self._head: dict[float, tuple[float, float]] = {}
         self._target: list[int] | None = None  # packed rows (self_window.track_rows)
-        self._c = (float(self.camera.c[0]), float(self.camera.c[1]))
-        self._plane_point = tuple(float(x) for x in self.plane_point)
-        self._pu, self._pv, self._pn = (
-            tuple(float(x) for x in self.pu),
-            tuple(float(x) for x in self.pv),
-            tuple(float(x) for x in self.pn),
-        )
-        self._head_position = tuple(float(x) for x in spec.head.position)
         self._had_target = False
         self._votes = {"rectangle": 0, "circle": 0}
         self.shape = "unknown"
@@ -199,14 +187,8 @@ class RecognitionTask(Controller):
         if angles is None:
             return None
         fill = self.shape == "unknown"
-        if _CHIP_TARGET is not None and chip.width <= 63 and len(chip.rows) <= 64:
-            target, reacquired, feats = _CHIP_TARGET.target_blob(  # track_rows and blob_rows
-                self._target, chip.rows, chip.width, fill, DIR_TABLE
-            )
-            b = None if feats is None else Blob(*feats)
-        else:
-            target, reacquired = track_rows(self._target, chip.rows, chip.width)
-            b = blob_rows(target, chip.width, fill=fill)
+        target, reacquired = track_rows(self._target, chip.rows, chip.width)
+        b = blob_rows(target, chip.width, fill=fill)
         self._target = target
         self.frames += 1
         window = int(chip.count) if reacquired else (b.area if b is not None else 0)
@@ -270,26 +252,8 @@ class RecognitionTask(Controller):
         distance, J00, J01, J10, J11): X where that ray meets the constraint plane, axis =
         atan2(e . pv, e . pu) of e = X' - X, X' that of (u + cos phi, v + sin phi) (NaN if it
         misses), distance = |X - o|, J = d (u, v) / d (pan, tilt) of X: Camera.ray, meet_plane
-        and Camera.jacobian (``_chip_target.plane_geometry`` where built)."""
+        and Camera.jacobian."""
         cam = self.camera
-        if _CHIP_TARGET is not None:
-            head = cam.head
-            return _CHIP_TARGET.plane_geometry(
-                head.yaw,
-                angles[0],
-                angles[1],
-                self._head_position,
-                head.camera_offset,
-                cam.f,
-                *self._c,
-                self._plane_point,
-                self._pn,
-                self._pu,
-                self._pv,
-                b.u,
-                b.v,
-                b.phi,
-            )
         pose = camera_pose(cam.head, *angles)
         o, d = cam.ray(angles, (b.u, b.v), pose)
         X = meet_plane(o, d, self.plane_point, self.pn)
