@@ -153,6 +153,13 @@ class RecognitionTask(Controller):
         self.pu, self.pv, self.pn = plane_basis(spec.plane.normal)
         self._head: dict[float, tuple[float, float]] = {}
         self._target: list[int] | None = None  # packed rows (self_window.track_rows)
+        # the same constants as floats for the per-frame plane geometry
+        self._c = (float(self.camera.c[0]), float(self.camera.c[1]))
+        self._head_position = tuple(float(x) for x in spec.head.position)
+        self._plane_point = tuple(float(x) for x in self.plane_point)
+        self._pu, self._pv, self._pn = (
+            tuple(float(x) for x in v) for v in (self.pu, self.pv, self.pn)
+        )
         self._had_target = False
         self._votes = {"rectangle": 0, "circle": 0}
         self.shape = "unknown"
@@ -251,23 +258,56 @@ class RecognitionTask(Controller):
         """None (the ray through the target's centre misses the plane) or (X0, X1, X2, axis,
         distance, J00, J01, J10, J11): X where that ray meets the constraint plane, axis =
         atan2(e . pv, e . pu) of e = X' - X, X' that of (u + cos phi, v + sin phi) (NaN if it
-        misses), distance = |X - o|, J = d (u, v) / d (pan, tilt) of X: Camera.ray, meet_plane
-        and Camera.jacobian."""
-        cam = self.camera
-        pose = camera_pose(cam.head, *angles)
-        o, d = cam.ray(angles, (b.u, b.v), pose)
-        X = meet_plane(o, d, self.plane_point, self.pn)
+        misses), distance = |X - o|, J = d (u, v) / d (pan, tilt) of X. In floats, per frame:
+        Camera.ray, meet_plane and Camera.jacobian (NumPy, the reference a test holds it to)
+        with camera_pose's R and o written out."""
+        cam, h = self.camera, self._head_position
+        f, (cx, cy) = cam.f, self._c
+        a = cam.head.yaw + angles[0]
+        ca, sa, ct, st = math.cos(a), math.sin(a), math.cos(angles[1]), math.sin(angles[1])
+        R = (sa, -st * ca, ca * ct, -ca, -st * sa, sa * ct, 0.0, -ct, -st)  # camera_pose's
+        k = cam.head.camera_offset
+        o = (h[0] + k * ca * ct, h[1] + k * sa * ct, h[2] - k * st)
+        (P0, P1, P2), n = self._plane_point, self._pn
+        po = (P0 - o[0]) * n[0] + (P1 - o[1]) * n[1] + (P2 - o[2]) * n[2]
+
+        def on_plane(x: float, y: float) -> tuple[float, float, float] | None:
+            x, y = (x - cx) / f, (y - cy) / f  # the ray R (x, y, 1) from o meets the plane
+            d0, d1, d2 = (
+                R[0] * x + R[1] * y + R[2],
+                R[3] * x + R[4] * y + R[5],
+                R[6] * x + R[7] * y + R[8],
+            )
+            denom = d0 * n[0] + d1 * n[1] + d2 * n[2]
+            if abs(denom) < 1e-12:
+                return None
+            s = po / denom
+            return (o[0] + s * d0, o[1] + s * d1, o[2] + s * d2) if s > 0.0 else None
+
+        X = on_plane(b.u, b.v)
         if X is None:
             return None
         axis = math.nan
-        o2, d2 = cam.ray(angles, (b.u + math.cos(b.phi), b.v + math.sin(b.phi)), pose)
-        X2 = meet_plane(o2, d2, self.plane_point, self.pn)
+        X2 = on_plane(b.u + math.cos(b.phi), b.v + math.sin(b.phi))
         if X2 is not None:
-            e = X2 - X
-            axis = math.atan2(float(e @ self.pv), float(e @ self.pu))
-        J = cam.jacobian(angles, X, pose)
-        dist = float(np.linalg.norm(X - o))
-        return (*X.tolist(), axis, dist, *J.ravel().tolist())
+            e0, e1, e2 = X2[0] - X[0], X2[1] - X[1], X2[2] - X[2]
+            pu, pv = self._pu, self._pv
+            axis = math.atan2(
+                e0 * pv[0] + e1 * pv[1] + e2 * pv[2], e0 * pu[0] + e1 * pu[1] + e2 * pu[2]
+            )
+        w0, w1, w2 = X[0] - o[0], X[1] - o[1], X[2] - o[2]
+        pc = [R[i] * w0 + R[3 + i] * w1 + R[6 + i] * w2 for i in range(3)]  # R^T (X - o)
+        r0, r1, r2 = X[0] - h[0], X[1] - h[1], X[2] - h[2]
+        z2 = pc[2] * pc[2]
+        J = []
+        for k0, k1, k2 in ((0.0, 0.0, 1.0), (-sa, ca, 0.0)):  # about z (pan), the tilt axis
+            kx = (k1 * r2 - k2 * r1, k2 * r0 - k0 * r2, k0 * r1 - k1 * r0)
+            d = [-(R[j] * kx[0] + R[3 + j] * kx[1] + R[6 + j] * kx[2]) for j in range(3)]
+            J.append(
+                (f * (d[0] * pc[2] - pc[0] * d[2]) / z2, f * (d[1] * pc[2] - pc[1] * d[2]) / z2)
+            )
+        dist = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        return (*X, axis, dist, J[0][0], J[1][0], J[0][1], J[1][1])
 
     def _vote(self, b) -> None:
         kind = shape_of(b, self.params)
