@@ -18,9 +18,10 @@
   mass and centre of mass, open posture) and the sensor's bias at start (tare), about the
   flange: the external wrench on the hand (N, N m).
 - No prediction of the object's motion: x^o is the latest measurement.
-- Per step: the chain and Jg (:meth:`ArmControlTask.kinematics`, NumPy), eq. 2's terms
-  (:func:`eq2_terms`) and F^a (:func:`wrench_reference`, floats); :meth:`reference_command` is
-  eq. 2 written out in NumPy, the formula a seeded test holds the task's command to.
+- Per step: the chain and Jg (:meth:`ArmControlTask._chain`, floats; :meth:`kinematics` is its
+  NumPy reference), eq. 2's terms (:func:`eq2_terms`) and F^a (:func:`wrench_reference`,
+  floats); :meth:`reference_command` is eq. 2 written out in NumPy, the formula a seeded test
+  holds the task's command to.
 """
 
 from __future__ import annotations
@@ -167,9 +168,18 @@ class ArmControlTask(Controller):
         self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
         self._M[:, 2, 3] = [r[2] for r in self.dh]
         self._M[:, 3, 3] = 1.0
-        # the Jacobians a step fills (tool, grasp point) and eq. 2's gains on the task vectors
+        # the same as floats for the per-step chain (cos alpha, sin alpha, a, d, theta offset
+        # per joint; base and tool as their top 3 rows), the Jacobians a step fills (tool, grasp
+        # point; J also as rows of floats) and eq. 2's gains on the task vectors
         n = self._n = len(self.dh)
+        self._dh_f = [
+            (float(ca), float(sa), float(a), float(d), float(off))
+            for ca, sa, a, d, off in zip(self._ca, self._sa, self._a, self._M[:, 2, 3], self._off)
+        ]
+        self._base_f = np.asarray(self.chain.base, float)[:3].ravel().tolist()
+        self._tool_f = np.asarray(self.chain.tool, float)[:3].ravel().tolist()
         self._J, self._Jg = np.zeros((6, n)), np.zeros((6, n))
+        self._J_rows: list[list[float]] = [[0.0] * n for _ in range(6)]
         self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
             raise ValueError("arm control needs a plant with a hand and a constraint plane")
@@ -231,21 +241,64 @@ class ArmControlTask(Controller):
 
     def _chain(self, grasp_point: float) -> tuple[float, ...]:
         """(R row-major, p, grasp point g = p + grasp_point R[:, 2]) of the tool at ``self.q``;
-        fills ``self._J`` (the tool's geometric Jacobian) and ``self._Jg`` (the grasp point's:
-        v_g = v + w x (g - p)), from :meth:`kinematics`."""
-        T, J = self.kinematics(self.q)
-        p, r = T[:3, 3], grasp_point * T[:3, 2]
-        self._J[:] = J
-        self._Jg[:] = J
-        self._Jg[:3] -= cross3(r[:, None], J[3:])
-        return (*T[:3, :3].ravel().tolist(), *p.tolist(), *(p + r).tolist())
+        sets ``self._J`` (the tool's geometric Jacobian, rows vx vy vz wx wy wz) and
+        ``self._Jg`` (the grasp point's: v_g = v + w x (g - p)). :meth:`kinematics` in floats
+        (3 x 4 rigid transforms as 12 floats; the reference a seeded test holds it to)."""
+        T = self._base_f
+        Z, O = [], []
+        for (ca, sa, a, d, off), q in zip(self._dh_f, self.q):
+            th = q + off
+            ct, st = math.cos(th), math.sin(th)
+            Z.append((T[2], T[6], T[10]))
+            O.append((T[3], T[7], T[11]))
+            m01, m02, m03 = -st * ca, st * sa, a * ct  # dh_transform's rows 0 and 1 (row 2:
+            m11, m12, m13 = ct * ca, -ct * sa, a * st  # 0, sa, ca, d)
+            T = [
+                x
+                for r in (0, 4, 8)
+                for x in (
+                    T[r] * ct + T[r + 1] * st,
+                    T[r] * m01 + T[r + 1] * m11 + T[r + 2] * sa,
+                    T[r] * m02 + T[r + 1] * m12 + T[r + 2] * ca,
+                    T[r] * m03 + T[r + 1] * m13 + T[r + 2] * d + T[r + 3],
+                )
+            ]
+        B = self._tool_f
+        T = [
+            T[r] * B[c] + T[r + 1] * B[4 + c] + T[r + 2] * B[8 + c] + (T[r + 3] if c == 3 else 0.0)
+            for r in (0, 4, 8)
+            for c in range(4)
+        ]
+        px, py, pz = T[3], T[7], T[11]
+        rx, ry, rz = grasp_point * T[2], grasp_point * T[6], grasp_point * T[10]  # g - p
+        vx, vy, vz = [], [], []
+        for (zx, zy, zz), (ox, oy, oz) in zip(Z, O):
+            dx, dy, dz = px - ox, py - oy, pz - oz
+            vx.append(zy * dz - zz * dy)
+            vy.append(zz * dx - zx * dz)
+            vz.append(zx * dy - zy * dx)
+        wx, wy, wz = (list(c) for c in zip(*Z))
+        self._J_rows = [vx, vy, vz, wx, wy, wz]
+        self._J = np.array(self._J_rows)
+        self._Jg = np.array(
+            [
+                [v - (ry * c - rz * b) for v, b, c in zip(vx, wy, wz)],
+                [v - (rz * a - rx * c) for v, a, c in zip(vy, wx, wz)],
+                [v - (rx * b - ry * a) for v, a, b in zip(vz, wx, wy)],
+                wx,
+                wy,
+                wz,
+            ]
+        )
+        R = (T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10])
+        return (*R, px, py, pz, px + rx, py + ry, pz + rz)
 
     def hand_acceleration(self, R) -> list[float]:
         """The hand's centre-of-mass acceleration (world, m/s^2) from the arm's kinematics:
         v_com = v_tool + w x (R com) with (v_tool, w) = J theta_dot (the tool Jacobian of this
         step's chain), differenced over the task's period."""
-        J, qd = self._J, self.qd
-        tw = [sum(J[i, j] * qd[j] for j in range(self._n)) for i in range(6)]
+        qd = self.qd
+        tw = [sum(a * b for a, b in zip(row, qd)) for row in self._J_rows]
         c = self._com
         r = [R[3 * i] * c[0] + R[3 * i + 1] * c[1] + R[3 * i + 2] * c[2] for i in range(3)]
         wx, wy, wz = tw[3], tw[4], tw[5]
