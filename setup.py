@@ -1,8 +1,8 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
-a few hot paths have optional C accelerators, one ``_name.c`` beside the Python module it speeds
+two hot paths have optional C accelerators, one ``_name.c`` beside the Python module it speeds
 (plain C over the buffer protocol, no NumPy headers, a ``.pyi`` stub, a test holding it to the
-Python path): ``ext_modules`` below. Each is optional: where it does not build (no C compiler,
+Python path): ``ext_modules`` below (the cameras' raster and the stick planners' sweep checks). Each is optional: where it does not build (no C compiler,
 ``CC=/bin/false``, a compiler that rejects it) the install goes on without it and the pure-Python
 path runs (replay.accel); docs/DESIGN.md, "Compiled code", says what each one gains."""
 
@@ -44,20 +44,9 @@ class OptionalBuildExt(build_ext):
             )
 
 
-# headers every module may include (replay/ is on the include path): floats between Python
-# sequences and C arrays
-SHARED = ["replay/_pyfloats.h"]
-
-
-def _ext(module: str, depends: tuple[str, ...] = ()) -> Extension:
+def _ext(module: str) -> Extension:
     """The extension ``module`` built from the one C file of that dotted path."""
-    return Extension(
-        module,
-        [module.replace(".", "/") + ".c"],
-        depends=[*depends, *SHARED],
-        include_dirs=["replay"],
-        optional=True,
-    )
+    return Extension(module, [module.replace(".", "/") + ".c"], optional=True)
 
 
 SHIPPED = {
@@ -73,13 +62,6 @@ setup(
     ext_modules=[
         _ext("replay.sensors._pixels"),
         _ext("replay.control.stick._sweep"),
-        _ext("replay.control.catching._mapping"),
-        _ext("replay.control.catching._ballistic"),
-        _ext("replay.control.catching._torque"),
-        _ext("replay.control.grasping._arm_kinematics"),
-        _ext("replay.control.grasping._chip_target"),
-        _ext("replay.control.grasping._hand_servo"),
-        _ext("plants.bullet_arm._arm_state"),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],

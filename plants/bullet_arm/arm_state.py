@@ -1,13 +1,12 @@
-"""The arm plant's once-a-step state arithmetic in Python: the references of the compiled
-``_arm_state`` functions the plant runs (a seeded test holds them equal to the bit).
-``_arm_state.palm_frame``'s reference is ``outcome.palm_frame_reference`` (the catch watch's)."""
+"""The arm plant's once-a-step state arithmetic in Python floats (``joint_state``,
+``limit_flags``: the PyBullet and MuJoCo arm plants run them)."""
 
 from __future__ import annotations
 
 import math
 
 
-def joint_state_reference(states: tuple, na: int, pick: tuple, locked: list) -> tuple:
+def joint_state(states: tuple, na: int, pick: tuple, locked: list) -> tuple:
     """((q, qd), (hand q, qd, applied torque)) from getJointStates' tuple ``states`` (the arm's
     ``na`` read joints, then the hand's): per arm joint ``pick`` gives its read joint, or -1
     for a locked joint (q ``locked[i]``, qd 0.0)."""
@@ -17,7 +16,7 @@ def joint_state_reference(states: tuple, na: int, pick: tuple, locked: list) -> 
     return (q, qd), (list(pos[na:]), list(vel[na:]), list(eff[na:]))
 
 
-def limit_flags_reference(q, qd, pos, v, vlim, lower, upper, over0, at0):
+def limit_flags(q, qd, pos, v, vlim, lower, upper, over0, at0):
     """None when the state is finite and no joint's flags changed since ``over0``, ``at0``;
     else (finite, over, at): over[i] |qd| > vlim, at[i] q <= lower or q >= upper (None, None
     when not finite). ``pos``, ``v``: the object's (None without one)."""

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from plants.bullet_arm.engine import pybullet as p
 
-from plants.bullet_arm._arm_state import joint_state
+from plants.bullet_arm.arm_state import joint_state
 from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.grasp_setup import head_setup, human_args, plane_setup
 from plants.bullet_arm.grasp_verdict import GraspVerdict

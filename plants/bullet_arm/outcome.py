@@ -26,8 +26,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from plants.bullet_arm._arm_state import palm_frame
-
 
 @dataclass
 class PalmSample:
@@ -76,7 +74,7 @@ class CatchWatch:
         caught: bool,
     ) -> None:
         """One step: the object's and the palm's state (world) and the parts touching now.
-        The geometry compiled (``palm_frame``; ``palm_frame_reference`` below is its Python)."""
+        The geometry: :func:`palm_frame`."""
         lx, ly, lz, speed, angle, d, dist2 = palm_frame(
             obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, self.palm_thickness
         )
@@ -151,13 +149,10 @@ def _first_part(parts: list) -> str:
     return "palm" if "palm" in parts else (parts[0] if parts else "arm")
 
 
-def palm_frame_reference(
-    obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, th: float
-) -> tuple:
+def palm_frame(obj_pos, obj_vel, palm_pos, palm_quat, palm_vel, palm_omega, th: float) -> tuple:
     """(lx, ly, lz, speed, angle, d, |d|^2): the object centre from the palm face centre d
     (world) and in the palm frame, its speed relative to the palm point under it and that
-    velocity's angle (deg) from the palm's inward normal; in floats (3-vectors as tuples), the
-    reference of the compiled ``_arm_state.palm_frame``."""
+    velocity's angle (deg) from the palm's inward normal; in floats (3-vectors as tuples)."""
     qx, qy, qz, qw = palm_quat  # the palm frame's z axis and in-plane axes (world)
     n = qx * qx + qy * qy + qz * qz + qw * qw
     k = 2.0 / n  # (quaternion_matrix's columns, normalised there too)

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from plants.bullet_arm._arm_state import joint_state, limit_flags
+from plants.bullet_arm.arm_state import joint_state, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
@@ -164,7 +164,7 @@ class BulletArmPlant(Plant):
         self._na = len(self._arm_j)
         self._all_active = len(self.active) == dof  # no locked joint: no index mapping
         self._q_locked_l = [float(self.locked.get(n, 0.0)) for n in names]
-        # per arm joint its read joint's index, -1 for a locked one (_arm_state.joint_state)
+        # per arm joint its read joint's index, -1 for a locked one (arm_state.joint_state)
         slot = {i: k for k, i in enumerate(self.active)}
         self._pick = tuple(slot.get(i, -1) for i in range(dof))
         # the tool frame and the palm: one getLinkStates a step (_frames_now)

@@ -20,7 +20,7 @@ from typing import cast
 import mujoco
 import numpy as np
 
-from plants.bullet_arm._arm_state import limit_flags
+from plants.bullet_arm.arm_state import limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts

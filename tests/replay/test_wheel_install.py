@@ -108,8 +108,8 @@ def test_a_user_scenario_builds_on_a_shipped_one(installed):
 
 def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_path):
     """``CC=/bin/false``: every accelerator fails to build and is left out (setup.py), the
-    wheel still builds, holds no compiled module, and the stick run works on the pure-Python
-    paths. (The catching and grasping runs still need modules outside issue #22's part.)"""
+    wheel still builds, holds no compiled module, and one short run of each paper, ``replay
+    claims`` and ``replay report`` work on the pure-Python paths."""
     import shutil
     import zipfile
 
@@ -138,13 +138,25 @@ def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_pa
     here = next(p for p in sys.path if p.endswith("site-packages"))
     (site / "deps.pth").write_text(here + "\n")
     _sh([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", site, wheel], work)
-    code = (
-        "import sys; from replay.entry import main; "
-        "sys.argv = ['replay', 'run', 'stick_3step', '--quiet', '--set', "
-        f"'timing.duration=0.3', '-o', {str(work / 'stick.mcap')!r}]; main()"
+
+    def replay(*args) -> str:
+        code = (
+            f"import sys; from replay.entry import main; sys.argv = {['replay', *args]!r}; main()"
+        )
+        return _sh([venv / "bin" / "python", "-c", code], cwd=work, env=env)
+
+    for name in ("stick_3step", "catch_optimised", "grasp_hexahedron"):
+        log = work / f"{name}.mcap"
+        out = replay("run", name, "--quiet", "--set", "timing.duration=0.3", "-o", str(log))
+        assert log.is_file() and "Traceback" not in out, out
+    out = replay("claims", *sorted(str(p) for p in work.glob("*.mcap")))
+    for title in ("Stick-shaped", "Direct Mapping", "High Speed Grasping"):  # all three tables
+        assert title in out, out[-2000:]
+    replay("report", "-o", str(work / "report"), "--logs", str(work))
+    assert "<img src=" in (work / "report" / "index.html").read_text(encoding="utf-8")
+    probe = (
+        "import replay.sensors.raster as r, replay.control.stick.sweep as s, replay.accel as a;"
+        " print(r._pixels, s._sweep, a.__file__)"
     )
-    _sh([venv / "bin" / "python", "-c", code], cwd=work, env=env)
-    assert (work / "stick.mcap").is_file()
-    probe = "import replay.sensors.raster as r, replay.accel as a; print(r._pixels, a.__file__)"
     out = _sh([venv / "bin" / "python", "-c", probe], cwd=work, env=env)
-    assert out.startswith("None") and str(site) in out
+    assert out.startswith("None None") and str(site) in out

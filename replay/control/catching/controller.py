@@ -30,7 +30,6 @@ from pathlib import Path
 
 import numpy as np
 
-from replay.control.catching import _torque
 from replay.control.catching.estimator import BallisticEstimator
 from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
 from replay.control.catching.optimise import (
@@ -252,7 +251,7 @@ def _saturated(tau, limit) -> list[float]:
 
 
 def pd_reference(ff, kp, q_d, q, kd, qd_d, qd, limit) -> list[float]:
-    """tau = ff + Kp (q_d - q) + Kd (qd_d - qd), saturated: the Python of ``_torque.pd``."""
+    """tau = ff + Kp (q_d - q) + Kd (qd_d - qd), saturated (step 4 above)."""
     return _saturated(
         [
             f + p * (a - b) + d * (c - e)
@@ -549,8 +548,8 @@ class CatchingController(Controller):
         else:
             ff = self._zeros
         q, qd = self.q, self.qd
-        if q is not None:  # compiled: pd_reference's operations
-            return _torque.pd(ff, self._kp, self.q_d, q, self._kd, self.qd_d, qd, self._tau_limit)
+        if q is not None:
+            return pd_reference(ff, self._kp, self.q_d, q, self._kd, self.qd_d, qd, self._tau_limit)
         if not self._warned_state:
             self._warned_state = True
             self._events.append(

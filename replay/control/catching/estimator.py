@@ -14,8 +14,6 @@ from collections import deque
 
 import numpy as np
 
-from replay.control.catching import _ballistic
-
 
 class BallisticEstimator:
     """The fit is solved from running sums (the 2 x 2 normal equations per axis) kept as
@@ -185,19 +183,9 @@ class BallisticEstimator:
         )
 
     def time_to_radius(self, t: float, origin, radius: float):
-        """Absolute time at which the arc first reaches |r - origin| = radius (None if never):
-        compiled (``_ballistic.time_to_radius``), :meth:`time_to_radius_reference` where
-        Newton's method cannot decide (the same value, to the bit, where it can)."""
-        f = self.fit_f()
-        if f is None or f[2] is None:
-            return None
-        tc = _ballistic.time_to_radius(t, f[0], f[1], f[2], self._g, origin, radius)
-        return tc if tc is not None else self.time_to_radius_reference(t, origin, radius)
-
-    def time_to_radius_reference(self, t: float, origin, radius: float):
-        """:meth:`time_to_radius` in Python floats (the compiled path's reference): the quartic's
-        first root by Newton's method where it provably finds it, else by the eigenvalues of its
-        companion matrix."""
+        """Absolute time at which the arc first reaches |r - origin| = radius (None if never),
+        in Python floats: the quartic's first root by Newton's method where it provably finds
+        it, else by the eigenvalues of its companion matrix."""
         st = self.state_f(t, from_fit=True)
         if st is None or self.n < 2:
             return None

@@ -1,7 +1,7 @@
 """The direct mapping q_d = f(r_o) = g o l_c^-1(r_o) of Namiki & Ishikawa (eqs. 6-8, 12-14, 16, 23).
 
 NumPy, batched: every function takes arrays with a leading sample axis ``(n, ...)``; the
-controller's one-sample path (``*_one``) is in Python floats, compiled in ``_mapping.c``.
+controller's one-sample path (``*_one``) is in Python floats.
 
 Coordinates. The arm has four joints; the paper uses axes 1, 2 and 4 and holds axis 3 at 0
 (Sec. IV-A). The mapping works in the *active* coordinates ``p = (q1, q2, q4)`` (m_q = 3); the
@@ -34,7 +34,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.catching import _mapping
 
 ACTIVE = (0, 1, 3)  # active joints of the 4-DOF arm (axes 1, 2, 4); axis 3 held at 0
 
@@ -99,18 +98,6 @@ class CatchGeometry:
         # the same constants as 3-tuples of floats for the one-sample path (*_one)
         self._f = tuple(tuple(x.tolist()) for x in (self.origin, self.w1, self.w2, self.c, self.t))
         self._x = _cross3(self._f[1], self._f[2])
-        # all of them, with q_alpha and p_ref, as the compiled path's float64 buffer (_mapping.c)
-        self._c = np.array(
-            [
-                *(x for v in self._f for x in v),
-                *self._x,
-                self._a,
-                self._b,
-                self._sigma,
-                self.q_alpha,
-                *self.p_ref.tolist(),
-            ]
-        )
 
     @classmethod
     def from_fk(cls, fk, q_alpha: float, p_ref=(0.0, math.pi / 4), check: bool = True):
@@ -385,7 +372,6 @@ class PolynomialB:
         self.n_mono = len(exps)
         self.n_alpha = self.n_mono * n_joints
         self._powers_t = tuple(tuple(int(e) for e in row) for row in self.powers)
-        self._powers_c = np.ascontiguousarray(self.powers, dtype=np.int32)
         self._top = int(self.powers.max())
 
     def _vars(self, p):
@@ -533,26 +519,17 @@ class DirectMapping:
 
     def evaluate_one(self, r, rd, rdd):
         """:meth:`evaluate` of one object state (r_o, r_o', r_o'' each (3,)): (q_d, qd_d,
-        qdd_d, q_o, in_domain), arrays (3,) but in_domain. Compiled (``_mapping.c``:
-        :meth:`evaluate_one_floats`' operations in the same order); tests hold the two and the
-        batched :meth:`evaluate` together."""
+        qdd_d, q_o, in_domain), arrays (3,) but in_domain (a test holds it to the batched
+        :meth:`evaluate`)."""
         q, qd, qdd, p, ok = self.evaluate_one_tuple(r, rd, rdd)
         return np.array(q), np.array(qd), np.array(qdd), np.array(p), ok
 
     def evaluate_one_tuple(self, r, rd, rdd) -> tuple[tuple, tuple, tuple, tuple, bool]:
-        """:meth:`evaluate_one` with 3-tuples of floats (the controller's per-step path: ~1 us,
-        ~60x less than :meth:`evaluate_one_floats`)."""
+        """:meth:`evaluate_one` with 3-tuples of floats, in Python floats (the controller's
+        per-step path): the closed-form inverse, J_c^-1 r_o' and J_c^-1 (r_o'' - H(r_o', r_o'))
+        by Cramer's rule, then b(q) and its derivatives (eq. 12) from the monomials."""
         if self.poly.m != 3 or self.poly.i != 2:
             raise ValueError("evaluate_one is written for 3 active joints, the last selected")
-        try:
-            return _mapping.evaluate_one(self.geo._c, self.poly._powers_c, self._A, r, rd, rdd)
-        except ValueError as exc:
-            if str(exc) == "Singular matrix":  # as np.linalg.solve
-                raise np.linalg.LinAlgError("Singular matrix") from None
-            raise
-
-    def evaluate_one_floats(self, r, rd, rdd):
-        """:meth:`evaluate_one` in Python floats (the compiled path's reference)."""
         r, rd, rdd = [float(x) for x in r], [float(x) for x in rd], [float(x) for x in rdd]
         p, ok = self.geo.inverse_one(r)
         J, H, _ = self.geo.derivatives_one(p)
@@ -568,7 +545,8 @@ class DirectMapping:
             ],
         )
         out = np.array((p, pd, pdd)) + np.array(self.poly.coefficients_one(p, pd, pdd)) @ self._A
-        return out[0], out[1], out[2], np.array(p), ok
+        q, qd, qdd = out.tolist()
+        return tuple(q), tuple(qd), tuple(qdd), tuple(p), ok
 
     def __call__(self, r) -> np.ndarray:
         """q_d = f(r_o) (active joints)."""

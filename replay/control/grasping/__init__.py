@@ -1,6 +1,5 @@
 """High-speed grasping with visual and force feedback (Namiki, Nakabo, Ishii & Ishikawa 1999):
-the loops of Fig. 4 as separate 1 ms tasks, simulator-free (floats, with small compiled per-step
-kernels: ``_arm_kinematics``, ``_chip_target``, ``_hand_servo``; NumPy references beside them).
+the loops of Fig. 4 as separate 1 ms tasks, simulator-free (floats and NumPy).
 
 - ``recognition`` (Sec. 4.1.1): Self Windowing, moments, x^o on the constraint plane, shape;
 - ``head_tracking`` (eq. 1), ``arm_control`` (eqs. 2-3), ``hand_control`` (eq. 4, preshaping);

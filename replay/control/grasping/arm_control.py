@@ -18,9 +18,10 @@
   mass and centre of mass, open posture) and the sensor's bias at start (tare), about the
   flange: the external wrench on the hand (N, N m).
 - No prediction of the object's motion: x^o is the latest measurement.
-- Per step in floats: the chain, Jg, eq. 2's terms and F^a are one compiled module
-  (``_arm_kinematics.c``); :meth:`ArmControlTask.kinematics` and :meth:`reference_command` are
-  the NumPy reference a seeded test holds it to.
+- Per step: the chain and Jg (:meth:`ArmControlTask._chain`, floats; :meth:`kinematics` is its
+  NumPy reference), eq. 2's terms (:func:`eq2_terms`) and F^a (:func:`wrench_reference`,
+  floats); :meth:`reference_command` is eq. 2 written out in NumPy, the formula a seeded test
+  holds the task's command to.
 """
 
 from __future__ import annotations
@@ -31,7 +32,6 @@ from typing import Any
 
 import numpy as np
 
-from replay.control.grasping import _arm_kinematics
 from replay.control.grasping.payloads import ArmLoop
 from replay.interfaces import Controller
 from replay.messages import (
@@ -47,6 +47,44 @@ from replay.robot.hand import hand_body
 from replay.spatial import cross3, wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
+
+
+def eq2_terms(Jg, J, n, lam2, b1, b2, qd, F, K_ap, K_av, K_af, vlim) -> tuple[list, ...]:
+    """Eq. 2's joint-velocity terms (track, reach, damp, force, command): track = K_ap Jg+ b1,
+    reach = K_ap Jg+ b2 with the damped pseudo-inverse Jg+ = Jg^T (Jg Jg^T + lam2 I)^-1 (b1 =
+    S K^a1 e_track, b2 = (I - S) K^a2 e_reach), damp = -K_av qd, force = K_af J^T F; command =
+    their sum clipped to +-vlim."""
+    A = Jg @ Jg.T + lam2 * np.eye(6)
+    y = np.linalg.solve(A, np.array([b1, b2], float).T)
+    tr = K_ap * (Jg.T @ y)
+    damp = -K_av * np.asarray(qd, float)
+    force = K_af * (J.T @ np.asarray(F, float))
+    cmd = np.clip(tr[:, 0] + tr[:, 1] + damp + force, -np.asarray(vlim), np.asarray(vlim))
+    return tr[:, 0].tolist(), tr[:, 1].tolist(), damp.tolist(), force.tolist(), cmd.tolist()
+
+
+def wrench_reference(R, force, torque, w_hand, com, bias, filtered, a, deadband):
+    """(ext, filtered, F): the wrist sensor's wrench turned into the world (R: the tool's
+    rotation, row-major 9 floats) minus the hand's weight ``w_hand`` acting at R com, ext = (R f
+    - w, R m - (R com) x w); ``bias`` None: this ext is the tare (the filter restarts at 0);
+    filtered += a ((ext - bias) - filtered); F = filtered, or 0 while its force is below the
+    deadband."""
+    r = [R[3 * i] * com[0] + R[3 * i + 1] * com[1] + R[3 * i + 2] * com[2] for i in range(3)]
+    w = w_hand
+    rxw = (r[1] * w[2] - r[2] * w[1], r[2] * w[0] - r[0] * w[2], r[0] * w[1] - r[1] * w[0])
+    ext = [
+        R[3 * i] * force[0] + R[3 * i + 1] * force[1] + R[3 * i + 2] * force[2] - w[i]
+        for i in range(3)
+    ]
+    ext += [
+        R[3 * i] * torque[0] + R[3 * i + 1] * torque[1] + R[3 * i + 2] * torque[2] - rxw[i]
+        for i in range(3)
+    ]
+    if bias is None:
+        bias, filtered = ext, [0.0] * 6
+    fl = [f + a * (e - b - f) for f, e, b in zip(filtered, ext, bias)]
+    quiet = math.sqrt(fl[0] * fl[0] + fl[1] * fl[1] + fl[2] * fl[2]) < deadband
+    return ext, fl, ([0.0] * 6 if quiet else list(fl))
 
 
 @dataclass
@@ -139,15 +177,18 @@ class ArmControlTask(Controller):
         self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
         self._M[:, 2, 3] = [r[2] for r in self.dh]
         self._M[:, 3, 3] = 1.0
-        # the compiled chain's constants (cos alpha, sin alpha, a, d, theta offset) per joint,
-        # its base and tool, the Jacobians it fills, and eq. 2's gains on the task vectors
+        # the same as floats for the per-step chain (cos alpha, sin alpha, a, d, theta offset
+        # per joint; base and tool as their top 3 rows), the Jacobians a step fills (tool, grasp
+        # point; J also as rows of floats) and eq. 2's gains on the task vectors
         n = self._n = len(self.dh)
-        self._consts = np.ascontiguousarray(
-            np.column_stack([self._ca, self._sa, self._a, self._M[:, 2, 3], self._off])
-        )
-        self._base = np.ascontiguousarray(self.chain.base, float)
-        self._tool = np.ascontiguousarray(self.chain.tool, float)
+        self._dh_f = [
+            (float(ca), float(sa), float(a), float(d), float(off))
+            for ca, sa, a, d, off in zip(self._ca, self._sa, self._a, self._M[:, 2, 3], self._off)
+        ]
+        self._base_f = np.asarray(self.chain.base, float)[:3].ravel().tolist()
+        self._tool_f = np.asarray(self.chain.tool, float)[:3].ravel().tolist()
         self._J, self._Jg = np.zeros((6, n)), np.zeros((6, n))
+        self._J_rows: list[list[float]] = [[0.0] * n for _ in range(6)]
         self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
             raise ValueError("arm control needs a plant with a hand and a constraint plane")
@@ -208,12 +249,66 @@ class ArmControlTask(Controller):
         J = np.vstack([cross3(Z, p[:, None] - O), Z])
         return T, J
 
+    def _chain(self, grasp_point: float) -> tuple[float, ...]:
+        """(R row-major, p, grasp point g = p + grasp_point R[:, 2]) of the tool at ``self.q``;
+        sets ``self._J`` (the tool's geometric Jacobian, rows vx vy vz wx wy wz) and
+        ``self._Jg`` (the grasp point's: v_g = v + w x (g - p)). :meth:`kinematics` in floats
+        (3 x 4 rigid transforms as 12 floats; the reference a seeded test holds it to)."""
+        T = self._base_f
+        Z, O = [], []
+        for (ca, sa, a, d, off), q in zip(self._dh_f, self.q):
+            th = q + off
+            ct, st = math.cos(th), math.sin(th)
+            Z.append((T[2], T[6], T[10]))
+            O.append((T[3], T[7], T[11]))
+            m01, m02, m03 = -st * ca, st * sa, a * ct  # dh_transform's rows 0 and 1 (row 2:
+            m11, m12, m13 = ct * ca, -ct * sa, a * st  # 0, sa, ca, d)
+            T = [
+                x
+                for r in (0, 4, 8)
+                for x in (
+                    T[r] * ct + T[r + 1] * st,
+                    T[r] * m01 + T[r + 1] * m11 + T[r + 2] * sa,
+                    T[r] * m02 + T[r + 1] * m12 + T[r + 2] * ca,
+                    T[r] * m03 + T[r + 1] * m13 + T[r + 2] * d + T[r + 3],
+                )
+            ]
+        B = self._tool_f
+        T = [
+            T[r] * B[c] + T[r + 1] * B[4 + c] + T[r + 2] * B[8 + c] + (T[r + 3] if c == 3 else 0.0)
+            for r in (0, 4, 8)
+            for c in range(4)
+        ]
+        px, py, pz = T[3], T[7], T[11]
+        rx, ry, rz = grasp_point * T[2], grasp_point * T[6], grasp_point * T[10]  # g - p
+        vx, vy, vz = [], [], []
+        for (zx, zy, zz), (ox, oy, oz) in zip(Z, O):
+            dx, dy, dz = px - ox, py - oy, pz - oz
+            vx.append(zy * dz - zz * dy)
+            vy.append(zz * dx - zx * dz)
+            vz.append(zx * dy - zy * dx)
+        wx, wy, wz = (list(c) for c in zip(*Z))
+        self._J_rows = [vx, vy, vz, wx, wy, wz]
+        self._J = np.array(self._J_rows)
+        self._Jg = np.array(
+            [
+                [v - (ry * c - rz * b) for v, b, c in zip(vx, wy, wz)],
+                [v - (rz * a - rx * c) for v, a, c in zip(vy, wx, wz)],
+                [v - (rx * b - ry * a) for v, a, b in zip(vz, wx, wy)],
+                wx,
+                wy,
+                wz,
+            ]
+        )
+        R = (T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10])
+        return (*R, px, py, pz, px + rx, py + ry, pz + rz)
+
     def hand_acceleration(self, R) -> list[float]:
         """The hand's centre-of-mass acceleration (world, m/s^2) from the arm's kinematics:
         v_com = v_tool + w x (R com) with (v_tool, w) = J theta_dot (the tool Jacobian of this
         step's chain), differenced over the task's period."""
-        J, qd = self._J, self.qd
-        tw = [sum(J[i, j] * qd[j] for j in range(self._n)) for i in range(6)]
+        qd = self.qd
+        tw = [sum(a * b for a, b in zip(row, qd)) for row in self._J_rows]
         c = self._com
         r = [R[3 * i] * c[0] + R[3 * i + 1] * c[1] + R[3 * i + 2] * c[2] for i in range(3)]
         wx, wy, wz = tw[3], tw[4], tw[5]
@@ -236,7 +331,7 @@ class ArmControlTask(Controller):
         acc = self.hand_acceleration(R)
         m = self.hand.mass
         load = [m * (g - x) for g, x in zip(self._g, acc)]
-        ext, self.filtered, F = _arm_kinematics.wrench(
+        ext, self.filtered, F = wrench_reference(
             R,
             self.wrench_raw.force,
             self.wrench_raw.torque,
@@ -267,9 +362,7 @@ class ArmControlTask(Controller):
             return None
         P, n = self.params, self._n
         # tool pose, grasp point x^a, J (tool) and Jg (grasp point: v_gp = v_tool + w x (gp - p))
-        k = _arm_kinematics.chain(
-            self.q, n, self._consts, self._base, self._tool, P.grasp_point, self._J, self._Jg
-        )
+        k = self._chain(P.grasp_point)
         R = k[:9]
         gp = k[12:15]
         n_palm, row = (R[2], R[5], R[8]), (R[1], R[4], R[7])
@@ -293,7 +386,7 @@ class ArmControlTask(Controller):
         ]
         self._hold_offsets(e_track, e_reach)
         F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
-        track, reach, damp, force, cmd = _arm_kinematics.terms(
+        track, reach, damp, force, cmd = eq2_terms(
             self._Jg,
             self._J,
             n,

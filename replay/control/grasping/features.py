@@ -14,8 +14,8 @@ give the centre xi and rotation phi; its extents and fill the object's size and 
 pixel (u, v)) in one pass over the rows: each row's pixel count, sum of u and of u^2 from a
 table, so the moments are exact integer sums; the extremes of a linear function over a row's
 pixels are at its first and last pixel, so the extents and bounding boxes need only those two.
-:func:`blob` (arrays) is its reference; the recognition task runs both steps compiled
-(``_chip_target.target_blob``, held equal to :func:`blob_rows` and ``track_rows`` by a test).
+:func:`blob` (arrays) is its reference (a test holds them equal); the recognition task runs
+:func:`blob_rows`.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ _NORMALS = np.stack([-np.sin(_ANGLES), np.cos(_ANGLES)])
 _PIXEL_EXTENT = np.abs(_DIRS).sum(axis=0)
 
 
-class Blob(NamedTuple):  # a named tuple: built once a frame from the compiled pass's tuple
+class Blob(NamedTuple):
     area: int
     u: float
     v: float
@@ -89,8 +89,6 @@ def blob(target: np.ndarray, fill: bool = True) -> Blob | None:
 _ROW_TABLE_MAX = 16  # px: the widest row the per-row tables cover (2^16 entries)
 _ROW_TABLES: dict[int, tuple[list[int], list[int], list[int]]] = {}
 _DIR_PAIRS = list(zip(_DIRS[0].tolist(), _DIRS[1].tolist(), _PIXEL_EXTENT.tolist()))
-# the same as float64 triples (cos, sin, pixel extent), for the compiled pass (_chip_target.c)
-DIR_TABLE = np.ascontiguousarray(np.column_stack([_DIRS[0], _DIRS[1], _PIXEL_EXTENT]))
 
 
 def _row_tables(width: int) -> tuple[list[int], list[int], list[int]]:

@@ -11,9 +11,8 @@ pixel extents at that depth give the size; the fill of the smallest bounding box
 the image border) and then kept. The image Jacobian of the head (d xi / d(pan, tilt), for eq. 1)
 is that of the same model at the estimated point. Nothing here predicts motion.
 
-Per frame the task runs compiled kernels (``_chip_target.c``: Self Windowing and the moments on
-the packed rows, the plane geometry); ``self_window``, ``features`` and :class:`Camera` are their
-references.
+Per frame the task runs ``self_window``'s Self Windowing and ``features``' moments on the packed
+rows, and :class:`Camera`'s plane geometry.
 """
 
 from __future__ import annotations
@@ -23,8 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.grasping import _chip_target
-from replay.control.grasping.features import DIR_TABLE, Blob, blob_rows
+from replay.control.grasping.features import blob_rows
 from replay.control.grasping.payloads import GraspObject
 from replay.control.grasping.self_window import track_rows
 from replay.interfaces import Controller, Occurrence
@@ -155,14 +153,13 @@ class RecognitionTask(Controller):
         self.pu, self.pv, self.pn = plane_basis(spec.plane.normal)
         self._head: dict[float, tuple[float, float]] = {}
         self._target: list[int] | None = None  # packed rows (self_window.track_rows)
+        # the same constants as floats for the per-frame plane geometry
         self._c = (float(self.camera.c[0]), float(self.camera.c[1]))
+        self._head_position = tuple(float(x) for x in spec.head.position)
         self._plane_point = tuple(float(x) for x in self.plane_point)
         self._pu, self._pv, self._pn = (
-            tuple(float(x) for x in self.pu),
-            tuple(float(x) for x in self.pv),
-            tuple(float(x) for x in self.pn),
+            tuple(float(x) for x in v) for v in (self.pu, self.pv, self.pn)
         )
-        self._head_position = tuple(float(x) for x in spec.head.position)
         self._had_target = False
         self._votes = {"rectangle": 0, "circle": 0}
         self.shape = "unknown"
@@ -197,14 +194,8 @@ class RecognitionTask(Controller):
         if angles is None:
             return None
         fill = self.shape == "unknown"
-        if chip.width <= 63 and len(chip.rows) <= 64:  # track_rows and blob_rows, compiled
-            target, reacquired, feats = _chip_target.target_blob(
-                self._target, chip.rows, chip.width, fill, DIR_TABLE
-            )
-            b = None if feats is None else Blob(*feats)
-        else:
-            target, reacquired = track_rows(self._target, chip.rows, chip.width)
-            b = blob_rows(target, chip.width, fill=fill)
+        target, reacquired = track_rows(self._target, chip.rows, chip.width)
+        b = blob_rows(target, chip.width, fill=fill)
         self._target = target
         self.frames += 1
         window = int(chip.count) if reacquired else (b.area if b is not None else 0)
@@ -234,24 +225,8 @@ class RecognitionTask(Controller):
             self._events.append(Occurrence("reacquired", {"t_image": chip.t, "area": b.area}))
         self._had_target = True
         # x_o on the constraint plane, the target's axis there and the image Jacobian, from the
-        # camera pose at capture (Camera.ray / meet_plane / Camera.jacobian, compiled)
-        head = self.camera.head
-        g = _chip_target.plane_geometry(
-            head.yaw,
-            angles[0],
-            angles[1],
-            self._head_position,
-            head.camera_offset,
-            self.camera.f,
-            *self._c,
-            self._plane_point,
-            self._pn,
-            self._pu,
-            self._pv,
-            b.u,
-            b.v,
-            b.phi,
-        )
+        # camera pose at capture
+        g = self._plane_geometry(angles, b)
         if g is None:
             return None
         X0, X1, X2, axis, dist, J00, J01, J10, J11 = g
@@ -278,6 +253,61 @@ class RecognitionTask(Controller):
             [[J00, J01], [J10, J11]],
             list(angles),
         )
+
+    def _plane_geometry(self, angles, b) -> tuple[float, ...] | None:
+        """None (the ray through the target's centre misses the plane) or (X0, X1, X2, axis,
+        distance, J00, J01, J10, J11): X where that ray meets the constraint plane, axis =
+        atan2(e . pv, e . pu) of e = X' - X, X' that of (u + cos phi, v + sin phi) (NaN if it
+        misses), distance = |X - o|, J = d (u, v) / d (pan, tilt) of X. In floats, per frame:
+        Camera.ray, meet_plane and Camera.jacobian (NumPy, the reference a test holds it to)
+        with camera_pose's R and o written out."""
+        cam, h = self.camera, self._head_position
+        f, (cx, cy) = cam.f, self._c
+        a = cam.head.yaw + angles[0]
+        ca, sa, ct, st = math.cos(a), math.sin(a), math.cos(angles[1]), math.sin(angles[1])
+        R = (sa, -st * ca, ca * ct, -ca, -st * sa, sa * ct, 0.0, -ct, -st)  # camera_pose's
+        k = cam.head.camera_offset
+        o = (h[0] + k * ca * ct, h[1] + k * sa * ct, h[2] - k * st)
+        (P0, P1, P2), n = self._plane_point, self._pn
+        po = (P0 - o[0]) * n[0] + (P1 - o[1]) * n[1] + (P2 - o[2]) * n[2]
+
+        def on_plane(x: float, y: float) -> tuple[float, float, float] | None:
+            x, y = (x - cx) / f, (y - cy) / f  # the ray R (x, y, 1) from o meets the plane
+            d0, d1, d2 = (
+                R[0] * x + R[1] * y + R[2],
+                R[3] * x + R[4] * y + R[5],
+                R[6] * x + R[7] * y + R[8],
+            )
+            denom = d0 * n[0] + d1 * n[1] + d2 * n[2]
+            if abs(denom) < 1e-12:
+                return None
+            s = po / denom
+            return (o[0] + s * d0, o[1] + s * d1, o[2] + s * d2) if s > 0.0 else None
+
+        X = on_plane(b.u, b.v)
+        if X is None:
+            return None
+        axis = math.nan
+        X2 = on_plane(b.u + math.cos(b.phi), b.v + math.sin(b.phi))
+        if X2 is not None:
+            e0, e1, e2 = X2[0] - X[0], X2[1] - X[1], X2[2] - X[2]
+            pu, pv = self._pu, self._pv
+            axis = math.atan2(
+                e0 * pv[0] + e1 * pv[1] + e2 * pv[2], e0 * pu[0] + e1 * pu[1] + e2 * pu[2]
+            )
+        w0, w1, w2 = X[0] - o[0], X[1] - o[1], X[2] - o[2]
+        pc = [R[i] * w0 + R[3 + i] * w1 + R[6 + i] * w2 for i in range(3)]  # R^T (X - o)
+        r0, r1, r2 = X[0] - h[0], X[1] - h[1], X[2] - h[2]
+        z2 = pc[2] * pc[2]
+        J = []
+        for k0, k1, k2 in ((0.0, 0.0, 1.0), (-sa, ca, 0.0)):  # about z (pan), the tilt axis
+            kx = (k1 * r2 - k2 * r1, k2 * r0 - k0 * r2, k0 * r1 - k1 * r0)
+            d = [-(R[j] * kx[0] + R[3 + j] * kx[1] + R[6 + j] * kx[2]) for j in range(3)]
+            J.append(
+                (f * (d[0] * pc[2] - pc[0] * d[2]) / z2, f * (d[1] * pc[2] - pc[1] * d[2]) / z2)
+            )
+        dist = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        return (*X, axis, dist, J[0][0], J[1][0], J[0][1], J[1][1])
 
     def _vote(self, b) -> None:
         kind = shape_of(b, self.params)

@@ -184,39 +184,6 @@ def test_packed_rows_self_windowing_and_features_equal_the_array_versions():
     assert ok == len(cases)
 
 
-def test_compiled_target_pass_equals_the_packed_row_functions():
-    """``_chip_target.target_blob`` (the recognition task's compiled per-frame pass) against
-    ``track_rows`` and ``blob_rows`` over seeded random images and previous targets (also none,
-    and empty ones): the same target rows and reacquired flag, features within 1e-12."""
-    from replay.control.grasping import _chip_target
-    from replay.control.grasping.features import DIR_TABLE
-
-    rng = np.random.default_rng(13)
-    cases = random_blobs(rng, 300) + random_blobs(rng, 30, w=9, h=12)
-    ok = 0
-    for i, (img, prev) in enumerate(cases):
-        h, w = img.shape
-        rows = pack_rows(img)
-        prev_rows = None if i % 7 == 0 else [0] * h if i % 7 == 1 else pack_rows(prev)
-        for fill in (True, False):
-            target, again, feats = _chip_target.target_blob(prev_rows, rows, w, fill, DIR_TABLE)
-            ref_target, ref_again = track_rows(prev_rows, rows, w)
-            ref = blob_rows(ref_target, w, fill=fill)
-            good = target == ref_target and again == ref_again
-            if ref is None or feats is None:
-                good &= ref is None and feats is None
-            else:
-                a = [ref.area, ref.u, ref.v, ref.phi, ref.elongation, ref.length, ref.width]
-                good &= feats[8] == ref.touches_border and feats[0] == ref.area
-                good &= bool(np.allclose(feats[:7], a, rtol=0.0, atol=1e-12))
-                good &= (math.isnan(feats[7]) and math.isnan(ref.fill)) or abs(
-                    feats[7] - ref.fill
-                ) < 1e-12
-            ok += bool(good)
-    print(f"compiled chip pass: {ok}/{2 * len(cases)} random cases equal the Python one")
-    assert ok == 2 * len(cases)
-
-
 def test_moments_give_centre_and_rotation():
     img = np.zeros((16, 16), bool)
     img[5:8, 3:11] = True  # 8 x 3, along u
@@ -302,7 +269,7 @@ def test_position_on_the_constraint_plane_from_one_chip_image(spec):
 
 
 def test_recognised_pose_and_jacobian_equal_the_numpy_camera_over_random_views(spec):
-    """The task's x_o, roll, size and image Jacobian (its compiled plane geometry) against the
+    """The task's x_o, roll, size and image Jacobian (its plane geometry) against the
     NumPy ``Camera`` (ray, meet_plane, jacobian) at the target's own moments, for seeded random
     boxes (rolled, off centre) and head angles off the line of sight: equal within 1e-9."""
     from replay.control.grasping.recognition import Camera, meet_plane
@@ -385,8 +352,8 @@ def test_image_jacobian_is_the_head_models(spec):
 
 
 def test_a_chip_wider_than_63_px_runs_the_grasp_method(tmp_path):
-    """The compiled chip paths stop at 63 px; wider chips take the Python ones (it was an
-    OverflowError in the recognition task: rows unpacked as int64)."""
+    """Packed rows wider than 63 px (it was an OverflowError in the recognition task: rows
+    unpacked as int64)."""
     sc = load_scenario(
         scenario_dir() / "grasp_hexahedron.yaml",
         sets=[
