@@ -9,7 +9,11 @@ from replay.scenario import load_scenario
 
 @pytest.mark.parametrize(
     "path,engine",
-    [("scenarios/stick_3step.yaml", "pymunk"), ("scenarios/catch_optimised.yaml", "pybullet")],
+    [
+        ("scenarios/stick_3step.yaml", "pymunk"),
+        ("scenarios/catch_optimised.yaml", "pybullet"),
+        ("scenarios/grasp_hexahedron_mujoco.yaml", "mujoco"),
+    ],
 )
 def test_the_bare_stepper_steps_the_engine_not_the_plant(path, engine):
     sc = load_scenario(path)
@@ -24,7 +28,14 @@ def test_the_bare_stepper_steps_the_engine_not_the_plant(path, engine):
     plant.close()
 
 
-@pytest.mark.parametrize("path", ["scenarios/stick_3step.yaml", "scenarios/catch_optimised.yaml"])
+@pytest.mark.parametrize(
+    "path",
+    [
+        "scenarios/stick_3step.yaml",
+        "scenarios/catch_optimised.yaml",
+        "scenarios/catch_optimised_mujoco.yaml",
+    ],
+)
 def test_a_run_times_its_parts_and_the_engine_inside_it(path, tmp_path):
     """Every part of the loop is timed, and the engine's step is seen at every physics step
     (a plant that reaches the engine another way would make `make bench` wrong: this says so)."""
