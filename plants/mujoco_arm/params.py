@@ -58,6 +58,14 @@ class Params(ArmParams):
     mj_iterations: int = param(
         50, ge=1, le=1000, doc="constraint solver iterations (as the PyBullet plant's 50)"
     )
+    mj_noslip_iterations: int = param(
+        0,
+        ge=0,
+        le=1000,
+        doc="MuJoCo's noslip solver iterations after the main solve (0: off, MuJoCo's default); "
+        "without it MuJoCo's soft friction lets a held object creep under a sustained "
+        "tangential load, inside the friction cone, where Coulomb friction would stick",
+    )
     mj_integrator: str = param(
         "implicitfast",
         choices=("Euler", "implicitfast", "implicit", "RK4"),

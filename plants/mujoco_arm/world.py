@@ -78,6 +78,7 @@ def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
     opt.integrator = INTEGRATORS[P.mj_integrator]
     opt.cone = CONES[P.mj_cone]
     opt.iterations = int(P.mj_iterations)
+    opt.noslip_iterations = int(P.mj_noslip_iterations)
     base = spec.body("wam_base")
     base.pos = [float(x) for x in P.base_position]
     base.quat = wxyz(matrix_to_quaternion(rpy_to_matrix(P.base_rpy)))

@@ -401,6 +401,7 @@ def test_mujoco_scenario_differs_only_in_the_plant(name):
         "mj_cone",
         "mj_condim",
         "mj_iterations",
+        "mj_noslip_iterations",
         "mj_integrator",
         "hand_servo_gain",
     }

@@ -36,6 +36,7 @@ MJ_FIELDS = {
     "mj_cone",
     "mj_condim",
     "mj_iterations",
+    "mj_noslip_iterations",
     "mj_integrator",
     "hand_servo_gain",
 }
