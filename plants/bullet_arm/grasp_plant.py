@@ -26,25 +26,21 @@ from plants.bullet_arm.engine import pybullet as p
 from plants.bullet_arm.arm_state import joint_state
 from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.grasp_setup import head_setup, human_args, plane_setup
+from plants.bullet_arm.grasp_topics import GraspRigTopics
 from plants.bullet_arm.grasp_verdict import GraspVerdict
 from plants.bullet_arm.head import HeadServo
 from plants.bullet_arm.human_hand import HumanHand
 from plants.bullet_arm.params import GraspParams
-from plants.bullet_arm.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
 from plants.bullet_arm.plant import BulletArmPlant
 from plants.bullet_arm.servo import VelocityMotors, VelocityServos
 from replay.interfaces import Occurrence
-from replay.messages import JointState
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.hand import palm_body
 from replay.robot.head import camera_pose
-from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
-HEAD_JOINTS = ("pan", "tilt")
 
-
-class BulletGraspPlant(GraspVerdict, BulletArmPlant):
+class BulletGraspPlant(GraspVerdict, GraspRigTopics, BulletArmPlant):
     Params = GraspParams
     spec_type = GraspSpec
     command_types = (ServoCommand,)  # type: ignore[assignment]
@@ -106,14 +102,6 @@ class BulletGraspPlant(GraspVerdict, BulletArmPlant):
         self._spec = self._grasp_spec(self._spec)
 
     # ------------------------------------------------------------------ spec
-    def _grasp_spec(self, base) -> GraspSpec:
-        fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
-        fields["notes"] = {
-            **base.notes,
-            "arm": "WAM-7 stands in for the paper's unnamed 7-axis arm; velocity servos",
-        }
-        return GraspSpec(**fields, head=self.head, plane=self.plane)
-
     # ------------------------------------------------------------------ state (one read a step)
     def _read(self) -> None:
         """The base's state cache (plain floats) from one getJointStates of arm, hand and palm
@@ -224,81 +212,3 @@ class BulletGraspPlant(GraspVerdict, BulletArmPlant):
             R, c = camera_pose(self.head, *self.head_servo.q_l)
             self._head_pose = (R, c, [float(x) for x in matrix_to_quaternion(R)])
         return self._head_pose
-
-    def truth(self, t: float) -> dict:
-        out = super().truth(t)
-        del out["/arm/applied_torque"]
-        servos = self.arm_servos
-        out["/arm/servo"] = ServoState(
-            t,
-            list(self.joint_names),
-            self._full(servos.command_l),
-            self._full(servos.integral_l),
-            self._tau_applied[:],
-            self._clamped[:],
-        )
-        hs = self.head_servo
-        out["/head/joint_state"] = JointState(
-            t, list(HEAD_JOINTS), hs.q_l[:], hs.qd_l[:], hs.torque_l[:]
-        )
-        _, c, quat = self._head_reading()
-        out["/head/state"] = HeadState(t, hs.q_l[0], hs.q_l[1], hs.qd_l[:], c.tolist(), quat[:])
-        human = self.human
-        out["/human/state"] = HumanState(
-            t, human.target_l[:], float(human.roll), human.force(), human.max_force
-        )
-        pos = self._state()[2][0]
-        out["/human/wrench"] = HumanWrench(
-            t,
-            human.force(),
-            human.torque_l[:],
-            [a - b for a, b in zip(pos, human.target_l)],
-            human.limited,
-        )
-        w = self._wrench
-        out["/wrist/wrench_truth"] = Wrench(t, w[:3], w[3:])
-        return out
-
-    def joints(self) -> tuple[list, list, list, list]:
-        """The arm's and hand's joints, then the head's pan and tilt."""
-        names, q, qd, effort = super().joints()
-        hs = self.head_servo
-        return (
-            names + list(HEAD_JOINTS),
-            q + hs.q_l,
-            qd + hs.qd_l,
-            effort + hs.torque_l,
-        )
-
-    def frames(self) -> list[Frame]:
-        """The robot's links and the head's camera (``head_camera``: x right, y down, z the
-        optical axis) in ``world``."""
-        _, c, quat = self._head_reading()
-        x, y, z = (float(v) for v in c)
-        return super().frames() + [Frame("world", "head_camera", (x, y, z), tuple(quat))]
-
-    def _full(self, values: list) -> list:
-        """Per-active-joint values as a list over every arm joint (zero where locked)."""
-        if self._all_active:
-            return list(values)
-        out = [0.0] * self.dof
-        for i, x in zip(self.active, values):
-            out[i] = x
-        return out
-
-    def scene(self) -> Scene:
-        sc = super().scene()
-        hs = self.head_servo
-        R, c, _ = self._head_reading()
-        hq, hqd, htau = self._state()[1]
-        sc.readings["hand"] = {"name": list(self.hand_names), "position": hq[:], "velocity": hqd[:]}
-        sc.readings["hand_torque"] = {"name": list(self.hand_names), "torque": htau}
-        sc.readings["head"] = {
-            "name": list(HEAD_JOINTS),
-            "position": hs.q_l[:],
-            "velocity": hs.qd_l[:],
-            "camera_rotation": R,
-            "camera_position": c,
-        }
-        sc.readings["wrist"] = {"wrench": self._wrench}
-        return sc

@@ -20,26 +20,22 @@ import mujoco
 import numpy as np
 
 from plants.bullet_arm.grasp_setup import head_setup, human_args, plane_setup
+from plants.bullet_arm.grasp_topics import GraspRigTopics
 from plants.bullet_arm.grasp_verdict import GraspVerdict
 from plants.bullet_arm.head import HeadServo
 from plants.bullet_arm.human_path import HumanPath
-from plants.bullet_arm.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
 from plants.bullet_arm.servo import VelocityServos
 from plants.mujoco_arm.human import drive_human
 from plants.mujoco_arm.params import GraspParams
 from plants.mujoco_arm.plant import MujocoArmPlant
 from plants.mujoco_arm.world import wrist_wrench
 from replay.interfaces import Occurrence
-from replay.messages import JointState
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import camera_pose
-from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
-HEAD_JOINTS = ("pan", "tilt")
 
-
-class MujocoGraspPlant(GraspVerdict, MujocoArmPlant):
+class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
     Params = GraspParams
     spec_type = GraspSpec
     command_types = (ServoCommand,)  # type: ignore[assignment]
@@ -84,14 +80,6 @@ class MujocoGraspPlant(GraspVerdict, MujocoArmPlant):
         self._spec = self._grasp_spec(self._spec)
 
     # ------------------------------------------------------------------ spec
-    def _grasp_spec(self, base) -> GraspSpec:
-        fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
-        fields["notes"] = {
-            **base.notes,
-            "arm": "WAM-7 stands in for the paper's unnamed 7-axis arm; velocity servos",
-        }
-        return GraspSpec(**fields, head=self.head, plane=self.plane)
-
     # ------------------------------------------------------------------ state
     def arm_mass_matrix(self) -> np.ndarray:
         """The arm joints' block of the joint-space mass matrix now (kg m^2)."""
@@ -209,76 +197,3 @@ class MujocoGraspPlant(GraspVerdict, MujocoArmPlant):
             R, c = camera_pose(self.head, *self.head_servo.q_l)
             self._head_pose = (R, c, [float(x) for x in matrix_to_quaternion(R)])
         return self._head_pose
-
-    def _full(self, values: list) -> list:
-        """Per-active-joint values as a list over every arm joint (zero where locked)."""
-        if self._all_active:
-            return list(values)
-        out = [0.0] * self.dof
-        for i, x in zip(self.active, values):
-            out[i] = x
-        return out
-
-    def truth(self, t: float) -> dict:
-        out = super().truth(t)
-        del out["/arm/applied_torque"]
-        servos = self.arm_servos
-        out["/arm/servo"] = ServoState(
-            t,
-            list(self.joint_names),
-            self._full(servos.command_l),
-            self._full(servos.integral_l),
-            self._tau_applied[:],
-            self._clamped[:],
-        )
-        hs = self.head_servo
-        out["/head/joint_state"] = JointState(
-            t, list(HEAD_JOINTS), hs.q_l[:], hs.qd_l[:], hs.torque_l[:]
-        )
-        _, c, quat = self._head_reading()
-        out["/head/state"] = HeadState(t, hs.q_l[0], hs.q_l[1], hs.qd_l[:], c.tolist(), quat[:])
-        human = self.human
-        out["/human/state"] = HumanState(
-            t, human.target_l[:], float(human.roll), human.force(), human.max_force
-        )
-        pos = self._state()[2][0]
-        out["/human/wrench"] = HumanWrench(
-            t,
-            human.force(),
-            human.torque_l[:],
-            [a - b for a, b in zip(pos, human.target_l)],
-            human.limited,
-        )
-        w = self._wrench
-        out["/wrist/wrench_truth"] = Wrench(t, w[:3], w[3:])
-        return out
-
-    def joints(self) -> tuple[list, list, list, list]:
-        """The arm's and hand's joints, then the head's pan and tilt."""
-        names, q, qd, effort = super().joints()
-        hs = self.head_servo
-        return names + list(HEAD_JOINTS), q + hs.q_l, qd + hs.qd_l, effort + hs.torque_l
-
-    def frames(self) -> list[Frame]:
-        """The robot's links and the head's camera (``head_camera``: x right, y down, z the
-        optical axis) in ``world``."""
-        _, c, quat = self._head_reading()
-        x, y, z = (float(v) for v in c)
-        return super().frames() + [Frame("world", "head_camera", (x, y, z), tuple(quat))]
-
-    def scene(self) -> Scene:
-        sc = super().scene()
-        hs = self.head_servo
-        R, c, _ = self._head_reading()
-        hq, hqd, htau = self._state()[1]
-        sc.readings["hand"] = {"name": list(self.hand_names), "position": hq[:], "velocity": hqd[:]}
-        sc.readings["hand_torque"] = {"name": list(self.hand_names), "torque": htau}
-        sc.readings["head"] = {
-            "name": list(HEAD_JOINTS),
-            "position": hs.q_l[:],
-            "velocity": hs.qd_l[:],
-            "camera_rotation": R,
-            "camera_position": c,
-        }
-        sc.readings["wrist"] = {"wrench": self._wrench}
-        return sc

@@ -1,0 +1,139 @@
+"""The grasping rig's logged topics and scene, engine-free: the truth topics it adds to an arm
+plant's (``/arm/servo``, ``/head/joint_state``, ``/head/state``, ``/human/state``,
+``/human/wrench``, ``/wrist/wrench_truth``), the head's joints and camera frame, the scene's
+hand, head and wrist readings and the rig's GraspSpec. Shared by the PyBullet rig
+(``grasp_plant.BulletGraspPlant``) and the MuJoCo one, so both log the same topics from one
+source.
+
+The host plant provides, besides its arm plant's ``truth``/``joints``/``frames``/``scene``:
+``arm_servos`` (servo.VelocityServos), ``head_servo`` (head.HeadServo), ``head`` and ``plane``
+(the rig's specs), ``human`` (human_path.HumanPath), ``joint_names``, ``hand_names``, ``dof``,
+``active``, ``_all_active``, ``_tau_applied``, ``_clamped``, ``_wrench`` (the wrist's true
+wrench, [F, M]), ``_state()`` (its [1]: the hand's (q, qd, torque), [2]: the object's (pos, ...))
+and ``_head_reading()`` ((R, c, quaternion) of the head camera).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Callable
+
+from plants.bullet_arm.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
+from replay.messages import JointState
+from replay.robot.arm_types import GraspSpec
+from replay.scene import Frame, Scene
+
+HEAD_JOINTS = ("pan", "tilt")
+
+if TYPE_CHECKING:
+    from replay.interfaces import Plant as _ArmPlant
+else:
+    _ArmPlant = object
+
+
+class GraspRigTopics(_ArmPlant):
+    """Mixin before the arm plant in the rig's bases (its ``super()`` calls reach the arm plant)."""
+
+    # the host plant's (annotations only: no attribute or method is defined here)
+    arm_servos: Any
+    head_servo: Any
+    head: Any
+    plane: Any
+    human: Any
+    joint_names: Any
+    hand_names: Any
+    dof: int
+    active: Any
+    _all_active: bool
+    _tau_applied: list
+    _clamped: list
+    _wrench: list
+    _state: Callable[[], tuple]
+    _head_reading: Callable[[], tuple]
+
+    def _grasp_spec(self, base) -> GraspSpec:
+        fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
+        fields["notes"] = {
+            **base.notes,
+            "arm": "WAM-7 stands in for the paper's unnamed 7-axis arm; velocity servos",
+        }
+        return GraspSpec(**fields, head=self.head, plane=self.plane)
+
+    def truth(self, t: float) -> dict:
+        out = super().truth(t)  # type: ignore[safe-super]  # the arm plant's, not Plant's
+        del out["/arm/applied_torque"]
+        servos = self.arm_servos
+        out["/arm/servo"] = ServoState(
+            t,
+            list(self.joint_names),
+            self._full(servos.command_l),
+            self._full(servos.integral_l),
+            self._tau_applied[:],
+            self._clamped[:],
+        )
+        hs = self.head_servo
+        out["/head/joint_state"] = JointState(
+            t, list(HEAD_JOINTS), hs.q_l[:], hs.qd_l[:], hs.torque_l[:]
+        )
+        _, c, quat = self._head_reading()
+        out["/head/state"] = HeadState(t, hs.q_l[0], hs.q_l[1], hs.qd_l[:], c.tolist(), quat[:])
+        human = self.human
+        out["/human/state"] = HumanState(
+            t, human.target_l[:], float(human.roll), human.force(), human.max_force
+        )
+        pos = self._state()[2][0]
+        out["/human/wrench"] = HumanWrench(
+            t,
+            human.force(),
+            human.torque_l[:],
+            [a - b for a, b in zip(pos, human.target_l)],
+            human.limited,
+        )
+        w = self._wrench
+        out["/wrist/wrench_truth"] = Wrench(t, w[:3], w[3:])
+        return out
+
+    def joints(self) -> tuple[list, list, list, list]:
+        """The arm's and hand's joints, then the head's pan and tilt."""
+        arm = super().joints()
+        assert arm is not None  # an arm plant always has joints
+        names, q, qd, effort = arm
+        hs = self.head_servo
+        return (
+            names + list(HEAD_JOINTS),
+            q + hs.q_l,
+            qd + hs.qd_l,
+            effort + hs.torque_l,
+        )
+
+    def frames(self) -> list[Frame]:
+        """The robot's links and the head's camera (``head_camera``: x right, y down, z the
+        optical axis) in ``world``."""
+        _, c, quat = self._head_reading()
+        x, y, z = (float(v) for v in c)
+        return super().frames() + [Frame("world", "head_camera", (x, y, z), tuple(quat))]
+
+    def _full(self, values: list) -> list:
+        """Per-active-joint values as a list over every arm joint (zero where locked)."""
+        if self._all_active:
+            return list(values)
+        out = [0.0] * self.dof
+        for i, x in zip(self.active, values):
+            out[i] = x
+        return out
+
+    def scene(self) -> Scene:
+        sc = super().scene()  # type: ignore[safe-super]  # the arm plant's, not Plant's
+        hs = self.head_servo
+        R, c, _ = self._head_reading()
+        hq, hqd, htau = self._state()[1]
+        sc.readings["hand"] = {"name": list(self.hand_names), "position": hq[:], "velocity": hqd[:]}
+        sc.readings["hand_torque"] = {"name": list(self.hand_names), "torque": htau}
+        sc.readings["head"] = {
+            "name": list(HEAD_JOINTS),
+            "position": hs.q_l[:],
+            "velocity": hs.qd_l[:],
+            "camera_rotation": R,
+            "camera_position": c,
+        }
+        sc.readings["wrist"] = {"wrench": self._wrench}
+        return sc
