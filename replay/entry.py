@@ -23,7 +23,20 @@ def _address_space_limit() -> int | None:
     return None if soft == resource.RLIM_INFINITY else soft
 
 
+def _by_ctrl_c(exc: BaseException) -> bool:
+    """Whether ``exc`` came of a Ctrl-C: a C extension whose initialisation the KeyboardInterrupt
+    broke raises ImportError from it (pybind11: "initialization failed")."""
+    seen: BaseException | None = exc
+    while seen is not None:
+        if isinstance(seen, KeyboardInterrupt):
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return False
+
+
 def _cannot_load(exc: BaseException, limit: int | None) -> None:
+    if _by_ctrl_c(exc):
+        _while_importing(signal.SIGINT, None)
     text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
     why = f"{type(exc).__name__}: {text}"
     if limit is not None:
