@@ -118,3 +118,18 @@ def test_an_address_space_limit_is_one_line_or_a_run(tmp_path, mb):
             assert f"ulimit -v) is {mb} MB" in lines[0]
     else:
         assert out.is_file()
+
+
+def test_an_import_broken_by_ctrl_c_is_an_interrupt_not_a_load_error():
+    """A C extension whose init a KeyboardInterrupt broke raises ImportError from it: that is
+    Ctrl-C (exit 130), while an ImportError of its own stays 'cannot load' (exit 1)."""
+    from replay.entry import _by_ctrl_c
+
+    try:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as k:
+            raise ImportError("initialization failed") from k
+    except ImportError as exc:
+        assert _by_ctrl_c(exc)
+    assert not _by_ctrl_c(ImportError("libGL.so.1: cannot open shared object file"))
