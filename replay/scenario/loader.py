@@ -254,13 +254,14 @@ def _bounds(meta: dict, default: float | None = None) -> str:
     return text.strip()
 
 
-def _check_range(value: float, meta: dict, node, path, default: float) -> None:
+def _check_range(value: float, meta: dict, node, path, default: float, what: str) -> None:
+    """Refuse ``value`` outside its bounds, naming what the field takes (``what``: "a number"
+    for a float field, even when the value was written as a whole number)."""
     low, high = _limits(meta, default)
     ok = (value > low if meta.get("gt") is not None else value >= low) and (
         value < high if meta.get("lt") is not None else value <= high
     )
     if not ok:
-        what = "a whole number" if isinstance(value, int) else "a number"
         got = show(value, 24) if isinstance(value, int) else f"{value:g}"
         raise ScenarioError(
             f"expected {what} {_bounds(meta, default)}, got {got}", node=node, path=path
@@ -290,7 +291,7 @@ def _number(node: yaml.ScalarNode, path: str, meta: dict) -> float:
                 f"expected a number {_bounds(meta)}, got {value}", node=node, path=path
             )
         return value
-    _check_range(value, meta, node, path, MAX_FLOAT)  # exact for huge ints: no overflow
+    _check_range(value, meta, node, path, MAX_FLOAT, "a number")  # exact for huge ints: no overflow
     return float(value)
 
 
@@ -337,7 +338,7 @@ def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
             raise ScenarioError(
                 f"expected a whole number, got {show(node.value)}", node=node, path=path
             )
-        _check_range(value, meta, node, path, MAX_INT)
+        _check_range(value, meta, node, path, MAX_INT, "a whole number")
     elif tp is bool:
         if not isinstance(value, bool):
             raise ScenarioError(

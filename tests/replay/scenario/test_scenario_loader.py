@@ -43,6 +43,14 @@ def test_negative_mass_is_out_of_range(tmp_path, toy_yaml):
     )
 
 
+def test_out_of_range_names_the_fields_type(tmp_path, toy_yaml):
+    # a float field given a whole number is still "a number", an int field "a whole number"
+    msg = _error(tmp_path, toy_yaml.read_text().replace("mass: 2.0", "mass: -1"))
+    assert "expected a number > 0" in msg and "whole" not in msg
+    msg = _error(tmp_path, toy_yaml.read_text().replace("seed: 3", "seed: -3"))
+    assert "seed: expected a whole number >= 0" in msg
+
+
 def test_wrong_type(tmp_path, toy_yaml):
     msg = _error(tmp_path, toy_yaml.read_text().replace("seed: 3", "seed: three"))
     assert "bad.yaml:4:7: seed: expected a whole number, got 'three'" in msg
