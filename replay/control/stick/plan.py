@@ -378,7 +378,8 @@ class ContactPlanner:
             times = sample_times_at(t, t1, 0, n)
             q = route_axes(hand, starts, frm, to, times)
         tips = route_tips(hand, q[:, :2], q[:, 2:].reshape(-1, 2, 2))
-        x, y, cs, sn = motion.sampled(t, t1)
+        c, th = motion.poses(times)
+        x, y, cs, sn = c[:, 0], c[:, 1], np.cos(th), np.sin(th)
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
         tip_r = hand.tip_radius - 5e-4
         j = 1 - k

@@ -58,16 +58,6 @@ class Motion:
             th = th + self.u_after[2] * t2
         return c, th
 
-    def sampled(self, t0: float, t1: float) -> tuple:
-        """(x, y, cos theta, sin theta), arrays at :func:`sample_times` (t0, t1): the poses of
-        :meth:`poses` (kept per span: the planners ask the same spans again and again)."""
-        cache = self.__dict__.setdefault("_sampled", {})  # (a frozen instance's own dict)
-        got = cache.get((t0, t1))
-        if got is None:
-            c, th = self.poses(sample_times(t0, t1))
-            got = cache[(t0, t1)] = (c[:, 0], c[:, 1], np.cos(th), np.sin(th))
-        return got
-
     def pose(self, t: float) -> tuple[np.ndarray, float]:
         x, y, th = self.pose_floats(t)
         return np.array([x, y]), float(th)
@@ -297,33 +287,18 @@ def covered_fixed(
     n = sample_count(t0, t1)
     r = math.sqrt(r2)
     step = (t1 - t0) / (n - 1) if n > 1 else 0.0
-    # the centre moves at most v_max, and within r / v_max of a near sample stays within 2 r,
-    # where the margin shrinks at most rate_near (each a little larger: rounding)
+    # a sample's distance beyond the corner reach, or margin outside the grown rectangle, g:
+    # the centre moves at most v_max (a sample apart: move), so no sooner than g / v_max is the
+    # distance within reach; in the stick's frame the point moves at most v_max + w_max |d|,
+    # and while it moves by g |d| grows by at most g, so no sooner than
+    # g / (v_max + w_max (|d| + g)) is the margin gone (each a little larger: rounding)
     move = v_max * step * (1.0 + 1e-6)
-    rate_near = (v_max + w_max * 2.0 * r) * step * (1.0 + 1e-6)
-    if not math.isfinite(move + rate_near + x0 + y0 + th0 + w + u2) or step == 0.0:
-        move = rate_near = 0.0  # (every sample looked at)
+    spin = w_max * step * (1.0 + 1e-6)
+    if not math.isfinite(move + spin + x0 + y0 + th0 + w + u2) or step == 0.0:
+        move = spin = 0.0  # (every sample looked at)
     for a, b in reversed(ranges) if last else ranges:
-        i, di, looked = (b - 1, -1, 0) if last else (a, 1, 0)
+        i, di = (b - 1, -1) if last else (a, 1)
         while a <= i < b:
-            if looked == _DENSE and b - a > 4 * _DENSE:  # many near samples: the rest at once
-                ra, rb = (a, i + 1) if last else (i, b)
-                x, y, cs, sn = motion.sampled(t0, t1)
-                hit = covered_samples(
-                    x[ra:rb],
-                    y[ra:rb],
-                    cs[ra:rb],
-                    sn[ra:rb],
-                    px,
-                    py,
-                    half_length,
-                    half_width,
-                    grow,
-                )
-                if hit.size:
-                    return ra + int(hit[-1] if last else hit[0])
-                break
-            looked += 1
             # sample_times (np.linspace) and Motion.poses at sample i, as floats
             t = i * step + t0 if i < n - 1 and step != 0.0 else sample_time(t0, t1, i)
             ta = (t if t < ts else ts) - t_ref
@@ -334,23 +309,20 @@ def covered_fixed(
                 cx, cy, th = cx + u0 * tb, cy + u1 * tb, th + u2 * tb
             dx, dy = px - cx, py - cy
             d2 = dx * dx + dy * dy
+            d = math.sqrt(d2)
             if d2 > r2:
-                gap = math.sqrt(d2) - r - 1e-12
-                k = int(gap / move) if move > 0.0 and gap > 0.0 else 1
+                gap = d - r - 1e-12
+                rate = move
             else:
                 c, sn = math.cos(th), math.sin(th)
                 xb, yb = dx * c + dy * sn, -dx * sn + dy * c
                 if abs(xb) <= gl and abs(yb) <= gw:
                     return i
                 gap = max(abs(xb) - gl, abs(yb) - gw) - 1e-12
-                k = int(gap / rate_near) if rate_near > 0.0 and gap > 0.0 else 1
-                if move > 0.0:
-                    k = min(k, int(r / move))
+                rate = move + spin * (d + gap)
+            k = int(gap / rate) if rate > 0.0 and gap > 0.0 else 1
             i += di * (k if k > 1 else 1)
     return None
-
-
-_DENSE = 16  # samples looked at one by one before covered_fixed does the rest of a range at once
 
 
 def first_covered(
