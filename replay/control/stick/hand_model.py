@@ -153,6 +153,20 @@ def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
     return out
 
 
+def finger_tips(hand: HandSpec, axes: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Finger k's tip centres (x, y arrays) for rows of :func:`route_axes`: :func:`route_tips`'
+    values for that finger alone."""
+    l1, l2 = hand.link_lengths
+    q1 = axes[:, 2 + 2 * k]
+    q12 = q1 + axes[:, 3 + 2 * k]
+    rx, ry = hand.root_offsets[k]
+    x = l1 * np.cos(q1) + l2 * np.cos(q12)
+    y = l1 * np.sin(q1) + l2 * np.sin(q12)
+    x += rx + axes[:, 0]  # (the root: its offset + the base, as route_tips adds them)
+    y += ry + axes[:, 1]
+    return x, y
+
+
 # ------------------------------------------------------------------------------------------
 # Candidates for the planners' inverse-kinematics search
 # ------------------------------------------------------------------------------------------

@@ -44,6 +44,7 @@ from replay.control.stick.hand_model import (
     base_candidates,
     posture_grid,
     route_configs,
+    finger_tips,
     route_axes,
     route_target,
     route_tips,
@@ -377,47 +378,41 @@ class ContactPlanner:
             m2 = n  # (rounding: not quite on the target yet) every sample in arrays
             times = sample_times_at(t, t1, 0, n)
             q = route_axes(hand, starts, frm, to, times)
-        tips = route_tips(hand, q[:, :2], q[:, 2:].reshape(-1, 2, 2))
         c, th = motion.poses(times)
-        x, y, cs, sn = c[:, 0], c[:, 1], np.cos(th), np.sin(th)
+        x, y = c[:, 0], c[:, 1]
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
         tip_r = hand.tip_radius - 5e-4
         j = 1 - k
         ak = min(a, m2)
-        if covered_samples(
-            x[:ak],
-            y[:ak],
-            cs[:ak],
-            sn[:ak],
-            tips[:ak, k, 0],
-            tips[:ak, k, 1],
-            half_l,
-            half_w,
-            tip_r,
-        ).size:
+        tx, ty = finger_tips(hand, q[:ak], k)
+        if covered_samples(x[:ak], y[:ak], th[:ak], tx, ty, half_l, half_w, tip_r).size:
             return None
-        if a > m2 and covered_fixed(motion, t, t1, m2, a, tips[-1, k], half_l, half_w, tip_r):
+        tip_k = finger_tips(hand, q[-1:], k)
+        if (
+            a > m2
+            and covered_fixed(
+                motion, t, t1, m2, a, (tip_k[0][0], tip_k[1][0]), half_l, half_w, tip_r
+            )
+            is not None
+        ):
             return None
         if check_idle:
-            on_way = self._idle_clearance(t, tips[0, j], motion)
+            tx, ty = finger_tips(hand, q, j)
+            on_way = self._idle_clearance(t, (tx[0], ty[0]), motion)
             far = hand.tip_radius + p.sweep_margin
             for lo, hi, grow in ((0, min(m, m2), on_way), (min(m, m2), m2, far)):
                 if (
                     hi > lo
                     and covered_samples(
-                        x[lo:hi],
-                        y[lo:hi],
-                        cs[lo:hi],
-                        sn[lo:hi],
-                        tips[lo:hi, j, 0],
-                        tips[lo:hi, j, 1],
-                        half_l,
-                        half_w,
-                        grow,
+                        x[lo:hi], y[lo:hi], th[lo:hi], tx[lo:hi], ty[lo:hi], half_l, half_w, grow
                     ).size
                 ):
                     return None
-            if m2 < n and covered_fixed(motion, t, t1, m2, n, tips[-1, j], half_l, half_w, far):
+            if (
+                m2 < n
+                and covered_fixed(motion, t, t1, m2, n, (tx[-1], ty[-1]), half_l, half_w, far)
+                is not None
+            ):
                 return None
         return arrival
 

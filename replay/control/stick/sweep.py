@@ -177,17 +177,19 @@ def corner_reach2(half_length: float, half_width: float) -> float:
 
 
 def covered_samples(
-    x, y, cs, sn, px, py, half_length: float, half_width: float, grow: float
+    x, y, th, px, py, half_length: float, half_width: float, grow: float
 ) -> np.ndarray:
-    """Indices of the samples (stick poses x, y, cos, sin: arrays; the point px, py: floats or
+    """Indices of the samples (stick poses x, y, theta: arrays; the point px, py: floats or
     arrays alike) at which the point is within ``grow`` of the stick rectangle: the samples of
-    :func:`covered_along` (the same operations) that are True, ascending."""
+    :func:`covered_along` (the same operations) that are True, ascending; cos and sin only of
+    the samples within the corner reach."""
     gl, gw = half_length + grow, half_width + grow
     dx, dy = px - x, py - y
     near = np.flatnonzero(dx * dx + dy * dy <= corner_reach2(gl, gw))
     if not near.size:
         return near
-    dx, dy, c, s = dx[near], dy[near], cs[near], sn[near]
+    dx, dy, a = dx[near], dy[near], th[near]
+    c, s = np.cos(a), np.sin(a)
     return near[(np.abs(dx * c + dy * s) <= gl) & (np.abs(-dx * s + dy * c) <= gw)]
 
 
