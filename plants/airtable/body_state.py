@@ -42,30 +42,38 @@ class TableIO:
         s[4], s[5] = b.angle, b.angular_velocity
         (s[6], s[7]), (s[8], s[9]) = self._tips[0].position, self._tips[1].position
         self._tip_v: list[tuple | None] = [None, None]  # the tips' velocities as last set
+        # the targets (the same object) and dt of a step that left both tips still on them
+        self._still_at: tuple | None = None
+        self._still_dt: float | None = None
 
     def step(self, tips, dt: float, space_step: Callable[[float], None]) -> None:
         """Each tip's velocity toward its target (``tips``: ((x, y), (x, y))), then
         ``space_step(dt)`` (the engine, called as given: what times or wraps ``space.step``
         sees every step), then the state after it."""
         s, set_v = self.state, self._tip_v
-        (t0x, t0y), (t1x, t1y) = tips
-        tip0, tip1 = self._tips
-        v0 = ((t0x - s[6]) / dt, (t0y - s[7]) / dt)
-        v1 = ((t1x - s[8]) / dt, (t1y - s[9]) / dt)
-        if v0 != set_v[0]:
-            _set_velocity(tip0, v0)
-            set_v[0] = v0
-        if v1 != set_v[1]:
-            _set_velocity(tip1, v1)
-            set_v[1] = v1
-        space_step(dt)
+        if tips is self._still_at and dt == self._still_dt:
+            space_step(dt)  # (the same targets, both tips on them and still: nothing to set)
+        else:
+            (t0x, t0y), (t1x, t1y) = tips
+            tip0, tip1 = self._tips
+            v0 = ((t0x - s[6]) / dt, (t0y - s[7]) / dt)
+            v1 = ((t1x - s[8]) / dt, (t1y - s[9]) / dt)
+            if v0 != set_v[0]:
+                _set_velocity(tip0, v0)
+                set_v[0] = v0
+            if v1 != set_v[1]:
+                _set_velocity(tip1, v1)
+                set_v[1] = v1
+            space_step(dt)
+            if v0 != _STILL:
+                s[6], s[7] = tip0.position
+            if v1 != _STILL:
+                s[8], s[9] = tip1.position
+            still = v0 == _STILL and v1 == _STILL
+            self._still_at, self._still_dt = (tips, dt) if still else (None, None)
         b = self._stick
         (s[0], s[1]), (s[2], s[3]) = b.position, b.velocity
         s[4], s[5] = b.angle, b.angular_velocity
-        if v0 != _STILL:
-            s[6], s[7] = tip0.position
-        if v1 != _STILL:
-            s[8], s[9] = tip1.position
 
     def step_hand(self, hand: HandServo, dt: float, space_step: Callable[[float], None]) -> None:
         """The hand servo's step (``hand.advance(dt)``), then :meth:`step` to its tips."""
