@@ -378,8 +378,7 @@ class ContactPlanner:
             m2 = n  # (rounding: not quite on the target yet) every sample in arrays
             times = sample_times_at(t, t1, 0, n)
             q = route_axes(hand, starts, frm, to, times)
-        c, th = motion.poses(times)
-        x, y = c[:, 0], c[:, 1]
+        x, y, th = motion.poses_before_switch(times)
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
         tip_r = hand.tip_radius - 5e-4
         j = 1 - k

@@ -58,6 +58,17 @@ class Motion:
             th = th + self.u_after[2] * t2
         return c, th
 
+    def poses_before_switch(self, times: np.ndarray) -> tuple[np.ndarray, ...]:
+        """:meth:`poses` as (x, y, theta) arrays; where every time is before ``t_switch`` in
+        fewer operations (min(t, t_switch) is t, and adding a finite u_after * 0 changes no more
+        than the sign of a zero)."""
+        e, u = self.est, self.u_after
+        if not (len(times) and times[-1] < self.t_switch and math.isfinite(u[0] + u[1] + u[2])):
+            c, th = self.poses(times)
+            return c[:, 0], c[:, 1], th
+        t1 = times - e.t_ref
+        return e.x + e.vx * t1, e.y + e.vy * t1, e.theta + e.omega * t1
+
     def pose(self, t: float) -> tuple[np.ndarray, float]:
         x, y, th = self.pose_floats(t)
         return np.array([x, y]), float(th)
@@ -154,13 +165,21 @@ def sample_time(t0: float, t1: float, i: int) -> float:
 def count_before(t0: float, t1: float, t: float, inclusive: bool) -> int:
     """How many of :func:`sample_times` (t0, t1) (ascending) are < t (``inclusive``: <= t)."""
     n = sample_count(t0, t1)
-    step = (t1 - t0) / (n - 1) if n > 1 else 0.0
-    guess = (t - t0) / step if step > 0.0 else 0.0
+    if n == 1:
+        return int(t0 <= t if inclusive else t0 < t)
+    step = (t1 - t0) / (n - 1)
+    if not step > 0.0:  # (a span of denormals: sample_time's other formula)
+        return sum(1 for i in range(n) if _before(sample_time(t0, t1, i), t, inclusive))
+    guess = (t - t0) / step
     i = min(max(int(guess), 0), n) if math.isfinite(guess) else (n if guess > 0 else 0)
+
+    def at(j: int) -> float:  # (sample_time)
+        return t1 if j == n - 1 else j * step + t0
+
     # (the guess within a sample or two of the count: moved onto it)
-    while i > 0 and not _before(sample_time(t0, t1, i - 1), t, inclusive):
+    while i > 0 and not _before(at(i - 1), t, inclusive):
         i -= 1
-    while i < n and _before(sample_time(t0, t1, i), t, inclusive):
+    while i < n and _before(at(i), t, inclusive):
         i += 1
     return i
 
