@@ -386,12 +386,10 @@ class ContactPlanner:
         tx, ty = finger_tips(hand, q[:ak], k)
         if covered_samples(x[:ak], y[:ak], th[:ak], tx, ty, half_l, half_w, tip_r).size:
             return None
-        tip_k = finger_tips(hand, q[-1:], k)
+        # (a > m2: ak = m2, and the arrays' last tip is where the hand stands from then on)
         if (
             a > m2
-            and covered_fixed(
-                motion, t, t1, m2, a, (tip_k[0][0], tip_k[1][0]), half_l, half_w, tip_r
-            )
+            and covered_fixed(motion, t, t1, m2, a, (tx[-1], ty[-1]), half_l, half_w, tip_r)
             is not None
         ):
             return None
