@@ -10,9 +10,10 @@ NumPy: each check one vectorised pass over the samples (:func:`covered`, :func:`
 the references). The checks the planners repeat most (:func:`first_covered`, ``ContactPlanner
 .route_clear``) look at fixed points over hundreds of samples: there only the samples at which
 the stick's centre (linear in time on each side of ``t_switch``) can be within the grown
-rectangle's corner reach of the point are made and rotated into the stick's frame (the others
-cannot be covered; :func:`near_samples` solves for them): the same answers as the references
-(tests/replay/control/stick/test_sweep_paths.py).
+rectangle's corner reach of the point are looked at (:func:`near_samples` solves for them),
+one by one, skipping those the stick cannot reach the point by (:func:`covered_fixed`): the
+same answers as the references (tests/replay/control/stick/test_sweep_paths.py). (This replaced
+a compiled ``_sweep.c``: stick_3step's sweep checks take ~15 ms a run here against its ~5.)
 """
 
 from __future__ import annotations

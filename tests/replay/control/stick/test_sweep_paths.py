@@ -1,10 +1,11 @@
 """The stick planners' sweep checks against their whole-array NumPy references: sweep
-.first_covered (cached sampled poses, only samples near the point rotated) against sweep.covered
-for a fixed point (first / last covered sample; Sweep.hits is that too,
-tests/.../test_stick_fast_paths.py), and ContactPlanner.route_clear (also the hand's
-trigonometry only where it moves, hand_model.route_tip_xy) against _route_clear_reference. The
-same operations on the samples they keep, so the answers agree exactly on seeded random
-motions, points and routes, and the random cases exercise both answers."""
+.first_covered (sweep.covered_fixed: only the samples near the point, looked at one by one with
+the skips the stick's speed and spin allow) against sweep.covered for a fixed point (first /
+last covered sample; Sweep.hits is that too, tests/.../test_stick_fast_paths.py), and
+ContactPlanner.route_clear (the moving hand in arrays, each finger's tips only where its check
+needs them, the standing hand as fixed points) against _route_clear_reference. The same
+operations on the samples they look at, so the answers agree exactly on seeded random motions,
+points and routes, and the random cases exercise both answers."""
 
 from __future__ import annotations
 
