@@ -1,10 +1,11 @@
 """Packaging details pyproject.toml cannot say: the top-level data/, scenarios/ and sweeps/
 folders ship in the wheel as package data under replay._shipped (found by replay.resources);
-two hot paths have optional C accelerators, one ``_name.c`` beside the Python module it speeds
+one hot path has an optional C accelerator, a ``_name.c`` beside the Python module it speeds
 (plain C over the buffer protocol, no NumPy headers, a ``.pyi`` stub, a test holding it to the
-Python path): ``ext_modules`` below (the cameras' raster and the stick planners' sweep checks). Each is optional: where it does not build (no C compiler,
-``CC=/bin/false``, a compiler that rejects it) the install goes on without it and the pure-Python
-path runs (replay.accel); docs/DESIGN.md, "Compiled code", says what each one gains."""
+Python path): ``ext_modules`` below (the cameras' raster). It is optional: where it does not
+build (no C compiler, ``CC=/bin/false``, a compiler that rejects it) the install goes on without
+it and the pure-Python path runs (replay.accel); docs/DESIGN.md, "Compiled code", says what it
+gains."""
 
 from setuptools import Extension, find_namespace_packages, setup
 
@@ -61,7 +62,6 @@ setup(
     package_dir=SHIPPED,
     ext_modules=[
         _ext("replay.sensors._pixels"),
-        _ext("replay.control.stick._sweep"),
     ],
     package_data={
         "replay._shipped.data": ["**/*"],

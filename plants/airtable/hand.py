@@ -145,8 +145,9 @@ class HandServo:
             b, q = s[BASE].tolist(), s[JOINTS].tolist()
             tips = finger_tip_xy(self.spec, b, 0, q[0:2]) + finger_tip_xy(self.spec, b, 1, q[2:4])
             s[TIPS], s[TIPS_VALID] = array("d", tips), 1.0
-        t0x, t0y, t1x, t1y = s[TIPS]
-        return (t0x, t0y), (t1x, t1y)
+            t0x, t0y, t1x, t1y = tips
+            self._tip_pair = (t0x, t0y), (t1x, t1y)  # (the same object until the hand moves)
+        return self._tip_pair
 
     def tips(self) -> np.ndarray:
         """Fingertip centres (2 x 2, world, m) for the current base and joints (a copy)."""

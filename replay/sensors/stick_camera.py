@@ -346,6 +346,10 @@ class StickCamera(Sensor):
         self._R = tuple(tuple(float(v) for v in row) for row in self.camera.rotation)
         self._o = tuple(float(v) for v in self.camera.position)
         self._last = None
+        # by name: (the primitive, its _silhouette): a primitive object seen again (a frozen
+        # one the plant keeps while it does not move, e.g. a still fingertip) is not projected
+        # again (the camera does not move either)
+        self._seen: dict[str, tuple] = {}
 
     # --- helpers usable without a sensor instance -------------------------------------------
     @staticmethod
@@ -476,9 +480,11 @@ class StickCamera(Sensor):
                 if prim is marker:
                     items.append(seen)
                 elif not _misses(cam, prim, window, self._R, self._o):
-                    it = _silhouette(cam, prim, self._o)
-                    if it is not None:
-                        items.append(it)
+                    kept = self._seen.get(prim.name)
+                    if kept is None or kept[0] is not prim:
+                        kept = self._seen[prim.name] = (prim, _silhouette(cam, prim, self._o))
+                    if kept[1] is not None:
+                        items.append(kept[1])
             _by_distance(items)
         img = render_scene(cam, scene, background=p.background, window=window, items=items)
         if p.noise_sigma > 0.0:

@@ -119,6 +119,12 @@ def route_configs(hand: HandSpec, starts, frm, to, times):
     """Base (T, 2) and joints (T, 2, 2) along waypoint segments, each axis moving toward its
     target at its speed limit (the plant's motion model). ``times`` ascending; segment i covers
     starts[i] <= t < starts[i + 1] (the first one also what comes before its start)."""
+    out = route_axes(hand, starts, frm, to, times)
+    return out[:, :2], out[:, 2:].reshape(-1, 2, 2)
+
+
+def route_axes(hand: HandSpec, starts, frm, to, times) -> np.ndarray:
+    """:func:`route_configs` as one (T, 6) array: base x, y, then the four joints."""
     times = np.asarray(times, dtype=float)
     out = np.empty((len(times), 6))  # base x, y, then the four joints
     speed = np.array([hand.base_speed] * 2 + [hand.joint_speed] * 4)
@@ -133,7 +139,7 @@ def route_configs(hand: HandSpec, starts, frm, to, times):
         vb = np.array([*b.base, *b.joints[0], *b.joints[1]], dtype=float)
         step = tau * speed
         out[lo:hi] = va + np.minimum(np.maximum(vb - va, -step), step)  # clip
-    return out[:, :2], out[:, 2:].reshape(-1, 2, 2)
+    return out
 
 
 def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
@@ -145,6 +151,20 @@ def route_tips(hand: HandSpec, base, joints) -> np.ndarray:
     out[..., 1] = l1 * np.sin(q1) + l2 * np.sin(q12)
     out += np.array(hand.root_offsets)[None, :, :] + np.asarray(base)[:, None, :]  # the roots
     return out
+
+
+def finger_tips(hand: HandSpec, axes: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Finger k's tip centres (x, y arrays) for rows of :func:`route_axes`: :func:`route_tips`'
+    values for that finger alone."""
+    l1, l2 = hand.link_lengths
+    q1 = axes[:, 2 + 2 * k]
+    q12 = q1 + axes[:, 3 + 2 * k]
+    rx, ry = hand.root_offsets[k]
+    x = l1 * np.cos(q1) + l2 * np.cos(q12)
+    y = l1 * np.sin(q1) + l2 * np.sin(q12)
+    x += rx + axes[:, 0]  # (the root: its offset + the base, as route_tips adds them)
+    y += ry + axes[:, 1]
+    return x, y
 
 
 # ------------------------------------------------------------------------------------------

@@ -23,13 +23,12 @@ The result is a :class:`ContactPlan` (the approach phase's plan; its ``intent`` 
 event's data). :class:`Shortfall` keeps the best time needed vs available of failed attempts
 (the ``unreachable`` report).
 
-NumPy (the sampled sweep checks: ``sweep``, with its optional accelerator).
+NumPy (the sampled sweep checks: ``sweep``).
 """
 
 from __future__ import annotations
 
 import math
-from array import array
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,22 +44,44 @@ from replay.control.stick.hand_model import (
     base_candidates,
     posture_grid,
     route_configs,
+    finger_tips,
+    route_axes,
     route_target,
     route_tips,
     travel,
 )
-from replay.control.stick import sweep as _sweeps
 from replay.control.stick.sweep import (
     Motion,
     Sweep,
     covered_along,
+    count_before,
+    covered_fixed,
+    covered_samples,
     first_covered,
     sample_count,
     sample_times,
+    sample_times_at,
 )
 
 CONTACT_GUARD = 0.003  # s, the sweep check of the waiting tip stops this long before the contact
 GO_DELAY = 0.003  # s, a staged tip moves in this long after the stick's last pass
+
+
+def _still_after(hand: HandSpec, start: float, a: Config, b: Config, t: float, row) -> bool:
+    """The last segment (``start``, a -> b) of a route has every axis on its target at t
+    (``route_axes``' clip no longer binds: so at every later sample too) and ``row`` (the
+    axes at t) is that segment's."""
+    if t < start:
+        return False
+    va = [*a.base, *a.joints[0], *a.joints[1]]
+    vb = [*b.base, *b.joints[0], *b.joints[1]]
+    tau = max(t - start, 0.0)
+    speeds = [hand.base_speed] * 2 + [hand.joint_speed] * 4
+    for i in range(6):
+        step, d = tau * speeds[i], float(vb[i]) - float(va[i])
+        if not (-step <= d <= step) or float(row[i]) != float(va[i]) + d:
+            return False
+    return True
 
 
 # ------------------------------------------------------------------------------------------
@@ -153,9 +174,6 @@ class ContactPlanner:
             l2 * np.sin(q[:, 0] + q[:, 1]),
         )
         self._grid_reach_lists = tuple(a.tolist() for a in self._grid_reach)  # (_passive)
-        (r0x, r0y), (r1x, r1y) = hand.root_offsets
-        self._geometry = tuple(map(float, (l1, l2, r0x, r0y, r1x, r1y)))  # (the accelerator's)
-        self._speeds = (float(hand.base_speed), float(hand.joint_speed))
 
     def crossings(
         self, t: float, est: StickEstimate, theta_star: float, keep_past: bool = False
@@ -338,10 +356,67 @@ class ContactPlanner:
         """The arrival time of ``route`` if every segment finishes before the next starts, the
         last before t_c - arrive_margin, and no fingertip is hit by the predicted sweep: on the
         way (both tips) and, once arrived, finger k's tip until just before t_c and the idle
-        tip (``sweep_margin`` clear) until t_c + post_horizon. Else None."""
-        if _sweeps._sweep is not None:
-            return self._route_clear_compiled(t, now, route, k, motion, t_c, check_idle)
+        tip (``sweep_margin`` clear) until t_c + post_horizon. Else None. The answer of
+        :meth:`_route_clear_reference`: the samples while the hand moves in whole arrays, those
+        after it stands still (on its last waypoint) as fixed points
+        (``sweep.covered_fixed``: only the samples near the stick made)."""
         p, st, hand = self.params, self.stick, self.hand
+        timed = self._route_timing(now, route, t_c)
+        if timed is None:
+            return None
+        arrival, starts, frm, to = timed
+        t1 = t_c + (p.post_horizon if check_idle else 0.0)
+        n = sample_count(t, t1)
+        # the samples before CONTACT_GUARD before t_c (finger k's check), before arrival, and
+        # up to the first one after arrival that the hand stands still at (m2)
+        a = count_before(t, t1, t_c - CONTACT_GUARD, inclusive=True)
+        m = count_before(t, t1, arrival, inclusive=False)
+        m2 = min(n, m + 1)
+        times = sample_times_at(t, t1, 0, m2)
+        q = route_axes(hand, starts, frm, to, times)
+        if m2 < n and not _still_after(hand, starts[-1], frm[-1], to[-1], times[-1], q[-1]):
+            m2 = n  # (rounding: not quite on the target yet) every sample in arrays
+            times = sample_times_at(t, t1, 0, n)
+            q = route_axes(hand, starts, frm, to, times)
+        x, y, th = motion.poses_before_switch(times)
+        half_l, half_w = 0.5 * st.length, 0.5 * st.width
+        tip_r = hand.tip_radius - 5e-4
+        j = 1 - k
+        ak = min(a, m2)
+        tx, ty = finger_tips(hand, q[:ak], k)
+        if covered_samples(x[:ak], y[:ak], th[:ak], tx, ty, half_l, half_w, tip_r).size:
+            return None
+        # (a > m2: ak = m2, and the arrays' last tip is where the hand stands from then on)
+        if (
+            a > m2
+            and covered_fixed(motion, t, t1, m2, a, (tx[-1], ty[-1]), half_l, half_w, tip_r)
+            is not None
+        ):
+            return None
+        if check_idle:
+            tx, ty = finger_tips(hand, q, j)
+            on_way = self._idle_clearance(t, (tx[0], ty[0]), motion)
+            far = hand.tip_radius + p.sweep_margin
+            for lo, hi, grow in ((0, min(m, m2), on_way), (min(m, m2), m2, far)):
+                if (
+                    hi > lo
+                    and covered_samples(
+                        x[lo:hi], y[lo:hi], th[lo:hi], tx[lo:hi], ty[lo:hi], half_l, half_w, grow
+                    ).size
+                ):
+                    return None
+            if (
+                m2 < n
+                and covered_fixed(motion, t, t1, m2, n, (tx[-1], ty[-1]), half_l, half_w, far)
+                is not None
+            ):
+                return None
+        return arrival
+
+    def _route_timing(self, now: Config, route: list, t_c: float) -> tuple | None:
+        """(arrival, starts, froms, tos) of ``route`` when each segment finishes before the next
+        starts and the last before t_c - arrive_margin, else None."""
+        hand = self.hand
         starts, frm, to = [], [], []
         prev = now
         for i, (t_start, cfg) in enumerate(route):
@@ -353,13 +428,42 @@ class ContactPlanner:
             to.append(cfg)
             prev = cfg
         arrival = starts[-1] + travel(hand, frm[-1], to[-1])
-        if arrival > t_c - p.arrive_margin:
+        if arrival > t_c - self.params.arrive_margin:
             return None
+        return arrival, starts, frm, to
+
+    def _idle_clearance(self, t: float, tip, motion: Motion) -> float:
+        """The grow of the idle tip's check on the way: at least the clearance it has at t
+        (it may start at the stick it just hit: a route grazing the stick at speed is a hit),
+        at most tip_radius + sweep_margin."""
+        p, st, hand = self.params, self.stick, self.hand
+        x0, y0, th0 = motion.pose_floats(t)
+        dx, dy = float(tip[0]) - x0, float(tip[1]) - y0
+        cs, sn = math.cos(th0), math.sin(th0)
+        xb, yb = dx * cs + dy * sn, -dx * sn + dy * cs
+        gap = max(abs(xb) - 0.5 * st.length, abs(yb) - 0.5 * st.width) - 1e-4
+        return max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
+
+    def _route_clear_reference(
+        self,
+        t: float,
+        now: Config,
+        route: list,
+        k: int,
+        motion: Motion,
+        t_c: float,
+        check_idle: bool = True,
+    ) -> float | None:
+        """:meth:`route_clear` in whole-array NumPy (its reference, test_sweep_paths.py)."""
+        p, st, hand = self.params, self.stick, self.hand
+        timed = self._route_timing(now, route, t_c)
+        if timed is None:
+            return None
+        arrival, starts, frm, to = timed
         # sampled every SAMPLE_DT from t: the hand along the route (route_configs, route_tips);
         # finger k's tip must stay out of the sweep (sweep.covered_along) until CONTACT_GUARD
         # before t_c; the idle tip, with check_idle, until t_c + post_horizon, keeping
-        # sweep_margin, or on the way at least the clearance it has now (it may start at the
-        # stick it just hit: a route grazing the stick at speed is a hit)
+        # sweep_margin, or on the way at least the clearance it has now
         times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
         base, joints = route_configs(hand, starts, frm, to, times)
         tips = route_tips(hand, base, joints)
@@ -372,68 +476,11 @@ class ContactPlanner:
         ).any():
             return None
         if check_idle:
-            x0, y0, th0 = motion.pose_floats(t)
-            dx, dy = float(tips[0, 1 - k, 0]) - x0, float(tips[0, 1 - k, 1]) - y0
-            cs, sn = math.cos(th0), math.sin(th0)
-            xb, yb = dx * cs + dy * sn, -dx * sn + dy * cs
-            gap = max(abs(xb) - half_l, abs(yb) - half_w) - 1e-4
-            on_way = max(tip_r, min(hand.tip_radius + p.sweep_margin, gap))
+            on_way = self._idle_clearance(t, tips[0, 1 - k], motion)
             grow = np.where(times < arrival, on_way, hand.tip_radius + p.sweep_margin)
             if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow, poses).any():
                 return None
         return arrival
-
-    def _route_clear_compiled(
-        self,
-        t: float,
-        now: Config,
-        route: list,
-        k: int,
-        motion: Motion,
-        t_c: float,
-        check_idle: bool,
-    ) -> float | None:
-        """:meth:`route_clear` by the accelerator (``_sweep.route_hit``: the same operations)."""
-        p, st, hand = self.params, self.stick, self.hand
-        rows = array("d")
-        prev = last = now
-        for i, (t_start, cfg) in enumerate(route):
-            if i + 1 < len(route):
-                if t_start + travel(hand, prev, cfg) > route[i + 1][0] + 1e-9:
-                    return None
-            rows.append(t_start)
-            for c in (prev, cfg):  # the axes route_configs moves: base x, y, then the joints
-                rows.extend(c.base)
-                rows.extend(c.joints[0])
-                rows.extend(c.joints[1])
-            last, prev = prev, cfg
-        arrival = route[-1][0] + travel(hand, last, prev)
-        if arrival > t_c - p.arrive_margin:
-            return None
-        # sampled every SAMPLE_DT from t: the hand along the route (route_configs, route_tips);
-        # finger k's tip must stay out of the sweep (sweep.covered_along) until CONTACT_GUARD
-        # before t_c; the idle tip, with check_idle, until t_c + post_horizon, keeping
-        # sweep_margin, or on the way at least the clearance it has now (it may start at the
-        # stick it just hit: a route grazing the stick at speed is a hit)
-        t1 = t_c + (p.post_horizon if check_idle else 0.0)
-        hit = _sweeps._sweep.route_hit(
-            motion.packed,
-            float(t),
-            float(t1),
-            sample_count(t, t1),
-            rows,
-            self._speeds,
-            self._geometry,
-            k,
-            t_c - CONTACT_GUARD,
-            0.5 * st.length,
-            0.5 * st.width,
-            hand.tip_radius - 5e-4,
-            check_idle,
-            arrival,
-            hand.tip_radius + p.sweep_margin,
-        )
-        return None if hit else arrival
 
     def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip, n) -> Config | None:
         """Finger k's tip backed away along -n (the way it came, away from the face the contact

@@ -1,9 +1,11 @@
-"""The stick planners' optional sweep accelerator (replay/control/stick/_sweep.c) against their
-NumPy paths (what runs without it): sweep.covered for a fixed point (first / last covered
-sample; Sweep.hits is that too, tests/.../test_stick_fast_paths.py) and ContactPlanner
-.route_clear. The kernel repeats the NumPy operations in the same order, so the answers agree
-exactly on seeded random motions, points and routes, and the random cases exercise both
-answers. Skipped where the accelerator is not built (a pure-Python install, REPLAY_NO_ACCEL)."""
+"""The stick planners' sweep checks against their whole-array NumPy references: sweep
+.first_covered (sweep.covered_fixed: only the samples near the point, looked at one by one with
+the skips the stick's speed and spin allow) against sweep.covered for a fixed point (first /
+last covered sample; Sweep.hits is that too, tests/.../test_stick_fast_paths.py), and
+ContactPlanner.route_clear (the moving hand in arrays, each finger's tips only where its check
+needs them, the standing hand as fixed points) against _route_clear_reference. The same
+operations on the samples they look at, so the answers agree exactly on seeded random motions,
+points and routes, and the random cases exercise both answers."""
 
 from __future__ import annotations
 
@@ -25,9 +27,6 @@ from replay.control.stick.sweep import (
 )
 
 from tests.replay.control.stick.test_stick_method import air_spec
-
-if sweeps._sweep is None:
-    pytest.skip("the sweep accelerator is not built (or REPLAY_NO_ACCEL)", allow_module_level=True)
 
 
 def random_motion(rng) -> Motion:
@@ -57,7 +56,7 @@ def near_points(rng, motion: Motion, t0: float, t1: float, count: int) -> np.nda
 
 
 def test_libm_cos_and_sin_are_numpys():
-    """The kernel's premise: NumPy's float64 cos/sin give libm's (math's) bits here."""
+    """sweep.covered_fixed's premise: NumPy's float64 cos/sin give libm's (math's) bits here."""
     x = np.random.default_rng(20).uniform(-60.0, 60.0, 20000)
     assert all(np.cos(x) == [math.cos(v) for v in x])
     assert all(np.sin(x) == [math.sin(v) for v in x])
@@ -83,15 +82,6 @@ def test_first_and_last_covered_sample_are_numpys():
             else:
                 assert first is None and last is None
     assert 0.1 * cases < hits < 0.9 * cases
-
-
-def route_clear_reference(planner, t, now, route, k, motion, t_c, check_idle=True):
-    """ContactPlanner.route_clear's NumPy path (the accelerator switched off)."""
-    kernel, sweeps._sweep = sweeps._sweep, None
-    try:
-        return planner.route_clear(t, now, route, k, motion, t_c, check_idle)
-    finally:
-        sweeps._sweep = kernel
 
 
 def random_config(rng, hand) -> Config:
@@ -138,7 +128,7 @@ def test_route_clear_is_the_numpy_reference(width):
             before = prev
         for k in (0, 1):
             for check_idle in (True, False):
-                ref = route_clear_reference(planner, t, now, route, k, motion, t_c, check_idle)
+                ref = planner._route_clear_reference(t, now, route, k, motion, t_c, check_idle)
                 got = planner.route_clear(t, now, route, k, motion, t_c, check_idle)
                 assert got == ref
                 cases += 1
@@ -146,7 +136,28 @@ def test_route_clear_is_the_numpy_reference(width):
                 # refused by the sweep, not by the timing: clear of a stick far away
                 hit += (
                     ref is None
-                    and route_clear_reference(planner, t, now, route, k, far, t_c, check_idle)
+                    and planner._route_clear_reference(t, now, route, k, far, t_c, check_idle)
                     is not None
                 )
     assert 0.05 * cases < clear < 0.95 * cases and hit > 0.05 * cases
+
+
+def test_samples_made_alone_are_sample_times():
+    """sample_time, sample_times_at and count_before: the values and counts of sample_times."""
+    rng = np.random.default_rng(24)
+    spans = [(0.0, 0.0), (0.1, 0.05), (1e-310, 2e-310)]
+    spans += [(float(a), float(a + b)) for a, b in rng.uniform(0.0, 0.9, (40, 2))]
+    for t0, t1 in spans:
+        times = sample_times(t0, t1)
+        n = len(times)
+        assert [sweeps.sample_time(t0, t1, i) for i in range(n)] == times.tolist()
+        for lo, hi in ((0, n), (0, 1), (n // 3, n), (n // 2, n // 2 + 2)):
+            assert sweeps.sample_times_at(t0, t1, lo, hi).tolist() == times[lo:hi].tolist()
+        for t in [
+            *times[[0, n // 2, -1]],
+            t0 - 1.0,
+            t1 + 1.0,
+            float(rng.uniform(t0, max(t0, t1) + 0.01)),
+        ]:
+            assert sweeps.count_before(t0, t1, t, inclusive=True) == int(np.sum(times <= t))
+            assert sweeps.count_before(t0, t1, t, inclusive=False) == int(np.sum(times < t))
