@@ -1,4 +1,4 @@
-"""The log's MCAP file (the ``mcap`` library's Writer, replay/log/chunks.py): an index the
+"""The log's MCAP file (foxglove-sdk's writer, replay/log/chunks.py): an index the
 library's readers follow, CRCs that check, sequence numbers per channel, and channels of any
 encoding."""
 
@@ -55,7 +55,7 @@ def test_channels_of_any_encoding_take_raw_bytes(tmp_path):
         ]
     assert got == [
         ("foxglove.CompressedImage", "protobuf", descriptor, "protobuf", data, k)
-        for k, data in enumerate(images)
+        for k, data in enumerate(images, 1)  # (each channel numbered from 1: foxglove-sdk's)
     ]
     r = LogReader(path).check()
     assert r.status == "complete" and not r.problems
