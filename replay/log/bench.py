@@ -69,10 +69,10 @@ def costs(messages: list[tuple[str, object, int]], repeat: int = 5) -> dict[str,
             log = channels.get(topic)
             if log is None:
                 schema = foxglove.Schema(name=topic, encoding="jsonschema", data=b"{}")
-                log = channels[topic] = foxglove.Channel(
-                    topic, message_encoding="json", schema=schema, context=context
-                ).log
-            log(data, log_time=t)
+                log = channels[topic] = context._create_channel(
+                    topic, message_encoding="json", schema=schema
+                ).log  # (as LogWriter makes its channels)
+            log(data, t)
         w.close()
 
     with tempfile.TemporaryDirectory() as tmp:
