@@ -32,6 +32,7 @@ import dataclasses
 import functools
 import glob
 import json
+import logging
 import math
 import os
 import signal
@@ -204,6 +205,17 @@ class _Sink:
         except OSError as exc:
             self._keep(exc)
             raise
+
+
+class _FailedWriteLine(logging.Filter):
+    """Drops foxglove-sdk's own warning about a failed write ("error logging message: ..."):
+    :class:`LogWriter` raises that error itself, as one clean line."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith("error logging message")
+
+
+logging.getLogger("foxglove.log_sink_set").addFilter(_FailedWriteLine())
 
 
 class _HeldSigint:
