@@ -28,23 +28,26 @@ class WindowedImage(NamedTuple):  # (a tuple: ~5x cheaper to make than a frozen 
     def shape(self) -> tuple[int, int]:
         return (self.height, self.width)
 
-    def full(self) -> np.ndarray:
-        """The whole frame as a (height, width) uint8 array."""
-        out = np.full((self.height, self.width), self.background, np.uint8)
+    def full(self, out: np.ndarray | None = None) -> np.ndarray:
+        """The whole frame as a (height, width) uint8 array: ``out`` (such an array, e.g. the
+        last frame's, refilled: no new array a frame) or a new one."""
+        if out is None or out.shape != (self.height, self.width):
+            out = np.empty((self.height, self.width), np.uint8)
+        out.fill(self.background)  # (np.empty + fill: cheaper than np.full)
         x0, y0, x1, y1 = self.window
         out[y0:y1, x0:x1] = self.pixels
         return out
 
 
-def grey(image: np.ndarray | WindowedImage) -> np.ndarray:
+def grey(image: np.ndarray | WindowedImage, out: np.ndarray | None = None) -> np.ndarray:
     """An (h, w) image as 8-bit grey pixels: uint8 as is, bool as 0 / 255, a
-    :class:`WindowedImage` as its whole frame. ValueError for an image it does not take (not
+    :class:`WindowedImage` as its whole frame (in ``out``: :meth:`WindowedImage.full`). ValueError for an image it does not take (not
     2-D, another dtype, pixels that do not fill the window, an empty frame)."""
     if isinstance(image, WindowedImage):
         x0, y0, x1, y1 = image.window
         if image.pixels.dtype != np.uint8 or image.pixels.shape != (y1 - y0, x1 - x0):
             raise ValueError(f"window {image.window}: pixels {image.pixels.shape}")
-        image = image.full()
+        image = image.full(out)
     image = np.asarray(image)
     if image.ndim != 2 or image.size == 0:
         raise ValueError(f"a grey image is 2-D and not empty, not of shape {image.shape}")
@@ -55,9 +58,12 @@ def grey(image: np.ndarray | WindowedImage) -> np.ndarray:
     return image
 
 
-def raw_image(image: np.ndarray | WindowedImage, frame_id: str, t_ns: int) -> bytes:
-    """``foxglove.RawImage`` (mono8) of an image (:func:`grey`) captured at ``t_ns``."""
-    pixels = grey(image)
+def raw_image(
+    image: np.ndarray | WindowedImage, frame_id: str, t_ns: int, out: np.ndarray | None = None
+) -> bytes:
+    """``foxglove.RawImage`` (mono8) of an image (:func:`grey`, a windowed one's frame built in
+    ``out`` when given) captured at ``t_ns``."""
+    pixels = grey(image, out)
     h, w = pixels.shape
     sec, nsec = divmod(t_ns, 1_000_000_000)
     return RawImage(

@@ -204,9 +204,8 @@ class FoxgloveTopics:
         self.log = log  # a replay.log.LogWriter
         self._channels: dict[str, int] = {}  # topic -> channel id
         self._schemas: dict[str, int] = {}  # schema name -> id (each stored once)
-        self._images: dict[
-            str, dict[str, tuple[int, str]]
-        ] = {}  # sensor -> view -> (channel id, frame id)
+        # sensor -> view -> (channel id, frame id, the array its windowed frames are built in)
+        self._images: dict[str, dict[str, tuple[int, str, np.ndarray]]] = {}
 
     def _channel(self, topic: str, schema: str, encoding: str, data: bytes, message: str) -> int:
         if schema not in self._schemas:
@@ -269,5 +268,6 @@ class FoxgloveTopics:
             got = views.get(view)
             if got is None:
                 channel = self._proto_channel(camera_topic(sensor, view), RawImage)
-                got = views[view] = (channel, f"{sensor}/{view}")
-            self.log.write_raw(got[0], raw_image(image, got[1], t_ns), t_ns)
+                shape = image.shape if isinstance(image, WindowedImage) else (0, 0)
+                got = views[view] = (channel, f"{sensor}/{view}", np.empty(shape, np.uint8))
+            self.log.write_raw(got[0], raw_image(image, got[1], t_ns, got[2]), t_ns)

@@ -2,7 +2,7 @@
 
 The messages of a short run of each scenario are kept (deep copies, as the observers saw them),
 then written again and again, CPU time (``time.process_time``), best of ``--repeat``: the JSON
-encoding alone; the MCAP records of the encoded bytes through the ``mcap`` library's ``Writer``
+encoding alone; the MCAP records of the encoded bytes through foxglove-sdk's MCAP writer
 as the log configures it (``replay.log.chunks``: zstd chunks); and the whole ``LogWriter.write``
 as the runner calls it (a log's opening and closing, once a run, apart). Nothing here is a
 test.
@@ -16,6 +16,9 @@ import io
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
+
+import foxglove
 
 from replay.log.chunks import mcap_writer
 from replay.log.writer import LogWriter, encode
@@ -59,20 +62,18 @@ def costs(messages: list[tuple[str, object, int]], repeat: int = 5) -> dict[str,
             encode(topic, p)
 
     def records() -> None:
-        w = mcap_writer(io.BytesIO(), chunk_size=CHUNK)
-        w.start()
-        channels: dict[str, int] = {}
-        sequence: dict[str, int] = {}
+        context = foxglove.Context()
+        w = mcap_writer(io.BytesIO(), context, chunk_size=CHUNK)
+        channels: dict[str, Any] = {}
         for topic, data, t in encoded:
-            c = channels.get(topic)
-            if c is None:
-                c = channels[topic] = w.register_channel(
-                    topic, "json", w.register_schema(topic, "jsonschema", b"{}")
-                )
-                sequence[topic] = 0
-            w.add_message(c, log_time=t, data=data, publish_time=t, sequence=sequence[topic])
-            sequence[topic] += 1
-        w.finish()
+            log = channels.get(topic)
+            if log is None:
+                schema = foxglove.Schema(name=topic, encoding="jsonschema", data=b"{}")
+                log = channels[topic] = context._create_channel(
+                    topic, message_encoding="json", schema=schema
+                ).log  # (as LogWriter makes its channels)
+            log(data, t)
+        w.close()
 
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "x.mcap"
@@ -113,7 +114,7 @@ def main(argv=None) -> None:
         print(
             f"log messages of {scenario} ({len(messages)} in {args.duration:g} s, {size:.0f} B "
             f"of JSON each), CPU us a message: LogWriter.write {1e6 * c['write']:.2f} = JSON "
-            f"{1e6 * c['encode']:.2f} + MCAP records and zstd (the mcap library's Writer) "
+            f"{1e6 * c['encode']:.2f} + MCAP records and zstd (foxglove-sdk's writer) "
             f"{1e6 * c['records']:.2f} + the rest; "
             f"opening and closing a log: {1e3 * c['open_close']:.1f} ms",
             flush=True,

@@ -1,4 +1,4 @@
-"""The log's MCAP file (the ``mcap`` library's Writer, replay/log/chunks.py): an index the
+"""The log's MCAP file (foxglove-sdk's writer, replay/log/chunks.py): an index the
 library's readers follow, CRCs that check, sequence numbers per channel, and channels of any
 encoding."""
 
@@ -55,7 +55,7 @@ def test_channels_of_any_encoding_take_raw_bytes(tmp_path):
         ]
     assert got == [
         ("foxglove.CompressedImage", "protobuf", descriptor, "protobuf", data, k)
-        for k, data in enumerate(images)
+        for k, data in enumerate(images, 1)  # (each channel numbered from 1: foxglove-sdk's)
     ]
     r = LogReader(path).check()
     assert r.status == "complete" and not r.problems
@@ -68,3 +68,35 @@ def test_a_topic_has_one_channel(tmp_path):
         log.write("/events", Event(0.0, "a"), 0)
         with pytest.raises(LogError, match="/events already has a channel"):
             log.register_channel("/events", "protobuf")
+
+
+def test_a_failed_write_raises_from_the_write_that_made_it(tmp_path, monkeypatch, caplog):
+    """foxglove-sdk's writer only logs a failed write of its file: LogWriter raises it (errno
+    kept) from the write whose chunk could not be written, and the SDK's own warning line is
+    not shown besides."""
+    import errno
+    import logging
+    import os
+
+    from replay.log.writer import LogWriteError, _FlushedFile
+
+    write, calls = _FlushedFile.write, []
+
+    def full(self, data):
+        calls.append(len(data))
+        if len(calls) > 4:  # the header and a chunk fit, the next chunk does not
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return write(self, data)
+
+    monkeypatch.setattr(_FlushedFile, "write", full)
+    caplog.set_level(logging.DEBUG)
+    log = LogWriter(tmp_path / "x.mcap", chunk_size=1_000)
+    written = 0
+    with pytest.raises(LogWriteError, match="No space left on device") as failed:
+        for k in range(1_000):
+            log.write("/events", Event(k * 1e-3, "tick", {"k": k}), k * 1_000_000)
+            written += 1
+    assert failed.value.errno == errno.ENOSPC and 0 < written < 100 and log.count == written
+    assert not [r for r in caplog.records if r.name.startswith("foxglove")]
+    with pytest.raises(LogWriteError):
+        log.close("failed")

@@ -32,7 +32,7 @@ def _payload(rng):
 
 def test_a_refused_payload_writes_nothing_and_sequences_count_per_channel(tmp_path):
     """Seeded random payloads of what runs log: each is written or refused whole (a refusal
-    leaves the count as it was), and each channel's messages are numbered 0, 1, 2, ..."""
+    leaves the count as it was), and each channel's messages are numbered 1, 2, 3, ..."""
     rng = np.random.default_rng(3)
     topics = [f"/t{i}" for i in range(6)] + ["/stick/state", "/events"]
     written: dict[str, int] = {}
@@ -53,7 +53,7 @@ def test_a_refused_payload_writes_nothing_and_sequences_count_per_channel(tmp_pa
         for _, channel, message in make_reader(f).iter_messages(log_time_order=False):
             seqs.setdefault(channel.topic, []).append(message.sequence)
     assert {t: len(v) for t, v in seqs.items()} == written
-    assert all(v == list(range(len(v))) for v in seqs.values())
+    assert all(v == list(range(1, len(v) + 1)) for v in seqs.values())
 
 
 def _write_dicts(path, groups, compiled: bool):
