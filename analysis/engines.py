@@ -86,13 +86,13 @@ def evaluate_runs(
 ) -> tuple[list[Claim], str]:
     """(rows, note) as the claims table and the report show them: with MuJoCo runs among
     ``logs`` both engines side by side, then the stored robustness rates of both on the same
-    inputs (``stored_rate_rows``), and the closing note; else the paper's rows alone."""
+    inputs (``stored_rate_rows``), and the closing note over both; else the paper's rows
+    alone."""
     if not any(n.endswith(SUFFIX) for n in logs):
         return evaluate(dict(logs)), ""
-    rows = engine_rows(evaluate, logs)
-    note = closing_note(rows)
     papers = {log.scenario()["paper"] for log in logs.values() if hasattr(log, "scenario")}
-    return rows + [r for p in sorted(papers) for r in stored_rate_rows(p)], note
+    rows = engine_rows(evaluate, logs) + [r for p in sorted(papers) for r in stored_rate_rows(p)]
+    return rows, closing_note(rows)
 
 
 def rate_row(label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]]) -> Claim:

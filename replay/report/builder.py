@@ -28,6 +28,7 @@ PACKAGES = (
     "scipy",
     "pymunk",
     "pybullet",
+    "mujoco",
     "opencv-python-headless",
     "mcap",
     "matplotlib",
@@ -150,6 +151,12 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
         sections.append(sec)
     info = _provenance(code_version())
     commands = _commands(sections, logs)
+    from analysis.engine_rates import COMMAND, TABLE
+    from replay.resources import data_path
+
+    if any(COMMAND in c.note for sec in sections for c in sec.claims):  # the stored rate rows'
+        (out / "tables").mkdir(exist_ok=True)
+        shutil.copy(data_path("ablations", f"{TABLE}.csv"), out / "tables" / f"{TABLE}.csv")
     (out / "index.md").write_text(_markdown(sections, info, commands), encoding="utf-8")
     (out / "index.html").write_text(_html(sections, info, commands), encoding="utf-8")
     return out / "index.html"
@@ -226,6 +233,10 @@ def _commands(sections, logs) -> list[str]:
     for sec in sections:
         for a in sec.ablations:
             cmds.append(f"{a.command} --store   # table: {a.source}")
+    from analysis.engine_rates import COMMAND, TABLE
+
+    if any(COMMAND in c.note for sec in sections for c in sec.claims):
+        cmds.append(f"{COMMAND}   # both engines' rates: tables/{TABLE}.csv (stored)")
     cmds.append("replay report")
     return cmds
 

@@ -144,7 +144,8 @@ def test_claims_show_the_rates_only_beside_both_engines(stored):
     rows, note = evaluate_runs(evaluate, logs)
     rates = [r for r in rows if "engine_rates.csv" in r.note]
     assert [r.quantity for r in rates] == [grasp_set(n, len(GRASP_PATHS)) for n in GRASP_SCENARIOS]
-    assert "grasp_sphere: q" in note.splitlines()[0]  # the closing note: the paper's rows
+    both = note.splitlines()[0]  # the closing note: the paper's rows and the rates
+    assert "grasp_sphere: q" in both and all(r.quantity in both for r in rates), note
 
 
 def test_the_report_names_the_mujoco_version():
@@ -153,3 +154,16 @@ def test_the_report_names_the_mujoco_version():
     from replay.report.builder import _provenance
 
     assert _provenance("x")["mujoco"] == metadata.version("mujoco")
+
+
+def test_the_report_names_the_command_of_the_stored_rates():
+    from types import SimpleNamespace
+
+    from analysis.engine_rates import COMMAND
+    from replay.report.builder import _commands
+
+    rows = stored_rate_rows("namiki2003", STORED)
+    with_rates = [SimpleNamespace(runs=[], falsifiers=(), ablations=[], key="k", claims=rows)]
+    assert any(c.startswith(COMMAND) for c in _commands(with_rates, []))
+    with_rates[0].claims = []
+    assert not any(c.startswith(COMMAND) for c in _commands(with_rates, []))
