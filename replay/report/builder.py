@@ -256,8 +256,8 @@ def _markdown(sections, info, commands) -> str:
         lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
         if sec.runs:
             lines += ["Runs: " + ", ".join(f"`{n}` (seed {s})" for n, s, _ in sec.runs), ""]
-        for note in sec.notes:
-            lines += [f"> {note}", ""]
+        for note in sec.notes:  # every line of a note quoted (the engines' note has three)
+            lines += ["\n>\n".join(f"> {x}" for x in note.splitlines()), ""]
         if sec.figures:
             lines += ["### Figures", ""]
             for f in sec.figures:
@@ -345,7 +345,7 @@ def _html(sections, info, commands) -> str:
                 + ", ".join(f"<code>{_e(n)}</code> (seed {s})" for n, s, _ in sec.runs)
                 + "</p>"
             )
-        h += [f"<p class='note'>{_e(n)}</p>" for n in sec.notes]
+        h += [f"<p class='note'>{'<br>'.join(map(_e, n.splitlines()))}</p>" for n in sec.notes]
         if sec.figures:
             h.append("<h3>Figures</h3>")
             for f in sec.figures:

@@ -167,3 +167,13 @@ def test_the_report_names_the_command_of_the_stored_rates():
     assert any(c.startswith(COMMAND) for c in _commands(with_rates, []))
     with_rates[0].claims = []
     assert not any(c.startswith(COMMAND) for c in _commands(with_rates, []))
+
+
+def test_the_reports_engine_note_keeps_its_lines():
+    """The closing note's three lines (both, one, neither) stay three in Markdown and HTML."""
+    from replay.report.builder import PaperSection, _html, _markdown
+
+    sec = PaperSection("k", "T", "A", notes=["Hold in both: a\nHold in one: b\nneither: c"])
+    md = _markdown([sec], {}, [])
+    assert "> Hold in both: a\n>\n> Hold in one: b\n>\n> neither: c" in md
+    assert "Hold in both: a<br>Hold in one: b<br>neither: c</p>" in _html([sec], {}, [])
