@@ -296,9 +296,10 @@ def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
     return float(max(0.0, mid - half)), float(min(1.0, mid + half))
 
 
-def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, out=None):
+def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, out=None, extra=()):
     """Every controller on every cell's n seeded throws (the same throws for all): one row per
-    run with the plant's outcome (success, reason). ``out``: a CSV path to write."""
+    run with the plant's outcome (success, reason). ``out``: a CSV path to write; ``extra``:
+    ``--set`` strings applied to every run after the cell's."""
     import csv
     import json
     import tempfile
@@ -321,7 +322,10 @@ def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, 
                 for i, th in enumerate(throws):
                     sc = load_scenario(
                         root / "scenarios" / f"{name}.yaml",
-                        throw_overrides(th) + sets + ["timing.duration=0.45", "stop.after=0.0"],
+                        throw_overrides(th)
+                        + sets
+                        + list(extra)
+                        + ["timing.duration=0.45", "stop.after=0.0"],
                     )
                     o = Runner(sc).run(Path(tmp) / "run.mcap").outcome
                     rows.append(

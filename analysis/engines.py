@@ -16,7 +16,9 @@ Wiring (for the claims table and the report): ``engine_rows(evaluate, logs)`` in
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 from analysis.claims import Claim
@@ -83,29 +85,76 @@ def evaluate_runs(
     evaluate: Callable[[dict], list[Claim]], logs: Mapping[str, Any]
 ) -> tuple[list[Claim], str]:
     """(rows, note) as the claims table and the report show them: with MuJoCo runs among
-    ``logs`` both engines side by side and the closing note; else the paper's rows alone."""
+    ``logs`` both engines side by side, then the stored robustness rates of both on the same
+    inputs (``stored_rate_rows``), and the closing note over both; else the paper's rows
+    alone."""
     if not any(n.endswith(SUFFIX) for n in logs):
         return evaluate(dict(logs)), ""
-    rows = engine_rows(evaluate, logs)
+    papers = {log.scenario()["paper"] for log in logs.values() if hasattr(log, "scenario")}
+    rows = engine_rows(evaluate, logs) + [r for p in sorted(papers) for r in stored_rate_rows(p)]
     return rows, closing_note(rows)
 
 
 def rate_row(label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]]) -> Claim:
     """A catch (or grasp) rate per engine on the same perturbed set: ``outcomes`` maps an
-    engine to its runs' ``outcome`` data (the plants' verdict). Reproduced when every engine
-    reaches 90 %; the failures' reasons in the note."""
-    parts, notes, ok = [], [], True
+    engine to its runs' verdicts (``success``, ``reason``), each rate with its Wilson 95 %
+    interval. Reproduced when every engine reaches 90 %; where the engines part the note says
+    so (and whether their intervals overlap), then each engine's failures with their reasons."""
+    from analysis.ablation_catch import wilson
+
+    parts, notes, passed, spans = [], [], {}, []
     for engine, res in outcomes.items():
         n = len(res)
         k = sum(bool(o["success"]) for o in res)
-        parts.append(f"{engine}: {k}/{n} = {100 * k / n:.0f} %" if n else f"{engine}: not run")
-        ok = ok and n > 0 and k >= 0.9 * n
-        fails = sorted({str(o["reason"]) for o in res if not o["success"]})
-        if fails:
-            notes.append(f"{engine} failures: {'; '.join(fails)}")
-    return Claim(
-        label, stated, ", ".join(parts), "reproduced" if ok else "differs", "; ".join(notes)
-    )
+        if n:
+            lo, hi = wilson(k, n)
+            spans.append((lo, hi))
+            parts.append(
+                f"{engine}: {k}/{n} = {100 * k / n:.0f} % [{100 * lo:.0f}–{100 * hi:.0f} %]"
+            )
+        else:
+            parts.append(f"{engine}: not run")
+        passed[engine] = n > 0 and k >= 0.9 * n
+        why = Counter(str(o["reason"]) for o in res if not o["success"])
+        if why:
+            fails = "; ".join(f"{v}× {x}" for x, v in why.most_common())
+            notes.append(f"{engine} failures: {fails}")
+    if len(set(passed.values())) > 1:
+        verdicts = ", ".join(f"{e} {'reproduced' if v else 'differs'}" for e, v in passed.items())
+        overlap = len(spans) == len(passed) and max(s[0] for s in spans) <= min(s[1] for s in spans)
+        notes.insert(
+            0,
+            f"engines part: {verdicts}"
+            + (" (their intervals overlap: within the sampling error)" if overlap else ""),
+        )
+    status = "reproduced" if all(passed.values()) else "differs"
+    return Claim(label, stated, " ‖ ".join(parts), status, "; ".join(notes))
+
+
+def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
+    """``paper``'s robustness rate rows from the stored runs of both engines on the same inputs
+    (data/ablations/engine_rates.csv, made by ``python -m analysis.engine_rates``): one per
+    set; none when the table has no runs of the paper."""
+    from analysis.engine_rates import COMMAND, TABLE, read
+    from replay.resources import data_path
+
+    path = path or data_path("ablations", f"{TABLE}.csv")
+    rows = [r for r in read(path) if r["paper"] == paper]
+    source = f"stored runs: data/ablations/{path.name} ({COMMAND})"
+    out = []
+    for s in dict.fromkeys(r["set"] for r in rows):
+        by_engine = {e: [r for r in rows if r["set"] == s and r["engine"] == e] for e in ENGINES}
+        row = rate_row(s, "≥ 90 % in each engine (issue #24)", by_engine)
+        probes = {r["engine"]: [] for r in rows if r["set"] == s and r["engine"] not in ENGINES}
+        for r in rows:
+            if r["engine"] in probes and r["set"] == s:
+                probes[r["engine"]].append(r)
+        why = [
+            "probe " + rate_row(s, "", {label: res}).measured for label, res in probes.items()
+        ]  # the twin with one setting changed, on the same inputs (analysis/engine_rates.py)
+        row.note = "; ".join(x for x in (row.note, *why, source) if x)
+        out.append(row)
+    return out
 
 
 def closing_note(rows: Sequence[Claim]) -> str:

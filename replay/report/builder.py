@@ -28,6 +28,7 @@ PACKAGES = (
     "scipy",
     "pymunk",
     "pybullet",
+    "mujoco",
     "opencv-python-headless",
     "mcap",
     "matplotlib",
@@ -150,6 +151,12 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
         sections.append(sec)
     info = _provenance(code_version())
     commands = _commands(sections, logs)
+    from analysis.engine_rates import COMMAND, TABLE
+    from replay.resources import data_path
+
+    if any(COMMAND in c.note for sec in sections for c in sec.claims):  # the stored rate rows'
+        (out / "tables").mkdir(exist_ok=True)
+        shutil.copy(data_path("ablations", f"{TABLE}.csv"), out / "tables" / f"{TABLE}.csv")
     (out / "index.md").write_text(_markdown(sections, info, commands), encoding="utf-8")
     (out / "index.html").write_text(_html(sections, info, commands), encoding="utf-8")
     return out / "index.html"
@@ -226,6 +233,10 @@ def _commands(sections, logs) -> list[str]:
     for sec in sections:
         for a in sec.ablations:
             cmds.append(f"{a.command} --store   # table: {a.source}")
+    from analysis.engine_rates import COMMAND, TABLE
+
+    if any(COMMAND in c.note for sec in sections for c in sec.claims):
+        cmds.append(f"{COMMAND}   # both engines' rates: tables/{TABLE}.csv (stored)")
     cmds.append("replay report")
     return cmds
 
@@ -245,8 +256,8 @@ def _markdown(sections, info, commands) -> str:
         lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
         if sec.runs:
             lines += ["Runs: " + ", ".join(f"`{n}` (seed {s})" for n, s, _ in sec.runs), ""]
-        for note in sec.notes:
-            lines += [f"> {note}", ""]
+        for note in sec.notes:  # every line of a note quoted (the engines' note has three)
+            lines += ["\n>\n".join(f"> {x}" for x in note.splitlines()), ""]
         if sec.figures:
             lines += ["### Figures", ""]
             for f in sec.figures:
@@ -334,7 +345,7 @@ def _html(sections, info, commands) -> str:
                 + ", ".join(f"<code>{_e(n)}</code> (seed {s})" for n, s, _ in sec.runs)
                 + "</p>"
             )
-        h += [f"<p class='note'>{_e(n)}</p>" for n in sec.notes]
+        h += [f"<p class='note'>{'<br>'.join(map(_e, n.splitlines()))}</p>" for n in sec.notes]
         if sec.figures:
             h.append("<h3>Figures</h3>")
             for f in sec.figures:

@@ -64,6 +64,14 @@ def test_rows_that_part_say_so():
 def test_rate_row():
     ok, bad = {"success": True, "reason": "caught"}, {"success": False, "reason": "x"}
     r = rate_row("rate", "≥ 90 %", {"PyBullet": [ok] * 10, "MuJoCo": [ok] * 9 + [bad]})
-    assert r.status == "reproduced" and "MuJoCo: 9/10 = 90 %" in r.measured
+    assert r.status == "reproduced" and "MuJoCo: 9/10 = 90 % [60–98 %]" in r.measured
+    assert r.measured.startswith("PyBullet: 10/10 = 100 % [72–100 %] ‖ ")
+    assert r.note == "MuJoCo failures: 1× x"
     r = rate_row("rate", "≥ 90 %", {"PyBullet": [ok] * 10, "MuJoCo": [ok] * 8 + [bad] * 2})
-    assert r.status == "differs" and "MuJoCo failures: x" in r.note
+    assert r.status == "differs" and "MuJoCo failures: 2× x" in r.note
+    # the engines part, but 10/10 and 8/10 are within each other's sampling error
+    assert r.note.startswith("engines part: PyBullet reproduced, MuJoCo differs (their intervals")
+    r = rate_row("rate", "≥ 90 %", {"PyBullet": [ok] * 40, "MuJoCo": [ok] * 20 + [bad] * 20})
+    assert r.note.startswith("engines part: PyBullet reproduced, MuJoCo differs; ")
+    r = rate_row("rate", "≥ 90 %", {"PyBullet": [bad] * 3, "MuJoCo": []})
+    assert r.status == "differs" and r.measured.endswith("MuJoCo: not run")

@@ -2,7 +2,7 @@
 their PyBullet twins only in the plant; the plant gives the PyBullet rig's truth topics with the
 same fields; box and ball are grasped and held on seeds and human speeds the scenarios do not use
 (they use seed 0 at 0.10 m/s), judged from the truth topics by the PyBullet robustness test's
-own criterion (tests/grasp_judge.py), >= 90 %; and the contact stiffness chosen (solref) still
+own criterion (analysis/grasp_judge.py), >= 90 %; and the contact stiffness chosen (solref) still
 grasps at half and twice its value."""
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from grasp_judge import physical_verdict
 from grasp_rig import DT, rig
 
+from analysis.grasp_judge import physical_verdict
 from plants.mujoco_arm.grasp_plant import MujocoGraspPlant
 from plants.mujoco_arm.params import GraspParams
 from plants.mujoco_arm.viewer_scene import MujocoGraspScene

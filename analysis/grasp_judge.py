@@ -1,6 +1,7 @@
 """The grasp's physical criterion from the truth topics alone (issue #20), shared by the PyBullet
 and MuJoCo robustness tests (tests/analysis/test_grasp_robustness.py,
-tests/plants/mujoco_arm/test_grasp_mujoco.py), never by the run's outcome flag:
+tests/plants/mujoco_arm/test_grasp_mujoco.py) and the stored per-engine rates
+(analysis/engine_rates.py), never by the run's outcome flag:
 
 - grasped: the plant's grasp event (contacts) and the object held for >= 0.5 s after it;
 - held: during that hold the object stays within 10 mm of where it sat in the true hand frame;
