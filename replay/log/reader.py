@@ -34,6 +34,10 @@ from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
 _OPCODES = range(0x01, 0x10)  # MCAP's record opcodes (0x00 is none: zeros are not records)
 _HEAD = struct.Struct("<BQ")  # a record's opcode and length
+# A chunk being written: foxglove-sdk's writer (the Rust mcap crate) puts a chunk's header down
+# with every length all ones, and writes its data and the real lengths when the chunk is done;
+# a run killed meanwhile ends on this header, a record cut short, not garbage.
+_CHUNK_OPCODE, _LENGTH_PENDING = 0x06, (1 << 64) - 1
 
 
 def content_end(f, size: int) -> tuple[int, bool]:
@@ -51,7 +55,8 @@ def content_end(f, size: int) -> tuple[int, bool]:
                 return pos + len(MAGIC), False
             return pos, False
         if length > min(_RECORD_LIMIT, size - pos - _HEAD.size):
-            return pos, length <= _RECORD_LIMIT
+            pending = opcode == _CHUNK_OPCODE and length == _LENGTH_PENDING
+            return pos, length <= _RECORD_LIMIT or pending
         pos += _HEAD.size + length
     return pos, pos < size
 

@@ -164,7 +164,9 @@ def test_killed_run_leaves_a_readable_part_file(toy_yaml, tmp_path):
     assert not out.exists()
     part = tmp_path / f"killed.mcap.{proc.pid}.part"  # the run's own name: its pid
     r = LogReader(part)
-    assert r.truncated
+    # truncated, not damaged: the writer's chunk in progress (its header down, lengths pending)
+    # is a record cut short
+    assert r.status == "truncated", r.problems
     states = r.series("/toy/state")
     assert len(states) > 100 and json.dumps(states[-1])
 
