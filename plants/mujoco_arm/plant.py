@@ -20,7 +20,7 @@ from typing import cast
 import mujoco
 import numpy as np
 
-from plants.bullet_arm.arm_state import limit_flags
+from plants.bullet_arm.arm_state import TorqueLimits, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
@@ -70,7 +70,7 @@ def _floats(values, n: int, what: str) -> list[float]:
     return a.tolist()
 
 
-class MujocoArmPlant(Plant):
+class MujocoArmPlant(TorqueLimits, Plant):
     Params = MujocoParams
     spec_type = ArmSpec
     command_types = (ArmCommand,)
@@ -354,45 +354,6 @@ class MujocoArmPlant(Plant):
             self._hand_target = [
                 min(max(x, lo), hi) for x, lo, hi in zip(h, self._hand_lo_l, self._hand_hi_l)
             ]
-
-    def _limit_torque(self, qdl: list) -> None:
-        """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
-        locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
-        its speed limit further (the PyBullet plant's rule)."""
-        applied, clamped = [0.0] * self.dof, [False] * self.dof
-        for i, (x, lim) in enumerate(zip(self._tau_cmd, self._tlim_l)):
-            if self._locked_l[i]:
-                continue
-            if not math.isfinite(x):
-                clamped[i] = True
-                continue
-            a = min(max(x, -lim), lim)
-            c = a != x
-            if (
-                self._enforce_vlim
-                and abs(qdl[i]) >= self._vlim_l[i]
-                and a * qdl[i] > 0.0  # the same sign, neither zero
-            ):
-                a, c = 0.0, True
-            applied[i], clamped[i] = a, c
-        self._tau_applied = applied
-        if True in clamped:
-            for i, c in enumerate(clamped):
-                if c and not self._torque_episode[i]:
-                    x = self._tau_cmd[i]
-                    self._events.append(
-                        Occurrence(
-                            "torque_limit",
-                            {
-                                "joint": self.joint_names[i],
-                                "commanded": x if math.isfinite(x) else None,
-                                "applied": applied[i],
-                                "limit": self._tlim_l[i],
-                            },
-                        )
-                    )
-            self.clamp_count += sum(clamped)
-        self._clamped = self._torque_episode = clamped
 
     def _hand_effort(self, v: list) -> list[float]:
         """The hand servos' torques of the last step (N*m): where clipped, MuJoCo's
