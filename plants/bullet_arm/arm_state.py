@@ -86,7 +86,7 @@ class TorqueLimits:
     _locked_l: list
     _enforce_vlim: bool
     _events: list
-    joint_names: tuple | list
+    joint_names: tuple[str, ...]
     clamp_count: int
 
     def _limit_torque(self, qdl: list) -> None:

@@ -375,16 +375,13 @@ class PolynomialB:
         self.powers[:, selected] += 2  # actual powers of eq. 12
         self.n_mono = len(exps)
         self.n_alpha = self.n_mono * n_joints
-        # coefficients_one's per monomial: (a, b, c), then per variable the factors and the
-        # powers of the first and second derivatives (e x^(e-1), e (e-1) x^(e-2)); a factor 0.0
-        # with power 0 (x^0 = 1.0) where the derivative vanishes: 0.0, as the branch it replaces
+        # coefficients_one's per monomial: the powers (a, b, c) and the indices of x^(e-1) and
+        # x^(e-2) per variable, then the factors e and e (e - 1): a factor 0.0 with index 0
+        # (x^0 = 1.0) where the derivative vanishes gives 0.0, as the branch it replaces
         self._powers_t = tuple(
             (
-                a,
-                b,
-                c,
-                *(x for e in (a, b, c) for x in (float(e), max(e - 1, 0))),
-                *(x for e in (a, b, c) for x in (float(e * (e - 1)), max(e - 2, 0))),
+                (a, b, c, *(max(e - 1, 0) for e in (a, b, c)), *(max(e - 2, 0) for e in (a, b, c))),
+                (*(float(e) for e in (a, b, c)), *(float(e * (e - 1)) for e in (a, b, c))),
             )
             for a, b, c in (tuple(int(e) for e in row) for row in self.powers)
         )
@@ -441,7 +438,7 @@ class PolynomialB:
         u0, u1, u2 = pd
         v0, v1, v2 = pdd
         m, m1, m2 = [], [], []
-        for a, b, c, ka, ia, kb, ib, kc, ic, la, ja, lb, jb, lc, jc in self._powers_t:
+        for (a, b, c, ia, ib, ic, ja, jb, jc), (ka, kb, kc, la, lb, lc) in self._powers_t:
             fa, fb, fc = X[a], Y[b], Z[c]
             ga, gb, gc = ka * X[ia], kb * Y[ib], kc * Z[ic]  # d x^e / dx = e x^(e-1)
             ha, hb, hc = la * X[ja], lb * Y[jb], lc * Z[jc]  # e (e-1) x^(e-2)
