@@ -1,9 +1,12 @@
 """The arm plant's once-a-step state arithmetic in Python floats (``joint_state``,
-``limit_flags``: the PyBullet and MuJoCo arm plants run them)."""
+``limit_flags``, ``limit_torque`` and ``torque_limit_events``, the ``TorqueLimits`` step of
+both): the PyBullet and MuJoCo arm plants run them."""
 
 from __future__ import annotations
 
 import math
+
+from replay.interfaces import Occurrence
 
 
 def joint_state(states: tuple, na: int, pick: tuple, locked: list) -> tuple:
@@ -31,3 +34,87 @@ def limit_flags(q, qd, pos, v, vlim, lower, upper, over0, at0):
     if over == over0 and at == at0:
         return None
     return (True, over, at)
+
+
+def limit_torque(cmd: list, tlim: list, locked: list, enforce: bool, vlim: list, qd: list):
+    """(applied, clamped) per joint: the commanded torque clipped to the limits ``tlim``
+    (non-finite: 0, clamped), zero on a ``locked`` joint and, with ``enforce``, zero where it
+    would push a joint at its speed limit ``vlim`` further (clamped). The usual case (no speed
+    limit enforced, every command finite) in one pass over the joints; else joint by joint
+    (:func:`limit_torque_loop`, the same results)."""
+    if enforce or not math.isfinite(sum(cmd)):
+        return limit_torque_loop(cmd, tlim, locked, enforce, vlim, qd)
+    applied = [min(max(x, -lim), lim) for x, lim in zip(cmd, tlim)]
+    clamped = [a != x for a, x in zip(applied, cmd)]
+    if True in locked:
+        for i, lk in enumerate(locked):
+            if lk:
+                applied[i], clamped[i] = 0.0, False
+    return applied, clamped
+
+
+def limit_torque_loop(cmd: list, tlim: list, locked: list, enforce: bool, vlim: list, qd: list):
+    """:func:`limit_torque` joint by joint in plain Python (4-7 floats)."""
+    n = len(cmd)
+    applied, clamped = [0.0] * n, [False] * n
+    for i, (x, lim) in enumerate(zip(cmd, tlim)):
+        if locked[i]:
+            continue
+        if not math.isfinite(x):
+            clamped[i] = True  # a non-finite command gives no torque
+            continue
+        a = min(max(x, -lim), lim)
+        c = a != x
+        v = qd[i]
+        if enforce and abs(v) >= vlim[i] and a != 0.0 and (a > 0.0) == (v > 0.0):  # same sign
+            a, c = 0.0, True
+        applied[i], clamped[i] = a, c
+    return applied, clamped
+
+
+class TorqueLimits:
+    """The arm plants' torque limiting, one home for the PyBullet and MuJoCo plants: each step
+    the command ``_tau_cmd`` becomes ``_tau_applied`` and ``_clamped`` (:func:`limit_torque`),
+    with a ``torque_limit`` event per joint clamped anew and the count ``clamp_count``."""
+
+    _tau_cmd: list
+    _tau_applied: list
+    _clamped: list
+    _torque_episode: list
+    _tlim_l: list
+    _vlim_l: list
+    _locked_l: list
+    _enforce_vlim: bool
+    _events: list
+    joint_names: tuple[str, ...]
+    clamp_count: int
+
+    def _limit_torque(self, qdl: list) -> None:
+        cmd = self._tau_cmd
+        applied, clamped = limit_torque(
+            cmd, self._tlim_l, self._locked_l, self._enforce_vlim, self._vlim_l, qdl
+        )
+        self._tau_applied = applied
+        if True in clamped:
+            self._events += torque_limit_events(
+                clamped, self._torque_episode, cmd, applied, self.joint_names, self._tlim_l
+            )
+            self.clamp_count += sum(clamped)
+        self._clamped = self._torque_episode = clamped
+
+
+def torque_limit_events(clamped, episode, cmd, applied, names, tlim) -> list[Occurrence]:
+    """A ``torque_limit`` event per joint clamped now and not in the step before (``episode``)."""
+    return [
+        Occurrence(
+            "torque_limit",
+            {
+                "joint": names[i],
+                "commanded": cmd[i] if math.isfinite(cmd[i]) else None,
+                "applied": applied[i],
+                "limit": tlim[i],
+            },
+        )
+        for i, c in enumerate(clamped)
+        if c and not episode[i]
+    ]

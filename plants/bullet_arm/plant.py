@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from plants.bullet_arm.arm_state import joint_state, limit_flags
+from plants.bullet_arm.arm_state import TorqueLimits, joint_state, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.params import Params
@@ -73,7 +73,7 @@ def _floats(values, n: int, what: str) -> list[float]:
     return a.tolist()
 
 
-class BulletArmPlant(Plant):
+class BulletArmPlant(TorqueLimits, Plant):
     Params = Params
     spec_type = ArmSpec
     command_types = (ArmCommand,)
@@ -242,7 +242,6 @@ class BulletArmPlant(Plant):
         self._tlim_l = self.torque_limits.tolist()
         self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
         self._locked_l = [n in self.locked for n in self.joint_names]
-        self._locked_i = [i for i, x in enumerate(self._locked_l) if x]
         self._enforce_vlim = bool(P.enforce_velocity_limits)
         self._contact_summary = (None, (), (), 0.0)  # (contacts list it is of, parts, links, N)
         self._contact_key: tuple = ()  # the touching links of the last summary, and their names
@@ -404,65 +403,6 @@ class BulletArmPlant(Plant):
             self._hand_target = [
                 min(max(x, lo), hi) for x, lo, hi in zip(h, self._hand_lo_l, self._hand_hi_l)
             ]
-
-    def _limit_torque(self, qdl: list) -> None:
-        """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
-        locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
-        its speed limit further. The usual case (no speed limit enforced, every command finite)
-        in one pass over the joints; else joint by joint (``_limit_torque_loop``)."""
-        cmd = self._tau_cmd
-        if self._enforce_vlim or not math.isfinite(sum(cmd)):
-            self._limit_torque_loop(qdl)
-            return
-        applied = [min(max(x, -lim), lim) for x, lim in zip(cmd, self._tlim_l)]
-        clamped = [a != x for a, x in zip(applied, cmd)]
-        for i in self._locked_i:
-            applied[i], clamped[i] = 0.0, False
-        self._tau_applied = applied
-        if True in clamped:
-            self._torque_events(clamped)
-        self._clamped = self._torque_episode = clamped
-
-    def _limit_torque_loop(self, qdl: list) -> None:
-        """``_limit_torque`` joint by joint in plain Python (4-7 floats)."""
-        enforce = self._enforce_vlim
-        cmd = self._tau_cmd
-        applied, clamped = [0.0] * self.dof, [False] * self.dof
-        sign = lambda x: (x > 0.0) - (x < 0.0)  # noqa: E731  (np.sign)
-        for i, (x, lim) in enumerate(zip(cmd, self._tlim_l)):
-            if self._locked_l[i]:
-                continue
-            if not math.isfinite(x):
-                clamped[i] = True  # a non-finite command gives no torque
-                continue
-            a = min(max(x, -lim), lim)
-            c = a != x
-            if enforce and abs(qdl[i]) >= self._vlim_l[i] and sign(a) == sign(qdl[i]) and a != 0:
-                a, c = 0.0, True
-            applied[i], clamped[i] = a, c
-        self._tau_applied = applied
-        if True in clamped:
-            self._torque_events(clamped)
-        self._clamped = self._torque_episode = clamped
-
-    def _torque_events(self, clamped: list) -> None:
-        """A torque_limit event per joint clamped now and not the step before; the count."""
-        cmd, applied = self._tau_cmd, self._tau_applied
-        for i, c in enumerate(clamped):
-            if c and not self._torque_episode[i]:
-                x = cmd[i]
-                self._events.append(
-                    Occurrence(
-                        "torque_limit",
-                        {
-                            "joint": self.joint_names[i],
-                            "commanded": x if math.isfinite(x) else None,
-                            "applied": applied[i],
-                            "limit": self._tlim_l[i],
-                        },
-                    )
-                )
-        self.clamp_count += sum(clamped)
 
     def step(self) -> None:
         bc = self.bc

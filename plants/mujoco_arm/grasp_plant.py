@@ -163,7 +163,7 @@ class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
         self._steps += 1
         self._t = self._steps * self.dt
         self._head_pose = None
-        if not self.diverged and any(d.warning[w].number for w in self._bad):
+        if not self.diverged and self._warned():
             self.diverged = True
             self._events.append(Occurrence("nan", {"step": self._steps}))
         if self.diverged:

@@ -20,7 +20,7 @@ from typing import cast
 import mujoco
 import numpy as np
 
-from plants.bullet_arm.arm_state import limit_flags
+from plants.bullet_arm.arm_state import TorqueLimits, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
@@ -49,6 +49,14 @@ def _xyzw(q) -> tuple[float, float, float, float]:
     return (float(x), float(y), float(z), float(w))
 
 
+def _index(ix: list) -> slice | list:
+    """A slice for ascending consecutive addresses (MuJoCo's arrays read and write a slice
+    for ~half a fancy index's cost), else the list itself."""
+    if ix and ix == list(range(ix[0], ix[0] + len(ix))):
+        return slice(ix[0], ix[0] + len(ix))
+    return ix
+
+
 def _floats(values, n: int, what: str) -> list[float]:
     """A flat list of ``n`` floats: a list or tuple of numbers by ``float()``, else NumPy's."""
     if type(values) in (list, tuple) and len(values) == n:
@@ -62,7 +70,7 @@ def _floats(values, n: int, what: str) -> list[float]:
     return a.tolist()
 
 
-class MujocoArmPlant(Plant):
+class MujocoArmPlant(TorqueLimits, Plant):
     Params = MujocoParams
     spec_type = ArmSpec
     command_types = (ArmCommand,)
@@ -90,6 +98,7 @@ class MujocoArmPlant(Plant):
         self._arm_qpos, self._arm_dof = list(W.arm_qpos), list(W.arm_dof)
         self._hand_qpos, self._hand_dof = list(W.hand_qpos), list(W.hand_dof)
         self._hand_act = list(W.hand_act)
+        self._arm_dof_ix, self._hand_act_ix = _index(self._arm_dof), _index(self._hand_act)
         self._tool = W.body_names.index("wam_tool")
         self._palm = W.body_names.index("palm") if "palm" in W.body_names else -1
         self._ob = W.object_body
@@ -178,11 +187,14 @@ class MujocoArmPlant(Plant):
             self._hand_reach2 = reach * reach
         self._hand_kv = float(P.hand_servo_gain)
         # MuJoCo resets the state where it diverges (a warning count): those are the "nan"
-        self._bad = (
-            mujoco.mjtWarning.mjWARN_BADQACC,
-            mujoco.mjtWarning.mjWARN_BADQVEL,
-            mujoco.mjtWarning.mjWARN_BADQPOS,
-        )
+        self._bad = [
+            int(w)
+            for w in (
+                mujoco.mjtWarning.mjWARN_BADQACC,
+                mujoco.mjtWarning.mjWARN_BADQVEL,
+                mujoco.mjtWarning.mjWARN_BADQPOS,
+            )
+        ]
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
         self._obj_vel_before = tuple(float(x) for x in P.object_velocity)
         self._contacts: list = []  # (body, position, normal robot->object, normal force)
@@ -343,45 +355,6 @@ class MujocoArmPlant(Plant):
                 min(max(x, lo), hi) for x, lo, hi in zip(h, self._hand_lo_l, self._hand_hi_l)
             ]
 
-    def _limit_torque(self, qdl: list) -> None:
-        """Applied = commanded clipped to the torque limits (non-finite: 0, clamped), zero on a
-        locked joint and, with ``enforce_velocity_limits``, zero where it would push a joint at
-        its speed limit further (the PyBullet plant's rule)."""
-        applied, clamped = [0.0] * self.dof, [False] * self.dof
-        for i, (x, lim) in enumerate(zip(self._tau_cmd, self._tlim_l)):
-            if self._locked_l[i]:
-                continue
-            if not math.isfinite(x):
-                clamped[i] = True
-                continue
-            a = min(max(x, -lim), lim)
-            c = a != x
-            if (
-                self._enforce_vlim
-                and abs(qdl[i]) >= self._vlim_l[i]
-                and a * qdl[i] > 0.0  # the same sign, neither zero
-            ):
-                a, c = 0.0, True
-            applied[i], clamped[i] = a, c
-        self._tau_applied = applied
-        if True in clamped:
-            for i, c in enumerate(clamped):
-                if c and not self._torque_episode[i]:
-                    x = self._tau_cmd[i]
-                    self._events.append(
-                        Occurrence(
-                            "torque_limit",
-                            {
-                                "joint": self.joint_names[i],
-                                "commanded": x if math.isfinite(x) else None,
-                                "applied": applied[i],
-                                "limit": self._tlim_l[i],
-                            },
-                        )
-                    )
-            self.clamp_count += sum(clamped)
-        self._clamped = self._torque_episode = clamped
-
     def _hand_effort(self, v: list) -> list[float]:
         """The hand servos' torques of the last step (N*m): where clipped, MuJoCo's
         actuator_force; else the implicit step's kv (v_cmd - v after it) (actuator_force is
@@ -389,7 +362,8 @@ class MujocoArmPlant(Plant):
         if self._hand_capped is None:
             return [0.0] * len(v)
         kv, d = self._hand_kv, self.md
-        f, u = d.actuator_force[self._hand_act].tolist(), d.ctrl[self._hand_act].tolist()
+        ix = self._hand_act_ix
+        f, u = d.actuator_force[ix].tolist(), d.ctrl[ix].tolist()
         return [a if c else kv * (x - y) for a, c, x, y in zip(f, self._hand_capped, u, v)]
 
     def _near_links(self) -> list[bool]:
@@ -400,14 +374,14 @@ class MujocoArmPlant(Plant):
         if self._ob < 0 or self._palm < 0:
             return [False] * n
         d = self.md
-        r = d.xpos[self._ob] - d.xpos[self._palm]
-        if float(r @ r) > self._hand_reach2:
+        x, y, z = d.xpos[self._ob].tolist()  # floats: 3-vectors cost less than arrays
+        px, py, pz = d.xpos[self._palm].tolist()
+        if (x - px) ** 2 + (y - py) ** 2 + (z - pz) ** 2 > self._hand_reach2:
             return [False] * n
-        x, y, z = d.xpos[self._ob].tolist()
+        xpos = d.geom_xpos.tolist()  # (one list of all: a dozen geoms)
         near = [False] * n
-        for (gx, gy, gz), k, lim2 in zip(
-            d.geom_xpos[self._near_geoms].tolist(), self._near_joint, self._near_lim2
-        ):
+        for g, k, lim2 in zip(self._near_geoms, self._near_joint, self._near_lim2):
+            gx, gy, gz = xpos[g]
             if (gx - x) ** 2 + (gy - y) ** 2 + (gz - z) ** 2 < lim2:
                 near[k] = True
         return near
@@ -427,7 +401,7 @@ class MujocoArmPlant(Plant):
         capped = [f > cap or n for f, n in zip(need, near)]
         if capped != self._hand_capped or True in capped:
             big = 1e6 * cap
-            self.mj.actuator_forcerange[self._hand_act] = [
+            self.mj.actuator_forcerange[self._hand_act_ix] = [
                 (-min(f, cap), min(f, cap)) if c else (-big, big) for c, f in zip(capped, need)
             ]
             self._hand_capped = capped
@@ -437,7 +411,7 @@ class MujocoArmPlant(Plant):
         (_, qd), hand, obj = self._state()
         self._limit_torque(qd)
         applied = self._tau_applied
-        d.qfrc_applied[self._arm_dof] = [applied[i] for i in self.active]
+        d.qfrc_applied[self._arm_dof_ix] = [applied[i] for i in self.active]
         if self._hand_act:
             speed, dt = self._hand_speed, self.dt
             # rate-limited position servo (as PyBullet's): reach the target at most at the
@@ -445,7 +419,7 @@ class MujocoArmPlant(Plant):
             v_cmd = [
                 min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])
             ]
-            d.ctrl[self._hand_act] = v_cmd
+            d.ctrl[self._hand_act_ix] = v_cmd
             self._hand_caps(v_cmd, hand[1])
         if obj is not None:
             v = obj[2]
@@ -465,7 +439,7 @@ class MujocoArmPlant(Plant):
         self._cache = None
         self._steps += 1
         self._t = self._steps * self.dt
-        if not self.diverged and any(d.warning[w].number for w in self._bad):
+        if not self.diverged and self._warned():
             # MuJoCo found a non-finite or huge state and reset it: the run has diverged
             self.diverged = True
             self._events.append(Occurrence("nan", {"step": self._steps}))
@@ -474,6 +448,12 @@ class MujocoArmPlant(Plant):
         self._check_events()
 
     # ------------------------------------------------------------------ events
+    def _warned(self) -> bool:
+        """MuJoCo counted a bad qacc, qvel or qpos warning: every count read as one list (a
+        warning struct per kind costs more than the step's own arithmetic)."""
+        counts = self.md.warning.number.tolist()
+        return any(counts[w] for w in self._bad)
+
     def _read_contacts(self) -> None:
         """The step's object-robot contacts (the robot touches nothing else) that were in its
         constraint solve (the nearer-than-margin ones are not: world.py): body, point, normal

@@ -17,6 +17,7 @@ Conventions (Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control*, Sec. 
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass, field
 from typing import Sequence
 
@@ -130,6 +131,7 @@ class SerialChain:
             tuple(B[:3, 3].tolist()),
         )
         self._g_f = tuple(float(x) for x in self.gravity)
+        self._frames_last: tuple = ((None,), [])  # _frames_f's last (q, frames); none yet
 
     # ------------------------------------------------------------------ variants
     def with_payload(self, body: RigidBody) -> SerialChain:
@@ -171,8 +173,13 @@ class SerialChain:
 
         The same products as :meth:`frames` (T_i = T_{i-1} Rz(q_i + offset) Tz(d) Tx(a) Rx(alpha),
         Spong Sec. 3.2) written per column, for one configuration (:meth:`point`,
-        :meth:`rnea`)."""
+        :meth:`rnea`). The last result is kept (shared: never mutated) and given again for the
+        same float objects (the controller's RNEA and l(q_d) of one posture, a step apart):
+        identity, not ==, so -0.0 is never taken for 0.0."""
         key = tuple(q)
+        last_q, last = self._frames_last
+        if len(key) == len(last_q) and all(map(operator.is_, key, last_q)):
+            return last
         (xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz) = self._base_f
         out = [self._base_f]
         cos, sin = math.cos, math.sin
@@ -192,6 +199,7 @@ class SerialChain:
             )
             xx, xy, xz = x1x, x1y, x1z
             out.append(((xx, xy, xz), (yx, yy, yz), (zx, zy, zz), (px, py, pz)))
+        self._frames_last = (key, out)
         return out
 
     def point(self, q, point_in_last=(0.0, 0.0, 0.0)) -> np.ndarray:

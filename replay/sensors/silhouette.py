@@ -71,25 +71,36 @@ class Ellipse:
         return self.polygon_and_box(inset, area_exact)[0]
 
     def polygon_and_box(self, inset: float = 0.0, area_exact: bool = True):
-        """:meth:`polygon` and its box (umin, vmin, umax, vmax) (the accelerator's
-        ``ellipse_polygon`` where built: the same operations)."""
-        k = _AREA_SCALE if area_exact else 1.0
-        a = max(self.a - inset, 0.05 * self.a) * k
-        b = max(self.b - inset, 0.05 * self.b) * k
-        c, s = math.cos(self.angle), math.sin(self.angle)
-        out = np.empty((ELLIPSE_VERTICES, 2))
-        if _pixels is not None:
-            box = _pixels.ellipse_polygon(_COS, _SIN, self.u, self.v, a, b, c, s, out)
-            return out, box
-        out[:, 0] = self.u + (a * c) * _COS - (b * s) * _SIN
-        out[:, 1] = self.v + (a * s) * _COS + (b * c) * _SIN
-        lo, hi = out.min(axis=0).tolist(), out.max(axis=0).tolist()
-        return out, (lo[0], lo[1], hi[0], hi[1])
+        """:meth:`polygon` and its box (umin, vmin, umax, vmax) (:func:`_ellipse_polygon`)."""
+        return _ellipse_polygon(self.u, self.v, self.a, self.b, self.angle, inset, area_exact)
+
+
+def _ellipse_polygon(u, v, a, b, angle, inset=0.0, area_exact=True):
+    """:meth:`Ellipse.polygon_and_box` of an ellipse given by its fields (the accelerator's
+    ``ellipse_polygon`` where built: the same operations)."""
+    k = _AREA_SCALE if area_exact else 1.0
+    a, b = max(a - inset, 0.05 * a) * k, max(b - inset, 0.05 * b) * k
+    c, s = math.cos(angle), math.sin(angle)
+    out = np.empty((ELLIPSE_VERTICES, 2))
+    if _pixels is not None:
+        box = _pixels.ellipse_polygon(_COS, _SIN, u, v, a, b, c, s, out)
+        return out, box
+    out[:, 0] = u + (a * c) * _COS - (b * s) * _SIN
+    out[:, 1] = v + (a * s) * _COS + (b * c) * _SIN
+    lo, hi = out.min(axis=0).tolist(), out.max(axis=0).tolist()
+    return out, (lo[0], lo[1], hi[0], hi[1])
 
 
 def sphere_ellipse(camera: PinholeCamera, centre, radius: float) -> Ellipse | None:
     """The exact outline of a sphere in the image, or None if the sphere is not entirely in
     front of the camera's plane (``Z <= r``: the outline is then unbounded or empty)."""
+    e = _sphere_ellipse_fields(camera, centre, radius)
+    return None if e is None else Ellipse(*e)
+
+
+def _sphere_ellipse_fields(camera: PinholeCamera, centre, radius: float) -> tuple | None:
+    """:func:`sphere_ellipse`'s fields (u, v, a, b, angle, depth) in floats, or None (the
+    raster's per-frame path makes no :class:`Ellipse`)."""
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = camera.rotation.tolist()
     o = camera.position.tolist()
     dx, dy, dz = float(centre[0]) - o[0], float(centre[1]) - o[1], float(centre[2]) - o[2]
@@ -112,13 +123,13 @@ def sphere_ellipse(camera: PinholeCamera, centre, radius: float) -> Ellipse | No
     rad = math.hypot(0.5 * (baa - bdd), bh)
     lam_small, lam_big = mean - rad, mean + rad  # semi-axes 1/sqrt(lambda)
     angle = 0.5 * math.atan2(2.0 * bh, baa - bdd) + 0.5 * math.pi  # axis of lam_small
-    return Ellipse(
-        u=fx * X * Z / E + k.cx,
-        v=fy * Y * Z / E + k.cy,
-        a=1.0 / math.sqrt(lam_small),
-        b=1.0 / math.sqrt(lam_big),
-        angle=math.atan2(math.sin(angle), math.cos(angle)),
-        depth=Z,
+    return (
+        fx * X * Z / E + k.cx,  # u
+        fy * Y * Z / E + k.cy,  # v
+        1.0 / math.sqrt(lam_small),  # a
+        1.0 / math.sqrt(lam_big),  # b
+        math.atan2(math.sin(angle), math.cos(angle)),  # angle
+        Z,  # depth
     )
 
 
@@ -261,8 +272,8 @@ def silhouette(
 def sphere_polygon(camera: PinholeCamera, centre, radius: float):
     """(polygon (N, 2), box) of a sphere's silhouette, or None if it reaches behind the camera:
     :func:`sphere_ellipse` and :meth:`Ellipse.polygon_and_box`."""
-    e = sphere_ellipse(camera, centre, radius)
-    return None if e is None else e.polygon_and_box()
+    e = _sphere_ellipse_fields(camera, centre, radius)
+    return None if e is None else _ellipse_polygon(*e[:5])
 
 
 def drawables(camera: PinholeCamera, scene: Scene) -> list[tuple[np.ndarray, float, tuple]]:

@@ -427,7 +427,6 @@ class StereoBallCamera(Sensor):
         grey = 255.0 * p.background
         blob_args = self._blob_args
         W, H = int(p.width), int(p.height)
-        blobs: list[dict | None] = []
         founds = []
         last = []
         for camera in self.cameras:
@@ -446,17 +445,16 @@ class StereoBallCamera(Sensor):
             last.append((img8, window))
             found = _ball_blob(img8, w, h, *blob_args, x0, y0, W, H) if w and h else None
             founds.append(found)
-            blobs.append(_blob(found, blob_args[2]))
         self._last = last
         self._found = tuple(founds)
         try:
             tracked = scene.get(p.tracked)
         except KeyError:
             return None
-        b0, b1 = blobs
+        b0, b1 = founds  # (u, v, area, background): the blob records' fields (_blob)
         if b0 is None or b1 is None:
             return None
-        uv0, uv1 = (b0["u"], b0["v"]), (b1["u"], b1["v"])
+        uv0, uv1 = (b0[0], b0[1]), (b1[0], b1[1])
         radius = None
         if p.bias_correction and isinstance(tracked, Sphere):
             radius = float(tracked.radius)
@@ -468,7 +466,7 @@ class StereoBallCamera(Sensor):
         return VisionObject(
             t=t,
             position=list(X),
-            features={"centroids": [list(uv0), list(uv1)], "areas": [b0["area"], b1["area"]]},
+            features={"centroids": [list(uv0), list(uv1)], "areas": [b0[2], b1[2]]},
         )
 
 

@@ -260,7 +260,11 @@ class CatchGeometry:
         best = None
         for sign in (1.0, -1.0):
             sg = sign * g
-            z = tuple(al * w1[i] + be * w2[i] + sg * x[i] for i in range(3))
+            z = (
+                al * w1[0] + be * w2[0] + sg * x[0],
+                al * w1[1] + be * w2[1] + sg * x[1],
+                al * w1[2] + be * w2[2] + sg * x[2],
+            )
             q2 = _wrap_near_f(_subproblem1_f(w2, u, z), ref1)
             q1 = _wrap_near_f(_subproblem1_f(w1, z, v), ref0)
             if not ok2:  # on the J1 axis: q1 undetermined, q2 re-solved with q1 = ref0
@@ -371,7 +375,16 @@ class PolynomialB:
         self.powers[:, selected] += 2  # actual powers of eq. 12
         self.n_mono = len(exps)
         self.n_alpha = self.n_mono * n_joints
-        self._powers_t = tuple(tuple(int(e) for e in row) for row in self.powers)
+        # coefficients_one's per monomial: the powers (a, b, c) and the indices of x^(e-1) and
+        # x^(e-2) per variable, then the factors e and e (e - 1): a factor 0.0 with index 0
+        # (x^0 = 1.0) where the derivative vanishes gives 0.0, as the branch it replaces
+        self._powers_t = tuple(
+            (
+                (a, b, c, *(max(e - 1, 0) for e in (a, b, c)), *(max(e - 2, 0) for e in (a, b, c))),
+                (*(float(e) for e in (a, b, c)), *(float(e * (e - 1)) for e in (a, b, c))),
+            )
+            for a, b, c in (tuple(int(e) for e in row) for row in self.powers)
+        )
         self._top = int(self.powers.max())
 
     def _vars(self, p):
@@ -425,14 +438,10 @@ class PolynomialB:
         u0, u1, u2 = pd
         v0, v1, v2 = pdd
         m, m1, m2 = [], [], []
-        for a, b, c in self._powers_t:
+        for (a, b, c, ia, ib, ic, ja, jb, jc), (ka, kb, kc, la, lb, lc) in self._powers_t:
             fa, fb, fc = X[a], Y[b], Z[c]
-            ga = a * X[a - 1] if a else 0.0
-            gb = b * Y[b - 1] if b else 0.0
-            gc = c * Z[c - 1] if c else 0.0
-            ha = a * (a - 1) * X[a - 2] if a > 1 else 0.0
-            hb = b * (b - 1) * Y[b - 2] if b > 1 else 0.0
-            hc = c * (c - 1) * Z[c - 2] if c > 1 else 0.0
+            ga, gb, gc = ka * X[ia], kb * Y[ib], kc * Z[ic]  # d x^e / dx = e x^(e-1)
+            ha, hb, hc = la * X[ja], lb * Y[jb], lc * Z[jc]  # e (e-1) x^(e-2)
             d0, d1, d2 = ga * fb * fc, fa * gb * fc, fa * fb * gc
             quad = (
                 ha * fb * fc * u0 * u0
@@ -530,20 +539,20 @@ class DirectMapping:
         by Cramer's rule, then b(q) and its derivatives (eq. 12) from the monomials."""
         if self.poly.m != 3 or self.poly.i != 2:
             raise ValueError("evaluate_one is written for 3 active joints, the last selected")
-        r, rd, rdd = [float(x) for x in r], [float(x) for x in rd], [float(x) for x in rdd]
+        r, rd, rdd = list(map(float, r)), list(map(float, rd)), list(map(float, rdd))
         p, ok = self.geo.inverse_one(r)
         J, H, _ = self.geo.derivatives_one(p)
         pd = _solve3(J, rd)
         a, b, c = pd
         H00, H01, H02, H11, H12 = H
         aa, ab2, ac2, bb, bc2 = a * a, 2 * a * b, 2 * a * c, b * b, 2 * b * c
-        pdd = _solve3(
-            J,
-            [
-                rdd[i] - (H00[i] * aa + H01[i] * ab2 + H02[i] * ac2 + H11[i] * bb + H12[i] * bc2)
-                for i in range(3)
-            ],
-        )
+        # r_o'' - H(pd, pd), per component written out (no comprehension a step)
+        h = [
+            rdd[0] - (H00[0] * aa + H01[0] * ab2 + H02[0] * ac2 + H11[0] * bb + H12[0] * bc2),
+            rdd[1] - (H00[1] * aa + H01[1] * ab2 + H02[1] * ac2 + H11[1] * bb + H12[1] * bc2),
+            rdd[2] - (H00[2] * aa + H01[2] * ab2 + H02[2] * ac2 + H11[2] * bb + H12[2] * bc2),
+        ]
+        pdd = _solve3(J, h)
         out = np.array((p, pd, pdd)) + np.array(self.poly.coefficients_one(p, pd, pdd)) @ self._A
         q, qd, qdd = out.tolist()
         return tuple(q), tuple(qd), tuple(qdd), tuple(p), ok

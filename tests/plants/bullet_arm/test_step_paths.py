@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from plants.bullet_arm import BulletArmPlant, Params
+from plants.bullet_arm.arm_state import limit_torque, limit_torque_loop
 from plants.bullet_arm.plant import _floats
 from replay.robot.arm_types import ArmCommand
 from replay.runner import Runner
@@ -57,10 +58,12 @@ def test_commands_read_as_numpy_reads_them():
 
 def test_torque_limits_one_pass_equals_the_joint_loop():
     """Seeded random commands (within and beyond the limits, NaN, inf, signed zeros): the one
-    pass over finite commands gives the loop's applied torques, clamps and events."""
-    fast, slow = make(**CATCHING), make(**CATCHING)
+    pass over finite commands (arm_state.limit_torque) gives the loop's applied torques and
+    clamps; the plant's step gives them and their events (both plants share TorqueLimits)."""
+    plant = make(**CATCHING)
     rng = np.random.default_rng(17)
-    lim = np.asarray(fast._tlim_l)
+    tlim, vlim, locked = plant._tlim_l, plant._vlim_l, plant._locked_l
+    lim = np.asarray(tlim)
     quick = clipped = 0
     for k in range(400):
         tau = rng.uniform(-1.3, 1.3, 4) * lim
@@ -69,23 +72,37 @@ def test_torque_limits_one_pass_equals_the_joint_loop():
         if k % 7 == 0:
             tau[rng.integers(4)] = [math.nan, math.inf, -math.inf, -0.0][k % 4]
         qd = rng.normal(0.0, 2.0, 4).tolist()
-        for plant in (fast, slow):
-            plant._tau_cmd = tau.tolist()
-            plant._torque_episode = [False] * 4
-            plant.pop_events()
-        fast._limit_torque(qd)
-        slow._limit_torque_loop(qd)
-        assert [a.hex() for a in fast._tau_applied] == [a.hex() for a in slow._tau_applied]
-        assert fast._clamped == slow._clamped
-        assert [(e.kind, e.data) for e in fast.pop_events()] == [
-            (e.kind, e.data) for e in slow.pop_events()
+        cmd = tau.tolist()
+        for enforce in (False, True):
+            fast = limit_torque(cmd, tlim, locked, enforce, vlim, qd)
+            slow = limit_torque_loop(cmd, tlim, locked, enforce, vlim, qd)
+            assert [a.hex() for a in fast[0]] == [a.hex() for a in slow[0]]
+            assert fast[1] == slow[1]
+        plant._tau_cmd = cmd
+        plant._torque_episode = [False] * 4
+        plant.pop_events()
+        plant._limit_torque(qd)
+        applied, clamped = limit_torque_loop(cmd, tlim, locked, False, vlim, qd)
+        assert [a.hex() for a in plant._tau_applied] == [a.hex() for a in applied]
+        assert plant._clamped == clamped
+        assert [(e.kind, e.data) for e in plant.pop_events()] == [
+            (
+                "torque_limit",
+                {
+                    "joint": plant.joint_names[i],
+                    "commanded": cmd[i] if math.isfinite(cmd[i]) else None,
+                    "applied": applied[i],
+                    "limit": tlim[i],
+                },
+            )
+            for i in range(4)
+            if clamped[i]
         ]
         quick += math.isfinite(sum(tau))
-        clipped += any(slow._clamped)
+        clipped += any(clamped)
     print(f"torque limits: {quick}/400 commands finite (the one pass), {clipped} clamped")
     assert 0 < quick < 400 and 0 < clipped < 400
-    fast.close()
-    slow.close()
+    plant.close()
 
 
 def test_hand_motors_set_only_on_new_targets_move_the_hand_the_same():
