@@ -69,7 +69,8 @@ def run_catch(n: int = 30, names=CATCH_SCENARIOS, probes: bool = False) -> list[
 
     rows = []
     for name in names:
-        engines, extra = {"PyBullet": name, "MuJoCo": name + SUFFIX}, ()
+        engines = {"PyBullet": name, "MuJoCo": name + SUFFIX}
+        extra: tuple[str, ...] = ()
         if probes:
             if name not in PROBES:
                 continue

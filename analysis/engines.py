@@ -145,7 +145,9 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
     for s in dict.fromkeys(r["set"] for r in rows):
         by_engine = {e: [r for r in rows if r["set"] == s and r["engine"] == e] for e in ENGINES}
         row = rate_row(s, "≥ 90 % in each engine (issue #24)", by_engine)
-        probes = {r["engine"]: [] for r in rows if r["set"] == s and r["engine"] not in ENGINES}
+        probes: dict[str, list[dict]] = {
+            r["engine"]: [] for r in rows if r["set"] == s and r["engine"] not in ENGINES
+        }
         for r in rows:
             if r["engine"] in probes and r["set"] == s:
                 probes[r["engine"]].append(r)
