@@ -23,15 +23,20 @@ def _address_space_limit() -> int | None:
     return None if soft == resource.RLIM_INFINITY else soft
 
 
-def _by_ctrl_c(exc: BaseException) -> bool:
-    """Whether ``exc`` came of a Ctrl-C: a C extension whose initialisation the KeyboardInterrupt
-    broke raises ImportError from it (pybind11: "initialization failed")."""
+def _caused_by(exc: BaseException, kind: type[BaseException]) -> bool:
+    """Whether ``exc`` is or came of a ``kind`` (through its causes and contexts)."""
     seen: BaseException | None = exc
     while seen is not None:
-        if isinstance(seen, KeyboardInterrupt):
+        if isinstance(seen, kind):
             return True
         seen = seen.__cause__ or seen.__context__
     return False
+
+
+def _by_ctrl_c(exc: BaseException) -> bool:
+    """Whether ``exc`` came of a Ctrl-C: a C extension whose initialisation the KeyboardInterrupt
+    broke raises ImportError from it (pybind11: "initialization failed")."""
+    return _caused_by(exc, KeyboardInterrupt)
 
 
 def _cannot_load(exc: BaseException, limit: int | None) -> None:
@@ -59,6 +64,11 @@ def main() -> None:
     try:
         from replay.cli import main as cli
     except (ImportError, MemoryError, OSError) as exc:
+        _cannot_load(exc, limit)
+    except RuntimeError as exc:  # a Rust extension (foxglove-sdk) out of memory at import
+        # raises RuntimeError from the MemoryError ("error occurred while initializing class")
+        if not _caused_by(exc, MemoryError):
+            raise
         _cannot_load(exc, limit)
 
     signal.signal(signal.SIGINT, signal.default_int_handler)
