@@ -77,9 +77,10 @@ def _still_after(hand: HandSpec, start: float, a: Config, b: Config, t: float, r
     vb = [*b.base, *b.joints[0], *b.joints[1]]
     tau = max(t - start, 0.0)
     speeds = [hand.base_speed] * 2 + [hand.joint_speed] * 4
+    row = row.tolist()  # (the row's floats at once, not an array index each)
     for i in range(6):
         step, d = tau * speeds[i], float(vb[i]) - float(va[i])
-        if not (-step <= d <= step) or float(row[i]) != float(va[i]) + d:
+        if not (-step <= d <= step) or row[i] != float(va[i]) + d:
             return False
     return True
 
