@@ -8,8 +8,6 @@ the workspace or the joint ranges are clamped. The plant's step advances the ser
 
 from __future__ import annotations
 
-from array import array
-
 import numpy as np
 
 from replay.robot.hand2d import HandSpec, clip, finger_tip_xy
@@ -38,8 +36,9 @@ ROOTS, LINKS, BASE_SPEED, JOINT_SPEED, STATE_SIZE = slice(18, 22), slice(22, 24)
 class HandServo:
     """Base position and joint angles of the two fingers, and their (clamped) targets.
 
-    The state is one float64 array (``state``, the layout above: base, joints, their targets,
-    whether on them, the tips' cache and the spec's kinematics and speeds); ``base``,
+    The state is one list of floats (``state``, the layout above: base, joints, their targets,
+    whether on them, the tips' cache and the spec's kinematics and speeds; a list, not
+    array("d"): read and written every step without re-boxing); ``base``,
     ``joints``, ``base_target`` and ``joint_targets`` give it as arrays."""
 
     def __init__(self, spec: HandSpec, base, joints) -> None:
@@ -55,14 +54,14 @@ class HandServo:
         )
         base = np.asarray(base, dtype=float)
         joints = np.asarray(joints, dtype=float).reshape(2, 2)
-        s = self.state = array("d", [0.0] * STATE_SIZE)
-        s[BASE] = array("d", self.clamp_base(base)[0].tolist())
-        s[JOINTS] = array("d", self.clamp_joints(joints)[0].ravel().tolist())
+        s = self.state = [0.0] * STATE_SIZE
+        s[BASE] = self.clamp_base(base)[0].tolist()
+        s[JOINTS] = self.clamp_joints(joints)[0].ravel().tolist()
         s[BASE_TARGET], s[JOINT_TARGETS] = s[BASE], s[JOINTS]
         s[SETTLED] = 1.0  # at the targets: advance() has nothing to do
         s[TIPS_VALID] = 0.0  # the tips' cache (tip_list) not computed yet
-        s[ROOTS] = array("d", [float(v) for off in spec.root_offsets for v in off])
-        s[LINKS] = array("d", [float(v) for v in spec.link_lengths])
+        s[ROOTS] = [float(v) for off in spec.root_offsets for v in off]
+        s[LINKS] = [float(v) for v in spec.link_lengths]
         s[BASE_SPEED], s[JOINT_SPEED] = float(spec.base_speed), float(spec.joint_speed)
 
     @property
@@ -109,7 +108,7 @@ class HandServo:
         bc = [clip(v, lo[i], hi[i]) for i, v in enumerate(b)]
         qc = [clip(v, lo[2 + i], hi[2 + i]) for i, v in enumerate(q)]
         s = self.state
-        s[BASE_TARGET], s[JOINT_TARGETS] = array("d", bc), array("d", qc)
+        s[BASE_TARGET], s[JOINT_TARGETS] = bc, qc
         s[SETTLED] = 0.0
         # elementwise, as np.any(c != v) (a list's == would take a NaN as equal to itself)
         base_clamped = any(c != v for c, v in zip(bc, b))
@@ -130,10 +129,10 @@ class HandServo:
         s = self.state
         if s[SETTLED]:
             return
-        b, q = s[BASE].tolist(), s[JOINTS].tolist()
-        at_b = _toward(b, s[BASE_TARGET].tolist(), s[BASE_SPEED] * dt)
-        at_q = _toward(q, s[JOINT_TARGETS].tolist(), s[JOINT_SPEED] * dt)
-        s[BASE], s[JOINTS] = array("d", b), array("d", q)
+        b, q = s[BASE], s[JOINTS]  # (copies)
+        at_b = _toward(b, s[BASE_TARGET], s[BASE_SPEED] * dt)
+        at_q = _toward(q, s[JOINT_TARGETS], s[JOINT_SPEED] * dt)
+        s[BASE], s[JOINTS] = b, q
         s[TIPS_VALID] = 0.0
         s[SETTLED] = float(at_b and at_q)
 
@@ -142,9 +141,9 @@ class HandServo:
         until the hand moves)."""
         s = self.state
         if not s[TIPS_VALID]:
-            b, q = s[BASE].tolist(), s[JOINTS].tolist()
+            b, q = s[BASE], s[JOINTS]
             tips = finger_tip_xy(self.spec, b, 0, q[0:2]) + finger_tip_xy(self.spec, b, 1, q[2:4])
-            s[TIPS], s[TIPS_VALID] = array("d", tips), 1.0
+            s[TIPS], s[TIPS_VALID] = tips, 1.0
             t0x, t0y, t1x, t1y = tips
             self._tip_pair = (t0x, t0y), (t1x, t1y)  # (the same object until the hand moves)
         return self._tip_pair

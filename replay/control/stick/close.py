@@ -260,13 +260,15 @@ class ClosePlanner:
         if max(abs(bx - cx), abs(by - cy)) > 1e-9:
             return cfg  # the base is still moving: the rear finger is parked
         px, py, _ = estimator.predict(t)
-        s_now = float(c.d[0] * (px - c.meet[0]) + c.d[1] * (py - c.meet[1]))
+        # in floats: the operations of the 2-vectors' (c.meet + c.d * s_rear), without them
+        (dx, dy), (mx, my) = c.d.tolist(), c.meet.tolist()
+        s_now = dx * (px - mx) + dy * (py - my)
         s_rear = (
             -c.half_gap
             if t >= c.t_meet
             else min(-c.half_gap, s_now - c.half_gap - self.params.follow_gap)
         )
-        point = c.meet + c.d * s_rear
+        point = (mx + dx * s_rear, my + dy * s_rear)
         q = hand2d.finger_ik(
             self.hand, cfg.base, c.rear, point, q_near=self.model.target.joints[c.rear]
         )

@@ -24,7 +24,6 @@ Defaults (SI): window 30 samples (0.1 s at 300 fps), ready after 6 samples (20 m
 from __future__ import annotations
 
 import math
-from array import array
 from dataclasses import dataclass
 
 
@@ -187,7 +186,7 @@ class StickEstimator:
     # restart and once the anchor is REANCHOR old (rounding never accumulates for long).
     def _rebuild(self) -> None:
         self._anchor = self._samples[0] if self._samples else (0.0, 0.0, 0.0, 0.0)
-        self._sums = array("d", [0.0] * 12)
+        self._sums = [0.0] * 12  # (a list: its floats are not re-boxed on every += and read)
         for sample in self._samples:
             self._sum(sample, 1.0)
 

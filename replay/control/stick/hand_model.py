@@ -123,12 +123,21 @@ def route_configs(hand: HandSpec, starts, frm, to, times):
     return out[:, :2], out[:, 2:].reshape(-1, 2, 2)
 
 
+@functools.lru_cache(maxsize=16)
+def _axis_speeds(base_speed: float, joint_speed: float) -> np.ndarray:
+    """The six axes' speed limits (base x, y, the four joints), made once (read only)."""
+    speed = np.array([base_speed] * 2 + [joint_speed] * 4)
+    speed.flags.writeable = False
+    return speed
+
+
 def route_axes(hand: HandSpec, starts, frm, to, times) -> np.ndarray:
     """:func:`route_configs` as one (T, 6) array: base x, y, then the four joints."""
     times = np.asarray(times, dtype=float)
     out = np.empty((len(times), 6))  # base x, y, then the four joints
-    speed = np.array([hand.base_speed] * 2 + [hand.joint_speed] * 4)
-    edges = np.searchsorted(times, starts, side="left")  # first sample at or after each start
+    speed = _axis_speeds(hand.base_speed, hand.joint_speed)
+    # first sample at or after each start (one segment, the straight route: none needed)
+    edges = np.searchsorted(times, starts, side="left").tolist() if len(starts) > 1 else [0]
     for i, (s0, a, b) in enumerate(zip(starts, frm, to)):
         lo = 0 if i == 0 else int(edges[i])
         hi = int(edges[i + 1]) if i + 1 < len(starts) else len(times)
