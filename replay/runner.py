@@ -80,7 +80,15 @@ def _git_commit() -> str:
 @functools.cache  # once a process (~3 ms of package metadata reads)
 def _versions() -> tuple[tuple[str, str], ...]:
     found = []
-    for pkg in ("numpy", "pymunk", "pybullet", "opencv-python-headless", "mcap"):
+    for pkg in (
+        "numpy",
+        "pymunk",
+        "pybullet",
+        "mujoco",
+        "opencv-python-headless",
+        "mcap",
+        "foxglove-sdk",  # (the log's writer)
+    ):
         try:
             found.append((pkg, importlib_metadata.version(pkg)))
         except importlib_metadata.PackageNotFoundError:

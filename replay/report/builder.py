@@ -31,6 +31,7 @@ PACKAGES = (
     "mujoco",
     "opencv-python-headless",
     "mcap",
+    "foxglove-sdk",
     "matplotlib",
     "click",
     "pyyaml",

@@ -111,6 +111,7 @@ def test_provenance_in_metadata_and_scenario_topic(toy_yaml, tmp_path):
     _, _, log = _run(toy_yaml, tmp_path)
     meta = log.metadata()
     assert meta["provenance"]["seed"] == "3" and "numpy" in meta["provenance"]
+    assert "foxglove-sdk" in meta["provenance"]  # (the log's writer)
     sc = log.scenario()
     assert sc["name"] == "toy" and "kp: 100.0" in sc["yaml"] and sc["seed"] == 3
 
