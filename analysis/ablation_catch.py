@@ -296,6 +296,14 @@ def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
     return float(max(0.0, mid - half)), float(min(1.0, mid + half))
 
 
+def rate_cell(k: int, n: int, why) -> str:
+    """A table cell of a rate: ``k/n [Wilson 95 % interval]`` and the failures' reasons (``why``:
+    a Counter of them), most common first."""
+    lo, hi = wilson(k, n)
+    fails = "; ".join(f"{v}× {x}" for x, v in why.most_common())
+    return f"{k}/{n} [{100 * lo:.0f}–{100 * hi:.0f} %]" + (f" ({fails})" if fails else "")
+
+
 def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, out=None, extra=()):
     """Every controller on every cell's n seeded throws (the same throws for all): one row per
     run with the plant's outcome (success, reason). ``out``: a CSV path to write; ``extra``:
@@ -361,13 +369,8 @@ def shared_table(rows: list[dict]) -> str:
         for c in ctrls:
             sub = [r for r in rows if r["cell"] == cell and r["controller"] == c]
             k = sum(str(r["success"]) in ("True", "true", "1") for r in sub)
-            lo, hi = wilson(k, len(sub))
             why = Counter(r["reason"] for r in sub if str(r["success"]) not in ("True", "true"))
-            fails = "; ".join(f"{v}× {k_}" for k_, v in why.most_common())
-            parts.append(
-                f"{k}/{len(sub)} [{100 * lo:.0f}–{100 * hi:.0f} %]"
-                + (f" ({fails})" if fails else "")
-            )
+            parts.append(rate_cell(k, len(sub), why))
         lines.append(f"| {cell} | " + " | ".join(parts) + " |")
     return "\n".join(lines)
 

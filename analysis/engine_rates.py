@@ -148,7 +148,7 @@ def write(rows: list[dict], path: Path) -> None:
 
 def markdown(rows: list[dict]) -> str:
     """Per set and engine: k/n with its Wilson 95 % interval and the failures' reasons."""
-    from analysis.ablation_catch import wilson
+    from analysis.ablation_catch import rate_cell
 
     engines = list(dict.fromkeys(r["engine"] for r in rows))
     lines = ["| set | " + " | ".join(engines) + " |", "|---" * (len(engines) + 1) + "|"]
@@ -160,13 +160,8 @@ def markdown(rows: list[dict]) -> str:
                 cells.append("–")
                 continue
             k = sum(r["success"] for r in sub)
-            lo, hi = wilson(k, len(sub))
             why = Counter(r["reason"] for r in sub if not r["success"])
-            fails = "; ".join(f"{v}× {x}" for x, v in why.most_common())
-            cells.append(
-                f"{k}/{len(sub)} [{100 * lo:.0f}–{100 * hi:.0f} %]"
-                + (f" ({fails})" if fails else "")
-            )
+            cells.append(rate_cell(k, len(sub), why))
         lines.append(f"| {s} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 

@@ -41,3 +41,23 @@ def toy_yaml(tmp_path):
     p = tmp_path / "toy.yaml"
     p.write_text(TOY)
     return p
+
+
+def fail_writes_after(monkeypatch, n: int) -> list[int]:
+    """Make the log file's writes fail as a full disk (ENOSPC) after the first ``n``: the
+    sizes of the writes tried, in order, are appended to the returned list."""
+    import errno
+    import os
+
+    from replay.log.writer import _FlushedFile
+
+    write, calls = _FlushedFile.write, []
+
+    def full(self, data):
+        calls.append(len(data))
+        if len(calls) > n:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return write(self, data)
+
+    monkeypatch.setattr(_FlushedFile, "write", full)
+    return calls

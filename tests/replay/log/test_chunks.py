@@ -76,19 +76,12 @@ def test_a_failed_write_raises_from_the_write_that_made_it(tmp_path, monkeypatch
     not shown besides."""
     import errno
     import logging
-    import os
 
-    from replay.log.writer import LogWriteError, _FlushedFile
+    from conftest import fail_writes_after
 
-    write, calls = _FlushedFile.write, []
+    from replay.log.writer import LogWriteError
 
-    def full(self, data):
-        calls.append(len(data))
-        if len(calls) > 4:  # the header and a chunk fit, the next chunk does not
-            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-        return write(self, data)
-
-    monkeypatch.setattr(_FlushedFile, "write", full)
+    fail_writes_after(monkeypatch, 4)  # the header and a chunk fit, the next does not
     caplog.set_level(logging.DEBUG)
     log = LogWriter(tmp_path / "x.mcap", chunk_size=1_000)
     written = 0

@@ -4,7 +4,6 @@ outputs that are not regular files are refused before the run; a full disk is ex
 
 from __future__ import annotations
 
-import errno
 import os
 import signal
 import socket
@@ -14,10 +13,11 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from conftest import fail_writes_after
 
 from replay.cli import main
 from replay.log import LogError, LogReader, LogWriter
-from replay.log.writer import OutputConflictError, _FlushedFile, live_writers, part_paths
+from replay.log.writer import OutputConflictError, live_writers, part_paths
 from replay.messages import Event
 
 HOLDER = r"""
@@ -190,16 +190,7 @@ def test_outputs_that_are_not_regular_files_are_refused_before_the_run(
 
 def test_a_full_disk_mid_run_is_exit_1_and_leaves_no_part(toy_yaml, tmp_path, monkeypatch):
     out = tmp_path / "full.mcap"
-    write = _FlushedFile.write
-    calls = []
-
-    def full(self, data):
-        calls.append(len(data))
-        if len(calls) > 3:  # header and a few chunks fit, then the disk is full
-            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-        return write(self, data)
-
-    monkeypatch.setattr(_FlushedFile, "write", full)
+    calls = fail_writes_after(monkeypatch, 3)  # header and a few chunks fit, then the disk is full
     r = CliRunner().invoke(
         main, ["run", str(toy_yaml), "-o", str(out), "-q", "--set", "timing.duration=20"]
     )
