@@ -18,6 +18,7 @@ start-up and the imports a run needs. Nothing here is a test: it prints, it does
 from __future__ import annotations
 
 import argparse
+import platform
 import resource
 import statistics
 import subprocess
@@ -217,6 +218,13 @@ def host_probe(n: int = 20000) -> float:
     for i in range(n):
         s += i * i
     return time.process_time() - c0
+
+
+def interpreter() -> str:
+    """Which Python runs the benchmark: its build matters as much as the code (pyenv's default
+    build, with no PGO or LTO and a shared libpython, ran whole catch runs 10-25 % slower than
+    Debian's own python3.11 here, the logs the same: ``make install PYTHON=...`` picks it)."""
+    return f"interpreter: {sys.executable} (CPython {platform.python_version()})"
 
 
 def _stats(values: list[float]) -> tuple[float, float, float]:
@@ -466,6 +474,7 @@ def main(argv=None) -> None:
             load_scenario(path)
         except ScenarioError as exc:
             ap.error(str(exc))
+    print(interpreter(), flush=True)
     for path in args.scenarios:
         print(
             report(
