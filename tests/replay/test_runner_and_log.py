@@ -182,7 +182,11 @@ orig = runner.Runner.run
 def run(self, out):
     def tick(t, d):
         if t > 1.0:
-            print("ready", flush=True); time.sleep(60)
+            # short sleeps: the kernel may hand SIGINT to another thread of the process (BLAS's),
+            # which does not wake the main thread's sleep; the handler runs at the next wake-up
+            print("ready", flush=True)
+            for _ in range(600):
+                time.sleep(0.1)
     self.progress = tick
     return orig(self, out)
 runner.Runner.run = run
