@@ -1,3 +1,4 @@
+import signal
 import sys
 from pathlib import Path
 
@@ -12,6 +13,20 @@ def _toy_plugins():
     import toy_plugins
 
     toy_plugins.install()
+
+
+@pytest.fixture(autouse=True)
+def _sigint_left_as_found():
+    """Each test leaves Python's SIGINT handler as it found it. A test that leaves another one
+    (SIG_IGN, a log writer's held-SIGINT handler) fails here, by name, instead of the Ctrl-C tests
+    that follow it: a child inherits an ignored SIGINT, and a writer installs its handler only
+    over the default one. The handler is put back either way."""
+    before = signal.getsignal(signal.SIGINT)
+    yield
+    after = signal.getsignal(signal.SIGINT)
+    if after is not before:
+        signal.signal(signal.SIGINT, before)
+        pytest.fail(f"the test left SIGINT's handler {after!r} (it found {before!r})")
 
 
 @pytest.fixture

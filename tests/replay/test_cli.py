@@ -197,7 +197,8 @@ def test_ctrl_c_while_starting_exits_130(tmp_path):
     import time
 
     codes = []
-    for delay in (0.2, 0.3, 0.6):
+    # the longer waits count when a loaded machine has not started the interpreter by 0.6 s
+    for delay in (0.2, 0.3, 0.6, 1.2, 2.4):
         p = subprocess.Popen(
             [sys.executable, "-m", "replay.entry", "list"],
             cwd=tmp_path,
