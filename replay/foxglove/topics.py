@@ -33,7 +33,7 @@ from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from google.protobuf.message import Message
 
-from replay.foxglove.image import WindowedImage, raw_image
+from replay.foxglove.image import FrameBuffer, WindowedImage, raw_image
 from replay.foxglove.schemas import (
     MESSAGE_ENCODING,
     SCHEMA_ENCODING,
@@ -205,8 +205,8 @@ class FoxgloveTopics:
         self.log = log  # a replay.log.LogWriter
         self._channels: dict[str, int] = {}  # topic -> channel id
         self._schemas: dict[str, int] = {}  # schema name -> id (each stored once)
-        # sensor -> view -> (channel id, frame id, the array its windowed frames are built in)
-        self._images: dict[str, dict[str, tuple[int, str, np.ndarray]]] = {}
+        # sensor -> view -> (channel id, frame id, the frame its windowed frames are built in)
+        self._images: dict[str, dict[str, tuple[int, str, FrameBuffer]]] = {}
 
     def _channel(self, topic: str, schema: str, encoding: str, data: bytes, message: str) -> int:
         if schema not in self._schemas:
@@ -269,6 +269,5 @@ class FoxgloveTopics:
             got = views.get(view)
             if got is None:
                 channel = self._proto_channel(camera_topic(sensor, view), RawImage)
-                shape = image.shape if isinstance(image, WindowedImage) else (0, 0)
-                got = views[view] = (channel, f"{sensor}/{view}", np.empty(shape, np.uint8))
+                got = views[view] = (channel, f"{sensor}/{view}", FrameBuffer())
             self.log.write_raw(got[0], raw_image(image, got[1], t_ns, got[2]), t_ns)

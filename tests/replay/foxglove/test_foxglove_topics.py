@@ -12,7 +12,7 @@ import pytest
 import yaml
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 
-from replay.foxglove.image import WindowedImage, grey, pixels, raw_image
+from replay.foxglove.image import FrameBuffer, WindowedImage, grey, pixels, raw_image
 from replay.foxglove.schemas import CLASSES, STRING_SCHEMA, decode, decode_string, message_dict
 from replay.log import LogReader
 from replay.messages import (
@@ -47,6 +47,26 @@ def catch_log(tmp_path_factory):
 
 def decoded(reader: LogReader, topic: str):
     return [(m.t_ns, decode(m.schema, m.data)) for m in reader.raw(topic)]
+
+
+def test_frame_buffer_gives_each_windowed_frame_whole():
+    """Seeded windowed frames through one view's FrameBuffer (windows moving, shrinking, growing,
+    the background and the frame size changing now and then) give the bytes of each frame made
+    anew (WindowedImage.full): nothing of an earlier window is left behind."""
+    rng = np.random.default_rng(29)
+    buf = FrameBuffer()
+    h, w, bg = 40, 50, 25
+    for k in range(300):
+        if rng.random() < 0.05:
+            h, w = (int(x) for x in rng.integers(1, 60, size=2))
+        if rng.random() < 0.05:
+            bg = int(rng.integers(0, 256))
+        x0, y0 = int(rng.integers(0, w)), int(rng.integers(0, h))
+        x1, y1 = int(rng.integers(x0, w + 1)), int(rng.integers(y0, h + 1))
+        px = rng.integers(0, 256, size=(y1 - y0, x1 - x0), dtype=np.uint8)
+        win = WindowedImage(h, w, bg, (x0, y0, x1, y1), px)
+        assert raw_image(win, "c", k, buf) == raw_image(win, "c", k), k
+        assert np.array_equal(grey(win, buf), win.full())
 
 
 def test_raw_images_round_trip_and_are_deterministic():
