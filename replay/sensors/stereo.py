@@ -364,18 +364,14 @@ class StereoBallCamera(Sensor):
     def last_images(self) -> list[np.ndarray | None]:
         """The two whole last frames (background outside the rendered windows)."""
         out: list[np.ndarray | None] = []
-        p = self.params
+        p, level = self.params, self._background_level
         for last in self._last:
             if last is None:
                 out.append(None)
-                continue
-            img, (x0, y0, x1, y1) = last
-            if (x0, y0, x1, y1) == (0, 0, p.width, p.height):
-                out.append(img)
-                continue
-            full = np.full((p.height, p.width), self._background_level, np.uint8)
-            full[y0:y1, x0:x1] = img
-            out.append(full)
+            elif last[1] == (0, 0, p.width, p.height):
+                out.append(last[0])  # rendered whole
+            else:
+                out.append(WindowedImage(p.height, p.width, level, last[1], last[0]).full())
         return out
 
     def _window(self, camera: PinholeCamera, boxes) -> tuple[int, int, int, int]:

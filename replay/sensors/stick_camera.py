@@ -439,13 +439,8 @@ class StickCamera(Sensor):
     @property
     def last_image(self) -> np.ndarray | None:
         """The whole last frame (background outside the rendered window, without its noise)."""
-        if self._last is None:
-            return None
-        crop, (x0, y0, x1, y1) = self._last
-        p = self.params
-        full = np.full((p.height, p.width), round(255.0 * p.background), np.uint8)
-        full[y0:y1, x0:x1] = crop
-        return full
+        frames = self.frame_images()
+        return frames[0][1].full() if frames else None
 
     def frame_images(self) -> list[tuple[str, WindowedImage]]:
         """The last frame (:attr:`last_image`, as its rendered window in the background):
