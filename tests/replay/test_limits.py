@@ -1,0 +1,39 @@
+"""replay.limits: the defaults, raising a limit by its environment variable, bad variables."""
+
+from __future__ import annotations
+
+import pytest
+
+from replay.limits import LIMITS, LimitError, check, limit
+
+
+def test_each_limit_has_a_positive_default_and_an_env_name():
+    for name, lim in LIMITS.items():
+        assert lim.name == name
+        assert lim.default > 0
+        assert lim.env == f"REPLAY_LIMIT_{name.upper()}"
+
+
+def test_over_the_limit_is_one_line_naming_the_limit_and_its_variable(monkeypatch):
+    monkeypatch.delenv("REPLAY_LIMIT_CAMERA_PIXELS", raising=False)
+    check("camera_pixels", LIMITS["camera_pixels"].default)  # at the limit: fine
+    with pytest.raises(LimitError) as err:
+        check("camera_pixels", LIMITS["camera_pixels"].default + 1, "sensors.chip: big image")
+    text = str(err.value)
+    assert "\n" not in text
+    assert text.startswith("sensors.chip: big image is 4,000,001 pixels")
+    assert "limit of 4,000,000" in text and "REPLAY_LIMIT_CAMERA_PIXELS" in text
+
+
+@pytest.mark.parametrize("raw", ["10_000_000", " 10000000 "])
+def test_the_variable_raises_the_limit(monkeypatch, raw):
+    monkeypatch.setenv("REPLAY_LIMIT_CAMERA_PIXELS", raw)
+    assert limit("camera_pixels") == 10_000_000
+    check("camera_pixels", 9_000_000)
+
+
+@pytest.mark.parametrize("raw", ["lots", "-5", "0", "1e9"])
+def test_a_bad_variable_is_an_error_not_the_default(monkeypatch, raw):
+    monkeypatch.setenv("REPLAY_LIMIT_SWEEP_VARIANTS", raw)
+    with pytest.raises(LimitError, match="REPLAY_LIMIT_SWEEP_VARIANTS"):
+        limit("sweep_variants")
