@@ -47,7 +47,6 @@ __all__ = [
 
 _SET_SOURCE = "<--set>"
 MAX_EXTENDS = 16  # extends chains at most this long
-MAX_SET_CHARS = 100_000
 _STR = "tag:yaml.org,2002:str"
 _MAP = "tag:yaml.org,2002:map"
 _PLAIN_FLOAT = re.compile(r"[-+]?(\d[\d_]*\.?\d*|\.\d+)[eE][-+]?\d+")  # 1e-3: YAML 1.1 says str
@@ -60,9 +59,25 @@ def _compose_root(text: str, name: str) -> yaml.MappingNode:
     node = compose(text, name)
     if node is None:
         raise ScenarioError("empty scenario", file=name)
-    if not isinstance(node, yaml.MappingNode):
-        raise ScenarioError(f"a scenario is a mapping of fields, got {_kind(node)}", node=node)
+    if not isinstance(node, yaml.MappingNode):  # (not quoted: the file may be no scenario at all)
+        got = "a list" if isinstance(node, yaml.SequenceNode) else "a single value"
+        raise ScenarioError(f"a scenario is a mapping of fields, got {got}", node=node)
     return node
+
+
+def _is_yaml(name: str) -> bool:
+    return name.lower().endswith((".yaml", ".yml"))
+
+
+def _check_base(node: yaml.MappingNode) -> None:
+    """A file named by ``extends`` is a scenario: every top-level field one of a scenario's, so
+    that no other file's content is quoted back (the field is named by its line only)."""
+    fields = [f.name for f in dataclasses.fields(Scenario) if not f.metadata.get("internal")]
+    for k, _ in node.value:
+        if k.value not in fields and k.value != "extends":
+            raise ScenarioError(
+                f"not a scenario: a top-level field that is none of {', '.join(fields)}", node=k
+            )
 
 
 def _compose_file(
@@ -72,11 +87,20 @@ def _compose_file(
     ``inputs`` collects every file read."""
     inputs.append(path.resolve())
     node = _compose_root(read_text(path), str(path))
+    if seen:
+        _check_base(node)
     base_node = _pop(node, "extends")
     if base_node is None:
         return node
     if not (isinstance(base_node, yaml.ScalarNode) and base_node.tag == _STR and base_node.value):
         raise ScenarioError("expected a file name", node=base_node, path="extends")
+    value = base_node.value
+    if not (_is_yaml(value) or ("/" not in value and "\\" not in value)):
+        raise ScenarioError(
+            f"expected a shipped scenario's name or a .yaml file, got {show(value)}",
+            node=base_node,
+            path="extends",
+        )
     try:
         base_path = _base_file(path, base_node.value, seen)
     except (OSError, RuntimeError, ValueError):
@@ -98,17 +122,19 @@ def _compose_file(
             node=base_node,
             path="extends",
         )
+    if not _is_yaml(base_path.resolve().name):  # (a link from NAME.yaml to another file)
+        raise ScenarioError(f"{show(value)} is not a .yaml file", node=base_node, path="extends")
     return _merge(_compose_file(base_path, seen + (path.resolve(),), inputs=inputs), node)
 
 
 def _base_file(path: Path, value: str, seen: tuple[Path, ...]) -> Path:
     """What ``extends: value`` in ``path`` names: a file beside ``path`` wins (for a bare name,
-    ``NAME`` or ``NAME.yaml``), unless it is ``path`` itself or already in the chain; else a
+    ``NAME.yaml``), unless it is ``path`` itself or already in the chain; else a
     bare name (``stick_3step`` or ``stick_3step.yaml``) is the shipped scenario of that name, so
     a user's own file can build on one after ``pip install``."""
     local = (path.parent / value).resolve()
-    bare = "/" not in value and "\\" not in value and not value.endswith((".yaml", ".yml"))
-    for candidate in (local, local.with_name(f"{local.name}.yaml")) if bare else (local,):
+    bare = "/" not in value and "\\" not in value and not _is_yaml(value)
+    for candidate in ((path.parent / f"{value}.yaml").resolve(),) if bare else (local,):
         if candidate.is_file() and candidate != path.resolve() and candidate not in seen:
             return candidate
     if "/" not in value and "\\" not in value:
@@ -165,10 +191,6 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
     keys = [k.strip() for k in key_path.strip().split(".")]
     if not all(keys):
         raise ScenarioError(f"--set: bad key path {show(key_path)}", file=_SET_SOURCE)
-    if len(text) > MAX_SET_CHARS:
-        raise ScenarioError(
-            f"--set {key_path}: value longer than {MAX_SET_CHARS} characters", file=_SET_SOURCE
-        )
     value = compose(text if text.strip() else "''", f"<--set {key_path}>", what="a value")
     if value is None:  # "key=" followed by a comment only
         value = compose("''", f"<--set {key_path}>")
@@ -440,10 +462,12 @@ def build_dataclass(node: yaml.Node, cls: type, path: str) -> Any:
         key = k.value
         sub = f"{path}.{key}" if path else str(key)
         if key not in fields:
+            named = _KEY.fullmatch(str(key))  # else not quoted: another file's text?
             raise ScenarioError(
-                f"unknown field {show(key)} (expected one of: {', '.join(fields)})",
+                f"unknown field {show(key) if named else '(not a name)'} "
+                f"(expected one of: {', '.join(fields)})",
                 node=k,
-                path=sub,
+                path=sub if named else path or "(top level)",
             )
         if key in values:
             raise ScenarioError("field given twice", node=k, path=sub)

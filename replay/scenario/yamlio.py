@@ -3,7 +3,9 @@
 Everything a hostile file can do to a YAML reader ends here as one :class:`ScenarioError` naming
 ``file:line:column``:
 
-- a file too big, not UTF-8 (binary, UTF-16, Latin-1) or with characters YAML forbids (NUL);
+- a text over the ``scenario_bytes`` limit (:mod:`replay.limits`: a file, a ``--set`` value or a
+  log's stored scenario, checked before it is read or parsed);
+- not UTF-8 (binary, UTF-16, Latin-1) or with characters YAML forbids (NUL);
 - nesting deeper than ``MAX_DEPTH`` (the composer recurses) and alias bombs (``MAX_NODES``
   counted with every alias expanded) or a recursive alias;
 - keys that are not plain names (``? [a, b]``), tags other than YAML's own (``!!python/...``).
@@ -14,12 +16,14 @@ scenario is data, never code.
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
 import yaml
 
-MAX_FILE_BYTES = 1 << 20  # a scenario is a page of text, not a megabyte
+from replay.limits import LimitError, check, limit
+
 MAX_DEPTH = 32  # mappings and lists nested at most this deep
 MAX_NODES = 100_000  # YAML nodes, aliases expanded (an alias bomb stays small)
 _YAML_TAG = "tag:yaml.org,2002:"
@@ -80,16 +84,37 @@ def _line_col(data: bytes | str, pos: int) -> tuple[int, int]:
     return text.count("\n") + 1, pos - (text.rfind("\n") + 1) + 1
 
 
+def check_size(size: int, name: str, what: str = "a scenario") -> None:
+    """Refuse a text of ``size`` bytes over the ``scenario_bytes`` limit (``name``: where it comes
+    from), before it is read or parsed (PyYAML's pure-Python scanner: ~0.25 s a MB)."""
+    try:
+        check("scenario_bytes", size, f"the text of {what}")
+    except LimitError as exc:
+        raise ScenarioError(str(exc), file=name) from None
+
+
+def check_text(text: str, name: str, what: str = "a scenario") -> None:
+    """:func:`check_size` of ``text`` in UTF-8 (e.g. a log's stored scenario, before parsing)."""
+    check_size(len(text), name, what)  # (its characters: a lower bound, before encoding it)
+    check_size(len(text.encode("utf-8", "surrogatepass")), name, what)
+
+
+def _cap(name: str) -> int:
+    try:
+        return limit("scenario_bytes")
+    except LimitError as exc:  # a bad REPLAY_LIMIT_SCENARIO_BYTES
+        raise ScenarioError(str(exc), file=name) from None
+
+
 def read_text(path: Path) -> str:
-    """The file's text: UTF-8 (a BOM is allowed), at most ``MAX_FILE_BYTES``."""
+    """The file's text: UTF-8 (a BOM is allowed), within the ``scenario_bytes`` limit (read
+    bounded: a device or a file growing while read cannot make it bigger)."""
     name = str(path)
     try:
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise ScenarioError(
-                f"file too big for a scenario ({size} bytes; at most {MAX_FILE_BYTES})", file=name
-            )
-        data = path.read_bytes()
+        with path.open("rb") as f:
+            check_size(os.fstat(f.fileno()).st_size, name)
+            data = f.read(_cap(name) + 1)
+        check_size(len(data), name)
     except OSError as exc:
         raise ScenarioError(f"cannot read scenario: {exc.strerror or exc}", file=name) from None
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
@@ -99,8 +124,7 @@ def read_text(path: Path) -> str:
     except UnicodeDecodeError as exc:
         line, col = _line_col(data, exc.start)
         raise ScenarioError(
-            f"not UTF-8 text (byte 0x{data[exc.start]:02x}); a scenario is UTF-8 YAML",
-            file=f"{name}:{line}:{col}",
+            "not UTF-8 text; a scenario is UTF-8 YAML", file=f"{name}:{line}:{col}"
         ) from None
     return text
 
@@ -136,6 +160,7 @@ def _loader(name: str):
 
 def compose(text: str, name: str, *, what: str = "a scenario") -> yaml.Node | None:
     """``text`` as a checked node tree (None for an empty document)."""
+    check_text(text, name, what)
     try:
         node = yaml.compose(text, Loader=_loader(name))
     except yaml.MarkedYAMLError as exc:
