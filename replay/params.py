@@ -15,12 +15,19 @@ meaningless number reaches a simulator):
 Checks between fields (a lower limit above its upper limit, a list as long as the arm's joints)
 go in the dataclass's ``__post_init__`` and raise :class:`ParamError` naming the field, so the
 error points at that field's line.
+
+A size that decides how much memory or time a plug-in will spend (a table's rows, an image's
+pixels) is bounded by a resource limit of :mod:`replay.limits`, which a user can raise: one
+field with ``param(limit="table_rows")`` (the loader checks it), a product of fields with
+:func:`check_limit` in ``__post_init__``.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from typing import Any
+
+from replay.limits import LIMITS, LimitError, check
 
 _MISSING = dataclasses.MISSING
 
@@ -56,6 +63,7 @@ def param(
     allow_inf: bool = False,
     pattern: str | None = None,
     omit_empty: bool = False,
+    limit: str | None = None,
 ) -> Any:
     """A dataclass field with validation metadata.
 
@@ -66,6 +74,8 @@ def param(
     float (meaning "no limit"), ``pattern`` is a regular expression a string must match whole.
     A field without a default is required in the YAML. ``omit_empty``: left out of the resolved
     scenario when empty (a field added later, so older scenarios resolve to the same text).
+    ``limit``: the :mod:`replay.limits` limit an integer is checked against (a size that
+    allocates in proportion: a table's rows).
     """
     meta = {
         "unit": unit,
@@ -83,12 +93,23 @@ def param(
     }
     if omit_empty:
         meta["omit_empty"] = True
+    if limit is not None:
+        meta["limit"] = LIMITS[limit].name
     if isinstance(default, (list, dict)):
         value = default
         return dataclasses.field(default_factory=lambda: _copy(value), metadata=meta)
     if default is _MISSING:
         return dataclasses.field(metadata=meta)
     return dataclasses.field(default=default, metadata=meta)
+
+
+def check_limit(name: str, value: int | float, field: str, what: str) -> None:
+    """:func:`replay.limits.check` from a ``__post_init__``: over the limit is a
+    :class:`ParamError` naming ``field`` (so the error points at its line)."""
+    try:
+        check(name, value, what)
+    except LimitError as exc:
+        raise ParamError(field, str(exc)) from None
 
 
 def _copy(value):
@@ -112,6 +133,8 @@ def describe(cls) -> list[dict]:
         for key, sym in (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")):
             if m.get(key) is not None:
                 bounds.append(f"{sym} {m[key]}")
+        if m.get("limit"):
+            bounds.append(f"at most {LIMITS[m['limit']].env}")
         if m.get("choices"):
             bounds.append("one of " + ", ".join(map(str, m["choices"])))
         if m.get("length") is not None:

@@ -270,7 +270,7 @@ class GraspParams(Params):
     )
     human_f_min: float = param(0.1, unit="Hz", gt=0.0, doc="lowest frequency of the path")
     human_f_max: float = param(1.0, unit="Hz", gt=0.0, doc="band limit of the path")
-    human_components: int = param(6, ge=1, doc="sinusoids per path axis")
+    human_components: int = param(6, ge=1, limit="table_rows", doc="sinusoids per path axis")
     human_max_force: float = param(
         30.0,
         unit="N",

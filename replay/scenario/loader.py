@@ -29,6 +29,7 @@ from typing import Any, Iterator
 import yaml
 
 from replay import registry
+from replay.limits import LimitError, check
 from replay.params import MAX_CHARS, MAX_FLOAT, MAX_INT, MAX_ITEMS, ParamError
 from replay.scenario.schema import Scenario
 from replay.scenario.yamlio import ScenarioError, compose, read_text, show
@@ -361,6 +362,11 @@ def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
                 f"expected a whole number, got {show(node.value)}", node=node, path=path
             )
         _check_range(value, meta, node, path, MAX_INT, "a whole number")
+        if meta.get("limit"):
+            try:
+                check(meta["limit"], value, "the value")
+            except LimitError as exc:
+                raise ScenarioError(str(exc), node=node, path=path) from None
     elif tp is bool:
         if not isinstance(value, bool):
             raise ScenarioError(
@@ -604,6 +610,7 @@ def check_timing(sc: Scenario, root: yaml.Node) -> None:
 
 
 def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = None) -> Scenario:
+    from replay.scenario.log_size import check_log_size
     from replay.scenario.ports import check_ports
 
     for s in sets:
@@ -621,6 +628,12 @@ def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = 
     check_timing(sc, root)
     _resolve_plugins(sc, root)
     check_ports(sc, lambda path: _nearest(root, path))
+    try:
+        check_log_size(sc)
+    except LimitError as exc:  # (duration scales every topic: its line)
+        raise ScenarioError(
+            str(exc), node=_nearest(root, "timing.duration"), path="timing.duration"
+        ) from None
     return sc
 
 

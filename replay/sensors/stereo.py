@@ -71,7 +71,7 @@ import numpy as np
 from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_OBJECT, VisionObject
-from replay.params import ParamError, param
+from replay.params import ParamError, check_limit, param
 from replay.scene import Scene, Sphere
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
 from replay.accel import accelerator
@@ -183,6 +183,12 @@ class StereoBallCameraParams:
     )
 
     def __post_init__(self) -> None:
+        check_limit(
+            "camera_pixels",
+            self.width * self.height,
+            "width",
+            f"a {self.width} x {self.height} image",
+        )
         for i, (eye, target) in enumerate(
             ((self.cam0_position, self.cam0_target), (self.cam1_position, self.cam1_target))
         ):
@@ -215,6 +221,7 @@ class StereoBallCamera(Sensor):
     """Two 128 x 128 cameras, blob moments and triangulation: ``/vision/object`` (``r_o``)."""
 
     Params = StereoBallCameraParams
+    images_per_frame = 2  # cam0 and cam1 (a run's projected log size: replay.scenario.log_size)
     topic = TOPIC_VISION_OBJECT
     description = (
         "two 128x128 pinhole cameras either side of the throw; threshold, image "

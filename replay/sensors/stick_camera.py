@@ -61,7 +61,7 @@ import numpy as np
 from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_STICK, VisionStick
-from replay.params import ParamError, param
+from replay.params import ParamError, check_limit, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
 from replay.sensors.pinhole import PinholeCamera, look_at_rotation
@@ -324,6 +324,12 @@ class StickCameraParams:
     )
 
     def __post_init__(self) -> None:
+        check_limit(
+            "camera_pixels",
+            self.width * self.height,
+            "width",
+            f"a {self.width} x {self.height} image",
+        )
         try:
             look_at_rotation(self.position, self.target, self.up)
         except ValueError as exc:

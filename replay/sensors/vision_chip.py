@@ -27,7 +27,7 @@ import numpy as np
 
 from replay.messages import TOPIC_VISION_CHIP, VisionChip, pack_rows
 from replay.interfaces import Sensor
-from replay.params import param
+from replay.params import check_limit, param
 from replay.scene import Scene
 from replay.sensors.pinhole import Intrinsics, PinholeCamera
 from replay.accel import accelerator
@@ -68,6 +68,14 @@ class VisionChipParams:
         doc="write the binary image to the log (RawImage mono8, 0/255, /camera/SENSOR/image) at the "
         "camera rate",
     )
+
+    def __post_init__(self) -> None:
+        check_limit(
+            "camera_pixels",
+            self.width * self.height,
+            "width",
+            f"a {self.width} x {self.height} image",
+        )
 
 
 class VisionChipSensor(Sensor):

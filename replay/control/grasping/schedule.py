@@ -29,7 +29,7 @@ class ScheduleParams:
     hold_time: float = param(0.0, unit="s", doc="grasp held this long; <= 0: to the end")
     release_time: float = param(0.3, unit="s", gt=0.0, doc="release and retreat")
     track_time_next: float = param(0.7, unit="s", ge=0.0, doc="tracking between cycles")
-    cycles: int = param(1, ge=1, doc="grasp/release cycles")
+    cycles: int = param(1, ge=1, limit="table_rows", doc="grasp/release cycles")
     x_far: float = param(
         0.15,
         unit="m",
