@@ -38,7 +38,7 @@ from replay.messages import (
     EffectorState,
     JointCommand,
 )
-from replay.params import param
+from replay.params import check_limit, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
 
@@ -129,6 +129,15 @@ class PredictiveParams:
         unit="s",
         doc="start closing the hand this long after the planned arrival (negative: before)",
     )
+
+    def __post_init__(self) -> None:
+        n = (self.max_lead - self.settle) / self.search_step  # the arrival times each plan tries
+        check_limit(
+            "table_rows",
+            n,
+            "search_step",
+            "the arrival times a plan tries (max_lead / search_step)",
+        )
 
 
 Params = PredictiveParams

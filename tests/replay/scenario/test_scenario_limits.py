@@ -87,6 +87,21 @@ def test_sizes_over_a_limit_are_one_line(project_root, sets, field, limit, stati
     assert field in line and limit in line and "over the limit" in line
 
 
+def test_a_plan_search_too_fine_is_refused_not_a_run_dying(project_root, tmp_path):
+    """search_step=1e-12 validated, then the run died allocating 2.8 TiB of arrival times and
+    left a .part; now validate and run refuse it at the field."""
+    sets = ["--set", "controller.params.search_step=1e-12"]
+    for args in (
+        ("validate", "predictive_catch"),
+        ("run", "predictive_catch", "-o", tmp_path / "p.mcap"),
+    ):
+        r = invoke(*args, *sets)
+        assert r.exit_code == 2
+        line = _one_error_line(r.output)
+        assert "controller.params.search_step" in line and "REPLAY_LIMIT_TABLE_ROWS" in line
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize(
     "scenario, sets",
     [
