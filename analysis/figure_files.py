@@ -1,7 +1,10 @@
-"""Saving a figure as PNG and SVG so that the same log gives the same files."""
+"""Saving a figure as PNG and SVG so that the same log gives the same files, under a file name
+that stays one harmless component of the output folder whatever the log names itself."""
 
 from __future__ import annotations
 
+import hashlib
+import re
 from pathlib import Path
 
 import matplotlib
@@ -9,12 +12,36 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from replay.log.writer import check_output  # noqa: E402
+
+# what an earlier figure starts with: the only file a figure overwrites
+MAGIC = {".png": b"\x89PNG\r\n\x1a\n", ".svg": b"<?xml"}
+STEM_LENGTH = 120  # characters of a figure's file stem (a scenario name is at most 100)
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]")  # what a scenario name may hold (NAME_PATTERN)
+
+
+def file_stem(text: str) -> str:
+    """``text`` as one path component: only ``[A-Za-z0-9_.-]`` (no ``/``, ``\\``, control or
+    NUL characters), no leading dot or dash, at most :data:`STEM_LENGTH` characters. A text
+    that is already such a name is kept; any other gets a short hash of itself, so two logs
+    whose names differ never share a file."""
+    text = str(text)
+    stem = _UNSAFE.sub("_", text).lstrip(".-")[:STEM_LENGTH]
+    if stem == text and stem:
+        return stem
+    digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:10]
+    return f"{stem[: STEM_LENGTH - 11]}-{digest}" if stem else f"run-{digest}"
+
 
 def save(fig, out: Path, stem: str) -> list[Path]:
-    """``out/stem.png`` and ``out/stem.svg``; the SVG has no date and fixed element ids
-    (matplotlib salts them randomly otherwise)."""
+    """``out/STEM.png`` and ``out/STEM.svg`` (``stem`` made safe by :func:`file_stem`); the SVG
+    has no date and fixed element ids (matplotlib salts them randomly otherwise). A file there
+    that is not an earlier PNG or SVG is refused (``replay.log.LogError``), not overwritten."""
     out.mkdir(parents=True, exist_ok=True)
+    stem = file_stem(stem)
     paths = [out / f"{stem}.png", out / f"{stem}.svg"]
+    for path in paths:
+        check_output(path, kind="figure", magic=MAGIC[path.suffix])
     fig.savefig(paths[0], dpi=150)
     with plt.rc_context({"svg.hashsalt": "paper-replay"}):
         fig.savefig(paths[1], metadata={"Date": None})
