@@ -5,23 +5,31 @@ table, the ablation plots (each redrawn from its sweep table: this machine's run
 out/ablations/, else the stored one under data/ablations/) with one sentence of what each shows,
 computed from the same table. Then the versions, seeds and commands that made it. Everything the
 page links to is copied under the report directory, so the folder is self-contained.
+
+What comes from a log (a run's name, its seed, a caption quoting the name) is data: escaped in
+both pages (``markup``), and the report links only files inside its own folder (``folder``).
 """
 
 from __future__ import annotations
 
-import html
 import platform
 import re
+import shlex
 import shutil
 from collections import defaultdict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import metadata
 from pathlib import Path
 
+from analysis.figure_files import file_stem
 from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
 from replay.report.captions import CAPTIONS
+from replay.report.folder import check_folder, staging, swap_in
+from replay.report.markup import e as _e
+from replay.report.markup import md, md_code, md_fence, url
+from replay.scenario.yamlio import one_line
 
 PACKAGES = (
     "numpy",
@@ -84,7 +92,9 @@ def _readers(logs: list[Path]) -> dict[str, dict[str, LogReader]]:
             sc = r.scenario()
         except LogError:
             continue
-        by_paper[sc["paper"]][sc["name"]] = r
+        paper, name = sc.get("paper"), sc.get("name")
+        if isinstance(paper, str) and paper and isinstance(name, str) and name:
+            by_paper[paper][name] = r
     return by_paper
 
 
@@ -98,14 +108,35 @@ def _caption(paper: str, stem: str, name: str) -> str:
 
 
 def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/logs") -> Path:
+    """Write the report to the folder ``out`` (replaced whole once the new report is complete:
+    only a folder the report made, an empty or a new one, else :class:`ReportFolderError`
+    before anything is touched); returns its ``index.html``."""
+    out = Path(out)
+    check_folder(out, Path(logs_dir))
+    work = staging(out)
+    try:
+        _build(work, Path(logs_dir))
+        swap_in(work, out)
+    except BaseException:
+        shutil.rmtree(work, ignore_errors=True)
+        raise
+    return out / "index.html"
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    """Whether ``path`` is a file inside ``folder`` (what the report may link to)."""
+    try:
+        return path.resolve().is_relative_to(folder.resolve()) and path.is_file()
+    except (OSError, RuntimeError):
+        return False
+
+
+def _build(out: Path, logs_dir: Path) -> None:
     from replay.sweep import ablations
     from replay.sweep.variants import code_version
 
-    out = Path(out)
-    if out.exists():
-        shutil.rmtree(out)
     (out / "figures").mkdir(parents=True)
-    logs = sorted(Path(logs_dir).glob("*.mcap"))
+    logs = sorted(logs_dir.glob("*.mcap"))
     by_paper = _readers(logs)
     sections = []
     for key, paper in PAPERS.items():
@@ -113,13 +144,19 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
         readers = by_paper.get(key, {})
         for name, r in sorted(readers.items()):
             sc = r.scenario()
-            sec.runs.append((name, sc["seed"], str(r.path) if hasattr(r, "path") else name))
+            sec.runs.append((name, sc.get("seed", "?"), str(getattr(r, "path", name))))
         if readers:
             try:
                 make = registry.load("figures", key)
                 paths = make(readers, out / "figures")
             except registry.UnknownPlugin:
                 paths = []
+            except OSError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a damaged or hostile log: said, not fatal
+                sec.notes.append(f"No figures: they could not be made from these logs: {exc!r}")
+                paths = []
+            paths = [Path(p) for p in paths if _inside(Path(p), out / "figures")]
             for png in (p for p in paths if p.suffix == ".png"):
                 svg = png.with_suffix(".svg")
                 run = next((n for n in readers if png.stem.startswith(n)), "")
@@ -144,6 +181,10 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
                 sec.claims_summary = summary(sec.claims, sec.falsifiers)
             except registry.UnknownPlugin:
                 sec.notes.append("No claims table defined yet.")
+            except OSError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a damaged or hostile log: said, not fatal
+                sec.notes.append(f"No claims: they could not be evaluated on these logs: {exc!r}")
         for name in ablations.names():
             sf = ablations.load(name)
             if sf.paper != key:
@@ -160,7 +201,6 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
         shutil.copy(data_path("ablations", f"{TABLE}.csv"), out / "tables" / f"{TABLE}.csv")
     (out / "index.md").write_text(_markdown(sections, info, commands), encoding="utf-8")
     (out / "index.html").write_text(_html(sections, info, commands), encoding="utf-8")
-    return out / "index.html"
 
 
 def _ablation(sf, out: Path, ablations) -> Ablation:
@@ -221,8 +261,9 @@ def _provenance(version: str) -> dict[str, str]:
 def _commands(sections, logs) -> list[str]:
     cmds = []
     for sec in sections:
-        for name, seed, _ in sec.runs:
-            cmds.append(f"replay run {name} --seed {seed} -o out/logs/{name}.mcap")
+        for name, seed, _ in sec.runs:  # (a log's name and seed quoted for the shell)
+            log = f"out/logs/{file_stem(name)}.mcap"
+            cmds.append(f"replay run {shlex.quote(name)} --seed {shlex.quote(str(seed))} -o {log}")
     if logs:
         cmds += [
             "replay figures out/logs/*.mcap -o out/figures",
@@ -256,15 +297,18 @@ def _markdown(sections, info, commands) -> str:
     for sec in sections:
         lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
         if sec.runs:
-            lines += ["Runs: " + ", ".join(f"`{n}` (seed {s})" for n, s, _ in sec.runs), ""]
+            runs = (f"{md_code(n)} (seed {md(s)})" for n, s, _ in sec.runs)
+            lines += ["Runs: " + ", ".join(runs), ""]
         for note in sec.notes:  # every line of a note quoted (the engines' note has three)
-            lines += ["\n>\n".join(f"> {x}" for x in note.splitlines()), ""]
+            lines += ["\n>\n".join(f"> {md(x)}" for x in note.splitlines()), ""]
         if sec.figures:
             lines += ["### Figures", ""]
             for f in sec.figures:
-                lines += [f"![{f.caption}]({f.png})", "", f"*{f.caption}*", ""]
+                cap = md(f.caption)
+                lines += [f"![{cap}]({url(f.png)})", "", f"*{cap}*", ""]
         if sec.claims_md:
-            lines += ["### Claims", "", sec.claims_md.split("\n", 2)[2], ""]
+            table = claims_markdown(sec.title, sec.claims, sec.falsifiers)
+            lines += ["### Claims", "", table.split("\n", 2)[2], ""]
         if sec.falsifiers:
             from analysis.claims import format_falsifiers
 
@@ -293,8 +337,30 @@ def _markdown(sections, info, commands) -> str:
                 ]
     lines += ["## Versions", "", "| package | version |", "|---|---|"]
     lines += [f"| {k} | {v} |" for k, v in info.items()]
-    lines += ["", "## Commands", "", "```sh", *commands, "```", ""]
+    commands = [one_line(c) for c in commands]
+    fence = md_fence(commands)
+    lines += ["", "## Commands", "", f"{fence}sh", *commands, fence, ""]
     return "\n".join(lines)
+
+
+def claims_markdown(title: str, rows, falsifiers=(), partial=None) -> str:
+    """``analysis.claims.format_table`` with every cell and log name escaped for Markdown (a
+    quantity can name a run): the claims table in index.md and in ``claims --markdown``."""
+    from analysis.claims import format_table
+
+    rows = [
+        replace(
+            c,
+            quantity=md(c.quantity),
+            stated=md(c.stated),
+            measured=md(c.measured),
+            note=md(c.note),
+        )
+        for c in rows
+    ]
+    falsifiers = [replace(f, row=md(f.row)) for f in falsifiers]
+    partial = {md(k): [md(n) for n in v] for k, v in (partial or {}).items()}
+    return format_table(title, rows, partial=partial, falsifiers=falsifiers)
 
 
 # -- HTML ------------------------------------------------------------------------------------
@@ -311,48 +377,51 @@ pre { background: #f5f5f5; padding: 0.6rem; overflow-x: auto; font-size: 0.8rem;
 .note { background: #fff8e0; padding: 0.5rem 0.8rem; border-left: 4px solid #e0b000; }
 """
 
-
-def _e(text) -> str:
-    return html.escape(str(text))
+# no script, frame, form or remote resource whatever the page holds: its own images, inline style
+_CSP = (
+    "default-src 'none'; img-src 'self' file: data:; style-src 'unsafe-inline'; "
+    "base-uri 'none'; form-action 'none'"
+)
 
 
 def _html(sections, info, commands) -> str:
     h = [
         "<!doctype html>",
-        "<html lang='en'><head><meta charset='utf-8'>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        f'<meta http-equiv="Content-Security-Policy" content="{_CSP}">',
         "<title>paper-replay: reproduction report</title>",
         f"<style>{_STYLE}</style>",
         "</head><body>",
         "<h1>paper-replay: reproduction report</h1>",
         "<p>Every figure below is regenerated from a run's MCAP log; every ablation plot from "
-        "its sweep table. <a href='index.md'>Markdown version</a>.</p>",
+        'its sweep table. <a href="index.md">Markdown version</a>.</p>',
         "<nav><ul>",
     ]
-    h += [f"<li><a href='#{s.key}'>{_e(s.title)}</a></li>" for s in sections]
+    h += [f'<li><a href="#{_e(s.key)}">{_e(s.title)}</a></li>' for s in sections]
     h += [
-        "<li><a href='#versions'>Versions</a></li>",
-        "<li><a href='#commands'>Commands</a></li>",
+        '<li><a href="#versions">Versions</a></li>',
+        '<li><a href="#commands">Commands</a></li>',
         "</ul></nav>",
     ]
     for sec in sections:
         h += [
-            f"<section id='{sec.key}'>",
+            f'<section id="{_e(sec.key)}">',
             f"<h2>{_e(sec.title)}</h2>",
-            f"<p><em>{_e(sec.authors)}</em> (<code>{sec.key}</code>)</p>",
+            f"<p><em>{_e(sec.authors)}</em> (<code>{_e(sec.key)}</code>)</p>",
         ]
         if sec.runs:
             h.append(
                 "<p>Runs: "
-                + ", ".join(f"<code>{_e(n)}</code> (seed {s})" for n, s, _ in sec.runs)
+                + ", ".join(f"<code>{_e(n)}</code> (seed {_e(s)})" for n, s, _ in sec.runs)
                 + "</p>"
             )
-        h += [f"<p class='note'>{'<br>'.join(map(_e, n.splitlines()))}</p>" for n in sec.notes]
+        h += [f'<p class="note">{"<br>".join(map(_e, n.splitlines()))}</p>' for n in sec.notes]
         if sec.figures:
             h.append("<h3>Figures</h3>")
             for f in sec.figures:
-                svg = f" <a href='{f.svg}'>SVG</a>" if f.svg else ""
+                svg = f' <a href="{url(f.svg)}">SVG</a>' if f.svg else ""
                 h.append(
-                    f"<figure><img src='{f.png}' alt='{_e(f.caption)}'>"
+                    f'<figure><img src="{url(f.png)}" alt="{_e(f.caption)}">'
                     f"<figcaption>{_e(f.caption)}{svg}</figcaption></figure>"
                 )
         if sec.claims:
@@ -366,7 +435,7 @@ def _html(sections, info, commands) -> str:
             for c in sec.claims:
                 h.append(
                     f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.kind)}</td><td>{_e(c.stated)}</td>"
-                    f"<td>{_e(c.measured)}</td><td class='{_e(c.status)}'><b>"
+                    f'<td>{_e(c.measured)}</td><td class="{_e(c.status)}"><b>'
                     f"{_e(c.status)}</b></td><td>{_e(row_note(c, sec.falsifiers))}</td></tr>"
                 )
             h += ["</table>", f"<p>{_e(sec.claims_summary)}</p>"]
@@ -390,27 +459,27 @@ def _html(sections, info, commands) -> str:
         if sec.ablations:
             h.append("<h3>Ablations</h3>")
             for a in sec.ablations:
-                h.append(f"<h4 id='ablation-{a.name}'>{_e(a.name)}</h4>")
+                h.append(f'<h4 id="ablation-{_e(a.name)}">{_e(a.name)}</h4>')
                 if a.png:
-                    svg = f" <a href='{a.svg}'>SVG</a>" if a.svg else ""
+                    svg = f' <a href="{url(a.svg)}">SVG</a>' if a.svg else ""
                     h.append(
-                        f"<figure><img src='{a.png}' alt='{_e(a.caption)}'><figcaption>"
+                        f'<figure><img src="{url(a.png)}" alt="{_e(a.caption)}"><figcaption>'
                         f"{_e(a.caption)} <strong>{_e(a.shows)}</strong>{svg}</figcaption>"
                         "</figure>"
                     )
                 else:
                     h.append(f"<p>{_e(a.caption)} {_e(a.shows)}</p>")
-                table = f"<a href='{a.table}'>table</a> ({_e(a.source)}), " if a.table else ""
+                table = f'<a href="{url(a.table)}">table</a> ({_e(a.source)}), ' if a.table else ""
                 h.append(
-                    f"<p>{table}<a href='{a.sweep}'>sweep file</a>; "
+                    f'<p>{table}<a href="{url(a.sweep)}">sweep file</a>; '
                     f"<code>{_e(a.command)}</code></p>"
                 )
         h.append("</section>")
-    h += ["<h2 id='versions'>Versions</h2>", "<table><tr><th>package</th><th>version</th></tr>"]
+    h += ['<h2 id="versions">Versions</h2>', "<table><tr><th>package</th><th>version</th></tr>"]
     h += [f"<tr><td>{_e(k)}</td><td>{_e(v)}</td></tr>" for k, v in info.items()]
     h += [
         "</table>",
-        "<h2 id='commands'>Commands</h2>",
+        '<h2 id="commands">Commands</h2>',
         "<pre>" + _e("\n".join(commands)) + "</pre>",
         "</body></html>",
     ]

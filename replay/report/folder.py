@@ -1,0 +1,84 @@
+"""The report's folder: ``replay report -o DIR`` replaces DIR whole, so it must be a folder the
+report made (its :data:`MARKER` file inside), an empty one or a new one; never the logs it reads,
+a folder holding them, the working folder or one of its parents, nor anything else.
+
+The report is built in a fresh sibling folder and swapped in once complete: a failed build leaves
+the earlier report as it was.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+
+MARKER = ".paper-replay-report"
+MARKER_TEXT = "made by `replay report`, which replaces this folder whole on its next run\n"
+# a report written before the marker existed: these entries only, and its index.html's title
+_OLD_ENTRIES = {"index.html", "index.md", "figures", "ablations", "tables", "sweeps"}
+_OLD_TITLE = "<title>paper-replay: reproduction report</title>"
+
+
+class ReportFolderError(ValueError):
+    """The folder given to ``replay report -o`` is not one it may replace (one line)."""
+
+
+def _ours(folder: Path) -> bool:
+    if (folder / MARKER).is_file():
+        return True
+    try:
+        names = {p.name for p in folder.iterdir()}
+        head = (folder / "index.html").read_text(encoding="utf-8", errors="replace")[:300]
+    except OSError:
+        return False
+    return names <= _OLD_ENTRIES and _OLD_TITLE in head
+
+
+def check_folder(out: Path, logs: Path) -> None:
+    """:class:`ReportFolderError` saying why the report may not replace ``out``, if it may
+    not; nothing is touched."""
+    try:
+        target = out.resolve()
+        read = logs.resolve()
+        cwd = Path.cwd().resolve()
+    except (OSError, RuntimeError) as exc:
+        raise ReportFolderError(f"cannot use report folder {out}: {exc}") from None
+    if target == cwd or target in cwd.parents:
+        raise ReportFolderError(
+            f"will not write the report to {out}: it is the working folder or one of its "
+            "parents (the report replaces its folder whole; give a folder of its own, e.g. "
+            "out/report)"
+        )
+    if target == read or target in read.parents:
+        raise ReportFolderError(
+            f"will not write the report to {out}: it holds the logs it reads ({logs}); give "
+            "another -o"
+        )
+    if out.is_symlink() or (target.exists() and not target.is_dir()):
+        what = "a symbolic link" if out.is_symlink() else "a file"
+        raise ReportFolderError(f"will not write the report to {out}: it is {what}, not a folder")
+    if target.is_dir() and any(target.iterdir()) and not _ours(target):
+        raise ReportFolderError(
+            f"will not replace {out}: a folder that is not empty and was not made by "
+            f"`replay report` (no {MARKER} in it); give a new or empty folder"
+        )
+
+
+def staging(target: Path) -> Path:
+    """A new empty folder beside ``target`` to build the report in (its parents made)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent))
+    (work / MARKER).write_text(MARKER_TEXT, encoding="utf-8")
+    return work
+
+
+def swap_in(work: Path, target: Path) -> None:
+    """Replace ``target`` (a folder :func:`check_folder` allowed, or nothing) by ``work``."""
+    old = None
+    if target.exists():
+        old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
+        target.rename(old / "report")
+    work.rename(target)
+    target.chmod(0o755)  # (mkdtemp made it 0700)
+    if old is not None:
+        shutil.rmtree(old)

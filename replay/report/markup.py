@@ -1,0 +1,46 @@
+"""Text from a log (a scenario's name, its seed, a caption quoting it) as data in the report's
+HTML and Markdown, never as markup: escaped, on one line, links only to the report's own files."""
+
+from __future__ import annotations
+
+import html
+import re
+from urllib.parse import quote
+
+from replay.scenario.yamlio import one_line
+
+_MD_SPECIAL = re.compile(r"[\\`\[\]<>&|]")  # (emphasis left: it cannot inject)
+_MD_ENTITY = {"<": "&lt;", ">": "&gt;", "&": "&amp;"}
+
+
+def e(text) -> str:
+    """HTML text or a double-quoted attribute value: ``& < > " '`` escaped."""
+    return html.escape(str(text), quote=True)
+
+
+def url(path: str) -> str:
+    """A link to a file of the report (a relative POSIX path): percent-encoded (so no
+    ``javascript:`` or other scheme, no query), then escaped for a double-quoted attribute."""
+    return e(quote(path, safe="/"))
+
+
+def md(text) -> str:
+    """Markdown text: one line, no raw HTML (``< > &`` as entities), no link, code or table
+    syntax (backslash-escaped)."""
+    return _MD_SPECIAL.sub(
+        lambda m: _MD_ENTITY.get(m.group(), "\\" + m.group()), one_line(str(text))
+    )
+
+
+def md_code(text) -> str:
+    """A Markdown code span of ``text`` on one line, its fence longer than any backtick run."""
+    text = one_line(str(text))
+    fence = "`" * (max((len(r) for r in re.findall("`+", text)), default=0) + 1)
+    pad = " " if text.startswith("`") or text.endswith("`") else ""
+    return f"{fence}{pad}{text}{pad}{fence}"
+
+
+def md_fence(lines: list[str]) -> str:
+    """A fenced block's opening/closing fence, longer than any backtick run in ``lines``."""
+    longest = max((len(r) for line in lines for r in re.findall("`+", line)), default=0)
+    return "`" * max(3, longest + 1)
