@@ -14,7 +14,17 @@ import numpy as np
 
 from replay import completion as complete
 from replay import registry
-from replay.console import RunProgress, bar, bars_on, fail, note, printable_streams, warn
+from replay.console import (
+    RunProgress,
+    bar,
+    bars_on,
+    fail,
+    note,
+    printable_streams,
+    quoted_warnings,
+    say,
+    warn,
+)
 from replay.foxglove.layouts import PAPERS as LAYOUT_PAPERS
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
@@ -34,6 +44,8 @@ from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
 
 DEFAULT_LOG_DIR = Path("out/logs")
 DEFAULT_FIGURE_DIR = Path("out/figures")
+# the first line of a `claims --markdown` file: what it may overwrite (an earlier claims table)
+CLAIMS_HEADER = "<!-- paper-replay claims table -->"
 
 
 _NoArgsIsHelp = getattr(click.exceptions, "NoArgsIsHelpError", ())  # click >= 8.2
@@ -500,7 +512,7 @@ def info(log):
             )
         )
         if metrics:
-            click.echo("  " + ", ".join(f"{k}={_short(v)}" for k, v in metrics.items()))
+            say("  " + ", ".join(f"{k}={_short(v)}" for k, v in metrics.items()))
     click.echo("topics:")
     for topic, n in r.topic_counts().items():
         click.echo(one_line(f"  {topic:<28} {n:>8}"))
@@ -638,13 +650,16 @@ def figures(logs, out):
             warn(f"{paper}: no figures defined yet ({', '.join(readers)})")
             continue
         try:
-            paths = make(readers, Path(out))
+            with quoted_warnings():
+                paths = make(readers, Path(out))
         except OSError as exc:
             fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+        except LogError as exc:  # (a file there that is not an earlier figure)
+            fail(str(exc))
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("figures", paper, readers, exc)
         for path in paths:
-            click.echo(f"figure: {path}")
+            say(f"figure: {path}")
         for name, notes in _partial(readers).items():
             for text in notes:
                 warn(
@@ -659,14 +674,20 @@ def claims(logs, markdown):
     """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
     from analysis.claims import falsifiers_of, format_table
     from analysis.engines import evaluate_runs
+    from replay.report.builder import claims_markdown
 
-    sections = []
+    sections, md_sections = [], []
     by_paper = _logs_by_paper(logs)
     inputs = {Path(r.path).resolve() for readers in by_paper.values() for r in readers.values()}
     if markdown and (
         Path(markdown).resolve() in inputs or Path(markdown).suffix in (".mcap", ".yaml", ".yml")
     ):
         fail(f"will not write the claims table over {markdown} (a log or a scenario)")
+    if markdown:  # (before the analysis: only a new file or an earlier claims table)
+        try:
+            check_output(Path(markdown), kind="claims table", magic=CLAIMS_HEADER.encode())
+        except LogError as exc:
+            fail(str(exc))
     for paper, readers in by_paper.items():
         try:
             evaluate = registry.load("claims", paper)
@@ -678,18 +699,14 @@ def claims(logs, markdown):
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("claims", paper, readers, exc)
         title = PAPERS[paper].title if paper in PAPERS else paper
-        table = format_table(
-            title, rows, partial=_partial(readers), falsifiers=falsifiers_of(evaluate)
-        )
-        sections.append(table + (f"\n\n{engines_note}" if engines_note else ""))
-    text = "\n\n".join(sections)
-    click.echo(text)
-    if markdown:
-        try:
-            Path(markdown).parent.mkdir(parents=True, exist_ok=True)
-            Path(markdown).write_text(text + "\n")
-        except OSError as exc:
-            fail(f"cannot write {markdown}: {exc.strerror or exc}")
+        partial, falsifiers = _partial(readers), falsifiers_of(evaluate)
+        closing = f"\n\n{engines_note}" if engines_note else ""
+        sections.append(format_table(title, rows, partial=partial, falsifiers=falsifiers) + closing)
+        md_sections.append(claims_markdown(title, rows, falsifiers, partial) + closing)
+    say("\n\n".join(sections))
+    if markdown:  # (the log's names escaped: no raw HTML where the Markdown is rendered)
+        text = "\n\n".join([CLAIMS_HEADER, *md_sections]) + "\n"
+        _write_output(Path(markdown), text, kind="claims table", magic=CLAIMS_HEADER.encode())
 
 
 @main.command()
@@ -733,7 +750,7 @@ def falsify(papers, logs_dir, keep):
                 fail(f"{paper}: {one_line(str(exc))}", code=1)
             click.echo(f"## {paper}")
             for v in verdicts:
-                click.echo(v.line())
+                say(v.line())
             bad = sum(not v.ok for v in verdicts)
             ran = sum(bool(v.status) for v in verdicts)
             click.echo(f"{paper}: {ran} falsifiers run, {bad} failing")

@@ -9,8 +9,10 @@ per runner callback and nothing more.
 from __future__ import annotations
 
 import codecs
+import contextlib
 import sys
 import time
+import warnings
 from typing import IO, Any, NoReturn
 
 import click
@@ -106,12 +108,29 @@ def fail(message: str, code: int = 2) -> NoReturn:
     sys.exit(code)
 
 
+def say(text: str) -> None:
+    """A result on stdout, each of its lines with control characters escaped (``one_line``): a
+    name or path read from a log never moves the cursor, clears the screen or sets a title."""
+    click.echo("\n".join(one_line(line) for line in str(text).split("\n")))
+
+
 def warn(message: str) -> None:
     click.echo(f"warning: {one_line(message)}", err=True)
 
 
 def note(message: str) -> None:
     click.echo(f"note: {one_line(message)}", err=True)
+
+
+@contextlib.contextmanager
+def quoted_warnings():
+    """Python warnings raised meanwhile (matplotlib's "Glyph 27 (\\x1b) missing" for a title
+    quoting a log's name) said once each by :func:`warn`, their control characters escaped."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        yield  # (an error raised: only its own line is said)
+    for text in dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught):
+        warn(text)
 
 
 def bars_on(quiet: bool = False, stream: IO | None = None) -> bool:
