@@ -1,0 +1,378 @@
+"""Hostile logs and output paths (issue #36): ``report``, ``figures`` and ``claims --markdown``
+write only the files they name or a folder they own, file names from a log stay one component
+inside the output folder, what a log holds is escaped in the report and on the terminal.
+
+The hostile logs are a real stick_3step run (~0.3 s) copied with its /scenario message changed
+(the loader refuses such names, so only a forged log carries them)."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from analysis.figure_files import STEM_LENGTH, file_stem
+from replay.cli import CLAIMS_HEADER, main
+from replay.log import LogReader, LogWriter
+from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
+from replay.report.folder import MARKER
+
+CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # (newline and tab aside)
+SAFE_FILE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], prog_name="replay")
+
+
+def one_error(r) -> str:
+    lines = [line for line in r.stderr.splitlines() if line.strip()]
+    assert r.exit_code == 2, (r.exit_code, r.output)
+    assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
+    assert "Traceback" not in r.output
+    return lines[0]
+
+
+def tree(root: Path) -> dict[str, str]:
+    """Every file and folder under ``root`` with a hash of its content: what must not change."""
+    out = {}
+    for p in sorted(root.rglob("*")):
+        rel = p.relative_to(root).as_posix()
+        if p.is_symlink():
+            out[rel] = "-> " + str(p.readlink())
+        elif p.is_file():
+            out[rel] = hashlib.sha256(p.read_bytes()).hexdigest()
+        else:
+            out[rel] = "dir"
+    return out
+
+
+@pytest.fixture(scope="module")
+def base_log(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("base") / "stick_3step.mcap"
+    r = invoke("run", "stick_3step", "-q", "-o", path)
+    assert r.exit_code == 0, r.output
+    return path
+
+
+def forge(base: Path, out: Path, outcome: dict | None = None, **fields) -> Path:
+    """A copy of the log ``base`` whose /scenario message has ``fields`` (name, seed, paper)
+    and, with ``outcome``, whose outcome event's data is that."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with LogWriter(out) as w:
+        for m in LogReader(base).messages():
+            data = m.data
+            if m.topic == TOPIC_SCENARIO:
+                data = dict(data, **fields)
+            elif m.topic == TOPIC_EVENTS and outcome is not None and data["kind"] == "outcome":
+                data = dict(data, data=outcome)
+            w.write(m.topic, data, m.t_ns)
+    return out
+
+
+ESCAPES = "a\x1b]0;PWNED TITLE\x07\x1b[2J\x1b[1;1Hb\rfigure: /etc/forged\nc"
+NAMES = [
+    "../../escaped/PWNED",  # the issue's reproducer
+    "..",
+    ".hidden",
+    "-rf",
+    "a\\..\\..\\b",
+    "nul\x00in\x00it",
+    ESCAPES,
+    "x' onerror='alert(1)\" <b>",
+    "é" * 10 + "/" + "n" * 400,
+]
+
+
+# -- file names from a log ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", [*NAMES, "/abs/PWNED", "", "a" * 5000, "\u2028", "ok.name-1"])
+def test_a_file_stem_is_one_safe_bounded_component(name):
+    stem = file_stem(name)
+    assert SAFE_FILE.fullmatch(stem) and len(stem) <= STEM_LENGTH, stem
+    assert Path(stem).name == stem and stem not in (".", "..")
+
+
+def test_a_valid_name_is_kept_and_different_names_never_share_a_file():
+    assert file_stem("stick_3step_fig7") == "stick_3step_fig7"
+    names = ["a/b", "a_b", "a\\b", "a b", "a" * 300, "a" * 301, "..", "."]
+    assert len({file_stem(n) for n in names}) == len(names)
+
+
+def test_figures_of_hostile_names_stay_in_the_output_folder(base_log, tmp_path, monkeypatch):
+    """`replay figures LOG -o figs/a` for a log named ../../escaped/PWNED (and the others):
+    every file inside figs/a, one safe name each; the terminal gets no control character."""
+    work = tmp_path / "work" / "deep"
+    work.mkdir(parents=True)
+    monkeypatch.chdir(work)
+    absolute = tmp_path / "abs" / "PWNED"
+    logs = [forge(base_log, tmp_path / "logs" / f"{i}.mcap", name=n) for i, n in enumerate(NAMES)]
+    logs.append(forge(base_log, tmp_path / "logs" / "abs.mcap", name=str(absolute)))
+    before = tree(tmp_path)
+    r = invoke("figures", *logs, "-o", "figs/a")
+    assert r.exit_code == 0, r.output
+    new = {k for k in tree(tmp_path).keys() - before.keys()}
+    figs = "work/deep/figs/a/"
+    assert {"work/deep/figs", "work/deep/figs/a"} <= new
+    made = sorted(k for k in new if k.startswith(figs))
+    assert len(made) == 2 * len(logs), made  # a PNG and an SVG for every log, none shared
+    assert new == {"work/deep/figs", "work/deep/figs/a", *made}, new  # nothing elsewhere
+    assert all(SAFE_FILE.fullmatch(k[len(figs) :]) for k in made), made
+    assert not (tmp_path / "escaped").exists() and not absolute.parent.exists()
+    assert not CONTROL.search(r.output), repr(r.output)
+    lines = r.stdout.splitlines()
+    assert len(lines) == 2 * len(logs) and all(line.startswith("figure: ") for line in lines)
+    assert not any("/etc/forged" in line for line in lines)  # no forged line
+
+
+def test_figures_do_not_overwrite_a_file_they_did_not_make(base_log, tmp_path):
+    figs = tmp_path / "figs"
+    figs.mkdir()
+    mine = figs / "stick_3step_fig7.png"
+    mine.write_text("my notes, not a figure")
+    r = invoke("figures", base_log, "-o", figs)
+    assert "will not overwrite" in one_error(r)
+    assert mine.read_text() == "my notes, not a figure"
+    mine.unlink()
+    assert invoke("figures", base_log, "-o", figs).exit_code == 0
+    assert invoke("figures", base_log, "-o", figs).exit_code == 0  # its own figures: replaced
+
+
+def test_info_escapes_what_an_outcome_event_holds(base_log, tmp_path):
+    log = forge(
+        base_log,
+        tmp_path / "x.mcap",
+        name=ESCAPES,
+        outcome={"success": True, "reason": ESCAPES, ESCAPES: ESCAPES},
+    )
+    r = invoke("info", log)
+    assert r.exit_code == 0, r.output
+    assert not CONTROL.search(r.output), repr(r.output)
+    assert "forged" in r.stdout and "\nfigure: /etc/forged" not in r.stdout
+
+
+# -- report: the folder it replaces -----------------------------------------------------------
+
+
+@pytest.fixture
+def site(base_log, tmp_path, monkeypatch):
+    """tmp/work (the working folder, with files of its own) and tmp/work/logs with one log;
+    the report's content is a stub (the folder is what these tests are about: ms, not s)."""
+    import replay.report.builder as builder
+
+    def stub(out, logs_dir):
+        (out / "figures").mkdir()
+        (out / "figures" / "a.png").write_bytes(b"\x89PNG\r\n\x1a\n")
+        (out / "index.html").write_text(f"report of {sorted(logs_dir.glob('*.mcap'))}")
+        (out / "index.md").write_text("report")
+
+    monkeypatch.setattr(builder, "_build", stub)
+    work = tmp_path / "work"
+    (work / "logs").mkdir(parents=True)
+    (work / "main.py").write_text("print('mine')\n")
+    (work / "notes").mkdir()
+    (work / "notes" / "a.txt").write_text("mine\n")
+    forge(base_log, work / "logs" / "s.mcap", name="stick_3step")
+    monkeypatch.chdir(work)
+    return work
+
+
+@pytest.mark.parametrize(
+    "out, logs, why",
+    [
+        (".", "logs", "working folder"),  # the issue's reproducer: `-o .`
+        (".", "../empty", "working folder"),  # ... with no logs at all
+        ("..", "logs", "working folder"),
+        ("{root}", "logs", "working folder"),
+        ("logs", "logs", "holds the logs"),  # `--logs L -o L`
+        ("logs/", "./logs/../logs", "holds the logs"),
+        ("notes", "logs", "not empty"),  # a foreign folder
+        ("main.py", "logs", "is a file"),
+        ("link", "logs", "symbolic link"),
+    ],
+)
+def test_report_refuses_a_folder_it_does_not_own_before_touching_anything(site, out, logs, why):
+    (site / "link").symlink_to(site / "notes")
+    (site.parent / "empty").mkdir(exist_ok=True)
+    before = tree(site.parent)
+    r = invoke("report", "-o", out.format(root=site.anchor), "--logs", logs)
+    assert why in one_error(r)
+    assert tree(site.parent) == before  # nothing made, nothing removed
+
+
+def test_report_refuses_a_parent_of_the_logs(base_log, tmp_path, monkeypatch):
+    logs = tmp_path / "data" / "runs" / "logs"
+    forge(base_log, logs / "s.mcap", name="stick_3step")
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    before = tree(tmp_path)
+    r = invoke("report", "-o", tmp_path / "data", "--logs", logs)
+    assert "holds the logs" in one_error(r)
+    assert tree(tmp_path) == before
+
+
+def test_report_replaces_its_own_folder_and_keeps_it_when_a_build_fails(site, monkeypatch):
+    assert invoke("report", "-o", "rep", "--logs", "logs").exit_code == 0
+    assert (site / "rep" / MARKER).is_file() and (site / "rep" / "figures").is_dir()
+    stale = site / "rep" / "figures" / "stale.png"
+    stale.write_bytes(b"\x89PNG\r\n\x1a\nold")
+    r = invoke("report", "-o", "rep", "--logs", "logs")
+    assert r.exit_code == 0, r.output
+    assert not stale.exists() and (site / "rep" / "index.html").is_file()  # replaced whole
+    good = tree(site / "rep")
+
+    import replay.report.builder as builder
+
+    def broken(out, logs_dir):
+        (out / "index.html").write_text("half a report")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(builder, "_build", broken)
+    r = invoke("report", "-o", "rep", "--logs", "logs")
+    assert r.exit_code == 1 and "No space left" in r.stderr
+    assert tree(site / "rep") == good  # the earlier report as it was
+    assert sorted(p.name for p in site.iterdir()) == ["logs", "main.py", "notes", "rep"]
+
+
+def test_report_takes_an_empty_folder_a_new_one_and_a_report_without_marker(site):
+    (site / "empty").mkdir()
+    for out in ("empty", "new/deeper", "logs/report"):  # (a folder inside --logs is no harm)
+        r = invoke("report", "-o", out, "--logs", "logs")
+        assert r.exit_code == 0, r.output
+        assert (site / out / MARKER).is_file() and (site / out / "index.html").is_file()
+    old = site / "old"  # a report written before the marker existed
+    old.mkdir()
+    (old / "figures").mkdir()
+    (old / "index.html").write_text(
+        "<!doctype html>\n<html lang='en'><head><meta charset='utf-8'>\n"
+        "<title>paper-replay: reproduction report</title>\n"
+    )
+    assert invoke("report", "-o", "old", "--logs", "logs").exit_code == 0
+    assert (old / MARKER).is_file()
+    (site / "notes" / "index.html").write_text(
+        "<title>paper-replay: reproduction report</title>"
+    )  # ... but not with a file of the user's beside it
+    assert "not empty" in one_error(invoke("report", "-o", "notes", "--logs", "logs"))
+    assert (site / "notes" / "a.txt").read_text() == "mine\n"
+
+
+# -- report: what a log holds is data ---------------------------------------------------------
+
+
+class _Links(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.links: list[str] = []
+        self.tags: list[str] = []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+        self.links += [v for k, v in attrs if k in ("src", "href") and v is not None]
+        for k, v in attrs:
+            assert not k.startswith("on"), (tag, k, v)  # no event handler attribute
+
+
+PAYLOADS = {
+    "name": [
+        "../../escaped/PWNED",
+        'run<iframe style=display:none srcdoc="<script>alert(1)</script>"></iframe>',
+        "x' onerror='alert(1)' y",
+        'y" onerror="alert(2)" z',
+        "javascript:alert(3)",
+        "a`<script>alert(4)</script>`b\n\n<script>alert(5)</script>",
+        "```\n<script>alert(6)</script>",
+        "[link](javascript:alert(7))",
+    ],
+    "seed": ["<script>alert(1)</script>", "1; rm -rf ~", {"a": "<b>"}],
+}
+
+
+@pytest.fixture(scope="module")
+def hostile_report(base_log, tmp_path_factory):
+    root = tmp_path_factory.mktemp("hostile")
+    logs = root / "logs"
+    for i, name in enumerate(PAYLOADS["name"]):
+        seed = PAYLOADS["seed"][i % len(PAYLOADS["seed"])]
+        forge(base_log, logs / f"{i}.mcap", name=name, seed=seed)
+    before = tree(root)
+    r = invoke("report", "-o", root / "report", "--logs", logs)
+    assert r.exit_code == 0, r.output
+    assert not CONTROL.search(r.output)
+    made = tree(root).keys() - before.keys()
+    assert all(k == "report" or k.startswith("report/") for k in made), made
+    return root / "report"
+
+
+def test_report_escapes_every_payload_in_html(hostile_report):
+    text = (hostile_report / "index.html").read_text(encoding="utf-8")
+    parser = _Links()
+    parser.feed(text)
+    assert "script" not in parser.tags and "iframe" not in parser.tags
+    assert "<script" not in text.lower() and "<iframe" not in text.lower()
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in text  # shown, as text
+    assert "x&#x27; onerror=&#x27;alert(1)&#x27; y" in text
+    figures = [link for link in parser.links if link.startswith("figures/")]
+    assert len(figures) >= 2 * len(PAYLOADS["name"]), parser.links
+    for link in parser.links:  # every link: an anchor or a file inside the report
+        if link.startswith("#"):
+            continue
+        assert ":" not in link and not link.startswith("/") and ".." not in link.split("/")
+        assert (hostile_report / link).resolve().is_relative_to(hostile_report.resolve())
+        assert (hostile_report / link).is_file(), link
+
+
+def test_report_escapes_every_payload_in_markdown(hostile_report):
+    text = (hostile_report / "index.md").read_text(encoding="utf-8")
+    body, commands = text.split("## Commands", 1)
+    outside_code = re.sub(r"(`+)(?!`).*?(?<!`)\1(?!`)", "", body)  # (code shows text)
+    assert "<script" not in outside_code.lower() and "<iframe" not in outside_code.lower()
+    assert "(seed &lt;script&gt;alert(1)&lt;/script&gt;)" in text  # shown, as text
+    assert "](javascript:" not in outside_code
+    assert "\n\n<" not in text  # no HTML block from a name's blank line
+    fence = re.match(r"\s*(`{3,})sh\n", commands)
+    assert fence, commands[:200]
+    inner = commands[fence.end() :]
+    assert inner.count(fence.group(1)) == 1  # the payload's ``` does not close the block
+    for line in inner.splitlines():  # a name and a seed are one shell word each
+        if line.startswith("replay run "):
+            assert "rm -rf ~'" in line or "rm -rf" not in line, line
+            log = line.split(" -o ", 1)[1]
+            assert log.startswith("out/logs/") and SAFE_FILE.fullmatch(log[len("out/logs/") :])
+
+
+# -- claims --markdown ------------------------------------------------------------------------
+
+
+def test_claims_markdown_overwrites_only_an_earlier_table(base_log, tmp_path):
+    main_py = tmp_path / "main.py"
+    main_py.write_text("print('mine')\n")
+    (tmp_path / "empty.md").write_text("")
+    (tmp_path / "folder").mkdir()
+    for target in (main_py, tmp_path / "empty.md", tmp_path / "folder", base_log):
+        r = invoke("claims", base_log, "--markdown", target)
+        assert one_error(r)
+    assert main_py.read_text() == "print('mine')\n" and (tmp_path / "empty.md").read_text() == ""
+    table = tmp_path / "claims.md"
+    assert invoke("claims", base_log, "--markdown", table).exit_code == 0
+    first = table.read_text()
+    assert first.startswith(CLAIMS_HEADER + "\n") and "| quantity |" in first
+    assert invoke("claims", base_log, "--markdown", table).exit_code == 0  # its own: rewritten
+
+
+def test_claims_escapes_a_hostile_name_in_markdown_and_on_the_terminal(base_log, tmp_path):
+    name = "<script>alert(1)</script>" + ESCAPES
+    log = forge(base_log, tmp_path / "x.mcap", name=name)
+    data = log.read_bytes()
+    log.write_bytes(data[: len(data) * 9 // 10])  # truncated: the table names it
+    table = tmp_path / "claims.md"
+    r = invoke("claims", log, "--markdown", table)
+    assert r.exit_code == 0, r.output
+    assert not CONTROL.search(r.output), repr(r.output)
+    text = table.read_text()
+    assert "&lt;script&gt;" in text and "<script" not in text
+    assert not CONTROL.search(text)
