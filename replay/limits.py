@@ -35,7 +35,7 @@ LIMITS: dict[str, Limit] = {
     x.name: x
     for x in (
         Limit(
-            "camera_pixels", 4_000_000, "pixels", "the pixels of one camera image (width x height)"
+            "camera_pixels", 16_777_216, "pixels", "the pixels of one camera image (width x height)"
         ),
         Limit("table_rows", 100_000, "rows", "the rows of a generated table (a human's path)"),
         Limit("sweep_variants", 100_000, "variants", "the variants of one sweep"),

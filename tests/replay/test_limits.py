@@ -21,8 +21,8 @@ def test_over_the_limit_is_one_line_naming_the_limit_and_its_variable(monkeypatc
         check("camera_pixels", LIMITS["camera_pixels"].default + 1, "sensors.chip: big image")
     text = str(err.value)
     assert "\n" not in text
-    assert text.startswith("sensors.chip: big image is 4,000,001 pixels")
-    assert "limit of 4,000,000" in text and "REPLAY_LIMIT_CAMERA_PIXELS" in text
+    assert text.startswith("sensors.chip: big image is 16,777,217 pixels")
+    assert "limit of 16,777,216" in text and "REPLAY_LIMIT_CAMERA_PIXELS" in text
 
 
 @pytest.mark.parametrize("raw", ["10_000_000", " 10000000 "])

@@ -73,7 +73,7 @@ def test_human_table_is_refused_before_it_is_built(project_root, command):
         ([f"{HUMAN}=100001"], HUMAN, "REPLAY_LIMIT_TABLE_ROWS"),
         (["tasks.schedule.params.cycles=2000000000"], "cycles", "REPLAY_LIMIT_TABLE_ROWS"),
         ([f"{CHIP_W}=100000", f"{CHIP_H}=100000"], CHIP_W, "REPLAY_LIMIT_CAMERA_PIXELS"),
-        ([f"{CHIP_W}=4000001", f"{CHIP_H}=2"], CHIP_W, "REPLAY_LIMIT_CAMERA_PIXELS"),
+        ([f"{CHIP_W}=8388609", f"{CHIP_H}=2"], CHIP_W, "REPLAY_LIMIT_CAMERA_PIXELS"),
     ],
 )
 @pytest.mark.parametrize("static", [True, False])
@@ -112,7 +112,8 @@ def test_a_plan_search_too_fine_is_refused_not_a_run_dying(project_root, tmp_pat
         ("stick_3step", ["sensors.camera.params.width=4096", "sensors.camera.params.height=4096"]),
     ],
 )
-def test_every_camera_counts_its_pixels(project_root, scenario, sets):
+def test_every_camera_counts_its_pixels(project_root, monkeypatch, scenario, sets):
+    monkeypatch.setenv("REPLAY_LIMIT_CAMERA_PIXELS", "1000000")  # under 2048 x 2048
     with pytest.raises(ScenarioError) as info:
         load_scenario(f"scenarios/{scenario}.yaml", sets=sets)
     msg = str(info.value)
