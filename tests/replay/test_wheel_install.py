@@ -85,7 +85,7 @@ def test_one_run_of_each_paper_from_an_empty_directory(installed):
     report = work / "report"
     out = _sh([replay, "report", "-o", report, "--logs", work], cwd=work, env=env)
     html = (report / "index.html").read_text(encoding="utf-8")
-    images = re.findall(r"<img src='([^']+)'", html)
+    images = re.findall(r'<img src="([^"]+)"', html)
     assert images, "the report shows no figure"
     missing = [src for src in images if not (report / src).is_file()]
     assert not missing, missing
