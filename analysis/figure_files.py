@@ -10,6 +10,8 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+# text on a figure is plain: a run's name from a log ("a$\\frac{$b") is never parsed as mathtext
+matplotlib.rcParams["text.parse_math"] = False
 import matplotlib.pyplot as plt  # noqa: E402
 
 from replay.log.writer import check_output  # noqa: E402

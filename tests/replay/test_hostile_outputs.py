@@ -85,6 +85,7 @@ NAMES = [
     ESCAPES,
     "x' onerror='alert(1)\" <b>",
     "é" * 10 + "/" + "n" * 400,
+    "a$\\frac{$b",  # mathtext that does not parse: a title is plain text
 ]
 
 
