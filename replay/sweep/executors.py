@@ -2,8 +2,9 @@
 
 Both take task dicts and yield rows as they finish, in completion order; the engine orders the
 table. Ray is optional (``pip install 'paper-replay[cluster]'``): ``address=None`` starts a private
-local instance (127.0.0.1, ``workers`` CPUs, no dashboard) and shuts it down at the end;
-``address="auto"`` or ``"HOST:PORT"`` joins an existing cluster, which then sets the parallelism.
+local instance (:mod:`.ray_local`: 127.0.0.1 only, ``workers`` CPUs, no dashboard, gone when the
+sweep ends or dies); ``address="auto"`` or ``"HOST:PORT"`` joins an existing cluster, which then
+sets the parallelism, and leaves it running.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import time
 from multiprocessing.connection import wait as mp_wait
 from typing import Iterator
 
+from replay.sweep import ray_local
 from replay.sweep.worker import run_variant
 
 EXECUTORS = ("local", "ray")
@@ -201,30 +203,29 @@ def ray_available() -> bool:
     return True
 
 
-last_ray_init = float("nan")  # s the last ray.init took (bench, tests)
-INIT_ATTEMPTS = 3  # Ray gives its raylet 30 s to register; on a loaded machine, try again
+last_ray_init = float("nan")  # s starting or joining Ray took (bench, tests)
 
 
-def _init_ray(ray, workers: int, address: str | None) -> float:
-    """Start a private local Ray (or join ``address``); the seconds it took."""
-    kw = dict(log_to_driver=False, logging_level="ERROR")
-    if not address:
-        kw.update(num_cpus=workers, include_dashboard=False, _node_ip_address="127.0.0.1")
-    # the raylet waits for its agents' port files; on a loaded machine they start slowly
-    os.environ.setdefault("RAY_agent_register_timeout_ms", "120000")
-    t0 = time.perf_counter()
-    for attempt in range(INIT_ATTEMPTS):
-        try:
-            ray.init(address=address, **kw)
-            return time.perf_counter() - t0
-        except Exception as exc:  # noqa: BLE001 - Ray raises bare Exception on timeouts
-            ray.shutdown()
-            if address or attempt == INIT_ATTEMPTS - 1:
-                text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-                raise ExecutorError(
-                    f"cannot start or join Ray{' at ' + address if address else ''}: {text}"
-                ) from None
-    return time.perf_counter() - t0
+def _start_ray(ray, workers: int, address: str | None):
+    """Join ``address``, or start a private local Ray and join it (:mod:`.ray_local`); the
+    private cluster's handle (None when joining)."""
+    where = f" at {address}" if address else ""
+    cluster = None
+    try:
+        if address:
+            ray.init(address=address, log_to_driver=False, logging_level="ERROR")
+        else:
+            cluster = ray_local.PrivateRay(workers)
+            ray_local.connect(ray, cluster)
+    except BaseException as exc:  # (Ray raises bare Exception on timeouts)
+        ray.shutdown()
+        if cluster is not None:
+            cluster.close()
+        if not isinstance(exc, Exception):
+            raise  # Ctrl-C while starting
+        text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ExecutorError(f"cannot start or join Ray{where}: {text}") from None
+    return cluster
 
 
 def run_ray(tasks: list[dict], workers: int, address: str | None = None) -> Iterator[dict]:
@@ -235,10 +236,12 @@ def run_ray(tasks: list[dict], workers: int, address: str | None = None) -> Iter
             "--executor ray needs Ray: pip install 'paper-replay[cluster]'"
         ) from None
     global last_ray_init
-    started = False
-    if not ray.is_initialized():
-        last_ray_init = _init_ray(ray, workers, address)
-        started = True
+    started = not ray.is_initialized()  # (else: a Ray this process joined before, kept)
+    cluster = None
+    if started:
+        t0 = time.perf_counter()
+        cluster = _start_ray(ray, workers, address)
+        last_ray_init = time.perf_counter() - t0
     try:
         remote = ray.remote(num_cpus=1, max_retries=0)(run_variant)
         of = {remote.remote(t): t for t in tasks}
@@ -252,4 +255,8 @@ def run_ray(tasks: list[dict], workers: int, address: str | None = None) -> Iter
                     yield crashed(of[ref], exc)
     finally:
         if started:
-            ray.shutdown()
+            try:
+                ray.shutdown()
+            finally:
+                if cluster is not None:
+                    cluster.close()

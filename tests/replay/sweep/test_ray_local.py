@@ -1,0 +1,196 @@
+"""A private local Ray (``replay sweep --executor ray`` without ``--address``, issue #36): every
+listener of its processes is on loopback, and none of them outlives the sweep, ended or SIGKILLed.
+The cluster is told apart from anything else on the machine by its session: the keeper that the
+sweep starts leads one, and every Ray process lives in it (see replay/sweep/ray_local.py)."""
+
+from __future__ import annotations
+
+import contextlib
+import ipaddress
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from replay.sweep import ray_local
+from replay.sweep.table import read_table
+
+ROOT = Path(__file__).resolve().parents[3]
+GONE_WITHIN = 30.0  # s after the sweep ends or dies
+STARTS_WITHIN = 120.0  # s for Ray to come up on a loaded machine
+
+
+def _procs() -> dict[int, tuple[int, int, str, str]]:
+    """pid -> (parent, session, state, name) of every live process (zombies left out)."""
+    out = {}
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/stat", "rb") as f:
+                stat = f.read()
+        except OSError:
+            continue
+        name, rest = stat.split(b"(", 1)[1].rsplit(b")", 1)
+        fields = rest.split()
+        if fields[0] != b"Z":
+            out[int(pid)] = (int(fields[1]), int(fields[3]), fields[0].decode(), name.decode())
+    return out
+
+
+def _keeper(sweep: int) -> int | None:
+    """The pid of the sweep's keeper: its child that leads a session and runs ray_local."""
+    for p, (ppid, sid, _, _) in _procs().items():
+        if ppid == sweep and sid == p and _cmdline(p)[2:3] == ["replay.sweep.ray_local"]:
+            return p  # (once exec'd: a fresh fork still shows the sweep's command)
+    return None
+
+
+def _cmdline(pid: int) -> list[str]:
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            return f.read().decode(errors="replace").split("\0")
+    except OSError:
+        return []
+
+
+def _session(sid: int) -> dict[int, str]:
+    return {p: name for p, (_, s, _, name) in _procs().items() if s == sid}
+
+
+def _temp_dir(keeper: int) -> Path:
+    return Path(_cmdline(keeper)[4])  # python -m replay.sweep.ray_local WORKERS TEMP_DIR
+
+
+def _listeners() -> list[tuple[int, str, str]]:
+    """(pid, local address, ss line) of every TCP/UDP listener, from ``ss -Hltunp``."""
+    text = subprocess.run(
+        ["ss", "-Hltunp"], capture_output=True, text=True, check=True, timeout=10
+    ).stdout
+    return [
+        (int(pid), line.split()[4], line)
+        for line in text.splitlines()
+        for pid in re.findall(r"pid=(\d+)", line)
+    ]
+
+
+def _loopback(address: str) -> bool:
+    host = address.rsplit(":", 1)[0].strip("[]").split("%")[0]
+    try:
+        ip = ipaddress.ip_address(host)
+    except ValueError:
+        return False  # "*", "0.0.0.0" is parsed; a name is not loopback
+    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped:
+        ip = ip.ipv4_mapped
+    return ip.is_loopback
+
+
+def _sweep(out: Path, frictions: int, *extra: str, env=None) -> subprocess.Popen:
+    grid = ",".join(f"{i / frictions:.3f}" for i in range(frictions))
+    return subprocess.Popen(
+        [sys.executable, "-m", "replay.cli", "sweep", "scenarios/stick_3step.yaml"]
+        + ["--grid", f"plant.params.stick.friction={grid}", "--set", "timing.duration=0.33"]
+        + ["--executor", "ray", "--workers", "2", "--no-logs", "-q", "-o", str(out), *extra],
+        cwd=ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+@contextlib.contextmanager
+def _ending(proc: subprocess.Popen):
+    """A sweep the test did not see to its end is killed (its keeper then clears its Ray)."""
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+
+
+def _wait(what, within: float, proc: subprocess.Popen | None = None):
+    end = time.monotonic() + within
+    while time.monotonic() < end:
+        got = what()
+        if got:
+            return got
+        if proc is not None and proc.poll() is not None:
+            break
+        time.sleep(0.1)
+    return what()
+
+
+def test_loopback_is_a_loopback_address():
+    assert all(
+        map(_loopback, ["127.0.0.1:80", "[::1]:80", "[::ffff:127.0.0.1]:80", "127.0.0.53%lo:53"])
+    )
+    assert not any(
+        map(_loopback, ["*:80", "0.0.0.0:80", "[::]:80", "192.0.2.2:80", "[::ffff:10.0.0.1]:80"])
+    )
+
+
+def test_private_ray_listens_on_loopback_only_and_ends_with_the_sweep(tmp_path):
+    with _ending(_sweep(tmp_path / "S", 3)) as sweep:
+        keeper = _wait(lambda: _keeper(sweep.pid), STARTS_WITHIN, sweep)
+        assert keeper, sweep.communicate()
+        temp_dir = _temp_dir(keeper)
+        seen: dict[str, set[str]] = {}  # process name -> its listening addresses
+        while sweep.poll() is None:  # every Ray process of this sweep, and the sweep (a driver)
+            ours = _session(keeper) | {sweep.pid: "sweep"}
+            for pid, address, line in _listeners():
+                if pid in ours:
+                    seen.setdefault(ours[pid], set()).add(address)
+                    assert _loopback(address), f"a Ray listener not on loopback: {line}"
+            time.sleep(0.2)
+        out, err = sweep.communicate()
+    assert sweep.returncode == 0, err
+    assert "3 ran" in out and len(read_table(tmp_path / "S" / "table.csv")) == 3
+    assert {"gcs_server", "raylet", "sweep"} <= set(seen), seen  # (the watch saw them)
+    assert _wait(lambda: not _session(keeper), GONE_WITHIN), f"left: {_session(keeper)}"
+    assert not temp_dir.exists()
+
+
+def test_a_sigkilled_sweep_leaves_no_ray_process(tmp_path):
+    with _ending(_sweep(tmp_path / "K", 40)) as sweep:
+        keeper = _wait(lambda: _keeper(sweep.pid), STARTS_WITHIN, sweep)
+        assert keeper, sweep.communicate()
+        temp_dir = _temp_dir(keeper)
+
+        def running():  # variants on Ray's workers, the agents up
+            names = list(_session(keeper).values())
+            return any(n.startswith("ray::run_var") for n in names) and any(
+                n.startswith("ray::RuntimeEnv") for n in names
+            )
+
+        assert _wait(running, STARTS_WITHIN, sweep), (_session(keeper), sweep.poll())
+        cluster = _session(keeper)
+        assert {"gcs_server", "raylet"} <= set(cluster.values()), cluster
+        t0 = time.monotonic()
+        sweep.kill()  # SIGKILL: no finally, no atexit
+        sweep.communicate()
+    assert sweep.returncode == -signal.SIGKILL  # (killed while variants still ran)
+    assert _wait(lambda: not _session(keeper), GONE_WITHIN), f"left: {_session(keeper)}"
+    print(f"the cluster's {len(cluster)} processes were gone {time.monotonic() - t0:.1f} s after")
+    assert not set(cluster) & set(_procs())  # (none of them went elsewhere either)
+    assert not temp_dir.exists()
+
+
+def test_address_joins_a_running_cluster_and_leaves_it_running(tmp_path):
+    theirs = ray_local.PrivateRay(1)  # someone's cluster on this machine (loopback, token)
+    try:
+        # its servers and agents (an idle worker may be retired at any time)
+        cluster = {p: n for p, n in _session(theirs.keeper.pid).items() if n != "ray::IDLE"}
+        env = dict(os.environ, RAY_AUTH_MODE="token", **ray_local.ENV)  # (how one joins it)
+        with _ending(_sweep(tmp_path / "J", 2, "--address", theirs.address, env=env)) as sweep:
+            out, err = sweep.communicate(timeout=STARTS_WITHIN)
+        assert sweep.returncode == 0, err
+        assert "2 ran" in out
+        lost = {p: name for p, name in cluster.items() if p not in _procs()}
+        assert not lost, f"the joined cluster lost {lost}"
+        assert theirs.keeper.poll() is None
+    finally:
+        theirs.close()
+    assert not _session(theirs.keeper.pid)
