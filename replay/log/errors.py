@@ -1,8 +1,15 @@
 """The log package's own error types."""
 
+from replay.limits import LimitError
+
 
 class LogError(Exception):
     """A log could not be written or read."""
+
+
+class LogLimitError(LogError, LimitError):
+    """A log holds more than a reader will load (a chunk or message over ``message_bytes``):
+    one line naming the limit and its environment variable."""
 
 
 class NotALogError(LogError):

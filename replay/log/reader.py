@@ -9,26 +9,36 @@ indexed log costs its own messages only: the others are read through the index (
 holds every channel). Zeros or garbage after the last whole record (a file extended, a disk
 block) are found by walking the records' headers, in time proportional to the real content.
 Nothing a log's bytes hold raises anything but :class:`LogError`.
+
+A reader loads at most ``message_bytes`` (:mod:`replay.limits`) at once: a chunk whose stated
+uncompressed size is over it, or a record the file holds whole that is, is refused
+(:class:`LogLimitError`, one line) before anything is read or decompressed, and a chunk is
+decompressed no further than its stated size (a zstd frame may claim any size of its own).
 """
 
 from __future__ import annotations
 
+import heapq
 import io
 import json
 import os
 import struct
 from collections import Counter
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
+import yaml
 from mcap.data_stream import ReadDataStream
+from mcap.exceptions import RecordLengthLimitExceeded
 from mcap.reader import make_reader
 from mcap.records import Channel, Chunk, Message, Schema
-from mcap.stream_reader import StreamReader, breakup_chunk
+from mcap.stream_reader import StreamReader
 
+from replay.limits import LimitError, check, limit
 from replay.log.chunks import MAGIC
-from replay.log.errors import LogError, NotALogError
+from replay.log.errors import LogError, LogLimitError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
@@ -38,6 +48,9 @@ _HEAD = struct.Struct("<BQ")  # a record's opcode and length
 # with every length all ones, and writes its data and the real lengths when the chunk is done;
 # a run killed meanwhile ends on this header, a record cut short, not garbage.
 _CHUNK_OPCODE, _LENGTH_PENDING = 0x06, (1 << 64) - 1
+_SCHEMA_OPCODE, _CHANNEL_OPCODE, _MESSAGE_OPCODE = 0x03, 0x04, 0x05
+_MESSAGE = struct.Struct("<HIQQ")  # a message's channel id, sequence, log and publish times
+_RECORD_HEAD = 1024  # bytes of a record besides its payload (a message's or chunk's header)
 
 
 def content_end(f, size: int) -> tuple[int, bool]:
@@ -138,8 +151,61 @@ def _decode(data: bytes) -> dict | None:
     return value if isinstance(value, dict) else None
 
 
-class _IndexUnusable(Exception):
-    """The index of a log points at bytes that are not its chunks."""
+def _chunk_body(data: bytes) -> list:
+    """The schemas, channels and messages of a chunk's data. Messages are parsed here, in one
+    ``struct`` call each (``mcap``'s reader makes ~5 calls a field: most of the time of 10**6
+    events read); schemas and channels by ``mcap``."""
+    out: list[Any] = []
+    pos, end = 0, len(data)
+    while pos < end:
+        if end - pos < _HEAD.size:
+            raise ValueError("a record cut short in its chunk")
+        opcode, length = _HEAD.unpack_from(data, pos)
+        body, after = pos + _HEAD.size, pos + _HEAD.size + length
+        if after > end:
+            raise ValueError("a record runs past its chunk's end")
+        if opcode == _MESSAGE_OPCODE:
+            if length < _MESSAGE.size:
+                raise ValueError("a message record shorter than its header")
+            channel_id, sequence, log_time, publish_time = _MESSAGE.unpack_from(data, body)
+            out.append(
+                Message(
+                    channel_id=channel_id,
+                    sequence=sequence,
+                    log_time=log_time,
+                    publish_time=publish_time,
+                    data=data[body + _MESSAGE.size : after],
+                )
+            )
+        elif opcode in (_SCHEMA_OPCODE, _CHANNEL_OPCODE):
+            stream = ReadDataStream(io.BytesIO(data[body:after]))
+            out.append(Schema.read(stream) if opcode == _SCHEMA_OPCODE else Channel.read(stream))
+        pos = after
+    return out
+
+
+def _decompress(compression: str, data: bytes, size: int) -> bytes:
+    """A chunk's data decompressed, at most ``size + 1`` bytes of it (one more than stated
+    says the chunk holds more than it states)."""
+    if compression == "":
+        return data[: size + 1]
+    if compression == "zstd":
+        import zstandard
+
+        parts, got = [], 0
+        with zstandard.ZstdDecompressor().stream_reader(data) as r:
+            while got <= size:
+                part = r.read(size + 1 - got)
+                if not part:
+                    break
+                parts.append(part)
+                got += len(part)
+        return b"".join(parts)
+    if compression == "lz4":
+        import lz4.frame
+
+        return lz4.frame.LZ4FrameDecompressor().decompress(data, max_length=size + 1)
+    raise ValueError(f"unknown compression {compression[:20]!r}")
 
 
 class LogReader:
@@ -165,9 +231,16 @@ class LogReader:
         self._bad_chunks: dict[int, str] = {}  # chunk offset -> why it does not read
         self._checked = False
         self._end = self.size  # where the records end (before zeros or garbage)
+        self._scenario: dict | None = None
+        self._config: dict = {}
+        self._events: list[dict] | None = None
         self._summary = self._read_summary() if tail == MAGIC else None
         if self._summary is None:
             self._find_end()
+        for c in self._summary.chunk_indexes if self._summary is not None else ():
+            self._check_size(
+                c.uncompressed_size, f"the chunk at byte {c.chunk_start_offset}, uncompressed,"
+            )
         if self._summary is None:
             self.truncated = True
             if tail == MAGIC and self.size > 2 * len(MAGIC):
@@ -207,6 +280,56 @@ class LogReader:
         self._damage(f"its last {self.size - end} bytes (from byte {end} on) are {what}: ignored")
         self._summary = self._read_summary()
 
+    def _check_size(self, size: int, what: str) -> None:
+        """LogLimitError if ``size`` bytes (of ``what``) are over ``message_bytes``."""
+        try:
+            check("message_bytes", size, f"{self.path}: {what}")
+        except LimitError as exc:
+            raise LogLimitError(str(exc)) from None
+
+    def _record_cap(self) -> int:
+        """The longest record a reader loads: ``message_bytes`` and a header."""
+        try:
+            return limit("message_bytes") + _RECORD_HEAD
+        except LimitError as exc:
+            raise LogLimitError(str(exc)) from None
+
+    def _walk(self, f, *, validate: bool, chunks: bool = True) -> Iterator[Any]:
+        """The records of ``f`` in file order, each chunk's broken up (``chunks``) or as it is;
+        raises what a bad record raises, and :class:`LogLimitError` for a record over
+        ``message_bytes`` that the file holds whole (a longer one is a torn tail)."""
+        records = StreamReader(
+            f, emit_chunks=True, validate_crcs=validate, record_size_limit=self._record_cap()
+        ).records
+        while True:
+            try:
+                record = next(records)
+            except StopIteration:
+                return
+            except RecordLengthLimitExceeded:
+                pos = f.tell()  # (just past the record's header)
+                f.seek(pos - _HEAD.size)
+                _, length = _HEAD.unpack(f.read(_HEAD.size))
+                if length <= self._end - pos:
+                    self._check_size(length, f"the record at byte {pos - _HEAD.size}")
+                raise
+            if chunks and isinstance(record, Chunk):
+                yield from self._chunk_records(record)
+            else:
+                yield record
+
+    def _chunk_records(self, chunk: Chunk) -> list:
+        """A chunk's records (schemas, channels, messages): its stated size checked against
+        ``message_bytes`` before it is decompressed, no further than that size, CRC checked."""
+        size = chunk.uncompressed_size
+        self._check_size(size, "a chunk, uncompressed,")
+        data = _decompress(chunk.compression, chunk.data, size)
+        if len(data) != size:
+            raise ValueError(f"the chunk decompresses to {'more' if len(data) > size else 'less'}")
+        if chunk.uncompressed_crc and zlib.crc32(data) != chunk.uncompressed_crc:
+            raise ValueError("the chunk's CRC does not match")
+        return _chunk_body(data)
+
     def _damage(self, what: str) -> None:
         self.damaged = True
         note = f"damaged: {what}"
@@ -232,10 +355,10 @@ class LogReader:
         n = 0
         try:
             with self._open() as f:
-                for _ in StreamReader(
-                    f, validate_crcs=True, record_size_limit=_RECORD_LIMIT
-                ).records:
+                for _ in self._walk(f, validate=True):
                     n += 1
+        except LogLimitError:
+            raise
         except Exception as exc:  # noqa: BLE001
             if not self.truncated or self._summary is not None:
                 self._damage(
@@ -251,9 +374,14 @@ class LogReader:
         return sorted(self._summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
 
     def _read_chunk(self, f, index) -> list:
-        """A chunk's records (schemas, channels, messages), its CRC checked."""
-        f.seek(index.chunk_start_offset + _HEAD.size)
-        return breakup_chunk(Chunk.read(ReadDataStream(f)), validate_crc=True)
+        """The records of the chunk an index entry points at, its CRC checked."""
+        f.seek(index.chunk_start_offset)
+        opcode, length = _HEAD.unpack(f.read(_HEAD.size).ljust(_HEAD.size, b"\0"))
+        if opcode != _CHUNK_OPCODE:
+            raise ValueError("the index points at a record that is not a chunk")
+        if self._record_cap() < length <= self._end - f.tell():
+            self._check_size(length, f"the chunk record at byte {index.chunk_start_offset}")
+        return self._chunk_records(Chunk.read(ReadDataStream(f)))
 
     def _check_chunks(self) -> None:
         indexes = self._chunk_indexes()
@@ -262,6 +390,8 @@ class LogReader:
                 for i, c in enumerate(indexes):
                     try:
                         self._read_chunk(f, c)
+                    except LogLimitError:
+                        raise
                     except Exception as exc:  # noqa: BLE001 - any damage of its bytes
                         self._bad_chunk(i, len(indexes), c, exc)
         except OSError as exc:
@@ -272,9 +402,10 @@ class LogReader:
         n = 0
         try:
             with self._open() as f:
-                reader = StreamReader(f, emit_chunks=True, record_size_limit=_RECORD_LIMIT)
-                for _ in reader.records:
+                for _ in self._walk(f, validate=False, chunks=False):
                     n += 1
+        except LogLimitError:
+            raise
         except Exception as exc:  # noqa: BLE001
             if not self._bad_chunks:
                 self._damage(
@@ -291,57 +422,49 @@ class LogReader:
             f"read ({type(exc).__name__}): its messages are missing, the other chunks are read"
         )
 
-    def _salvaged(self, wanted) -> Iterator[tuple[Channel, Message]]:
-        """(channel, message) of every chunk that reads, in log-time order (a chunk that does
-        not read skipped and said); channels from the summary, which holds them all."""
+    def _indexed(self, wanted) -> Iterator[tuple[Any, Channel, Message]]:
+        """(schema, channel, message) through the index, in log-time order (ties in file
+        order), chunk by chunk: a message is handed on once no chunk still to be read can
+        start before it. A chunk that does not read is skipped and said."""
         assert self._summary is not None
-        channels = self._summary.channels
-        out: list[tuple[int, int, Channel, Message]] = []
+        channels, schemas = self._summary.channels, self._summary.schemas
         indexes = self._chunk_indexes()
+        number = {c.chunk_start_offset: i for i, c in enumerate(indexes)}
+
+        def wanted_in(c) -> bool:
+            ids = c.message_index_offsets
+            return (
+                wanted is None
+                or not ids
+                or any(i not in channels or channels[i].topic in wanted for i in ids)
+            )
+
+        todo = sorted(
+            (c for c in indexes if c.chunk_start_offset not in self._bad_chunks and wanted_in(c)),
+            key=lambda c: (c.message_start_time, c.chunk_start_offset),
+        )
+        heap: list[tuple[int, int, int, Channel, Message]] = []  # (C tuples: fast to compare)
         with self._open() as f:
-            for i, c in enumerate(indexes):
-                if c.chunk_start_offset in self._bad_chunks:
-                    continue
+            for c in todo:
+                while heap and heap[0][0] < c.message_start_time:
+                    _, _, _, channel, msg = heapq.heappop(heap)
+                    yield schemas.get(channel.schema_id), channel, msg
                 try:
                     records = self._read_chunk(f, c)
-                except Exception as exc:  # noqa: BLE001
-                    self._bad_chunk(i, len(indexes), c, exc)
+                except LogLimitError:
+                    raise
+                except Exception as exc:  # noqa: BLE001 - any damage of its bytes
+                    self._bad_chunk(number[c.chunk_start_offset], len(indexes), c, exc)
                     continue
-                for record in records:
+                for i, record in enumerate(records):
                     if isinstance(record, Message) and record.channel_id in channels:
                         channel = channels[record.channel_id]
                         if wanted is None or channel.topic in wanted:
-                            out.append((record.log_time, len(out), channel, record))
-        out.sort(key=lambda item: (item[0], item[1]))
-        for _, _, channel, msg in out:
-            yield channel, msg
-
-    def _indexed(self, wanted) -> Iterator[tuple[Any, Channel, Message]]:
-        """(schema, channel, message) through the index; a chunk found damaged on the way
-        makes the rest come from :meth:`_salvaged` (what was yielded not yielded again)."""
-        if not self._bad_chunks:
-            done = 0
-            try:
-                with self._open() as f:
-                    for schema, channel, msg in make_reader(f, validate_crcs=True).iter_messages(
-                        topics=wanted
-                    ):
-                        done += 1
-                        yield schema, channel, msg
-                return
-            except Exception:  # noqa: BLE001 - a chunk that does not read: which one, below
-                self._checked = False
-                self.check()
-                if not self._bad_chunks:  # (not a chunk: the index itself is wrong)
-                    self._damage("the index points at bad bytes; read record by record")
-                    raise _IndexUnusable from None
-        else:
-            done = 0
-        assert self._summary is not None
-        schemas = self._summary.schemas
-        for i, (channel, msg) in enumerate(self._salvaged(wanted)):
-            if i >= done:
-                yield schemas.get(channel.schema_id), channel, msg
+                            item = (record.log_time, c.chunk_start_offset, i, channel, record)
+                            heapq.heappush(heap, item)
+        while heap:
+            _, _, _, channel, msg = heapq.heappop(heap)
+            yield schemas.get(channel.schema_id), channel, msg
 
     # -- messages -------------------------------------------------------------------------
     def messages(self, topics: Iterable[str] | str | None = None) -> Iterator[LogMessage]:
@@ -349,24 +472,14 @@ class LogReader:
         Only channels of JSON messages are read (others, e.g. protobuf, are for other tools);
         messages on them that are not JSON objects are skipped (and counted in ``problems``)."""
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
-        skip = 0
-        if self._summary is not None:
-            done = 0
-            try:
-                for _, channel, msg in self._indexed(wanted):
-                    if channel.message_encoding != "json":
-                        continue  # e.g. Foxglove's protobuf channels: not JSON payloads
-                    item = self._message(channel.topic, msg.log_time, msg.data)
-                    if item is not None:
-                        done += 1
-                        yield item
-                return
-            except _IndexUnusable:
-                self._summary = None
-                self.truncated = True
-                skip = done
-        for i, item in enumerate(self._stream(wanted)):
-            if i >= skip:
+        if self._summary is None or not self._summary.chunk_indexes:
+            yield from self._stream(wanted)
+            return
+        for _, channel, msg in self._indexed(wanted):
+            if channel.message_encoding != "json":
+                continue  # e.g. Foxglove's protobuf channels: not JSON payloads
+            item = self._message(channel.topic, msg.log_time, msg.data)
+            if item is not None:
                 yield item
 
     def _message(self, topic: str, t_ns: int, data: bytes) -> LogMessage | None:
@@ -382,12 +495,14 @@ class LogReader:
     def _records(self) -> Iterator[Any]:
         """The file's records in order, CRCs checked, ending quietly at a torn or damaged tail."""
         with self._open() as f:
-            records = StreamReader(f, validate_crcs=True, record_size_limit=_RECORD_LIMIT).records
+            records = self._walk(f, validate=True)
             while True:
                 try:
                     yield next(records)
                 except StopIteration:
                     return
+                except LogLimitError:
+                    raise
                 except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
                     return
 
@@ -408,16 +523,13 @@ class LogReader:
         """The messages of the channels that are not JSON, undecoded, in log-time order (file
         order for a truncated log), optionally by topic."""
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
-        if self._summary is not None:
-            try:
-                for schema, channel, msg in self._indexed(wanted):
-                    if channel.message_encoding != "json":
-                        name = schema.name if schema is not None else ""
-                        yield RawMessage(
-                            channel.topic, msg.log_time, name, channel.message_encoding, msg.data
-                        )
-            except _IndexUnusable:
-                pass  # (said in problems)
+        if self._summary is not None and self._summary.chunk_indexes:
+            for schema, channel, msg in self._indexed(wanted):
+                if channel.message_encoding != "json":
+                    name = schema.name if schema is not None else ""
+                    yield RawMessage(
+                        channel.topic, msg.log_time, name, channel.message_encoding, msg.data
+                    )
             return
         yield from self._stream_raw(wanted)
 
@@ -487,13 +599,65 @@ class LogReader:
         return out
 
     def scenario(self) -> dict:
-        """The ``/scenario`` message (name, paper, yaml, seed, version)."""
-        for m in self.messages(TOPIC_SCENARIO):
-            return m.data
-        raise LogError(f"{self.path}: no /scenario message")
+        """The ``/scenario`` message (name, paper, yaml, seed, version), its YAML checked as
+        :meth:`scenario_config` says (a :class:`LogError` if it is not)."""
+        if self._scenario is None:
+            for m in self.messages(TOPIC_SCENARIO):
+                self._config = self._stored_config(m.data.get("yaml", ""))
+                self._scenario = m.data
+                break
+            else:
+                raise LogError(f"{self.path}: no /scenario message")
+        return dict(self._scenario)
+
+    def scenario_config(self) -> dict:
+        """The stored scenario YAML as data: within the ``scenario_bytes`` limit, YAML as a
+        scenario file must be (nesting, size, tags), a mapping whose plug-in sections (plant,
+        controller, each sensor and task) and their ``params`` are mappings."""
+        self.scenario()
+        return self._config
+
+    def _stored_config(self, text) -> dict:
+        from replay.scenario.yamlio import ScenarioError, compose
+
+        where = f"{self.path}: its stored scenario"
+        if not isinstance(text, str):
+            raise LogError(f"{where} is not text ({type(text).__name__})")
+        try:
+            check("scenario_bytes", len(text), where)  # (characters: before encoding them)
+            check("scenario_bytes", len(text.encode("utf-8", "surrogatepass")), where)
+            node = compose(text, f"{self.path}:/scenario")
+            config = {} if node is None else yaml.SafeLoader("").construct_document(node)
+        except (LimitError, ScenarioError) as exc:
+            raise LogError(
+                str(exc) if str(exc).startswith(str(self.path)) else f"{where}: {exc}"
+            ) from None
+        except (yaml.YAMLError, RecursionError, ValueError, TypeError) as exc:
+            raise LogError(f"{where} does not read ({type(exc).__name__})") from None
+        if not isinstance(config, dict):
+            raise LogError(f"{where} is not a mapping of sections ({type(config).__name__})")
+        sections = [("plant", config.get("plant")), ("controller", config.get("controller"))]
+        for group in ("sensors", "tasks"):
+            members = config.get(group)
+            if members is not None and not isinstance(members, dict):
+                raise LogError(f"{where}: {group} is not a mapping ({type(members).__name__})")
+            sections += [(f"{group}.{k}", v) for k, v in (members or {}).items()]
+        for name, section in sections:
+            if section is None:
+                continue
+            if not isinstance(section, dict):
+                raise LogError(f"{where}: {name} is not a mapping ({type(section).__name__})")
+            params = section.get("params")
+            if params is not None and not isinstance(params, dict):
+                raise LogError(f"{where}: {name}.params is not a mapping ({type(params).__name__})")
+        return config
 
     def events(self) -> list[dict]:
-        return [e for e in self.series(TOPIC_EVENTS) if isinstance(e.get("kind"), str)]
+        """The ``/events`` payloads that have a kind, read once (a log does not change; the
+        claims of one paper ask for them many times)."""
+        if self._events is None:
+            self._events = [e for e in self.series(TOPIC_EVENTS) if isinstance(e.get("kind"), str)]
+        return list(self._events)
 
     def outcome(self) -> dict | None:
         """The run's final ``outcome`` event (None when the log does not reach it)."""
