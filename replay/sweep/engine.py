@@ -21,7 +21,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 from replay.sweep.executors import WORKER_DIED, default_workers, run_local, run_ray
 from replay.sweep.lock import FolderLock, SweepOutputError
@@ -80,7 +80,7 @@ class SweepSummary:
         return ("interrupted: " if self.interrupted else "") + text
 
 
-def _progress(total: int, enabled: bool):
+def _progress(total: int, enabled: bool, desc: str = "sweep"):
     from tqdm import tqdm
 
     return tqdm(
@@ -90,9 +90,20 @@ def _progress(total: int, enabled: bool):
         file=sys.stderr,
         disable=(not enabled) or None,
         leave=False,
-        desc="sweep",
+        desc=desc,
         bar_format="{desc}: {n_fmt}/{total_fmt} |{bar}| {rate_fmt} ETA {remaining}{postfix}",
     )
+
+
+def planned(variants: Iterable[Variant], total: int, progress: bool = True) -> list[Variant]:
+    """The variants of :func:`replay.sweep.variants.plan`, made one by one under a bar on
+    stderr (``total`` of them: each loads its scenario, so 10,000 take a minute or two)."""
+    out = []
+    with _progress(total, progress, desc="plan") as bar:
+        for v in variants:
+            out.append(v)
+            bar.update(1)
+    return out
 
 
 def run_sweep(
@@ -109,13 +120,7 @@ def run_sweep(
 ) -> SweepSummary:
     """Run the variants the table of ``out_dir`` does not hold yet (see the module); the folder
     is locked for the sweep (:class:`SweepOutputError` naming the sweep that holds it)."""
-    out_dir = Path(out_dir)
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise SweepOutputError(
-            f"cannot make sweep folder {out_dir}: {exc.strerror or exc}"
-        ) from None
+    out_dir = make_folder(out_dir)
     with FolderLock(out_dir), _sigterm_as_interrupt() as terminated:
         summary = _run_locked(
             variants,
@@ -130,6 +135,19 @@ def run_sweep(
         )
     summary.terminated = bool(terminated)
     return summary
+
+
+def make_folder(out_dir: str | Path) -> Path:
+    """The sweep's folder, made if missing (:class:`SweepOutputError` if it cannot be: said
+    before the variants are planned)."""
+    out_dir = Path(out_dir)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SweepOutputError(
+            f"cannot make sweep folder {out_dir}: {exc.strerror or exc}"
+        ) from None
+    return out_dir
 
 
 @contextlib.contextmanager

@@ -6,7 +6,8 @@ value (sweep files only, e.g. a throw speed that sets the release point and velo
 the axis ``scenario`` varies the scenario file itself (e.g. the direct mapping against the
 predictive baseline) and the axis ``seed`` the run's seed. Random axes draw ``n`` values uniformly from ``[lo, hi]`` with a generator
 seeded by the sweep's seed, so the same command gives the same variants. Variants are the cartesian
-product of the grid axes, times the ``n`` random draws.
+product of the grid axes, times the ``n`` random draws: their count, known before any is made, is
+bounded by the ``sweep_variants`` limit (:mod:`replay.limits`), and they are made one at a time.
 
 Bad specifications raise :class:`SweepSpecError` (one line; the CLI exits 2).
 """
@@ -15,14 +16,18 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 import yaml
 
+from replay.limits import LimitError, check
+
 SCENARIO_AXIS = "scenario"
+INT64 = (-(2**63), 2**63 - 1)  # whole-number bounds NumPy's generator draws between
 
 
 class SweepSpecError(Exception):
@@ -54,32 +59,45 @@ class SweepSpec:
     random: list[RandomAxis] = field(default_factory=list)
     n: int = 1
 
+    @property
+    def count(self) -> int:
+        """How many variants :meth:`iter_points` makes (the product of the axes' lengths)."""
+        return math.prod(len(a.values) for a in self.grid) * (self.n if self.random else 1)
+
+    def check_count(self) -> None:
+        """SweepSpecError if the variants are over the ``sweep_variants`` limit."""
+        try:
+            check("sweep_variants", self.count, "this sweep")
+        except LimitError as exc:
+            raise SweepSpecError(str(exc)) from None
+
     def points(self, seed: int) -> list[dict[str, Any]]:
         """Every variant's parameters: {axis name: value} in a fixed order."""
+        self.check_count()
+        return list(self.iter_points(seed))
+
+    def iter_points(self, seed: int) -> Iterator[dict[str, Any]]:
+        """:meth:`points` one at a time (the draws made again for each grid point: the same)."""
         grid = [[(a, i) for i in range(len(a.values))] for a in self.grid]
-        draws = self._draws(seed)
-        out = []
         for combo in itertools.product(*grid) if grid else [()]:
-            for d in draws:
+            for d in self._draws(seed):
                 point = {a.name: a.values[i] for a, i in combo}
                 point.update(d)
-                out.append(point)
-        return out
+                yield point
 
-    def _draws(self, seed: int) -> list[dict[str, Any]]:
+    def _draws(self, seed: int) -> Iterator[dict[str, Any]]:
         if not self.random:
-            return [{}]
+            yield {}
+            return
         rng = np.random.default_rng(np.random.SeedSequence([seed, 0x5EE9]))
-        draws = []
         for _ in range(self.n):
             d: dict[str, Any] = {}
             for r in self.random:
                 if r.integer:
-                    d[r.name] = int(rng.integers(int(r.lo), int(r.hi) + 1))
+                    d[r.name] = int(rng.integers(int(r.lo), int(r.hi), endpoint=True))
                 else:
                     d[r.name] = float(rng.uniform(r.lo, r.hi))
-            draws.append(d)
-        return draws
+            yield d
 
     def label(self, name: str, value: Any) -> str:
         """The table's cell for an axis value (a linked axis shows its label)."""
@@ -114,8 +132,8 @@ def _key_path(text: str, option: str) -> str:
 def _yaml_value(text: str, option: str, key: str) -> Any:
     try:
         return yaml.safe_load(text) if text.strip() else None
-    except yaml.YAMLError:
-        raise SweepSpecError(f"{option} {key}: value {text!r} is not valid YAML") from None
+    except (yaml.YAMLError, ValueError):  # (ValueError: an integer of over 4300 digits)
+        raise SweepSpecError(f"{option} {key}: value {_short(text)} is not valid YAML") from None
 
 
 def _split_values(text: str) -> list[str]:
@@ -152,9 +170,21 @@ def parse_grid(text: str) -> Axis:
 
 def _number(text: str, option: str, key: str) -> float:
     v = _yaml_value(text, option, key)
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
-        raise SweepSpecError(f"{option} {key}: expected a number, got {text.strip()!r}")
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise SweepSpecError(f"{option} {key}: expected a number, got {_short(text)}")
+    if isinstance(v, int) and not INT64[0] <= v <= INT64[1]:
+        raise SweepSpecError(
+            f"{option} {key}: {_short(text)} is out of range (whole numbers from -2**63 to "
+            "2**63-1; write it with a decimal point for a real number)"
+        )
+    if not math.isfinite(v):
+        raise SweepSpecError(f"{option} {key}: expected a finite number, got {_short(text)}")
     return v
+
+
+def _short(text: str) -> str:
+    text = text.strip()
+    return repr(text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)")
 
 
 def parse_random(text: str) -> RandomAxis:
@@ -167,7 +197,10 @@ def parse_random(text: str) -> RandomAxis:
     lo, hi = _number(lo_t, "--random", key), _number(hi_t, "--random", key)
     if not lo < hi:
         raise SweepSpecError(f"--random {key}: expected lo < hi, got {lo:g}:{hi:g}")
-    return RandomAxis(key, float(lo), float(hi), isinstance(lo, int) and isinstance(hi, int))
+    if not math.isfinite(float(hi) - float(lo)):
+        raise SweepSpecError(f"--random {key}: the range {lo:g}:{hi:g} is too wide to draw from")
+    integer = isinstance(lo, int) and isinstance(hi, int)
+    return RandomAxis(key, lo if integer else float(lo), hi if integer else float(hi), integer)
 
 
 def from_options(grids: tuple | list, randoms: tuple | list, n: int | None) -> SweepSpec:
@@ -179,6 +212,7 @@ def from_options(grids: tuple | list, randoms: tuple | list, n: int | None) -> S
     elif n is not None:
         raise SweepSpecError("--n needs at least one --random axis")
     _check_unique(spec)
+    spec.check_count()
     return spec
 
 
@@ -256,8 +290,12 @@ def load_sweep_file(path: str | Path) -> SweepFile:
         if not (isinstance(bounds, list) and len(bounds) == 2):
             raise SweepSpecError(f"{path}: random.{name}: expected [lo, hi]")
         randoms.append(parse_random(f"{name}={bounds[0]}:{bounds[1]}"))
-    spec = SweepSpec(grid=grid, random=randoms, n=int(data.get("n", 10 if randoms else 1)))
+    n = data.get("n", 10 if randoms else 1)
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise SweepSpecError(f"{path}: n: expected a whole number of draws >= 1, got {n!r:.40}")
+    spec = SweepSpec(grid=grid, random=randoms, n=n)
     _check_unique(spec)
+    spec.check_count()
     sets = data.get("set") or {}
     if not isinstance(sets, dict):
         raise SweepSpecError(f"{path}: set: expected a mapping key.path -> value")
