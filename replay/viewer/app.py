@@ -18,8 +18,10 @@ from typing import Callable, Iterable
 import numpy as np
 
 from replay.viewer.data import RunAccumulator, RunData, load_run
+from replay.viewer import guard
 from replay.viewer.errors import ViewerError
 from replay.viewer.images import ImagePanel, load_image_tracks
+from replay.viewer.markup import plain
 from replay.viewer.plots import PlotPanel
 from replay.viewer.scenes import RunScene, run_color, scene_class
 from replay.viewer.timeline import DEFAULT_SPEED, Timeline
@@ -71,8 +73,16 @@ def start_server(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT):
     import viser
 
     port, note = free_port(host, port)
-    with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: we print the URL
-        server = viser.ViserServer(host=host, port=port, label="paper-replay", verbose=False)
+    with guard.guarded_serve(host) as guarded:
+        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: we print the URL
+            server = viser.ViserServer(host=host, port=port, label="paper-replay", verbose=False)
+    if not guarded:  # fail closed: this viser starts its websocket some other way
+        with contextlib.redirect_stdout(io.StringIO()):
+            server.stop()
+        raise ViewerError(
+            f"viser {viser.__version__}: cannot check who connects to its server (this viewer "
+            "knows how viser 1.1.1 starts it); not serving"
+        )
     return server, note
 
 
@@ -117,7 +127,19 @@ class Viewer:
         runs = [load_run(p) for p in paths]
         for run in runs:
             scene_class(run)  # fail before starting a server
-        return cls(runs, **kw)
+        viewer = cls(**kw)
+        try:
+            viewer.load(runs)
+        except ViewerError:
+            viewer.stop()
+            raise
+        except (LookupError, TypeError, ValueError, AttributeError) as exc:
+            # a log of the right topics with the wrong fields (a scene plug-in read a field
+            # the log does not hold, or of another shape): one line, not a traceback
+            viewer.stop()
+            where = ", ".join(str(r.path or r.label) for r in runs)
+            raise ViewerError(f"{where}: cannot draw it ({guard.describe(exc)})") from None
+        return viewer
 
     @property
     def port(self) -> int:
@@ -202,15 +224,15 @@ class Viewer:
             gui = self.server.gui
             t0 = min(r.time_range()[0] for r in self.runs)
             t1 = max(r.time_range()[1] for r in self.runs)
-            title = " vs ".join(f"**{r.label}**" for r in self.runs)
-            papers = sorted({str(r.scenario.get("paper", "")) for r in self.runs} - {""})
+            title = " vs ".join(f"**{plain(r.label)}**" for r in self.runs)
+            papers = sorted({plain(r.scenario.get("paper", "")) for r in self.runs} - {""})
             gui.add_markdown(
                 f"{title}  \n{', '.join(papers) or 'no scenario'} · {t1 - t0:.3f} s simulated"
             )
             if len(self.runs) > 1:
                 gui.add_markdown(self.legend())
             if self.notes:
-                gui.add_markdown("\n".join(f"- ⚠ {n}" for n in self.notes))
+                gui.add_markdown("\n".join(f"- ⚠ {plain(n)}" for n in self.notes))
             frames = np.unique(np.concatenate([s.frame_times() for s in self.scenes]))
             events = [(r.label, e) for r in self.runs for e in r.events if "t" in e]
             events.sort(key=lambda le: le[1]["t"])
@@ -224,16 +246,18 @@ class Viewer:
                     self.follow = gui.add_checkbox(
                         "follow object", False, hint="keep the camera on the object"
                     )
-                    self.follow.on_update(lambda _: self.show(self.time))
+                    self.follow.on_update(guard.safe(lambda _: self.show(self.time)))
                 home = gui.add_button("fit view", hint="back to the fitted view at load")
-                home.on_click(lambda _: self._home())
+                home.on_click(guard.safe(lambda _: self._home()))
             self.run_toggles = []
             if len(self.runs) > 1:
                 with gui.add_folder("Runs"):
                     for s in self.scenes:
                         cb = gui.add_checkbox(f"show {s.run.label}", True)
                         cb.on_update(
-                            lambda ev, s=s: setattr(s.root_frame, "visible", ev.target.value)
+                            guard.safe(
+                                lambda ev, s=s: setattr(s.root_frame, "visible", ev.target.value)
+                            )
                         )
                         self.run_toggles.append(cb)
             run0 = self.runs[0]  # its cameras' images (the first run's, when overlaid)
@@ -250,7 +274,7 @@ class Viewer:
     def legend(self) -> str:
         """Overlaid runs: each run's colour (its arm or stick, object and path) and label."""
         return "  \n".join(
-            f"<span style='color:rgb{run_color(k)}'>■</span> {r.label}"
+            f"<span style='color:rgb{run_color(k)}'>■</span> {plain(r.label)}"
             for k, r in enumerate(self.runs)
         )
 
@@ -275,7 +299,8 @@ class Viewer:
             if tl is not None:
                 k = int(np.searchsorted(tl.frames, t + 1e-9, side="right"))
                 tl.status.content = (
-                    f"t = {t:.4f} s · frame {max(k, 1)}/{len(tl.frames)} · speed {tl.speed.value}"
+                    f"t = {t:.4f} s · frame {max(k, 1)}/{len(tl.frames)} · "
+                    f"speed {plain(tl.speed.value)}"
                 )
 
     def seek(self, t: float) -> None:
@@ -364,7 +389,7 @@ class LiveSession:
                 with v.server.atomic():
                     for s in v.scenes:
                         s.draw(run, t)
-                v._status.content = f"**live** · {run.label} · t = {t:.4f} s (running)"
+                v._status.content = f"**live** · {plain(run.label)} · t = {t:.4f} s (running)"
                 self.refreshes += 1
         except Exception as exc:  # noqa: BLE001
             self.error = f"live view stopped: {exc.__class__.__name__}: {exc}"

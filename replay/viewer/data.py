@@ -17,9 +17,11 @@ from typing import Any
 import numpy as np
 import yaml
 
+from replay.limits import LimitError, check
 from replay.log import LogError, LogReader
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, to_dict
 from replay.viewer.errors import ViewerError
+from replay.viewer.markup import clean
 
 # topics kept as Python objects rather than columns (few messages, free-form data)
 OBJECT_TOPICS = (TOPIC_SCENARIO, TOPIC_EVENTS)
@@ -155,15 +157,18 @@ class RunData:
 
     @property
     def plant_type(self) -> str:
-        return str((self.config.get("plant") or {}).get("type", ""))
+        return str(_mapping(self.config.get("plant")).get("type", ""))
 
     @property
     def plant_params(self) -> dict:
-        return dict((self.config.get("plant") or {}).get("params") or {})
+        return dict(_mapping(_mapping(self.config.get("plant")).get("params")))
 
     @property
     def sensors(self) -> dict:
-        return dict(self.config.get("sensors") or {})
+        """The scenario's sensors that are mappings (a log may hold anything)."""
+        return {
+            k: v for k, v in _mapping(self.config.get("sensors")).items() if isinstance(v, dict)
+        }
 
     def time_range(self) -> tuple[float, float]:
         ts = [tr.t for tr in self.tracks.values() if len(tr)]
@@ -171,6 +176,53 @@ class RunData:
         if not ts:
             return 0.0, 0.0
         return float(min(a[0] for a in ts if len(a))), float(max(a[-1] for a in ts if len(a)))
+
+
+def _mapping(value) -> dict:
+    return value if isinstance(value, dict) else {}
+
+
+def _config(text) -> tuple[dict, list[str]]:
+    """A log's stored scenario YAML, parsed (``{}`` if absent), and what was wrong with it: the
+    viewer draws a run whose YAML is too big, too deep, not YAML or not the right shape with
+    default geometry, and says so."""
+    if not text:
+        return {}, []
+    why = ""
+    config = None
+    if not isinstance(text, str):
+        why = "not text"
+    else:
+        try:
+            check("scenario_bytes", len(text.encode("utf-8", "replace")), "the scenario YAML")
+            config = yaml.safe_load(text)
+        except LimitError as exc:
+            why = str(exc)
+        except yaml.YAMLError as exc:
+            why = exc.__class__.__name__
+        except RecursionError:
+            why = "nested too deep"
+    if why:
+        return {}, [f"scenario YAML unreadable ({why}); default geometry used"]
+    if not isinstance(config, dict):
+        return {}, ["scenario YAML is not a mapping; default geometry used"]
+    plant = config.get("plant")
+    if plant is not None and not isinstance(plant, dict):
+        return config, ["scenario plant is not a mapping; default geometry used"]
+    params = _mapping(plant).get("params")
+    if params is not None and not isinstance(params, dict):
+        return config, ["scenario plant.params is not a mapping; default geometry used"]
+    return config, []
+
+
+def _event(t_ns: int, data: dict) -> dict:
+    """An event as the timeline takes it: ``t`` a finite number (the message's time if not),
+    ``kind`` a short line of text, ``data`` a mapping."""
+    t = data.get("t")
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not np.isfinite(t):
+        t = t_ns * 1e-9
+    kind = clean(data["kind"]) if "kind" in data else "?"
+    return {**data, "t": float(t), "kind": kind, "data": _mapping(data.get("data"))}
 
 
 class RunAccumulator:
@@ -191,7 +243,7 @@ class RunAccumulator:
             if topic == TOPIC_SCENARIO:
                 self.scenario = data
             elif topic == TOPIC_EVENTS:
-                self.events.append({"t": t_ns * 1e-9, **data} if "t" not in data else data)
+                self.events.append(_event(t_ns, data))
             else:
                 b = self.builders.get(topic)
                 if b is None:
@@ -207,17 +259,8 @@ class RunAccumulator:
             tracks = {topic: b.track() for topic, b in self.builders.items()}
             events = list(self.events)
             scenario = dict(self.scenario)
-        config, notes = {}, []
-        if scenario.get("yaml"):
-            try:
-                config = yaml.safe_load(scenario["yaml"]) or {}
-            except yaml.YAMLError as exc:
-                notes.append(
-                    f"scenario YAML unreadable ({exc.__class__.__name__}); default geometry used"
-                )
-            if not isinstance(config, dict):
-                config = {}
-        label = scenario.get("name") or (self.path.stem if self.path else "live run")
+        config, notes = _config(scenario.get("yaml"))
+        label = clean(scenario.get("name") or (self.path.stem if self.path else "live run"))
         for tr in tracks.values():
             for name in tr.ragged:
                 notes.append(

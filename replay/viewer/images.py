@@ -60,7 +60,10 @@ def _marks(reader: LogReader, sensor_type: str, sensor: dict, view: str) -> dict
     """The measured centroid of each frame of one camera view, by capture time."""
     out: dict[int, tuple[float, float]] = {}
     if sensor_type == "stereo_ball":
-        topic = (sensor.get("params") or {}).get("topic") or TOPIC_VISION_OBJECT
+        params = sensor.get("params")
+        topic = str(
+            (params if isinstance(params, dict) else {}).get("topic") or TOPIC_VISION_OBJECT
+        )
         i = int(view[-1]) if view[-1:].isdigit() else 0
         for m in reader.messages(topic):
             c = (m.data.get("features") or {}).get("centroids")

@@ -333,3 +333,38 @@ def write_arm_log(
             if outcome and k == n:
                 log.write(TOPIC_EVENTS, Event(t, "outcome", {"success": True}), t_ns)
     return Path(path)
+
+
+def write_hostile_log(
+    path,
+    *,
+    name: str,
+    paper: str = "higashimori2007",
+    kinds: tuple[str, ...] = (),
+    field: str = "",
+    yaml_text: str | None = None,
+    duration: float = 0.2,
+    rate: int = 100,
+) -> Path:
+    """A small stick log whose strings are someone else's: ``name`` and ``paper`` in its
+    /scenario message (and YAML), an event of each of ``kinds`` besides a ``collision`` and a
+    ``rest``, a /stick/state field called ``field`` whose length changes (the viewer notes it by
+    name), and ``yaml_text`` as the stored scenario YAML if given."""
+    text = yaml_text
+    if text is None:
+        text = _scenario(name, paper, duration, rate, {"type": "airtable", "params": {}}, {})
+    n = int(round(duration * rate))
+    with LogWriter(path) as log:
+        log.write(TOPIC_SCENARIO, ScenarioInfo(0.0, name, paper, text, 0, "synthetic"), 0)
+        for k in range(n + 1):
+            t = k / rate
+            state = {"t": t, "x": 0.5 * t - 0.05, "y": 0.2, "theta": 3.0 * t}
+            state |= {"vx": 0.5, "vy": 0.0, "omega": 3.0}
+            if field:
+                state[field] = [1.0] * (1 + k % 2)
+            log.write(TOPIC_STICK_STATE, state, seconds_to_ns(t))
+        kinds = ("collision", *kinds, "rest")
+        for i, kind in enumerate(kinds):
+            t = duration * (i + 1) / (len(kinds) + 1)
+            log.write(TOPIC_EVENTS, Event(t, kind, {"reason": kind}), seconds_to_ns(t))
+    return Path(path)

@@ -17,9 +17,13 @@ from typing import Any, Callable
 
 import numpy as np
 
+from replay.viewer.guard import safe
+from replay.viewer.markup import TEXT_CHARS, clean, plain
+
 SPEEDS = ("1/100", "1/50", "1/20", "1/10", "1/5", "1/4", "1/2", "1", "2")
 DEFAULT_SPEED = "1/10"
 MAX_EVENT_BUTTONS = 40  # listed for the filter's choice; the rest are counted, not listed
+MAX_KINDS = 50  # kinds in the summary and the kind dropdown (the filter finds the others)
 # the experiment's milestones, by event kind: always listed as buttons, whatever else happened
 MILESTONES = ("capture", "catch", "grasp", "release", "drop", "miss", "outcome", "interrupted")
 ALL_KINDS = "all kinds"
@@ -35,7 +39,7 @@ def _event_brief(e: dict) -> str:
     for key in ("finger", "joint", "parts", "reason"):
         if key in data:
             v = data[key]
-            v = "+".join(map(str, v)) if isinstance(v, list) else v
+            v = "+".join(map(str, v[:12])) if isinstance(v, list) else v
             return f" ({key} {v})"
     return ""
 
@@ -43,7 +47,7 @@ def _event_brief(e: dict) -> str:
 def event_label(e: dict, who: str = "") -> str:
     """A button's label: ``[run: ]t s  kind (detail)``."""
     prefix = f"{who}: " if who else ""
-    return f"{prefix}{e['t']:.4f} s  {e.get('kind', '?')}{_event_brief(e)}"
+    return clean(f"{prefix}{e['t']:.4f} s  {e.get('kind', '?')}{_event_brief(e)}", TEXT_CHARS)
 
 
 def kind_counts(events: list[tuple[str, dict]]) -> dict[str, int]:
@@ -132,10 +136,11 @@ class Timeline:
         )
         self.loop = gui.add_checkbox("loop", False)
         self.status = gui.add_markdown("")
-        self.slider.on_update(lambda _: self._show(self.slider.value))
-        self.play.on_click(lambda _: self.toggle())
-        self.back.on_click(lambda _: self.step(-1))
-        self.fwd.on_click(lambda _: self.step(+1))
+        self.slider.on_update(safe(lambda _: self._slid()))
+        self.speed.on_update(safe(lambda _: self._speed_chosen()))
+        self.play.on_click(safe(lambda _: self.toggle()))
+        self.back.on_click(safe(lambda _: self.step(-1)))
+        self.fwd.on_click(safe(lambda _: self.step(+1)))
         self.events = list(events)
         self.multi = len({label for label, _ in self.events}) > 1
         self.counts = kind_counts(self.events)
@@ -147,18 +152,21 @@ class Timeline:
         self.more: Any = None
         if self.events:
             with gui.add_folder("Events", expand_by_default=True):
+                kinds = list(self.counts.items())[:MAX_KINDS]
+                more = len(self.counts) - len(kinds)
                 gui.add_markdown(
                     f"{len(self.events)} events: "
-                    + " · ".join(f"{k} × {n}" for k, n in self.counts.items())
+                    + " · ".join(f"{plain(k)} × {n}" for k, n in kinds)
+                    + (f" · {more} more kinds" if more > 0 else "")
                 )
                 stones = milestones(self.events)
                 if stones:
                     gui.add_markdown("**milestones**")
-                for label, e in stones:
+                for label, e in stones[:MAX_EVENT_BUTTONS]:
                     self.milestone_buttons.append(self._button(label, e, icon=viser.Icon.FLAG))
                 self.kind = gui.add_dropdown(
                     "kind",
-                    (ALL_KINDS, *(kind_option(k, n) for k, n in self.counts.items())),
+                    (ALL_KINDS, *(kind_option(k, n) for k, n in kinds)),
                     initial_value=ALL_KINDS,
                     hint="list the events of one kind",
                 )
@@ -166,8 +174,8 @@ class Timeline:
                     "filter", "", hint="list the events whose label holds these words"
                 )
                 self._list_folder = gui.add_folder("listed", expand_by_default=True)
-                self.kind.on_update(lambda _: self.relist())
-                self.filter.on_update(lambda _: self.relist())
+                self.kind.on_update(safe(lambda _: self.relist()))
+                self.filter.on_update(safe(lambda _: self.relist()))
                 self.relist()
         self._thread = threading.Thread(target=self._run, name="replay-viewer-player", daemon=True)
         self._thread.start()
@@ -176,8 +184,9 @@ class Timeline:
         b = self.server.gui.add_button(
             event_label(e, label if self.multi else ""), icon=icon, hint="jump to this event"
         )
-        b.on_click(lambda _, t=float(e["t"]): self.seek(t))
-        return float(e["t"]), b
+        t = float(e["t"])
+        b.on_click(safe(lambda _: self.seek(t)))
+        return t, b
 
     def selected_kind(self) -> str | None:
         value = self.kind.value if self.kind is not None else ALL_KINDS
@@ -211,6 +220,19 @@ class Timeline:
                 self._listed.append(self.server.gui.add_markdown("*no event matches*"))
 
     # -- moving in time ---------------------------------------------------------------------
+    def _slid(self) -> None:
+        """The slider moved: show its time. A value no slider of ours sends (not a number, off
+        the run) is put back in the run, which calls this again."""
+        t = float(self.slider.value)
+        if not self.t0 <= t <= max(self.t1, self.slider.max):
+            self.slider.value = min(max(t, self.t0), self.t1) if np.isfinite(t) else self.t0
+            return
+        self._show(t)
+
+    def _speed_chosen(self) -> None:
+        if self.speed.value not in SPEEDS:  # not one of the dropdown's: back to the default
+            self.speed.value = DEFAULT_SPEED
+
     @property
     def t(self) -> float:
         return float(self.slider.value)
@@ -253,7 +275,8 @@ class Timeline:
             if not self.playing:
                 continue
             try:
-                t = self.t + wall * speed_value(self.speed.value)
+                speed = self.speed.value if self.speed.value in SPEEDS else DEFAULT_SPEED
+                t = self.t + wall * speed_value(speed)
                 end = t >= self.t1 and not self.loop.value
                 if t >= self.t1:
                     t = self.t1 if end else self.t0
