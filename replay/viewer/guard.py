@@ -36,7 +36,7 @@ from urllib.parse import urlsplit
 from replay.viewer.markup import clean
 
 LOOPBACK_NAMES = frozenset({"localhost", "127.0.0.1", "::1"})
-WILDCARDS = frozenset({"", "0.0.0.0", "::"})
+WILDCARDS = frozenset({"0.0.0.0", "::"})
 MESSAGE_CHARS = 200  # of an exception's text in a warning line
 
 log = logging.getLogger("replay.viewer.server")
@@ -124,14 +124,15 @@ def _is_ip(name: str) -> bool:
 
 def allowed_names(served: str, local_ip: str) -> set[str]:
     """The host names a request to ``local_ip`` (where it came in) may use, for a server told to
-    serve on ``served``: that address and name, and the loopback names on a loopback address."""
+    serve on ``served``: that address and name (``0.0.0.0`` too: the URL printed for it), the
+    loopback names on a loopback address, and on a wildcard address the machine's own name."""
     names = {_host_name(local_ip), _host_name(served)} - {""}
     ip = _host_name(local_ip)
     if ip in LOOPBACK_NAMES or (_is_ip(ip) and ipaddress.ip_address(ip).is_loopback):
         names |= LOOPBACK_NAMES
     if _host_name(served) in WILDCARDS:
         names.add(socket.gethostname().lower())  # the machine's own name, not a stranger's
-    return names - WILDCARDS
+    return names
 
 
 def refusal(served: str, local: tuple, headers: Any) -> str:

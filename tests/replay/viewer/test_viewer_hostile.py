@@ -290,9 +290,11 @@ def test_a_refused_client_receives_nothing(served):
     [
         ("127.0.0.1", "127.0.0.1", {"localhost", "127.0.0.1", "::1"}, {"evil.example"}),
         ("::1", "::1", {"localhost", "::1", "127.0.0.1"}, {"evil.example"}),
-        ("0.0.0.0", "192.0.2.7", {"192.0.2.7"}, {"localhost", "evil.example"}),
-        ("0.0.0.0", "::ffff:127.0.0.1", {"127.0.0.1", "localhost"}, {"evil.example"}),
+        ("0.0.0.0", "192.0.2.7", {"192.0.2.7", "0.0.0.0"}, {"localhost", "evil.example"}),
+        ("0.0.0.0", "::ffff:127.0.0.1", {"127.0.0.1", "localhost", "0.0.0.0"}, {"evil.example"}),
+        ("::", "::1", {"::1", "::", "localhost"}, {"evil.example", "0.0.0.0"}),
         ("myhost.lan", "192.0.2.7", {"myhost.lan", "192.0.2.7"}, {"localhost", "evil.example"}),
+        ("127.0.0.1", "127.0.0.1", set(), {"0.0.0.0", "::", ""}),
     ],
 )
 def test_allowed_names(served_on, local, ok, bad):
