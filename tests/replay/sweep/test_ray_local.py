@@ -132,6 +132,41 @@ def test_loopback_is_a_loopback_address():
     )
 
 
+KEEPER_LIKE = """
+import os, subprocess, sys
+from replay.sweep import ray_local
+ray_local._subreaper()
+quiet = dict(stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+inside = subprocess.Popen(["sleep", "60"], **quiet)  # in the session
+# a process that leaves the session, then its parent exits
+escape = "import subprocess as s; print(s.Popen(['sleep', '60'], start_new_session=True, " + \\
+    "stdin=s.DEVNULL, stdout=s.DEVNULL, stderr=s.DEVNULL).pid)"
+escaped = subprocess.run([sys.executable, "-c", escape], capture_output=True, text=True).stdout
+print(inside.pid, escaped.strip(), flush=True)
+sys.stdin.read()
+ray_local.kill_session(os.getsid(0), adopted=True)
+"""
+
+
+def test_the_keeper_clears_its_session_and_the_orphans_that_left_it():
+    """No Ray: what the keeper does when its pipe closes, on a process that left the session."""
+    keeper = subprocess.Popen(
+        [sys.executable, "-c", KEEPER_LIKE],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    with _ending(keeper):
+        inside, escaped = map(int, keeper.stdout.readline().split())  # type: ignore[union-attr]
+        procs = _procs()
+        assert procs[inside][1] == keeper.pid and procs[escaped][1] != keeper.pid
+        assert procs[escaped][0] == keeper.pid  # (adopted: a subreaper)
+        keeper.stdin.close()  # type: ignore[union-attr]
+        assert keeper.wait(GONE_WITHIN) == 0
+    assert not {inside, escaped} & set(_procs())
+
+
 def test_private_ray_listens_on_loopback_only_and_ends_with_the_sweep(tmp_path):
     with _ending(_sweep(tmp_path / "S", 3)) as sweep:
         keeper = _wait(lambda: _keeper(sweep.pid), STARTS_WITHIN, sweep)
