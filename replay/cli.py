@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import errno
 import ipaddress
-import logging
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -236,17 +235,6 @@ def _runner(scenario: str, sc, Runner, **kw):
         fail(_refusal(scenario, exc))
 
 
-def _quiet_websockets() -> None:
-    """A bare TCP connect (a port scanner, a health check) is no reason for a traceback."""
-
-    class _NoHandshakeNoise(logging.Filter):
-        def filter(self, record):
-            return "opening handshake failed" not in record.getMessage()
-
-    for name in ("websockets.server", "websockets"):
-        logging.getLogger(name).addFilter(_NoHandshakeNoise())
-
-
 def _is_ip(host: str) -> bool:
     try:
         ipaddress.ip_address(host)
@@ -271,7 +259,6 @@ def _live_viewer():
     """A browser viewer fed by the runner (``run --view``); its URL printed at once."""
     from replay.viewer import LiveSession, ViewerError
 
-    _quiet_websockets()
     try:
         live = LiveSession()
     except ViewerError as exc:
@@ -561,7 +548,6 @@ def view(logs, host, port, speed, timeout):
     are overlaid in step (e.g. optimised vs unoptimised)."""
     from replay.viewer import Viewer, ViewerError
 
-    _quiet_websockets()
     named = not _is_ip(host)
     if not named:
         _warn_if_exposed(host)  # before anything listens
