@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from replay import completion as complete
-from replay.console import fail, note
+from replay.console import fail, note, quoted_warnings, say
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.lock import SweepOutputError
 from replay.sweep.spec import SweepSpecError
@@ -64,7 +64,9 @@ DEFAULT_SWEEP_OUT = Path("out/sweeps")
 )
 @click.option("--executor", type=click.Choice(EXECUTORS), default="local", show_default=True)
 @click.option(
-    "--address", help="Ray cluster to join (auto or HOST:PORT); default: a private local Ray"
+    "--address",
+    help="Ray cluster to join (auto or HOST:PORT); default: a private Ray on 127.0.0.1, "
+    "ended with the sweep",
 )
 @click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
 @click.option(
@@ -140,19 +142,27 @@ def _run(
     metrics="",
     retry_failed=False,
 ):
-    from replay.sweep.engine import run_sweep
-    from replay.sweep.variants import check_keys, code_version, expand
+    from replay.sweep.engine import make_folder, planned, run_sweep
+    from replay.sweep.variants import check_keys, code_version, plan
 
     if executor != "ray" and address:
         fail("--address is for --executor ray")
     try:
+        spec.check_count()  # (before anything is made)
         check_keys(scenario, spec, list(sets))
+        make_folder(out)
     except SweepSpecError as exc:
         fail(str(exc))
+    except SweepOutputError as exc:
+        fail(str(exc), code=exc.code)
+    if progress:  # (-q: the summary line only)
+        note(f"sweep: {spec.count:,} variant{'s' if spec.count != 1 else ''} to plan")
     try:
         # the metrics function makes columns: a different one is a different row
         version = code_version() + (f"|{metrics}" if metrics else "")
-        variants = expand(scenario, spec, seed, sets=list(sets), version=version)
+        variants = planned(
+            plan(scenario, spec, seed, sets=list(sets), version=version), spec.count, progress
+        )
     except SweepSpecError as exc:
         fail(str(exc))
     try:
@@ -261,16 +271,19 @@ def ablate(
 def report(out, logs):
     """Write the reproduction report (index.html and index.md): per paper the regenerated
     figures, the claims table and the ablation plots; versions, seeds and commands."""
-    from replay.report import build_report
+    from replay.report import ReportFolderError, build_report
 
     if not Path(logs).is_dir():
         note(f"no {logs}/: the report has no figures or claims (run `make run`)")
     try:
-        path = build_report(out, logs)
+        with quoted_warnings():
+            path = build_report(out, logs)
+    except ReportFolderError as exc:  # (nothing touched)
+        fail(str(exc))
     except OSError as exc:  # a read-only or full disk: one line (1: the disk, 2: the folder)
         where = f" ({exc.filename})" if exc.filename else ""
         fail(f"cannot write the report to {out}{where}: {exc.strerror or exc}", code=_code(exc))
-    click.echo(f"report: {path} (and {path.with_suffix('.md')})")
+    say(f"report: {path} (and {path.with_suffix('.md')})")
 
 
 def _code(exc: OSError) -> int:
