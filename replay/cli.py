@@ -481,8 +481,11 @@ def info(log):
                 f"seed {sc.get('seed', '?')}, code {sc.get('version', '?')})"
             )
         )
-    except LogError:
-        click.echo("scenario: (no /scenario message)")
+    except LogError as exc:  # none, or its stored YAML is not a scenario's (too big, deep, ...)
+        missing = str(exc).endswith("no /scenario message")
+        click.echo("scenario: (no /scenario message)" if missing else "scenario: (unreadable)")
+        if not missing:
+            warn(str(exc))
     t0, t1 = r.time_range()
     flag = {"truncated": "  [TRUNCATED log]", "damaged": "  [DAMAGED log]"}.get(r.status, "")
     click.echo(f"duration: {t1 - t0:.4f} s simulated{flag}")
@@ -510,7 +513,7 @@ def info(log):
         brief = ", ".join(f"{k}={_short(v)}" for k, v in list(data.items())[:6])
         t = e.get("t")
         t = f"{t:8.4f}" if isinstance(t, (int, float)) else f"{'?':>8}"
-        click.echo(one_line(f"  t = {t} s  {e['kind']:<12} {brief}"))
+        click.echo(one_line(f"  t = {t} s  {_short(e['kind']):<12} {brief}"))
     for text in _log_notes(log, r):
         warn(text)
 
@@ -572,7 +575,8 @@ def _short(v) -> str:
         return "[" + ", ".join(_short(x) for x in v[:3]) + (", …" if len(v) > 3 else "") + "]"
     if isinstance(v, dict):
         return "{…}"
-    return str(v)
+    text = str(v)  # (a log's value: up to message_bytes long)
+    return text if len(text) <= 80 else f"{text[:60]}…({len(text):,} characters)"
 
 
 def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
