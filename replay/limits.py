@@ -69,6 +69,11 @@ def check(name: str, value: int | float, what: str | None = None) -> None:
     if value > cap:
         lim = LIMITS[name]
         raise LimitError(
-            f"{what or lim.what} is {value:,.0f} {lim.unit}, over the limit of {cap:,} "
+            f"{what or lim.what} is {_count(value)} {lim.unit}, over the limit of {cap:,} "
             f"(raise it with {lim.env}=N)"
         )
+
+
+def _count(value: int | float) -> str:
+    """``value`` with thousands separators, exactly for an integer (10**30 is not a float's)."""
+    return f"{value:,}" if isinstance(value, int) else f"{value:,.0f}"

@@ -37,3 +37,8 @@ def test_a_bad_variable_is_an_error_not_the_default(monkeypatch, raw):
     monkeypatch.setenv("REPLAY_LIMIT_SWEEP_VARIANTS", raw)
     with pytest.raises(LimitError, match="REPLAY_LIMIT_SWEEP_VARIANTS"):
         limit("sweep_variants")
+
+
+def test_a_huge_integer_is_printed_exactly():
+    with pytest.raises(LimitError, match=r"is 1,000,000,000,000,000,000,000,000,000,000 variants"):
+        check("sweep_variants", 10**30)
