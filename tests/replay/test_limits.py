@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from pathlib import Path
+
 from replay.limits import LIMITS, LimitError, check, limit
 
 
@@ -42,3 +44,16 @@ def test_a_bad_variable_is_an_error_not_the_default(monkeypatch, raw):
 def test_a_huge_integer_is_printed_exactly():
     with pytest.raises(LimitError, match=r"is 1,000,000,000,000,000,000,000,000,000,000 variants"):
         check("sweep_variants", 10**30)
+
+
+def test_the_security_note_lists_every_limit_with_its_default():
+    """docs/security.md's table: one row a limit, its default and variable as in the code."""
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "security.md").read_text("utf-8")
+    rows = {
+        line.split("|")[1].strip(" `"): line
+        for line in doc.splitlines()
+        if "REPLAY_LIMIT_" in line and line.startswith("| `")
+    }
+    assert set(rows) == set(LIMITS)
+    for name, lim in LIMITS.items():
+        assert f"{lim.default:,} {lim.unit}" in rows[name] and lim.env in rows[name], rows[name]
