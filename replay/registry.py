@@ -1,10 +1,20 @@
 """Plug-ins found by name through entry points, so a new plant, sensor or controller needs no
-core edit: declare it in a package's ``pyproject.toml`` under one of these groups."""
+core edit: declare it in a package's ``pyproject.toml`` under one of these groups.
+
+A scenario may also name one by its import path, ``module:Class`` (a ``my_module.py`` beside the
+scenario file, or any importable module): :func:`import_plugin` imports it, for the scenario
+loader only when it loads a scenario to run (never from a log's stored scenario), and
+:func:`load` finds it afterwards by that name."""
 
 from __future__ import annotations
 
 import functools
+import importlib
+import inspect
+import re
+import sys
 from importlib.metadata import EntryPoint, entry_points
+from pathlib import Path
 from typing import Any
 
 GROUPS = {
@@ -22,6 +32,9 @@ class UnknownPlugin(LookupError):
 
 
 _registered: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}
+_imported: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}  # module:Class names
+
+_IMPORT_PATH = re.compile(r"[A-Za-z_]\w*(\.[A-Za-z_]\w*)*:[A-Za-z_]\w*(\.[A-Za-z_]\w*)*")
 
 
 class _Loaded:
@@ -49,12 +62,90 @@ def _entries(kind: str) -> dict[str, Any]:
     return found
 
 
+def is_import_path(name: str) -> bool:
+    """Whether a plug-in name is an import path (``module:Class``) rather than a name."""
+    return ":" in name
+
+
+def known(kind: str, name: str) -> bool:
+    """Whether :func:`load` finds ``name`` without importing anything new."""
+    return name in _imported[kind] if is_import_path(name) else name in _entries(kind)
+
+
+def _interface(kind: str) -> type | None:
+    from replay.interfaces import Controller, Plant, Sensor
+
+    return {"plant": Plant, "sensor": Sensor, "controller": Controller}.get(kind)
+
+
+def import_plugin(kind: str, name: str, folder: str | Path) -> type:
+    """The class ``module:Class`` names, imported (once a process) with ``folder`` (the scenario
+    file's) at the end of ``sys.path`` so that a module beside the scenario is found, while an
+    installed package of the same name still wins (docs/DESIGN.md, "Top-level packages").
+    Importing runs the module's code: call it only for a scenario about to run. Raises
+    UnknownPlugin, one line: no such module, no such object, not a class of the interface."""
+    if name in _imported[kind]:
+        return _imported[kind][name]
+    if not _IMPORT_PATH.fullmatch(name):
+        raise UnknownPlugin(f"bad import path {name[:100]!r} (expected module:Class)")
+    module_name, _, attr = name.partition(":")
+    where = str(Path(folder).resolve())
+    if where not in sys.path:
+        sys.path.append(where)
+        importlib.invalidate_caches()
+    try:
+        module = importlib.import_module(module_name)
+    except ModuleNotFoundError as exc:
+        if exc.name and (module_name + ".").startswith(exc.name + "."):
+            raise UnknownPlugin(
+                f"no module {module_name!r} for {kind} {name!r} (neither in {where} nor installed)"
+            ) from None
+        raise UnknownPlugin(f"{kind} {name!r}: its module cannot import {exc.name!r}") from None
+    except Exception as exc:  # noqa: BLE001 - the module's own code failed: one line
+        raise UnknownPlugin(
+            f"{kind} {name!r}: importing {module_name!r} failed: {_first(exc)}"
+        ) from None
+    obj: Any = module
+    for part in attr.split("."):
+        if not hasattr(obj, part):
+            raise UnknownPlugin(f"module {module_name!r} has no {attr!r} ({kind} {name!r})")
+        obj = getattr(obj, part)
+    base = _interface(kind)
+    if base is not None and not (isinstance(obj, type) and issubclass(obj, base)):
+        raise UnknownPlugin(
+            f"{kind} {name!r} is not a class implementing replay.interfaces.{base.__name__}"
+        )
+    if inspect.isabstract(obj):
+        missing = ", ".join(sorted(getattr(obj, "__abstractmethods__", ())))
+        raise UnknownPlugin(f"{kind} {name!r} does not implement {missing}")
+    if not hasattr(obj, "Params"):
+        raise UnknownPlugin(f"{kind} {name!r} declares no Params dataclass")
+    _imported[kind][name] = obj
+    return obj
+
+
+def _first(exc: BaseException) -> str:
+    """``exc`` as one short line (a SyntaxError with its file and line)."""
+    if isinstance(exc, SyntaxError):
+        return f"SyntaxError: {exc.msg} ({Path(exc.filename or '?').name}:{exc.lineno})"
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0][:200]}" if text else type(exc).__name__
+
+
 def names(kind: str) -> list[str]:
     return sorted(_entries(kind))
 
 
 def load(kind: str, name: str) -> Any:
-    """The plug-in class called ``name``; an unknown name answers with the known ones."""
+    """The plug-in class called ``name``; an unknown name answers with the known ones. An
+    import path (``module:Class``) is found only once :func:`import_plugin` imported it."""
+    if is_import_path(name):
+        if name in _imported[kind]:
+            return _imported[kind][name]
+        raise UnknownPlugin(
+            f"{kind} {name[:100]!r} is not imported (a module:Class plug-in is imported only by "
+            "loading a scenario to run, never from a log)"
+        )
     entries = _entries(kind)
     if name not in entries:
         known = ", ".join(sorted(entries)) or "none installed"

@@ -3,7 +3,11 @@
 - ``extends: other.yaml`` (relative to the file) starts from that file; mappings merge key by
   key, anything else is replaced, and a plug-in section whose ``type:`` changes is replaced
   whole.
-- ``--set key.path=value`` overrides one field (the value is read as YAML).
+- ``--set key.path=value`` overrides one field (the value is read as YAML); one that changes a
+  plug-in's ``type`` drops that section's ``params`` (they belong to the other plug-in).
+- A plug-in ``type`` is an installed plug-in's name or an import path ``module:Class``, imported
+  from the folder of the file that wrote it (the cwd for ``--set``) when a scenario is loaded
+  to run, never when a log's stored scenario is read (``plugins="known-only"``).
 - Every value passes one validation layer before a run starts: its type (every list item too,
   and the list's length), finiteness, range, choices, size; then the checks between fields
   (each ``Params.__post_init__``, rates that divide the physics rate) and between plug-ins
@@ -90,6 +94,14 @@ def _compose_file(
     node = _compose_root(read_text(path), str(path))
     if seen:
         _check_base(node)
+    return _extends(node, path, seen, inputs=inputs)
+
+
+def _extends(
+    node: yaml.MappingNode, path: Path, seen: tuple[Path, ...] = (), *, inputs: list[Path]
+) -> yaml.MappingNode:
+    """``node`` (read from ``path``; for a text, a name in the folder it resolves against)
+    merged onto the scenario its ``extends`` names, if any."""
     base_node = _pop(node, "extends")
     if base_node is None:
         return node
@@ -200,6 +212,9 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
         last = depth == len(keys) - 1
         found = _get(node, key)
         if last:
+            if found and key == "type" and not _same_scalar(found[1], value):
+                _pop(node, "params")  # another plug-in: the old one's params do not apply
+                found = _get(node, key)
             if found:
                 node.value[node.value.index(found)] = (found[0], value)
             else:
@@ -222,6 +237,16 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
                 f"--set {key_path}: {'.'.join(keys[: depth + 1])} is not a mapping",
                 file=_SET_SOURCE,
             )
+
+
+def _same_scalar(a: yaml.Node, b: yaml.Node) -> bool:
+    return isinstance(a, yaml.ScalarNode) and isinstance(b, yaml.ScalarNode) and a.value == b.value
+
+
+def _type_sets_first(sets) -> list[str]:
+    """``--set`` assignments with those of a ``type`` first, so that one changing a plug-in
+    (which drops its params) never drops params another ``--set`` gives."""
+    return sorted(sets, key=lambda s: s.split("=", 1)[0].strip().rsplit(".", 1)[-1] != "type")
 
 
 # -- node trees into typed values ------------------------------------------------------------
@@ -539,8 +564,30 @@ def plugin_sections(sc: Scenario) -> Iterator[tuple[str, Any, str]]:
         yield "controller", task, f"tasks.{name}"
 
 
-def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
-    """Replace each plug-in's raw ``params`` node by its validated ``Params`` instance."""
+PLUGIN_MODES = ("import", "installed", "known-only")
+
+
+def _plugin_class(kind: str, spec: Any, path: str, root: yaml.Node, plugins: str) -> type | None:
+    """The class of a plug-in section. ``plugins``: "import" imports a ``module:Class`` type
+    from the folder of the file that wrote it (the cwd for ``--set`` or a text); "installed"
+    finds installed (and already imported) ones only; "known-only" (reading a log) answers None
+    for any other, never importing."""
+    node = _nearest(root, f"{path}.type")
+    if plugins == "known-only" and not registry.known(kind, spec.type):
+        return None
+    try:
+        if plugins == "import" and registry.is_import_path(spec.type):
+            written = Path(getattr(node.start_mark, "name", "") or "")
+            folder = written.resolve().parent if written.is_file() else Path.cwd()
+            return registry.import_plugin(kind, spec.type, folder)
+        return registry.load(kind, spec.type)
+    except registry.UnknownPlugin as exc:
+        raise ScenarioError(str(exc), node=node, path=f"{path}.type") from None
+
+
+def _resolve_plugins(sc: Scenario, root: yaml.MappingNode, plugins: str = "import") -> Scenario:
+    """Replace each plug-in's raw ``params`` node by its validated ``Params`` instance (by
+    plain data for a plug-in "known-only" mode does not know)."""
     if (sc.controller is None) == (not sc.tasks):
         raise ScenarioError(
             "give either controller: or tasks:, not " + ("both" if sc.tasks else "neither"),
@@ -548,12 +595,11 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
             path="controller",
         )
     for kind, spec, path in plugin_sections(sc):
-        try:
-            cls = registry.load(kind, spec.type)
-        except registry.UnknownPlugin as exc:
-            raise ScenarioError(
-                str(exc), node=_nearest(root, f"{path}.type"), path=f"{path}.type"
-            ) from None
+        cls = _plugin_class(kind, spec, path, root, plugins)
+        if cls is None:  # kept as the log stored it
+            raw = spec.params
+            spec.params = _scalar(raw, f"{path}.params") if isinstance(raw, yaml.Node) else {}
+            continue
         raw = spec.params
         if not isinstance(raw, yaml.Node):  # no params given: all defaults
             raw = yaml.MappingNode(_MAP, [], _nearest(root, path).start_mark, None)
@@ -565,7 +611,7 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode) -> Scenario:
     src = Path(str(sc.source)) if sc.source else None
     if src is not None and src.is_file():
         for _, spec, path in plugin_sections(sc):
-            if hasattr(spec.params, "scenario_dir"):
+            if hasattr(spec.params, "scenario_dir") and not isinstance(spec.params, dict):
                 spec.params.scenario_dir = str(_files_dir(root, path, spec.params, src))
     return sc
 
@@ -609,11 +655,19 @@ def check_timing(sc: Scenario, root: yaml.Node) -> None:
             )
 
 
-def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = None) -> Scenario:
+def _load_node(
+    root: yaml.MappingNode,
+    source: str,
+    sets=(),
+    seed: int | None = None,
+    plugins: str = "import",
+) -> Scenario:
     from replay.scenario.log_size import check_log_size
     from replay.scenario.ports import check_ports
 
-    for s in sets:
+    if plugins not in PLUGIN_MODES:
+        raise ValueError(f"plugins: expected one of {PLUGIN_MODES}, got {plugins!r}")
+    for s in _type_sets_first(sets):
         _apply_set(root, s)
     sc = build_dataclass(root, Scenario, "")
     sc.source = source
@@ -626,7 +680,9 @@ def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = 
             )
         sc.seed = seed
     check_timing(sc, root)
-    _resolve_plugins(sc, root)
+    _resolve_plugins(sc, root, plugins)
+    if plugins == "known-only":  # a log read back: it ran as it is (its plug-ins may be absent)
+        return sc
     check_ports(sc, lambda path: _nearest(root, path))
     try:
         check_log_size(sc)
@@ -640,10 +696,16 @@ def _load_node(root: yaml.MappingNode, source: str, sets=(), seed: int | None = 
 def load_scenario(
     path: str | Path, sets: list[str] | tuple = (), seed: int | None = None
 ) -> Scenario:
-    """Read, merge, override and validate a scenario file."""
-    path = Path(path)
+    """Read, merge, override and validate a scenario file, or the shipped scenario of a bare
+    name (``stick_3step``: :func:`replay.resources.find_scenario`)."""
+    from replay.resources import find_scenario
+
+    path = Path(find_scenario(str(path)))
     if not path.is_file():
-        raise ScenarioError("no such scenario file", file=str(path))
+        raise ScenarioError(
+            "no such scenario file (nor a shipped scenario: `replay list` names them)",
+            file=str(path),
+        )
     inputs: list[Path] = []
     root = _compose_file(path, inputs=inputs)
     sc = _load_node(root, str(path), sets, seed)
@@ -652,12 +714,32 @@ def load_scenario(
 
 
 def scenario_from_text(
-    text: str, name: str = "<log>", sets=(), seed: int | None = None
+    text: str,
+    name: str = "<log>",
+    sets=(),
+    seed: int | None = None,
+    base_dir: str | Path | None = None,
+    plugins: str = "installed",
 ) -> Scenario:
-    """A resolved scenario text (e.g. from a log's /scenario message) back into a Scenario."""
+    """A scenario text (e.g. a log's resolved /scenario message) into a Scenario. Its
+    ``extends`` is honoured as a file's is: a bare name is a shipped scenario (or NAME.yaml
+    in ``base_dir``), a relative path resolves against ``base_dir`` (default: the cwd).
+    ``plugins``: "installed" finds installed plug-ins (and ``module:Class`` ones this process
+    imported already), importing nothing; "import" imports a ``module:Class`` from the cwd, for a
+    text about to run; "known-only" reads a log: a plug-in not available here keeps its
+    ``params`` as plain data, and nothing is imported or port-checked (docs/security.md)."""
     root = _compose_root(text, name)
-    _pop(root, "extends")
-    return _load_node(root, name, sets, seed)
+    inputs: list[Path] = []
+    extends = _get(root, "extends") is not None
+    where = Path(base_dir if base_dir is not None else Path.cwd()) / "<text>"
+    root = _extends(root, where, inputs=inputs)
+    sc = _load_node(root, name, sets, seed, plugins)
+    if extends:  # file parameters resolve from the file that set them (as for a file)
+        for _, spec, path in plugin_sections(sc):
+            if getattr(spec.params, "scenario_dir", None) == "":
+                spec.params.scenario_dir = str(_files_dir(root, path, spec.params, where))
+    sc.inputs = tuple(inputs)
+    return sc
 
 
 def params_from_data(cls: type, data: dict | None, path: str, source: str = "<log>") -> Any:
