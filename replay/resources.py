@@ -43,9 +43,11 @@ def sweep_dir() -> Path:
 
 
 def find_scenario(arg: str) -> str:
-    """A scenario argument as a path: an existing file wins; else a bare name (``stick_3step``)
-    is a shipped scenario; else the argument as given (the loader says it does not exist)."""
-    if Path(arg).exists() or "/" in arg or arg.endswith((".yaml", ".yml")):
+    """A scenario argument as a path: an existing file wins; else a bare name (``stick_3step``
+    or ``stick_3step.yaml``, as ``extends:`` takes it) is a shipped scenario; else the argument
+    as given (the loader says it does not exist)."""
+    if Path(arg).exists() or "/" in arg or "\\" in arg or not arg:
         return arg
-    shipped = scenario_dir() / f"{arg}.yaml"
+    name = arg if arg.endswith((".yaml", ".yml")) else f"{arg}.yaml"
+    shipped = scenario_dir() / name
     return str(shipped) if shipped.is_file() else arg
