@@ -30,15 +30,57 @@ from analysis.catch_claims import (
     first_contact,
     load_run,
 )
+from analysis import runs as run_labels  # noqa: E402
 from analysis.figure_files import save  # noqa: E402
+from analysis.needs import has, skip  # noqa: E402
 from replay.log import LogReader  # noqa: E402
+from replay.messages import (  # noqa: E402
+    TOPIC_ARM_JOINT_COMMAND,
+    TOPIC_ARM_JOINT_STATE,
+    TOPIC_EFFECTOR_STATE,
+    TOPIC_OBJECT_STATE,
+    TOPIC_OPTIMIZATION_COST,
+)
 
 STYLE = {"optimised": dict(ls="-", lw=1.5), "initial": dict(ls="--", lw=1.3)}
 C_BALL, C_DES, C_ACT = "tab:orange", "tab:blue", "tab:green"
+# the variants overlaid on a pair (runs of the same experiments that differ in a setting)
+MAX_VARIANTS = 4
+VARIANT_STYLES = (
+    dict(ls=":", lw=1.6),
+    dict(ls="-.", lw=1.3),
+    dict(ls=(0, (5, 1, 1, 1, 1, 1)), lw=1.3),
+    dict(ls=(0, (1, 3)), lw=1.8),
+)
+VARIANT_COLORS = ("tab:purple", "tab:brown", "tab:olive", "tab:cyan")
+# what each figure reads (the contract a catching controller fulfils: docs/catching.md)
+TOPICS = {
+    "Fig. 6": (TOPIC_OPTIMIZATION_COST,),
+    "Fig. 7": (TOPIC_OBJECT_STATE, TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND),
+    "Fig. 8": (TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND),
+    "Fig. 9": (TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND),
+}
+_VARIANT: dict[str, tuple[int, str]] = {}  # run key -> (its variant index, its label)
 
 
 def _label(run: CatchRun) -> str:
-    return f"{run.name} ({'optimised' if run.mapping == 'optimised' else 'initial parameters'})"
+    what = "optimised" if run.mapping == "optimised" else "initial parameters"
+    if run.mapping not in ("optimised", "initial"):
+        what = f"controller {run.mapping}"
+    label = _VARIANT.get(run.name, (0, ""))[1]
+    return f"{run.name} ({what}{'; ' + label if label and label not in run.name else ''})"
+
+
+def _style(run: CatchRun) -> dict:
+    if run.name in _VARIANT and _VARIANT[run.name][0] >= 0:
+        return VARIANT_STYLES[_VARIANT[run.name][0] % len(VARIANT_STYLES)]
+    return STYLE["optimised" if run.mapping == "optimised" else "initial"]
+
+
+def _color(run: CatchRun) -> str:
+    if run.name in _VARIANT and _VARIANT[run.name][0] >= 0:
+        return VARIANT_COLORS[_VARIANT[run.name][0] % len(VARIANT_COLORS)]
+    return "tab:blue" if run.mapping == "optimised" else "tab:red"
 
 
 def _span(run: CatchRun, after: float = 0.08) -> tuple[float, float]:
@@ -85,11 +127,12 @@ def _marks(ax, run: CatchRun, style: dict, text: bool = False) -> None:
             row += 1
 
 
-def fig6(opt: CatchRun | None, ini: CatchRun | None):
+def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, ...] = ()):
     fig, (ax_t, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.0, 5.0))
     for run, color, label in (
         (opt, "tab:blue", "optimisation (eq. 25)"),
         (ini, "tab:red", "initial parameters (unoptimised run)"),
+        *((r, _color(r), _label(r)) for r in variants),
     ):
         if run is None or not run.costs:
             continue
@@ -152,7 +195,7 @@ def fig7(runs: list[CatchRun], title: str):
     for ax in axes:
         ax.set_xlim(*span)
     for run in runs:
-        st = STYLE["optimised" if run.mapping == "optimised" else "initial"]
+        st = _style(run)
         t0, t1 = _span(run)
         wc = run.window(run.t_ctrl, t0, t1)
         tb, ball = _ball_series(run, t0, t1)
@@ -190,7 +233,7 @@ def fig7(runs: list[CatchRun], title: str):
             [],
             color="0.3",
             label=_label(r),
-            **STYLE["optimised" if r.mapping == "optimised" else "initial"],
+            **_style(r),
         )
         for r in runs
     ]
@@ -213,7 +256,7 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.6, 6.4))
     axes[0].set_xlim(min(_to_contact(r)[0] for r in runs), max(_to_contact(r)[1] for r in runs))
     for run in runs:
-        st = STYLE["optimised" if run.mapping == "optimised" else "initial"]
+        st = _style(run)
         t0, t1 = _to_contact(run)
         wa = run.window(run.t_arm, t0, t1)
         wc = run.window(run.t_ctrl, t0, t1)
@@ -222,7 +265,7 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
                 ax.plot(
                     run.t_arm[wa],
                     run.q[wa, j],
-                    color="tab:blue" if run.mapping == "optimised" else "tab:red",
+                    color=_color(run),
                     label=f"q, {_label(run)}",
                     **st,
                 )
@@ -239,7 +282,7 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
                 ax.plot(
                     run.t_ctrl[wc],
                     run.torque[wc, j],
-                    color="tab:blue" if run.mapping == "optimised" else "tab:red",
+                    color=_color(run),
                     label=_label(run),
                     **st,
                 )
@@ -271,46 +314,98 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
     return fig
 
 
-def _pair_figures(pair: list[CatchRun], out: Path, prefix: str, note: str = "") -> list[Path]:
-    opt = next((r for r in pair if r.mapping == "optimised"), None)
-    ini = next((r for r in pair if r.mapping != "optimised"), None)
-    what = " vs ".join(r.name for r in pair) + note
-    paths = save(fig6(opt, ini), out, f"{prefix}_fig6")
-    paths += save(fig7(pair, f"Catching trajectory: {what} (cf. Fig. 7)"), out, f"{prefix}_fig7")
-    paths += save(
-        _joint_figure(pair, f"Joint angles: {what} (cf. Fig. 8)", "angles"), out, f"{prefix}_fig8"
-    )
-    paths += save(
-        _joint_figure(pair, f"Command torques: {what} (cf. Fig. 9)", "torques"),
-        out,
-        f"{prefix}_fig9",
-    )
+def _pair_figures(
+    pair: list[CatchRun], logs: dict[str, LogReader], out: Path, prefix: str, note: str = ""
+) -> list[Path]:
+    """Figs. 6-9 of ``pair`` (optimised, initial) and its variants, each figure over the runs
+    whose logs hold what it reads (the others named in a note)."""
+    opt = next((r for r in pair if r.mapping == "optimised" and r.name not in _VARIANT), None)
+    ini = next((r for r in pair if r is not opt and r.name not in _VARIANT), None)
+    what = " vs ".join(r.name for r in pair if r.name not in _VARIANT) + note
+    if any(r.name in _VARIANT for r in pair):
+        what += f" and {sum(r.name in _VARIANT for r in pair)} variant(s)"
+
+    def fit(fig: str) -> list[CatchRun]:
+        return [r for r in pair if has({r.name: logs[r.name]}, TOPICS[fig], f"{prefix} {fig}")]
+
+    paths: list[Path] = []
+    six = fit("Fig. 6")
+    if six:
+        variants = tuple(r for r in six if r not in (opt, ini))
+        shown = [r.name for r in six]
+        o, i = (opt if opt in six else None), (ini if ini in six else None)
+        paths += save(fig6(o, i, variants), out, f"{prefix}_fig6", shown)
+    for fig, make in (
+        ("Fig. 7", lambda rs: fig7(rs, f"Catching trajectory: {what} (cf. Fig. 7)")),
+        ("Fig. 8", lambda rs: _joint_figure(rs, f"Joint angles: {what} (cf. Fig. 8)", "angles")),
+        (
+            "Fig. 9",
+            lambda rs: _joint_figure(rs, f"Command torques: {what} (cf. Fig. 9)", "torques"),
+        ),
+    ):
+        drawn = fit(fig)
+        if drawn:
+            stem = f"{prefix}_fig{fig[-1]}"
+            paths += save(make(drawn), out, stem, [r.name for r in drawn])
     return paths
+
+
+def _variants(
+    pair: list[CatchRun], rest: dict[str, CatchRun], logs: dict[str, LogReader]
+) -> list[CatchRun]:
+    """The runs of ``rest`` (not the pair) of the same experiments as the pair's runs."""
+    experiments = {run_labels.describe(logs[r.name], r.name).experiment for r in pair}
+    experiments.discard("")
+    return [
+        r
+        for n, r in rest.items()
+        if r not in pair and run_labels.describe(logs[n], n).experiment in experiments
+    ]
 
 
 SLOW_PAIR = ("catch_5ms_optimised", "catch_5ms_initial")  # 4.5 m/s, outside the paper's speeds
 
 
 def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
-    """Figs. 6-9 for the optimised / unoptimised pair, again for the 4.5 m/s pair
-    (``catch_5ms_fig*``, outside the paper's 8-10 m/s), and Fig. 7 for every other run."""
+    """Figs. 6-9 for the optimised / unoptimised pair with every run of the same experiments
+    overlaid (a variant: the same scenario with a setting changed, up to MAX_VARIANTS), again
+    for the 4.5 m/s pair (``catch_5ms_fig*``, outside the paper's 8-10 m/s), and Fig. 7 for
+    every other run."""
     out = Path(out)
     runs = {name: load_run(log, name) for name, log in sorted(logs.items())}
     if not runs:
         return []
+    _VARIANT.clear()
     slow = [runs[n] for n in SLOW_PAIR if n in runs]
     rest = {n: r for n, r in runs.items() if n not in SLOW_PAIR}
     opt, ini = _pair(rest) if rest else (None, None)
     pair = [r for r in (opt, ini) if r is not None]
+    groups = [(pair, "catch", ""), (slow, "catch_5ms", " (4.5 m/s, not the paper's)")]
     paths: list[Path] = []
-    if pair:
-        paths += _pair_figures(pair, out, "catch")
-    if slow:
-        paths += _pair_figures(slow, out, "catch_5ms", " (4.5 m/s, not the paper's)")
-    for name, run in rest.items():
-        if run in pair:
+    alone = dict(rest)
+    for group, prefix, note in groups:
+        if not group:
             continue
-        paths += save(
-            fig7([run], f"Catching trajectory: {_label(run)} (cf. Fig. 7)"), out, f"{name}_fig7"
-        )
+        for r in group:
+            alone.pop(r.name, None)
+        more = _variants(group, alone, logs)
+        for k, r in enumerate(more):
+            if k < MAX_VARIANTS:
+                _VARIANT[r.name] = (k, run_labels.describe(logs[r.name], r.name).label)
+                alone.pop(r.name)
+            else:
+                skip(
+                    f"{r.name}: not overlaid on {prefix} Figs. 6-9 (at most {MAX_VARIANTS} "
+                    "variants of a pair): drawn in a Fig. 7 of its own"
+                )
+        paths += _pair_figures(group + more[:MAX_VARIANTS], logs, out, prefix, note)
+    for name, run in alone.items():
+        _VARIANT[name] = (-1, run_labels.describe(logs[name], name).label)
+        if has({name: logs[name]}, TOPICS["Fig. 7"], "catch Fig. 7"):
+            paths += save(
+                fig7([run], f"Catching trajectory: {_label(run)} (cf. Fig. 7)"),
+                out,
+                f"{name}_fig7",
+                [name],
+            )
     return paths

@@ -28,10 +28,24 @@ ENGINES = ("PyBullet", "MuJoCo")
 
 
 def split_logs(logs: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(PyBullet logs, MuJoCo logs), the MuJoCo ones named as their PyBullet twins."""
-    pb = {n: log for n, log in logs.items() if not n.endswith(SUFFIX)}
-    mj = {n[: -len(SUFFIX)]: log for n, log in logs.items() if n.endswith(SUFFIX)}
+    """(PyBullet logs, MuJoCo logs), the MuJoCo ones named as their PyBullet twins (by the
+    scenario's name: a key may carry a label after it, analysis/runs.py)."""
+    pb, mj = {}, {}
+    for key, log in logs.items():
+        name = _name(key, log)
+        if name.endswith(SUFFIX) and key.startswith(name):
+            mj[name[: -len(SUFFIX)] + key[len(name) :]] = log
+        else:
+            pb[key] = log
     return pb, mj
+
+
+def _name(key: str, log: Any) -> str:
+    try:
+        name = log.scenario().get("name")
+    except Exception:  # noqa: BLE001 - no readable scenario: the key is the name
+        name = None
+    return name if isinstance(name, str) and name else key
 
 
 def join(pybullet: Sequence[Claim], mujoco: Sequence[Claim]) -> list[Claim]:
@@ -88,7 +102,7 @@ def evaluate_runs(
     ``logs`` both engines side by side, then the stored robustness rates of both on the same
     inputs (``stored_rate_rows``), and the closing note over both; else the paper's rows
     alone."""
-    if not any(n.endswith(SUFFIX) for n in logs):
+    if not split_logs(logs)[1]:
         return evaluate(dict(logs)), ""
     papers = {log.scenario()["paper"] for log in logs.values() if hasattr(log, "scenario")}
     rows = engine_rows(evaluate, logs) + [r for p in sorted(papers) for r in stored_rate_rows(p)]

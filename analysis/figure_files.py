@@ -35,13 +35,28 @@ def file_stem(text: str) -> str:
     return f"{stem[: STEM_LENGTH - 11]}-{digest}" if stem else f"run-{digest}"
 
 
-def save(fig, out: Path, stem: str) -> list[Path]:
-    """``out/STEM.png`` and ``out/STEM.svg`` (``stem`` made safe by :func:`file_stem`); the SVG
-    has no date and fixed element ids (matplotlib salts them randomly otherwise). A file there
-    that is not an earlier PNG or SVG is refused (``replay.log.LogError``), not overwritten."""
+class FigureFile(type(Path())):  # type: ignore[misc]
+    """A figure's file: a path that also says which runs it shows (their keys, analysis/runs.py),
+    so the report captions each figure with its own runs. A figures plug-in may return bare
+    paths too (the report then matches the file name to a run)."""
+
+    runs: tuple[str, ...] = ()
+
+
+def figure_file(path: Path, runs) -> FigureFile:
+    f = FigureFile(path)
+    f.runs = tuple(runs)
+    return f
+
+
+def save(fig, out: Path, stem: str, runs=()) -> list[Path]:
+    """``out/STEM.png`` and ``out/STEM.svg`` (``stem`` made safe by :func:`file_stem`), as
+    :class:`FigureFile` paths showing ``runs``; the SVG has no date and fixed element ids
+    (matplotlib salts them randomly otherwise). A file there that is not an earlier PNG or SVG
+    is refused (``replay.log.LogError``), not overwritten."""
     out.mkdir(parents=True, exist_ok=True)
     stem = file_stem(stem)
-    paths = [out / f"{stem}.png", out / f"{stem}.svg"]
+    paths: list[Path] = [figure_file(out / f"{stem}.{x}", runs) for x in ("png", "svg")]
     for path in paths:
         check_output(path, kind="figure", magic=MAGIC[path.suffix])
     fig.savefig(paths[0], dpi=150)

@@ -23,10 +23,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
+from analysis.needs import has  # noqa: E402
 from analysis.grasp_run import (
     GRASP_PHASES,
     REACHING,
     RELEASING,
+    T_ARM,
+    T_ARM_TASK,
+    T_OBJECT,
     GraspRun,  # noqa: E402
     head_camera_at,
     load_run,
@@ -38,6 +42,8 @@ C_OBJ, C_HAND, C_TARGET = "tab:orange", "tab:blue", "tab:green"
 SHADE = {"grasp": ("tab:blue", 0.10), RELEASING: ("tab:red", 0.10)}
 EVENT_KINDS = ("grasp", "release", "drop", "slip")
 VIEW = (math.radians(-125.0), math.radians(22.0))  # azimuth, elevation of the filmstrip view
+# what each figure reads (the contract a grasping controller fulfils: docs/grasping.md)
+TOPICS = {"Fig. 9": (T_ARM_TASK, T_OBJECT), "filmstrip": (T_ARM, T_OBJECT)}
 
 
 # ----------------------------------------------------------------------------- Fig. 9
@@ -281,15 +287,17 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     out = Path(out)
     paths: list[Path] = []
     for name, log in sorted(logs.items()):
-        run = load_run(log, name)
-        if not len(run.t_eff) or not len(run.t_obj):
+        if not has({name: log}, TOPICS["Fig. 9"], "grasp Fig. 9"):
             continue
-        paths += save(fig9(run), out, f"{name}_fig9")
-        if len(run.t_arm):
+        run = load_run(log, name)
+        paths += save(fig9(run), out, f"{name}_fig9", [name])
+        if has({name: log}, TOPICS["filmstrip"], "grasp filmstrip (Figs. 6-8)"):
             what = (
                 "a sphere (cf. Fig. 8)"
                 if run.params.object == "ball"
                 else "a hexahedron (cf. Figs. 6, 7)"
             )
-            paths += save(filmstrip(run, f"Grasping of {what}: {name}"), out, f"{name}_filmstrip")
+            paths += save(
+                filmstrip(run, f"Grasping of {what}: {name}"), out, f"{name}_filmstrip", [name]
+            )
     return paths

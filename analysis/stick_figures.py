@@ -13,11 +13,16 @@ import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
+from analysis.needs import has  # noqa: E402
 from analysis.series import arrays, events  # noqa: E402
 from plants.airtable.params import Params  # noqa: E402
 from replay.log import LogReader  # noqa: E402
 from replay.messages import TOPIC_STICK_STATE  # noqa: E402
 from replay.scenario import ScenarioError, params_from_data  # noqa: E402
+
+
+# what each figure reads (the contract a stick-capture controller fulfils: README)
+TOPICS = {"Fig. 7": (TOPIC_STICK_STATE,), "friction overlay": (TOPIC_STICK_STATE,)}
 
 
 def fig7(log: LogReader, title: str = ""):
@@ -99,8 +104,11 @@ def _mu(log: LogReader):
 def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     """Fig. 7 for every stick run, and the friction overlay for runs of the same strategy."""
     paths: list[Path] = []
+    logs = {n: log for n, log in logs.items() if has({n: log}, TOPICS["Fig. 7"], "stick Fig. 7")}
     for name, log in sorted(logs.items()):
-        paths += save(fig7(log, f"{name}: velocities vs time (cf. Fig. 7)"), out, f"{name}_fig7")
+        paths += save(
+            fig7(log, f"{name}: velocities vs time (cf. Fig. 7)"), out, f"{name}_fig7", [name]
+        )
     by_strategy: dict[str, dict[str, LogReader]] = {}
     for name, log in logs.items():
         sc = yaml.safe_load(log.scenario()["yaml"])
@@ -108,5 +116,5 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
             by_strategy.setdefault(sc["controller"]["type"], {})[name] = log
     for strategy, group in sorted(by_strategy.items()):
         if len({_mu(log) for log in group.values()}) > 1:
-            paths += save(friction_overlay(group), out, f"{strategy}_friction")
+            paths += save(friction_overlay(group), out, f"{strategy}_friction", sorted(group))
     return paths

@@ -5,7 +5,6 @@ from __future__ import annotations
 import errno
 import ipaddress
 import sys
-from collections import defaultdict
 from pathlib import Path
 
 import click
@@ -583,7 +582,9 @@ def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
     paths = logs or sorted(str(p) for p in DEFAULT_LOG_DIR.glob("*.mcap"))
     if not paths:
         fail(f"no logs given and none in {DEFAULT_LOG_DIR}/ (run `replay run SCENARIO` first)")
-    by_paper: dict[str, dict[str, LogReader]] = defaultdict(dict)
+    from analysis import runs
+
+    readers = []
     for p in paths:
         r = _reader(p)
         try:
@@ -593,8 +594,8 @@ def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
         paper, name = sc.get("paper"), sc.get("name")
         if not (isinstance(paper, str) and paper and isinstance(name, str) and name):
             fail(f"{p}: its /scenario message names no paper or scenario (not a run log?)")
-        by_paper[paper][name] = r
-    return by_paper
+        readers.append(r)
+    return runs.by_paper(readers)  # one key per log: two logs of one name are two runs
 
 
 def _partial(readers: dict[str, LogReader]) -> dict[str, list[str]]:
@@ -628,6 +629,8 @@ def _analysis_failed(what: str, paper: str, readers, exc: Exception) -> None:
 )
 def figures(logs, out):
     """Regenerate the papers' figures (PNG and SVG) from LOGS (default: out/logs/*.mcap)."""
+    from analysis.needs import figure_notes, skipped_notes
+
     by_paper = _logs_by_paper(logs)
     try:
         Path(out).mkdir(parents=True, exist_ok=True)
@@ -640,7 +643,7 @@ def figures(logs, out):
             warn(f"{paper}: no figures defined yet ({', '.join(readers)})")
             continue
         try:
-            with quoted_warnings():
+            with quoted_warnings(), skipped_notes() as skipped:
                 paths = make(readers, Path(out))
         except OSError as exc:
             fail(f"cannot write figures to {out}: {exc.strerror or exc}")
@@ -650,6 +653,11 @@ def figures(logs, out):
             _analysis_failed("figures", paper, readers, exc)
         for path in paths:
             say(f"figure: {path}")
+        shown = {k for p in paths for k in getattr(p, "runs", ())}
+        if not any(hasattr(p, "runs") for p in paths):  # (a plug-in's bare paths)
+            shown = {k for k in readers if any(Path(p).stem.startswith(k) for p in paths)}
+        for text in figure_notes(readers, shown, skipped):
+            warn(text)
         for name, notes in _partial(readers).items():
             for text in notes:
                 warn(
@@ -664,6 +672,7 @@ def claims(logs, markdown):
     """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
     from analysis.claims import falsifiers_of, format_table
     from analysis.engines import evaluate_runs
+    from analysis.needs import skipped_notes
     from replay.report.builder import claims_markdown
 
     sections, md_sections = [], []
@@ -685,9 +694,12 @@ def claims(logs, markdown):
             warn(f"{paper}: no claims defined yet")
             continue
         try:
-            rows, engines_note = evaluate_runs(evaluate, readers)  # both engines, if both ran
+            with skipped_notes() as skipped:  # (rows left out for a topic a log lacks)
+                rows, engines_note = evaluate_runs(evaluate, readers)  # both engines, if both ran
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("claims", paper, readers, exc)
+        for text in skipped:
+            warn(text)
         title = PAPERS[paper].title if paper in PAPERS else paper
         partial, falsifiers = _partial(readers), falsifiers_of(evaluate)
         closing = f"\n\n{engines_note}" if engines_note else ""

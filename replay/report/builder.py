@@ -16,12 +16,13 @@ import platform
 import re
 import shlex
 import shutil
-from collections import defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from importlib import metadata
 from pathlib import Path
 
 from analysis.figure_files import file_stem
+from analysis.needs import figure_notes, skipped_notes
 from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
@@ -84,27 +85,57 @@ class PaperSection:
     notes: list = field(default_factory=list)
 
 
-def _readers(logs: list[Path]) -> dict[str, dict[str, LogReader]]:
-    by_paper: dict = defaultdict(dict)
+def _readers(logs: list[Path]) -> tuple[dict[str, dict[str, LogReader]], list[str]]:
+    """The readable run logs per paper, one key per log (analysis/runs.py), and a note for
+    each log left out."""
+    from analysis import runs
+
+    readers, dropped = [], []
     for p in logs:
         try:
             r = LogReader(p)
             sc = r.scenario()
-        except LogError:
+        except LogError as exc:
+            dropped.append(f"{p.name}: not read ({exc})")
             continue
         paper, name = sc.get("paper"), sc.get("name")
         if isinstance(paper, str) and paper and isinstance(name, str) and name:
-            by_paper[paper][name] = r
-    return by_paper
+            readers.append(r)
+        else:
+            dropped.append(f"{p.name}: its /scenario message names no paper or scenario")
+    return runs.by_paper(readers), dropped
 
 
-def _caption(paper: str, stem: str, name: str) -> str:
+def _shows(runs: Sequence[str], readers: dict[str, LogReader]) -> str:
+    """'the run 'a' (label)' / 'the runs 'a', 'b' (label)': each run with what differs."""
+    from analysis.runs import describe
+
+    said = []
+    for key in runs:
+        r = readers.get(key)
+        label = describe(r, key).label if r is not None else ""
+        said.append(f"{key!r}" + (f" ({label})" if label and label not in key else ""))
+    if not said:
+        return ""
+    return f" Regenerated from the run{'s' if len(said) > 1 else ''} {', '.join(said)}."
+
+
+def _caption(paper: str, stem: str, shows: str) -> str:
     m = re.search(r"fig(\d+)", stem)
     num = int(m.group(1)) if m else 0
     quoted = CAPTIONS.get(paper, {}).get(num)
     base = f"Fig. {num}" if num else stem
-    run = f" Regenerated from the run {name!r}." if name else ""
-    return f"{base} (paper: “{quoted}”).{run}" if quoted else f"{base}.{run}"
+    return f"{base} (paper: “{quoted}”).{shows}" if quoted else f"{base}.{shows}"
+
+
+def _runs_of(path: Path, readers: dict[str, LogReader]) -> tuple[str, ...]:
+    """The runs a figure file shows: its own record (analysis.figure_files.FigureFile), else
+    (a plug-in's bare path) the run whose file stem begins its name, the longest one."""
+    runs = getattr(path, "runs", None)
+    if runs is not None and (runs or type(path).__name__ == "FigureFile"):
+        return tuple(runs)
+    match = [k for k in readers if path.stem.startswith(file_stem(k))]
+    return (max(match, key=len),) if match else ()
 
 
 def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/logs") -> Path:
@@ -137,7 +168,7 @@ def _build(out: Path, logs_dir: Path) -> None:
 
     (out / "figures").mkdir(parents=True)
     logs = sorted(logs_dir.glob("*.mcap"))
-    by_paper = _readers(logs)
+    by_paper, dropped = _readers(logs)
     sections = []
     for key, paper in PAPERS.items():
         sec = PaperSection(key, paper.title, paper.authors)
@@ -145,10 +176,14 @@ def _build(out: Path, logs_dir: Path) -> None:
         for name, r in sorted(readers.items()):
             sc = r.scenario()
             sec.runs.append((name, sc.get("seed", "?"), str(getattr(r, "path", name))))
+        if key == next(iter(PAPERS)):
+            sec.notes += [f"Log left out: {d}" for d in dropped]
         if readers:
+            figure_skips: list[str] = []
             try:
                 make = registry.load("figures", key)
-                paths = make(readers, out / "figures")
+                with skipped_notes() as figure_skips:
+                    paths = make(readers, out / "figures")
             except registry.UnknownPlugin:
                 paths = []
             except OSError:
@@ -156,23 +191,29 @@ def _build(out: Path, logs_dir: Path) -> None:
             except Exception as exc:  # noqa: BLE001 - a damaged or hostile log: said, not fatal
                 sec.notes.append(f"No figures: they could not be made from these logs: {exc!r}")
                 paths = []
-            paths = [Path(p) for p in paths if _inside(Path(p), out / "figures")]
+            paths = [p if isinstance(p, Path) else Path(p) for p in paths]
+            paths = [p for p in paths if _inside(p, out / "figures")]
+            shown: set[str] = set()
             for png in (p for p in paths if p.suffix == ".png"):
                 svg = png.with_suffix(".svg")
-                run = next((n for n in readers if png.stem.startswith(n)), "")
+                runs = _runs_of(png, readers)
+                shown.update(runs)
                 sec.figures.append(
                     Figure(
                         png.relative_to(out).as_posix(),
                         svg.relative_to(out).as_posix() if svg.is_file() else "",
-                        _caption(key, png.stem, run),
+                        _caption(key, png.stem, _shows(runs, readers)),
                     )
                 )
+            sec.notes += figure_notes(readers, shown, figure_skips)
             try:
                 evaluate = registry.load("claims", key)
                 from analysis.claims import falsifiers_of, format_table, summary
                 from analysis.engines import evaluate_runs
 
-                sec.claims, engines_note = evaluate_runs(evaluate, readers)
+                with skipped_notes() as skipped:
+                    sec.claims, engines_note = evaluate_runs(evaluate, readers)
+                sec.notes += skipped
                 if engines_note:
                     sec.notes.append("Both physics engines (docs/mujoco.md): " + engines_note)
 

@@ -27,9 +27,10 @@ def url(path: str) -> str:
 def md(text) -> str:
     """Markdown text: one line, no raw HTML (``< > &`` as entities), no link, code or table
     syntax (backslash-escaped)."""
-    return _MD_SPECIAL.sub(
+    text = _MD_SPECIAL.sub(
         lambda m: _MD_ENTITY.get(m.group(), "\\" + m.group()), one_line(str(text))
     )
+    return text.replace("\\](", "\\]\\(")  # (no "](" left to read as a link's target)
 
 
 def md_code(text) -> str:

@@ -1,0 +1,202 @@
+"""Runs identified by their logs, labelled by what differs from their experiment's default.
+
+Analysis (figures, claims, the report) takes logs, not names: two logs of the same scenario name
+(``catch_optimised`` and the same run with ``--set sensors.stereo.latency=0.01``) are two runs.
+Each run gets a key unique among the logs given (the scenario name; for a second log of that name
+the name and its label, ``catch_optimised (stereo latency 10 ms)``) and a label: a short diff
+of its stored, resolved scenario against the shipped scenario of the same name, or for a name
+that is not shipped against the nearest shipped scenario of its paper (its experiment: a renamed
+variant ``catch_lat10`` is a variant of ``catch_optimised``).
+
+The paper's own rows look their runs up by scenario name: the log that matches the shipped
+scenario keeps the plain name.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import yaml
+
+from replay.log import LogError, LogReader
+
+MAX_ITEMS = 3  # differences named in a label ("+N more" after)
+LABEL_LENGTH = 80  # characters of a label
+_IGNORED = {"name", "description", "notes", "paper"}
+_SECONDS = {"latency", "duration", "after"}  # fields in s, written in ms below 1 s
+_ENGINES = {"mujoco_arm": "MuJoCo", "mujoco_grasp": "MuJoCo", "bullet_arm": "PyBullet"}
+
+
+@dataclass(frozen=True)
+class Run:
+    key: str  # unique among the logs analysed together
+    name: str  # the scenario's name
+    paper: str
+    label: str  # what differs from ``experiment`` ("" when nothing)
+    experiment: str  # the shipped scenario it was compared with ("" when none)
+    reader: LogReader
+
+
+_RUNS: weakref.WeakKeyDictionary[LogReader, Run] = weakref.WeakKeyDictionary()
+
+
+def _flat(data: Any, prefix: str = "") -> dict[str, Any]:
+    if isinstance(data, dict):
+        out: dict[str, Any] = {}
+        for k, v in data.items():
+            out.update(_flat(v, f"{prefix}{k}."))
+        return out
+    return {prefix.rstrip("."): data}
+
+
+@lru_cache(maxsize=None)
+def _shipped(name: str) -> dict[str, Any] | None:
+    """The shipped scenario ``name`` resolved as a log stores it, flattened (None: none)."""
+    from replay.resources import scenario_dir
+    from replay.scenario import ScenarioError, load_scenario, resolved_yaml
+
+    path = scenario_dir() / f"{name}.yaml"
+    if not path.is_file():
+        return None
+    try:
+        return _flat(yaml.safe_load(resolved_yaml(load_scenario(path))))
+    except (ScenarioError, OSError, ValueError, yaml.YAMLError):
+        return None
+
+
+@lru_cache(maxsize=None)
+def _shipped_of(paper: str) -> tuple[str, ...]:
+    from replay.resources import scenario_dir
+
+    names = sorted(p.stem for p in scenario_dir().glob("*.yaml"))
+    return tuple(n for n in names if (_shipped(n) or {}).get("paper") == paper)
+
+
+def _short(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:g}"
+    if isinstance(v, list):
+        return "[" + ", ".join(_short(x) for x in v[:3]) + (", …" if len(v) > 3 else "") + "]"
+    return str(v)
+
+
+def _item(path: str, value: Any) -> str:
+    parts = [p for p in path.split(".") if p != "params"]
+    if parts[0] == "sensors" and len(parts) > 2:
+        what = " ".join(parts[1:])
+    else:
+        what = parts[-1].replace("_", " ")
+    if parts[-1] in _SECONDS and isinstance(value, (int, float)) and 0 < value < 1:
+        return f"{what} {1000 * value:g} ms"
+    return f"{what} {_short(value)}"
+
+
+def differences(stored: Mapping[str, Any], ref: Mapping[str, Any]) -> list[str]:
+    """What ``stored`` (a flattened resolved scenario) sets differently from ``ref``, as short
+    phrases: a changed plug-in type names the new type (its params are then not listed)."""
+    items, replaced = [], []
+    sensors = sorted({p.split(".")[1] for p in stored if p.startswith("sensors.")})
+    for path in ("plant.type", "controller.type", *(f"sensors.{s}.type" for s in sensors)):
+        new = stored.get(path)
+        if new is not None and new != ref.get(path):
+            if path == "plant.type" and str(new) in _ENGINES:
+                items.append(f"engine {_ENGINES[str(new)]}")
+            else:
+                items.append(f"{path.split('.')[-2]} {_short(new)}")
+            replaced.append(path[: -len("type")])
+    for path in sorted(stored.keys() | ref.keys()):
+        if path.split(".")[0] in _IGNORED or any(path.startswith(r) for r in replaced):
+            continue
+        a, b = stored.get(path), ref.get(path)
+        if a != b:
+            items.append(_item(path, a) if path in stored else f"no {_item(path, '')}".strip())
+    return items
+
+
+def _label(items: list[str]) -> str:
+    text = ", ".join(items[:MAX_ITEMS])
+    if len(items) > MAX_ITEMS:
+        text += f", +{len(items) - MAX_ITEMS} more"
+    text = " ".join(text.split())  # one line
+    return text if len(text) <= LABEL_LENGTH else text[: LABEL_LENGTH - 1] + "…"
+
+
+def _compare(stored: dict[str, Any], name: str, paper: str) -> tuple[str, list[str]]:
+    """(the experiment, the differences from it): the shipped scenario of the same name, else
+    the shipped scenario of the paper with the fewest differences."""
+    ref = _shipped(name)
+    if ref is not None:
+        return name, differences(stored, ref)
+    best: tuple[str, list[str]] | None = None
+    for other in _shipped_of(paper):
+        d = differences(stored, _shipped(other) or {})
+        if best is None or len(d) < len(best[1]):
+            best = (other, d)
+    return best or ("", [])
+
+
+def describe(reader: LogReader, key: str | None = None) -> Run:
+    """The run ``reader`` holds (as :func:`keyed` named it, else by its scenario name)."""
+    known = _RUNS.get(reader)
+    if known is not None and (key is None or known.key == key):
+        return known
+    try:
+        sc = reader.scenario()
+        stored = _flat(reader.scenario_config())
+    except (LogError, AttributeError):
+        sc, stored = {}, {}
+    name, paper = str(sc.get("name", key or "?")), str(sc.get("paper", ""))
+    experiment, items = _compare(stored, name, paper) if stored else ("", [])
+    run = Run(key or name, name, paper, _label(items), experiment, reader)
+    _RUNS[reader] = run
+    return run
+
+
+def label(reader: LogReader) -> str:
+    return describe(reader).label
+
+
+def keyed(readers: Iterable[LogReader]) -> dict[str, LogReader]:
+    """A unique key per log (in the order given): the scenario name; a second log of that name
+    gets the name and its label (``name (label)``), or ``name #2``; the log matching the shipped
+    scenario keeps the plain name."""
+    runs = [describe(r) for r in readers]
+    taken: dict[str, int] = {}
+    for r in runs:
+        taken[r.name] = taken.get(r.name, 0) + 1
+    first: dict[
+        str, Run
+    ] = {}  # name -> the run that keeps it: the unlabelled one, else the first given
+    for r in runs:
+        if r.name not in first or (not r.label and first[r.name].label):
+            first[r.name] = r
+    out: dict[str, LogReader] = {}
+    for r in runs:
+        key = r.name
+        if first[r.name] is not r:
+            key = f"{r.name} ({r.label})" if r.label else r.name
+        n = 2
+        base = key
+        while key in out:
+            key, n = f"{base} #{n}", n + 1
+        _RUNS[r.reader] = Run(key, r.name, r.paper, r.label, r.experiment, r.reader)
+        out[key] = r.reader
+    return out
+
+
+def by_paper(readers: Iterable[LogReader]) -> dict[str, dict[str, LogReader]]:
+    """:func:`keyed` per paper (the stored scenario's ``paper``)."""
+    keys = keyed(readers)
+    out: dict[str, dict[str, LogReader]] = {}
+    for key, r in keys.items():
+        out.setdefault(describe(r).paper, {})[key] = r
+    return out
+
+
+def name_of(reader: LogReader) -> str:
+    """The run's scenario name (its key may carry a label)."""
+    return describe(reader).name

@@ -1,0 +1,125 @@
+"""Analysis over any set of logs (issue #37): two logs of one scenario name are two runs, each
+labelled by what differs from its shipped scenario; variants are overlaid on the paper's pair;
+a log lacking a topic a figure or claims row reads skips it with a note, never a crash."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from analysis import runs
+from analysis.figure_files import FigureFile
+from replay.cli import main
+from replay.log import LogReader, LogWriter
+from replay.messages import TOPIC_EFFECTOR_STATE, TOPIC_SCENARIO, TOPIC_STICK_STATE
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], prog_name="replay")
+
+
+def run(out: Path, scenario: str, *sets: str) -> Path:
+    args = ["run", scenario, "-q", "-o", out]
+    for s in sets:
+        args += ["--set", s]
+    r = invoke(*args)
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def forge(base: Path, out: Path, drop: str, name: str) -> Path:
+    """A copy of ``base`` without the topic ``drop``, its scenario named ``name``."""
+    with LogWriter(out) as w:
+        for m in LogReader(base).messages():
+            if m.topic == drop:
+                continue
+            data = dict(m.data, name=name) if m.topic == TOPIC_SCENARIO else m.data
+            w.write(m.topic, data, m.t_ns)
+    return out
+
+
+@pytest.fixture(scope="module")
+def catch(tmp_path_factory) -> dict[str, Path]:
+    d = tmp_path_factory.mktemp("catch")
+    logs = {
+        "opt": run(d / "opt.mcap", "catch_optimised"),
+        "ini": run(d / "ini.mcap", "catch_initial"),
+        "lat": run(d / "lat.mcap", "catch_optimised", "sensors.stereo.latency=0.01"),
+        "renamed": run(
+            d / "lat10.mcap", "catch_optimised", "name=catch_lat10", "sensors.stereo.latency=0.01"
+        ),
+    }
+    logs["mine"] = forge(logs["opt"], d / "mine.mcap", TOPIC_EFFECTOR_STATE, "catch_mine")
+    return logs
+
+
+@pytest.fixture(scope="module")
+def stick(tmp_path_factory) -> dict[str, Path]:
+    d = tmp_path_factory.mktemp("stick")
+    short = "timing.duration=0.3"
+    logs = {
+        "mu03": run(d / "a.mcap", "stick_3step", short),
+        "mu1": run(d / "b.mcap", "stick_3step", short, "plant.params.stick.friction=1.0"),
+    }
+    logs["bare"] = forge(logs["mu03"], d / "bare.mcap", TOPIC_STICK_STATE, "stick_bare")
+    return logs
+
+
+def test_two_logs_of_one_name_are_two_labelled_runs(stick):
+    keyed = runs.keyed([LogReader(stick["mu03"]), LogReader(stick["mu1"])])
+    keys = list(keyed)
+    assert keys[0] == "stick_3step" and keys[1].startswith("stick_3step (")
+    labels = [runs.describe(r).label for r in keyed.values()]
+    assert "friction 1" in labels[1] and "friction" not in labels[0]
+    assert "duration 300 ms" in labels[0]  # what differs from the shipped stick_3step
+
+
+def test_stick_runs_of_one_name_each_get_a_figure_and_the_overlay(stick, tmp_path):
+    r = invoke("figures", stick["mu03"], stick["mu1"], "-o", tmp_path)
+    assert r.exit_code == 0, r.output
+    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert len([p for p in pngs if "_fig7" in p]) == 2, pngs
+    assert "stick_3step_friction.png" in pngs
+    assert "warning" not in r.stderr, r.stderr
+
+
+def test_catch_variants_are_overlaid_on_the_pair_and_labelled(catch, tmp_path):
+    from analysis.catch_figures import make_figures
+
+    logs = runs.keyed(LogReader(catch[k]) for k in ("opt", "ini", "lat", "renamed"))
+    paths = make_figures(logs, tmp_path)
+    fig7 = next(p for p in paths if p.name == "catch_fig7.png")
+    assert isinstance(fig7, FigureFile)
+    assert set(fig7.runs) == set(logs) and len(logs) == 4  # every run in the pair's figure
+    for k in (6, 8, 9):
+        assert any(p.name == f"catch_fig{k}.png" and len(p.runs) >= 2 for p in paths)
+    assert runs.describe(logs["catch_lat10"]).label == "stereo latency 10 ms"
+    assert runs.describe(logs["catch_lat10"]).experiment == "catch_optimised"
+    svg = fig7.with_suffix(".svg").read_text()
+    assert "stereo latency 10 ms" in svg  # the legend says what differs
+
+
+def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
+    """A controller that publishes no /effector/state: Figs. 7-9 and the claims rows that read
+    it are left out for that run with a note naming the topic; the rest is made."""
+    r = invoke("figures", catch["opt"], catch["ini"], catch["mine"], "-o", tmp_path / "f")
+    assert r.exit_code == 0, r.output
+    assert "Traceback" not in r.output
+    notes = [line for line in r.stderr.splitlines() if "catch_mine" in line]
+    assert notes and all("/effector/state" in n for n in notes), r.stderr
+    assert (tmp_path / "f" / "catch_fig8.png").is_file()
+    r = invoke("claims", catch["opt"], catch["mine"])
+    assert r.exit_code == 0, r.output
+    assert "catch_mine" in r.stderr and "/effector/state" in r.stderr
+    assert "catch_mine: ball caught" not in r.stdout
+    assert "catch_optimised: ball caught" in r.stdout
+    # a log in no figure at all is said once, with why
+    r = invoke("figures", stick["bare"], "-o", tmp_path / "g")
+    assert r.exit_code == 0, r.output
+    lines = [line for line in r.stderr.splitlines() if line.startswith("warning: ")]
+    assert len(lines) == 1 and "stick_bare: in no figure" in lines[0], r.stderr
+    assert TOPIC_STICK_STATE in lines[0]
+    r = invoke("claims", stick["bare"])
+    assert r.exit_code == 0 and TOPIC_STICK_STATE in r.stderr, r.output

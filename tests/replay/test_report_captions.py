@@ -1,0 +1,73 @@
+"""The report captions each figure with the runs it shows (issue #37): not the first run whose
+name begins the file's name (MuJoCo figures were captioned as the PyBullet runs,
+``stick_3step_mu0`` as ``stick_3step``). Short runs of default scenarios whose names prefix one
+another."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from analysis.figure_files import file_stem
+from replay.cli import main
+from replay.report.builder import build_report
+
+SCENARIOS = {
+    "stick_3step": (),
+    "stick_3step_mu0": (),
+    "stick_2step": (),
+    "catch_optimised": (),
+    "catch_initial": (),
+    "catch_optimised_mujoco": (),
+    "grasp_sphere": ("timing.duration=1.0",),
+}
+PAIR = {"catch_optimised", "catch_initial"}
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("logs")
+    for name, sets in SCENARIOS.items():
+        args = ["run", name, "-q", "-o", str(out / f"{name}.mcap")]
+        for s in sets:
+            args += ["--set", s]
+        r = CliRunner().invoke(main, args)
+        assert r.exit_code == 0, r.output
+    return out
+
+
+def _expected(stem: str) -> set[str]:
+    """The runs a figure file of the default scenarios shows, from its file name alone."""
+    if re.fullmatch(r"catch_fig\d", stem):
+        return PAIR if stem != "catch_fig6" else {"catch_optimised", "catch_initial"}
+    if stem.endswith("_friction"):
+        return {"stick_3step", "stick_3step_mu0"}
+    for name in sorted(SCENARIOS, key=len, reverse=True):
+        if re.fullmatch(re.escape(file_stem(name)) + r"_(fig\d|filmstrip)", stem):
+            return {name}
+    raise AssertionError(f"unexpected figure {stem}")
+
+
+def test_every_caption_names_the_runs_its_figure_shows(logs, tmp_path):
+    index = build_report(tmp_path / "report", logs)
+    md = index.with_name("index.md").read_text(encoding="utf-8")
+    figures = re.findall(r"!\[([^\]]*)\]\(figures/([^)]+)\.png\)", md)
+    stems = {stem for _, stem in figures}
+    assert {"catch_fig7", "catch_optimised_mujoco_fig7", "stick_3step_mu0_fig7"} <= stems
+    assert {"stick_3step_fig7", "stick_2step_fig7", "grasp_sphere_fig9"} <= stems
+    for caption, stem in figures:
+        named = set(re.findall(r"'([^']+)'", caption.replace("\\_", "_")))
+        assert named == _expected(stem), (stem, caption)
+    assert "in no figure" not in md  # every log is in a figure
+
+
+def test_a_plugin_returning_bare_paths_is_captioned_by_the_longest_name():
+    from replay.report.builder import _runs_of
+
+    readers = dict.fromkeys(["stick_3step", "stick_3step_mu0"])
+    assert _runs_of(Path("x/stick_3step_mu0_fig7.png"), readers) == ("stick_3step_mu0",)
+    assert _runs_of(Path("x/stick_3step_fig7.png"), readers) == ("stick_3step",)
+    assert _runs_of(Path("x/other.png"), readers) == ()
