@@ -56,6 +56,9 @@ def _cannot_load(exc: BaseException, limit: int | None) -> None:
 
 def main() -> None:
     signal.signal(signal.SIGINT, _while_importing)
+    from replay.top_level import guard
+
+    guard()  # plants and analysis: the installed ones (replay/top_level.py)
     limit = _address_space_limit()
     if limit is not None:
         # each OpenBLAS thread reserves its buffers at import: under a limit (ulimit -v) one

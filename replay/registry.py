@@ -17,6 +17,10 @@ from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 from typing import Any
 
+from replay.top_level import guard
+
+guard()  # entry points name plants.* and analysis.*: the installed ones, never a cwd folder
+
 GROUPS = {
     "plant": "paper_replay.plants",
     "sensor": "paper_replay.sensors",
