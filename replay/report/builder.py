@@ -176,8 +176,6 @@ def _build(out: Path, logs_dir: Path) -> None:
         for name, r in sorted(readers.items()):
             sc = r.scenario()
             sec.runs.append((name, sc.get("seed", "?"), str(getattr(r, "path", name))))
-        if key == next(iter(PAPERS)):
-            sec.notes += [f"Log left out: {d}" for d in dropped]
         if readers:
             figure_skips: list[str] = []
             try:
@@ -240,8 +238,9 @@ def _build(out: Path, logs_dir: Path) -> None:
     if any(COMMAND in c.note for sec in sections for c in sec.claims):  # the stored rate rows'
         (out / "tables").mkdir(exist_ok=True)
         shutil.copy(data_path("ablations", f"{TABLE}.csv"), out / "tables" / f"{TABLE}.csv")
-    (out / "index.md").write_text(_markdown(sections, info, commands), encoding="utf-8")
-    (out / "index.html").write_text(_html(sections, info, commands), encoding="utf-8")
+    left = [f"Log left out: {d}" for d in dropped]  # (a log that is no run's is said, not lost)
+    (out / "index.md").write_text(_markdown(sections, info, commands, left), encoding="utf-8")
+    (out / "index.html").write_text(_html(sections, info, commands, left), encoding="utf-8")
 
 
 def _ablation(sf, out: Path, ablations) -> Ablation:
@@ -327,7 +326,7 @@ def _commands(sections, logs) -> list[str]:
 # -- Markdown --------------------------------------------------------------------------------
 
 
-def _markdown(sections, info, commands) -> str:
+def _markdown(sections, info, commands, notes=()) -> str:
     lines = [
         "# paper-replay: reproduction report",
         "",
@@ -335,6 +334,7 @@ def _markdown(sections, info, commands) -> str:
         "its sweep table.",
         "",
     ]
+    lines += [x for n in notes for x in (f"> {md(n)}", "")]
     for sec in sections:
         lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
         if sec.runs:
@@ -425,7 +425,7 @@ _CSP = (
 )
 
 
-def _html(sections, info, commands) -> str:
+def _html(sections, info, commands, notes=()) -> str:
     h = [
         "<!doctype html>",
         '<html lang="en"><head><meta charset="utf-8">',
@@ -436,6 +436,7 @@ def _html(sections, info, commands) -> str:
         "<h1>paper-replay: reproduction report</h1>",
         "<p>Every figure below is regenerated from a run's MCAP log; every ablation plot from "
         'its sweep table. <a href="index.md">Markdown version</a>.</p>',
+        *(f'<p class="note">{_e(n)}</p>' for n in notes),
         "<nav><ul>",
     ]
     h += [f'<li><a href="#{_e(s.key)}">{_e(s.title)}</a></li>' for s in sections]

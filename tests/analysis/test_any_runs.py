@@ -123,3 +123,50 @@ def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     assert TOPIC_STICK_STATE in lines[0]
     r = invoke("claims", stick["bare"])
     assert r.exit_code == 0 and TOPIC_STICK_STATE in r.stderr, r.output
+
+
+def _doc_rows(doc: str) -> dict[str, str]:
+    text = (Path(__file__).resolve().parents[2] / "docs" / doc).read_text(encoding="utf-8")
+    rows = [line.split("|")[1:3] for line in text.splitlines() if line.startswith("| ")]
+    return {a.strip(): b for a, b in rows}
+
+
+@pytest.mark.parametrize(
+    "doc, module",
+    [
+        ("catching.md", "catch_figures"),
+        ("catching.md", "catch_claims"),
+        ("grasping.md", "grasp_figures"),
+        ("grasping.md", "grasp_claims"),
+        ("stick.md", "stick_figures"),
+        ("stick.md", "stick_claims"),
+    ],
+)
+def test_the_docs_list_what_each_figure_and_row_reads(doc, module):
+    """The contract a controller fulfils: each paper's doc names every topic each figure and
+    claims row reads (the modules' TOPICS)."""
+    import importlib
+
+    topics = importlib.import_module(f"analysis.{module}").TOPICS
+    groups = topics if isinstance(topics, dict) else {"every claims row": topics}
+    rows = _doc_rows(doc)
+    for group, needed in groups.items():
+        row = next((v for k, v in rows.items() if k.startswith(group)), None)
+        assert row is not None, (doc, group)
+        for topic in needed:
+            assert f"`{topic}`" in row, (doc, group, topic)
+
+
+def test_variants_beyond_the_cap_get_a_figure_of_their_own_and_a_note(catch, tmp_path, monkeypatch):
+    from analysis import catch_figures
+    from analysis.needs import skipped_notes
+
+    monkeypatch.setattr(catch_figures, "MAX_VARIANTS", 1)
+    logs = runs.keyed(LogReader(catch[k]) for k in ("opt", "ini", "lat", "renamed"))
+    with skipped_notes() as notes:
+        paths = catch_figures.make_figures(logs, tmp_path)
+    fig7 = next(p for p in paths if p.name == "catch_fig7.png")
+    assert len(fig7.runs) == 3
+    (left,) = set(logs) - set(fig7.runs)
+    assert any(n.startswith(f"{left}: not overlaid") and "at most 1" in n for n in notes), notes
+    assert any(p.runs == (left,) and p.suffix == ".png" for p in paths)  # its own Fig. 7

@@ -71,3 +71,26 @@ def test_a_plugin_returning_bare_paths_is_captioned_by_the_longest_name():
     assert _runs_of(Path("x/stick_3step_mu0_fig7.png"), readers) == ("stick_3step_mu0",)
     assert _runs_of(Path("x/stick_3step_fig7.png"), readers) == ("stick_3step",)
     assert _runs_of(Path("x/other.png"), readers) == ()
+
+
+def test_a_variant_is_captioned_with_its_label_and_no_log_is_lost(logs, tmp_path):
+    """A second stick_3step log (μ = 1) is its own run, captioned with what differs; a file
+    that is not a run log is named in the report, not skipped silently."""
+    import shutil
+
+    d = tmp_path / "logs"
+    d.mkdir()
+    for name in ("stick_3step", "catch_optimised", "catch_initial"):
+        shutil.copy(logs / f"{name}.mcap", d / f"{name}.mcap")
+    r = CliRunner().invoke(
+        main,
+        ["run", "stick_3step", "-q", "-o", str(d / "mu1.mcap"), "--set", "timing.duration=0.3"]
+        + ["--set", "plant.params.stick.friction=1.0"],
+    )
+    assert r.exit_code == 0, r.output
+    (d / "junk.mcap").write_bytes(b"not a log")
+    md = build_report(tmp_path / "report", d).with_name("index.md").read_text(encoding="utf-8")
+    captions = re.findall(r"!\[([^\]]*)\]\(figures/([^)]+)\.png\)", md)
+    variant = [c for c, stem in captions if "friction 1" in c and "_fig7" in stem]
+    assert len(variant) == 1 and "'stick_3step (friction 1, duration 300 ms)'" in variant[0]
+    assert "Log left out: junk.mcap" in md
