@@ -138,7 +138,7 @@ class Run:
         lists of numbers 2-D (N-D) arrays, one row a message; anything else (strings, lists of
         varying length, missing values) object arrays, None where missing."""
         if topic not in self.topics:
-            shown = ", ".join(list(self.topics)[:40])
+            shown = ", ".join(show(t, 60)[1:-1] for t in list(self.topics)[:40])  # (a log's)
             raise KeyError(f"no topic {show(topic)} in this run (its topics: {shown})")
         messages = self._read(topic)
         if not messages and self.topics[topic]:

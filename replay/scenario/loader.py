@@ -727,9 +727,12 @@ def scenario_from_text(
     ``plugins``: "installed" finds installed plug-ins (and ``module:Class`` ones this process
     imported already), importing nothing; "import" imports a ``module:Class`` from the cwd, for a
     text about to run; "known-only" reads a log: a plug-in not available here keeps its
-    ``params`` as plain data, and nothing is imported or port-checked (docs/security.md)."""
+    ``params`` as plain data, and nothing is imported, port-checked or extended (an
+    ``extends`` in a log's text is ignored: docs/security.md)."""
     root = _compose_root(text, name)
     inputs: list[Path] = []
+    if plugins == "known-only":  # a log's text is resolved: reading it reads no other file
+        _pop(root, "extends")
     extends = _get(root, "extends") is not None
     where = Path(base_dir if base_dir is not None else Path.cwd()) / "<text>"
     root = _extends(root, where, inputs=inputs)

@@ -138,6 +138,11 @@ def test_the_loader_takes_shipped_names_and_extends_in_a_text(tmp_path, monkeypa
     assert (sc.name, sc.timing.duration) == ("slower", 0.5)
     with pytest.raises(ScenarioError, match="no such scenario file 'slow.yaml'"):
         scenario_from_text("extends: slow.yaml\n")
+    # reading a log's text (known-only) reads no other file: its extends is ignored
+    (tmp_path / "other.yaml").write_text("extends: stick_3step\nname: other\n")
+    text = (scenario_dir() / "stick_3step.yaml").read_text() + "extends: other.yaml\n"
+    assert (tmp_path / "other.yaml").resolve() in scenario_from_text(text).inputs
+    assert scenario_from_text(text, plugins="known-only").inputs == ()
     # a file parameter resolves from the file that set it (the catch's alpha_file)
     sc = scenario_from_text("extends: catch_optimised\n")
     assert Path(sc.controller.params.scenario_dir) == scenario_dir().resolve()
@@ -169,8 +174,9 @@ def test_other_misuse_says_what_was_expected(tmp_path):
     with pytest.raises(LogError, match="no such log file"):
         replay.open_log(tmp_path / "none.mcap")
     run = replay.open_log(ROOT / "data" / "golden" / "stick_3step.mcap")
-    with pytest.raises(KeyError, match="no topic '/nope' in this run"):
+    with pytest.raises(KeyError, match="no topic '/nope' in this run") as info:
         run.table("/nope")
+    assert "/stick/state" in str(info.value)
 
 
 def test_a_table_flattens_fills_and_types_its_columns(tmp_path):
