@@ -15,7 +15,6 @@ import collections
 import functools
 import heapq
 import platform
-import subprocess
 import time
 from dataclasses import dataclass, field
 from importlib import metadata as importlib_metadata
@@ -24,7 +23,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from replay import __version__, registry
+from replay import __version__, registry, version
 from replay.foxglove.run import RunTopics
 from replay.log import LogWriter, NonFiniteValueError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
@@ -62,19 +61,7 @@ class RunResult:
 COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 
-@functools.cache  # once a process: the code a process runs is the code it loaded
-def _git_commit() -> str:
-    try:
-        out = subprocess.run(
-            ["git", "rev-parse", "--short=12", "HEAD"],
-            capture_output=True,
-            text=True,
-            timeout=5,
-            cwd=Path(__file__).resolve().parent,
-        )
-        return out.stdout.strip() if out.returncode == 0 else ""
-    except (OSError, subprocess.SubprocessError):
-        return ""
+_git_commit = version.commit  # from git in a checkout, from the build in a wheel
 
 
 @functools.cache  # once a process (~3 ms of package metadata reads)

@@ -9,14 +9,13 @@ parameter) is still a variant: it becomes a row with that reason, keyed by what 
 from __future__ import annotations
 
 import hashlib
-import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator
 
-from replay import __version__
 from replay.scenario import ScenarioError, load_scenario, resolved_yaml
 from replay.sweep.spec import SweepSpec, sets_for
+from replay.version import code_version
 
 
 @dataclass
@@ -32,31 +31,6 @@ class Variant:
     name: str = ""  # the scenario's name
     version: str = ""  # the code version it is keyed by (the table's version column)
     extra: dict[str, Any] = field(default_factory=dict)
-
-
-def code_version() -> str:
-    """Package version, git commit and a digest of uncommitted changes (so an edit re-runs)."""
-    here = Path(__file__).resolve().parent
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short=12", "HEAD"],
-            capture_output=True,
-            text=True,
-            timeout=10,
-            cwd=here,
-        )
-        diff = subprocess.run(
-            ["git", "diff", "HEAD", "--", ".", ":(exclude)*.csv"],
-            capture_output=True,
-            timeout=30,
-            cwd=here.parent.parent,
-        )
-    except (OSError, subprocess.SubprocessError):
-        return __version__
-    version = f"{__version__}+{commit.stdout.strip() or 'unknown'}"
-    if diff.returncode == 0 and diff.stdout:
-        version += "." + hashlib.sha256(diff.stdout).hexdigest()[:8]
-    return version
 
 
 def variant_key(resolved: str, seed: int, version: str) -> str:

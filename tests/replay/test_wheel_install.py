@@ -78,6 +78,7 @@ def test_one_run_of_each_paper_from_an_empty_directory(installed):
         assert "Traceback" not in out and "pybullet build time" not in out, out
         info = _sh([replay, "info", work / f"{name}.mcap"], cwd=work, env=env)
         assert "outcome" in info
+        _assert_names_a_commit(info)
     out = _sh([replay, "claims", *sorted(work.glob("*.mcap"))], cwd=work, env=env)
     assert "Traceback" not in out
     for title in ("Stick-shaped", "Direct Mapping", "High Speed Grasping"):  # all three tables
@@ -93,6 +94,17 @@ def test_one_run_of_each_paper_from_an_empty_directory(installed):
     assert any((work / "figs").glob("*.png"))
     out = _sh([replay, "golden", "check", "stick_3step"], cwd=work, env=env)
     assert "ok" in out
+
+
+def _assert_names_a_commit(info: str) -> None:
+    """The log's code version names the checkout's commit the wheel was built from (HEAD, or
+    an ancestor of it when a commit landed since the build), not ``+unknown``."""
+    found = re.search(r"code 0\.1\.0\+([0-9a-f]{12})\b", info)
+    assert found, info[:400]
+    r = subprocess.run(
+        ["git", "merge-base", "--is-ancestor", found.group(1), "HEAD"], cwd=ROOT, timeout=30
+    )
+    assert r.returncode == 0, f"{found.group(1)} is not a commit of this checkout"
 
 
 def test_a_user_scenario_builds_on_a_shipped_one(installed):
