@@ -209,8 +209,8 @@ def _sets(given: Any) -> list[str]:
     if isinstance(given, Mapping):
         out = []
         for key, value in given.items():
-            if not isinstance(key, str):
-                raise ScenarioError(f"set: a key path is a string, got {show(key)}", file="set")
+            if not isinstance(key, str) or "=" in key:
+                raise ScenarioError(f"expected a key path, got {show(key)}", file="set")
             text = yaml.safe_dump(
                 _plain(value, key), default_flow_style=True, width=1 << 30, allow_unicode=True
             )

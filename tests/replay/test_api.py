@@ -158,6 +158,7 @@ def test_the_loader_takes_shipped_names_and_extends_in_a_text(tmp_path, monkeypa
         (lambda: replay.run({"extends": "nope"}), r"^<mapping>: extends: no such scen"),
         (lambda: replay.run({"extends": "stick_3step", "seed": object()}), r"^<mapping>: seed"),
         (lambda: replay.run("stick_3step", seed=-1), r"seed from 0"),
+        (lambda: replay.run("stick_3step", set={"seed=1": 2}), r"^set: expected a key path"),
     ],
 )
 def test_a_bad_scenario_is_one_scenario_error(call, match, tmp_path, monkeypatch):
