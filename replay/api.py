@@ -9,8 +9,8 @@
 
 A run writes its log as ``replay run`` does and its data are read back from it, so what a run
 returns and what its log holds are the same numbers by construction; without ``log=`` the log
-is written in a temporary folder, read whole and deleted (reading it back costs about a third
-of the run's own time).
+is written in a temporary folder, read whole and deleted (reading it back adds at most about
+half the run's own time: stick_3step 0.18 -> 0.26 s, catch_optimised 0.29 -> 0.30 s).
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ def run(
     if log is not None:
         return open_log(Runner(sc).run(os.fspath(log)).path)
     with tempfile.TemporaryDirectory(prefix="replay-run-") as tmp:
-        result = Runner(sc).run(Path(tmp) / f"{sc.name}.mcap")
+        result = Runner(sc).run(Path(tmp) / "run.mcap")
         return Run(LogReader(result.path), keep=False)
 
 
