@@ -118,6 +118,26 @@ def test_a_user_scenario_builds_on_a_shipped_one(installed):
     assert "seed 5" in _sh([replay, "info", work / "mine.yaml.mcap"], cwd=work, env=env)
 
 
+def test_a_controller_from_a_file_runs_and_its_log_is_analysed_elsewhere(installed, tmp_path):
+    """examples/my_controller.py beside its scenario in a user's folder (no packaging); the log
+    then read by figures, claims and report from a folder where that file is absent."""
+    import shutil
+
+    replay, _, env = installed
+    mine, other = tmp_path / "mine", tmp_path / "other"
+    mine.mkdir()
+    other.mkdir()
+    for f in ("my_controller.py", "my_controller.yaml"):
+        shutil.copy(ROOT / "examples" / f, mine)
+    log = other / "keeper.mcap"
+    _sh([replay, "run", "my_controller.yaml", "--quiet", "-o", log], cwd=mine, env=env)
+    for args in (["figures", log, "-o", other / "figs"], ["claims", log], ["info", log]):
+        out = _sh([replay, *args], cwd=other, env=env)
+        assert "Traceback" not in out and "not imported" not in out, out[-2000:]
+    _sh([replay, "report", "-o", other / "report", "--logs", other], cwd=other, env=env)
+    assert (other / "report" / "index.html").is_file()
+
+
 def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_path):
     """``CC=/bin/false``: every accelerator fails to build and is left out (setup.py), the
     wheel still builds, holds no compiled module, and one short run of each paper, ``replay
