@@ -201,16 +201,26 @@ def test_events_are_read_once_and_in_linear_time(tmp_path):
         return path
 
     def cost(path: Path) -> float:
-        t0 = time.perf_counter()
-        r = LogReader(path).check()
-        for _ in range(10):  # (a paper's claims ask for the events many times)
-            r.events()
-        return time.perf_counter() - t0
+        """CPU time of a paper's many asks for the events; the least of three (a loaded
+        machine's noise only adds)."""
+        times = []
+        for _ in range(3):
+            t0 = time.process_time()
+            r = LogReader(path).check()
+            for _ in range(10):
+                r.events()
+            times.append(time.process_time() - t0)
+        return min(times)
 
     small, big = write(5_000), write(50_000)
-    cost(small)
+    reads = []
+    counted = LogReader(small)
+    series = counted.series
+    counted.series = lambda *a, **k: reads.append(a) or series(*a, **k)  # type: ignore[method-assign]
+    assert [len(counted.events()) for _ in range(5)] == [5_000] * 5
+    assert len(reads) == 1  # read once, then kept
     ratio = cost(big) / cost(small)
-    assert ratio < 25  # 10x the events: ~10x the time (quadratic would be ~100x)
+    assert ratio < 40  # 10x the events: ~10x the time (quadratic would be ~100x)
     r = LogReader(big)
     events = r.events()
     assert len(events) == 50_000 and [e["t"] for e in events] == sorted(e["t"] for e in events)
