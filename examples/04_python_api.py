@@ -1,6 +1,6 @@
 """The Python API, as a notebook would use it: run a scenario twice, compare, open a log.
 
-    .venv/bin/python examples/python_api.py [OUT_DIR]
+    .venv/bin/python examples/04_python_api.py [OUT_DIR]
 
 Each ``# %%`` is a notebook cell (Jupyter, VS Code). Without OUT_DIR the kept log goes to a
 temporary folder.

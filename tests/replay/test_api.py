@@ -226,7 +226,7 @@ def test_import_replay_stays_light():
 
 def test_the_python_api_example_runs(tmp_path):
     r = subprocess.run(
-        [sys.executable, str(ROOT / "examples" / "python_api.py"), str(tmp_path)],
+        [sys.executable, str(ROOT / "examples" / "04_python_api.py"), str(tmp_path)],
         capture_output=True,
         text=True,
         timeout=300,

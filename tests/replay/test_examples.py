@@ -24,7 +24,17 @@ def _run(name: str, *args) -> str:
 
 def test_examples_are_numbered_and_all_tested():
     names = sorted(p.name for p in EXAMPLES.glob("*.py"))
-    assert names == ["01_run_a_scenario.py", "02_read_a_log.py", "03_write_a_plugin_plant.py"]
+    scripts = [n for n in names if n[:2].isdigit()]
+    assert scripts == [
+        "01_run_a_scenario.py",
+        "02_read_a_log.py",
+        "03_write_a_plugin_plant.py",
+        "04_python_api.py",  # (run by tests/replay/test_api.py)
+    ]
+    # the one module that is no script: the controller examples/my_controller.yaml names by
+    # file (type: my_controller:GoalKeeper; tests/replay/test_plugins_from_files.py)
+    assert sorted(set(names) - set(scripts)) == ["my_controller.py"]
+    assert "my_controller:" in (EXAMPLES / "my_controller.yaml").read_text(encoding="utf-8")
 
 
 def test_01_runs_a_scenario_from_python(tmp_path):
