@@ -986,26 +986,18 @@ def _vision_rows(run: CatchRun, st: dict) -> list[Claim]:
     ]
 
 
-_CTRL = (TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND)  # the control-step arrays (t_ctrl)
+# the control-step arrays (t_ctrl) and the ball's truth (the first contact is placed with both)
+_CTRL = (TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND, TOPIC_OBJECT_STATE)
 # what each group of rows reads (the contract a catching controller fulfils: docs/catching.md);
 # a run whose log lacks one is left out of the group's rows, with a note naming the topic
 TOPICS = {
-    "per-run rows (throw, catch, eq. 4, eq. 9)": (
-        *_CTRL,
-        TOPIC_OBJECT_STATE,
-        TOPIC_ARM_JOINT_STATE,
-    ),
+    "per-run rows (throw, catch, eq. 4, eq. 9)": (*_CTRL, TOPIC_ARM_JOINT_STATE),
     "catch over the stated throws": (TOPIC_OBJECT_STATE,),
     "catch within the stated arm speed": (*_CTRL, TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_MOTION),
     "delay of the arm": (*_CTRL, TOPIC_EFFECTOR_MOTION),
-    "simple feedback control": (*_CTRL, TOPIC_OBJECT_STATE),
+    "simple feedback control": _CTRL,
     "torque limits (eq. 22)": _CTRL,
-    "arm capability rows": (
-        *_CTRL,
-        TOPIC_OBJECT_STATE,
-        TOPIC_ARM_JOINT_STATE,
-        TOPIC_EFFECTOR_MOTION,
-    ),
+    "arm capability rows": (*_CTRL, TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_MOTION),
     "hand closing": (TOPIC_HAND_JOINT_STATE,),
 }
 

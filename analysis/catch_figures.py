@@ -57,8 +57,13 @@ VARIANT_COLORS = ("tab:purple", "tab:brown", "tab:olive", "tab:cyan")
 TOPICS = {
     "Fig. 6": (TOPIC_OPTIMIZATION_COST,),
     "Fig. 7": (TOPIC_OBJECT_STATE, TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND),
-    "Fig. 8": (TOPIC_ARM_JOINT_STATE, TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND),
-    "Fig. 9": (TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND),
+    "Fig. 8": (
+        TOPIC_ARM_JOINT_STATE,
+        TOPIC_EFFECTOR_STATE,
+        TOPIC_ARM_JOINT_COMMAND,
+        TOPIC_OBJECT_STATE,  # (the window ends at the first contact, placed on the ball)
+    ),
+    "Fig. 9": (TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND, TOPIC_OBJECT_STATE),
 }
 _VARIANT: dict[str, tuple[int, str]] = {}  # run key -> (its variant index, its label)
 
