@@ -38,7 +38,8 @@ class UnknownPlugin(LookupError):
 _registered: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}
 _imported: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}  # module:Class names
 
-_IMPORT_PATH = re.compile(r"[A-Za-z_]\w*(\.[A-Za-z_]\w*)*:[A-Za-z_]\w*(\.[A-Za-z_]\w*)*")
+IMPORT_PATH = r"[A-Za-z_]\w*(\.[A-Za-z_]\w*)*:[A-Za-z_]\w*(\.[A-Za-z_]\w*)*"  # module:Class
+_IMPORT_PATH = re.compile(IMPORT_PATH)
 
 
 class _Loaded:

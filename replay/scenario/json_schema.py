@@ -118,11 +118,14 @@ class _Generator:
                     "then": {"properties": {"params": {"$ref": f"#/definitions/{key}"}}},
                 }
             )
-        # enumDescriptions: shown by VS Code's YAML extension next to each completion
+        # an installed plug-in's name (enumDescriptions: shown by VS Code's YAML extension next
+        # to each completion), or a plug-in's import path, module:Class (its params unchecked here)
         out["properties"]["type"] = {
             **out["properties"]["type"],
-            "enum": names,
-            "enumDescriptions": docs,
+            "anyOf": [
+                {"enum": names, "enumDescriptions": docs},
+                {"pattern": f"^{registry.IMPORT_PATH}$", "description": "module:Class"},
+            ],
         }
         if rules:
             out["allOf"] = rules

@@ -82,7 +82,9 @@ def test_schema_to_stdout_and_to_a_file(tmp_path):
     assert schema["$schema"].startswith("http://json-schema.org/draft-07")
     assert (
         "airtable"
-        in schema["definitions"]["scenario"]["properties"]["plant"]["properties"]["type"]["enum"]
+        in schema["definitions"]["scenario"]["properties"]["plant"]["properties"]["type"]["anyOf"][
+            0
+        ]["enum"]
     )
     out = tmp_path / "editor/scenario.schema.json"
     r = invoke("schema", "-o", out)

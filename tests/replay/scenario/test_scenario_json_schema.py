@@ -116,6 +116,23 @@ def test_bad_scenarios_fail_both_schema_and_loader(validator, change, where):
         load_scenario_text(yaml.safe_dump(data))
 
 
+@pytest.mark.parametrize(
+    "kind, name, ok",
+    [
+        ("controller", "my_controller:GoalKeeper", True),
+        ("plant", "pkg.sub:Mod.Plant", True),
+        ("controller", "no colon", False),
+        ("controller", "a:b:c", False),
+        ("controller", "x; rm -rf /:A", False),
+    ],
+)
+def test_a_plugin_type_may_be_an_import_path(validator, kind, name, ok):
+    data = read(BASE)
+    data[kind]["type"] = name
+    data[kind].pop("params", None)
+    assert (errors(validator, data) == []) == ok, errors(validator, data)
+
+
 def test_what_the_loader_takes_as_defaults_validates(validator):
     data = read(BASE)
     data["stop"] = None  # "stop:" alone: every default
