@@ -189,3 +189,26 @@ def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_pa
     probe = "import replay.sensors.raster as r, replay.accel as a; print(r._pixels, a.__file__)"
     out = _sh([venv / "bin" / "python", "-c", probe], cwd=work, env=env)
     assert out.startswith("None ") and str(site) in out
+
+
+def test_the_python_api_from_the_wheel(installed):
+    """replay.run / replay.open_log from an empty folder: a kept run's table is what its log
+    holds, and a run in memory gives the same numbers and writes no file."""
+    replay, work, env = installed
+    api = work / "api"
+    api.mkdir()
+    code = (
+        "import replay\n"
+        "from replay.log import LogReader\n"
+        "kept = replay.run({'extends': 'stick_3step'}, set={'timing.duration': 0.35}, "
+        "log='api.mcap')\n"
+        "logged = [m.data['omega'] for m in LogReader('api.mcap').messages('/stick/state')]\n"
+        "assert kept.table('/stick/state')['omega'].tolist() == logged\n"
+        "assert replay.open_log('api.mcap').table('/stick/state')['omega'].tolist() == logged\n"
+        "mem = replay.run('stick_3step', set=['timing.duration=0.35'])\n"
+        "assert mem.path is None and mem.table('/stick/state')['omega'].tolist() == logged\n"
+        "print('api ok', len(logged))\n"
+    )
+    out = _sh([replay.parent / "python", "-c", code], cwd=api, env=env)
+    assert "api ok 35" in out, out[-2000:]  # 0.35 s of /stick/state at 1 kHz: 350 or 351
+    assert sorted(p.name for p in api.iterdir()) == ["api.mcap"]
