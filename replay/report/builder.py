@@ -75,7 +75,8 @@ class PaperSection:
     key: str
     title: str
     authors: str
-    runs: list = field(default_factory=list)  # (scenario name, seed, log path)
+    runs: list = field(default_factory=list)  # (run key, seed, log path)
+    scenarios: dict = field(default_factory=dict)  # run key -> (scenario name, its label)
     figures: list = field(default_factory=list)
     claims: list = field(default_factory=list)
     claims_md: str = ""
@@ -163,6 +164,7 @@ def _inside(path: Path, folder: Path) -> bool:
 
 
 def _build(out: Path, logs_dir: Path) -> None:
+    from analysis.runs import describe
     from replay.sweep import ablations
     from replay.sweep.variants import code_version
 
@@ -176,6 +178,8 @@ def _build(out: Path, logs_dir: Path) -> None:
         for name, r in sorted(readers.items()):
             sc = r.scenario()
             sec.runs.append((name, sc.get("seed", "?"), str(getattr(r, "path", name))))
+            run = describe(r, name)
+            sec.scenarios[name] = (run.name, run.label)
         if readers:
             figure_skips: list[str] = []
             try:
@@ -301,9 +305,13 @@ def _provenance(version: str) -> dict[str, str]:
 def _commands(sections, logs) -> list[str]:
     cmds = []
     for sec in sections:
-        for name, seed, _ in sec.runs:  # (a log's name and seed quoted for the shell)
-            log = f"out/logs/{file_stem(name)}.mcap"
-            cmds.append(f"replay run {shlex.quote(name)} --seed {shlex.quote(str(seed))} -o {log}")
+        for key, seed, _ in sec.runs:  # (a log's name and seed quoted for the shell)
+            log = f"out/logs/{file_stem(key)}.mcap"
+            name, label = sec.scenarios.get(key, (key, ""))
+            differs = f"   # differs from the shipped {name}: {label}" if label else ""
+            cmds.append(
+                f"replay run {shlex.quote(name)} --seed {shlex.quote(str(seed))} -o {log}{differs}"
+            )
     if logs:
         cmds += [
             "replay figures out/logs/*.mcap -o out/figures",
@@ -323,6 +331,12 @@ def _commands(sections, logs) -> list[str]:
     return cmds
 
 
+def _differs(sec: PaperSection, key: str) -> str:
+    """'; LABEL' for a run that differs from its shipped scenario, unless its key says it."""
+    label = sec.scenarios.get(key, (key, ""))[1]
+    return f"; {label}" if label and label not in key else ""
+
+
 # -- Markdown --------------------------------------------------------------------------------
 
 
@@ -338,7 +352,7 @@ def _markdown(sections, info, commands, notes=()) -> str:
     for sec in sections:
         lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
         if sec.runs:
-            runs = (f"{md_code(n)} (seed {md(s)})" for n, s, _ in sec.runs)
+            runs = (f"{md_code(n)} (seed {md(s)}{md(_differs(sec, n))})" for n, s, _ in sec.runs)
             lines += ["Runs: " + ", ".join(runs), ""]
         for note in sec.notes:  # every line of a note quoted (the engines' note has three)
             lines += ["\n>\n".join(f"> {md(x)}" for x in note.splitlines()), ""]
@@ -454,7 +468,10 @@ def _html(sections, info, commands, notes=()) -> str:
         if sec.runs:
             h.append(
                 "<p>Runs: "
-                + ", ".join(f"<code>{_e(n)}</code> (seed {_e(s)})" for n, s, _ in sec.runs)
+                + ", ".join(
+                    f"<code>{_e(n)}</code> (seed {_e(s)}{_e(_differs(sec, n))})"
+                    for n, s, _ in sec.runs
+                )
                 + "</p>"
             )
         h += [f'<p class="note">{"<br>".join(map(_e, n.splitlines()))}</p>' for n in sec.notes]
