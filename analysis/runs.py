@@ -23,6 +23,7 @@ from typing import Any
 import yaml
 
 from replay.log import LogError, LogReader
+from replay.scenario.yamlio import one_line
 
 MAX_ITEMS = 3  # differences named in a label ("+N more" after)
 LABEL_LENGTH = 80  # characters of a label
@@ -53,15 +54,23 @@ def _flat(data: Any, prefix: str = "") -> dict[str, Any]:
     return {prefix.rstrip("."): data}
 
 
+@lru_cache(maxsize=1)
+def _shipped_names() -> frozenset[str]:
+    from replay.resources import scenario_dir
+
+    return frozenset(p.stem for p in scenario_dir().glob("*.yaml"))
+
+
 @lru_cache(maxsize=None)
 def _shipped(name: str) -> dict[str, Any] | None:
-    """The shipped scenario ``name`` resolved as a log stores it, flattened (None: none)."""
+    """The shipped scenario ``name`` resolved as a log stores it, flattened (None: none). Only
+    a name of the shipped folder's listing is read (a log's name never makes a path)."""
     from replay.resources import scenario_dir
     from replay.scenario import ScenarioError, load_scenario, resolved_yaml
 
-    path = scenario_dir() / f"{name}.yaml"
-    if not path.is_file():
+    if name not in _shipped_names():
         return None
+    path = scenario_dir() / f"{name}.yaml"
     try:
         return _flat(yaml.safe_load(resolved_yaml(load_scenario(path))))
     except (ScenarioError, OSError, ValueError, yaml.YAMLError):
@@ -70,10 +79,7 @@ def _shipped(name: str) -> dict[str, Any] | None:
 
 @lru_cache(maxsize=None)
 def _shipped_of(paper: str) -> tuple[str, ...]:
-    from replay.resources import scenario_dir
-
-    names = sorted(p.stem for p in scenario_dir().glob("*.yaml"))
-    return tuple(n for n in names if (_shipped(n) or {}).get("paper") == paper)
+    return tuple(n for n in sorted(_shipped_names()) if (_shipped(n) or {}).get("paper") == paper)
 
 
 def _short(v: Any) -> str:
@@ -121,7 +127,7 @@ def _label(items: list[str]) -> str:
     text = ", ".join(items[:MAX_ITEMS])
     if len(items) > MAX_ITEMS:
         text += f", +{len(items) - MAX_ITEMS} more"
-    text = " ".join(text.split())  # one line
+    text = one_line(" ".join(text.split()))  # one line, control characters escaped
     return text if len(text) <= LABEL_LENGTH else text[: LABEL_LENGTH - 1] + "…"
 
 

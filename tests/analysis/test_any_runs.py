@@ -204,3 +204,15 @@ def test_catch_figures_and_claims_survive_any_topic_missing(catch, tmp_path, top
     assert rows
     needed = any(topic in t for t in (*FIGS.values(), *ROWS.values()))
     assert needed == any(topic in n for n in notes), notes
+
+
+def test_a_logs_name_never_makes_a_path_and_a_label_stays_one_bounded_line(stick, tmp_path):
+    assert runs._shipped("../scenarios/stick_3step") is None
+    assert runs._shipped("stick_3step") is not None
+    hostile = "\x1b]0;PWNED\x07" + "x" * 500
+    log = LogReader(forge(stick["mu03"], tmp_path / "h.mcap", "/nothing", "stick_h"))
+    stored = runs._flat(log.scenario_config())
+    stored["controller.type"] = hostile
+    label = runs._label(runs.differences(stored, runs._shipped("stick_3step") or {}))
+    assert "\x1b" not in label and "\n" not in label and len(label) <= runs.LABEL_LENGTH
+    assert label.startswith("controller \\x1b]0;PWNED")
