@@ -13,7 +13,8 @@ import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
-from analysis.needs import has  # noqa: E402
+from analysis import runs as run_labels  # noqa: E402
+from analysis.needs import has, skip  # noqa: E402
 from analysis.series import arrays, events  # noqa: E402
 from plants.airtable.params import Params  # noqa: E402
 from replay.log import LogReader  # noqa: E402
@@ -23,6 +24,7 @@ from replay.scenario import ScenarioError, params_from_data  # noqa: E402
 
 # what each figure reads (the contract a stick-capture controller fulfils: README)
 TOPICS = {"Fig. 7": (TOPIC_STICK_STATE,), "friction overlay": (TOPIC_STICK_STATE,)}
+MAX_VARIANTS = 6  # runs in one variants overlay
 
 
 def fig7(log: LogReader, title: str = ""):
@@ -68,19 +70,21 @@ def fig7(log: LogReader, title: str = ""):
     return fig
 
 
-def friction_overlay(logs: dict[str, LogReader]):
-    """The same strategy run under different friction: the curves should coincide (Sec. II-C)."""
+def friction_overlay(logs: dict[str, LogReader], labels: dict[str, str] | None = None, title=""):
+    """The same strategy run under different friction: the curves should coincide (Sec. II-C).
+    With ``labels`` (run key -> legend entry), any runs overlaid under ``title``."""
     fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
     for name, log in sorted(logs.items()):
         mu = _mu(log)
         s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy", "omega"])
         label = f"{name} (μ = {mu:g})" if mu is not None else name
+        label = labels[name] if labels is not None else label
         ax_v.plot(s["t"], np.hypot(s["vx"], s["vy"]), lw=1.2, label=label)
         ax_w.plot(s["t"], s["omega"], lw=1.2, label=label)
     ax_v.set_ylabel("|v| [m/s]")
     ax_w.set_ylabel("ω [rad/s]")
     ax_w.set_xlabel("time [s]")
-    ax_v.set_title("Friction independence: the same plan under different μ", fontsize=10)
+    ax_v.set_title(title or "Friction independence: the same plan under different μ", fontsize=10)
     ax_v.legend(fontsize=7)
     for ax in (ax_v, ax_w):
         ax.grid(alpha=0.3)
@@ -117,4 +121,27 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     for strategy, group in sorted(by_strategy.items()):
         if len({_mu(log) for log in group.values()}) > 1:
             paths += save(friction_overlay(group), out, f"{strategy}_friction", sorted(group))
+    return paths + _variant_figures(logs, out)
+
+
+def _variant_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
+    """Fig. 7's velocities of every run of one experiment overlaid, each labelled by what
+    differs (analysis/runs.py), when some run of it differs from its shipped scenario."""
+    groups: dict[str, dict[str, LogReader]] = {}
+    for name, log in logs.items():
+        groups.setdefault(run_labels.describe(log, name).experiment, {})[name] = log
+    paths: list[Path] = []
+    for experiment, group in sorted(groups.items()):
+        labels = {n: run_labels.describe(log, n).label for n, log in group.items()}
+        if not experiment or len(group) < 2 or not any(labels.values()):
+            continue
+        keys = sorted(group, key=lambda n: (bool(labels[n]), n))
+        for n in keys[MAX_VARIANTS:]:
+            skip(f"{n}: not in {experiment}'s variants overlay (at most {MAX_VARIANTS} runs)")
+        shown = {n: group[n] for n in keys[:MAX_VARIANTS]}
+        legend = {n: f"{n}: {labels[n]}" if labels[n] not in n else n for n in shown}
+        legend.update({n: f"{n} (as shipped)" for n in shown if not labels[n]})
+        title = f"{experiment} and its variants: velocities vs time (cf. Fig. 7)"
+        fig = friction_overlay(shown, legend, title)
+        paths += save(fig, out, f"{experiment}_variants", sorted(shown))
     return paths

@@ -82,6 +82,9 @@ def test_stick_runs_of_one_name_each_get_a_figure_and_the_overlay(stick, tmp_pat
     pngs = sorted(p.name for p in tmp_path.glob("*.png"))
     assert len([p for p in pngs if "_fig7" in p]) == 2, pngs
     assert "stick_3step_friction.png" in pngs
+    assert "stick_3step_variants.png" in pngs  # Fig. 7's velocities, each run labelled
+    svg = (tmp_path / "stick_3step_variants.svg").read_text()
+    assert "friction 1" in svg and "duration 300 ms" in svg
     assert "warning" not in r.stderr, r.stderr
 
 
