@@ -41,6 +41,12 @@ LIMITS: dict[str, Limit] = {
         Limit("sweep_variants", 100_000, "variants", "the variants of one sweep"),
         Limit("scenario_bytes", 1_000_000, "bytes", "the text of one scenario (a file or a log's)"),
         Limit("message_bytes", 64_000_000, "bytes", "one message a log reader will load"),
+        Limit(
+            "series_bytes",
+            256_000_000,
+            "bytes",
+            "the messages of one topic a reader decodes and keeps (e.g. all events)",
+        ),
         Limit("log_bytes", 8_000_000_000, "bytes", "the projected size of a run's log"),
     )
 }
