@@ -1031,11 +1031,10 @@ def evaluate(logs: dict[str, LogReader]) -> list[Claim]:
     pair = fit("torque limits (eq. 22)", [r.name for r in (opt, ini) if r is not None])
     rows += _torque_limit_rows(pair.get(opt.name) if opt else None, ini and pair.get(ini.name))
     able = fit("arm capability rows", [opt.name] if opt else list(runs)[:1])
-    if able:
-        ref = next(iter(able.values()))
-        rows += _capability_rows(ref, st)
-        rows += _vision_rows(ref, st)
+    ref = next(iter(able.values()), None)
+    rows += _capability_rows(ref, st) if ref else []
     rows += _hand_rows(fit("hand closing"), st)
+    rows += _vision_rows(ref, st) if ref else []
     # Figs. 6/8/9 per regime (8-10 m/s and the 4.5 m/s catch_5ms_* pair), windows ending at the
     # first contact, the optimiser's model beside the run, the clamp-aware extension (#21)
     rows += thesis.rows(logs)
