@@ -676,6 +676,7 @@ def claims(logs, markdown):
     from analysis.engines import evaluate_runs
     from analysis.needs import skipped_notes
     from replay.report.builder import claims_markdown
+    from replay.report.markup import md
 
     sections, md_sections = [], []
     by_paper = _logs_by_paper(logs)
@@ -706,7 +707,8 @@ def claims(logs, markdown):
         partial, falsifiers = _partial(readers), falsifiers_of(evaluate)
         closing = f"\n\n{engines_note}" if engines_note else ""
         sections.append(format_table(title, rows, partial=partial, falsifiers=falsifiers) + closing)
-        md_sections.append(claims_markdown(title, rows, falsifiers, partial) + closing)
+        left = "".join(f"\n\n> {md(t)}" for t in skipped)  # (a topic a log lacks)
+        md_sections.append(claims_markdown(title, rows, falsifiers, partial) + closing + left)
     say("\n\n".join(sections))
     if markdown:  # (the log's names escaped: no raw HTML where the Markdown is rendered)
         text = "\n\n".join([CLAIMS_HEADER, *md_sections]) + "\n"

@@ -113,8 +113,10 @@ def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     notes = [line for line in r.stderr.splitlines() if "catch_mine" in line]
     assert notes and all("/effector/state" in n for n in notes), r.stderr
     assert (tmp_path / "f" / "catch_fig8.png").is_file()
-    r = invoke("claims", catch["opt"], catch["mine"])
+    r = invoke("claims", catch["opt"], catch["mine"], "--markdown", tmp_path / "c.md")
     assert r.exit_code == 0, r.output
+    table = (tmp_path / "c.md").read_text(encoding="utf-8")
+    assert "> catch\\_mine: claims" in table or "> catch_mine: claims" in table
     assert "catch_mine" in r.stderr and "/effector/state" in r.stderr
     assert "catch_mine: ball caught" not in r.stdout
     assert "catch_optimised: ball caught" in r.stdout
