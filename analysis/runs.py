@@ -194,6 +194,17 @@ def keyed(readers: Iterable[LogReader]) -> dict[str, LogReader]:
     return out
 
 
+def label_runs(readers: Iterable[LogReader]) -> dict[str, str]:
+    """Each log's key (:func:`keyed`) and what its run sets differently from its experiment."""
+    return {key: describe(r, key).label for key, r in keyed(readers).items()}
+
+
+def titled(key: str, reader: LogReader) -> str:
+    """``key``, with its label when the key does not already say it: a figure's run name."""
+    label = describe(reader, key).label
+    return f"{key} ({label})" if label and label not in key else key
+
+
 def by_paper(readers: Iterable[LogReader]) -> dict[str, dict[str, LogReader]]:
     """:func:`keyed` per paper (the stored scenario's ``paper``)."""
     keys = keyed(readers)

@@ -111,7 +111,10 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     logs = {n: log for n, log in logs.items() if has({n: log}, TOPICS["Fig. 7"], "stick Fig. 7")}
     for name, log in sorted(logs.items()):
         paths += save(
-            fig7(log, f"{name}: velocities vs time (cf. Fig. 7)"), out, f"{name}_fig7", [name]
+            fig7(log, f"{run_labels.titled(name, log)}: velocities vs time (cf. Fig. 7)"),
+            out,
+            f"{name}_fig7",
+            [name],
         )
     by_strategy: dict[str, dict[str, LogReader]] = {}
     for name, log in logs.items():

@@ -221,3 +221,15 @@ def test_a_logs_name_never_makes_a_path_and_a_label_stays_one_bounded_line(stick
     label = runs._label(runs.differences(stored, runs._shipped("stick_3step") or {}))
     assert "\x1b" not in label and "\n" not in label and len(label) <= runs.LABEL_LENGTH
     assert label.startswith("controller \\x1b]0;PWNED")
+
+
+def test_label_runs_gives_each_log_its_key_and_label(stick, catch):
+    logs = [LogReader(stick["mu03"]), LogReader(stick["mu1"]), LogReader(catch["renamed"])]
+    labels = runs.label_runs(logs)
+    assert list(labels) == [
+        "stick_3step",
+        "stick_3step (friction 1, duration 300 ms)",
+        "catch_lat10",
+    ]
+    assert labels["catch_lat10"] == "stereo latency 10 ms"
+    assert runs.titled("catch_lat10", logs[2]) == "catch_lat10 (stereo latency 10 ms)"
