@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 matplotlib.rcParams["text.parse_math"] = False
 import matplotlib.pyplot as plt  # noqa: E402
 
-from replay.log.writer import check_output  # noqa: E402
+from replay.log.writer import check_output, write_output  # noqa: E402
 
 # what an earlier figure starts with: the only file a figure overwrites
 MAGIC = {".png": b"\x89PNG\r\n\x1a\n", ".svg": b"<?xml"}
@@ -49,18 +49,28 @@ def figure_file(path: Path, runs) -> FigureFile:
     return f
 
 
+def runs_of(path: Path, keys) -> tuple[str, ...]:
+    """The runs a figure file shows: its own record (:class:`FigureFile`), else (a plug-in's
+    bare path) the run whose file stem begins its name, the longest such."""
+    if isinstance(path, FigureFile):
+        return tuple(path.runs)
+    match = [k for k in keys if Path(path).stem.startswith(file_stem(k))]
+    return (max(match, key=len),) if match else ()
+
+
 def save(fig, out: Path, stem: str, runs=()) -> list[Path]:
     """``out/STEM.png`` and ``out/STEM.svg`` (``stem`` made safe by :func:`file_stem`), as
     :class:`FigureFile` paths showing ``runs``; the SVG has no date and fixed element ids
     (matplotlib salts them randomly otherwise). A file there that is not an earlier PNG or SVG
-    is refused (``replay.log.LogError``), not overwritten."""
+    is refused (``replay.log.LogError``), not overwritten, and so is a symbolic link."""
     out.mkdir(parents=True, exist_ok=True)
     stem = file_stem(stem)
     paths: list[Path] = [figure_file(out / f"{stem}.{x}", runs) for x in ("png", "svg")]
     for path in paths:
         check_output(path, kind="figure", magic=MAGIC[path.suffix])
-    fig.savefig(paths[0], dpi=150)
+    # each written beside its name and renamed onto it: never through a link planted there
+    write_output(paths[0], lambda tmp: fig.savefig(tmp, format="png", dpi=150))
     with plt.rc_context({"svg.hashsalt": "paper-replay"}):
-        fig.savefig(paths[1], metadata={"Date": None})
+        write_output(paths[1], lambda tmp: fig.savefig(tmp, format="svg", metadata={"Date": None}))
     plt.close(fig)
     return paths

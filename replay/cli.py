@@ -631,6 +631,7 @@ def _analysis_failed(what: str, paper: str, readers, exc: Exception) -> None:
 )
 def figures(logs, out):
     """Regenerate the papers' figures (PNG and SVG) from LOGS (default: out/logs/*.mcap)."""
+    from analysis.figure_files import runs_of
     from analysis.needs import figure_notes, skipped_notes
 
     by_paper = _logs_by_paper(logs)
@@ -655,9 +656,7 @@ def figures(logs, out):
             _analysis_failed("figures", paper, readers, exc)
         for path in paths:
             say(f"figure: {path}")
-        shown = {k for p in paths for k in getattr(p, "runs", ())}
-        if not any(hasattr(p, "runs") for p in paths):  # (a plug-in's bare paths)
-            shown = {k for k in readers if any(Path(p).stem.startswith(k) for p in paths)}
+        shown = {k for p in paths for k in runs_of(p if isinstance(p, Path) else Path(p), readers)}
         for text in figure_notes(readers, shown, skipped):
             warn(text)
         for name, notes in _partial(readers).items():

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 from importlib import metadata
 from pathlib import Path
 
-from analysis.figure_files import file_stem
+from analysis.figure_files import file_stem, runs_of
 from analysis.needs import figure_notes, skipped_notes
 from replay import registry
 from replay.log import LogError, LogReader
@@ -129,16 +129,6 @@ def _caption(paper: str, stem: str, shows: str) -> str:
     return f"{base} (paper: “{quoted}”).{shows}" if quoted else f"{base}.{shows}"
 
 
-def _runs_of(path: Path, readers: dict[str, LogReader]) -> tuple[str, ...]:
-    """The runs a figure file shows: its own record (analysis.figure_files.FigureFile), else
-    (a plug-in's bare path) the run whose file stem begins its name, the longest one."""
-    runs = getattr(path, "runs", None)
-    if runs is not None and (runs or type(path).__name__ == "FigureFile"):
-        return tuple(runs)
-    match = [k for k in readers if path.stem.startswith(file_stem(k))]
-    return (max(match, key=len),) if match else ()
-
-
 def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/logs") -> Path:
     """Write the report to the folder ``out`` (replaced whole once the new report is complete:
     only a folder the report made, an empty or a new one, else :class:`ReportFolderError`
@@ -198,7 +188,7 @@ def _build(out: Path, logs_dir: Path) -> None:
             shown: set[str] = set()
             for png in (p for p in paths if p.suffix == ".png"):
                 svg = png.with_suffix(".svg")
-                runs = _runs_of(png, readers)
+                runs = runs_of(png, readers)
                 shown.update(runs)
                 sec.figures.append(
                     Figure(

@@ -65,12 +65,12 @@ def test_every_caption_names_the_runs_its_figure_shows(logs, tmp_path):
 
 
 def test_a_plugin_returning_bare_paths_is_captioned_by_the_longest_name():
-    from replay.report.builder import _runs_of
+    from analysis.figure_files import runs_of
 
     readers = dict.fromkeys(["stick_3step", "stick_3step_mu0"])
-    assert _runs_of(Path("x/stick_3step_mu0_fig7.png"), readers) == ("stick_3step_mu0",)
-    assert _runs_of(Path("x/stick_3step_fig7.png"), readers) == ("stick_3step",)
-    assert _runs_of(Path("x/other.png"), readers) == ()
+    assert runs_of(Path("x/stick_3step_mu0_fig7.png"), readers) == ("stick_3step_mu0",)
+    assert runs_of(Path("x/stick_3step_fig7.png"), readers) == ("stick_3step",)
+    assert runs_of(Path("x/other.png"), readers) == ()
 
 
 def test_a_variant_is_captioned_with_its_label_and_no_log_is_lost(logs, tmp_path):
