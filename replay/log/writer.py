@@ -282,19 +282,30 @@ def _what(mode: int) -> str | None:
 def check_output(path: Path, *, kind: str = "log", magic: bytes | None = MAGIC) -> None:
     """Raise :class:`LogError` when ``path`` cannot take a log (or another ``kind`` of output):
     a folder, anything but a regular file (a device, a FIFO, a socket: checked without opening
-    it, which would block on a FIFO), an existing file that does not start with ``magic`` or is
-    empty, a parent that is not a folder, cannot be made or takes no files."""
+    it, which would block on a FIFO), a symbolic link (dangling or not: an output is never
+    written through one), an existing file that does not start with ``magic`` or is empty, a
+    parent that is not a folder, cannot be made or takes no files. The output itself is then
+    written beside ``path`` and renamed onto it (:func:`write_output`, ``LogWriter``), which
+    never follows a link planted after this check."""
+    link = os.path.islink(path)
     try:
         st = os.stat(path)
     except (FileNotFoundError, NotADirectoryError):
         st = None  # (a parent that is a file: said below)
     except OSError as exc:
-        raise LogError(f"cannot write {kind} {path}: {exc.strerror}") from None
+        if not link:  # (a link's loop: said below)
+            raise LogError(f"cannot write {kind} {path}: {exc.strerror}") from None
+        st = None
     if st is not None and stat.S_ISDIR(st.st_mode):
         raise LogError(f"cannot write {kind} {path}: it is a folder (give a file name)")
     if st is not None and _what(st.st_mode):
         raise LogError(
             f"will not write {kind} {path}: it is {_what(st.st_mode)}, not a regular file"
+        )
+    if link:
+        raise LogError(
+            f"will not write {kind} {path} through a symbolic link (to {os.readlink(path)}); "
+            "remove the link or give another path"
         )
     if st is not None and magic is not None:
         what = "an MCAP log" if magic == MAGIC else f"an earlier {kind} (a file starting {magic!r})"
@@ -325,6 +336,22 @@ def check_output(path: Path, *, kind: str = "log", magic: bytes | None = MAGIC) 
         raise LogError(
             f"cannot write {kind} {path}: folder {parent} takes no files ({exc.strerror})"
         ) from None
+
+
+def write_output(path: Path, write, *, mode: int = 0o644) -> None:
+    """``write(tmp)`` makes the output in a new file of its own beside ``path`` (``tmp``, a
+    path), which then replaces ``path`` whole: never a write through a link or into a file
+    this command did not make (a hard link, one planted after :func:`check_output`); nothing
+    left behind when ``write`` raises."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 def _identity(path: Path) -> tuple[int, int, int, int] | None:
