@@ -9,6 +9,7 @@ The file says who holds it (process, command, start time) for the refusal's one 
 from __future__ import annotations
 
 import os
+import stat
 import sys
 import time
 from pathlib import Path
@@ -49,12 +50,27 @@ class FolderLock:
         self._fd: int | None = None
 
     def __enter__(self) -> "FolderLock":
+        # never through a link: a folder shipped with sweep.lock -> a file of yours would have
+        # it truncated (O_NOFOLLOW: ELOOP); nor a FIFO, a device or a hard link's other name
+        flags = os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
         try:
-            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            fd = os.open(self.path, flags, 0o644)
         except OSError as exc:
+            if os.path.islink(self.path):
+                raise SweepOutputError(
+                    f"will not use sweep folder {self.folder}: its {LOCK} is a symbolic link "
+                    f"(to {os.readlink(self.path)}); remove it"
+                ) from None
             raise SweepOutputError(
                 f"cannot use sweep folder {self.folder}: {exc.strerror or exc}"
             ) from None
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_nlink != 1:
+            os.close(fd)
+            what = "has other names (hard links)" if stat.S_ISREG(st.st_mode) else "is no file"
+            raise SweepOutputError(
+                f"will not use sweep folder {self.folder}: its {LOCK} {what}; remove it"
+            )
         if fcntl is not None:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)

@@ -39,6 +39,18 @@ class TableError(Exception):
         self.code = code
 
 
+def refuse_link(path: Path) -> None:
+    """:class:`TableError` (exit 2) when ``path`` is a symbolic link: a sweep's table, its
+    stale rows and its logs folder are never read or written through one (a folder shipped
+    with ``table.csv -> ~/notes`` would have the notes read as rows and copied)."""
+    if os.path.islink(path):
+        raise TableError(
+            f"will not write {path} through a symbolic link (to {os.readlink(path)}); "
+            "remove the link or give another -o",
+            2,
+        )
+
+
 def param_columns(row: dict[str, Any]) -> list[str]:
     """The varied parameters' columns of a row read back (everything but the fixed columns and
     the metrics)."""
@@ -50,6 +62,7 @@ def write_table(path: str | Path, rows: Iterable[dict[str, Any]], params: list[s
     """Write ``rows`` to ``path`` atomically (a temporary file of this writer's own, replacing
     ``path`` only once whole); :class:`TableError` when it cannot, nothing left behind."""
     path = Path(path)
+    refuse_link(path)
     rows = sorted(rows, key=lambda r: int(r["index"]))
     metrics = sorted({k for r in rows for k in r if str(k)[:2] in ("m.", "x.", "e.")})
     columns = FIRST + [p for p in params if p not in LAST + TAIL] + LAST + metrics + TAIL
