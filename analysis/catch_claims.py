@@ -216,7 +216,9 @@ class CatchRun:
 
 def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     sc = _scenario(log)
-    typed = scenario_from_text(log.scenario()["yaml"], name=f"{log.path.name}:/scenario")
+    typed = scenario_from_text(
+        log.scenario()["yaml"], name=f"{log.path.name}:/scenario", plugins="known-only"
+    )
     eff = [m for m in log.series(TOPIC_EFFECTOR_STATE) if m["desired_position"] and m["position"]]
     cmd = log.series(TOPIC_ARM_JOINT_COMMAND)
     cmd_t = {round(m["t"], 9): m for m in cmd}

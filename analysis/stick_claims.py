@@ -190,7 +190,8 @@ def _not_run(quantity: str, stated: str, name: str, kind: str = "measured") -> C
 
 
 def _params(log: LogReader) -> AirTableParams:
-    plant = scenario_from_text(log.scenario()["yaml"]).plant.params  # typed by the loader
+    text = log.scenario()["yaml"]
+    plant = scenario_from_text(text, plugins="known-only").plant.params  # typed by the loader
     assert isinstance(plant, AirTableParams)
     return plant
 
@@ -354,7 +355,7 @@ def _params_ctrl(log: LogReader) -> dict:
 
 def _captured_row(log: LogReader, name: str, st: dict) -> Claim:
     o = _outcome(log)
-    dur = scenario_from_text(log.scenario()["yaml"]).timing.duration
+    dur = scenario_from_text(log.scenario()["yaml"], plugins="known-only").timing.duration
     t_stated = st["results"]["t_stopped"]["value"]
     if o.get("captured"):
         t = o["t_capture"]
