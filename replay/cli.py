@@ -371,7 +371,7 @@ def validate(scenarios, sets, static):
                 click.echo(f"error: {one_line(_refusal(p, exc))}", err=True)
                 bad += 1
                 continue
-        click.echo(f"ok: {p}")
+        say(f"ok: {p}")
     if bad:
         sys.exit(2)
 

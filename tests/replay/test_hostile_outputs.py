@@ -377,3 +377,11 @@ def test_claims_escapes_a_hostile_name_in_markdown_and_on_the_terminal(base_log,
     text = table.read_text()
     assert "&lt;script&gt;" in text and "<script" not in text
     assert not CONTROL.search(text)
+
+
+def test_validate_names_a_hostile_file_name_without_its_escapes(tmp_path):
+    path = tmp_path / "a\x1b]0;PWNED\x07\rb.yaml"
+    path.write_text("extends: stick_3step\n", encoding="utf-8")
+    r = invoke("validate", "--static", path)
+    assert r.exit_code == 0, r.output
+    assert r.stdout.startswith("ok: ") and not CONTROL.search(r.stdout.rstrip("\n")), repr(r.stdout)
