@@ -1,14 +1,16 @@
 """A run's log in Rerun's viewer with a ready layout: ``replay rerun LOG [--web] [--port N]``
 (docs/foxglove.md, "Rerun"). Needs the optional extra: ``pip install 'paper-replay[rerun]'``.
 
-Converts the log with ``rerun mcap convert`` (next to it, ``NAME.rrd``) on a *duration*
-timeline, so that Rerun's time axis reads the run's simulated seconds (not dates in 1970);
-writes a blueprint (``NAME.rbl``: a 3-D view in the ``world`` frame, each camera's images, the
-/log lines) and opens both in Rerun's viewer: native, or with ``--web`` its web viewer served on
-127.0.0.1. The viewer runs in a process group of its own, and every process of that group (the
-web server and whatever it started) is stopped when the command ends, however it ends.
+Converts the log with ``rerun mcap convert`` (``NAME.rrd``) on a *duration* timeline, so that
+Rerun's time axis reads the run's simulated seconds (not dates in 1970); writes a blueprint
+(``NAME.rbl``: a 3-D view in the ``world`` frame, each camera's images, the /log lines) and opens
+both in Rerun's viewer: native, or with ``--web`` its web viewer served on 127.0.0.1. Both files
+go in a private temporary folder, removed at the end (nothing is written beside the log). The
+viewer runs in a process group of its own, and every process of that group (the web server and
+whatever it started) is stopped when the command ends: closed, Ctrl-C, SIGTERM or SIGHUP.
 ``--shot FILE`` (with ``--web``) screenshots the web viewer with Debian's chromium (Playwright,
-shared/BROWSER-TESTS.md); ``--at T`` converts the log only up to T seconds.
+shared/BROWSER-TESTS.md), FILE checked as any output (a new file or an earlier PNG, never a
+link); ``--at T`` converts the log only up to T seconds.
 """
 
 from __future__ import annotations
@@ -19,6 +21,8 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 from pathlib import Path
 from typing import Iterator
@@ -26,6 +30,10 @@ from urllib.parse import quote
 
 APP_ID = "paper-replay"
 EXTRA = "pip install 'paper-replay[rerun]'"
+RRD_MAGIC = b"RRF2"  # what a Rerun recording or blueprint starts with
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+# what ends the command as Ctrl-C does: `kill`, `timeout`, a closed terminal
+STOP_SIGNALS = (signal.SIGTERM, *([signal.SIGHUP] if hasattr(signal, "SIGHUP") else []))
 STOP_GRACE = 5.0  # s between SIGTERM and SIGKILL of the viewer's process group
 CHROMIUM_FLAGS = [
     "--headless=new",
@@ -45,11 +53,20 @@ class RerunError(Exception):
 
 
 def rerun_cli() -> str:
-    """The ``rerun`` executable of rerun-sdk (beside this Python first); RerunError if absent."""
+    """The ``rerun`` executable of rerun-sdk: its binary itself (the ``rerun`` script runs it as
+    a child of its own, which would outlive a ``kill -9`` of this command: see
+    :func:`_die_with_parent`), else the script beside this Python or on PATH; RerunError if
+    absent."""
     try:
         import rerun  # noqa: F401
     except ImportError:
         raise RerunError(f"Rerun is not installed: {EXTRA}") from None
+    with contextlib.suppress(ImportError):
+        import rerun_cli
+
+        binary = Path(rerun_cli.__file__).with_name("rerun")  # (where its script finds it)
+        if "RERUN_CLI_PATH" not in os.environ and os.access(binary, os.X_OK):
+            return str(binary)
     local = Path(sys.executable).with_name("rerun")
     found = str(local) if local.exists() else shutil.which("rerun")
     if not found:
@@ -65,8 +82,23 @@ def convert_command(log: Path, rrd: Path, at: float | None = None) -> list[str]:
     return cmd
 
 
-def convert(log: Path, at: float | None = None) -> Path:
-    rrd = log.with_suffix(".rrd")
+def _output(log: Path, folder: Path | None, suffix: str) -> Path:
+    """``folder/NAME.SUFFIX``; with no folder, beside the log, checked as any output (a new
+    file or an earlier Rerun file, never a link)."""
+    path = (folder / log.name if folder else log).with_suffix(suffix)
+    if folder is None:
+        from replay.log import LogError
+        from replay.log.writer import check_output
+
+        try:
+            check_output(path, kind="Rerun file", magic=RRD_MAGIC)
+        except LogError as exc:
+            raise RerunError(str(exc)) from None
+    return path
+
+
+def convert(log: Path, at: float | None = None, folder: Path | None = None) -> Path:
+    rrd = _output(log, folder, ".rrd")
     r = subprocess.run(convert_command(log, rrd, at), capture_output=True, text=True)
     if r.returncode != 0:
         last = (r.stderr.strip().splitlines() or ["(no message)"])[-1]
@@ -88,7 +120,7 @@ def robot_name(log: Path) -> str | None:
     return None
 
 
-def blueprint(log: Path) -> Path:
+def blueprint(log: Path, folder: Path | None = None) -> Path:
     import rerun as rr
     import rerun.blueprint as rrb
 
@@ -122,7 +154,7 @@ def blueprint(log: Path) -> Path:
         rrb.TimePanel(state="collapsed", play_state="paused"),
         collapse_panels=True,
     )
-    rbl = log.with_suffix(".rbl")
+    rbl = _output(log, folder, ".rbl")
     bp.save(APP_ID, str(rbl))
     return rbl
 
@@ -168,11 +200,39 @@ def stop_group(proc: subprocess.Popen, grace: float = STOP_GRACE) -> None:
 def running(cmd: list[str], quiet: bool = True) -> Iterator[subprocess.Popen]:
     """``cmd`` in a process group of its own, stopped with all it started on leaving."""
     out = subprocess.DEVNULL if quiet else None
-    proc = subprocess.Popen(cmd, stdout=out, stderr=out, start_new_session=True)
+    proc = subprocess.Popen(
+        cmd, stdout=out, stderr=out, start_new_session=True, preexec_fn=_die_with_parent()
+    )
     try:
         yield proc
     finally:
-        stop_group(proc)
+        held = {signal.SIGINT, *STOP_SIGNALS}
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)  # (none interrupts the stop)
+        try:
+            stop_group(proc)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _die_with_parent():
+    """On Linux, a function for the child (``preexec_fn``) that has the kernel send it SIGTERM
+    when this process dies, ``kill -9`` included (``prctl(PR_SET_PDEATHSIG)``); else None."""
+    if not sys.platform.startswith("linux"):
+        return None
+    import ctypes
+
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return None
+    parent = os.getpid()
+
+    def child() -> None:
+        prctl(1, int(signal.SIGTERM), 0, 0, 0)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent:  # (died before that: nobody will send it)
+            os._exit(1)
+
+    return child
 
 
 def screenshot(url: str, out: Path, wait: float) -> None:
@@ -188,8 +248,11 @@ def screenshot(url: str, out: Path, wait: float) -> None:
         for fraction in (0.5, 0.98):  # the first click may only wake the (busy) viewer
             page.mouse.click(350 + fraction * (1172 - 350), 786)
             time.sleep(wait / 4)
-        page.screenshot(path=str(out), timeout=180_000)
+        png = page.screenshot(timeout=180_000)
         browser.close()
+    from replay.log.writer import write_output
+
+    write_output(out, lambda tmp: tmp.write_bytes(png))  # (never through a link)
 
 
 def view(
@@ -202,17 +265,59 @@ def view(
     wait: float = 40.0,
     echo=print,
 ) -> None:
-    """Convert ``log``, write its blueprint, and show both until the viewer (or Ctrl-C) ends."""
+    """Convert ``log``, write its blueprint (both in a private temporary folder), and show them
+    until the viewer (or Ctrl-C, SIGTERM, SIGHUP) ends; then the viewer's processes are stopped
+    and the folder removed. SIGTERM and SIGHUP end the command with 128 + the signal's number."""
     if shot is not None and not web:
         raise RerunError("--shot needs --web")
-    rrd, rbl = convert(log, at), blueprint(log)
-    with running(viewer_command(rrd, rbl, web, port), quiet=web) as proc:
-        if shot is not None:
-            time.sleep(2.0)
-            screenshot(web_url(port), shot, wait)
-            echo(str(shot))
-            return
-        if web:
-            echo(web_url(port))
-        with contextlib.suppress(KeyboardInterrupt):
-            proc.wait()
+    if shot is not None:  # (before anything starts)
+        from replay.log import LogError
+        from replay.log.writer import check_output
+
+        try:
+            check_output(shot, kind="screenshot", magic=PNG_MAGIC)
+        except LogError as exc:
+            raise RerunError(str(exc)) from None
+    waiting = False
+    with _signals_as_interrupt() as came, tempfile.TemporaryDirectory(prefix="replay-rerun-") as d:
+        try:
+            rrd, rbl = convert(log, at, Path(d)), blueprint(log, Path(d))
+            with running(viewer_command(rrd, rbl, web, port), quiet=web) as proc:
+                if shot is not None:
+                    time.sleep(2.0)
+                    screenshot(web_url(port), shot, wait)
+                    echo(str(shot))
+                    return
+                if web:
+                    echo(web_url(port))
+                waiting = True
+                proc.wait()
+        except KeyboardInterrupt:
+            if not (came or waiting):
+                raise
+            # (Ctrl-C while the viewer shows: it closed, as its own window's close would)
+    if came:
+        raise SystemExit(128 + came[0])
+
+
+@contextlib.contextmanager
+def _signals_as_interrupt() -> Iterator[list[int]]:
+    """SIGTERM and SIGHUP (``kill``, ``timeout``, a closed terminal) take Ctrl-C's path: the
+    viewer's process group is stopped, the temporary folder removed. Yields the signals that
+    came (in the main thread only; elsewhere Python cannot handle signals)."""
+    came: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield came
+        return
+
+    def handler(signum, frame) -> None:
+        came.append(signum)
+        if len(came) == 1:  # (a second one while the first is handled: the same stop)
+            raise KeyboardInterrupt
+
+    old = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
+    try:
+        yield came
+    finally:
+        for sig, h in old.items():
+            signal.signal(sig, h)
