@@ -37,6 +37,7 @@ class UnknownPlugin(LookupError):
 
 _registered: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}
 _imported: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}  # module:Class names
+_folders: dict[tuple[str, str], str] = {}  # (kind, module:Class) -> the folder it came from
 
 IMPORT_PATH = r"[A-Za-z_]\w*(\.[A-Za-z_]\w*)*:[A-Za-z_]\w*(\.[A-Za-z_]\w*)*"  # module:Class
 _IMPORT_PATH = re.compile(IMPORT_PATH)
@@ -126,7 +127,14 @@ def import_plugin(kind: str, name: str, folder: str | Path) -> type:
     if not hasattr(obj, "Params"):
         raise UnknownPlugin(f"{kind} {name!r} declares no Params dataclass")
     _imported[kind][name] = obj
+    _folders[(kind, name)] = where
     return obj
+
+
+def imported_plugins() -> list[tuple[str, str, str]]:
+    """(kind, ``module:Class``, folder) of every plug-in this process imported by its path: what
+    a fresh worker process (a Ray worker of a sweep) imports again before it loads a variant."""
+    return [(kind, name, folder) for (kind, name), folder in _folders.items()]
 
 
 def _first(exc: BaseException) -> str:

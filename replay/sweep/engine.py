@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable
 
+from replay import registry
 from replay.sweep.executors import WORKER_DIED, default_workers, run_local, run_ray
 from replay.sweep.lock import FolderLock, SweepOutputError
 from replay.sweep.table import as_bool, param_columns, read_table, refuse_link, write_table
@@ -213,6 +214,7 @@ def _run_locked(
     if stale:
         _set_aside(out_dir / STALE, stale)
     todo = [v for v in variants if v.key not in rows]
+    plugins = registry.imported_plugins()  # (the planning imported them)
     workers = workers or default_workers()
     tasks = [
         {
@@ -224,6 +226,7 @@ def _run_locked(
             if keep_logs
             else "",
             "cwd": os.getcwd(),
+            "plugins": plugins,  # module:Class plug-ins to import again in a fresh worker
             "metrics": metrics,
         }
         for v in todo

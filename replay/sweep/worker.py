@@ -40,8 +40,11 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     from replay.runner import RunInterrupted, Runner
 
     try:
+        from replay import registry
         from replay.scenario.loader import scenario_from_text
 
+        for kind, name, folder in task.get("plugins", ()):  # (a forked worker has them already)
+            registry.import_plugin(kind, name, folder)
         sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>")
         if log:
             Path(log).parent.mkdir(parents=True, exist_ok=True)
