@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replay.params import check_limit
+
 
 @dataclass(frozen=True)
 class Intrinsics:
@@ -193,3 +195,9 @@ class PinholeCamera:
     def backproject_to_height(self, pixels, z: float = 0.0) -> np.ndarray:
         """World points where the pixels' rays meet the horizontal plane at height ``z`` (m)."""
         return self.backproject_to_plane(pixels, point=(0.0, 0.0, z), normal=(0.0, 0.0, 1.0))
+
+
+def check_image_size(width: int, height: int) -> None:
+    """A camera's ``Params.__post_init__``: its image under the ``camera_pixels`` limit (a
+    ParamError at ``width``, checked before any frame is allocated; docs/security.md)."""
+    check_limit("camera_pixels", width * height, "width", f"a {width} x {height} image")

@@ -71,9 +71,14 @@ import numpy as np
 from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_OBJECT, VisionObject
-from replay.params import ParamError, check_limit, param
+from replay.params import ParamError, param
 from replay.scene import Scene, Sphere
-from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
+from replay.sensors.pinhole import (
+    Intrinsics,
+    PinholeCamera,
+    check_image_size,
+    look_at_rotation,
+)
 from replay.accel import accelerator
 from replay.sensors.raster import composite, quantise
 from replay.sensors.silhouette import correct_sphere_centroid, drawables, render_views
@@ -183,12 +188,7 @@ class StereoBallCameraParams:
     )
 
     def __post_init__(self) -> None:
-        check_limit(
-            "camera_pixels",
-            self.width * self.height,
-            "width",
-            f"a {self.width} x {self.height} image",
-        )
+        check_image_size(self.width, self.height)
         for i, (eye, target) in enumerate(
             ((self.cam0_position, self.cam0_target), (self.cam1_position, self.cam1_target))
         ):

@@ -61,10 +61,10 @@ import numpy as np
 from replay.foxglove.image import WindowedImage
 from replay.interfaces import Sensor
 from replay.messages import TOPIC_VISION_STICK, VisionStick
-from replay.params import ParamError, check_limit, param
+from replay.params import ParamError, param
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import quaternion_matrix, wrap_half_pi
-from replay.sensors.pinhole import PinholeCamera, look_at_rotation
+from replay.sensors.pinhole import PinholeCamera, check_image_size, look_at_rotation
 from replay.accel import accelerator
 from replay.sensors.silhouette import project_hull
 from replay.sensors.raster import composite, quantise
@@ -324,12 +324,7 @@ class StickCameraParams:
     )
 
     def __post_init__(self) -> None:
-        check_limit(
-            "camera_pixels",
-            self.width * self.height,
-            "width",
-            f"a {self.width} x {self.height} image",
-        )
+        check_image_size(self.width, self.height)
         try:
             look_at_rotation(self.position, self.target, self.up)
         except ValueError as exc:

@@ -27,9 +27,9 @@ import numpy as np
 
 from replay.messages import TOPIC_VISION_CHIP, VisionChip, pack_rows
 from replay.interfaces import Sensor
-from replay.params import check_limit, param
+from replay.params import param
 from replay.scene import Scene
-from replay.sensors.pinhole import Intrinsics, PinholeCamera
+from replay.sensors.pinhole import Intrinsics, PinholeCamera, check_image_size
 from replay.accel import accelerator
 from replay.sensors.silhouette import render
 
@@ -70,12 +70,7 @@ class VisionChipParams:
     )
 
     def __post_init__(self) -> None:
-        check_limit(
-            "camera_pixels",
-            self.width * self.height,
-            "width",
-            f"a {self.width} x {self.height} image",
-        )
+        check_image_size(self.width, self.height)
 
 
 class VisionChipSensor(Sensor):
