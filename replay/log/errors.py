@@ -8,8 +8,8 @@ class LogError(Exception):
 
 
 class LogLimitError(LogError, LimitError):
-    """A log holds more than a reader will load (a chunk or message over ``message_bytes``):
-    one line naming the limit and its environment variable."""
+    """A log holds more than a reader will load (a chunk or message over ``message_bytes``, a
+    topic over ``series_bytes``): one line naming the limit and its environment variable."""
 
 
 class NotALogError(LogError):

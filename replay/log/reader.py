@@ -14,10 +14,14 @@ A reader loads at most ``message_bytes`` (:mod:`replay.limits`) at once: a chunk
 uncompressed size is over it, or a record the file holds whole that is, is refused
 (:class:`LogLimitError`, one line) before anything is read or decompressed, and a chunk is
 decompressed no further than its stated size (a zstd frame may claim any size of its own).
+What it decodes and keeps of one topic (:meth:`LogReader.series`, the events) is at most
+``series_bytes`` as stored, and the ``/scenario`` message's fields are typed and clipped
+(:meth:`LogReader.scenario`): a log's tiny compressed bytes cannot make it keep gigabytes.
 """
 
 from __future__ import annotations
 
+import hashlib
 import heapq
 import io
 import json
@@ -141,6 +145,39 @@ class RawMessage:
     @property
     def t(self) -> float:
         return self.t_ns * 1e-9
+
+
+TEXT_CHARS = 200  # a log's scenario name, paper or version: at most this long (clipped)
+DESCRIPTION_CHARS = 2000
+_TEXTS = {  # the /scenario message's text fields, and how long each may be (None: any)
+    "name": TEXT_CHARS,
+    "paper": TEXT_CHARS,
+    "yaml": None,  # (within scenario_bytes: its reader checks that)
+    "version": TEXT_CHARS,
+    "description": DESCRIPTION_CHARS,  # (the stored scenario's)
+}
+
+
+def clip(text: str, chars: int) -> str:
+    """``text`` if at most ``chars`` characters long, else its start, "…" and a short hash of
+    the whole, ``chars`` long at most: two long names that start alike stay two names."""
+    if len(text) <= chars:
+        return text
+    digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:10]
+    return f"{text[: chars - 40]}…{digest}"
+
+
+def _fields(data: dict) -> dict:
+    """A ``/scenario`` message's fields of their types (as :meth:`LogReader.scenario` says)."""
+    out: dict[str, Any] = {}
+    for key, chars in _TEXTS.items():
+        value = data.get(key)
+        if isinstance(value, str):
+            out[key] = value if chars is None else clip(value, chars)
+    seed = data.get("seed")
+    if type(seed) is int and 0 <= seed <= 2**63 - 1:
+        out["seed"] = seed
+    return out
 
 
 def _decode(data: bytes) -> dict | None:
@@ -282,17 +319,27 @@ class LogReader:
 
     def _check_size(self, size: int, what: str) -> None:
         """LogLimitError if ``size`` bytes (of ``what``) are over ``message_bytes``."""
+        self._check("message_bytes", size, f"{self.path}: {what}")
+
+    @staticmethod
+    def _limit(name: str) -> int:
+        """:func:`replay.limits.limit`, raising :class:`LogLimitError` (a bad variable)."""
         try:
-            check("message_bytes", size, f"{self.path}: {what}")
+            return limit(name)
+        except LimitError as exc:
+            raise LogLimitError(str(exc)) from None
+
+    @staticmethod
+    def _check(name: str, size: int, what: str) -> None:
+        """:func:`replay.limits.check`, raising :class:`LogLimitError`."""
+        try:
+            check(name, size, what)
         except LimitError as exc:
             raise LogLimitError(str(exc)) from None
 
     def _record_cap(self) -> int:
         """The longest record a reader loads: ``message_bytes`` and a header."""
-        try:
-            return limit("message_bytes") + _RECORD_HEAD
-        except LimitError as exc:
-            raise LogLimitError(str(exc)) from None
+        return self._limit("message_bytes") + _RECORD_HEAD
 
     def _walk(self, f, *, validate: bool, chunks: bool = True) -> Iterator[Any]:
         """The records of ``f`` in file order, each chunk's broken up (``chunks``) or as it is;
@@ -472,15 +519,20 @@ class LogReader:
         Only channels of JSON messages are read (others, e.g. protobuf, are for other tools);
         messages on them that are not JSON objects are skipped (and counted in ``problems``)."""
         wanted = None if topics is None else ({topics} if isinstance(topics, str) else set(topics))
+        for topic, t_ns, data in self._json(wanted):
+            item = self._message(topic, t_ns, data)
+            if item is not None:
+                yield item
+
+    def _json(self, wanted) -> Iterator[tuple[str, int, bytes]]:
+        """(topic, log time, stored bytes) of the JSON channels' messages, in the order
+        :meth:`messages` says, undecoded."""
         if self._summary is None or not self._summary.chunk_indexes:
             yield from self._stream(wanted)
             return
         for _, channel, msg in self._indexed(wanted):
-            if channel.message_encoding != "json":
-                continue  # e.g. Foxglove's protobuf channels: not JSON payloads
-            item = self._message(channel.topic, msg.log_time, msg.data)
-            if item is not None:
-                yield item
+            if channel.message_encoding == "json":  # (not e.g. Foxglove's protobuf channels)
+                yield channel.topic, msg.log_time, msg.data
 
     def _message(self, topic: str, t_ns: int, data: bytes) -> LogMessage | None:
         value = _decode(data)
@@ -506,7 +558,7 @@ class LogReader:
                 except Exception:  # noqa: BLE001 - the torn or damaged tail: stop there
                     return
 
-    def _stream(self, wanted) -> Iterator[LogMessage]:
+    def _stream(self, wanted) -> Iterator[tuple[str, int, bytes]]:
         channels: dict[int, str] = {}  # the JSON channels' topics
         for record in self._records():
             if isinstance(record, Channel):
@@ -515,9 +567,7 @@ class LogReader:
             elif isinstance(record, Message):
                 topic = channels.get(record.channel_id)
                 if topic is not None and (wanted is None or topic in wanted):
-                    item = self._message(topic, record.log_time, record.data)
-                    if item is not None:
-                        yield item
+                    yield topic, record.log_time, record.data
 
     def raw(self, topics: Iterable[str] | str | None = None) -> Iterator[RawMessage]:
         """The messages of the channels that are not JSON, undecoded, in log-time order (file
@@ -560,8 +610,18 @@ class LogReader:
                     )
 
     def series(self, topic: str) -> list[dict]:
-        """All payloads of one topic, in order."""
-        return [m.data for m in self.messages(topic)]
+        """All payloads of one topic, in order: at most ``series_bytes`` of them as stored,
+        counted as they are read, before each is decoded (:class:`LogLimitError` past it)."""
+        cap, out, stored = self._limit("series_bytes"), [], 0
+        for name, t_ns, data in self._json({topic}):
+            stored += len(data)
+            if stored > cap:
+                what = f"{self.path}: its {topic} topic (as stored, read so far)"
+                self._check("series_bytes", stored, what)
+            item = self._message(name, t_ns, data)
+            if item is not None:
+                out.append(item.data)
+        return out
 
     # -- summary --------------------------------------------------------------------------
     def topic_counts(self) -> dict[str, int]:
@@ -599,12 +659,17 @@ class LogReader:
         return out
 
     def scenario(self) -> dict:
-        """The ``/scenario`` message (name, paper, yaml, seed, version), its YAML checked as
-        :meth:`scenario_config` says (a :class:`LogError` if it is not)."""
+        """The ``/scenario`` message's fields, bounded and typed (the one place analysis,
+        report, figures and ``info`` get them): ``name``, ``paper``, ``version`` text of at most
+        :data:`TEXT_CHARS` characters and ``description`` (the stored scenario's) of
+        :data:`DESCRIPTION_CHARS`, longer ones :func:`clip`-ped; ``seed`` an integer from 0 to
+        2^63 - 1; ``yaml`` checked as :meth:`scenario_config` says (a :class:`LogError` if it
+        is not, or if there is no message). A field that is not of its type (a seed that is
+        text, a name that is a list) is left out, as one the message lacks: ``.get`` says None."""
         if self._scenario is None:
             for m in self.messages(TOPIC_SCENARIO):
                 self._config = self._stored_config(m.data.get("yaml", ""))
-                self._scenario = m.data
+                self._scenario = _fields({**m.data, "description": self._config.get("description")})
                 break
             else:
                 raise LogError(f"{self.path}: no /scenario message")
