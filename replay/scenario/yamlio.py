@@ -55,11 +55,22 @@ class ScenarioError(Exception):
         super().__init__(f"{self.where}: {self.path + ': ' if self.path else ''}{self.message}")
 
 
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+# what a terminal must not be handed raw: control characters (C0, DEL, C1), line and paragraph
+# separators, lone surrogates, and the format characters (Unicode category Cf: bidi overrides
+# and isolates such as U+202E, zero-width characters, soft hyphen, tags), which reorder or hide
+# what is shown; the Cf ranges are Unicode 15's (tests check them against unicodedata)
+_CONTROL = re.compile(
+    "[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff"
+    "\u00ad\u0600-\u0605\u061c\u06dd\u070f\u0890\u0891\u08e2\u180e\u200b-\u200f"
+    "\u202a-\u202e\u2060-\u2064\u2066-\u206f\ufeff\ufff9-\ufffb\U000110bd\U000110cd"
+    "\U00013430-\U0001343f\U0001bca0-\U0001bca3\U0001d173-\U0001d17a\U000e0001"
+    "\U000e0020-\U000e007f]"
+)
 
 
 def one_line(text: str) -> str:
-    """``text`` with line breaks and control characters escaped: an error is one line."""
+    """``text`` with line breaks, control and format characters escaped (``\\u202e``): an
+    error is one line, and a log's text cannot reorder, hide or restyle what a terminal shows."""
     return _CONTROL.sub(lambda m: repr(m.group())[1:-1], str(text))
 
 
