@@ -26,11 +26,35 @@ def url(path: str) -> str:
 
 def md(text) -> str:
     """Markdown text: one line, no raw HTML (``< > &`` as entities), no link, code or table
-    syntax (backslash-escaped)."""
+    syntax (backslash-escaped), and no autolink where GitHub renders it (GFM's extension links
+    bare ``https://...``, ``www.x`` and ``a@b.c``): :func:`no_autolink`."""
     text = _MD_SPECIAL.sub(
         lambda m: _MD_ENTITY.get(m.group(), "\\" + m.group()), one_line(str(text))
     )
-    return text.replace("\\](", "\\]\\(")  # (no "](" left to read as a link's target)
+    text = text.replace("\\](", "\\]\\(")  # (no "](" left to read as a link's target)
+    return no_autolink(text)
+
+
+_WWW = re.compile(r"(?<![A-Za-z0-9])(www)\.", re.IGNORECASE)
+
+
+def no_autolink(text: str) -> str:
+    """Markdown ``text`` in which GitHub's autolink extension finds no link (checked with
+    cmark-gfm, GitHub's parser): the ``:`` of ``://`` and the ``.`` of ``www.``
+    backslash-escaped (the extension looks for them in the source, not in escapes); after
+    ``@`` a zero-width space (``&#8203;``), since e-mail autolinks (``a@b.c``, ``mailto:``,
+    ``xmpp:``) are found in the parsed text, where an escape of ``@`` no longer shows (it also
+    keeps ``@name`` from reading as a GitHub mention). The rendered text reads the same."""
+    text = text.replace("://", "\\://")
+    text = _WWW.sub(lambda m: m.group(1) + "\\.", text)
+    return text.replace("@", "@&#8203;")
+
+
+def pre(lines) -> str:
+    """An HTML ``<pre>`` block of ``lines`` (commands), each on its one line (line breaks and
+    control characters in it escaped as ``\\n``...: a name holding a line break never shows
+    as a command line of its own), HTML-escaped."""
+    return "<pre>" + e("\n".join(one_line(str(line)) for line in lines)) + "</pre>"
 
 
 def md_code(text) -> str:
