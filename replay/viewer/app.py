@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import io
+import ipaddress
 import socket
 import threading
 import time
@@ -34,17 +35,22 @@ FIT_DISTANCE = 1.1  # the camera's distance from the fitted box's centre, in box
 
 
 def _can_bind(host: str, port: int) -> OSError | None:
+    """Why asyncio's ``create_server`` (viser's) could not listen on ``host:port``, or None: it
+    binds every address the name resolves to, IPv6 ones IPv6-only (so ``::ffff:0.0.0.0``, an
+    IPv4-mapped address, cannot be bound; viser would retry 1000 ports and hang)."""
     try:
-        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
     except socket.gaierror as exc:
         return exc
-    family, _, _, _, addr = infos[0]
-    with socket.socket(family, socket.SOCK_STREAM) as s:
-        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as asyncio's server does
-        try:
-            s.bind(addr)
-        except OSError as exc:
-            return exc
+    for family, _, _, _, addr in dict.fromkeys(infos):
+        with socket.socket(family, socket.SOCK_STREAM) as s:
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as asyncio's server does
+            if family == socket.AF_INET6:
+                s.setsockopt(socket.IPPROTO_IPV6, socket.IPV6_V6ONLY, 1)
+            try:
+                s.bind(addr)
+            except OSError as exc:
+                return exc
     return None
 
 
@@ -53,7 +59,12 @@ def free_port(host: str, port: int) -> tuple[int, str]:
     Port 0 lets the system choose. Raises :class:`ViewerError` for a host we cannot bind."""
     err = _can_bind(host, 0)
     if err is not None:
-        raise ViewerError(f"cannot listen on host {host!r}: {err.strerror or err}")
+        hint = ""
+        with contextlib.suppress(ValueError):
+            ip = ipaddress.ip_address(host.strip("[]"))
+            if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
+                hint = f" (an IPv4-mapped address: give {ip.ipv4_mapped} instead)"
+        raise ViewerError(f"cannot listen on host {host!r}: {err.strerror or err}{hint}")
     if port == 0:
         return 0, ""
     for p in range(port, min(port + PORT_TRIES, 65536)):
