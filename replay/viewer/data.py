@@ -1,10 +1,15 @@
 """Log -> compact NumPy arrays: one :class:`Track` per topic, found by time with ``searchsorted``.
 
 A log is read once, message by message (the MCAP reader decompresses one chunk at a time), and
-each message's numbers go straight into preallocated float64 columns: the decoded JSON is
-dropped at once, so the file is never held in memory twice. Non-numeric fields (joint names)
-are kept once, from a topic's first message. The same accumulator grows during a live run
-(``replay run --view``), where the runner hands it each message as it is written.
+each message's numbers go straight into float64 columns: the decoded JSON is dropped at once,
+so the file is never held in memory twice. Non-numeric fields (joint names) are kept once, from
+a topic's first message. The same accumulator grows during a live run (``replay run --view``),
+where the runner hands it each message as it is written.
+
+A log is someone else's data: what one run keeps (columns at 8 bytes a number, events, topics)
+is at most ``series_bytes`` (:mod:`replay.limits`), counted as it is allocated; the count in
+the log's statistics only sizes the first allocation, up to :data:`HINT_BYTES`; a label or an
+event field too big to be a name or a detail is left out, and a note says so.
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from replay.limits import LimitError, check
+from replay.limits import LimitError, check, limit
 from replay.log import LogError, LogReader
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, to_dict
 from replay.viewer.errors import ViewerError
@@ -25,6 +30,49 @@ from replay.viewer.markup import clean
 
 # topics kept as Python objects rather than columns (few messages, free-form data)
 OBJECT_TOPICS = (TOPIC_SCENARIO, TOPIC_EVENTS)
+HINT_BYTES = 16 * 2**20  # a topic's first columns, sized by the log's count: at most this
+TOPIC_BYTES = 4096  # what a topic costs besides its columns (its Python objects), counted
+LABEL_BYTES = 65_536  # a non-numeric field kept (joint names): at most this big
+EVENT_FIELD_BYTES = 16_384  # one field of an event's data kept: at most this big
+EVENT_BYTES = 65_536  # an event's data kept: at most this big (fields past it left out)
+
+
+def _size(value, cap: int) -> int:
+    """About the bytes decoded JSON ``value`` takes as Python objects, counted until past
+    ``cap`` (a huge value costs no more time than a small one)."""
+    total, stack = 0, [value]
+    while stack and total <= cap:
+        v = stack.pop()
+        if isinstance(v, str):
+            total += 50 + len(v)
+        elif isinstance(v, list):
+            total += 56 + 8 * len(v)
+            if total <= cap:
+                stack.extend(v)
+        elif isinstance(v, dict):
+            total += 64 + 100 * len(v)
+            if total <= cap:
+                stack.extend(v.keys())
+                stack.extend(v.values())
+        else:
+            total += 32
+    return total
+
+
+class _Budget:
+    """What one run keeps, counted against ``series_bytes`` (read once)."""
+
+    def __init__(self) -> None:
+        self.cap = limit("series_bytes")
+        self.used = 0
+
+    def left(self) -> int:
+        return self.cap - self.used
+
+    def take(self, n: int, topic: str) -> None:
+        """Count ``n`` more bytes, kept for ``topic``; :class:`LimitError` past the limit."""
+        check("series_bytes", self.used + n, f"what the viewer keeps of one run (at {topic})")
+        self.used += n
 
 
 @dataclass
@@ -74,14 +122,18 @@ def _shape_of(value) -> tuple | None:
 
 
 class _TrackBuilder:
-    def __init__(self, topic: str, capacity: int) -> None:
+    def __init__(self, topic: str, count: int, budget: _Budget) -> None:
         self.topic = topic
-        self.cap = max(8, capacity)
-        self.n = 0
-        self.t = np.empty(self.cap)
+        self.count = count  # the log's word for it: a hint, not a promise
+        self.budget = budget
+        budget.take(TOPIC_BYTES, topic)
+        self.cap = self.n = 0
+        self.row = 8  # bytes of one message's numbers, its time included
+        self.t = np.empty(0)
         self.cols: dict[str, np.ndarray] | None = None
         self.labels: dict[str, Any] = {}
         self.ragged: set[str] = set()
+        self.left_out: list[str] = []  # labels too big to keep
 
     def _layout(self, data: dict) -> None:
         self.cols = {}
@@ -90,28 +142,37 @@ class _TrackBuilder:
                 continue
             shape = _shape_of(value)
             if shape is None:
-                self.labels[name] = value
+                if _size(value, LABEL_BYTES) <= LABEL_BYTES:
+                    self.labels[name] = value
+                else:
+                    self.left_out.append(name)
             else:
-                self.cols[name] = np.full((self.cap, *shape), np.nan)
+                self.cols[name] = np.empty((0, *shape))
+                self.row += 8 * int(np.prod(shape))
+        self._resize(min(max(8, self.count), max(8, HINT_BYTES // self.row)))
 
-    def _grow(self) -> None:
-        self.cap *= 2
-        t = np.empty(self.cap)
+    def _resize(self, want: int) -> None:
+        """Room for ``want`` rows, or as many as the run's budget leaves (one more row than
+        held at least: else :class:`LimitError`). Rows past ``n`` are never read."""
+        cap = max(self.n + 1, min(want, self.cap + self.budget.left() // self.row))
+        self.budget.take((cap - self.cap) * self.row, self.topic)
+        t = np.empty(cap)
         t[: self.n] = self.t[: self.n]
         self.t = t
-        for name, col in self.cols.items():
-            new = np.full((self.cap, *col.shape[1:]), np.nan)
+        for name, col in (self.cols or {}).items():
+            new = np.empty((cap, *col.shape[1:]))
             new[: self.n] = col[: self.n]
             self.cols[name] = new
+        self.cap = cap
 
     def add(self, t_ns: int, data: dict) -> None:
         if self.cols is None:
             self._layout(data)
         if self.n == self.cap:
-            self._grow()
+            self._resize(2 * self.cap)
         n = self.n
         self.t[n] = t_ns * 1e-9
-        for name, col in self.cols.items():
+        for name, col in (self.cols or {}).items():
             value = data.get(name)
             shape = col.shape[1:]
             try:
@@ -215,14 +276,22 @@ def _config(text) -> tuple[dict, list[str]]:
     return config, []
 
 
-def _event(t_ns: int, data: dict) -> dict:
+def _event(t_ns: int, data: dict) -> tuple[dict, int]:
     """An event as the timeline takes it: ``t`` a finite number (the message's time if not),
-    ``kind`` a short line of text, ``data`` a mapping."""
+    ``kind`` a short line of text, ``data`` a mapping of the fields that fit
+    :data:`EVENT_FIELD_BYTES` each and :data:`EVENT_BYTES` in all; and how many were left out."""
     t = data.get("t")
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not np.isfinite(t):
         t = t_ns * 1e-9
     kind = clean(data["kind"]) if "kind" in data else "?"
-    return {**data, "t": float(t), "kind": kind, "data": _mapping(data.get("data"))}
+    kept, size, left_out = {}, 0, 0
+    for key, value in _mapping(data.get("data")).items():
+        n = _size(key, EVENT_FIELD_BYTES) + _size(value, EVENT_FIELD_BYTES)
+        if n > EVENT_FIELD_BYTES or size + n > EVENT_BYTES:
+            left_out += 1
+        else:
+            kept[key], size = value, size + n
+    return {"t": float(t), "kind": kind, "data": kept}, left_out
 
 
 class RunAccumulator:
@@ -233,22 +302,39 @@ class RunAccumulator:
         self.counts = counts or {}
         self.scenario: dict = {}
         self.events: list[dict] = []
+        self.event_fields_left_out = 0
         self.builders: dict[str, _TrackBuilder] = {}
         self.t_last = 0.0
+        self.full = ""  # why messages are no longer kept: over the limit (kept before it)
+        self.budget = _Budget()
         self._lock = threading.Lock()
 
     def add(self, topic: str, t_ns: int, data: dict) -> None:
+        """Keep a message; past the run's ``series_bytes``, none more (``full`` says why)."""
         with self._lock:
-            self.t_last = max(self.t_last, t_ns * 1e-9)
-            if topic == TOPIC_SCENARIO:
-                self.scenario = data
-            elif topic == TOPIC_EVENTS:
-                self.events.append(_event(t_ns, data))
-            else:
-                b = self.builders.get(topic)
-                if b is None:
-                    b = self.builders[topic] = _TrackBuilder(topic, self.counts.get(topic, 256))
-                b.add(t_ns, data)
+            if self.full:
+                return
+            try:
+                self._add(topic, t_ns, data)
+            except LimitError as exc:
+                self.full = str(exc)
+
+    def _add(self, topic: str, t_ns: int, data: dict) -> None:
+        self.t_last = max(self.t_last, t_ns * 1e-9)
+        if topic == TOPIC_SCENARIO:
+            self.scenario = data
+        elif topic == TOPIC_EVENTS:
+            event, left_out = _event(t_ns, data)
+            self.budget.take(_size(event, EVENT_BYTES * 2), topic)
+            self.events.append(event)
+            self.event_fields_left_out += left_out
+        else:
+            b = self.builders.get(topic)
+            if b is None:
+                b = self.builders[topic] = _TrackBuilder(
+                    topic, self.counts.get(topic, 256), self.budget
+                )
+            b.add(t_ns, data)
 
     def observe(self, topic: str, payload, t_ns: int) -> None:
         """A runner observer: ``Runner(..., observers=(acc.observe,))``."""
@@ -260,13 +346,26 @@ class RunAccumulator:
             events = list(self.events)
             scenario = dict(self.scenario)
         config, notes = _config(scenario.get("yaml"))
-        label = clean(scenario.get("name") or (self.path.stem if self.path else "live run"))
+        name = scenario.get("name")
+        label = clean(
+            name if name and isinstance(name, str) else self.path.stem if self.path else "live run"
+        )
+        if self.full:
+            notes.insert(0, f"messages past t = {self.t_last:.4f} s not kept: {self.full}")
+        for b in self.builders.values():
+            for name in b.left_out:
+                notes.append(f"{b.topic}.{name}: over {LABEL_BYTES:,} bytes, left out")
         for tr in tracks.values():
             for name in tr.ragged:
                 notes.append(
                     f"{tr.topic}.{name} changes shape or is missing in some messages; "
                     "those messages are left out"
                 )
+        if self.event_fields_left_out:
+            notes.append(
+                f"{self.event_fields_left_out} event field(s) over {EVENT_FIELD_BYTES:,} bytes "
+                f"(or past {EVENT_BYTES:,} in one event) left out"
+            )
         return RunData(
             label=str(label),
             path=self.path,
@@ -288,9 +387,13 @@ def load_run(path: str | Path) -> RunData:
         acc = RunAccumulator(path, counts)
         for m in reader.messages():
             acc.add(m.topic, m.t_ns, m.data)
+            if acc.full:
+                raise ViewerError(f"{path}: {acc.full}")
     except ViewerError:
         raise
     except LogError as exc:
+        raise ViewerError(str(exc)) from None
+    except LimitError as exc:  # a REPLAY_LIMIT_* variable that is not a number
         raise ViewerError(str(exc)) from None
     except (ValueError, OSError) as exc:  # a corrupt message (bad JSON) or a read error
         raise ViewerError(f"{path}: unreadable log ({exc})") from None

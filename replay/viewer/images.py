@@ -14,8 +14,10 @@ import numpy as np
 
 from replay.foxglove.image import pixels
 from replay.foxglove.schemas import decode
+from replay.limits import LimitError, check, limit
 from replay.log import LogReader
 from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_VISION_OBJECT
+from replay.viewer.errors import ViewerError
 
 CAMERA_PREFIX = "/camera/"
 SIZE = 256  # px: the panel's image width (nearest-neighbour up, area-averaged down)
@@ -56,8 +58,9 @@ class ImageTrack:
         return rgb
 
 
-def _marks(reader: LogReader, sensor_type: str, sensor: dict, view: str) -> dict:
-    """The measured centroid of each frame of one camera view, by capture time."""
+def _marks(reader: LogReader, sensor_type: str, sensor: dict, view: str, times: set) -> dict:
+    """The measured centroid of each frame of one camera view, by capture time (``times``:
+    the frames', so no more are kept than frames)."""
     out: dict[int, tuple[float, float]] = {}
     if sensor_type == "stereo_ball":
         params = sensor.get("params")
@@ -67,22 +70,33 @@ def _marks(reader: LogReader, sensor_type: str, sensor: dict, view: str) -> dict
         i = int(view[-1]) if view[-1:].isdigit() else 0
         for m in reader.messages(topic):
             c = (m.data.get("features") or {}).get("centroids")
-            if isinstance(c, list) and len(c) > i:
+            if isinstance(c, list) and len(c) > i and m.t_ns in times:
                 out[m.t_ns] = (float(c[i][0]), float(c[i][1]))
     elif sensor_type == "vision_chip":
         for m in reader.messages(TOPIC_GRASP_OBJECT):
             xi = m.data.get("xi")
             if m.data.get("found") and isinstance(xi, list) and len(xi) == 2:
-                out[int(round(float(m.data["t"]) * 1e9))] = (float(xi[0]), float(xi[1]))
+                t_ns = int(round(float(m.data["t"]) * 1e9))
+                if t_ns in times:
+                    out[t_ns] = (float(xi[0]), float(xi[1]))
     return out
 
 
 def load_image_tracks(path: str | Path, sensors: dict) -> list[ImageTrack]:
-    """Every camera view's images in the log at ``path`` (``sensors``: the scenario's)."""
+    """Every camera view's images in the log at ``path`` (``sensors``: the scenario's), at
+    most ``series_bytes`` of them as stored (each image is a view of its stored bytes):
+    :class:`LimitError` past it."""
     reader = LogReader(path)
     found: dict[str, tuple[list, list]] = {}
+    cap, kept = limit("series_bytes"), 0
     for m in reader.raw():
         if m.topic.startswith(CAMERA_PREFIX) and m.schema == "foxglove.RawImage":
+            kept += len(m.data)
+            if kept > cap:
+                try:
+                    check("series_bytes", kept, f"{path}: its camera images (read so far)")
+                except LimitError as exc:
+                    raise ViewerError(str(exc)) from None
             ts, images = found.setdefault(m.topic, ([], []))
             ts.append(m.t_ns)
             images.append(pixels(decode(m.schema, m.data)))
@@ -91,7 +105,7 @@ def load_image_tracks(path: str | Path, sensors: dict) -> list[ImageTrack]:
         sensor, _, view = topic[len(CAMERA_PREFIX) :].partition("/")
         spec = sensors.get(sensor) or {}
         tr = ImageTrack(topic, sensor, view, np.asarray(ts, np.int64), images)
-        tr.marks = _marks(reader, str(spec.get("type", "")), spec, view)
+        tr.marks = _marks(reader, str(spec.get("type", "")), spec, view, set(ts))
         tracks.append(tr)
     return tracks
 

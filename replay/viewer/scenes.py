@@ -29,6 +29,7 @@ from replay.scenario import ScenarioError, params_from_data
 from replay.viewer.data import RunData
 from replay.viewer.errors import ViewerError
 from replay.viewer.geometry import cameras
+from replay.viewer.markup import clean
 
 RUN_COLORS = [(225, 95, 30), (35, 110, 220), (40, 160, 70), (150, 60, 180), (200, 160, 20)]
 PATH_POINTS = 600  # a path so far is drawn with at most this many points
@@ -331,8 +332,10 @@ def scene_class(run: RunData) -> type[RunScene]:
         if cls.drawable(run):
             return cls
     where = run.path if run.path is not None else run.label
-    need = " or ".join(t for c in scenes.values() for t in c.needs)
-    have = ", ".join(sorted(run.tracks)) or "none"
+    need = " or ".join(dict.fromkeys(t for c in scenes.values() for t in c.needs))
+    topics = sorted(run.tracks)
+    have = ", ".join(clean(t, 80) for t in topics[:10]) or "none"
+    have += f" and {len(topics) - 10:,} more" if len(topics) > 10 else ""
     raise ViewerError(
         f"{where}: nothing the viewer can draw: needs {need} (topics in the log: {have})"
     )
