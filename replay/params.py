@@ -8,7 +8,9 @@ so the YAML mirrors the code field for field.
 Defaults that hold unless a field says otherwise (so that memory and run time stay bounded and no
 meaningless number reaches a simulator):
 
-- a float is finite (NaN never; +-inf only with ``allow_inf=True``) and ``|x| <= MAX_FLOAT``;
+- a float is finite (NaN never; +-inf only with ``allow_inf=True``) and ``|x| <= MAX_FLOAT``,
+  and zero or a normal float (a subnormal such as 1e-320, or 1e-400 read as 0, is refused:
+  a simulator dividing by it gets infinity);
 - an integer is ``|n| <= MAX_INT``;
 - a list has at most ``MAX_ITEMS`` items, a string at most ``MAX_CHARS`` characters.
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+import sys
 import types
 import typing
 from pathlib import Path
@@ -339,8 +340,22 @@ def _number(node: yaml.ScalarNode, path: str, meta: dict) -> float:
                 f"expected a number {_bounds(meta)}, got {value}", node=node, path=path
             )
         return value
+    _check_representable(value, node, path, f"a number {bounds}")
     _check_range(value, meta, node, path, MAX_FLOAT, "a number")  # exact for huge ints: no overflow
     return float(value)
+
+
+def _check_representable(value: Any, node: yaml.ScalarNode, path: str, what: str) -> None:
+    """Refuse a float written nonzero that is not a normal float: subnormal (1e-320: a
+    simulator dividing by it gets infinity) or read as 0 (1e-400)."""
+    if isinstance(value, float) and abs(value) < sys.float_info.min:
+        if any(c in "123456789" for c in re.split("[eE]", node.value)[0]):
+            raise ScenarioError(
+                f"expected {what}, got {show(node.value)}: too small, not representable "
+                f"(a nonzero magnitude is at least {sys.float_info.min:.4g})",
+                node=node,
+                path=path,
+            )
 
 
 def _check_length(n: int, meta: dict, node, path, what: str) -> None:
@@ -409,6 +424,7 @@ def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
     elif tp is Any or tp is object:
         if isinstance(value, float) and not math.isfinite(value):
             raise ScenarioError(f"expected a finite value, got {value}", node=node, path=path)
+        _check_representable(value, node, path, "a finite value")
     if meta.get("choices") and value not in meta["choices"]:
         raise ScenarioError(
             f"expected one of {', '.join(map(str, meta['choices']))}, got {show(value)}",
