@@ -94,7 +94,7 @@ def sweep(
     (outcome, metrics, wall time, log). Reruns skip the variants already in the table."""
     from replay.resources import find_scenario
     from replay.scenario import ScenarioError, load_scenario
-    from replay.sweep.spec import from_options
+    from replay.sweep.spec import check_seed, from_options
 
     scenario = find_scenario(scenario)
     try:
@@ -103,8 +103,10 @@ def sweep(
         fail(str(exc))
     if not spec.columns:
         fail("nothing to vary: give at least one --grid or --random")
-    if seed < 0:
-        fail(f"--seed: expected a seed >= 0, got {seed}")
+    try:
+        check_seed(seed, "--seed")  # (before anything is planned: every variant's seed)
+    except SweepSpecError as exc:
+        fail(str(exc))
     try:
         base = load_scenario(scenario, sets=list(sets))
     except ScenarioError as exc:

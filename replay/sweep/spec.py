@@ -25,6 +25,7 @@ import numpy as np
 import yaml
 
 from replay.limits import LimitError, check
+from replay.scenario.yamlio import show
 
 SCENARIO_AXIS = "scenario"
 INT64 = (-(2**63), 2**63 - 1)  # whole-number bounds NumPy's generator draws between
@@ -304,7 +305,7 @@ def load_sweep_file(path: str | Path) -> SweepFile:
         path=path,
         scenario=(path.parent / str(data["scenario"])),
         spec=spec,
-        seed=int(data.get("seed", 0)),
+        seed=check_seed(data.get("seed", 0), f"{path}: seed"),
         sets=[f"{k}={_yaml_text(v)}" for k, v in sets.items()],
         description=str(data.get("description", "")),
         plot=str(data["plot"]),
@@ -347,6 +348,15 @@ def _yaml_text(v: Any) -> str:
 
 
 SEED_AXIS = "seed"
+SEED_MAX = 2**63 - 1  # a scenario's seed is 0 to 2^63 - 1 (replay.scenario.schema)
+
+
+def check_seed(value: Any, where: str) -> int:
+    """``value`` if it is a scenario's seed (a whole number from 0 to 2^63 - 1), else a
+    SweepSpecError naming ``where`` (--seed, a sweep file's seed, the seed axis)."""
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= SEED_MAX:
+        raise SweepSpecError(f"{where}: expected a seed from 0 to 2^63 - 1, got {show(value, 24)}")
+    return value
 
 
 def sets_for(point: dict[str, Any]) -> tuple[str | None, int | None, list[str]]:
@@ -357,9 +367,7 @@ def sets_for(point: dict[str, Any]) -> tuple[str | None, int | None, list[str]]:
         if name == SCENARIO_AXIS:
             scenario = value
         elif name == SEED_AXIS:
-            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-                raise SweepSpecError(f"seed: expected whole numbers >= 0, got {value!r}")
-            seed = value
+            seed = check_seed(value, SEED_AXIS)
         elif isinstance(value, dict):
             sets += [f"{k}={_yaml_text(v)}" for k, v in value.items()]
         else:

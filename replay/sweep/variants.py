@@ -95,12 +95,18 @@ def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] | tuple = 
     """A varied key that names no field of the scenario is a bad --grid/--random, not a variant
     failure: raise SweepSpecError before anything runs."""
     from replay.scenario.loader import to_plain
-    from replay.sweep.spec import SCENARIO_AXIS, SEED_AXIS, SweepSpecError
+    from replay.sweep.spec import SCENARIO_AXIS, SEED_AXIS, SweepSpecError, check_seed
 
     try:
         base = to_plain(load_scenario(scenario, sets=list(sets)))
     except ScenarioError as exc:
         raise SweepSpecError(str(exc)) from None
+    seeds = [("--grid seed", v) for a in spec.grid if a.name == SEED_AXIS for v in a.values]
+    seeds += [
+        ("--random seed", v) for r in spec.random if r.name == SEED_AXIS for v in (r.lo, r.hi)
+    ]
+    for where, value in seeds:  # (a seed axis: each value a scenario's seed)
+        check_seed(value, where)
     keys = [a.name for a in spec.random]
     for a in spec.grid:
         if a.name in (SCENARIO_AXIS, SEED_AXIS):
