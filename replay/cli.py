@@ -44,6 +44,9 @@ DEFAULT_LOG_DIR = Path("out/logs")
 DEFAULT_FIGURE_DIR = Path("out/figures")
 # the first line of a `claims --markdown` file: what it may overwrite (an earlier claims table)
 CLAIMS_HEADER = "<!-- paper-replay claims table -->"
+DEFAULT_COMPARE_DIR = Path("out/compare")
+# the first line of a `compare --markdown` file: what it may overwrite (an earlier comparison)
+COMPARE_HEADER = "<!-- paper-replay comparison -->"
 
 
 _NoArgsIsHelp = getattr(click.exceptions, "NoArgsIsHelpError", ())  # click >= 8.2
@@ -471,8 +474,20 @@ def _log_notes(name: str, r: LogReader) -> list[str]:
 
 @main.command()
 @click.argument("log", type=click.Path(dir_okay=False))
-def info(log):
+@click.option(
+    "--events",
+    "kinds",
+    metavar="KIND[,KIND]",
+    help="list only the events of these kinds (e.g. outcome,collision)",
+)
+@click.option("--no-events", is_flag=True, help="list no events (their count stays)")
+def info(log, kinds, no_events):
     """Summarise a LOG: scenario, topics, counts, duration and events."""
+    if kinds is not None and no_events:
+        fail("--events and --no-events exclude each other")
+    wanted = None if kinds is None else {k.strip() for k in kinds.split(",") if k.strip()}
+    if wanted is not None and not wanted:
+        fail("--events: give one or more event kinds, e.g. --events outcome,collision")
     r = _reader(log)
     try:
         sc = r.scenario()
@@ -507,8 +522,13 @@ def info(log):
     click.echo("topics:")
     for topic, n in r.topic_counts().items():
         click.echo(one_line(f"  {topic:<28} {n:>8}"))
-    click.echo(f"events: {len(events)}")
-    for e in events:
+    shown = [] if no_events else [e for e in events if wanted is None or e["kind"] in wanted]
+    counted = f" ({len(shown)} shown: {', '.join(sorted(wanted))})" if wanted is not None else ""
+    click.echo(one_line(f"events: {len(events)}{counted}"))
+    if wanted is not None and not shown and events:
+        kinds_seen = sorted({str(e["kind"]) for e in events})
+        note(f"no event of kind {', '.join(sorted(wanted))}; this log has {_kinds(kinds_seen)}")
+    for e in shown:
         data = e.get("data", {})
         data = data if isinstance(data, dict) else {"data": data}
         brief = ", ".join(f"{k}={_short(v)}" for k, v in list(data.items())[:6])
@@ -517,6 +537,12 @@ def info(log):
         click.echo(one_line(f"  t = {t} s  {_short(e['kind']):<12} {brief}"))
     for text in _log_notes(log, r):
         warn(text)
+
+
+def _kinds(kinds: list[str], most: int = 12) -> str:
+    """The event kinds a log has, bounded (a forged log may hold many)."""
+    text = ", ".join(_short(k) for k in kinds[:most])
+    return text + (f", +{len(kinds) - most} more" if len(kinds) > most else "")
 
 
 @main.command()
@@ -631,39 +657,42 @@ def _analysis_failed(what: str, paper: str, readers, exc: Exception) -> None:
 )
 def figures(logs, out):
     """Regenerate the papers' figures (PNG and SVG) from LOGS (default: out/logs/*.mcap)."""
+    for paper, readers in _logs_by_paper(logs).items():
+        for path in _paper_figures(paper, readers, Path(out)):
+            say(f"figure: {path}")
+
+
+def _paper_figures(paper: str, readers: dict[str, LogReader], out: Path) -> list[Path]:
+    """``paper``'s figures of ``readers`` written to ``out``; what they leave out warned."""
     from analysis.figure_files import runs_of
     from analysis.needs import figure_notes, skipped_notes
 
-    by_paper = _logs_by_paper(logs)
     try:
-        Path(out).mkdir(parents=True, exist_ok=True)
+        out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         fail(f"cannot write figures to {out}: {exc.strerror or exc}")
-    for paper, readers in by_paper.items():
-        try:
-            make = registry.load("figures", paper)
-        except registry.UnknownPlugin:
-            warn(f"{paper}: no figures defined yet ({', '.join(readers)})")
-            continue
-        try:
-            with quoted_warnings(), skipped_notes() as skipped:
-                paths = make(readers, Path(out))
-        except OSError as exc:
-            fail(f"cannot write figures to {out}: {exc.strerror or exc}")
-        except LogError as exc:  # (a file there that is not an earlier figure)
-            fail(str(exc))
-        except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
-            _analysis_failed("figures", paper, readers, exc)
-        for path in paths:
-            say(f"figure: {path}")
-        shown = {k for p in paths for k in runs_of(p if isinstance(p, Path) else Path(p), readers)}
-        for text in figure_notes(readers, shown, skipped):
-            warn(text)
-        for name, notes in _partial(readers).items():
-            for text in notes:
-                warn(
-                    f"{name} is not a finished run ({text}): its figures show only what was logged"
-                )
+    try:
+        make = registry.load("figures", paper)
+    except registry.UnknownPlugin:
+        warn(f"{paper}: no figures defined yet ({', '.join(readers)})")
+        return []
+    try:
+        with quoted_warnings(), skipped_notes() as skipped:
+            paths = make(readers, out)
+    except OSError as exc:
+        fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+    except LogError as exc:  # (a file there that is not an earlier figure)
+        fail(str(exc))
+    except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
+        _analysis_failed("figures", paper, readers, exc)
+    paths = [p if isinstance(p, Path) else Path(p) for p in paths]
+    shown = {k for p in paths for k in runs_of(p, readers)}
+    for text in figure_notes(readers, shown, skipped):
+        warn(text)
+    for name, notes in _partial(readers).items():
+        for text in notes:
+            warn(f"{name} is not a finished run ({text}): its figures show only what was logged")
+    return paths
 
 
 @main.command()
@@ -712,6 +741,84 @@ def claims(logs, markdown):
     if markdown:  # (the log's names escaped: no raw HTML where the Markdown is rendered)
         text = "\n\n".join([CLAIMS_HEADER, *md_sections]) + "\n"
         _write_output(Path(markdown), text, kind="claims table", magic=CLAIMS_HEADER.encode())
+
+
+@main.command()
+@click.argument("logs", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(file_okay=False),
+    default=str(DEFAULT_COMPARE_DIR),
+    show_default=True,
+    help="where the overlaid figures go",
+)
+@click.option("--no-figures", is_flag=True, help="only the tables (faster: no figures made)")
+@click.option("--markdown", type=click.Path(dir_okay=False), help="also write it here")
+def compare(logs, out, no_figures, markdown):
+    """Runs side by side, from their LOGS (2 or more; normally runs of one experiment): the
+    scenario fields that differ, each run's outcome and metrics, and the papers' figures
+    overlaying them (in -o)."""
+    from analysis.compare import MAX_RUNS, compare, markdown as compare_md, text
+
+    readers, seen = [], set()
+    for p in logs:
+        try:
+            r = LogReader(p).check()
+            sc = r.scenario()
+        except LogError as exc:
+            warn(f"left out: {exc}")
+            continue
+        if not (isinstance(sc.get("paper"), str) and isinstance(sc.get("name"), str)):
+            warn(f"left out: {p}: its /scenario message names no paper or scenario")
+            continue
+        if r.path.resolve() in seen:
+            warn(f"left out: {p}: given twice")
+            continue
+        seen.add(r.path.resolve())
+        readers.append(r)
+    if len(readers) > MAX_RUNS:
+        for r in readers[MAX_RUNS:]:
+            warn(f"left out: {r.path}: at most {MAX_RUNS} runs are compared")
+        readers = readers[:MAX_RUNS]
+    if len(readers) < 2:
+        fail(
+            f"compare needs 2 readable run logs; {len(readers)} of {len(logs)} given could be read"
+        )
+    md_path = Path(markdown) if markdown else None
+    if md_path is not None:  # (before the analysis: only a new file or an earlier comparison)
+        if md_path.resolve() in seen or md_path.suffix in (".mcap", ".yaml", ".yml"):
+            fail(f"will not write the comparison over {markdown} (a log or a scenario)")
+        try:
+            check_output(md_path, kind="comparison", magic=COMPARE_HEADER.encode())
+        except LogError as exc:
+            fail(str(exc))
+    c = compare(readers)
+    say(text(c))
+    for t in c.notes:
+        warn(t)
+    made: list[Path] = []
+    if not no_figures:
+        from analysis import runs
+
+        for paper, keyed in runs.by_paper(readers).items():
+            made += _paper_figures(paper, keyed, Path(out))
+        for path in made:
+            say(f"figure: {path}")
+    if md_path is not None:
+        import os
+
+        base = md_path.resolve().parent
+        shown = [
+            (p.stem, Path(os.path.relpath(p.resolve(), base)).as_posix())
+            for p in made
+            if p.suffix == ".png"
+        ]
+        body = compare_md(c, shown)
+        _write_output(
+            md_path, f"{COMPARE_HEADER}\n{body}", kind="comparison", magic=COMPARE_HEADER.encode()
+        )
+        say(f"markdown: {md_path}")
 
 
 @main.command()
