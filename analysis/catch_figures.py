@@ -30,6 +30,7 @@ from analysis.catch_claims import (
     first_contact,
     load_run,
 )
+from analysis import line_labels  # noqa: E402
 from analysis import runs as run_labels  # noqa: E402
 from analysis.figure_files import save  # noqa: E402
 from analysis.needs import has, skip  # noqa: E402
@@ -103,9 +104,25 @@ def _to_contact(run: CatchRun) -> tuple[float, float]:
     return start, min(end, run.t_ctrl[-1])
 
 
-def _marks(ax, run: CatchRun, style: dict, text: bool = False) -> None:
-    """t0 (mapping starts), t_c (catch surface), first contact and catch/miss, within the axes'
-    time span (labels staggered so that close instants stay readable)."""
+MARKS = {  # what a vertical line is, in a figure's footer
+    "t₀": "t₀ (first vision frame used)",
+    "t_c": "t_c (r_o on the catch surface, q4 = q_α)",
+    "contact": "first contact",
+    "catch": "catch",
+    "miss": "miss",
+    "drop": "drop",
+}
+
+
+def _lines_said(drawn: set[str]) -> str:
+    """The footer's account of the vertical lines drawn (only those)."""
+    said = [text for name, text in MARKS.items() if name in drawn]
+    return "vertical lines: " + ", ".join(said) if said else "no event in the time span"
+
+
+def _marks(ax, run: CatchRun, style: dict) -> list[tuple[float, str]]:
+    """Draw t0 (mapping starts), t_c (catch surface), first contact and catch/miss within the
+    axes' time span; returns them for :func:`analysis.line_labels.place` (after the layout)."""
     marks = [(run.t0, "t₀"), (run.t_c, "t_c")]
     c = first_contact(run)
     if c is not None:
@@ -114,22 +131,10 @@ def _marks(ax, run: CatchRun, style: dict, text: bool = False) -> None:
         if e["kind"] in ("catch", "miss", "drop"):
             marks.append((e["t"], e["kind"]))
     lo, hi = ax.get_xlim()
-    row = 0
-    for t, name in sorted((m for m in marks if m[0] is not None), key=lambda m: m[0]):
-        if not lo <= t <= hi:
-            continue
+    marks = [m for m in marks if m[0] is not None and lo <= m[0] <= hi]
+    for t, _ in marks:
         ax.axvline(t, color="0.55", lw=0.7, ls=style.get("ls", "-"))
-        if text:
-            ax.annotate(
-                name,
-                (t, 1.0),
-                xycoords=("data", "axes fraction"),
-                xytext=(2, -9 - 8 * (row % 3)),
-                textcoords="offset points",
-                fontsize=7,
-                color="0.35",
-            )
-            row += 1
+    return marks
 
 
 def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, ...] = ()):
@@ -172,7 +177,7 @@ def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, .
             0.005,
             "K_τ = diag(1/τ_max²), τ_max = ("
             + ", ".join(f"{x:g}" for x in tau)
-            + ") N·m;  K_ω = diag(1/ω_max²), ω_max = ("
+            + ") N·m;\nK_ω = diag(1/ω_max²), ω_max = ("
             + ", ".join(f"{x:g}" for x in w)
             + ") rad/s;  joints 1, 2, 4",
             fontsize=7,
@@ -182,7 +187,7 @@ def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, .
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     ax_t.set_title("Optimisation of the cost functions (cf. Fig. 6)", fontsize=10)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.tight_layout(rect=(0, 0.05, 1, 1))  # (the footer's two lines below)
     return fig
 
 
@@ -199,6 +204,8 @@ def fig7(runs: list[CatchRun], title: str):
     span = (min(_span(r)[0] for r in runs), max(_span(r)[1] for r in runs))
     for ax in axes:
         ax.set_xlim(*span)
+    named: list[tuple[float, str]] = []  # the first run's marks, named on the x panel
+    drawn: set[str] = set()
     for run in runs:
         st = _style(run)
         t0, t1 = _span(run)
@@ -208,7 +215,10 @@ def fig7(runs: list[CatchRun], title: str):
             ax.plot(tb, ball[:, i], color=C_BALL, **st)
             ax.plot(run.t_ctrl[wc], run.effector_desired[wc, i], color=C_DES, **st)
             ax.plot(run.t_ctrl[wc], run.effector[wc, i], color=C_ACT, **st)
-            _marks(ax, run, st, text=(run is runs[0] and i == 0))
+            marks = _marks(ax, run, st)
+            drawn.update(name for _, name in marks)
+            if run is runs[0] and i == 0:
+                named = marks
         side.plot(ball[:, 0], ball[:, 2], color=C_BALL, **st)
         side.plot(run.effector_desired[wc, 0], run.effector_desired[wc, 2], color=C_DES, **st)
         side.plot(run.effector[wc, 0], run.effector[wc, 2], color=C_ACT, **st)
@@ -227,38 +237,68 @@ def fig7(runs: list[CatchRun], title: str):
     side.set_aspect("equal", adjustable="datalim")
     side.grid(alpha=0.3)
     side.set_title("side view (x-z): ○ l(q_d) at t_c, × ball at the first contact", fontsize=9)
-    handles = [
-        plt.Line2D([], [], color=C_BALL, label="ball r_o (truth)"),
-        plt.Line2D([], [], color=C_DES, label="desired l(q_d)"),
-        plt.Line2D([], [], color=C_ACT, label="actual l(q)"),
-    ]
-    handles += [
-        plt.Line2D(
-            [],
-            [],
-            color="0.3",
-            label=_label(r),
-            **_style(r),
-        )
-        for r in runs
-    ]
-    side.legend(handles=handles, fontsize=7, loc="upper left")
+    # colour says what a curve is, line style which run: two legends, so that no entry
+    # stands for a curve of its own
+    colours = side.legend(
+        handles=[
+            plt.Line2D([], [], color=C_BALL, label="ball r_o (truth)"),
+            plt.Line2D([], [], color=C_DES, label="desired l(q_d)"),
+            plt.Line2D([], [], color=C_ACT, label="actual l(q)"),
+        ],
+        fontsize=7,
+        loc="upper left",
+        title="colour",
+        title_fontsize=7,
+    )
+    side.add_artist(colours)
+    side.legend(
+        handles=[plt.Line2D([], [], color="0.2", label=_label(r), **_style(r)) for r in runs],
+        fontsize=7,
+        loc="lower right",
+        title="line style (every curve and mark of a run)",
+        title_fontsize=7,
+    )
     fig.suptitle(title, fontsize=10)
     fig.text(
         0.01,
         0.005,
-        "l(q): the catch point (ball centre on the palm); vertical lines: t₀ "
-        "(first vision frame used), t_c (r_o on the catch surface, q4 = q_α), contact, "
-        "catch/miss",
+        "l(q): the catch point (ball centre on the palm); " + _lines_said(drawn),
         fontsize=7,
         color="0.35",
     )
     fig.tight_layout(rect=(0, 0.02, 1, 0.97))
+    line_labels.place(axes[0], named)
     return fig
+
+
+MIN_SPAN = 0.1  # rad: the least range of a joint-angle panel (a planar throw leaves q1 ~1e-5)
+
+
+def _min_span(ax, name: str) -> None:
+    """Widen ``ax``'s angle range to :data:`MIN_SPAN` about its middle; a joint that stays
+    within a thousandth of that is said to be still (q1 in a planar throw)."""
+    lo, hi = ax.get_ylim()
+    if hi - lo >= MIN_SPAN:
+        return
+    mid = (lo + hi) / 2.0
+    ax.set_ylim(mid - MIN_SPAN / 2.0, mid + MIN_SPAN / 2.0)
+    lo, hi = ax.dataLim.intervaly  # (the curves' own range, without the margins)
+    if hi - lo < MIN_SPAN / 100:
+        ax.text(
+            0.01,
+            0.05,
+            f"{name} ≈ {round(mid, 3) + 0.0:.3f} rad throughout (range {hi - lo:.0e} rad: "
+            "a planar throw)",
+            transform=ax.transAxes,
+            fontsize=7,
+            color="0.35",
+        )
 
 
 def _joint_figure(runs: list[CatchRun], title: str, what: str):
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.6, 6.4))
+    named: list[tuple[float, str]] = []  # the first run's marks, named on the top panel
+    drawn: set[str] = set()
     axes[0].set_xlim(min(_to_contact(r)[0] for r in runs), max(_to_contact(r)[1] for r in runs))
     for run in runs:
         st = _style(run)
@@ -292,15 +332,20 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
                     **st,
                 )
                 ax.set_ylabel(f"τ{name[1]} [N·m]")
-            _marks(ax, run, st, text=(run is runs[0] and j == 0))
+            marks = _marks(ax, run, st)
+            drawn.update(name for _, name in marks)
+            if run is runs[0] and j == 0:
+                named = marks
     if what == "torques":
         tau, _ = _opt_limits(runs[0])
         for ax, lim in zip(axes, tau):
             for s in (-1, 1):
                 ax.axhline(s * lim, color="0.6", lw=0.8, ls=":")
+    else:
+        for ax, name in zip(axes, JOINTS):
+            _min_span(ax, f"q{name[1]}")
     for ax in axes:
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7, loc="best")
     axes[-1].set_xlabel("time [s]")
     axes[0].set_title(title, fontsize=10)
     note = (
@@ -311,11 +356,13 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
     fig.text(
         0.01,
         0.005,
-        note + "; t₀ → first contact; vertical lines: t₀, t_c, contact",
+        note + ";\nfrom t₀ to the first contact; " + _lines_said(drawn),
         fontsize=7,
         color="0.35",
     )
-    fig.tight_layout(rect=(0, 0.025, 1, 1))
+    fig.tight_layout(rect=(0, 0.04, 1, 1))  # (the footer's two lines below)
+    line_labels.place(axes[0], named)
+    axes[0].legend(fontsize=7, loc="best")  # (after the labels: "best" keeps clear of them)
     return fig
 
 

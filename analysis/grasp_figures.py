@@ -47,13 +47,17 @@ TOPICS = {"Fig. 9": (T_ARM_TASK, T_OBJECT), "filmstrip": (T_ARM, T_OBJECT)}
 
 
 # ----------------------------------------------------------------------------- Fig. 9
-def _shade(ax, run: GraspRun, labels: bool = False) -> None:
+def _shade(ax, run: GraspRun, labels: bool = False) -> set[str]:
+    """Shade the grasp and releasing phases, draw the plant's events and slip ticks; returns
+    what was drawn (for the figure's footer: it explains only those)."""
+    drawn: set[str] = set()
     for p in run.phases:
         key = "grasp" if p.name in GRASP_PHASES else p.name if p.name == RELEASING else None
         if key is None:
             continue
         color, alpha = SHADE[key]
         ax.axvspan(p.t0, p.t1, color=color, alpha=alpha, lw=0)
+        drawn.add(key)
         if labels and p.name in (REACHING, RELEASING):
             ax.annotate(
                 "grasp" if p.name == REACHING else "release",
@@ -67,6 +71,7 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> None:
     for e in run.events:
         if e["kind"] in EVENT_KINDS and e["kind"] != "slip":
             ax.axvline(e["t"], color="0.45", lw=0.7, ls=":" if e["kind"] != "drop" else "-")
+            drawn.add(e["kind"])
     slips = [e["t"] for e in run.events if e["kind"] == "slip"]
     if slips:  # a rug along the bottom edge
         ax.plot(
@@ -77,6 +82,27 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> None:
             ms=6,
             transform=ax.get_xaxis_transform(),
         )
+        drawn.add("slip")
+    return drawn
+
+
+def _footer(drawn: set[str]) -> str:
+    """Fig. 9's footer: the axes, then only the shading and marks that are drawn."""
+    said = []
+    if "grasp" in drawn:
+        said.append("blue: grasp phases (reach, hold)")
+    if RELEASING in drawn:
+        said.append("red: releasing")
+    events = [k for k in ("grasp", "release") if k in drawn]
+    if events:
+        said.append(f"dotted: the plant's {' and '.join(events)} event{'s' * (len(events) > 1)}")
+    if "drop" in drawn:
+        said.append("solid grey: drop")
+    said.append("red ticks at the bottom: slip events" if "slip" in drawn else "no slip event")
+    return (
+        "Y: tracking on the constraint plane (S = 1); X: reaching along its normal (S = 0).\n"
+        + "; ".join(said)
+    )
 
 
 def fig9(run: GraspRun):
@@ -109,20 +135,19 @@ def fig9(run: GraspRun):
             lw=0.9,
             label="F^a: external force at the wrist (eq. 2)",
         )
+    drawn: set[str] = set()
     for ax, name in ((ax_y, "Y [m]"), (ax_x, "X [m]"), (ax_f, "force [N]")):
         ax.set_ylabel(name)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower right" if ax is not ax_f else "upper right")
         ax.set_xlim(0.0, run.t_end)
-        _shade(ax, run, labels=ax is ax_y)
+        drawn |= _shade(ax, run, labels=ax is ax_y)
     ax_f.set_xlabel("time [s]")
     ax_y.set_title(f"Feedback response: {run.name} (cf. Fig. 9)", fontsize=10)
     fig.text(
         0.01,
         0.005,
-        "Y: tracking on the constraint plane (S = 1); X: reaching along its "
-        "normal (S = 0). Blue: grasp phases (reach, hold); red: releasing;\ndotted: the "
-        "plant's grasp and release events; red ticks at the bottom: slip events",
+        _footer(drawn),
         fontsize=7,
         color="0.35",
     )

@@ -13,6 +13,7 @@ import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
+from analysis import line_labels  # noqa: E402
 from analysis import runs as run_labels  # noqa: E402
 from analysis.needs import has, skip  # noqa: E402
 from analysis.series import arrays, events  # noqa: E402
@@ -33,21 +34,11 @@ def fig7(log: LogReader, title: str = ""):
     fig, (ax_v, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
     ax_v.plot(s["t"], speed, color="tab:blue", lw=1.4, label="simulated (Pymunk)")
     ax_w.plot(s["t"], s["omega"], color="tab:red", lw=1.4, label="simulated (Pymunk)")
-    last_label = -1.0
+    marks = []
     for e in events(log, "collision"):
         for ax in (ax_v, ax_w):
             ax.axvline(e["t"], color="0.4", lw=0.8, ls="--")
-        if e["t"] - last_label > 0.04:  # label collisions that are far enough apart to read
-            ax_v.annotate(
-                f"#{e['data'].get('index', '')}",
-                (e["t"], 1.0),
-                xytext=(2, -10),
-                xycoords=("data", "axes fraction"),
-                textcoords="offset points",
-                fontsize=7,
-                color="0.3",
-            )
-            last_label = e["t"]
+        marks.append((e["t"], f"#{e['data'].get('index', '')}"))
     for e in events(log, "capture"):
         for ax in (ax_v, ax_w):
             ax.axvline(e["t"], color="tab:green", lw=1.0)
@@ -58,7 +49,6 @@ def fig7(log: LogReader, title: str = ""):
     for ax in (ax_v, ax_w):
         ax.grid(alpha=0.3)
     ax_v.set_title(title or "Translational and rotational velocities (cf. Fig. 7)", fontsize=10)
-    ax_v.legend(fontsize=8, loc="upper right")
     fig.text(
         0.01,
         0.005,
@@ -67,6 +57,8 @@ def fig7(log: LogReader, title: str = ""):
         color="0.35",
     )
     fig.tight_layout()
+    line_labels.place(ax_v, marks)  # (close collisions' labels stagger down)
+    ax_v.legend(fontsize=8, loc="best")
     return fig
 
 
