@@ -29,7 +29,7 @@ from replay.papers import PAPERS
 from replay.report.captions import CAPTIONS
 from replay.report.folder import check_folder, staging, swap_in
 from replay.report.markup import e as _e
-from replay.report.markup import md, md_code, md_fence, url
+from replay.report.markup import md, md_code, md_fence, pre, url
 from replay.scenario.yamlio import one_line
 
 PACKAGES = (
@@ -529,7 +529,7 @@ def _html(sections, info, commands, notes=()) -> str:
     h += [
         "</table>",
         '<h2 id="commands">Commands</h2>',
-        "<pre>" + _e("\n".join(commands)) + "</pre>",
+        pre(commands),  # (each command on its one line: no forged line from a name)
         "</body></html>",
     ]
     return "\n".join(h) + "\n"
