@@ -242,4 +242,7 @@ def test_a_report_of_a_log_naming_links_renders_none(base_log, tmp_path):
     outside_code = re.sub(r"(`+)(?!`).*?(?<!`)\1(?!`)", "", body)  # (code shows text)
     outside_code = re.sub(r"\]\([^)]*\)", "]", outside_code)  # (a file's link: no autolink)
     assert "https\\://evil" in outside_code and "https://evil" not in outside_code  # (captions)
+    html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
+    block = html.split('<h2 id="commands">Commands</h2>', 1)[1].split("</pre>", 1)[0]
+    assert not any(line.startswith("curl") for line in block.splitlines()), block
     assert "www\\.x.y" in outside_code and "www.x.y" not in outside_code
