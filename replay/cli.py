@@ -374,9 +374,23 @@ def validate(scenarios, sets, static):
                 click.echo(f"error: {one_line(_refusal(p, exc))}", err=True)
                 bad += 1
                 continue
+            _warn_unpublished(p, sc)
         say(f"ok: {p}")
     if bad:
         sys.exit(2)
+
+
+def _warn_unpublished(path: str, sc) -> None:
+    """A warning when ``sc`` will not publish topics its paper's figures and claims read (a
+    brief trial run against its experiment's: analysis/published.py)."""
+    from analysis.published import unmet
+
+    try:
+        text = unmet(sc)
+    except Exception as exc:  # noqa: BLE001 - a plug-in failing in its first steps: one line
+        text = f"its trial run failed, so what it publishes is unknown: {type(exc).__name__}: {exc}"
+    if text:
+        warn(f"{path}: {text}")
 
 
 @main.command("list")
