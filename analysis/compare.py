@@ -50,7 +50,8 @@ def cell(value: Any) -> str:
 def _rows(
     per_run: list[dict[str, Any]], only_differing: bool
 ) -> tuple[list[tuple[str, list[str]]], int]:
-    names = sorted({k for d in per_run for k in d})
+    # the plug-ins' params after the rest (a name, a type, a rate read first)
+    names = sorted({k for d in per_run for k in d}, key=lambda k: (".params." in k, k))
     rows = []
     for name in names:
         values = [d.get(name) for d in per_run]
