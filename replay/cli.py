@@ -26,6 +26,7 @@ from replay.console import (
 from replay.foxglove.layouts import PAPERS as LAYOUT_PAPERS
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
+from replay.log.errors import LogLimitError
 from replay.log.writer import (
     LogWriteError,
     OutputConflictError,
@@ -375,7 +376,7 @@ def validate(scenarios, sets, static):
                 bad += 1
                 continue
             _warn_unpublished(p, sc)
-        say(f"ok: {p}")
+        click.echo(one_line(f"ok: {p}"))  # (a file name with a line break: still one line)
     if bad:
         sys.exit(2)
 
@@ -519,7 +520,10 @@ def info(log, kinds, no_events):
     t0, t1 = r.time_range()
     flag = {"truncated": "  [TRUNCATED log]", "damaged": "  [DAMAGED log]"}.get(r.status, "")
     click.echo(f"duration: {t1 - t0:.4f} s simulated{flag}")
-    events = r.events()
+    try:
+        events = r.events()
+    except LogError as exc:  # (over series_bytes)
+        fail(str(exc))
     outcome = next((e["data"] for e in reversed(events) if e["kind"] == "outcome"), None)
     if outcome is None:
         click.echo("outcome: (none: the run did not finish)")
@@ -741,6 +745,8 @@ def claims(logs, markdown):
         try:
             with skipped_notes() as skipped:  # (rows left out for a topic a log lacks)
                 rows, engines_note = evaluate_runs(evaluate, readers)  # both engines, if both ran
+        except LogLimitError as exc:  # a log asking for more than a limit: the input's fault
+            fail(str(exc))
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("claims", paper, readers, exc)
         for text in skipped:

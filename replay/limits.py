@@ -43,7 +43,7 @@ LIMITS: dict[str, Limit] = {
         Limit("message_bytes", 64_000_000, "bytes", "one message a log reader will load"),
         Limit(
             "series_bytes",
-            256_000_000,
+            64_000_000,
             "bytes",
             "the messages of one topic a reader decodes and keeps (e.g. all events)",
         ),

@@ -332,7 +332,8 @@ def test_report_escapes_every_payload_in_markdown(hostile_report):
     body, commands = text.split("## Commands", 1)
     outside_code = re.sub(r"(`+)(?!`).*?(?<!`)\1(?!`)", "", body)  # (code shows text)
     assert "<script" not in outside_code.lower() and "<iframe" not in outside_code.lower()
-    assert "(seed &lt;script&gt;alert(1)&lt;/script&gt;)" in text  # shown, as text
+    # a seed that is no integer is left out by the reader (LogReader.scenario): "?"
+    assert "(seed ?)" in text and "alert(1)</script>)" not in text
     assert "](javascript:" not in outside_code
     assert "\n\n<" not in text  # no HTML block from a name's blank line
     fence = re.match(r"\s*(`{3,})sh\n", commands)

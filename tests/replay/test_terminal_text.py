@@ -9,7 +9,6 @@ import sys
 import unicodedata
 from pathlib import Path
 
-import pytest
 from click.testing import CliRunner
 
 from replay.cli import main
@@ -72,7 +71,6 @@ def test_validate_prints_a_file_name_escaped(tmp_path, project_root):
     assert r.output.startswith("ok: ") and "\\u202e" in r.output
 
 
-@pytest.mark.xfail(strict=True, reason="replay/cli.py: validate's `say(f'ok: {p}')` splits lines")
 def test_validate_prints_a_file_name_with_a_newline_on_one_line(tmp_path, project_root):
     base = Path(project_root) / "scenarios" / "stick_3step.yaml"
     name = tmp_path / "a\nok: forged.yaml"

@@ -86,16 +86,12 @@ def stick_events(tmp_path_factory) -> Path:
     return d / "ev.mcap"
 
 
-def _later(reason: str):
-    return pytest.mark.xfail(strict=True, reason=f"replay/cli.py: {reason}")
-
-
 @pytest.mark.parametrize(
     "command",
     [
         "figures",
-        pytest.param("info", marks=_later("info's r.events() not in try/except LogError")),
-        pytest.param("claims", marks=_later("claims: a LogLimitError is exit 1, not 2")),
+        "info",
+        "claims",
     ],
 )
 def test_a_command_over_series_bytes_says_one_line(tmp_path, monkeypatch, stick_events, command):
