@@ -32,6 +32,7 @@ from replay.viewer.markup import clean
 OBJECT_TOPICS = (TOPIC_SCENARIO, TOPIC_EVENTS)
 HINT_BYTES = 16 * 2**20  # a topic's first columns, sized by the log's count: at most this
 TOPIC_BYTES = 4096  # what a topic costs besides its columns (its Python objects), counted
+FIELD_BYTES = 256  # and each of its fields (a column's or a label's Python objects)
 LABEL_BYTES = 65_536  # a non-numeric field kept (joint names): at most this big
 EVENT_FIELD_BYTES = 16_384  # one field of an event's data kept: at most this big
 EVENT_BYTES = 65_536  # an event's data kept: at most this big (fields past it left out)
@@ -136,13 +137,16 @@ class _TrackBuilder:
         self.left_out: list[str] = []  # labels too big to keep
 
     def _layout(self, data: dict) -> None:
+        self.budget.take(FIELD_BYTES * len(data), self.topic)
         self.cols = {}
         for name, value in data.items():
             if name == "t":
                 continue
             shape = _shape_of(value)
             if shape is None:
-                if _size(value, LABEL_BYTES) <= LABEL_BYTES:
+                size = _size(value, LABEL_BYTES)
+                if size <= LABEL_BYTES:
+                    self.budget.take(size, self.topic)
                     self.labels[name] = value
                 else:
                     self.left_out.append(name)

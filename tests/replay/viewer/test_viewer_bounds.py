@@ -156,3 +156,14 @@ def test_an_ipv4_mapped_host_is_refused_at_once(tmp_path):
     )
     assert r.returncode == 2 and time.monotonic() - t0 < 30
     assert r.stderr.strip().splitlines()[-1].startswith("error: cannot listen on host")
+
+
+def test_many_fields_and_topics_count_against_the_limit(monkeypatch):
+    monkeypatch.setenv("REPLAY_LIMIT_SERIES_BYTES", str(2**20))
+    acc = RunAccumulator()
+    acc.add("/wide", 0, {f"k{i}": 1.0 for i in range(10_000)})  # 10,000 columns of one row
+    assert "REPLAY_LIMIT_SERIES_BYTES" in acc.full
+    acc = RunAccumulator()
+    for i in range(1000):  # a thousand topics of one message
+        acc.add(f"/t{i}", 0, {"t": 0.0, "x": 1.0})
+    assert "REPLAY_LIMIT_SERIES_BYTES" in acc.full and len(acc.builders) < 1000
