@@ -327,6 +327,56 @@ def _differs(sec: PaperSection, key: str) -> str:
     return f"; {label}" if label and label not in key else ""
 
 
+# -- the headline across papers ---------------------------------------------------------------
+
+HEADLINE = (
+    "paper",
+    "measured rows reproduced",
+    "ties",
+    "configuration rows",
+    "paper rows",
+    "falsifiers",
+)
+
+
+def _headline(sections) -> list[tuple[str, ...]]:
+    """Per paper with a claims table: its counts (as the table's summary line counts them) and
+    what this report did with its falsifiers: it lists them, it does not run them (``replay
+    falsify`` does, and no result of it is stored for the report to read)."""
+    from analysis.claims import counted
+
+    rows: list[tuple[str, ...]] = []
+    for sec in sections:
+        if not sec.claims:
+            continue
+        n_ok, n = counted(sec.claims, sec.falsifiers)
+        kinds = [c.kind for c in sec.claims]
+        ties = sum(c.kind == "measured" and c.status == "tie" for c in sec.claims)
+        falsifiers = (
+            f"{len(sec.falsifiers)} declared, not run in this report: "
+            f"replay falsify {sec.key} --logs out/logs"
+            if sec.falsifiers
+            else "none declared"
+        )
+        rows.append(
+            (
+                sec.title,
+                f"{n_ok} / {n}",
+                str(ties),
+                str(kinds.count("configuration")),
+                str(kinds.count("paper")),
+                falsifiers,
+            )
+        )
+    return rows
+
+
+HEADLINE_NOTE = (
+    "A measured row counts as reproduced only with a falsifier: a variant under which the "
+    "paper's claim is false in the simulation, run by replay falsify (not by this report)."
+)
+
+
 # -- Markdown --------------------------------------------------------------------------------
 
 
@@ -339,6 +389,12 @@ def _markdown(sections, info, commands, notes=()) -> str:
         "",
     ]
     lines += [x for n in notes for x in (f"> {md(n)}", "")]
+    headline = _headline(sections)
+    if headline:
+        lines += ["## Summary", "", "| " + " | ".join(HEADLINE) + " |"]
+        lines += ["|" + "---|" * len(HEADLINE)]
+        lines += ["| " + " | ".join(md(x) for x in row) + " |" for row in headline]
+        lines += ["", md(HEADLINE_NOTE), ""]
     for sec in sections:
         lines += [f"## {sec.title}", "", f"*{sec.authors}* (`{sec.key}`)", ""]
         if sec.runs:
@@ -362,7 +418,7 @@ def _markdown(sections, info, commands, notes=()) -> str:
                 "",
                 "Each reproduced measured row counts only with a variant under which the paper's "
                 "claim is false in the simulation; `replay falsify` runs them and requires the "
-                "row to read *differs*.",
+                "row to read *differs*. This report lists them; it did not run them.",
                 "",
                 format_falsifiers(sec.falsifiers),
                 "",
@@ -420,6 +476,11 @@ td, th { border: 1px solid #ccc; padding: 0.25rem 0.5rem; vertical-align: top; }
 .reproduced { color: #176317; } .differs { color: #a33; } .inconsistent { color: #a60; }
 pre { background: #f5f5f5; padding: 0.6rem; overflow-x: auto; font-size: 0.8rem; }
 .note { background: #fff8e0; padding: 0.5rem 0.8rem; border-left: 4px solid #e0b000; }
+table.falsifiers { table-layout: fixed; width: 100%; }
+table.falsifiers col.row { width: 24%; } table.falsifiers col.variant { width: 30%; }
+table.falsifiers col.why { width: 46%; }
+table.falsifiers td { overflow-wrap: anywhere; }
+table.headline td:nth-child(n+2):nth-child(-n+5) { text-align: right; }
 """
 
 # no script, frame, form or remote resource whatever the page holds: its own images, inline style
@@ -443,12 +504,23 @@ def _html(sections, info, commands, notes=()) -> str:
         *(f'<p class="note">{_e(n)}</p>' for n in notes),
         "<nav><ul>",
     ]
+    headline = _headline(sections)
+    if headline:
+        h.append('<li><a href="#summary">Summary</a></li>')
     h += [f'<li><a href="#{_e(s.key)}">{_e(s.title)}</a></li>' for s in sections]
     h += [
         '<li><a href="#versions">Versions</a></li>',
         '<li><a href="#commands">Commands</a></li>',
         "</ul></nav>",
     ]
+    if headline:
+        h += [
+            '<h2 id="summary">Summary</h2>',
+            '<table class="headline"><tr>' + "".join(f"<th>{_e(x)}</th>" for x in HEADLINE),
+            "</tr>",
+        ]
+        h += ["<tr>" + "".join(f"<td>{_e(x)}</td>" for x in row) + "</tr>" for row in headline]
+        h += ["</table>", f"<p>{_e(HEADLINE_NOTE)}</p>"]
     for sec in sections:
         h += [
             f'<section id="{_e(sec.key)}">',
@@ -493,16 +565,19 @@ def _html(sections, info, commands, notes=()) -> str:
                     "<h4>Falsifiers</h4>",
                     "<p>Each reproduced measured row counts only with a variant under which the "
                     "paper's claim is false in the simulation; <code>replay falsify</code> runs "
-                    "them and requires the row to read <i>differs</i>.</p>",
-                    "<table><tr><th>row</th><th>variant</th><th>replaces</th><th>overrides</th>"
-                    "<th>why the claim is false under it</th></tr>",
+                    "them and requires the row to read <i>differs</i>. This report lists them; "
+                    "it did not run them.</p>",
+                    '<table class="falsifiers"><colgroup><col class="row"><col class="variant">'
+                    '<col class="why"></colgroup><tr><th>row</th><th>variant (the run it '
+                    "replaces: overrides)</th><th>why the claim is false under it</th></tr>",
                 ]
                 for f in sec.falsifiers:
                     sets = ", ".join(f"{k}={v}" for k, v in f.overrides.items())
                     run = f"{f.scenario} " if f.scenario else ""
                     h.append(
-                        f"<tr><td>{_e(f.row)}</td><td>{_e(f.name)}</td><td>{_e(f.replaces)}</td>"
-                        f"<td>{_e(run + sets)}</td><td>{_e(f.why)}</td></tr>"
+                        f"<tr><td>{_e(f.row)}</td><td><b>{_e(f.name)}</b><br>replaces "
+                        f"{_e(f.replaces)}: <code>{_e(run + sets)}</code></td>"
+                        f"<td>{_e(f.why)}</td></tr>"
                     )
                 h.append("</table>")
         if sec.ablations:
