@@ -11,6 +11,7 @@ import click
 
 from replay import completion as complete
 from replay.console import fail, note, quoted_warnings, say
+from replay.log import LogError
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.lock import SweepOutputError
 from replay.sweep.spec import SweepSpecError
@@ -253,6 +254,8 @@ def ablate(
                     fail(f"cannot store {sf.name}'s table: {exc.strerror or exc}", code=_code(exc))
         try:
             plots = ablations.plot(sf, table, out)
+        except LogError as exc:  # a link or another program's file at a plot's path
+            fail(f"{sf.name}: {exc}")
         except OSError as exc:
             fail(f"cannot write {sf.name}'s plots to {out}: {exc.strerror or exc}", code=_code(exc))
         for path in plots:

@@ -206,6 +206,7 @@ def test_markdown_text_holds_no_autolink(text):
 
 def test_markdown_autolinks_as_github_renders_them():
     import cmarkgfm  # GitHub's parser (cmark-gfm; the test extra installs it)
+
     for text in LINKS:
         html = cmarkgfm.github_flavored_markdown_to_html(f"seed {md(text)} and | {md(text)} |")
         assert "<a " not in html, (text, html)
@@ -246,3 +247,19 @@ def test_a_report_of_a_log_naming_links_renders_none(base_log, tmp_path):
     block = html.split('<h2 id="commands">Commands</h2>', 1)[1].split("</pre>", 1)[0]
     assert not any(line.startswith("curl") for line in block.splitlines()), block
     assert "www\\.x.y" in outside_code and "www.x.y" not in outside_code
+
+
+def test_ablate_refuses_a_link_at_a_plot_path_in_one_line(tmp_path, monkeypatch):
+    """`replay ablate NAME --plot-only` redraws from the stored table: a link planted at a plot's
+    path is refused (exit 2, one line), its target untouched."""
+    monkeypatch.chdir(tmp_path)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("secret")
+    plots = tmp_path / "out" / "ablations" / "catch_arm_limits"
+    plots.mkdir(parents=True)
+    (plots / "ablation_catch_arm_limits.svg").symlink_to(victim)
+    r = CliRunner().invoke(main, ["ablate", "catch_arm_limits", "--plot-only"])
+    assert r.exit_code == 2, r.output
+    lines = [line for line in r.output.splitlines() if line.startswith("error: ")]
+    assert len(lines) == 1 and "symbolic link" in lines[0] and "Traceback" not in r.output
+    assert victim.read_text() == "secret"
