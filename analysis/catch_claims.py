@@ -232,7 +232,7 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     cs = log.series(TOPIC_CATCHING_STATE)
     ev = events(log)
     run = CatchRun(
-        name=name or sc["name"],
+        name=name or log.scenario().get("name") or "?",  # (clipped by the reader)
         scenario=sc,
         # the typed scenario: no default here; a run of another controller (the feedback
         # baseline) has no mapping and is named by its controller
