@@ -19,6 +19,13 @@ from analysis.ablation_table import (
     rate_at,  # noqa: E402
     rate_by,
 )
+from analysis.ablation_plot import (  # noqa: E402
+    RATE_NOTE,
+    counts_by,
+    plain_log_ticks,
+    plot_rates,
+    shifts,
+)
 from analysis.figure_files import save  # noqa: E402
 
 
@@ -56,10 +63,11 @@ def catch_metrics(log) -> dict:
 
 def _rate_axes(ax, xlabel: str, log_x: bool = False) -> None:
     ax.set_xlabel(xlabel)
-    ax.set_ylabel("catch rate")
+    ax.set_ylabel(f"catch rate k/n\n({RATE_NOTE})", fontsize=8)
     ax.set_ylim(-0.05, 1.05)
     if log_x:
         ax.set_xscale("log")
+        plain_log_ticks(ax)
     ax.grid(True, alpha=0.3)
 
 
@@ -68,6 +76,7 @@ def _near_axes(ax, xlabel: str, log_x: bool = True) -> None:
     ax.set_ylabel("ball speed rel. to hand\nat first hand contact [m/s]", fontsize=8)
     if log_x:
         ax.set_xscale("log")
+        plain_log_ticks(ax)
     ax.grid(True, alpha=0.3)
 
 
@@ -75,10 +84,9 @@ def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     x, line = "sensors.stereo.rate", "sensors.stereo.latency"
     speeds = mean_by(rows, x, line, "x.contact_speed")
-    for lat, (xs, ys) in sorted(
-        rate_by(rows, x, line, caught).items(), key=lambda kv: float(kv[0])
-    ):
-        ax.plot(xs, ys, "o-", label=f"latency {float(lat) * 1e3:g} ms")
+    curves = sorted(counts_by(rows, x, line, caught).items(), key=lambda kv: float(kv[0]))
+    for (lat, (xs, ks, ns)), dx in zip(curves, shifts(len(curves), 0.02)):
+        plot_rates(ax, xs, ks, ns, "o-", f"latency {float(lat) * 1e3:g} ms", dx, log_x=True)
         ax2.plot(*speeds[lat], "o-")
     _rate_axes(ax, "", log_x=True)
     _near_axes(ax2, "stereo frame rate [Hz]")
@@ -90,8 +98,8 @@ def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 def plot_throw_speed(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
-    ((xs, ys),) = rate_by(rows, "throw_speed", None, caught).values()
-    ax.plot(xs, ys, "o-", color="tab:blue")
+    ((xs, ks, ns),) = counts_by(rows, "throw_speed", None, caught).values()
+    plot_rates(ax, xs, ks, ns, "o-", "catch rate", color="tab:blue")
     ax2.plot(*mean_by(rows, "throw_speed", None, "x.contact_speed")[""], "o-", color="tab:blue")
     for a in (ax, ax2):
         a.axvspan(
@@ -113,10 +121,9 @@ def plot_arm_limits(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     x, line = "joint_speed_limit", "torque_scale"
     speeds = mean_by(rows, x, line, "x.contact_speed")
-    for scale, (xs, ys) in sorted(
-        rate_by(rows, x, line, caught).items(), key=lambda kv: float(kv[0])
-    ):
-        ax.plot(xs, ys, "o-", label=f"torque limits x{scale}")
+    curves = sorted(counts_by(rows, x, line, caught).items(), key=lambda kv: float(kv[0]))
+    for (scale, (xs, ks, ns)), dx in zip(curves, shifts(len(curves), 0.02)):
+        plot_rates(ax, xs, ks, ns, "o-", f"torque limits x{scale}", dx, log_x=True)
         ax2.plot(*speeds[scale], "o-")
     _rate_axes(ax, "", log_x=True)
     _near_axes(ax2, "enforced joint speed limit [rad/s]")
@@ -132,16 +139,21 @@ def plot_direct_vs_predictive(rows: list[dict], out: Path, stem: str) -> list[Pa
         "catch_optimised": ("tab:blue", "direct mapping"),
         "predictive_catch": ("tab:orange", "predict-then-intercept"),
     }
-    for (method, kick), sub in sorted(_split(rows, "scenario", "kick").items()):
-        ((xs, ys),) = rate_by(sub, "camera", None, caught).values()
+    groups = sorted(_split(rows, "scenario", "kick").items())
+    for ((method, kick), sub), dx in zip(groups, shifts(len(groups), 0.02)):
+        ((xs, ks, ns),) = counts_by(sub, "camera", None, caught).values()
         color, label = styles.get(method, ("0.4", method))
         style = "o-" if kick == "none" else "s--"
-        ax.plot(
+        plot_rates(
+            ax,
             xs,
-            ys,
+            ks,
+            ns,
             style,
+            f"{label}, {'no kick' if kick == 'none' else 'mid-flight kick'}",
+            dx,
+            log_x=True,
             color=color,
-            label=f"{label}, {'no kick' if kick == 'none' else 'mid-flight kick'}",
         )
         ax2.plot(*mean_by(sub, "camera", None, "x.contact_speed")[""], style, color=color)
     _rate_axes(ax, "", log_x=True)

@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.ablation_table import grasped, mean_by, overall, pct, rate_by  # noqa: E402
+from analysis.ablation_plot import RATE_NOTE, counts_by, plot_rates, shifts  # noqa: E402
 from analysis.figure_files import save  # noqa: E402
 
 PERIOD = "loop_period_ms"
@@ -25,18 +26,18 @@ def plot_loops(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     errors = mean_by(rows, PERIOD, SPEED, TRACKING)
     periods: set = set()
-    curves = sorted(rate_by(rows, PERIOD, SPEED, grasped).items(), key=lambda kv: float(kv[0]))
-    for i, (speed, (xs, ys)) in enumerate(curves):
+    curves = sorted(counts_by(rows, PERIOD, SPEED, grasped).items(), key=lambda kv: float(kv[0]))
+    for i, ((speed, (xs, ks, ns)), dx) in enumerate(zip(curves, shifts(len(curves), 0.02))):
         # markers shrink line by line so that coinciding curves stay visible
         style = {
             "marker": "osD^v"[i % 5],
             "markersize": 9 - 2 * (i % 4),
             "lw": 2.4 - 0.6 * (i % 4),
-            "label": f"object {float(speed):g} m/s RMS",
         }
-        ax.plot(xs, ys, **style)
+        label = f"object {float(speed):g} m/s RMS"
+        plot_rates(ax, xs, ks, ns, "-", label, dx, log_x=True, **style)
         ex, ey = errors[speed]
-        ax2.plot(ex, np.asarray(ey) * 1e3, **style)
+        ax2.plot(ex, np.asarray(ey) * 1e3, label=label, **style)
         periods.update(xs)
     for a in (ax, ax2):
         a.axvline(1.0, color="0.5", lw=0.8, ls=":", label="paper: 1 ms" if a is ax else None)
@@ -45,7 +46,7 @@ def plot_loops(rows: list[dict], out: Path, stem: str) -> list[Path]:
         a.minorticks_off()
         a.grid(True, alpha=0.3)
     ax.set_ylim(-0.05, 1.05)
-    ax.set_ylabel("grasp rate")
+    ax.set_ylabel(f"grasp rate k/n\n({RATE_NOTE})", fontsize=8)
     ax2.set_ylabel("RMS tracking error\nbefore the grasp [mm]", fontsize=8)
     ax2.set_xlabel("loop period of every task and the vision chip [ms]")
     ax.legend(fontsize=8)

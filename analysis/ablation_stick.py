@@ -13,6 +13,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.ablation_table import captured, rate_by  # noqa: E402
+from analysis.ablation_plot import (  # noqa: E402
+    RATE_NOTE,
+    counts_by,
+    plain_log_ticks,
+    plot_rates,
+    shifts,
+)
 from analysis.figure_files import save  # noqa: E402
 from replay.sweep.table import as_float  # noqa: E402
 
@@ -68,16 +75,19 @@ def plot_friction(rows: list[dict], out: Path, stem: str) -> list[Path]:
 
 def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for noise, (xs, ys) in sorted(
-        rate_by(rows, "camera", "sensors.camera.params.noise_sigma", captured).items(),
+    curves = sorted(
+        counts_by(rows, "camera", "sensors.camera.params.noise_sigma", captured).items(),
         key=lambda kv: float(kv[0]),
-    ):
-        ax.plot(xs, ys, "o-", label=f"pixel noise σ = {float(noise):g} grey levels")
+    )
+    for (noise, (xs, ks, ns)), dx in zip(curves, shifts(len(curves), 0.02)):
+        label = f"pixel noise σ = {float(noise):g} grey levels"
+        plot_rates(ax, xs, ks, ns, "o-", label, dx, log_x=True)
     ax.axvline(300, color="0.5", lw=0.8, ls=":", label="paper: 300 fps")
     ax.set_xscale("log")
+    plain_log_ticks(ax)
     ax.set_ylim(-0.05, 1.05)
     ax.set_xlabel("camera frame rate [Hz] (latency one frame)")
-    ax.set_ylabel("capture rate")
+    ax.set_ylabel(f"capture rate k/n\n({RATE_NOTE})", fontsize=8)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title("3-step strategy: capture rate vs vision rate and noise", fontsize=10)

@@ -179,3 +179,55 @@ def test_grasp_fig9_footer_explains_only_what_is_drawn():
         assert ticks and list(ticks[0].get_xdata()) == [1.2]
     finally:
         plt.close(fig)
+
+
+# -- the ablation plots: rates as k/n with Wilson 95 % intervals -------------------------------
+
+ABLATIONS = [
+    ("analysis.ablation_catch", "plot_vision", "catch_vision"),
+    ("analysis.ablation_catch", "plot_throw_speed", "catch_throw_speed"),
+    ("analysis.ablation_catch", "plot_arm_limits", "catch_arm_limits"),
+    ("analysis.ablation_catch", "plot_direct_vs_predictive", "catch_direct_vs_predictive"),
+    ("analysis.ablation_stick", "plot_vision", "stick_vision"),
+    ("analysis.ablation_grasp", "plot_loops", "grasp_loops"),
+]
+
+
+@pytest.mark.parametrize("module, func, table", ABLATIONS)
+def test_ablation_rates_have_n_and_wilson_error_bars(module, func, table, monkeypatch, tmp_path):
+    import importlib
+
+    from matplotlib.container import ErrorbarContainer
+
+    from analysis.ablation_catch import wilson
+    from replay.sweep.table import read_table
+
+    mod = importlib.import_module(module)
+    drawn = []
+    monkeypatch.setattr(mod, "save", lambda fig, out, stem: drawn.append(fig) or [])
+    rows = read_table(ROOT / "data" / "ablations" / f"{table}.csv")
+    getattr(mod, func)(rows, tmp_path, table)
+    (fig,) = drawn
+    try:
+        assert_readable(fig)
+        ax = fig.axes[0]
+        bars = [c for c in ax.containers if isinstance(c, ErrorbarContainer)]
+        assert bars, "no error bars"
+        n_rows = 0
+        for c in bars:
+            assert "n = " in c.get_label(), c.get_label()
+            line, _, (segments,) = c.lines[0], c.lines[1], c.lines[2]
+            ys = line.get_ydata()
+            n = int(c.get_label().split("n = ")[1].split("-")[0].rstrip(")"))
+            for y, seg in zip(ys, segments.get_segments()):
+                if "-" in c.get_label().split("n = ")[1]:
+                    break  # (n differs between points: checked by the count below)
+                lo, hi = wilson(round(y * n), n)
+                assert seg[:, 1].min() == pytest.approx(lo) and seg[:, 1].max() == pytest.approx(hi)
+            n_rows += len(ys)
+        assert n_rows >= 2
+        for a in fig.axes:  # (mathtext is off: no '$\\mathdefault{10^{2}}$' tick labels)
+            fig.canvas.draw()
+            assert not any("$" in t.get_text() for t in a.get_xticklabels())
+    finally:
+        plt.close(fig)
