@@ -22,10 +22,8 @@ REPLAY = [sys.executable, "-m", "replay.cli"]
 
 CONTROLLER = """\
 from dataclasses import dataclass
-from pathlib import Path
 from replay.interfaces import Controller
 from replay.params import param
-Path("imported.marker").write_text("the module ran")  # (cwd) seen by the log-reading test
 
 @dataclass
 class HoldParams:
@@ -150,7 +148,12 @@ def test_the_cli_runs_a_plugin_from_a_file_and_refuses_a_bad_one(tmp_path):
     assert r.returncode == 2, r.stderr
     assert "ok: " in r.stdout and "my_controller.yaml" in r.stdout
     lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and "has no 'Nope'" in lines[0] and "Traceback" not in r.stderr
+    errors = [line for line in lines if line.startswith("error: ")]
+    assert len(errors) == 1 and "has no 'Nope'" in errors[0] and "Traceback" not in r.stderr
+    # the good one validates, with a warning: GoalKeeper publishes less than the paper's figures read
+    warnings = [line for line in lines if line.startswith("warning: ")]
+    assert len(warnings) == 1 and "/effector/state" in warnings[0], lines
+    assert len(lines) == 2
 
 
 def test_set_type_drops_the_old_params():
