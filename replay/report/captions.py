@@ -12,5 +12,8 @@ CAPTIONS = {
         8: "Time response of joint angles.",
         9: "Time response of joint command torques.",
     },
-    "namiki1999": {},
+    "namiki1999": {
+        # (Figs. 6-8 are drawn as one filmstrip of the run, captioned by its file name)
+        9: "Feedback Response",
+    },
 }

@@ -6,6 +6,7 @@ the room (it was squeezed into ~100 px beside unbreakable override strings)."""
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import pytest
@@ -15,6 +16,8 @@ from analysis.claims import counted
 from replay.cli import main
 from replay.report.builder import HEADLINE, _headline, build_report
 
+ROOT = Path(__file__).resolve().parents[2]
+
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory) -> Path:
@@ -22,6 +25,7 @@ def report(tmp_path_factory) -> Path:
     for name in ("stick_2step", "catch_optimised"):
         r = CliRunner().invoke(main, ["run", name, "-q", "-o", str(logs / f"{name}.mcap")])
         assert r.exit_code == 0, r.output
+    shutil.copy(ROOT / "data" / "golden" / "grasp_hexahedron.mcap", logs)
     out = tmp_path_factory.mktemp("out") / "report"
     build_report(out, logs)
     return out
@@ -110,3 +114,8 @@ def test_falsifier_explanation_is_wide_in_chromium(report):
     assert widths
     for table, why in widths:
         assert why >= 0.4 * table and why >= 300, (table, why)
+
+
+def test_grasp_fig9_quotes_the_papers_caption(report):
+    md = (report / "index.md").read_text()
+    assert "Fig. 9 (paper: “Feedback Response”). Regenerated from the run 'grasp_hexahedron'" in md
