@@ -3,8 +3,9 @@
 Per paper: the regenerated figures (from the runs' logs, with the paper's captions), the claims
 table, the ablation plots (each redrawn from its sweep table: this machine's run under
 out/ablations/, else the stored one under data/ablations/) with one sentence of what each shows,
-computed from the same table. Then the versions, seeds and commands that made it. Everything the
-page links to is copied under the report directory, so the folder is self-contained.
+computed from the same table; above them a headline across papers (rows reproduced, and that
+the falsifiers are listed, not run, here). Then the versions, seeds and commands that made it.
+Everything the page links to is copied under the report directory, so it is self-contained.
 
 What comes from a log (a run's name, its seed, a caption quoting the name) is data: escaped in
 both pages (``markup``), and the report links only files inside its own folder (``folder``).
