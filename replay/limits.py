@@ -47,6 +47,12 @@ LIMITS: dict[str, Limit] = {
             "bytes",
             "the messages of one topic a reader decodes and keeps (e.g. all events)",
         ),
+        Limit(
+            "viewer_bytes",
+            1_000_000_000,
+            "bytes",
+            "what the viewer keeps of one run (its series as numbers, its camera images)",
+        ),
         Limit("log_bytes", 8_000_000_000, "bytes", "the projected size of a run's log"),
     )
 }

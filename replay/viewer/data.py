@@ -7,7 +7,7 @@ a topic's first message. The same accumulator grows during a live run (``replay 
 where the runner hands it each message as it is written.
 
 A log is someone else's data: what one run keeps (columns at 8 bytes a number, events, topics)
-is at most ``series_bytes`` (:mod:`replay.limits`), counted as it is allocated; the count in
+is at most ``viewer_bytes`` (:mod:`replay.limits`), counted as it is allocated; the count in
 the log's statistics only sizes the first allocation, up to :data:`HINT_BYTES`; a label or an
 event field too big to be a name or a detail is left out, and a note says so.
 """
@@ -61,10 +61,10 @@ def _size(value, cap: int) -> int:
 
 
 class _Budget:
-    """What one run keeps, counted against ``series_bytes`` (read once)."""
+    """What one run keeps, counted against ``viewer_bytes`` (read once)."""
 
     def __init__(self) -> None:
-        self.cap = limit("series_bytes")
+        self.cap = limit("viewer_bytes")
         self.used = 0
 
     def left(self) -> int:
@@ -72,7 +72,7 @@ class _Budget:
 
     def take(self, n: int, topic: str) -> None:
         """Count ``n`` more bytes, kept for ``topic``; :class:`LimitError` past the limit."""
-        check("series_bytes", self.used + n, f"what the viewer keeps of one run (at {topic})")
+        check("viewer_bytes", self.used + n, f"what the viewer keeps of one run (at {topic})")
         self.used += n
 
 
@@ -314,7 +314,7 @@ class RunAccumulator:
         self._lock = threading.Lock()
 
     def add(self, topic: str, t_ns: int, data: dict) -> None:
-        """Keep a message; past the run's ``series_bytes``, none more (``full`` says why)."""
+        """Keep a message; past the run's ``viewer_bytes``, none more (``full`` says why)."""
         with self._lock:
             if self.full:
                 return

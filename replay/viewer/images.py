@@ -84,17 +84,17 @@ def _marks(reader: LogReader, sensor_type: str, sensor: dict, view: str, times: 
 
 def load_image_tracks(path: str | Path, sensors: dict) -> list[ImageTrack]:
     """Every camera view's images in the log at ``path`` (``sensors``: the scenario's), at
-    most ``series_bytes`` of them as stored (each image is a view of its stored bytes):
+    most ``viewer_bytes`` of them as stored (each image is a view of its stored bytes):
     :class:`LimitError` past it."""
     reader = LogReader(path)
     found: dict[str, tuple[list, list]] = {}
-    cap, kept = limit("series_bytes"), 0
+    cap, kept = limit("viewer_bytes"), 0
     for m in reader.raw():
         if m.topic.startswith(CAMERA_PREFIX) and m.schema == "foxglove.RawImage":
             kept += len(m.data)
             if kept > cap:
                 try:
-                    check("series_bytes", kept, f"{path}: its camera images (read so far)")
+                    check("viewer_bytes", kept, f"{path}: its camera images (read so far)")
                 except LimitError as exc:
                     raise ViewerError(str(exc)) from None
             ts, images = found.setdefault(m.topic, ([], []))

@@ -3,7 +3,7 @@
 - The count in a log's statistics only sizes the first allocation: a 3-message log that claims
   10^9 messages allocates kilobytes, not gigabytes.
 - A topic whose first message is wide and whose other messages are not (ragged rows) is one
-  error line naming ``REPLAY_LIMIT_SERIES_BYTES``, before the memory is spent; in a live run
+  error line naming ``REPLAY_LIMIT_VIEWER_BYTES``, before the memory is spent; in a live run
   the accumulator stops keeping messages and notes why, never raising into the run.
 - Event fields and labels too big to be a detail or a name are left out, with a note.
 - A 2 MB scenario name is a short label; a host the server cannot listen on (an IPv4-mapped
@@ -76,7 +76,7 @@ def test_a_lying_message_count_allocates_little(tmp_path):
 
 def test_ragged_wide_rows_are_one_error_naming_the_limit(tmp_path, monkeypatch):
     log = _wide_log(tmp_path / "wide.mcap", 2000, 10_000)  # 160 MB of NaN rows if kept
-    monkeypatch.setenv("REPLAY_LIMIT_SERIES_BYTES", str(20 * 2**20))
+    monkeypatch.setenv("REPLAY_LIMIT_VIEWER_BYTES", str(20 * 2**20))
     tracemalloc.start()
     try:
         with pytest.raises(ViewerError) as err:
@@ -86,14 +86,14 @@ def test_ragged_wide_rows_are_one_error_naming_the_limit(tmp_path, monkeypatch):
         tracemalloc.stop()
     assert peak < 64 * 2**20, f"{peak:,} bytes kept"
     text = str(err.value)
-    assert "REPLAY_LIMIT_SERIES_BYTES" in text and "/x" in text and "\n" not in text
-    monkeypatch.setenv("REPLAY_LIMIT_SERIES_BYTES", str(200 * 2**20))
+    assert "REPLAY_LIMIT_VIEWER_BYTES" in text and "/x" in text and "\n" not in text
+    monkeypatch.setenv("REPLAY_LIMIT_VIEWER_BYTES", str(200 * 2**20))
     assert len(load_run(log).tracks["/x"]) == 2000  # raised, it loads
 
 
 def test_view_of_a_wide_log_is_one_error_line(tmp_path):
     log = _wide_log(tmp_path / "wide.mcap", 2000, 10_000)
-    env = {**os.environ, "REPLAY_LIMIT_SERIES_BYTES": str(20 * 2**20)}
+    env = {**os.environ, "REPLAY_LIMIT_VIEWER_BYTES": str(20 * 2**20)}
     r = subprocess.run(
         [*REPLAY, "view", str(log), "--port", "0", "--timeout", "1"],
         capture_output=True,
@@ -104,19 +104,19 @@ def test_view_of_a_wide_log_is_one_error_line(tmp_path):
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error:"), r.stderr
-    assert "REPLAY_LIMIT_SERIES_BYTES" in lines[0] and "MemoryError" not in lines[0]
+    assert "REPLAY_LIMIT_VIEWER_BYTES" in lines[0] and "MemoryError" not in lines[0]
 
 
 def test_a_live_run_past_the_limit_stops_keeping_and_says_so(monkeypatch):
-    monkeypatch.setenv("REPLAY_LIMIT_SERIES_BYTES", str(2**20))
+    monkeypatch.setenv("REPLAY_LIMIT_VIEWER_BYTES", str(2**20))
     acc = RunAccumulator()
     for k in range(100_000):  # 100k x 2 numbers x 8 bytes: past 1 MiB
         acc.add(TOPIC_STICK_STATE, k * 10**6, {"t": k * 1e-3, "x": 1.0})
-    assert acc.full and "REPLAY_LIMIT_SERIES_BYTES" in acc.full
+    assert acc.full and "REPLAY_LIMIT_VIEWER_BYTES" in acc.full
     run = acc.snapshot()
     kept = len(run.tracks[TOPIC_STICK_STATE])
     assert 0 < kept < 100_000
-    assert "not kept" in run.notes[0] and "REPLAY_LIMIT_SERIES_BYTES" in run.notes[0]
+    assert "not kept" in run.notes[0] and "REPLAY_LIMIT_VIEWER_BYTES" in run.notes[0]
 
 
 def test_big_event_fields_and_labels_are_left_out_with_a_note():
@@ -159,11 +159,11 @@ def test_an_ipv4_mapped_host_is_refused_at_once(tmp_path):
 
 
 def test_many_fields_and_topics_count_against_the_limit(monkeypatch):
-    monkeypatch.setenv("REPLAY_LIMIT_SERIES_BYTES", str(2**20))
+    monkeypatch.setenv("REPLAY_LIMIT_VIEWER_BYTES", str(2**20))
     acc = RunAccumulator()
     acc.add("/wide", 0, {f"k{i}": 1.0 for i in range(10_000)})  # 10,000 columns of one row
-    assert "REPLAY_LIMIT_SERIES_BYTES" in acc.full
+    assert "REPLAY_LIMIT_VIEWER_BYTES" in acc.full
     acc = RunAccumulator()
     for i in range(1000):  # a thousand topics of one message
         acc.add(f"/t{i}", 0, {"t": 0.0, "x": 1.0})
-    assert "REPLAY_LIMIT_SERIES_BYTES" in acc.full and len(acc.builders) < 1000
+    assert "REPLAY_LIMIT_VIEWER_BYTES" in acc.full and len(acc.builders) < 1000
