@@ -182,6 +182,7 @@ def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, .
             + ") rad/s;  joints 1, 2, 4",
             fontsize=7,
             color="0.35",
+            va="bottom",
         )
     for ax in (ax_t, ax_w):
         ax.grid(alpha=0.3)
@@ -265,6 +266,7 @@ def fig7(runs: list[CatchRun], title: str):
         "l(q): the catch point (ball centre on the palm); " + _lines_said(drawn),
         fontsize=7,
         color="0.35",
+        va="bottom",
     )
     fig.tight_layout(rect=(0, 0.02, 1, 0.97))
     line_labels.place(axes[0], named)
@@ -359,6 +361,7 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
         note + ";\nfrom t₀ to the first contact; " + _lines_said(drawn),
         fontsize=7,
         color="0.35",
+        va="bottom",
     )
     fig.tight_layout(rect=(0, 0.04, 1, 1))  # (the footer's two lines below)
     line_labels.place(axes[0], named)

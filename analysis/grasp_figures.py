@@ -150,6 +150,7 @@ def fig9(run: GraspRun):
         _footer(drawn),
         fontsize=7,
         color="0.35",
+        va="bottom",
     )
     fig.tight_layout(rect=(0, 0.04, 1, 1))
     return fig
@@ -302,6 +303,7 @@ def filmstrip(run: GraspRun, title: str):
         f"(purple, as long as the distance to the object); view azimuth {math.degrees(VIEW[0]):.0f}°, elevation {math.degrees(VIEW[1]):.0f}°",
         fontsize=7,
         color="0.35",
+        va="bottom",
     )
     fig.tight_layout(rect=(0, 0.02, 1, 0.96))
     return fig

@@ -55,6 +55,7 @@ def fig7(log: LogReader, title: str = ""):
         "dashed: fingertip-stick collisions #index (from /events); green: capture",
         fontsize=7,
         color="0.35",
+        va="bottom",
     )
     fig.tight_layout()
     line_labels.place(ax_v, marks)  # (close collisions' labels stagger down)

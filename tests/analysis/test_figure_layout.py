@@ -34,6 +34,7 @@ def logs(tmp_path_factory) -> dict[str, LogReader]:
 
 
 def _renderer(fig):
+    fig.set_dpi(150)  # as figure_files.save writes the PNG (text metrics differ with the dpi)
     fig.canvas.draw()
     return fig.canvas.get_renderer()
 
