@@ -212,3 +212,40 @@ def test_the_python_api_from_the_wheel(installed):
     out = _sh([replay.parent / "python", "-c", code], cwd=api, env=env)
     assert "api ok 35" in out, out[-2000:]  # 0.35 s of /stick/state at 1 kHz: 350 or 351
     assert sorted(p.name for p in api.iterdir()) == ["api.mcap"]
+
+
+def test_variants_of_an_experiment_are_overlaid_and_labelled_from_an_empty_folder(
+    installed, tmp_path
+):
+    """Issue #37's first "done when": the paper's catch pair plus a variant that differs in one
+    parameter, and two stick runs at two frictions, from a non-editable install in an empty
+    folder: the report's figures name every run by its difference, none is left out, and
+    `compare` puts the variant beside the paper's run."""
+    replay, _, env = installed
+    work = tmp_path / "runs"
+    work.mkdir()
+    runs = {
+        "catch_optimised": ["catch_optimised"],
+        "catch_initial": ["catch_initial"],
+        "lat10": ["catch_optimised", "--set", "sensors.stereo.latency=0.01"],
+        "stick_mu03": ["stick_3step", "--set", "plant.params.stick.friction=0.3"],
+        "stick_mu10": ["stick_3step", "--set", "plant.params.stick.friction=1.0"],
+    }
+    for name, args in runs.items():
+        _sh([replay, "run", *args, "--quiet", "-o", work / f"{name}.mcap"], cwd=work, env=env)
+    out = _sh([replay, "figures", *sorted(work.glob("*.mcap")), "-o", "figs"], cwd=work, env=env)
+    assert "in no figure" not in out and "Traceback" not in out, out[-2000:]
+    _sh([replay, "report", "-o", "report", "--logs", work], cwd=work, env=env)
+    html = (work / "report" / "index.html").read_text(encoding="utf-8")
+    captions = re.findall(r"<figcaption>(.*?)</figcaption>", html, re.S)
+    for fig in ("Fig. 6", "Fig. 7", "Fig. 8", "Fig. 9"):
+        caption = next(c for c in captions if c.startswith(fig) and "catch_initial" in c)
+        assert "catch_optimised (stereo latency 10 ms)" in caption, caption
+    stick = [c for c in captions if "stick_3step" in c and "friction" in c]
+    assert stick, [c[:120] for c in captions]
+    out = _sh(
+        [replay, "compare", work / "catch_optimised.mcap", work / "lat10.mcap", "--no-figures"],
+        cwd=work,
+        env=env,
+    )
+    assert "latency" in out and "Traceback" not in out, out[-2000:]
