@@ -118,8 +118,11 @@ def _gone(pids: list[int], port: int, within: float = 20.0) -> None:
     for p in left:  # (a failed test leaves nothing behind either)
         os.kill(p, signal.SIGKILL)
     assert not left, f"Rerun's processes {left} outlived the command"
-    for p in (port, port + 1):  # nothing listens any more
-        with socket.socket() as s:
+    for p in (port, port + 1):  # nothing listens any more (a closed connection's TIME_WAIT
+        with (
+            socket.socket() as s
+        ):  # may hold the port: SO_REUSEADDR binds past that, not a listener)
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             s.bind(("127.0.0.1", p))
 
 
