@@ -118,10 +118,10 @@ def _gone(pids: list[int], port: int, within: float = 20.0) -> None:
     for p in left:  # (a failed test leaves nothing behind either)
         os.kill(p, signal.SIGKILL)
     assert not left, f"Rerun's processes {left} outlived the command"
-    for p in (port, port + 1):  # nothing listens any more (a closed connection's TIME_WAIT
-        with (
-            socket.socket() as s
-        ):  # may hold the port: SO_REUSEADDR binds past that, not a listener)
+    # nothing listens any more (a closed connection's TIME_WAIT may hold the port for a plain
+    # bind: with SO_REUSEADDR it binds past that, never past a listener)
+    for p in (port, port + 1):
+        with socket.socket() as s:
             s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             s.bind(("127.0.0.1", p))
 
