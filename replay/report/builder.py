@@ -17,17 +17,19 @@ import platform
 import re
 import shlex
 import shutil
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field, replace
 from importlib import metadata
 from pathlib import Path
+
+import yaml
 
 from analysis.figure_files import file_stem, runs_of
 from analysis.needs import figure_notes, skipped_notes
 from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
-from replay.report.captions import CAPTIONS
+from replay.report.captions import CAPTIONS, DRAWN_FOR
 from replay.report.folder import check_folder, staging, swap_in
 from replay.report.markup import e as _e
 from replay.report.markup import md, md_code, md_fence, pre, url
@@ -122,12 +124,36 @@ def _shows(runs: Sequence[str], readers: dict[str, LogReader]) -> str:
     return f" Regenerated from the run{'s' if len(said) > 1 else ''} {', '.join(said)}."
 
 
-def _caption(paper: str, stem: str, shows: str) -> str:
+def _caption(paper: str, stem: str, shows: str, controllers: Collection[str] = ()) -> str:
+    """The paper's caption of the figure ``stem`` draws again, and the runs it ``shows``; "cf."
+    when a run's ``controllers`` are not the method the paper's figure is drawn for."""
     m = re.search(r"fig(\d+)", stem)
     num = int(m.group(1)) if m else 0
     quoted = CAPTIONS.get(paper, {}).get(num)
     base = f"Fig. {num}" if num else stem
+    drawn_for = DRAWN_FOR.get((paper, num))
+    others = sorted(c for c in controllers if c != drawn_for)
+    if quoted and drawn_for and others:
+        return (
+            f"Cf. {base}, which the paper draws for {drawn_for} (paper: “{quoted}”); this "
+            f"figure shows {', '.join(others)}.{shows}"
+        )
     return f"{base} (paper: “{quoted}”).{shows}" if quoted else f"{base}.{shows}"
+
+
+def _controllers(runs, readers) -> set[str]:
+    """The controller types of the runs ``runs`` (keys of ``readers``), from their logs."""
+    types = set()
+    for key in runs:
+        r = readers.get(key)
+        try:
+            sc = yaml.safe_load(r.scenario()["yaml"]) if r is not None else None
+            kind = sc["controller"]["type"]
+        except (LogError, yaml.YAMLError, KeyError, TypeError):
+            continue
+        if isinstance(kind, str):
+            types.add(kind)
+    return types
 
 
 def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/logs") -> Path:
@@ -195,7 +221,7 @@ def _build(out: Path, logs_dir: Path) -> None:
                     Figure(
                         png.relative_to(out).as_posix(),
                         svg.relative_to(out).as_posix() if svg.is_file() else "",
-                        _caption(key, png.stem, _shows(runs, readers)),
+                        _caption(key, png.stem, _shows(runs, readers), _controllers(runs, readers)),
                     )
                 )
             sec.notes += figure_notes(readers, shown, figure_skips)

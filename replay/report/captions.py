@@ -17,3 +17,11 @@ CAPTIONS = {
         9: "Feedback Response",
     },
 }
+
+# the method a figure of the paper is drawn for, where its caption names one: the same figure of
+# a run of another method is captioned "cf." and names both (a 2-step run's Fig. 7 is not the
+# paper's 3-step Fig. 7)
+DRAWN_FOR = {
+    ("higashimori2007", 6): "stick_3step",
+    ("higashimori2007", 7): "stick_3step",
+}

@@ -62,6 +62,12 @@ def test_every_caption_names_the_runs_its_figure_shows(logs, tmp_path):
         named = set(re.findall(r"'([^']+)'", caption.replace("\\_", "_")))
         assert named == _expected(stem), (stem, caption)
     assert "in no figure" not in md  # every log is in a figure
+    # the paper's Fig. 7 is drawn for the 3-step strategy: a 2-step run's is a "cf."
+    two = next(c for c, stem in figures if stem == "stick_2step_fig7").replace("\\_", "_")
+    three = next(c for c, stem in figures if stem == "stick_3step_fig7")
+    assert two.startswith("Cf. Fig. 7, which the paper draws for stick_3step"), two
+    assert "this figure shows stick_2step" in two, two
+    assert three.startswith("Fig. 7 (paper:"), three
 
 
 def test_a_plugin_returning_bare_paths_is_captioned_by_the_longest_name():
