@@ -146,9 +146,10 @@ def _controllers(runs, readers) -> set[str]:
     types = set()
     for key in runs:
         r = readers.get(key)
+        if r is None:
+            continue
         try:
-            sc = yaml.safe_load(r.scenario()["yaml"]) if r is not None else None
-            kind = sc["controller"]["type"]
+            kind = yaml.safe_load(r.scenario()["yaml"])["controller"]["type"]
         except (LogError, yaml.YAMLError, KeyError, TypeError):
             continue
         if isinstance(kind, str):
