@@ -43,23 +43,19 @@ from replay.control.stick.hand_model import (
     HandModel,
     base_candidates,
     posture_grid,
-    route_configs,
     finger_tips,
     route_axes,
     route_target,
-    route_tips,
     travel,
 )
 from replay.control.stick.sweep import (
     Motion,
     Sweep,
-    covered_along,
     count_before,
     covered_fixed,
     covered_samples,
     first_covered,
     sample_count,
-    sample_times,
     sample_times_at,
 )
 
@@ -366,9 +362,9 @@ class ContactPlanner:
         """The arrival time of ``route`` if every segment finishes before the next starts, the
         last before t_c - arrive_margin, and no fingertip is hit by the predicted sweep: on the
         way (both tips) and, once arrived, finger k's tip until just before t_c and the idle
-        tip (``sweep_margin`` clear) until t_c + post_horizon. Else None. The answer of
-        :meth:`_route_clear_reference`: the samples while the hand moves in whole arrays, those
-        after it stands still (on its last waypoint) as fixed points
+        tip (``sweep_margin`` clear) until t_c + post_horizon. Else None. The answer of the
+        array oracle (tests/replay/control/stick/oracles.py): the samples while the hand moves
+        in whole arrays, those after it stands still (on its last waypoint) as fixed points
         (``sweep.covered_fixed``: only the samples near the stick made)."""
         p, st, hand = self.params, self.stick, self.hand
         timed = self._route_timing(now, route, t_c)
@@ -454,44 +450,6 @@ class ContactPlanner:
         gap = max(abs(xb) - 0.5 * st.length, abs(yb) - 0.5 * st.width) - 1e-4
         return max(hand.tip_radius - 5e-4, min(hand.tip_radius + p.sweep_margin, gap))
 
-    def _route_clear_reference(
-        self,
-        t: float,
-        now: Config,
-        route: list,
-        k: int,
-        motion: Motion,
-        t_c: float,
-        check_idle: bool = True,
-    ) -> float | None:
-        """:meth:`route_clear` in whole-array NumPy (its reference, test_sweep_paths.py)."""
-        p, st, hand = self.params, self.stick, self.hand
-        timed = self._route_timing(now, route, t_c)
-        if timed is None:
-            return None
-        arrival, starts, frm, to = timed
-        # sampled every SAMPLE_DT from t: the hand along the route (route_configs, route_tips);
-        # finger k's tip must stay out of the sweep (sweep.covered_along) until CONTACT_GUARD
-        # before t_c; the idle tip, with check_idle, until t_c + post_horizon, keeping
-        # sweep_margin, or on the way at least the clearance it has now
-        times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
-        base, joints = route_configs(hand, starts, frm, to, times)
-        tips = route_tips(hand, base, joints)
-        half_l, half_w = 0.5 * st.length, 0.5 * st.width
-        act = times <= t_c - CONTACT_GUARD
-        c, th = poses = motion.poses(times)
-        tip_r = hand.tip_radius - 5e-4
-        if covered_along(
-            motion, times[act], tips[act, k], half_l, half_w, tip_r, poses=(c[act], th[act])
-        ).any():
-            return None
-        if check_idle:
-            on_way = self._idle_clearance(t, tips[0, 1 - k], motion)
-            grow = np.where(times < arrival, on_way, hand.tip_radius + p.sweep_margin)
-            if covered_along(motion, times, tips[:, 1 - k], half_l, half_w, grow, poses).any():
-                return None
-        return arrival
-
     def _exit_after(self, cfg: Config, k: int, motion: Motion, t_c: float, tip, n) -> Config | None:
         """Finger k's tip backed away along -n (the way it came, away from the face the contact
         pushes off) out of the stick's reach just after the contact when
@@ -523,8 +481,8 @@ class ContactPlanner:
     def _exit_config(self, t: float, now: Config, motion: Motion) -> Config | None:
         """``now`` with every fingertip within the stick's reach moved radially out of it
         (base kept), or None when no tip is inside or a tip cannot get out. In floats: the
-        operations of the array version (:meth:`_exit_config_reference`; a 2-vector's norm is
-        sqrt(x x + y y), as NumPy's dot sums it here: test_stick_fast_paths.py)."""
+        operations of the array version (tests/replay/control/stick/oracles.py; a 2-vector's
+        norm is sqrt(x x + y y), as NumPy's dot sums it here: test_stick_fast_paths.py)."""
         p, st, hand = self.params, self.stick, self.hand
         cx, cy, _ = motion.pose_floats(t)
         r_in = 0.5 * st.length + hand.tip_radius + p.sweep_margin
@@ -543,30 +501,12 @@ class ContactPlanner:
             cfg, moved = cfg.with_finger(k, q), True
         return cfg if moved else None
 
-    def _exit_config_reference(self, t: float, now: Config, motion: Motion) -> Config | None:
-        """:meth:`_exit_config` on arrays (its reference)."""
-        p, st, hand = self.params, self.stick, self.hand
-        c, _ = motion.pose(t)
-        r_in = 0.5 * st.length + hand.tip_radius + p.sweep_margin
-        r_out = 0.5 * st.length + hand.tip_radius + p.stage_margin
-        cfg, moved = now, False
-        for k in (0, 1):
-            d = now.tip(hand, k) - c
-            dist = float(np.linalg.norm(d))
-            if dist >= r_in or dist < 1e-9:
-                continue
-            q = hand2d.finger_ik(hand, now.base, k, c + d / dist * r_out, q_near=now.joints[k])
-            if q is None:
-                return None
-            cfg, moved = cfg.with_finger(k, q), True
-        return cfg if moved else None
-
     def _passive(self, cfg: Config, j: int, sweep: Sweep, active_tip):
         """The idle finger's joints nearest its current ones whose tip stays clear of the
         predicted sweep (and of the active tip); None when no posture is clear. Postures are
         checked nearest first (ties: current, then grid order), the first clear one wins; a
         posture's tip is worked out only when its turn comes (the floats of the array
-        formulation, :meth:`_passive_reference`, test_stick_fast_paths.py)."""
+        formulation, tests/replay/control/stick/oracles.py)."""
         hand, st, p = self.hand, self.stick, self.params
         cur = cfg.joints[j]
         ax, ay = float(active_tip[0]), float(active_tip[1])
@@ -592,27 +532,4 @@ class ContactPlanner:
         for i in sorted(range(len(dist)), key=dist.__getitem__):  # (stable: ties in order)
             if clear((rx + g0[i]) + g2[i], (ry + g1[i]) + g3[i]):
                 return grid[i]
-        return None
-
-    def _passive_reference(self, cfg: Config, j: int, sweep: Sweep, active_tip):
-        """:meth:`_passive` on arrays: every posture's tip and distance, then the first clear
-        one in order (its reference)."""
-        hand, st, p = self.hand, self.stick, self.params
-        cur = cfg.joints[j]
-        g = self._grid_reach  # (l1 cos q1, l1 sin q1, l2 cos q12, l2 sin q12) of the grid
-        rx, ry = cfg.base[0] + hand.root_offsets[j][0], cfg.base[1] + hand.root_offsets[j][1]
-        tips = np.empty((1 + len(g[0]), 2))
-        tips[0] = hand2d.finger_tip(hand, cfg.base, j, cur)
-        tips[1:, 0] = (rx + g[0]) + g[2]
-        tips[1:, 1] = (ry + g[1]) + g[3]
-        d = tips - np.asarray(active_tip)[None, :]
-        far = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2) > 2.0 * hand.tip_radius + p.sweep_margin
-        grid = self._grid_q
-        dist = np.empty(len(tips))
-        dist[0] = 0.0
-        dist[1:] = np.maximum(np.abs(grid[:, 0] - cur[0]), np.abs(grid[:, 1] - cur[1]))
-        half_l, half_w, grow = 0.5 * st.length, 0.5 * st.width, hand.tip_radius + p.sweep_margin
-        for i in np.lexsort((np.arange(len(tips)), dist)):
-            if far[i] and not sweep.hits(tips[i], half_l, half_w, grow):
-                return tuple(cur) if i == 0 else self._passive_grid[i - 1]
         return None

@@ -18,6 +18,7 @@ from replay.control.stick.plan import Shortfall
 from replay.control.stick.strategy import ThreeStepController, ThreeStepParams
 from replay.control.stick.sweep import Motion, Sweep, covered, sample_times
 
+from tests.replay.control.stick import oracles
 from tests.replay.control.stick.test_stick_method import V0, SyntheticStick, air_spec
 
 
@@ -241,7 +242,7 @@ def test_hand2d_clips_are_np_clips():
 
 def test_passive_posture_search_is_the_array_references():
     """ContactPlanner._passive (postures in order of distance, each tip worked out only when its
-    turn comes) against _passive_reference (every tip and distance as arrays, then the first
+    turn comes) against oracles.passive (every tip and distance as arrays, then the first
     clear one): the same posture or None, for seeded random idle postures, active tips and
     spinning sticks over the idle tip (so that nearer postures are often swept)."""
     ctrl, _, _ = three_step_run(1e-4, t_end=0.12)
@@ -258,7 +259,7 @@ def test_passive_posture_search_is_the_array_references():
         sweep = Sweep(Motion(est, 0.1, tuple(rng.normal(0.0, 1.0, 3))), 0.0, 0.3)
         active = cfg.tip(hand, 1 - j) + rng.normal(0.0, 0.01, 2)
         got = planner._passive(cfg, j, sweep, active)
-        assert got == planner._passive_reference(cfg, j, sweep, active)
+        assert got == oracles.passive(planner, cfg, j, sweep, active)
         compared += 1
         moved += got is not None and got != tuple(cfg.joints[j])
     print(f"_passive = reference in {compared} cases ({moved} moved the idle finger)")
@@ -266,7 +267,7 @@ def test_passive_posture_search_is_the_array_references():
 
 
 def test_exit_config_in_floats_is_the_array_references():
-    """ContactPlanner._exit_config (floats) against _exit_config_reference (NumPy arrays, a
+    """ContactPlanner._exit_config (floats) against oracles.exit_config (NumPy arrays, a
     2-vector's norm by np.linalg.norm): the same configuration or None, for seeded random hands
     with fingertips inside, at the edge of and outside the stick's reach. Within 1e-12: NumPy's
     2-element dot is BLAS's, which may fuse x x + y y on another CPU (equal to the bit here)."""
@@ -284,7 +285,7 @@ def test_exit_config_in_floats_is_the_array_references():
         motion = Motion(est, 0.05, tuple(rng.normal(0.0, 1.0, 3)))
         t = float(rng.uniform(0.0, 0.1))
         got = planner._exit_config(t, cfg, motion)
-        want = planner._exit_config_reference(t, cfg, motion)
+        want = oracles.exit_config(planner, t, cfg, motion)
         assert (got is None) == (want is None)
         if got is not None:
             np.testing.assert_allclose(got.base, want.base, rtol=0.0, atol=1e-12)

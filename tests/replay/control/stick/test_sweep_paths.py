@@ -3,7 +3,7 @@
 the skips the stick's speed and spin allow) against sweep.covered for a fixed point (first /
 last covered sample; Sweep.hits is that too, tests/.../test_stick_fast_paths.py), and
 ContactPlanner.route_clear (the moving hand in arrays, each finger's tips only where its check
-needs them, the standing hand as fixed points) against _route_clear_reference. The same
+needs them, the standing hand as fixed points) against oracles.route_clear. The same
 operations on the samples they look at, so the answers agree exactly on seeded random motions,
 points and routes, and the random cases exercise both answers."""
 
@@ -26,6 +26,7 @@ from replay.control.stick.sweep import (
     sample_times,
 )
 
+from tests.replay.control.stick import oracles
 from tests.replay.control.stick.test_stick_method import air_spec
 
 
@@ -128,7 +129,7 @@ def test_route_clear_is_the_numpy_reference(width):
             before = prev
         for k in (0, 1):
             for check_idle in (True, False):
-                ref = planner._route_clear_reference(t, now, route, k, motion, t_c, check_idle)
+                ref = oracles.route_clear(planner, t, now, route, k, motion, t_c, check_idle)
                 got = planner.route_clear(t, now, route, k, motion, t_c, check_idle)
                 assert got == ref
                 cases += 1
@@ -136,7 +137,7 @@ def test_route_clear_is_the_numpy_reference(width):
                 # refused by the sweep, not by the timing: clear of a stick far away
                 hit += (
                     ref is None
-                    and planner._route_clear_reference(t, now, route, k, far, t_c, check_idle)
+                    and oracles.route_clear(planner, t, now, route, k, far, t_c, check_idle)
                     is not None
                 )
     assert 0.05 * cases < clear < 0.95 * cases and hit > 0.05 * cases
