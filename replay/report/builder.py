@@ -30,7 +30,7 @@ from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
 from replay.report.captions import CAPTIONS, DRAWN_FOR
-from replay.report.folder import check_folder, staging, swap_in
+from replay.report.folder import check_folder, discard, staging, swap_in
 from replay.report.markup import e as _e
 from replay.report.markup import md, md_code, md_fence, pre, url
 from replay.scenario.yamlio import one_line
@@ -168,7 +168,7 @@ def build_report(out: str | Path = "out/report", logs_dir: str | Path = "out/log
         _build(work, Path(logs_dir))
         swap_in(work, out)
     except BaseException:
-        shutil.rmtree(work, ignore_errors=True)
+        discard(work)
         raise
     return out / "index.html"
 

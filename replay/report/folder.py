@@ -73,12 +73,29 @@ def staging(target: Path) -> Path:
 
 
 def swap_in(work: Path, target: Path) -> None:
-    """Replace ``target`` (a folder :func:`check_folder` allowed, or nothing) by ``work``."""
+    """Replace ``target`` (a folder :func:`check_folder` allowed, or nothing) by ``work``. What
+    is removed is only a report (checked again here: the folder may have changed during the
+    build) moved into a folder made for it."""
     old = None
-    if target.exists():
+    if target.exists() or target.is_symlink():
+        if (
+            target.is_symlink()
+            or not target.is_dir()
+            or (any(target.iterdir()) and not _ours(target))
+        ):
+            raise ReportFolderError(
+                f"will not replace {target}: it changed during the build and is no report now"
+            )
         old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
         target.rename(old / "report")
     work.rename(target)
     target.chmod(0o755)  # (mkdtemp made it 0700)
     if old is not None:
         shutil.rmtree(old)
+
+
+def discard(work: Path) -> None:
+    """Remove a staging folder of :func:`staging` (its marker inside) after a failed build;
+    anything else at that path is left alone."""
+    if not work.is_symlink() and (work / MARKER).is_file():
+        shutil.rmtree(work, ignore_errors=True)

@@ -28,6 +28,7 @@ import sys
 import tempfile
 import threading
 import time
+from pathlib import Path
 
 LOCAL_IP = "127.0.0.1"
 ENV = {
@@ -38,6 +39,27 @@ INIT_ATTEMPTS = 3  # Ray gives its raylet 30 s to register; on a loaded machine,
 CLOSE_WAIT = 10.0  # s the sweep waits for the keeper to clear the cluster
 
 
+TEMP_PREFIX = "replay-ray-"  # the cluster's folder: tempfile.mkdtemp(prefix=TEMP_PREFIX)
+
+
+def made_here(path: str) -> bool:
+    """Whether ``path`` is a cluster folder of this module's making: a real folder named
+    ``TEMP_PREFIX...`` directly in the temporary directory (never a path given otherwise)."""
+    p = Path(path)
+    return (
+        p.name.startswith(TEMP_PREFIX)
+        and not p.is_symlink()
+        and p.is_dir()
+        and p.parent.resolve() == Path(tempfile.gettempdir()).resolve()
+    )
+
+
+def remove_temp(path: str) -> None:
+    """Remove the cluster's folder, and only if :func:`made_here`."""
+    if made_here(path):
+        shutil.rmtree(path, ignore_errors=True)
+
+
 class StartError(Exception):
     """The keeper could not start Ray (its one-line reason)."""
 
@@ -46,7 +68,7 @@ class PrivateRay:
     """The sweep's handle on its keeper: ``address`` to join; :meth:`close` ends the cluster."""
 
     def __init__(self, workers: int) -> None:
-        self.temp_dir = tempfile.mkdtemp(prefix="replay-ray-")
+        self.temp_dir = tempfile.mkdtemp(prefix=TEMP_PREFIX)
         env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}
         env.setdefault("RAY_agent_register_timeout_ms", "120000")  # slow agents on a busy host
         env.update(ENV)
@@ -78,7 +100,7 @@ class PrivateRay:
             self.keeper.wait()
         with contextlib.suppress(OSError):
             self.keeper.stdout.close()  # type: ignore[union-attr]
-        shutil.rmtree(self.temp_dir, ignore_errors=True)
+        remove_temp(self.temp_dir)
 
 
 @contextlib.contextmanager
@@ -176,7 +198,7 @@ def _keep(workers: int, temp_dir: str) -> None:
 
     def clear(*_) -> None:
         kill_session(os.getsid(0), adopted=True)
-        shutil.rmtree(temp_dir, ignore_errors=True)
+        remove_temp(temp_dir)
         os._exit(0)
 
     def watch() -> None:
@@ -217,4 +239,6 @@ def _keep(workers: int, temp_dir: str) -> None:
 
 
 if __name__ == "__main__":
+    if not made_here(sys.argv[2]):  # (the keeper removes its folder at the end: only its own)
+        sys.exit(f"error: {sys.argv[2]!r} is not a folder PrivateRay made")
     _keep(int(sys.argv[1]), sys.argv[2])

@@ -386,3 +386,24 @@ def test_validate_names_a_hostile_file_name_without_its_escapes(tmp_path):
     r = invoke("validate", "--static", path)
     assert r.exit_code == 0, r.output
     assert r.stdout.startswith("ok: ") and not CONTROL.search(r.stdout.rstrip("\n")), repr(r.stdout)
+
+
+def test_the_report_removes_only_what_it_made(tmp_path):
+    """swap_in checks the old folder again (it may change during a build): a folder that became
+    foreign is not removed; discard removes a staging folder only (its marker inside)."""
+    from replay.report.folder import MARKER, ReportFolderError, discard, staging, swap_in
+
+    target = tmp_path / "report"
+    target.mkdir()
+    (target / "thesis.tex").write_text("mine")
+    work = staging(target)
+    with pytest.raises(ReportFolderError, match="changed during the build"):
+        swap_in(work, target)
+    assert (target / "thesis.tex").read_text() == "mine"
+    discard(work)
+    assert not work.exists()
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "data.csv").write_text("1")
+    discard(foreign)  # no marker: left alone
+    assert (foreign / "data.csv").is_file() and not (foreign / MARKER).exists()

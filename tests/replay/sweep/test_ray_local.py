@@ -229,3 +229,24 @@ def test_address_joins_a_running_cluster_and_leaves_it_running(tmp_path):
     finally:
         theirs.close()
     assert not _session(theirs.keeper.pid)
+
+
+def test_the_keeper_removes_only_a_folder_it_was_made_for(tmp_path):
+    """The keeper deletes its folder at the end: run by hand on any other folder it refuses
+    before starting anything, and remove_temp leaves such a folder alone."""
+    from replay.sweep.ray_local import made_here, remove_temp
+
+    mine = tmp_path / "replay-ray-x"  # the right name, not in the temporary directory
+    mine.mkdir()
+    (mine / "keep.txt").write_text("keep")
+    assert not made_here(str(mine)) and not made_here(str(tmp_path))
+    remove_temp(str(mine))
+    r = subprocess.run(
+        [sys.executable, "-m", "replay.sweep.ray_local", "1", str(mine)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        stdin=subprocess.DEVNULL,
+    )
+    assert r.returncode != 0 and "not a folder PrivateRay made" in r.stderr
+    assert (mine / "keep.txt").read_text() == "keep"
