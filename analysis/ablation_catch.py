@@ -18,10 +18,10 @@ from analysis.ablation_table import (
     pct,
     rate_at,  # noqa: E402
     rate_by,
+    counts_by,
 )
 from analysis.ablation_plot import (  # noqa: E402
     RATE_NOTE,
-    counts_by,
     plain_log_ticks,
     plot_rates,
     shifts,

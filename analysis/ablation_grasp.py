@@ -14,7 +14,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.ablation_table import grasped, mean_by, overall, pct, rate_by  # noqa: E402
-from analysis.ablation_plot import RATE_NOTE, counts_by, plot_rates, shifts  # noqa: E402
+from analysis.ablation_plot import RATE_NOTE, plot_rates, shifts  # noqa: E402
+from analysis.ablation_table import counts_by  # noqa: E402
 from analysis.figure_files import save  # noqa: E402
 
 PERIOD = "loop_period_ms"

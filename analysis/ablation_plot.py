@@ -4,24 +4,9 @@ plain tick labels."""
 
 from __future__ import annotations
 
-from collections import defaultdict
 
 import numpy as np
 from matplotlib.ticker import FuncFormatter, NullFormatter
-
-from replay.sweep.table import as_float
-
-
-def counts_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[list, list, list]]:
-    """{line value: (sorted x values, successes k, runs n at each)} over the rows."""
-    groups: dict = defaultdict(lambda: defaultdict(list))
-    for r in rows:
-        groups[r.get(line, "") if line else ""][as_float(r[x])].append(bool(ok(r)))
-    out = {}
-    for name, by_x in groups.items():
-        xs = sorted(by_x)
-        out[name] = (xs, [sum(by_x[v]) for v in xs], [len(by_x[v]) for v in xs])
-    return out
 
 
 def n_said(ns: list[int]) -> str:

@@ -12,10 +12,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from analysis.ablation_table import captured, rate_by  # noqa: E402
+from analysis.ablation_table import captured, counts_by, rate_by  # noqa: E402
 from analysis.ablation_plot import (  # noqa: E402
     RATE_NOTE,
-    counts_by,
     plain_log_ticks,
     plot_rates,
     shifts,

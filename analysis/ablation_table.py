@@ -32,16 +32,24 @@ def grasped(row: dict) -> bool:
     return as_bool(row.get("success")) and not np.isnan(n) and n > 0
 
 
-def rate_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[list, list]]:
-    """{line value: (sorted x values, success rate at each)} over the rows."""
+def counts_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[list, list, list]]:
+    """{line value: (sorted x values, successes k, runs n at each)} over the rows."""
     groups: dict = defaultdict(lambda: defaultdict(list))
     for r in rows:
         groups[r.get(line, "") if line else ""][as_float(r[x])].append(bool(ok(r)))
     out = {}
     for name, by_x in groups.items():
         xs = sorted(by_x)
-        out[name] = (xs, [float(np.mean(by_x[v])) for v in xs])
+        out[name] = (xs, [sum(by_x[v]) for v in xs], [len(by_x[v]) for v in xs])
     return out
+
+
+def rate_by(rows: list[dict], x: str, line: str | None, ok) -> dict[str, tuple[list, list]]:
+    """{line value: (sorted x values, success rate at each)} over the rows."""
+    return {
+        name: (xs, [k / n for k, n in zip(ks, ns)])
+        for name, (xs, ks, ns) in counts_by(rows, x, line, ok).items()
+    }
 
 
 def mean_by(
