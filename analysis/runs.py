@@ -23,6 +23,7 @@ from typing import Any
 import yaml
 
 from replay.log import LogError, LogReader
+from replay.scenario import ScenarioError, scenario_from_text
 from replay.scenario.yamlio import one_line
 
 MAX_ITEMS = 3  # differences named in a label ("+N more" after)
@@ -217,3 +218,22 @@ def by_paper(readers: Iterable[LogReader]) -> dict[str, dict[str, LogReader]]:
 def name_of(reader: LogReader) -> str:
     """The run's scenario name (its key may carry a label)."""
     return describe(reader).name
+
+
+def unreadable(reader: LogReader) -> str:
+    """Why ``reader``'s log is no run the analysis can read, "" when it is one: its /scenario
+    message names a paper and a scenario, and its stored scenario types as one here (plug-ins
+    not installed here kept as data). A log from another machine or version that fails this is
+    left out with this line, not fatal to the other runs."""
+    try:
+        sc = reader.scenario()
+    except LogError as exc:
+        return str(exc)
+    paper, name = sc.get("paper"), sc.get("name")
+    if not (isinstance(paper, str) and paper and isinstance(name, str) and name):
+        return "its /scenario message names no paper or scenario (not a run log?)"
+    try:
+        scenario_from_text(sc["yaml"], name=f"{reader.path.name}:/scenario", plugins="known-only")
+    except ScenarioError as exc:
+        return f"its stored scenario is not one this version reads ({one_line(str(exc))[:300]})"
+    return ""

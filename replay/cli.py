@@ -633,14 +633,13 @@ def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
     readers = []
     for p in paths:
         r = _reader(p)
-        try:
-            sc = r.scenario()
-        except LogError as exc:
-            fail(str(exc))
-        paper, name = sc.get("paper"), sc.get("name")
-        if not (isinstance(paper, str) and paper and isinstance(name, str) and name):
-            fail(f"{p}: its /scenario message names no paper or scenario (not a run log?)")
+        why = runs.unreadable(r)
+        if why:  # (a colleague's log this version cannot type: the others are still analysed)
+            warn(f"left out: {p}: {why}")
+            continue
         readers.append(r)
+    if not readers:
+        fail("none of the logs given is a run log this version reads (see the warnings)")
     return runs.by_paper(readers)  # one key per log: two logs of one name are two runs
 
 
@@ -780,17 +779,18 @@ def compare(logs, out, no_figures, markdown):
     scenario fields that differ, each run's outcome and metrics, and the papers' figures
     overlaying them (in -o)."""
     from analysis.compare import MAX_RUNS, compare, markdown as compare_md, text
+    from analysis.runs import unreadable
 
     readers, seen = [], set()
     for p in logs:
         try:
             r = LogReader(p).check()
-            sc = r.scenario()
         except LogError as exc:
             warn(f"left out: {exc}")
             continue
-        if not (isinstance(sc.get("paper"), str) and isinstance(sc.get("name"), str)):
-            warn(f"left out: {p}: its /scenario message names no paper or scenario")
+        why = unreadable(r)
+        if why:
+            warn(f"left out: {p}: {why}")
             continue
         if r.path.resolve() in seen:
             warn(f"left out: {p}: given twice")

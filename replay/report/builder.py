@@ -98,15 +98,14 @@ def _readers(logs: list[Path]) -> tuple[dict[str, dict[str, LogReader]], list[st
     for p in logs:
         try:
             r = LogReader(p)
-            sc = r.scenario()
         except LogError as exc:
             dropped.append(f"{p.name}: not read ({exc})")
             continue
-        paper, name = sc.get("paper"), sc.get("name")
-        if isinstance(paper, str) and paper and isinstance(name, str) and name:
-            readers.append(r)
+        why = runs.unreadable(r)
+        if why:
+            dropped.append(f"{p.name}: {why}")
         else:
-            dropped.append(f"{p.name}: its /scenario message names no paper or scenario")
+            readers.append(r)
     return runs.by_paper(readers), dropped
 
 
