@@ -36,7 +36,7 @@ import yaml
 from replay import registry
 from replay.limits import LimitError, check
 from replay.params import MAX_CHARS, MAX_FLOAT, MAX_INT, MAX_ITEMS, ParamError
-from replay.scenario.schema import Scenario
+from replay.scenario.schema import NAME_PATTERN, Scenario
 from replay.scenario.yamlio import ScenarioError, compose, read_text, show
 
 __all__ = [
@@ -729,6 +729,17 @@ def load_scenario(
     return sc
 
 
+def _plain_name(root: yaml.MappingNode) -> None:
+    """A log's stored ``name`` that no scenario here may have (``<img ...>/../x``, from another
+    machine or a forged log) read as ``unnamed``: a name is the log's label, not what its
+    analysis needs, and the one the reader hands on is bounded and escaped where shown."""
+    for i, (key, value) in enumerate(root.value):
+        text = value.value if isinstance(value, yaml.ScalarNode) else None
+        if key.value == "name" and not (isinstance(text, str) and re.fullmatch(NAME_PATTERN, text)):
+            plain = yaml.ScalarNode(_STR, "unnamed", value.start_mark, value.end_mark)
+            root.value[i] = (key, plain)
+
+
 def scenario_from_text(
     text: str,
     name: str = "<log>",
@@ -749,6 +760,7 @@ def scenario_from_text(
     inputs: list[Path] = []
     if plugins == "known-only":  # a log's text is resolved: reading it reads no other file
         _pop(root, "extends")
+        _plain_name(root)
     extends = _get(root, "extends") is not None
     where = Path(base_dir if base_dir is not None else Path.cwd()) / "<text>"
     root = _extends(root, where, inputs=inputs)
