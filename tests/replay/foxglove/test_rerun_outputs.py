@@ -4,6 +4,7 @@ SIGHUP or even SIGKILL of the command leave none of Rerun's processes listening.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import socket
@@ -110,20 +111,35 @@ def _untouched(folder: Path) -> None:
     ]
 
 
+def _listening(port: int) -> bool:
+    """Whether any socket of this machine listens on TCP ``port`` (from /proc/net/tcp{,6}: a
+    bind test would also trip over a closed client connection's TIME_WAIT on that port)."""
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        with contextlib.suppress(OSError), open(table) as f:
+            next(f)
+            for row in f:
+                local, state = row.split()[1], row.split()[3]
+                if state == "0A" and int(local.rsplit(":", 1)[1], 16) == port:
+                    return True
+    return False
+
+
 def _gone(pids: list[int], port: int, within: float = 20.0) -> None:
+    """Within ``within`` seconds, none of ``pids`` runs and nothing listens on ``port`` or its
+    +1. (A process whose main thread has exited shows as a zombie while its other threads still
+    close its sockets, so the ports are waited for too.)"""
+
+    def left() -> tuple[list[int], list[int]]:
+        return [p for p in pids if _alive(p)], [p for p in (port, port + 1) if _listening(p)]
+
     deadline = time.monotonic() + within
-    while any(_alive(p) for p in pids) and time.monotonic() < deadline:
+    while any(left()) and time.monotonic() < deadline:
         time.sleep(0.1)
-    left = [p for p in pids if _alive(p)]
-    for p in left:  # (a failed test leaves nothing behind either)
+    running, listening = left()
+    for p in running:  # (a failed test leaves nothing behind either)
         os.kill(p, signal.SIGKILL)
-    assert not left, f"Rerun's processes {left} outlived the command"
-    # nothing listens any more (a closed connection's TIME_WAIT may hold the port for a plain
-    # bind: with SO_REUSEADDR it binds past that, never past a listener)
-    for p in (port, port + 1):
-        with socket.socket() as s:
-            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            s.bind(("127.0.0.1", p))
+    assert not running, f"Rerun's processes {running} outlived the command"
+    assert not listening, f"ports {listening} still listened on {within} s after the command"
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
