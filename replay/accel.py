@@ -1,7 +1,7 @@
 """Optional compiled accelerators (setup.py builds them where a C compiler is found; a wheel
 or checkout without them runs the pure-Python path, the same algorithm, which is the reference
 their tests hold them to). ``REPLAY_NO_ACCEL=1`` runs the pure-Python path even where they are
-built (CI runs the suite both ways)."""
+built (CI runs the cameras' tests and the golden runs both ways: ``make test-pure``)."""
 
 from __future__ import annotations
 
