@@ -238,14 +238,6 @@ def _runner(scenario: str, sc, Runner, **kw):
         fail(_refusal(scenario, exc))
 
 
-def _is_ip(host: str) -> bool:
-    try:
-        ipaddress.ip_address(host)
-        return True
-    except ValueError:
-        return False
-
-
 def _warn_if_exposed(host: str) -> None:
     try:
         local = ipaddress.ip_address(host).is_loopback
@@ -596,7 +588,9 @@ def view(logs, host, port, speed, timeout):
     are overlaid in step (e.g. optimised vs unoptimised)."""
     from replay.viewer import Viewer, ViewerError
 
-    named = not _is_ip(host)
+    from replay.viewer.guard import is_ip
+
+    named = not is_ip(host)
     if not named:
         _warn_if_exposed(host)  # before anything listens
     try:

@@ -114,7 +114,8 @@ def _host_name(value: str) -> str:
     return str(ip)
 
 
-def _is_ip(name: str) -> bool:
+def is_ip(name: str) -> bool:
+    """Whether ``name`` is an IP address (v4 or v6), not a host name."""
     try:
         ipaddress.ip_address(name)
         return True
@@ -128,7 +129,7 @@ def allowed_names(served: str, local_ip: str) -> set[str]:
     loopback names on a loopback address, and on a wildcard address the machine's own name."""
     names = {_host_name(local_ip), _host_name(served)} - {""}
     ip = _host_name(local_ip)
-    if ip in LOOPBACK_NAMES or (_is_ip(ip) and ipaddress.ip_address(ip).is_loopback):
+    if ip in LOOPBACK_NAMES or (is_ip(ip) and ipaddress.ip_address(ip).is_loopback):
         names |= LOOPBACK_NAMES
     if _host_name(served) in WILDCARDS:
         names.add(socket.gethostname().lower())  # the machine's own name, not a stranger's
