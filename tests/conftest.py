@@ -76,3 +76,14 @@ def fail_writes_after(monkeypatch, n: int) -> list[int]:
 
     monkeypatch.setattr(_FlushedFile, "write", full)
     return calls
+
+
+@pytest.fixture(scope="session")
+def stick_3step_log(tmp_path_factory):
+    """A finished stick_3step run's log, made once for the session (do not change it: copy it)."""
+    from cli_checks import invoke
+
+    path = tmp_path_factory.mktemp("base") / "stick_3step.mcap"
+    r = invoke("run", "stick_3step", "-q", "-o", path)
+    assert r.exit_code == 0, r.output
+    return path

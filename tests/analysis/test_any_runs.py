@@ -7,17 +7,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
 from analysis import runs
 from analysis.figure_files import FigureFile
-from replay.cli import main
 from replay.log import LogReader, LogWriter
 from replay.messages import TOPIC_EFFECTOR_STATE, TOPIC_SCENARIO, TOPIC_STICK_STATE
 
-
-def invoke(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="replay")
+from cli_checks import invoke
 
 
 def run(out: Path, scenario: str, *sets: str) -> Path:

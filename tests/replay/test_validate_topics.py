@@ -6,18 +6,14 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
 from analysis import published
-from replay.cli import main
 from replay.resources import scenario_dir
 from replay.scenario import load_scenario
 
+from cli_checks import invoke
+
 EXAMPLE = Path(__file__).parents[2] / "examples" / "my_controller.yaml"
-
-
-def invoke(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="replay")
 
 
 def warnings_of(r) -> list[str]:
