@@ -5,7 +5,9 @@ At each control step (1 kHz) the controller
 1. takes the newest stereo position r_o ("/vision/object", one frame old) and the joint state
    ("/arm/encoders", from the joint_encoders sensor; without it the torque is the feed-forward only);
 2. estimates r_o' (and r_o'' = g) with a ballistic least-squares fit (:mod:`.estimator`) and,
-   optionally, carries r_o forward over the measurement's age (latency compensation);
+   optionally, carries r_o forward over the measurement's age (latency compensation); or, with
+   ``estimator: last``, takes the newest frame and the two newest frames' difference quotient
+   (no flight model, no extrapolation: the prediction-free variant);
 3. maps q_d = f(r_o) (eq. 7), qd_d = F r_o' (eq. 23), qdd_d = F r_o'' + Fdot r_o' (eq. 16);
 4. commands tau = tau_ff + Kp (q_d - q) + Kd (qd_d - qd), tau_ff = M(q_d) qdd_d + H qd_d + g(q_d)
    (eqs. 17-21, "dynamics") or g(q) ("gravity") or 0, saturated at the spec's torque limits.
@@ -30,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from replay.control.catching.estimator import BallisticEstimator
+from replay.control.catching.estimator import BallisticEstimator, LastFrameEstimator
 from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
 from replay.control.catching.optimise import (
     CostRecord,
@@ -203,8 +205,15 @@ class Params:
         choices=("dynamics", "gravity", "none"),
         doc="tau_ff: eq. 17 at q_d ('dynamics'), g(q) or none",
     )
+    estimator: str = param(
+        "ballistic",
+        choices=("ballistic", "last"),
+        doc="r_o, r_o' for eqs. 7, 23: 'ballistic' (fit with known g over fit_window, carried "
+        "over the latency) or 'last' (newest frame, difference of the two newest: no prediction)",
+    )
     latency_compensation: bool = param(
-        True, doc="carry r_o forward over the measurement's age with the fitted velocity"
+        True,
+        doc="carry r_o forward over the measurement's age with the fitted velocity (ballistic only)",
     )
     fit_window: float = param(
         0.1, unit="s", gt=0.0, le=10, doc="ballistic fit over this much history"
@@ -356,7 +365,11 @@ class CatchingController(Controller):
         self.kd = np.asarray(P.kd, float)
         if self.kp.shape != (self.n,) or self.kd.shape != (self.n,):
             raise ValueError(f"kp and kd need {self.n} values")
-        self.est = BallisticEstimator(self.gravity, P.fit_window)
+        self.est: BallisticEstimator | LastFrameEstimator = (
+            BallisticEstimator(self.gravity, P.fit_window)
+            if P.estimator == "ballistic"
+            else LastFrameEstimator()
+        )
         hand = getattr(spec, "hand", None)
         self.hand = hand
         if hand is not None:

@@ -5,11 +5,13 @@ says neither how it got the derivatives nor when the hand closed. Ours: a least-
 ballistic arc with *known* gravity, r(t) = r0 + v (t - t_last) + g (t - t_last)^2 / 2, over the
 measurements of the last ``window`` seconds (per axis two unknowns, r0 and v). The time to reach
 the catch surface |r - O| = R_c (where q4 = q_alpha, i.e. contact) is the first future root of the
-quartic |d + v s + g s^2 / 2|^2 = R_c^2.
+quartic |d + v s + g s^2 / 2|^2 = R_c^2. This is the default (``estimator: ballistic``);
+:class:`LastFrameEstimator` (``estimator: last``) is the prediction-free alternative.
 """
 
 from __future__ import annotations
 
+import math
 from collections import deque
 
 import numpy as np
@@ -249,3 +251,65 @@ def _roots(coeffs) -> np.ndarray:
     A = np.eye(n, k=-1)
     A[0, :] = [-c / coeffs[0] for c in coeffs[1:]]
     return np.linalg.eigvals(A)
+
+
+class LastFrameEstimator:
+    """The prediction-free estimate (``estimator: last``; issue #38): no model of the flight.
+
+    Eq. 7 takes r_o as the newest stereo position, as measured (no latency extrapolation); eq. 23
+    takes r_o' as the backward difference of the two newest frames (no fit, no gravity); eq. 16's
+    r_o'' is 0 (a second difference of frames ~1 mm apart in error is +-10^3 m/s^2 at 1 kHz). The
+    hand still needs a time to contact to close in time: the first-order one (Lee's tau), the gap
+    to the catch surface over the closing speed, |d + v s| = R_c, with no gravity either.
+    """
+
+    ZERO = (0.0, 0.0, 0.0)
+
+    def __init__(self) -> None:
+        self.buf: deque[tuple[float, tuple[float, float, float]]] = deque(maxlen=2)
+
+    def reset(self) -> None:
+        self.buf.clear()
+
+    @property
+    def n(self) -> int:
+        return len(self.buf)
+
+    def add(self, t: float, r) -> None:
+        if self.buf and t <= self.buf[-1][0]:
+            return  # out of order or repeated frame
+        self.buf.append((float(t), (float(r[0]), float(r[1]), float(r[2]))))
+
+    def state_f(self, t: float, *, from_fit: bool = False):
+        """(r, v, a) as 3-tuples, whatever ``t``: the newest frame, the two newest frames'
+        difference quotient (zero with one frame) and zero acceleration."""
+        if not self.buf:
+            return None
+        t1, r1 = self.buf[-1]
+        if len(self.buf) == 1:
+            return r1, self.ZERO, self.ZERO
+        t0, r0 = self.buf[0]
+        h = t1 - t0
+        return r1, ((r1[0] - r0[0]) / h, (r1[1] - r0[1]) / h, (r1[2] - r0[2]) / h), self.ZERO
+
+    def state(self, t: float, *, from_fit: bool = False):
+        st = self.state_f(t)
+        return None if st is None else tuple(np.array(x) for x in st)
+
+    def time_to_radius(self, t: float, origin, radius: float):
+        """Absolute time at which |d + v s| = radius first (d = r - origin; None if never): the
+        smaller root s >= 0 of |v|^2 s^2 + 2 d.v s + |d|^2 - radius^2."""
+        st = self.state_f(t)
+        if st is None or self.n < 2:
+            return None
+        r, v, _ = st
+        d = [r[i] - float(origin[i]) for i in range(3)]
+        c = sum(x * x for x in d) - radius * radius
+        if c <= 0.0:
+            return t
+        a = sum(x * x for x in v)
+        b = sum(x * y for x, y in zip(d, v))
+        disc = b * b - a * c
+        if a == 0.0 or b >= 0.0 or disc < 0.0:
+            return None  # not closing in, or passing the sphere by
+        return t + (-b - math.sqrt(disc)) / a
