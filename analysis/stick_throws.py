@@ -4,10 +4,12 @@ The paper shows one throw per strategy (Sec. IV-B: 1.1 m/s, ~10 rad/s). This dra
 throws in its neighbourhood, within the hand's reach, runs each through the full pipeline (Pymunk
 air table, rendered 300 fps camera, the strategy) and reads the run's ``outcome`` event.
 
-A throw (our choice; the paper gives no distribution): speed 0.8-1.4 m/s, heading within +-15 deg
-of straight at the palm (-y), spin 4-14 rad/s either way, orientation uniform, and a pass point:
-the stick's centre would cross y = 0.12 m (the paper's first collision, Sec. IV-B) at
-x in +-0.06 m, 0.20-0.35 s after the start (the start is then on the 300 fps camera's view).
+A throw (our choice; the paper gives no distribution) is the plant's seeded random throw
+(``plant.params.throw.random``, ``plants.airtable.throw``; the sweeps use it through the run's
+seed): speed 0.8-1.4 m/s, heading within +-15 deg of straight at the palm (-y), spin 4-14 rad/s
+either way, orientation uniform, and a pass point: the stick's centre would cross y = 0.12 m
+(the paper's first collision, Sec. IV-B) at x in +-0.06 m, 0.20-0.35 s after the start (the
+start is then on the 300 fps camera's view).
 ``out_of_reach=True`` throws it across the table instead, along x at y = 0.50-0.58 m, where no
 fingertip can get (slider +-0.2 m, finger reach 0.14 m: y <= 0.34 m).
 
@@ -25,13 +27,14 @@ from pathlib import Path
 
 import numpy as np
 
+from plants.airtable.params import ThrowParams
+from plants.airtable.throw import draw
 from replay.resources import scenario_dir
 
 SCENARIO = {
     "stick_2step": scenario_dir() / "stick_2step.yaml",
     "stick_3step": scenario_dir() / "stick_3step.yaml",
 }
-PASS_Y = 0.12  # m, where the paper's first collision happens (Sec. IV-B)
 # s, per strategy: a run stops 0.1 s after the capture; the 3-step's clamped second contact
 # leaves ~30 % of the spin and the spin-stop collision added then waits up to half a turn (~1 s)
 DURATION = {"stick_2step": 2.0, "stick_3step": 3.0}
@@ -54,27 +57,24 @@ class Throw:
 
 
 def random_throw(rng: np.random.Generator, out_of_reach: bool = False) -> Throw:
-    speed = rng.uniform(0.8, 1.4)  # all drawn whatever out_of_reach
+    """One throw of ``plants.airtable.throw.draw`` (the plant's ``throw.random``, default
+    ranges), or with ``out_of_reach`` the same draws sent across the table."""
+    if not out_of_reach:
+        return Throw(**draw(rng, ThrowParams()))
+    speed = rng.uniform(0.8, 1.4)  # the draws of ``draw`` in its order
     heading = math.radians(rng.uniform(-15.0, 15.0))
     omega = rng.uniform(4.0, 14.0) * rng.choice([-1.0, 1.0])
     theta = rng.uniform(0.0, math.pi)
-    if out_of_reach:  # across the table at y = 0.50-0.58 m, moving along +-x
-        t_pass = rng.uniform(0.20, 0.35)
-        sign = float(rng.choice([-1.0, 1.0]))
-        vx, vy = sign * speed * math.cos(heading), speed * math.sin(heading)
-        return Throw(
-            x=-vx * t_pass,
-            y=rng.uniform(0.50, 0.58) - vy * t_pass,
-            theta=theta,
-            vx=vx,
-            vy=vy,
-            omega=omega,
-        )
-    x_pass = rng.uniform(-0.06, 0.06)
-    t_pass = rng.uniform(0.20, 0.35)
-    vx, vy = speed * math.sin(heading), -speed * math.cos(heading)
+    t_pass = rng.uniform(0.20, 0.35)  # across the table at y = 0.50-0.58 m, moving along +-x
+    sign = float(rng.choice([-1.0, 1.0]))
+    vx, vy = sign * speed * math.cos(heading), speed * math.sin(heading)
     return Throw(
-        x=x_pass - vx * t_pass, y=PASS_Y - vy * t_pass, theta=theta, vx=vx, vy=vy, omega=omega
+        x=-vx * t_pass,
+        y=rng.uniform(0.50, 0.58) - vy * t_pass,
+        theta=theta,
+        vx=vx,
+        vy=vy,
+        omega=omega,
     )
 
 

@@ -4,9 +4,24 @@
 first asked for.
 """
 
-from plants.airtable.params import HandParams, InitialParams, Params, SolverParams, StickParams
+from plants.airtable.params import (
+    HandParams,
+    InitialParams,
+    Params,
+    SolverParams,
+    StickParams,
+    ThrowParams,
+)
 
-__all__ = ["AirTablePlant", "Params", "StickParams", "InitialParams", "HandParams", "SolverParams"]
+__all__ = [
+    "AirTablePlant",
+    "Params",
+    "StickParams",
+    "InitialParams",
+    "HandParams",
+    "SolverParams",
+    "ThrowParams",
+]
 
 
 def __getattr__(name: str):

@@ -76,6 +76,53 @@ class InitialParams:
 
 
 @dataclass
+class ThrowParams:
+    """A seeded random throw that replaces ``initial`` (``plants.airtable.throw``; our choice:
+    the paper shows one throw per strategy). Left out of the resolved scenario while off."""
+
+    random: bool = param(
+        False, doc="draw the initial state from the run's seed instead of taking ``initial``"
+    )
+    speed: list[float] = param(
+        [0.8, 1.4], unit="m/s", length=2, gt=0, le=100, doc="speed range (paper: 1.1 m/s)"
+    )
+    heading: list[float] = param(
+        [-0.2617993877991494, 0.2617993877991494],
+        unit="rad",
+        length=2,
+        ge=-3.15,
+        le=3.15,
+        doc="direction range from straight at the palm (-y); +-15 deg",
+    )
+    spin: list[float] = param(
+        [4.0, 14.0],
+        unit="rad/s",
+        length=2,
+        ge=0,
+        le=1000,
+        doc="spin magnitude range, either sign at equal odds (paper: ~10 rad/s)",
+    )
+    pass_x: list[float] = param(
+        [-0.06, 0.06], unit="m", length=2, ge=-10, le=10, doc="x where the centre crosses pass_y"
+    )
+    pass_y: float = param(
+        0.12, unit="m", ge=-10, le=10, doc="the line the centre crosses (paper: 0.12 m)"
+    )
+    pass_time: list[float] = param(
+        [0.20, 0.35], unit="s", length=2, gt=0, le=100, doc="time from the start to pass_y"
+    )
+
+    def __post_init__(self) -> None:
+        for name in ("speed", "heading", "spin", "pass_x", "pass_time"):
+            lo, hi = getattr(self, name)
+            if not lo <= hi:
+                raise ParamError(name, f"lower bound {lo} above upper bound {hi}")
+
+    def __bool__(self) -> bool:  # omit_empty: the resolved scenario shows it only when on
+        return bool(self.random)
+
+
+@dataclass
 class HandParams:
     """XY slider base and two planar 2-joint fingers (paper Sec. IV-A)."""
 
@@ -208,6 +255,14 @@ class Params:
     )
     initial: InitialParams = field(
         default_factory=InitialParams, metadata={"doc": "the object's initial state", "unit": ""}
+    )
+    throw: ThrowParams = field(
+        default_factory=ThrowParams,
+        metadata={
+            "doc": "a seeded random initial state (off: ``initial``)",
+            "unit": "",
+            "omit_empty": True,
+        },
     )
     hand: HandParams = field(
         default_factory=HandParams, metadata={"doc": "slider base and fingers", "unit": ""}

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from replay.robot.hand2d import AirTableSpec, HandCommand, root_distance
+from replay.robot.hand2d import AirTableSpec, HandCommand
 from replay.interfaces import Occurrence, Plant
 from replay.messages import (
     TOPIC_FINGERS_STATE,
@@ -41,7 +41,7 @@ from replay.messages import (
 from replay.scene import Box, Cylinder, Scene
 from replay.spatial import yaw_quaternion
 
-from plants.airtable import body_state, settings
+from plants.airtable import body_state, settings, throw
 from plants.airtable.hand import HandServo
 from plants.airtable.params import Params
 
@@ -73,6 +73,7 @@ class AirTablePlant(Plant):
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
         p = params
+        self._events: list[Occurrence] = []
         self._hand_spec = settings.hand_spec(p)
         self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
 
@@ -88,10 +89,11 @@ class AirTablePlant(Plant):
         # The stick: m and I set on the body; its shape has no mass or density.
         st = p.stick
         body = pymunk.Body(st.mass, st.inertia, body_type=pymunk.Body.DYNAMIC)
-        body.position = (p.initial.x, p.initial.y)
-        body.angle = p.initial.theta
-        body.velocity = (p.initial.vx, p.initial.vy)
-        body.angular_velocity = p.initial.omega
+        init = self._initial_state()
+        body.position = (init["x"], init["y"])
+        body.angle = init["theta"]
+        body.velocity = (init["vx"], init["vy"])
+        body.angular_velocity = init["omega"]
         half = st.length / 2.0
         if st.collision_width > 0.0:
             shape = pymunk.Poly.create_box(body, (st.length, st.collision_width), radius=0.0)
@@ -123,7 +125,6 @@ class AirTablePlant(Plant):
         space.on_collision(TIP_TYPE, STICK_TYPE, begin=self._on_begin)
 
         self._steps = 0
-        self._events: list[Occurrence] = []
         self._pending: list[dict] = []
         self._last_command: tuple | None = None
         self._last_object: HandCommand | None = None
@@ -144,6 +145,19 @@ class AirTablePlant(Plant):
             (st.thickness + marker_h / 2.0, (st.marker_length, st.marker_width, marker_h)),
         )
         self._tip_prims: list[Cylinder | None] = [None, None]
+
+    def _initial_state(self) -> dict[str, float]:
+        """``initial``, or a seeded random throw (``throw.random``), said in a ``throw`` event."""
+        p = self.params
+        if not p.throw.random:
+            return {
+                k: float(getattr(p.initial, k)) for k in ("x", "y", "theta", "vx", "vy", "omega")
+            }
+        state = throw.draw(self.rng, p.throw)
+        self._events.append(
+            Occurrence("throw", {**state, "speed": math.hypot(state["vx"], state["vy"])})
+        )
+        return state
 
     # -- Plant interface ------------------------------------------------------------------
 
@@ -298,9 +312,7 @@ class AirTablePlant(Plant):
     def _in_reach(self) -> bool:
         """The stick's centre within finger reach (l1 + l2, joint limits ignored) plus L/2 of a
         finger root anywhere on the slider's range: a loose, purely geometric bound."""
-        h = self._hand_spec
-        reach = sum(h.link_lengths) + h.tip_radius + 0.5 * self.params.stick.length
-        return root_distance(h, self._state[0]) <= reach
+        return settings.in_reach(self._hand_spec, self.params.stick.length, self._state[0])
 
     def _held(self) -> bool:
         """Slow (``hold_speed``, ``hold_omega``) with a fingertip at each face: between the
@@ -330,7 +342,9 @@ class AirTablePlant(Plant):
 
     def outcome(self, t: float) -> dict:
         """Captured: the stick held between the fingertips (``_held``) for the last
-        ``hold_time`` of the run; ``t_capture`` = since when. Else why not, physically."""
+        ``hold_time`` of the run; ``t_capture`` = since when: the run's capture time, the one
+        the claims and sweeps read (the method's ``t_capture_method`` and ``capture`` event are
+        its own, later, belief; docs/stick.md). Else why not, physically."""
         p, b = self.params, self.stick_body
         speed, omega = math.hypot(b.velocity.x, b.velocity.y), float(b.angular_velocity)
         held = self._held_since is not None and t - self._held_since >= p.hold_time - 1e-12

@@ -6,7 +6,7 @@
 from __future__ import annotations
 
 from plants.airtable.params import Params
-from replay.robot.hand2d import AirTableSpec, HandSpec, StickSpec
+from replay.robot.hand2d import AirTableSpec, HandSpec, StickSpec, root_distance
 
 
 def _pair(v) -> tuple[float, float]:
@@ -42,3 +42,10 @@ def spec(p: Params, hand: HandSpec | None = None) -> AirTableSpec:
             restitution=st.restitution,
         ),
     )
+
+
+def in_reach(hand: HandSpec, length: float, xy) -> bool:
+    """The stick's centre ``xy`` within finger reach (l1 + l2, joint limits ignored) plus L/2 of
+    a finger root anywhere on the slider's range: a loose, purely geometric bound."""
+    reach = sum(hand.link_lengths) + hand.tip_radius + 0.5 * length
+    return root_distance(hand, xy) <= reach
