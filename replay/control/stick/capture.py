@@ -51,6 +51,10 @@ not friction independent); but a closing to be (re)planned on a stick spinning f
 ``respin`` first gets a spin-stop collision (eq. 30), up to ``max_extra`` in all.
 A ``capture`` event is emitted once the estimated speed stays below ``capture_speed`` and spin
 below ``capture_spin`` for ``capture_hold`` with both modelled fingertips at the stick's two faces.
+That is the method's own belief (from vision, a frame late and a fit window behind), not the
+run's capture time: the event comes at ``t_since`` + ``capture_hold`` (``t_since``, also the
+outcome's ``t_capture_method``, is when the method first saw the conditions); the run's capture
+time is the plant's ``t_capture`` (docs/stick.md, "Capture time").
 
 Infeasibility and fallbacks (each reported once per step as an ``infeasible`` event; the
 ``r_x_beyond_stick`` one with the plan's final numbers, when it freezes or the collision happens):
@@ -379,7 +383,9 @@ class StickCaptureController(Controller):
         return out
 
     def outcome(self, t: float) -> dict:
-        """The method's metrics and, when it has not captured the stick, why (the last thing that
+        """The method's metrics (``t_capture_method``: when its estimate first saw the stick held,
+        the ``capture`` event's ``t_since``; not the run's capture time, the plant's
+        ``t_capture``) and, when it has not captured the stick, why (the last thing that
         stopped it: out of reach, r_x beyond the stick, no feasible plan, or the run ended first)."""
         out = {
             "method_captured": self.captured,
