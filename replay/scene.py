@@ -9,12 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 
-# Box, Sphere, Cylinder and Frame store their fields straight into the instance's dict: a frozen
-# dataclass's generated __init__ sets each through object.__setattr__ (~1 us a field on Python
-# 3.11; the air table makes ~800 primitives a simulated second, the catching arm a Sphere a step
-# and ~1000 link Frames); tests/replay/test_scene_inits.py holds them to the generated signature
-# and result.
-@dataclass(frozen=True, init=False)
+@dataclass(frozen=True)
 class Box:
     name: str
     position: tuple[float, float, float]
@@ -22,25 +17,16 @@ class Box:
     size: tuple[float, float, float]  # full extents along the body x, y, z axes (m)
     albedo: float = 0.5  # 0 black .. 1 white, as a camera sees it
 
-    def __init__(self, name: str, position, orientation, size, albedo: float = 0.5) -> None:
-        d = self.__dict__
-        d["name"], d["position"], d["orientation"] = name, position, orientation
-        d["size"], d["albedo"] = size, albedo
 
-
-@dataclass(frozen=True, init=False)
+@dataclass(frozen=True)
 class Sphere:
     name: str
     position: tuple[float, float, float]
     radius: float
     albedo: float = 0.5
 
-    def __init__(self, name: str, position, radius: float, albedo: float = 0.5) -> None:
-        d = self.__dict__
-        d["name"], d["position"], d["radius"], d["albedo"] = name, position, radius, albedo
 
-
-@dataclass(frozen=True, init=False)
+@dataclass(frozen=True)
 class Cylinder:
     name: str
     position: tuple[float, float, float]
@@ -49,18 +35,11 @@ class Cylinder:
     length: float
     albedo: float = 0.5
 
-    def __init__(
-        self, name: str, position, orientation, radius: float, length: float, albedo: float = 0.5
-    ) -> None:
-        d = self.__dict__
-        d["name"], d["position"], d["orientation"] = name, position, orientation
-        d["radius"], d["length"], d["albedo"] = radius, length, albedo
-
 
 Primitive = Box | Sphere | Cylinder
 
 
-@dataclass(frozen=True, init=False)
+@dataclass(frozen=True)
 class Frame:
     """A moving body's or robot link's frame ``child`` in frame ``parent`` (for 3-D viewers:
     ``/tf``): translation (m) and rotation [qx, qy, qz, qw] of ``child`` in ``parent``."""
@@ -69,15 +48,6 @@ class Frame:
     child: str
     position: tuple[float, float, float]
     orientation: tuple[float, float, float, float]
-
-    def __init__(self, parent: str, child: str, position, orientation) -> None:
-        d = self.__dict__
-        d["parent"], d["child"], d["position"], d["orientation"] = (
-            parent,
-            child,
-            position,
-            orientation,
-        )
 
 
 @dataclass

@@ -47,18 +47,12 @@ class AirTableSpec:
     stick: StickSpec
 
 
-@dataclass(frozen=True, init=False)
+@dataclass(frozen=True)
 class HandCommand:
     """Position targets; the plant moves toward them no faster than the spec's speed limits."""
 
     base: tuple[float, float]  # m
     joints: tuple[tuple[float, float], tuple[float, float]]  # rad, (q1, q2) per finger
-
-    def __init__(self, base: tuple[float, float], joints) -> None:
-        # the fields straight into the instance's dict (the generated frozen __init__ costs
-        # ~1 us a field on Python 3.11; tests/replay/test_scene_inits.py holds it to that one)
-        d = self.__dict__
-        d["base"], d["joints"] = base, joints
 
 
 def clip(v: float, lo: float, hi: float) -> float:

@@ -1,7 +1,9 @@
 """Frozen dataclasses whose __init__ is written by hand for speed (the generated one sets each
-field through object.__setattr__, ~1 us a field on Python 3.11): replay.scene's Box and Cylinder
-(and Sphere, Frame) here, with the stick hand's HandCommand and the planner's Motion; the stick controller's
-StickEstimate, ContactSolution and Config in tests/replay/control/stick/test_stick_fast_paths.py. Each must be what dataclasses generates:
+field through object.__setattr__, ~1 us a field on Python 3.11): the stick planner's Motion here;
+the stick controller's StickEstimate, ContactSolution and Config in
+tests/replay/control/stick/test_stick_fast_paths.py. (replay.scene's primitives and frames and the
+stick hand's HandCommand went back to the generated __init__: a whole run differed by 0.2-0.5 %
+in instructions.) Each must be what dataclasses generates:
 the same signature (names, order, defaults), the same instance, equal and hashing alike, still
 frozen, and dataclasses.replace works."""
 
@@ -12,8 +14,6 @@ import numpy as np
 import pytest
 
 from replay.control.stick.sweep import Motion
-from replay.robot.hand2d import HandCommand
-from replay.scene import Box, Cylinder, Frame, Sphere
 
 
 def assert_generated_init(cls, rng, n: int = 20) -> None:
@@ -45,6 +45,6 @@ def assert_generated_init(cls, rng, n: int = 20) -> None:
             assert vars(cls(*values[:-1])) == vars(ref(*values[:-1]))  # the default
 
 
-@pytest.mark.parametrize("cls", [Box, Cylinder, Sphere, Frame, HandCommand, Motion])
+@pytest.mark.parametrize("cls", [Motion])
 def test_hand_written_inits_are_the_generated_ones(cls):
     assert_generated_init(cls, np.random.default_rng(3))
