@@ -799,67 +799,10 @@ def to_plain(value: Any) -> Any:
 # libyaml's emitter where PyYAML has it: ~4x faster (a run's set-up paid 6-13 ms for this), the
 # same text for every shipped scenario (tests/replay/test_runner_and_log.py compares them)
 _DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
-_STR, _INT, _FLOAT = "tag:yaml.org,2002:str", "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
-_BOOL, _NULL = "tag:yaml.org,2002:bool", "tag:yaml.org,2002:null"
-_SEQ, _MAP = "tag:yaml.org,2002:seq", "tag:yaml.org,2002:map"
-
-
-class _NotPlain(Exception):
-    pass
-
-
-def _float_text(x: float) -> str:
-    """A float as SafeRepresenter.represent_float writes it."""
-    if x != x:
-        return ".nan"
-    if x in (math.inf, -math.inf):
-        return ".inf" if x > 0 else "-.inf"
-    text = repr(x).lower()
-    return text.replace("e", ".0e", 1) if "." not in text and "e" in text else text
-
-
-def _node(value: Any) -> yaml.Node:
-    """``to_plain(value)``'s representation tree as SafeDumper (``default_flow_style=None``,
-    unsorted keys) builds it, built in one walk: a collection of plain scalars is a flow one.
-    Raises _NotPlain for anything else (yaml.dump then decides)."""
-    tp = type(value)
-    if tp is str:
-        return yaml.ScalarNode(_STR, value)
-    if tp is float:
-        return yaml.ScalarNode(_FLOAT, _float_text(value))
-    if tp is bool:
-        return yaml.ScalarNode(_BOOL, "true" if value else "false")
-    if tp is int:
-        return yaml.ScalarNode(_INT, str(value))
-    if value is None:
-        return yaml.ScalarNode(_NULL, "null")
-    if tp is list or tp is tuple:
-        items = [_node(v) for v in value]
-        flat = all(type(n) is yaml.ScalarNode for n in items)
-        return yaml.SequenceNode(_SEQ, items, flow_style=flat)
-    if tp is dict:
-        pairs = [(_node(k), _node(v)) for k, v in value.items()]
-    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
-        pairs = [
-            (yaml.ScalarNode(_STR, f.name), _node(getattr(value, f.name)))
-            for f in dataclasses.fields(value)
-            if not f.metadata.get("internal")
-            and not (f.metadata.get("omit_empty") and not getattr(value, f.name))
-        ]
-    else:
-        raise _NotPlain(tp)
-    flat = all(type(k) is yaml.ScalarNode and type(v) is yaml.ScalarNode for k, v in pairs)
-    return yaml.MappingNode(_MAP, pairs, flow_style=flat)
 
 
 def resolved_yaml(sc: Scenario) -> str:
-    """The scenario as it ran: every default filled in (saved in each log). Its tree is built
-    directly (PyYAML's representer took ~3/4 of the 3-6 ms a run paid for this text), then
-    libyaml's emitter writes it; the text is yaml.dump's (tests/replay/test_runner_and_log.py)."""
-    try:
-        node = _node(sc)
-    except _NotPlain:
-        return yaml.dump(
-            to_plain(sc), Dumper=_DUMPER, sort_keys=False, default_flow_style=None, width=100
-        )
-    return yaml.serialize(node, Dumper=_DUMPER, width=100)
+    """The scenario as it ran: every default filled in (saved in each log)."""
+    return yaml.dump(
+        to_plain(sc), Dumper=_DUMPER, sort_keys=False, default_flow_style=None, width=100
+    )

@@ -321,56 +321,6 @@ def test_resolved_yaml_is_the_pure_python_emitters_text_for_every_scenario():
         assert resolved_yaml(sc) == text, path.name
 
 
-def test_resolved_yaml_tree_is_the_representers_on_random_plain_data():
-    """resolved_yaml builds the representation tree itself (replay/scenario/loader.py _node):
-    for random nested plain data (floats of every kind, ints, bools, None, strings that need
-    quoting, flow and block collections) the text is yaml.dump's."""
-    import random
-
-    import yaml
-
-    from replay.scenario.loader import _DUMPER, _node
-
-    rng = random.Random(7)
-    scalars = [
-        0.0,
-        -0.0,
-        1e-05,
-        1e16,
-        2.5e-300,
-        float("nan"),
-        float("inf"),
-        -float("inf"),
-        3,
-        -7,
-        True,
-        False,
-        None,
-        "",
-        "yes",
-        "a: b",
-        "1.5",
-        "null",
-        "x\ny",
-        "#c",
-        "~",
-        "ok",
-    ]
-
-    def value(depth):
-        r = rng.random()
-        if depth > 3 or r < 0.5:
-            return rng.choice(scalars + [rng.uniform(-1e3, 1e3)])
-        if r < 0.75:
-            return [value(depth + 1) for _ in range(rng.randrange(4))]
-        return {f"k{i}": value(depth + 1) for i in range(rng.randrange(4))}
-
-    for _ in range(300):
-        data = {"root": value(0)}
-        want = yaml.dump(data, Dumper=_DUMPER, sort_keys=False, default_flow_style=None, width=100)
-        assert yaml.serialize(_node(data), Dumper=_DUMPER, width=100) == want
-
-
 def test_a_list_in_truth_is_its_items_messages_with_and_without_observers(
     toy_yaml, tmp_path, monkeypatch
 ):
