@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from replay.control.grasping.gain_rule import check_period, direct_gains, scale
 from replay.control.grasping.payloads import ArmLoop
 from replay.interfaces import Controller
 from replay.messages import (
@@ -47,6 +48,9 @@ from replay.robot.hand import hand_body
 from replay.spatial import cross3, wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
+# 1/s: the wrist force loop's rate at 1 ms, K^af r^2 k_h (0.3 rad/(s N m), ~0.6 m from the
+# shoulder, the human's 500 N/m), the direct loop K^af shares its gain factor with (gain_rule.py)
+FORCE_LOOP_RATE = 54.0
 
 
 def eq2_terms(Jg, J, n, lam2, b1, b2, qd, F, K_ap, K_av, K_af, vlim) -> tuple[list, ...]:
@@ -152,6 +156,15 @@ class ArmParams:
         "wrist also feels the hand's inertia (m a), and feeding that "
         "back through the 1 ms loop unfiltered is unstable",
     )
+    gain_period: float = param(
+        0.0,
+        unit="s",
+        ge=0.0,
+        omit_empty=True,
+        doc="the gain rule: 0 keeps K^a1, K^a2, K^af as given (tuned for 1 ms loops); a period T "
+        "(s, the task's 1 / rate) re-designs each for it, the 1 ms loop's pole kept "
+        "(gain_rule.direct_gain; K^af scaled as a loop of FORCE_LOOP_RATE)",
+    )
 
 
 class ArmControlTask(Controller):
@@ -202,7 +215,10 @@ class ArmControlTask(Controller):
         self._vlim = self.vlim.tolist()
         self.dt = spec.dt  # the task's period (from its update times)
         self._t_last: float | None = None
-        self.K_a1, self.K_a2 = np.asarray(params.K_a1, float), np.asarray(params.K_a2, float)
+        T = params.gain_period  # the gain rule (gain_rule.py): 0 keeps the gains
+        self.K_a1 = np.asarray(direct_gains(params.K_a1, T), float)
+        self.K_a2 = np.asarray(direct_gains(params.K_a2, T), float)
+        self.K_af = params.K_af * scale(FORCE_LOOP_RATE, T)
         self._g_track = (S_DIAG * self.K_a1).tolist()  # eq. 2's S K^a1 and (I - S) K^a2
         self._g_reach = ((1.0 - S_DIAG) * self.K_a2).tolist()
         self._g_track_reach = [params.reach_tracking * g for g in self._g_track]
@@ -216,6 +232,8 @@ class ArmControlTask(Controller):
         self.bias: list[float] | None = [0.0] * 6
         self.filtered = [0.0] * 6
         self._v_com: list[float] | None = None  # the hand's centre of mass velocity (world)
+        self._enc_t: float | None = None  # the newest encoder reading's time, and the one before's
+        self._enc_prev: tuple[float | None, list[float]] = (None, self.qd)
         self._hold: tuple | None = None  # (cycle, offset on x^o - x^a, offset on x_d - x^a)
         self._out: ArmLoop | None = None
         self.track_sq: dict[str, list] = {}
@@ -307,20 +325,32 @@ class ArmControlTask(Controller):
         """The hand's centre-of-mass acceleration (world, m/s^2) from the arm's kinematics:
         v_com = v_tool + w x (R com) with (v_tool, w) = J theta_dot (the tool Jacobian of this
         step's chain), differenced over the task's period."""
-        qd = self.qd
-        tw = [sum(a * b for a, b in zip(row, qd)) for row in self._J_rows]
         c = self._com
         r = [R[3 * i] * c[0] + R[3 * i + 1] * c[1] + R[3 * i + 2] * c[2] for i in range(3)]
-        wx, wy, wz = tw[3], tw[4], tw[5]
-        v = [
-            tw[0] + wy * r[2] - wz * r[1],
-            tw[1] + wz * r[0] - wx * r[2],
-            tw[2] + wx * r[1] - wy * r[0],
-        ]
+        v = self._com_velocity(self.qd, r)
+        t0, qd0 = self._enc_prev
+        if self.params.gain_period > 0.0 and t0 is not None and self._enc_t is not None:
+            # the discrete rule: the newest two encoder readings (1 ms apart, this step's chain),
+            # the acceleration at the wrist sensor's instant; over a long period the difference
+            # of the task's own steps lags it and feeds m dv / T back as a force
+            dt = self._enc_t - t0
+            v0 = self._com_velocity(qd0, r)
+            return [(a - b) / dt for a, b in zip(v, v0)] if dt > 0.0 else [0.0, 0.0, 0.0]
         prev, self._v_com = self._v_com, v
         if prev is None or self.dt <= 0.0:
             return [0.0, 0.0, 0.0]
         return [(a - b) / self.dt for a, b in zip(v, prev)]
+
+    def _com_velocity(self, qd, r) -> list[float]:
+        """The hand's centre-of-mass velocity v_tool + w x r (world) at joint rates ``qd``, ``r``
+        the centre of mass from the tool origin (world), by this step's tool Jacobian."""
+        tw = [sum(a * b for a, b in zip(row, qd)) for row in self._J_rows]
+        wx, wy, wz = tw[3], tw[4], tw[5]
+        return [
+            tw[0] + wy * r[2] - wz * r[1],
+            tw[1] + wz * r[0] - wx * r[2],
+            tw[2] + wx * r[1] - wy * r[0],
+        ]
 
     def external_wrench(self, R) -> list[float]:
         """F^a (world, about the flange): the sensor's wrench minus the hand's gravity and
@@ -347,6 +377,8 @@ class ArmControlTask(Controller):
     def update(self, t: float, measurements) -> ServoCommand | None:
         for topic, m in measurements:
             if topic == TOPIC_ARM_ENCODERS:
+                self._enc_prev = (self._enc_t, self.qd)
+                self._enc_t = m.t
                 self.q, self.qd = m.position, m.velocity
             elif topic == TOPIC_WRIST_WRENCH:
                 self.wrench_raw = m
@@ -357,6 +389,7 @@ class ArmControlTask(Controller):
                 self.state = m
         if self._t_last is not None and t > self._t_last:
             self.dt = t - self._t_last
+            check_period(self.params.gain_period, self.dt, "arm")
         self._t_last = t
         if self.state is None:
             return None
@@ -402,7 +435,7 @@ class ArmControlTask(Controller):
             F,
             P.K_ap,
             P.K_av,
-            P.K_af,
+            self.K_af,
             self._vlim,
         )
         self._out = ArmLoop(
@@ -467,7 +500,7 @@ class ArmControlTask(Controller):
             "track": P.K_ap * Jpinv @ (share * S_DIAG * self.K_a1 * e_track),
             "reach": P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach),
             "damp": -P.K_av * np.asarray(qd, float),
-            "force": P.K_af * (J.T @ np.asarray(F, float)),
+            "force": self.K_af * (J.T @ np.asarray(F, float)),
         }
         out["command"] = np.clip(sum(out.values()), -self.vlim, self.vlim)
         out["x_a"] = gp

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from replay.control.grasping.gain_rule import check_period, direct_gain, scale
 from replay.control.grasping.payloads import HandLoop
 from replay.interfaces import Controller, Occurrence
 from replay.messages import (
@@ -148,6 +149,15 @@ class HandParams:
         "within this closed on nothing (a missed grasp): an object "
         "stops them ~0.4 rad short",
     )
+    gain_period: float = param(
+        0.0,
+        unit="s",
+        ge=0.0,
+        omit_empty=True,
+        doc="the gain rule: 0 keeps K^hg, K^hf as given (tuned for 1 ms loops); a period T (s, "
+        "the task's 1 / rate) re-designs K^hg for it, the 1 ms loop's pole kept "
+        "(gain_rule.direct_gain), and scales K^hf alike (the grip's K^hg / K^hf kept)",
+    )
 
 
 class HandControlTask(Controller):
@@ -212,6 +222,9 @@ class HandControlTask(Controller):
         self._width_sum, self._width_n = 0.0, 0
         self.width: float | None = None
         self.dt = spec.dt
+        T = params.gain_period  # the gain rule (gain_rule.py): 0 keeps the gains
+        self.K_hg = direct_gain(params.K_hg, T) if T > 0.0 else params.K_hg
+        self.K_hf = params.K_hf * scale(params.K_hg, T)
         self._t_last: float | None = None
         self.state: Any = None
         self._events: list[Occurrence] = []
@@ -246,6 +259,7 @@ class HandControlTask(Controller):
                 self.state = m
         if self._t_last is not None and t > self._t_last:
             self.dt = t - self._t_last
+            check_period(self.params.gain_period, self.dt, "hand")
         self._t_last = t
         if self.state is None:
             return None
@@ -278,7 +292,7 @@ class HandControlTask(Controller):
             c = 1.0
             vmax = min(vmax, P.touch_speed)
         theta_d, cmd, deficit = eq4_reference(
-            pre, grip, c, self.q, self.qd, self.load, P.K_hg, P.K_hv, P.K_hf, vmax
+            pre, grip, c, self.q, self.qd, self.load, self.K_hg, P.K_hv, self.K_hf, vmax
         )
         if st.phase == "hold":
             self._shape_at_grasp.setdefault(st.cycle, self.preshape)

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from replay.control.grasping.gain_rule import check_period, delayed_gain
 from replay.control.grasping.payloads import HeadLoop
 from replay.interfaces import Controller
 from replay.messages import TOPIC_GRASP_HEAD, TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS
@@ -40,6 +41,15 @@ class HeadParams:
     xi_d: list = param([], unit="px", doc="objective image position; [] = the image centre")
     width: int = param(16, unit="px", ge=2, doc="chip width (for the default xi_d)")
     height: int = param(16, unit="px", ge=2, doc="chip height")
+    gain_period: float = param(
+        0.0,
+        unit="s",
+        ge=0.0,
+        omit_empty=True,
+        doc="the gain rule: 0 keeps K^v as given (tuned for 1 ms loops); a period T (s, the "
+        "task's 1 / rate) re-designs K^v for it, the 1 ms loop's dominant pole kept given the "
+        "chip's one-frame latency (gain_rule.delayed_gain)",
+    )
 
 
 class HeadTrackingTask(Controller):
@@ -58,7 +68,9 @@ class HeadTrackingTask(Controller):
             if params.xi_d
             else np.array([(params.width - 1) / 2.0, (params.height - 1) / 2.0])
         )
-        self.K_v, self.K_vv = np.asarray(params.K_v, float), np.asarray(params.K_vv, float)
+        T = params.gain_period  # the gain rule (gain_rule.py): 0 keeps K^v
+        K_v = [delayed_gain(k, T) for k in params.K_v] if T > 0.0 else params.K_v
+        self.K_v, self.K_vv = np.asarray(K_v, float), np.asarray(params.K_vv, float)
         if spec.head is None:
             raise ValueError("head tracking needs a plant with a head")
         self.limit = np.asarray(spec.head.velocity_limit, float)
@@ -67,6 +79,7 @@ class HeadTrackingTask(Controller):
         self._K_vv, self._limit = self.K_vv.tolist(), self.limit.tolist()
         self.obj: Any = None
         self._out: HeadLoop | None = None
+        self._t_last: float | None = None
 
     def update(self, t: float, measurements) -> ServoCommand:
         for topic, m in measurements:
@@ -74,6 +87,10 @@ class HeadTrackingTask(Controller):
                 self.rate = m.velocity
             elif topic == TOPIC_GRASP_OBJECT:
                 self.obj = m
+        if self.params.gain_period > 0.0:
+            if self._t_last is not None:
+                check_period(self.params.gain_period, t - self._t_last, "head")
+            self._t_last = t
         # eq. 1 per axis in floats (2 x 2: J^-1 e by Cramer's rule)
         (kv0, kv1), (kvv0, kvv1), (lim0, lim1) = self._K_v, self._K_vv, self._limit
         c0, c1 = -kvv0 * self.rate[0], -kvv1 * self.rate[1]
