@@ -32,6 +32,8 @@ from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import HeadSpec, camera_pose
 from replay.spatial import wrap_half_pi
 
+HEAD_READINGS = 1024  # the head encoder readings kept at most: a chip latency up to ~1 s at 1 kHz
+
 
 @dataclass
 class RecognitionParams:
@@ -176,10 +178,16 @@ class RecognitionTask(Controller):
                 self._head[round(m.t, 9)] = (m.position[0], m.position[1])
             elif topic == TOPIC_VISION_CHIP:
                 chip = m
-        while len(self._head) > 16:
+        while len(self._head) > HEAD_READINGS:
             del self._head[min(self._head)]
         if chip is not None:
             self._out = self._frame(chip)
+            # frames come in time order: the readings before the one this frame used serve no
+            # later frame (a fixed 16 kept lost every frame at a chip latency above 16 ms)
+            key = round(chip.t, 9)
+            used = max((k for k in self._head if k <= key), default=None)
+            for k in [k for k in self._head if used is not None and k < used]:
+                del self._head[k]
         return None
 
     def _angles_at(self, t: float):

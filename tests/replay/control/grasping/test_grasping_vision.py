@@ -367,3 +367,35 @@ def test_a_chip_wider_than_63_px_runs_the_grasp_method(tmp_path):
     chips = [m.data for m in LogReader(tmp_path / "wide.mcap").messages("/vision/chip")]
     assert len(chips) == 50 and {c["width"] for c in chips} == {80}
     assert max(c["count"] for c in chips) > 0  # the object is seen
+
+
+@pytest.mark.parametrize("latency_ms", [1, 20, 33])
+def test_a_frame_a_chip_latency_old_finds_the_head_angles_it_was_taken_at(spec, latency_ms):
+    """The recognition ticks every T with the T 1 kHz head readings since its last tick and a
+    frame taken T ago (sweeps/grasp_loops.yaml): it finds that frame's angles (a fixed 16
+    readings kept found none beyond 16 ms, and every frame was dropped), and keeps no more
+    readings than it needs."""
+    centre = (0.75, 0.0, 0.55)
+    angles = look_angles(spec.head, np.array(centre))
+    task = RecognitionTask(RecognitionParams(fov=FOV, shape_frames=1), spec=spec)
+    sensor = chip_sensor()
+    ball = Sphere("ball", centre, 0.035, 0.9)
+    T = latency_ms * 1e-3
+    frame = None
+    for tick in range(1, 4):
+        t = tick * T
+        readings = [
+            (
+                TOPIC_HEAD_ENCODERS,
+                JointState(t - i * 1e-3, ["pan", "tilt"], list(angles), [0.0] * 2, [0.0] * 2),
+            )
+            for i in range(latency_ms - 1, -1, -1)
+        ]
+        msgs = readings + ([(TOPIC_VISION_CHIP, frame)] if frame is not None else [])
+        task.update(t, msgs)
+        if frame is not None:
+            out = task.telemetry(t)[TOPIC_GRASP_OBJECT]
+            assert out.found and out.t == pytest.approx(t - T)
+            assert len(task._head) <= latency_ms + 1
+        frame = sensor.measure(t, head_scene(spec, ball, angles))
+    assert task.frames == 2
