@@ -69,4 +69,7 @@ def human_args(P, u, v, n) -> dict:
         rot_stiffness=P.human_rot_stiffness,
         rot_damping=P.human_rot_damping,
         max_torque=P.human_max_torque,
+        kick_rate=P.human_kick_rate,
+        kick_speed=P.human_kick_speed,
+        kick_duration=P.human_kick_duration,
     )

@@ -8,6 +8,12 @@ RMS in-plane speed over time is ``speed`` (m/s) and the RMS roll rate is ``roll_
 It starts at the object's initial pose. Irregular and not known to the robot (Sec. 5: "moved by
 a human hand, its trajectory is irregular and difficult to predict").
 
+Kicks (off unless ``kick_rate`` > 0; issue #38's harder motion): at the times of a Poisson process
+of rate ``kick_rate`` (1/s, from the path's start) the path's in-plane velocity steps by
+``kick_speed`` (m/s) in a uniformly random direction for ``kick_duration`` (s), then steps back:
+the path is displaced by ``kick_speed * kick_duration`` within that time. Drawn from a generator
+seeded by one draw of the run's, after the path's, only when kicks are on.
+
 The hand holds the object compliantly (issue #20; the paper gives no model of the human): a
 spring-damper to the path's pose plus the object's weight, applied at its centre of mass as an
 external force and torque each step,
@@ -79,6 +85,9 @@ class HumanPath:
         rot_stiffness: float,
         rot_damping: float,
         max_torque: float,
+        kick_rate: float = 0.0,
+        kick_speed: float = 0.0,
+        kick_duration: float = 0.0,
     ) -> None:
         self.origin = np.asarray(origin, float)
         self.u, self.v, self.n = (np.asarray(x, float) for x in (u, v, n))
@@ -117,6 +126,7 @@ class HumanPath:
         self.force_l = [0.0, 0.0, 0.0]  # N, world: the hand's force on the object (last step)
         self.torque_l = [0.0, 0.0, 0.0]  # N m, world
         self.limited = False  # the force (or torque) was at its limit in the last step
+        self.kicks = Kicks(rng, kick_rate, kick_speed, kick_duration) if kick_rate > 0.0 else None
 
     def offset(self, t: float) -> tuple[float, float, float]:
         """(du, dv, droll) of the path from the start pose at time ``t``."""
@@ -128,6 +138,9 @@ class HumanPath:
             numpy_row_sum([a * (sin(w * tt + phi) - s0) for w, a, phi, s0 in row])
             for row in self._rows
         )
+        if self.kicks is not None:
+            ku, kv = self.kicks.offset(tt)
+            du, dv = du + ku, dv + kv
         return du, dv, r
 
     def rate(self, t: float) -> tuple[float, float, float]:
@@ -137,6 +150,9 @@ class HumanPath:
         tt = t - self.start
         cos = math.cos
         du, dv, r = (sum(a * w * cos(w * tt + phi) for w, a, phi, _ in row) for row in self._rows)
+        if self.kicks is not None:
+            ku, kv = self.kicks.rate(tt)
+            du, dv = du + ku, dv + kv
         return du, dv, r
 
     @property
@@ -198,6 +214,46 @@ class HumanPath:
     def force(self) -> list[float]:
         """The hand's force on the object (N, world), applied in the last step."""
         return self.force_l[:]
+
+
+class Kicks:
+    """The kicks' in-plane (u, v) offset and rate at a time since the path's start: each kick
+    (t_k, direction) adds ``speed`` along its direction during [t_k, t_k + ``duration``]. Kick
+    times are drawn lazily (exponential gaps of mean 1 / ``rate``) as time passes them."""
+
+    def __init__(self, rng: np.random.Generator, rate: float, speed: float, duration: float):
+        if speed <= 0.0 or duration <= 0.0:
+            raise ValueError("kicks need human_kick_speed > 0 and human_kick_duration > 0")
+        self.rng = np.random.default_rng(int(rng.integers(2**63)))
+        self.mean_gap, self.speed, self.duration = 1.0 / rate, float(speed), float(duration)
+        self.times: list[float] = []
+        self.dirs: list[tuple[float, float]] = []
+        self._next = float(self.rng.exponential(self.mean_gap))
+
+    def _draw(self, tt: float) -> None:
+        while self._next <= tt:
+            a = float(self.rng.uniform(0.0, 2.0 * math.pi))
+            self.times.append(self._next)
+            self.dirs.append((math.cos(a), math.sin(a)))
+            self._next += float(self.rng.exponential(self.mean_gap))
+
+    def offset(self, tt: float) -> tuple[float, float]:
+        """(du, dv) m: the kicks' displacement of the path at ``tt`` s after its start."""
+        self._draw(tt)
+        du = dv = 0.0
+        for t0, (cu, cv) in zip(self.times, self.dirs):
+            d = self.speed * min(tt - t0, self.duration)
+            du, dv = du + d * cu, dv + d * cv
+        return du, dv
+
+    def rate(self, tt: float) -> tuple[float, float]:
+        """(du/dt, dv/dt) m/s of the kicks at ``tt``."""
+        self._draw(tt)
+        ru = rv = 0.0
+        for t0, (cu, cv) in zip(self.times, self.dirs):
+            if t0 <= tt < t0 + self.duration:
+                ru, rv = ru + self.speed * cu, rv + self.speed * cv
+        return ru, rv
 
 
 def numpy_row_sum(xs: list) -> float:
