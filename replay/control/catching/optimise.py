@@ -62,6 +62,21 @@ def null_space(C: np.ndarray) -> np.ndarray:
     return Vt[rank:].T
 
 
+def project_eq13(alpha: np.ndarray, C: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """The alpha nearest ``alpha`` (Euclidean) that meets C alpha = rhs (eq. 13): an alpha made
+    for other throws, re-solved for this set's initial constraint with no cost (a falsifier)."""
+    alpha = np.asarray(alpha, float)
+    return alpha + np.linalg.pinv(C, rcond=1e-12) @ (rhs - C @ alpha)
+
+
+def null_space_alpha(C: np.ndarray, rhs: np.ndarray, size: float, seed: int) -> np.ndarray:
+    """alpha0 + Z beta (eq. 13 exact) with beta a seeded random direction and |Z beta| = size:
+    an alpha as far from the initial one as an optimum may be, chosen with no cost (a falsifier)."""
+    Z = null_space(C)
+    beta = np.random.default_rng(seed).standard_normal(Z.shape[1])
+    return initial_alpha(C, rhs) + Z @ (size * beta / np.linalg.norm(beta))
+
+
 class Objective:
     """E(alpha) of eq. 25 over fixed samples, with its residuals and Jacobian (plus, optionally, the
     approach-direction term of approach.py, which is not in the paper)."""
