@@ -696,14 +696,7 @@ class MujocoArmPlant(TorqueLimits, Plant):
             if P.object == "ball":
                 prims.append(Sphere("ball", obj[0], float(P.object_radius), P.object_albedo))
             else:
-                prims.append(
-                    Box(
-                        "box",
-                        obj[0],
-                        obj[1],
-                        tuple(float(s) for s in P.object_size),
-                        P.object_albedo,
-                    )
-                )
+                sx, sy, sz = (float(s) for s in P.object_size)
+                prims.append(Box("box", obj[0], obj[1], (sx, sy, sz), P.object_albedo))
         encoders = {"name": list(self.joint_names), "position": q[:], "velocity": qd[:]}
         return Scene(prims, readings={"arm": encoders})
