@@ -9,8 +9,8 @@ CPU time (``time.process_time``: what other users of the machine do not inflate 
 time; the real-time factor (simulated seconds per second, CPU and wall); the CPU time per
 simulated second; the ratio of a full run's CPU time to the bare engine's stepping the same scene
 the same number of steps (Pymunk ``space.step``, PyBullet ``stepSimulation``, MuJoCo ``mj_step``, nothing else); the
-share of each part of the loop (the runner's own timers: sensors, controller, plant, logging,
-runner); what a JSON message, a camera image, a 3-D frame and a /log line cost each (one more
+share of each part of the loop (sensors, controller, plant, logging, runner: each plug-in call
+timed from outside the runner, :func:`timed_run`); what a JSON message, a camera image, a 3-D frame and a /log line cost each (one more
 run, each such call timed); whether the issue's target is met (#10; #24 for the MuJoCo twins); and, apart, the interpreter's
 start-up and the imports a run needs. Nothing here is a test: it prints, it does not fail.
 """
@@ -31,7 +31,7 @@ from replay.foxglove.run import RunTopics
 from replay.foxglove.topics import FoxgloveTopics
 from replay.log import LogWriter
 from replay.resources import scenario_dir
-from replay.runner import COMPONENTS, Runner
+from replay.runner import RunResult, Runner
 from replay.scenario import ScenarioError, load_scenario
 
 DEFAULT = [
@@ -44,6 +44,53 @@ DEFAULT = [
         "grasp_hexahedron_mujoco",
     )
 ]
+
+
+# The parts of a run :func:`timed_run` times: sensors (measure); controller (update, pop_events,
+# telemetry, intent); plant (scene, apply, truth, step, pop_events); logging (the log's writes,
+# observers and the Foxglove topics); runner (the rest: the loop itself, delivery, set-up, closing).
+COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
+
+
+def timed_run(runner: Runner, out: Path) -> tuple[RunResult, dict[str, float]]:
+    """``runner.run(out)`` with the wall time of each part of the loop (``COMPONENTS``): every
+    plug-in call and log write wrapped in a timer (only the outermost of nested ones counts),
+    "runner" the rest of the run's wall time."""
+    spent = dict.fromkeys(COMPONENTS, 0.0)
+    depth, clock = [0], time.perf_counter
+
+    def timed(part: str, fn):
+        def wrapper(*args, **kw):
+            if depth[0]:
+                return fn(*args, **kw)
+            depth[0] += 1
+            c0 = clock()
+            try:
+                return fn(*args, **kw)
+            finally:
+                spent[part] += clock() - c0
+                depth[0] -= 1
+
+        return wrapper
+
+    for attr in ("scene", "apply", "truth", "step", "pop_events"):
+        setattr(runner.plant, attr, timed("plant", getattr(runner.plant, attr)))
+    for _, sensor, _, _ in runner.sensors:
+        sensor.measure = timed("sensors", sensor.measure)
+    for attr in ("update", "pop_events", "telemetry", "intent"):
+        setattr(runner.controller, attr, timed("controller", getattr(runner.controller, attr)))
+    logged = [(LogWriter, "write"), (LogWriter, "write_all")]
+    logged += [(RunTopics, a) for a in ("start", "frame", "sensor", "event")]
+    original = {(cls, attr): getattr(cls, attr) for cls, attr in logged}
+    for (cls, attr), fn in original.items():
+        setattr(cls, attr, timed("logging", fn))
+    try:
+        result = runner.run(out)
+    finally:
+        for (cls, attr), fn in original.items():
+            setattr(cls, attr, fn)
+    spent["runner"] = result.wall_time - sum(spent.values())
+    return result, spent
 
 
 def bare_stepper(runner: Runner):
@@ -283,7 +330,7 @@ def bench(
             runner = Runner(sc)  # run 0 warms up (imports, caches, files)
             probe = host_probe()
             c0, w0 = time.process_time(), time.perf_counter()
-            result = runner.run(Path(tmp) / f"run{i % 2}.mcap")
+            result, times = timed_run(runner, Path(tmp) / f"run{i % 2}.mcap")
             c1, w1 = time.process_time(), time.perf_counter()
             i += 1
             if i == 1:
@@ -291,9 +338,9 @@ def bench(
             probes.append(probe)
             cpu.append(c1 - c0)
             wall.append(w1 - w0)
-            total = sum(result.timings.values())
+            total = sum(times.values())
             for c in COMPONENTS:
-                shares[c].append(result.timings[c] / total)
+                shares[c].append(times[c] / total)
         run_cpu, engine_cpu, engine_steps = engine_in_run(sc, Path(tmp) / "engine.mcap")
         logged = logging_costs(sc, Path(tmp) / "logging.mcap")
     engine, plant, step = bare_stepper(Runner(sc))

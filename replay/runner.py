@@ -7,11 +7,13 @@ plant (or, with ``tasks:``, each due task reads its inputs and writes its part o
 ``replay.tasks``), the plant's state is logged, the plant steps, and the physics events of that step are
 logged at its end, collisions with the controller's intent attached. The run stops at
 ``timing.duration`` or ``stop.after`` seconds after one of ``stop.on_events``.
+
+``Runner(scenario).run(out)`` is the whole run; it is :meth:`Runner.start`, :meth:`Runner.step`
+until :attr:`Runner.done`, then :meth:`Runner.finish`, which a caller may drive itself.
 """
 
 from __future__ import annotations
 
-import collections
 import functools
 import heapq
 import platform
@@ -19,7 +21,7 @@ import time
 from dataclasses import dataclass, field
 from importlib import metadata as importlib_metadata
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
@@ -50,15 +52,6 @@ class RunResult:
     wall_time: float = 0.0
     error: str = ""
     outcome: dict = field(default_factory=dict)  # the final ``outcome`` event's data
-    # wall seconds spent in each part of the loop (COMPONENTS); "runner" is the rest of the run
-    timings: dict = field(default_factory=dict)
-
-
-# The parts of a run timed by the runner itself (perf_counter, one reading a part), so `make
-# bench` shows where the time goes without a profiler: sensors (measure); controller (update,
-# pop_events, telemetry, intent); plant (scene, apply, truth, step, pop_events); logging (log
-# writes and observers); runner (the rest: the loop itself, delivery, set-up, closing the log).
-COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 
 _git_commit = version.commit  # from git in a checkout, from the build in a wheel
@@ -101,6 +94,8 @@ def _divider(physics_rate: int, rate: float) -> int:
 
 
 class Runner:
+    viz: RunTopics  # the run's Foxglove topics, from start()
+
     def __init__(
         self,
         scenario: Scenario,
@@ -111,7 +106,7 @@ class Runner:
         self.sc = scenario
         self.progress = progress
         self.observers = observers  # callables(topic, payload, t) — e.g. a live viewer
-        rate = scenario.timing.physics_rate
+        self.rate = rate = scenario.timing.physics_rate
         self.dt = 1.0 / rate
         seeds = np.random.SeedSequence(scenario.seed).spawn(2 + len(scenario.sensors))
         plant_cls = registry.load("plant", scenario.plant.type)
@@ -152,198 +147,144 @@ class Runner:
         )
         fr = scenario.timing.frame_rate  # the 3-D viewer topics (replay/foxglove)
         self.frame_div = _divider(rate, fr) if fr else 0
-        self.viz: RunTopics | None = None
-        self._t_log = 0.0  # seconds in log writes (and observers) this run
 
     def t_ns(self, k: int) -> int:
         return k * 1_000_000_000 // self.sc.timing.physics_rate
 
+    # -- the run, step by step: start(out), step() until done, finish() ----------------------
+
     def run(self, out: str | Path) -> RunResult:
+        """The whole run into the log ``out``: :meth:`start`, :meth:`step` until :attr:`done`,
+        :meth:`finish`. Ctrl-C closes the log (kept) and raises :class:`RunInterrupted`."""
+        self.start(out)
+        progress_div = max(1, self.rate // 20)
+        try:
+            while not self.done:
+                self.step()
+                if self.progress and self.k % progress_div == 0:
+                    self.progress(self.k / self.rate, self.sc.timing.duration)
+            return self.finish()
+        except NonFiniteValueError as exc:
+            return self._failed(exc)
+        except KeyboardInterrupt:
+            raise RunInterrupted(self._interrupted()) from None
+        except BaseException:
+            self.plant.close()
+            raise
+
+    def start(self, out: str | Path) -> None:
+        """Open the log ``out`` and write what a run starts with (its provenance, the resolved
+        scenario, the robot's description); the run is at step 0."""
         sc = self.sc
-        rate = sc.timing.physics_rate
-        n_steps = int(round(sc.timing.duration * rate))
-        result = RunResult(path=Path(out))
-        wall0 = time.perf_counter()
-        log = LogWriter(out)
+        self.result = RunResult(path=Path(out))
+        self._wall0 = time.perf_counter()
+        self.k = 0
+        self._n_steps = int(round(sc.timing.duration * self.rate))
+        self._stop_at: int | None = None
+        self._collisions = 0
+        self._seq = 0
+        # (deliver at step, sequence, topic, payload), delivered in that order whatever the
+        # sensors' order and latencies
+        self._pending: list = []
+        log = self.log = LogWriter(out)
         commit = _git_commit() or "unknown"
         log.metadata("provenance", provenance(sc, commit))
         text = resolved_yaml(sc)
         log.metadata("scenario", {"yaml": text})
         version = f"{__version__}+{commit}"
-        self._write(
-            log, TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0
-        )
-        viz = self.viz = RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
-        viz.start(0)
-        seq = 0
-        stop_at: int | None = None
-        collisions = 0
-        k = 0
-        # The loop is the hot path (1-3 k steps and 4-22 k messages per simulated second): the
-        # plug-ins' methods are bound once, and each part is timed by one clock reading at its
-        # end (the start is the previous part's end), so timing a message costs one perf_counter.
-        clock = time.perf_counter
-        plant, controller = self.plant, self.controller
-        scene_of, apply, truth_of, step = plant.scene, plant.apply, plant.truth, plant.step
-        plant_events = plant.pop_events
-        update, telemetry_of, controller_events = (
-            controller.update,
-            controller.telemetry,
-            controller.pop_events,
-        )
-        write = self._emitter(log)
-        write_all = self._emitter_all(log)
-        sensors = [
-            (s.measure, s.topic, div, latency, (name, s) if name in viz.imaging else None)
-            for name, s, div, latency in self.sensors
-        ]
-        ctrl_div, log_div, n_ns = self.ctrl_div, self.log_div, 1_000_000_000
-        frame_div = self.frame_div
-        progress, progress_div = self.progress, max(1, rate // 20)
-        # (deliver at step, sequence, topic, payload), delivered in that order whatever the
-        # sensors' order and latencies: a heap; with one latency for all, readings are made in
-        # delivery order, so a FIFO (half the cost of a heap's push and pop) is that order
-        pending: Any
-        if len({latency for _, _, _, latency, _ in sensors}) <= 1:
-            pending = collections.deque()
-            push, pop = pending.append, pending.popleft
-        else:
-            pending = []
-            push = functools.partial(heapq.heappush, pending)
-            pop = functools.partial(heapq.heappop, pending)
-        t_sensors = t_controller = t_plant = 0.0
-        self._t_log = 0.0
-        t_log = 0.0
-        try:
-            while k < n_steps and (stop_at is None or k < stop_at):
-                t = k / rate
-                t_ns = k * n_ns // rate
-                scene = None
-                for measure, topic, div, latency, imaging in sensors:
-                    if k % div == 0:
-                        c0 = clock()
-                        if scene is None:
-                            scene = scene_of()
-                            c1 = clock()
-                            t_plant += c1 - c0
-                            c0 = c1
-                        m = measure(t, scene)
-                        c1 = clock()
-                        t_sensors += c1 - c0
-                        if imaging is not None:  # its frame, for Foxglove / Rerun
-                            viz.sensor(imaging[0], imaging[1], t_ns)
-                            c0 = clock()
-                            t_log += c0 - c1
-                            c1 = c0
-                        if m is not None:
-                            write(topic, m, t_ns)
-                            t_log += clock() - c1
-                            push((k + latency, seq, topic, m))
-                            seq += 1
-                if k % ctrl_div == 0:
-                    delivered = []
-                    while pending and pending[0][0] <= k:
-                        _, _, topic, m = pop()
-                        delivered.append((topic, m))
-                    c0 = clock()
-                    command = update(t, delivered)
-                    c1 = clock()
-                    t_controller += c1 - c0
-                    if command is not None:
-                        if isinstance(command, list):  # parallel tasks' partial commands
-                            for c in command:
-                                apply(c)
-                        else:
-                            apply(command)
-                        c0 = clock()
-                        t_plant += c0 - c1
-                        c1 = c0
-                    occurrences = controller_events()
-                    telemetry = telemetry_of(t)
-                    c0 = clock()
-                    t_controller += c0 - c1
-                    if occurrences:
-                        for occ in occurrences:
-                            stop_at = self._event(log, occ, t, t_ns, result, stop_at, k)
-                        c0 = clock()
-                    if telemetry:
-                        write_all(telemetry, t_ns)
-                        t_log += clock() - c0
-                c0 = clock()
-                if k % log_div == 0:
-                    truth = truth_of(t)
-                    c1 = clock()
-                    t_plant += c1 - c0
-                    write_all(truth, t_ns)
-                    c0 = clock()
-                    t_log += c0 - c1
-                if frame_div and k % frame_div == 0:  # the 3-D topics (replay/foxglove)
-                    c1 = clock()
-                    viz.frame(scene if scene is not None else scene_of(), t_ns)
-                    c0 = clock()
-                    t_log += c0 - c1
-                step()
-                k += 1
-                occurrences = plant_events()
-                t_plant += clock() - c0
-                if occurrences:
-                    t1, t1_ns = k / rate, k * n_ns // rate
-                    for occ in occurrences:
-                        if occ.kind == "collision":
-                            collisions += 1
-                            c0 = clock()
-                            planned = controller.intent()
-                            t_controller += clock() - c0
-                            occ.data = {"index": collisions, **occ.data, "planned": planned}
-                        stop_at = self._event(log, occ, t1, t1_ns, result, stop_at, k)
-                if progress and k % progress_div == 0:
-                    progress(k / rate, sc.timing.duration)
-            # the final state, so the log ends where the run ended
-            t_end = k / rate
-            truth = self.plant.truth(t_end)
-            c0 = clock()
-            write_all(truth, self.t_ns(k))  # (as in the loop)
-            t_log += clock() - c0
-            if frame_div:
-                viz.frame(self.plant.scene(), self.t_ns(k))
-            self._outcome(log, result, k, self._verdict(k / rate))
-        except NonFiniteValueError as exc:
-            result.stopped_by = "error"
-            result.error = str(exc)
-            self._write(
-                log,
-                TOPIC_EVENTS,
-                Event(
-                    k / rate,
-                    "error",
-                    {"reason": "non-finite value", "topic": exc.topic, "fields": exc.fields},
-                ),
-                self.t_ns(k),
-            )
-            self._outcome(
-                log,
-                result,
-                k,
-                {"success": False, "reason": f"error: non-finite value on {exc.topic}"},
-            )
-        except KeyboardInterrupt:
-            result.stopped_by = "interrupted"
-            self._write(log, TOPIC_EVENTS, Event(k / rate, "interrupted", {}), self.t_ns(k))
-            self._outcome(log, result, k, {"success": False, "reason": "interrupted"})
-            self._finish(log, result, k, wall0)
-            raise RunInterrupted(result) from None
-        finally:
-            self._t_log += t_log
-            self.plant.close()
-        self._finish(log, result, k, wall0)
-        result.timings = {
-            "sensors": t_sensors,
-            "controller": t_controller,
-            "plant": t_plant,
-            "logging": self._t_log,
-        }
-        result.timings["runner"] = result.wall_time - sum(result.timings.values())
-        return result
+        self._emit = self._emitter(log)
+        self._emit_all = self._emitter_all(log)
+        self.viz = RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
+        self._write(TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0)
+        self.viz.start(0)
+
+    @property
+    def done(self) -> bool:
+        """The run's duration is over, or ``stop.after`` seconds after a stopping event."""
+        return self.k >= self._n_steps or (self._stop_at is not None and self.k >= self._stop_at)
+
+    def step(self) -> None:
+        """One physics step k: the sensors due capture the scene (logged now, delivered
+        ``latency`` later), the controller due reads what was delivered and commands the
+        plant, the plant's state is logged, the plant steps, and its events are logged at the
+        step's end (a collision with the controller's intent)."""
+        k, plant = self.k, self.plant
+        t, t_ns = k / self.rate, self.t_ns(k)
+        scene = None
+        for name, sensor, div, latency in self.sensors:
+            if k % div:
+                continue
+            if scene is None:
+                scene = plant.scene()
+            m = sensor.measure(t, scene)
+            self.viz.sensor(name, sensor, t_ns)  # its frame, for Foxglove / Rerun
+            if m is not None:
+                self._emit(sensor.topic, m, t_ns)
+                heapq.heappush(self._pending, (k + latency, self._seq, sensor.topic, m))
+                self._seq += 1
+        if k % self.ctrl_div == 0:
+            self._control(t, t_ns)
+        if k % self.log_div == 0:
+            self._emit_all(plant.truth(t), t_ns)
+        if self.frame_div and k % self.frame_div == 0:  # the 3-D topics (replay/foxglove)
+            self.viz.frame(scene if scene is not None else plant.scene(), t_ns)
+        plant.step()
+        self.k = k = k + 1
+        t1, t1_ns = k / self.rate, self.t_ns(k)
+        for occ in plant.pop_events():
+            if occ.kind == "collision":
+                self._collisions += 1
+                occ.data = {
+                    "index": self._collisions,
+                    **occ.data,
+                    "planned": self.controller.intent(),
+                }
+            self._event(occ, t1, t1_ns)
+
+    def _control(self, t: float, t_ns: int) -> None:
+        """The controller's turn: what the sensors delivered by now in, the command out."""
+        delivered, pending = [], self._pending
+        while pending and pending[0][0] <= self.k:
+            _, _, topic, m = heapq.heappop(pending)
+            delivered.append((topic, m))
+        command = self.controller.update(t, delivered)
+        if isinstance(command, list):  # parallel tasks' partial commands
+            for c in command:
+                self.plant.apply(c)
+        elif command is not None:
+            self.plant.apply(command)
+        occurrences = self.controller.pop_events()
+        telemetry = self.controller.telemetry(t)
+        for occ in occurrences:
+            self._event(occ, t, t_ns)
+        if telemetry:
+            self._emit_all(telemetry, t_ns)
+
+    def finish(self) -> RunResult:
+        """The final state (so the log ends where the run ended), the ``outcome`` event, the
+        log closed; the run's result."""
+        k, t_ns = self.k, self.t_ns(self.k)
+        self._emit_all(self.plant.truth(k / self.rate), t_ns)
+        if self.frame_div:
+            self.viz.frame(self.plant.scene(), t_ns)
+        self._outcome(self._verdict(k / self.rate))
+        return self._finish()
+
+    def _failed(self, exc: NonFiniteValueError) -> RunResult:
+        """A non-finite value on a topic: an ``error`` event and a failed outcome."""
+        self.result.stopped_by = "error"
+        self.result.error = str(exc)
+        data = {"reason": "non-finite value", "topic": exc.topic, "fields": exc.fields}
+        self._write(TOPIC_EVENTS, Event(self.k / self.rate, "error", data), self.t_ns(self.k))
+        reason = f"error: non-finite value on {exc.topic}"
+        self._outcome({"success": False, "reason": reason})
+        return self._finish()
+
+    def _interrupted(self) -> RunResult:
+        self.result.stopped_by = "interrupted"
+        self._write(TOPIC_EVENTS, Event(self.k / self.rate, "interrupted", {}), self.t_ns(self.k))
+        self._outcome({"success": False, "reason": "interrupted"})
+        return self._finish()
 
     def _verdict(self, t: float) -> dict:
         """The plant's physical verdict, with the method's metrics and its own failure reason."""
@@ -358,25 +299,23 @@ class Runner:
             verdict["reason"] = reason or "the method reported a failure"
         return verdict
 
-    def _outcome(self, log: LogWriter, result: RunResult, k: int, verdict: dict) -> None:
+    def _outcome(self, verdict: dict) -> None:
         """Every run ends with one ``outcome`` event: the one place a user or a sweep reads it."""
-        result.outcome = verdict
-        self._write(
-            log,
-            TOPIC_EVENTS,
-            Event(k / self.sc.timing.physics_rate, "outcome", verdict),
-            self.t_ns(k),
-        )
+        self.result.outcome = verdict
+        self._write(TOPIC_EVENTS, Event(self.k / self.rate, "outcome", verdict), self.t_ns(self.k))
 
-    def _finish(self, log: LogWriter, result: RunResult, k: int, wall0: float) -> None:
+    def _finish(self) -> RunResult:
+        result, k = self.result, self.k
+        self.plant.close()
         result.steps = k
-        result.t_end = k / self.sc.timing.physics_rate
-        result.messages = log.count
+        result.t_end = k / self.rate
+        result.messages = self.log.count
         # a failed or interrupted run never replaces a finished log at ``out``: NAME.failed.mcap
-        result.path = log.close(
+        result.path = self.log.close(
             {"error": "failed", "interrupted": "interrupted"}.get(result.stopped_by, "")
         )
-        result.wall_time = time.perf_counter() - wall0
+        result.wall_time = time.perf_counter() - self._wall0
+        return result
 
     def _emitter(self, log: LogWriter) -> Callable[[str, object, int], None]:
         """``write(topic, payload, t_ns)``: the log's own write, and the observers' after it."""
@@ -405,20 +344,21 @@ class Runner:
 
         return write_all
 
-    def _write(self, log: LogWriter, topic: str, payload, t_ns: int) -> None:
-        """A message outside the loop's hot path (scenario, events, outcome), timed as logging."""
-        c0 = time.perf_counter()
-        self._emitter(log)(topic, payload, t_ns)
-        if topic == TOPIC_EVENTS and self.viz is not None:
+    def _write(self, topic: str, payload, t_ns: int) -> None:
+        """A message outside the step's sensor, control and state topics (scenario, events,
+        outcome); an event is also a ``/log`` line of the Foxglove topics."""
+        self._emit(topic, payload, t_ns)
+        if topic == TOPIC_EVENTS:
             self.viz.event(payload, t_ns)  # its /log line
-        self._t_log += time.perf_counter() - c0
 
-    def _event(self, log, occ, t, t_ns, result, stop_at, k):
-        self._write(log, TOPIC_EVENTS, Event(t, occ.kind, occ.data), t_ns)
-        result.events[occ.kind] = result.events.get(occ.kind, 0) + 1
+    def _event(self, occ, t: float, t_ns: int) -> None:
+        """An occurrence of the plant or the method, logged as an event; a stopping one sets
+        the run to end ``stop.after`` seconds later."""
+        self._write(TOPIC_EVENTS, Event(t, occ.kind, occ.data), t_ns)
+        events = self.result.events
+        events[occ.kind] = events.get(occ.kind, 0) + 1
         if occ.kind == "nan":
             raise NonFiniteValueError(TOPIC_EVENTS, occ.data)
-        if stop_at is None and occ.kind in self.sc.stop.on_events:
-            result.stopped_by = occ.kind
-            stop_at = k + int(round(self.sc.stop.after * self.sc.timing.physics_rate))
-        return stop_at
+        if self._stop_at is None and occ.kind in self.sc.stop.on_events:
+            self.result.stopped_by = occ.kind
+            self._stop_at = self.k + int(round(self.sc.stop.after * self.rate))
