@@ -317,7 +317,7 @@ def plot_factors(rows: list[dict], out: Path, stem: str) -> list[Path]:
     ax.set_xlim(-0.05, 1.05)
     ax.set_xlabel(f"rate k/n ({RATE_NOTE})", fontsize=8)
     ax.grid(True, axis="x", alpha=0.3)
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
     ax.set_title("3-step strategy: one condition changed at a time", fontsize=10)
     fig.tight_layout()
     return save(fig, out, stem)
@@ -359,18 +359,16 @@ def plot_workspace(rows: list[dict], out: Path, stem: str) -> list[Path]:
         ax_u.plot(
             xs + dx,
             [_median(g, "x.base_y_max") for g in sub],
-            fmt,
+            fmt[1:] + "x",
             color=c,
             alpha=0.5,
-            marker="x",
             label=f"{label}: |y| max [m]",
         )
         ax_u.plot(
             xs + dx,
             [_median(g, "x.base_speed_max") for g in sub],
-            ":",
+            "d:",
             color=c,
-            marker="d",
             label=f"{label}: peak axis speed [m/s]",
         )
     _rate_axes(ax, "")
@@ -546,6 +544,18 @@ def thesis(tables: dict[str, list[dict]] | None = None) -> dict:
         verdict = "holds only when " + " and ".join(when) if when else "holds"
     if rows:
         numbers["undecided runs"] = sum(undecided(r) for r in rows)
+    for rule, (xs, counts) in _vision_curves(tables["stick_vision"]).items():
+        if xs:
+            numbers[f"camera, estimator spans in {rule}"] = {
+                **{f"{x:g} fps": rate_text(*c) for x, c in zip(xs[::-1], counts[::-1])},
+                "tie over rates": tie(counts),
+            }
+    slider = cells(tables["stick_workspace"], "slider", "scenario")
+    if slider:
+        numbers["slider (Sec. III-C)"] = {
+            f"{lim} {_strategy({'scenario': sc})}": rate_text(*kn(g))
+            for (lim, sc), g in slider.items()
+        }
     return {
         "thesis": THESIS,
         "verdict": verdict,
