@@ -60,31 +60,35 @@ N_BOOT = 2000
 INITIAL, OPTIMISED, SHIPPED = "initial", "optimised", "optimised, eq. 22 off"
 OTHER, RANDOM = "eq13 from 4-5 m/s", "eq13 random"
 RANDOM_FULL = "eq13 random, optimum's length"
-ALPHAS = (INITIAL, OPTIMISED, SHIPPED, OTHER, RANDOM, RANDOM_FULL)
+NEIGHBOUR = "optimised, K_tau per level"  # the cost-weight rule's neighbour: w_tau = 1
+ALPHAS = (INITIAL, OPTIMISED, NEIGHBOUR, SHIPPED, OTHER, RANDOM, RANDOM_FULL)
 FALSIFIER_FILES = {
     OTHER: "alpha_eq13_from_4_5ms.json",
     RANDOM: "alpha_eq13_random.json",
     RANDOM_FULL: "alpha_eq13_random_long.json",
 }
 FULL_SCALES = (1.0, 4.0)  # the levels the long random step (a strawman: eq. 24 broken) runs at
+NEIGHBOUR_SCALES = (2.0, 4.0, 8.0)  # (at 1 it is 'optimised'; at 0.5 eq. 22 is far off)
 
 
-def level_file(scale: float) -> str:
-    return f"alpha_catchopt_x{scale:g}.json"
+def level_file(scale: float, neighbour: bool = False) -> str:
+    return f"alpha_catchopt_x{scale:g}" + ("_ktau_level" if neighbour else "") + ".json"
 
 
 # -- the cells: what each alpha sets at each level ---------------------------------------------
 
 
-def _opt_sets(scale: float) -> dict:
+def _opt_sets(scale: float, neighbour: bool = False) -> dict:
     """Eq. 25 at a level: eq. 22's limits s x OPT_TAU with its hinge as eq. 24's (weight
     limit_penalty = 100), K_tau held at scale 1's normalisers (w_tau = s^2, since K_tau =
-    w_tau diag(1/tau_max^2)): only the constraint moves with the level, not the cost."""
+    w_tau diag(1/tau_max^2)): only the constraint moves with the level, not the cost. The
+    ``neighbour`` rule keeps w_tau = 1 (K_tau normalised by the level's limits, as the shipped
+    scenario's rule reads): the torque term weighs 1/s^2 as much against the velocity term."""
     return {
         "controller.params.mapping": "optimised",
-        "controller.params.alpha_file": f"{ALPHA_REL}/{level_file(scale)}",
+        "controller.params.alpha_file": f"{ALPHA_REL}/{level_file(scale, neighbour)}",
         "controller.params.opt_torque_limits": [scale * t for t in OPT_TAU],
-        "controller.params.w_tau": scale * scale,
+        "controller.params.w_tau": 1.0 if neighbour else scale * scale,
         "controller.params.torque_limit_penalty": -1.0,
     }
 
@@ -104,8 +108,8 @@ def _default_sets(mapping: str, alpha_file: str) -> dict:
 def cell_sets(scale: float, alpha: str) -> dict:
     """The scenario fields of one cell: the plant's limits at the scale and the alpha."""
     plant = {"plant.params.torque_limits": [scale * t for t in PLANT_TAU]}
-    if alpha == OPTIMISED:
-        return plant | _opt_sets(scale)
+    if alpha in (OPTIMISED, NEIGHBOUR):
+        return plant | _opt_sets(scale, alpha == NEIGHBOUR)
     if alpha == INITIAL:
         return plant | _default_sets("initial", "")
     name = "alpha_optimised.json" if alpha == SHIPPED else FALSIFIER_FILES[alpha]
@@ -185,13 +189,15 @@ def write_alphas(dest: Path = ALPHA_DIR) -> dict[str, dict]:
     from replay.control.catching.optimise import OptimResult, load_alpha, save_alpha
 
     out = {}
-    for s in SCALES:
-        runner = _controller(_opt_sets(s))
+    levels = [(s, False) for s in SCALES] + [(s, True) for s in NEIGHBOUR_SCALES]
+    for s, neighbour in levels:
+        name = level_file(s, neighbour)
+        runner = _controller(_opt_sets(s, neighbour))
         try:
-            runner.controller.write_alpha_file(dest / level_file(s))
+            runner.controller.write_alpha_file(dest / name)
         finally:
             runner.plant.close()
-        out[level_file(s)] = load_alpha(dest / level_file(s))["history"][-1]
+        out[name] = load_alpha(dest / name)["history"][-1]
     runner = _controller(_default_sets("optimised", ""))
     try:
         ctrl = runner.controller
@@ -267,7 +273,8 @@ def model_costs(dest: Path = ALPHA_DIR) -> dict[str, dict]:
     from replay.control.catching.optimise import load_alpha
 
     out = {}
-    files = [level_file(s) for s in SCALES] + list(FALSIFIER_FILES.values())
+    files = [level_file(s) for s in SCALES] + [level_file(s, True) for s in NEIGHBOUR_SCALES]
+    files += list(FALSIFIER_FILES.values())
     for name in files + ["alpha_optimised.json"]:
         path = dest / name
         if path.is_file():
@@ -289,6 +296,8 @@ _HEADER = """\
 # - 'optimised': eq. 25 re-optimised offline at the level (data/catching/alpha_catchopt_xS.json,
 #   `python -m analysis.ablation_catch_opt alphas`) with eq. 22's hinge ON (weight 100, as eq.
 #   24's) and K_tau held at s = 1's normalisers (w_tau = s^2): only the constraint moves;
+#   its neighbour 'optimised, K_tau per level' (w_tau = 1: K_tau normalised by the level's
+#   limits, so the torque term weighs 1/s^2 as much) at s = 2, 4, 8 (_ktau_level.json);
 # - 'initial': the minimum-norm alpha that meets eq. 13 only (it does not depend on the limits);
 # - 'optimised, eq. 22 off': the shipped alpha_optimised.json (catch_optimised's: eq. 22 not
 #   imposed, the hinge inactive at s >= 4 where it is the 'optimised' one);
@@ -310,7 +319,7 @@ def sweep_data() -> dict:
         cell_label(s, a): cell_sets(s, a)
         for s in SCALES
         for a in ALPHAS
-        if a != RANDOM_FULL or s in FULL_SCALES
+        if (a != RANDOM_FULL or s in FULL_SCALES) and (a != NEIGHBOUR or s in NEIGHBOUR_SCALES)
     }
     grid_throws = {
         throw_label(i, th): {
@@ -507,6 +516,7 @@ def _pct(r: tuple[float, float, float]) -> str:
 
 _STYLE = {
     OPTIMISED: ("tab:blue", "o-"),
+    NEIGHBOUR: ("tab:purple", "P-."),
     SHIPPED: ("tab:cyan", "D:"),
     OTHER: ("tab:red", "s--"),
     RANDOM: ("tab:orange", "^--"),
@@ -518,7 +528,7 @@ _STYLE = {
 def plot_catch_opt(rows: list[dict], out: Path, stem: str) -> list[Path]:
     res = compare(rows)
     scales = sorted({s for s, _ in res})
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.6, 8.2))
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.6, 9.2))
     ratio_alphas = [a for a in ALPHAS if a != INITIAL]
     for ax, what, label in (
         (axes[0], "tau_sq_dt_ratio", "Σ τ² dt before contact\nrel. to initial α"),
@@ -554,6 +564,8 @@ def plot_catch_opt(rows: list[dict], out: Path, stem: str) -> list[Path]:
             )
     for alpha, dx in zip(ALPHAS, shifts(len(ALPHAS), 0.02)):
         pts = [(s, res[(s, alpha)]) for s in scales if (s, alpha) in res]
+        if not pts:
+            continue
         color, fmt = _STYLE[alpha]
         plot_rates(
             axes[2],
@@ -574,7 +586,7 @@ def plot_catch_opt(rows: list[dict], out: Path, stem: str) -> list[Path]:
     axes[2].set_xticks(scales)
     axes[2].set_xlabel("torque-limit scale s (limits s × (60, 60, 45, 30) N·m)")
     axes[0].legend(fontsize=7)
-    axes[2].legend(fontsize=7)
+    axes[2].legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.3))
     axes[0].set_title("Optimised vs initial α at 8-10 m/s against the torque limits", fontsize=10)
     fig.tight_layout()
     return save(fig, out, stem)
@@ -623,6 +635,17 @@ def _beats_falsifiers(res: dict, s: float) -> bool:
     return all(hi < res[(s, a)]["tau_sq_dt_ratio"][1] for a in (OTHER, RANDOM) if (s, a) in res)
 
 
+def _neighbour_said(res: dict, s: float) -> str:
+    """The cost-weight neighbour at a level, if it ran: its ratios and catches."""
+    r = res.get((s, NEIGHBOUR))
+    if r is None:
+        return ""
+    return (
+        f"; with K_τ normalised per level instead (w_τ = 1) x{s:g}: Σ τ² dt "
+        f"{_pct(r['tau_sq_dt_ratio'])}, travel {_pct(r['travel_ratio'])}, caught {r['k']}/{r['n']}"
+    )
+
+
 def thesis(tables: dict) -> dict:
     """The verdict on Figs. 6/8/9's thesis from the stored table: {verdict, numbers, figure}.
     A level supports it if the re-optimised alpha lowers sum tau^2 dt against the initial one
@@ -657,6 +680,7 @@ def thesis(tables: dict) -> dict:
         + (f"; eq. 22 holds at the model optimum from x{feasible:g}" if feasible else "")
         + f", joints at their limit x{top:g} {100 * o['saturated_share'][0]:.0f} % of steps"
         + f"; unoptimised eq.-13 α (falsifiers) at x{top:g}: {fal}"
+        + _neighbour_said(res, top)
         + f"; caught x{base:g} {ob['k']}/{ob['n']}, x{top:g} {o['k']}/{o['n']} (initial "
         f"{res[(base, INITIAL)]['k']}/{res[(base, INITIAL)]['n']}, "
         f"{res[(top, INITIAL)]['k']}/{res[(top, INITIAL)]['n']})"

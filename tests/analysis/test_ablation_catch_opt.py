@@ -82,6 +82,10 @@ def test_level_alphas_are_keyed_to_their_cells_and_eq22_becomes_feasible():
         assert cfg["w_tau"] == pytest.approx(s * s) and cfg["torque_penalty"] < 0
         ratios.append(data["history"][-1].max_torque_ratio)
     assert ratios == sorted(ratios, reverse=True)
+    for s in opt.NEIGHBOUR_SCALES:  # the neighbour rule: K_tau normalised by the level's limits
+        cfg = load_alpha(opt.ALPHA_DIR / opt.level_file(s, True))["meta"]["config"]
+        np.testing.assert_allclose(cfg["tau_max"], [s * t for t in opt.OPT_TAU])
+        assert cfg["w_tau"] == 1.0
     feasible = opt.eq22_feasible_scale()
     assert feasible is not None and feasible > min(opt.SCALES)
 
@@ -164,3 +168,34 @@ def test_thesis_is_computed_from_the_table(rows):
     shuffled = list(rows)
     np.random.default_rng(0).shuffle(shuffled)
     assert opt.thesis({opt.NAME: shuffled}) == said
+
+
+def test_plot_is_readable_and_its_rates_carry_wilson_bars(rows, monkeypatch, tmp_path):
+    import sys
+    from pathlib import Path
+
+    import matplotlib.pyplot as plt
+    from matplotlib.container import ErrorbarContainer
+
+    from analysis.ablation_catch import wilson
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from test_figure_layout import assert_readable
+
+    drawn = []
+    monkeypatch.setattr(opt, "save", lambda fig, out, stem: drawn.append(fig) or [])
+    opt.plot_catch_opt(rows, tmp_path, opt.NAME)
+    (fig,) = drawn
+    try:
+        assert_readable(fig)
+        rates = fig.axes[2]
+        bars = [c for c in rates.containers if isinstance(c, ErrorbarContainer)]
+        assert len(bars) == len({opt.parse_cell(r["cell"])[1] for r in rows})
+        for c in bars:
+            n = int(c.get_label().split("n = ")[1].rstrip(")"))
+            ys = c.lines[0].get_ydata()
+            for y, seg in zip(ys, c.lines[2][0].get_segments()):
+                lo, hi = wilson(round(y * n), n)
+                assert seg[:, 1].min() == pytest.approx(lo) and seg[:, 1].max() == pytest.approx(hi)
+    finally:
+        plt.close(fig)
