@@ -7,13 +7,22 @@ declares is then run (its scenario with its overrides) and stands in for the log
 ``replaces``; the paper's rows are evaluated again and the falsifier's row must read "differs".
 
 A measured row that is "reproduced" at baseline and has no falsifier, or whose falsifier leaves
-it anything but "differs", fails the check.
+it anything but "differs", fails the check. Rows of other kinds (``other regime``,
+``extension``: outside the paper's experiment, never counted) have their falsifiers listed, not
+run.
+
+``replay falsify --store`` keeps the result (:func:`store`): per paper, when it ran, on which code
+version, with which command, and each verdict (row, variant, baseline, status, flipped) in
+``data/claims/falsified.json``; the claims table and the report count a reproduced row only if
+it is recorded there as flipped (``analysis.claims.counted``).
 """
 
 from __future__ import annotations
 
 import hashlib
+import json
 import sys
+from datetime import datetime, timezone
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,9 +48,16 @@ class Verdict:
     ok: bool
     why: str = ""
 
+    @property
+    def flipped(self) -> bool:
+        """The falsifier ran and turned its row to "differs"."""
+        return bool(self.variant) and self.ok and self.status == "differs"
+
     def line(self) -> str:
         if not self.variant:
             return f"FAIL  {self.row}: reproduced, but no falsifier is declared"
+        if not self.status and self.why:  # (not run: nothing to flip, or never counted)
+            return f"skip  {self.row} | {self.variant} | {self.why}"
         mark = "ok  " if self.ok else "FAIL"
         got = f"{self.baseline} -> {self.status}" if self.status else self.baseline or "(no row)"
         return f"{mark}  {self.row} | {self.variant} (replaces {self.replaces}) | {got}"
@@ -101,8 +117,18 @@ def check(
     for f in falsifiers:
         base = _row(rows, f.row)
         if base is None or base.kind != "measured" or base.status != "reproduced":
-            # nothing to flip: a row that is missing (its log not run) or does not agree
-            out.append(Verdict(f.row, f.name, f.replaces, base.status if base else "", "", True))
+            # nothing to flip: a row that is missing (its log not run), does not agree, or is
+            # of a kind that never counts (another regime, an extension)
+            why = (
+                "no such row"
+                if base is None
+                else f"{base.kind}, never counted: not run"
+                if base.kind != "measured"
+                else f"{base.status}: nothing to flip"
+            )
+            out.append(
+                Verdict(f.row, f.name, f.replaces, base.status if base else "", "", True, why)
+            )
             continue
         if f.replaces not in baseline:
             out.append(
@@ -166,3 +192,46 @@ def falsify_paper(
         run_variant,
         progress=lambda s: say(f"{paper}: variant {s}"),
     )
+
+
+def store(
+    paper: str,
+    verdicts: Iterable[Verdict],
+    command: str,
+    path: Path | None = None,
+    when: datetime | None = None,
+    code: str | None = None,
+) -> Path:
+    """Record ``paper``'s verdicts in ``path`` (default data/claims/falsified.json), keeping the
+    other papers' records: when (UTC), the code version, the command, and per verdict its row,
+    variant, the run it replaced, the row's status at baseline and with the variant, and whether
+    it flipped."""
+    from analysis.claims import falsified_path
+    from replay.version import code_version
+
+    path = Path(path or falsified_path())
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        data = {}
+    if not isinstance(data, dict):
+        data = {}
+    stamp = (when or datetime.now(timezone.utc)).astimezone(timezone.utc)
+    data[paper] = {
+        "when": stamp.strftime("%Y-%m-%d %H:%M UTC"),
+        "code": code or code_version(),
+        "command": command,
+        "rows": [
+            {
+                "row": v.row,
+                "variant": v.variant,
+                "replaces": v.replaces,
+                "baseline": v.baseline,
+                "status": v.status,
+                "flipped": v.flipped,
+            }
+            for v in verdicts
+        ],
+    }
+    path.write_text(json.dumps(data, indent=1, ensure_ascii=False, sort_keys=True) + "\n", "utf-8")
+    return path

@@ -711,7 +711,7 @@ def _paper_figures(paper: str, readers: dict[str, LogReader], out: Path) -> list
 @click.option("--markdown", type=click.Path(dir_okay=False), help="also write the table here")
 def claims(logs, markdown):
     """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
-    from analysis.claims import falsifiers_of, format_table
+    from analysis.claims import falsifiers_of, format_table, shown
     from analysis.engines import evaluate_runs
     from analysis.needs import skipped_notes
     from replay.report.builder import claims_markdown
@@ -746,10 +746,13 @@ def claims(logs, markdown):
             warn(text)
         title = PAPERS[paper].title if paper in PAPERS else paper
         partial, falsifiers = _partial(readers), falsifiers_of(evaluate)
+        record = shown(paper)  # (what `replay falsify --store` showed flipping)
         closing = f"\n\n{engines_note}" if engines_note else ""
-        sections.append(format_table(title, rows, partial=partial, falsifiers=falsifiers) + closing)
+        sections.append(format_table(title, rows, partial, falsifiers, record) + closing)
         left = "".join(f"\n\n> {md(t)}" for t in skipped)  # (a topic a log lacks)
-        md_sections.append(claims_markdown(title, rows, falsifiers, partial) + closing + left)
+        md_sections.append(
+            claims_markdown(title, rows, falsifiers, partial, record) + closing + left
+        )
     say("\n\n".join(sections))
     if markdown:  # (the log's names escaped: no raw HTML where the Markdown is rendered)
         text = "\n\n".join([CLAIMS_HEADER, *md_sections]) + "\n"
@@ -848,14 +851,20 @@ def compare(logs, out, no_figures, markdown):
     type=click.Path(file_okay=False),
     help="write the runs here and keep them (default: a temporary folder)",
 )
-def falsify(papers, logs_dir, keep):
+@click.option(
+    "--store",
+    is_flag=True,
+    help="record the verdicts (when, code version, rows flipped) in data/claims/falsified.json",
+)
+def falsify(papers, logs_dir, keep, store):
     """Run each claims row's falsifier (a variant under which the paper's claim is false) and
     require its row to read "differs"; one line per falsifier (row | variant | verdict). Exits 1
     if a measured reproduced row has no falsifier or is not flipped by it. PAPERS default to
-    every paper with a claims table."""
+    every paper with a claims table. With --store the result is kept, and the claims table
+    counts a reproduced row only if it is recorded as flipped."""
     import tempfile
 
-    from analysis.falsify import falsify_paper
+    from analysis import falsify as fz
 
     names = list(papers) or [p for p in PAPERS if _has_claims(p)]
     for p in names:
@@ -866,7 +875,7 @@ def falsify(papers, logs_dir, keep):
         work = Path(keep) if keep else Path(tmp)
         for paper in names:
             try:
-                verdicts = falsify_paper(
+                verdicts = fz.falsify_paper(
                     paper,
                     work / paper,
                     Path(logs_dir) if logs_dir else None,
@@ -880,6 +889,10 @@ def falsify(papers, logs_dir, keep):
             bad = sum(not v.ok for v in verdicts)
             ran = sum(bool(v.status) for v in verdicts)
             click.echo(f"{paper}: {ran} falsifiers run, {bad} failing")
+            if store:
+                how = f" --logs {logs_dir}" if logs_dir else ""
+                path = fz.store(paper, verdicts, f"replay falsify {paper}{how} --store")
+                note(f"{paper}: stored in {path}")
             failed += bad
     if failed:
         sys.exit(1)

@@ -3,8 +3,10 @@
 Per paper: the regenerated figures (from the runs' logs, with the paper's captions), the claims
 table, the ablation plots (each redrawn from its sweep table: this machine's run under
 out/ablations/, else the stored one under data/ablations/) with one sentence of what each shows,
-computed from the same table; above them a headline across papers (rows reproduced, and that
-the falsifiers are listed, not run, here). Then the versions, seeds and commands that made it.
+computed from the same table; above them a headline across papers (measured rows of the paper's
+own experiment reproduced with a falsifier that the stored ``replay falsify --store`` result
+shows flipping them, and when that ran; the report lists the falsifiers, it does not run them).
+Then the versions, seeds and commands that made it.
 Everything the page links to is copied under the report directory, so it is self-contained.
 
 What comes from a log (a run's name, its seed, a caption quoting the name) is data: escaped in
@@ -21,6 +23,7 @@ from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field, replace
 from importlib import metadata
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -85,6 +88,7 @@ class PaperSection:
     claims_md: str = ""
     claims_summary: str = ""
     falsifiers: tuple = ()
+    shown: Any = None  # analysis.claims.Shown: the stored `replay falsify --store` result
     ablations: list = field(default_factory=list)
     notes: list = field(default_factory=list)
 
@@ -228,6 +232,7 @@ def _build(out: Path, logs_dir: Path) -> None:
             try:
                 evaluate = registry.load("claims", key)
                 from analysis.claims import falsifiers_of, format_table, summary
+                from analysis.claims import shown as falsified
                 from analysis.engines import evaluate_runs
 
                 with skipped_notes() as skipped:
@@ -237,8 +242,11 @@ def _build(out: Path, logs_dir: Path) -> None:
                     sec.notes.append("Both physics engines (docs/mujoco.md): " + engines_note)
 
                 sec.falsifiers = falsifiers_of(evaluate)
-                sec.claims_md = format_table(paper.title, sec.claims, falsifiers=sec.falsifiers)
-                sec.claims_summary = summary(sec.claims, sec.falsifiers)
+                sec.shown = falsified(key)  # (what `replay falsify --store` last showed)
+                sec.claims_md = format_table(
+                    paper.title, sec.claims, falsifiers=sec.falsifiers, record=sec.shown
+                )
+                sec.claims_summary = summary(sec.claims, sec.shown)
             except registry.UnknownPlugin:
                 sec.notes.append("No claims table defined yet.")
             except OSError:
@@ -336,7 +344,7 @@ def _commands(sections, logs) -> list[str]:
         ]
     papers = [sec.key for sec in sections if sec.falsifiers]
     if papers:
-        cmds.append(f"replay falsify {' '.join(papers)} --logs out/logs")
+        cmds.append(f"replay falsify {' '.join(papers)} --logs out/logs --store")
     for sec in sections:
         for a in sec.ablations:
             cmds.append(f"{a.command} --store   # table: {a.source}")
@@ -358,49 +366,58 @@ def _differs(sec: PaperSection, key: str) -> str:
 
 HEADLINE = (
     "paper",
-    "measured rows reproduced",
+    "measured rows reproduced (falsifier shown)",
     "ties",
+    "reproduced, falsifier not shown",
+    "other regime / extension rows",
     "configuration rows",
     "paper rows",
-    "falsifiers",
+    "falsifiers last run",
 )
 
 
 def _headline(sections) -> list[tuple[str, ...]]:
-    """Per paper with a claims table: its counts (as the table's summary line counts them) and
-    what this report did with its falsifiers: it lists them, it does not run them (``replay
-    falsify`` does, and no result of it is stored for the report to read)."""
-    from analysis.claims import counted
+    """Per paper with a claims table: its counts (as the table's summary line counts them:
+    measured rows of the paper's own experiment, a reproduced one only where the stored
+    ``replay falsify --store`` result shows its falsifier flipping it) and when that ran."""
+    from analysis.claims import NOT_SHOWN, SHOWN, counted, shown_status
 
     rows: list[tuple[str, ...]] = []
     for sec in sections:
         if not sec.claims:
             continue
-        n_ok, n = counted(sec.claims, sec.falsifiers)
+        n_ok, n = counted(sec.claims, sec.shown)
         kinds = [c.kind for c in sec.claims]
         ties = sum(c.kind == "measured" and c.status == "tie" for c in sec.claims)
-        falsifiers = (
-            f"{len(sec.falsifiers)} declared, not run in this report: "
-            f"replay falsify {sec.key} --logs out/logs"
-            if sec.falsifiers
-            else "none declared"
-        )
+        bare = sum(shown_status(c, sec.shown) == NOT_SHOWN for c in sec.claims)
+        if sec.shown is not None:
+            ran = f"{sec.shown.when}, code {sec.shown.code} ({sec.shown.command})"
+        elif sec.falsifiers:
+            ran = f"never stored: replay falsify {sec.key} --logs out/logs --store"
+        else:
+            ran = "none declared"
         rows.append(
             (
                 sec.title,
                 f"{n_ok} / {n}",
                 str(ties),
+                str(bare),
+                str(sum(k in SHOWN for k in kinds)),
                 str(kinds.count("configuration")),
                 str(kinds.count("paper")),
-                falsifiers,
+                ran,
             )
         )
     return rows
 
 
 HEADLINE_NOTE = (
-    "A measured row counts as reproduced only with a falsifier: a variant under which the "
-    "paper's claim is false in the simulation, run by replay falsify (not by this report)."
+    "Only measured rows count: claims the paper states, measured on runs of the paper's own "
+    "experiment (its stated conditions); rows of other regimes and extensions are shown in the "
+    "tables, not counted. A measured row counts as reproduced only if its falsifier (a variant "
+    "under which the claim is false in the simulation) was run by replay falsify --store and "
+    "turned it to 'differs'; that stored result (data/claims/falsified.json) is what is read "
+    "here, with when and on which code version it ran. This report does not run the falsifiers."
 )
 
 
@@ -435,7 +452,7 @@ def _markdown(sections, info, commands, notes=()) -> str:
                 cap = md(f.caption)
                 lines += [f"![{cap}]({url(f.png)})", "", f"*{cap}*", ""]
         if sec.claims_md:
-            table = claims_markdown(sec.title, sec.claims, sec.falsifiers)
+            table = claims_markdown(sec.title, sec.claims, sec.falsifiers, record=sec.shown)
             lines += ["### Claims", "", table.split("\n", 2)[2], ""]
         if sec.falsifiers:
             from analysis.claims import format_falsifiers
@@ -444,8 +461,9 @@ def _markdown(sections, info, commands, notes=()) -> str:
                 "#### Falsifiers",
                 "",
                 "Each reproduced measured row counts only with a variant under which the paper's "
-                "claim is false in the simulation; `replay falsify` runs them and requires the "
-                "row to read *differs*. This report lists them; it did not run them.",
+                "claim is false in the simulation; `replay falsify --store` runs them, requires "
+                "the row to read *differs* and records it. This report lists them and reads the "
+                "record: " + md(_ran(sec)),
                 "",
                 format_falsifiers(sec.falsifiers),
                 "",
@@ -471,7 +489,14 @@ def _markdown(sections, info, commands, notes=()) -> str:
     return "\n".join(lines)
 
 
-def claims_markdown(title: str, rows, falsifiers=(), partial=None) -> str:
+def _ran(sec) -> str:
+    """When the falsifiers were last run (the stored record), or that they never were."""
+    if sec.shown is None:
+        return f"never stored (replay falsify {sec.key} --logs out/logs --store)."
+    return sec.shown.line() + "."
+
+
+def claims_markdown(title: str, rows, falsifiers=(), partial=None, record=None) -> str:
     """``analysis.claims.format_table`` with every cell and log name escaped for Markdown (a
     quantity can name a run): the claims table in index.md and in ``claims --markdown``."""
     from analysis.claims import format_table
@@ -488,7 +513,7 @@ def claims_markdown(title: str, rows, falsifiers=(), partial=None) -> str:
     ]
     falsifiers = [replace(f, row=md(f.row)) for f in falsifiers]
     partial = {md(k): [md(n) for n in v] for k, v in (partial or {}).items()}
-    return format_table(title, rows, partial=partial, falsifiers=falsifiers)
+    return format_table(title, rows, partial=partial, falsifiers=falsifiers, record=record)
 
 
 # -- HTML ------------------------------------------------------------------------------------
@@ -578,22 +603,24 @@ def _html(sections, info, commands, notes=()) -> str:
                 "<table><tr><th>quantity</th><th>kind</th><th>paper states</th>"
                 "<th>this run</th><th>status</th><th>note</th></tr>",
             ]
-            from analysis.claims import row_note
+            from analysis.claims import row_note, shown_status
 
             for c in sec.claims:
+                status = shown_status(c, sec.shown)
                 h.append(
                     f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.kind)}</td><td>{_e(c.stated)}</td>"
                     f'<td>{_e(c.measured)}</td><td class="{_e(c.status)}"><b>'
-                    f"{_e(c.status)}</b></td><td>{_e(row_note(c, sec.falsifiers))}</td></tr>"
+                    f"{_e(status)}</b></td><td>{_e(row_note(c, sec.falsifiers, sec.shown))}"
+                    "</td></tr>"
                 )
             h += ["</table>", f"<p>{_e(sec.claims_summary)}</p>"]
             if sec.falsifiers:
                 h += [
                     "<h4>Falsifiers</h4>",
                     "<p>Each reproduced measured row counts only with a variant under which the "
-                    "paper's claim is false in the simulation; <code>replay falsify</code> runs "
-                    "them and requires the row to read <i>differs</i>. This report lists them; "
-                    "it did not run them.</p>",
+                    "paper's claim is false in the simulation; <code>replay falsify --store"
+                    "</code> runs them, requires the row to read <i>differs</i> and records it. "
+                    f"This report lists them and reads the record: {_e(_ran(sec))}</p>",
                     '<table class="falsifiers"><colgroup><col class="row"><col class="variant">'
                     '<col class="why"></colgroup><tr><th>row</th><th>variant (the run it '
                     "replaces: overrides)</th><th>why the claim is false under it</th></tr>",

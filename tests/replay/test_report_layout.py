@@ -1,7 +1,8 @@
 """The report reads well (issue #37): a headline across papers at the top (per paper the
-measured rows reproduced of all, ties, configuration and paper rows, and what was done with
-its falsifiers: listed, not run, by this report), and falsifier tables whose explanation gets
-the room (it was squeezed into ~100 px beside unbreakable override strings)."""
+measured rows reproduced of all, ties, rows whose falsifier was not shown, rows of other regimes
+and extensions, configuration and paper rows, and when `replay falsify --store` last ran: the
+report reads that record, it does not run the falsifiers, issue #38), and falsifier tables whose
+explanation gets the room (it was squeezed into ~100 px beside unbreakable override strings)."""
 
 from __future__ import annotations
 
@@ -49,30 +50,50 @@ def test_the_headline_comes_first_and_counts_each_paper(report):
     k, n = map(int, stick[1].split(" / "))
     assert 0 < k <= n
     for r in rows[1:]:
-        assert re.fullmatch(r"\d+ / \d+", r[1]) and all(x.isdigit() for x in r[2:5])
-        assert "not run in this report" in r[5] or r[5] == "none declared"
+        assert re.fullmatch(r"\d+ / \d+", r[1]) and all(x.isdigit() for x in r[2:7])
+        # when the stored falsifiers ran (data/claims/falsified.json), or that they never did
+        assert re.match(r"\d{4}-\d\d-\d\d \d\d:\d\d UTC, code ", r[7]) or r[7].startswith(
+            ("never stored", "none declared")
+        ), r[7]
     md = (report / "index.md").read_text()
     assert md.index("## Summary") < md.index("## Friction Independent")
     assert "| " + " | ".join(HEADLINE) + " |" in md
 
 
 def test_headline_counts_as_the_claims_summary():
-    from analysis.claims import Claim, Falsifier
+    from analysis.claims import Claim, Falsifier, Shown, summary
     from replay.report.builder import PaperSection
 
     sec = PaperSection("p", "P", "A")
     sec.claims = [
         Claim("a", "1", "1", "reproduced"),
-        Claim("b", "1", "1", "reproduced"),  # no falsifier: not counted
+        Claim("b", "1", "1", "reproduced"),  # its falsifier did not flip it: not counted
         Claim("c", "1", "2", "tie"),
+        Claim("x", "1", "1", "reproduced", kind="other regime"),  # never counted
         Claim("d", "1", "1", "consistent", kind="configuration"),
         Claim("e", "1", "1", "consistent", kind="paper"),
     ]
-    sec.falsifiers = (Falsifier("a", "v", "run"),)
-    ((paper, measured, ties, conf, prow, fals),) = _headline([sec, PaperSection("q", "Q", "B")])
-    assert counted(sec.claims, sec.falsifiers) == (1, 3)
-    assert (paper, measured, ties, conf, prow) == ("P", "1 / 3", "1", "1", "1")
-    assert fals.startswith("1 declared, not run in this report")
+    sec.falsifiers = (Falsifier("a", "v", "run"), Falsifier("b", "w", "run"))
+    rows = ({"row": "a", "flipped": True}, {"row": "b", "flipped": False})
+    sec.shown = Shown("2026-01-02 03:04 UTC", "0.1.0+abc", "replay falsify p --store", rows)
+    ((paper, measured, ties, bare, other, conf, prow, ran),) = _headline(
+        [sec, PaperSection("q", "Q", "B")]
+    )
+    assert counted(sec.claims, sec.shown) == (1, 3)
+    assert (paper, measured, ties, bare, other, conf, prow) == (
+        "P",
+        "1 / 3",
+        "1",
+        "1",
+        "1",
+        "1",
+        "1",
+    )
+    assert ran == "2026-01-02 03:04 UTC, code 0.1.0+abc (replay falsify p --store)"
+    assert summary(sec.claims, sec.shown).startswith("1 of 3 measured rows")
+    sec.shown = None  # never stored: nothing counts
+    assert counted(sec.claims, None) == (0, 3)
+    assert _headline([sec])[0][7].startswith("never stored: replay falsify p")
 
 
 def test_falsifier_tables_give_the_explanation_room(report):
@@ -88,7 +109,7 @@ def test_falsifier_tables_give_the_explanation_room(report):
         assert t.count("<col ") == 3
         for row in re.findall(r"<tr>(.*?)</tr>", t, re.S)[1:]:
             assert row.count("<td>") == 3
-    assert html.count("This report lists them; it did not run them.") == len(tables)
+    assert html.count("This report lists them and reads the record: ") == len(tables)
 
 
 def test_falsifier_explanation_is_wide_in_chromium(report):
