@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from analysis.claims import Claim
+from analysis.claims import ASSESSED, Claim
 
 SUFFIX = "_mujoco"
 ENGINES = ("PyBullet", "MuJoCo")
@@ -86,6 +86,7 @@ def _pair(a: Claim | None, b: Claim | None) -> Claim:
         status,
         note,
         kind=ref.kind,
+        measures=ref.measures,
     )
 
 
@@ -109,11 +110,24 @@ def evaluate_runs(
     return rows, closing_note(rows)
 
 
-def rate_row(label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]]) -> Claim:
+# the robustness rates are a test the papers did not make (each shows its runs one by one), held
+# to a project target: rows of kind "extension", the target in the note, never in "paper states"
+TARGET = 0.9  # the share of runs that must succeed in each engine
+TARGET_NOTE = "project target (issue #24, not the paper's): ≥ 90 % in each engine"
+RATE_STATED = {
+    "namiki2003": "no rate stated (Sec. IV-B, Figs. 10, 11: the catch of single throws)",
+    "namiki1999": "no rate stated (Figs. 7, 8: one grasp of each object)",
+}
+
+
+def rate_row(
+    label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]], kind: str = "extension"
+) -> Claim:
     """A catch (or grasp) rate per engine on the same perturbed set: ``outcomes`` maps an
     engine to its runs' verdicts (``success``, ``reason``), each rate with its Wilson 95 %
-    interval. Reproduced when every engine reaches 90 %; where the engines part the note says
-    so (and whether their intervals overlap), then each engine's failures with their reasons."""
+    interval. "reproduced" (the target met) when every engine reaches :data:`TARGET`; where the
+    engines part the note says so (and whether their intervals overlap), then each engine's
+    failures with their reasons."""
     from analysis.ablation_catch import wilson
 
     parts, notes, passed, spans = [], [], {}, []
@@ -128,7 +142,7 @@ def rate_row(label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]])
             )
         else:
             parts.append(f"{engine}: not run")
-        passed[engine] = n > 0 and k >= 0.9 * n
+        passed[engine] = n > 0 and k >= TARGET * n
         why = Counter(str(o["reason"]) for o in res if not o["success"])
         if why:
             fails = "; ".join(f"{v}× {x}" for x, v in why.most_common())
@@ -142,7 +156,7 @@ def rate_row(label: str, stated: str, outcomes: Mapping[str, Sequence[Mapping]])
             + (" (their intervals overlap: within the sampling error)" if overlap else ""),
         )
     status = "reproduced" if all(passed.values()) else "differs"
-    return Claim(label, stated, " ‖ ".join(parts), status, "; ".join(notes))
+    return Claim(label, stated, " ‖ ".join(parts), status, "; ".join(notes), kind=kind)
 
 
 def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
@@ -158,7 +172,7 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
     out = []
     for s in dict.fromkeys(r["set"] for r in rows):
         by_engine = {e: [r for r in rows if r["set"] == s and r["engine"] == e] for e in ENGINES}
-        row = rate_row(s, "≥ 90 % in each engine (issue #24)", by_engine)
+        row = rate_row(s, RATE_STATED.get(paper, "no rate stated"), by_engine)
         probes: dict[str, list[dict]] = {
             r["engine"]: [] for r in rows if r["set"] == s and r["engine"] not in ENGINES
         }
@@ -168,16 +182,17 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
         why = [
             "probe " + rate_row(s, "", {label: res}).measured for label, res in probes.items()
         ]  # the twin with one setting changed, on the same inputs (analysis/engine_rates.py)
-        row.note = "; ".join(x for x in (row.note, *why, source) if x)
+        row.note = "; ".join(x for x in (row.note, *why, TARGET_NOTE, source) if x)
         out.append(row)
     return out
 
 
 def closing_note(rows: Sequence[Claim]) -> str:
-    """Which measured claims hold in both engines, which in one (and why: the row's note)."""
+    """Which assessed rows (measured, other regime, extension: those with a verdict) hold in
+    both engines, which in one (and why: the row's note)."""
     both, one, neither, single = [], [], [], 0
     for r in rows:
-        if r.kind != "measured":
+        if r.kind not in ASSESSED:
             continue
         if r.measured.startswith("PyBullet: not run") or r.measured.endswith("MuJoCo: not run"):
             single += 1  # run in one engine only: no cross-engine verdict
@@ -192,5 +207,5 @@ def closing_note(rows: Sequence[Claim]) -> str:
     lines.append(f"Hold in one engine only ({len(one)}): {', '.join(one) or 'none'}.")
     lines.append(f"Hold in neither ({len(neither)}): {', '.join(neither) or 'none'}.")
     if single:
-        lines.append(f"Run in one engine only, not compared: {single} measured rows.")
+        lines.append(f"Run in one engine only, not compared: {single} rows.")
     return "\n".join(lines)

@@ -115,7 +115,7 @@ def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     assert "> catch\\_mine: claims" in table or "> catch_mine: claims" in table
     assert "catch_mine" in r.stderr and "/effector/state" in r.stderr
     assert "catch_mine: ball caught" not in r.stdout
-    assert "catch_optimised: ball caught" in r.stdout
+    assert "| catch over the stated throws, 8 ~ 10 m/s |" in r.stdout
     # a log in no figure at all is said once, with why
     r = invoke("figures", stick["bare"], "-o", tmp_path / "g")
     assert r.exit_code == 0, r.output
