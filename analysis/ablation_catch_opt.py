@@ -45,11 +45,12 @@ NAME = "catch_optimisation"
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIO = ROOT / "scenarios" / "catch_optimised.yaml"
 ALPHA_DIR = ROOT / "data" / "catching"
-# alpha files as the sweep names them: relative to the working directory of `replay ablate` (the
-# checkout's root), since a sweep's variant is run from its resolved text, which has no scenario
-# directory to resolve them from; a missing file would be recomputed silently as eq. 25's
-# optimum, so every run logs the model cost of the alpha it used (effort_metrics' alpha_cost)
-ALPHA_REL = "data/catching"
+# alpha files as the sweep names them: relative to the scenario's folder, as a scenario file
+# writes them (a sweep's worker resolves them there: replay.scenario.loader.file_dirs); a
+# missing file would be recomputed as eq. 25's optimum, so every run logs the model cost of the
+# alpha it used (effort_metrics' alpha_cost) and tests/replay/sweep/test_sweep_file_params.py
+# checks that every shipped sweep's file exists
+ALPHA_REL = "../data/catching"
 PLANT_TAU = (60.0, 60.0, 45.0, 30.0)  # N*m: public_urdf (assumed, scenarios/catch_optimised.yaml)
 OPT_TAU = (60.0, 60.0, 30.0)  # N*m: eq. 22's tau_max on J1, J2, J4 at scale 1
 SCALES = (0.5, 1.0, 2.0, 3.0, 4.0, 8.0)  # torque-limit scales swept

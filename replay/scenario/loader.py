@@ -580,6 +580,25 @@ def plugin_sections(sc: Scenario) -> Iterator[tuple[str, Any, str]]:
         yield "controller", task, f"tasks.{name}"
 
 
+def file_dirs(sc: Scenario) -> dict[str, str]:
+    """{plug-in section path: the directory its ``*_file`` parameters resolve against} (the
+    internal ``scenario_dir``, which a resolved text does not carry: a sweep's worker gets it
+    with the text, :func:`set_file_dirs`)."""
+    return {
+        path: spec.params.scenario_dir
+        for _, spec, path in plugin_sections(sc)
+        if getattr(spec.params, "scenario_dir", "")
+    }
+
+
+def set_file_dirs(sc: Scenario, dirs: dict[str, str]) -> None:
+    """Give the plug-in sections of ``sc`` (made from a resolved text) the ``file_dirs`` of the
+    scenario the text was resolved from."""
+    for _, spec, path in plugin_sections(sc):
+        if path in dirs and hasattr(spec.params, "scenario_dir"):
+            spec.params.scenario_dir = dirs[path]
+
+
 PLUGIN_MODES = ("import", "installed", "known-only")
 
 

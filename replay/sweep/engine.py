@@ -221,6 +221,7 @@ def _run_locked(
             "key": v.key,
             "index": v.index,
             "resolved": v.resolved,
+            "file_dirs": v.file_dirs,  # (relative *_file parameters: the scenario's folder)
             "error": v.error,
             "log": str((out_dir / "logs" / f"{v.name or 'variant'}-{v.key}.mcap").resolve())
             if keep_logs

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 from replay.scenario import ScenarioError, load_scenario, resolved_yaml
+from replay.scenario.loader import file_dirs
 from replay.sweep.spec import SweepSpec, sets_for
 from replay.version import code_version
 
@@ -30,6 +31,8 @@ class Variant:
     error: str = ""  # why it failed to load
     name: str = ""  # the scenario's name
     version: str = ""  # the code version it is keyed by (the table's version column)
+    # where each plug-in's *_file parameters resolve (loader.file_dirs): not in the resolved text
+    file_dirs: dict[str, str] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -83,6 +86,7 @@ def plan(
         try:
             sc = load_scenario(path, sets=all_sets, seed=vseed)
             v.resolved = resolved_yaml(sc)
+            v.file_dirs = file_dirs(sc)
             v.name = sc.name
             v.key = variant_key(v.resolved, vseed, version)
         except ScenarioError as exc:

@@ -22,8 +22,9 @@ INTERRUPTED = "interrupted"
 
 
 def run_variant(task: dict[str, Any]) -> dict[str, Any]:
-    """task: key, index, resolved, error, log (path or ""), cwd, metrics ("module:function" of
-    a LogReader -> extra columns, or "") -> a row (without the params)."""
+    """task: key, index, resolved, file_dirs (where relative ``*_file`` parameters resolve), error,
+    log (path or ""), cwd, metrics ("module:function" of a LogReader -> extra columns, or "") ->
+    a row (without the params)."""
     wall0 = time.perf_counter()
     cpu0 = time.process_time()
     row: dict[str, Any] = {"key": task["key"], "index": task["index"]}
@@ -41,11 +42,12 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
 
     try:
         from replay import registry
-        from replay.scenario.loader import scenario_from_text
+        from replay.scenario.loader import scenario_from_text, set_file_dirs
 
         for kind, name, folder in task.get("plugins", ()):  # (a forked worker has them already)
             registry.import_plugin(kind, name, folder)
         sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>")
+        set_file_dirs(sc, task.get("file_dirs") or {})
         if log:
             Path(log).parent.mkdir(parents=True, exist_ok=True)
         result = Runner(sc).run(log or tmp)
