@@ -420,15 +420,11 @@ class CatchingController(Controller):
             if data.get("meta", {}).get("key") == key:
                 self.history = data["history"]
                 return data["alpha"]
-            self._events.append(
-                Occurrence(
-                    "warning",
-                    {
-                        "reason": "alpha_file made for another configuration; recomputed",
-                        "file": str(path),
-                    },
-                )
-            )
+            why = "alpha_file made for another configuration; recomputed"
+            self._events.append(Occurrence("warning", {"reason": why, "file": str(path)}))
+        elif path is not None:  # (a mistyped or misplaced file is said, not silently replaced)
+            why = "alpha_file not found; optimised here"
+            self._events.append(Occurrence("warning", {"reason": why, "file": str(path)}))
         res = self.problem.solve(progress)
         self.history = res.history
         self.result = res

@@ -404,6 +404,12 @@ def test_controller_initial_mapping_and_stale_alpha_file(tmp_path, alpha_file):
         Params(alpha_file=alpha_file, throw_spread=0.05, max_iterations=2), spec=spec
     )
     assert any(e.kind == "warning" for e in other.pop_events())
+    # nor is a file that is not there replaced by an optimum without a word
+    missing = CatchingController(
+        Params(alpha_file=str(tmp_path / "typo.json"), max_iterations=2), spec=spec
+    )
+    said = [e.data["reason"] for e in missing.pop_events() if e.kind == "warning"]
+    assert said == ["alpha_file not found; optimised here"]
 
 
 def test_controller_holds_pose_before_the_ball_is_seen():
