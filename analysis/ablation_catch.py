@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -11,12 +12,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from analysis.ablation_table import (
+from analysis.ablation_table import (  # noqa: E402
     caught,
     mean_by,
     overall,
-    pct,
-    rate_at,  # noqa: E402
     rate_by,
     counts_by,
 )
@@ -80,22 +79,6 @@ def _near_axes(ax, xlabel: str, log_x: bool = True) -> None:
     ax.grid(True, alpha=0.3)
 
 
-def plot_vision(rows: list[dict], out: Path, stem: str) -> list[Path]:
-    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
-    x, line = "sensors.stereo.rate", "sensors.stereo.latency"
-    speeds = mean_by(rows, x, line, "x.contact_speed")
-    curves = sorted(counts_by(rows, x, line, caught).items(), key=lambda kv: float(kv[0]))
-    for (lat, (xs, ks, ns)), dx in zip(curves, shifts(len(curves), 0.02)):
-        plot_rates(ax, xs, ks, ns, "o-", f"latency {float(lat) * 1e3:g} ms", dx, log_x=True)
-        ax2.plot(*speeds[lat], "o-")
-    _rate_axes(ax, "", log_x=True)
-    _near_axes(ax2, "stereo frame rate [Hz]")
-    ax.legend(fontsize=8)
-    ax.set_title("Direct mapping: catch rate vs camera rate and latency", fontsize=10)
-    fig.tight_layout()
-    return save(fig, out, stem)
-
-
 def plot_throw_speed(rows: list[dict], out: Path, stem: str) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6))
     ((xs, ks, ns),) = counts_by(rows, "throw_speed", None, caught).values()
@@ -133,37 +116,6 @@ def plot_arm_limits(rows: list[dict], out: Path, stem: str) -> list[Path]:
     return save(fig, out, stem)
 
 
-def plot_direct_vs_predictive(rows: list[dict], out: Path, stem: str) -> list[Path]:
-    fig, (ax, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.0))
-    styles = {
-        "catch_optimised": ("tab:blue", "direct mapping"),
-        "predictive_catch": ("tab:orange", "predict-then-intercept"),
-    }
-    groups = sorted(_split(rows, "scenario", "kick").items())
-    for ((method, kick), sub), dx in zip(groups, shifts(len(groups), 0.02)):
-        ((xs, ks, ns),) = counts_by(sub, "camera", None, caught).values()
-        color, label = styles.get(method, ("0.4", method))
-        style = "o-" if kick == "none" else "s--"
-        plot_rates(
-            ax,
-            xs,
-            ks,
-            ns,
-            style,
-            f"{label}, {'no kick' if kick == 'none' else 'mid-flight kick'}",
-            dx,
-            log_x=True,
-            color=color,
-        )
-        ax2.plot(*mean_by(sub, "camera", None, "x.contact_speed")[""], style, color=color)
-    _rate_axes(ax, "", log_x=True)
-    _near_axes(ax2, "stereo frame rate [Hz] (latency one frame)")
-    ax.legend(fontsize=8)
-    ax.set_title("Direct mapping vs predictor: catch rate vs camera rate", fontsize=10)
-    fig.tight_layout()
-    return save(fig, out, stem)
-
-
 def _split(rows, *cols):
     out: dict = {}
     for r in rows:
@@ -172,18 +124,6 @@ def _split(rows, *cols):
 
 
 # -- one sentence per plot (the report's text), computed from the same table -------------------
-
-
-def summary_vision(rows: list[dict]) -> str:
-    curves = rate_by(rows, "sensors.stereo.rate", "sensors.stereo.latency", caught)
-    parts = []
-    for lat in sorted(curves, key=float):
-        xs, ys = curves[lat]
-        parts.append(
-            f"latency {float(lat) * 1e3:g} ms: {pct(ys[-1])} at {xs[-1]:g} Hz, "
-            f"{pct(ys[0])} at {xs[0]:.0f} Hz"
-        )
-    return f"Direct mapping ({overall(rows, caught, 'caught')}): " + "; ".join(parts) + "."
 
 
 def summary_throw_speed(rows: list[dict]) -> str:
@@ -223,51 +163,259 @@ def summary_arm_limits(rows: list[dict]) -> str:
     )
 
 
-def summary_direct_vs_predictive(rows: list[dict]) -> str:
-    split = _split(rows, "scenario", "kick")
-    rates = {k: rate_by(v, "camera", None, caught)[""] for k, v in split.items()}
-    xs = sorted({x for v in rates.values() for x in v[0]})
-    if not xs:
-        return "Not run."
+# -- the rate study (sweeps/catch_rate.yaml, issue #38) ----------------------------------------
 
-    def at(method, kick, x):
-        return rate_at({"": rates.get((method, kick), ([], []))}, "", x)
+RATE_PERIODS_MS = (1, 2, 5, 10, 15, 20, 33)  # loop periods: each a whole number of 1 ms steps
+RATE_DESIGN_PERIOD = 0.001  # s: the period the scenarios' PD gains were tuned at
+RATE_THROWS = 20  # held-out throws a cell (catch_shared_throws' "arrival spread +-0.1 m")
+RATE_SEED = 20030914
+RATE_SPREAD = 0.1  # m
+BALLISTIC, FREE, PREDICTOR = "catch_optimised", "prediction_free_catch", "predictive_catch"
+RATE_CONTROLLERS = {
+    BALLISTIC: "direct (ballistic fit)",
+    FREE: "direct, prediction-free",
+    PREDICTOR: "predict-then-intercept",
+}
+RATE_MOTIONS = {"spread": "throw spread", "spread+kick": "throw spread + mid-flight kick"}
 
-    hi, lo = xs[-1], xs[0]
-    d = [at("catch_optimised", k, x) for k in ("none", "kick") for x in (hi, lo)]
-    p = [at("predictive_catch", k, x) for k in ("none", "kick") for x in (hi, lo)]
-    text = (
-        f"At {hi:g} Hz the direct mapping caught {pct(d[0])} (kick: {pct(d[2])}) and the "
-        f"predictor {pct(p[0])} (kick: {pct(p[2])}); at {lo:g} Hz direct {pct(d[1])} "
-        f"(kick: {pct(d[3])}), predictor {pct(p[1])} (kick: {pct(p[3])}). "
+
+def sampled_pd_poles(kp: float, kd: float, inertia: float, period: float) -> np.ndarray:
+    """The closed-loop poles (z-plane) of one joint under PD sampled every ``period`` with the
+    torque held in between (the runner's zero-order hold; encoders read at the control step):
+    e = q - q_d of I e'' = -(kp e + kd e') over one period, x = (e, e'),
+    x+ = [[1 - kp T^2 / 2I, T - kd T^2 / 2I], [-kp T / I, 1 - kd T / I]] x."""
+    a, b = kp * period / inertia, kd * period / inertia
+    phi = np.array([[1.0 - a * period / 2.0, period * (1.0 - b / 2.0)], [-a, 1.0 - b]])
+    return np.linalg.eigvals(phi)
+
+
+def step_response(kp: float, kd: float, inertia: float, period: float, duration: float = 0.3):
+    """(t, e): the sampled joint loop of :func:`sampled_pd_poles` from e = 1 rad at rest."""
+    a, b = kp * period / inertia, kd * period / inertia
+    phi = np.array([[1.0 - a * period / 2.0, period * (1.0 - b / 2.0)], [-a, 1.0 - b]])
+    n = int(round(duration / period))
+    x, e = np.array([1.0, 0.0]), [1.0]
+    for _ in range(n):
+        x = phi @ x
+        e.append(float(x[0]))
+    return period * np.arange(n + 1), np.array(e)
+
+
+def plot_gain_rule(out: Path, stem: str = "catch_rate_steps") -> list[Path]:
+    """The step responses the rule gives at every period (one panel per joint), beside the
+    scenarios' fixed 1 ms gains at 33 ms (docs/catching.md)."""
+    from replay.scenario import load_scenario
+
+    root = Path(__file__).resolve().parents[1]
+    controller: Any = load_scenario(root / "scenarios" / f"{BALLISTIC}.yaml").controller
+    params = controller.params
+    inertias = joint_inertias()
+    fig, axes = plt.subplots(1, len(inertias), sharey=True, figsize=(10.0, 3.4))
+    for ax, (j, inertia) in zip(axes, inertias.items()):
+        for T_ms, c in zip(RATE_PERIODS_MS, plt.cm.viridis(np.linspace(0, 0.9, 7))):
+            kp, kd = rate_gains(params.kp[j], params.kd[j], inertia, T_ms * 1e-3)
+            ax.step(
+                *step_response(kp, kd, inertia, T_ms * 1e-3),
+                where="post",
+                color=c,
+                label=f"{T_ms} ms, rule",
+            )
+        t, e = step_response(params.kp[j], params.kd[j], inertia, 0.033)
+        ax.step(t, e, "--", where="post", color="tab:red", label="33 ms, 1 ms gains")
+        ax.set_title(f"J{j + 1} (I = {inertia:.3f} kg m^2)", fontsize=9)
+        ax.set_xlabel("t [s]")
+        ax.grid(True, alpha=0.3)
+    axes[0].set_ylabel("joint error e [rad] from 1 rad")
+    axes[-1].legend(fontsize=7)
+    fig.tight_layout()
+    return save(fig, out, stem)
+
+
+def rate_gains(
+    kp: float, kd: float, inertia: float, period: float, design: float = RATE_DESIGN_PERIOD
+) -> tuple[float, float]:
+    """The fair-ablation rule: the gains that give the joint sampled at ``period`` the closed-loop
+    poles of the ``design``-period loop, matched (z = exp(s T), s = ln(z_design) / T_design): the
+    same natural frequency and damping at every period (kp, kd returned at T = design).
+
+    Derivation: with sigma = z1 + z2 and p = z1 z2 the characteristic polynomial of
+    :func:`sampled_pd_poles` is z^2 - (2 - kp T^2 / 2I - kd T / I) z + (1 - kd T / I +
+    kp T^2 / 2I), so kp = I (1 - sigma + p) / T^2 and kd = I (3 - p - sigma) / (2 T)."""
+    s = np.log(sampled_pd_poles(kp, kd, inertia, design).astype(complex)) / design
+    z = np.exp(s * period)
+    sigma, p = float(np.real(z.sum())), float(np.real(np.prod(z)))
+    return inertia * (1.0 - sigma + p) / period**2, inertia * (3.0 - p - sigma) / (2.0 * period)
+
+
+def joint_inertias(scenario: str = "catch_optimised") -> dict[int, float]:
+    """The active joints' effective inertias (kg m^2): the diagonal of the arm model's M(q) at
+    the initial posture (hand and ball included as the controller's model has them)."""
+    from replay.runner import Runner
+    from replay.scenario import load_scenario
+
+    root = Path(__file__).resolve().parents[1]
+    ctl: Any = Runner(load_scenario(root / "scenarios" / f"{scenario}.yaml")).controller
+    model = ctl.model
+    act = [int(i) for i in model.active]
+    mass = model.mass(np.asarray(ctl.q_init, float)[act])
+    return {i: float(mass[k, k]) for k, i in enumerate(act)}
+
+
+def rate_cell_gains(period: float, kp, kd, inertias: dict[int, float]) -> tuple[list, list]:
+    """kp, kd for every arm joint at ``period`` by :func:`rate_gains` (rounded to 0.1 N*m/rad
+    and 0.001 N*m*s/rad as the sweep file stores them); a joint without an inertia (held by
+    the plant) keeps its gains."""
+    out_p, out_d = [], []
+    for i, (p, d) in enumerate(zip(kp, kd)):
+        if i in inertias:
+            p, d = rate_gains(p, d, inertias[i], period)
+        out_p.append(round(float(p), 1))
+        out_d.append(round(float(d), 3))
+    return out_p, out_d
+
+
+def _rate_counts(rows: list[dict]) -> dict[tuple[str, str], dict[float, tuple[int, int]]]:
+    """{(scenario, motion): {period in ms: (caught k, runs n)}} of the catch_rate table."""
+    out: dict = {}
+    for (scenario, motion), sub in _split(rows, "scenario", "motion").items():
+        ((xs, ks, ns),) = counts_by(sub, "period_ms", None, caught).values()
+        out[(scenario, motion)] = {x: (k, n) for x, k, n in zip(xs, ks, ns)}
+    return out
+
+
+def plot_rate(rows: list[dict], out: Path, stem: str) -> list[Path]:
+    """Catch rate against the loop period, one line per controller, one panel per motion."""
+    counts = _rate_counts(rows)
+    motions = [m for m in RATE_MOTIONS if any(k[1] == m for k in counts)]
+    motions += sorted({k[1] for k in counts} - set(motions))
+    fig, axes = plt.subplots(1, max(1, len(motions)), sharey=True, figsize=(10.0, 4.2))
+    axes = np.atleast_1d(axes)
+    colours = dict(zip(RATE_CONTROLLERS, ("tab:blue", "tab:green", "tab:orange")))
+    names = [c for c in RATE_CONTROLLERS if any(k[0] == c for k in counts)]
+    names += sorted({k[0] for k in counts} - set(names))
+    for ax, motion in zip(axes, motions):
+        for name, dx in zip(names, shifts(len(names), 0.015)):
+            cell = counts.get((name, motion))
+            if not cell:
+                continue
+            xs = sorted(cell)
+            plot_rates(
+                ax,
+                xs,
+                [cell[x][0] for x in xs],
+                [cell[x][1] for x in xs],
+                "o-",
+                RATE_CONTROLLERS.get(name, name),
+                dx,
+                log_x=True,
+                color=colours.get(name, "0.4"),
+            )
+        _rate_axes(ax, "loop period T [ms] (stereo 1/T, latency T, control 1/T)", log_x=True)
+        ax.set_title(RATE_MOTIONS.get(motion, motion), fontsize=10)
+    for ax in axes[1:]:
+        ax.set_ylabel("")
+    axes[0].legend(fontsize=7, loc="lower left")
+    fig.suptitle(
+        "Catch rate vs loop period, gains re-tuned per period (matched poles)", fontsize=10
     )
-    speeds = {k: mean_by(v, "camera", None, "x.contact_speed")[""] for k, v in split.items()}
-    sd = rate_at({"": speeds.get(("catch_optimised", "none"), ([], []))}, "", hi)
-    sp = rate_at({"": speeds.get(("predictive_catch", "none"), ([], []))}, "", hi)
-    if not (np.isnan(sd) or np.isnan(sp)):
-        text += (
-            f"At first hand contact the ball moved at {sd:.1f} m/s relative to the hand "
-            f"with the direct mapping and {sp:.1f} m/s with the predictor ({hi:g} Hz, no "
-            "kick). "
+    fig.tight_layout()
+    return save(fig, out, stem)
+
+
+def _k_n(cell: dict, x: float) -> str:
+    k, n = cell.get(x, (0, 0))
+    lo, hi = wilson(k, n)
+    return f"{k}/{n} [{100 * lo:.0f}-{100 * hi:.0f} %]"
+
+
+def _ties_up_to(cell: dict) -> float:
+    """The longest period up to which every period's catch interval overlaps the fastest's."""
+    xs = sorted(cell)
+    lo0, hi0 = wilson(*cell[xs[0]])
+    last = xs[0]
+    for x in xs[1:]:
+        lo, hi = wilson(*cell[x])
+        if hi < lo0 or lo > hi0:
+            break
+        last = x
+    return last
+
+
+def _against(a: tuple[int, int], b: tuple[int, int]) -> str:
+    """'ahead of' / 'tied with' / 'behind': rate a against b by their Wilson 95 % intervals."""
+    lo_a, hi_a = wilson(*a)
+    lo_b, hi_b = wilson(*b)
+    return "ahead of" if lo_a > hi_b else "behind" if hi_a < lo_b else "tied with"
+
+
+def thesis(tables: dict[str, list[dict]]) -> dict:
+    """Namiki & Ishikawa's thesis from the stored catch_rate table: does the direct mapping catch
+    without prediction, and is the fast loop what makes it work? Per motion level the
+    prediction-free mapping works if at the fastest period it catches at least half the throws
+    and is not behind the ballistic default (Wilson 95 % intervals disjoint: ahead / behind;
+    overlapping: a tie); the longest period up to which it ties with its fastest rate says where
+    the thesis stops."""
+    counts = _rate_counts(tables.get("catch_rate", []))
+    parts: list[str] = []
+    works, spans, ahead_of_both = {}, {}, {}
+    for motion, label in RATE_MOTIONS.items():
+        f, b, p = (counts.get((c, motion), {}) for c in (FREE, BALLISTIC, PREDICTOR))
+        if not f or not b or not p:
+            continue
+        fast, slow = min(f), max(f)
+        k, n = f[fast]
+        works[motion] = n > 0 and k / n >= 0.5 and _against(f[fast], b[fast]) != "behind"
+        spans[motion] = _ties_up_to(f)
+        ahead_of_both[motion] = all(_against(f[fast], o[fast]) == "ahead of" for o in (b, p))
+        parts.append(
+            f"{label}: at {fast:g} ms prediction-free {_k_n(f, fast)} ({_against(f[fast], b[fast])}"
+            f" the ballistic fit's {_k_n(b, fast)}, {_against(f[fast], p[fast])} the predictor's "
+            f"{_k_n(p, fast)}); at {slow:g} ms {_k_n(f, slow)}, ballistic {_k_n(b, slow)}, "
+            f"predictor {_k_n(p, slow)}; prediction-free tied with its {fast:g} ms rate up to "
+            f"{spans[motion]:g} ms"
         )
-    per_cell = min(len(v) for v in _split(rows, "scenario", "kick", "camera").values())
-    if per_cell < 20:  # a rate from a throw or two is no evidence either way
-        return text + (
-            f"With {per_cell} throw{'s' if per_cell > 1 else ''} a cell this sweep supports no "
-            "conclusion; the shared throw set (python -m analysis.ablation_catch, "
-            "data/ablations/catch_shared_throws.md: 20 throws a cell, Wilson intervals) does."
+    if not works:
+        return {
+            "verdict": "not run",
+            "numbers": "run `replay ablate catch_rate`",
+            "figure": "catch_rate",
+        }
+    ok = [m for m, w in works.items() if w]
+    ahead = [m for m in ok if ahead_of_both.get(m)]
+    beats = (
+        " ("
+        + "; ".join(
+            f"under the {RATE_MOTIONS[m]} ahead of the ballistic fit and the predictor"
+            for m in ahead
         )
-    fast_gap = np.nanmean([d[0] - p[0], d[2] - p[2]])
-    slow_gap = np.nanmean([d[1] - p[1], d[3] - p[3]])
-    if np.isnan(fast_gap) or (max(np.nanmax(d), np.nanmax(p)) == 0):
-        text += "Neither method caught in this sweep, so it cannot test the claim."
-    elif fast_gap > 0 and fast_gap > slow_gap:
-        text += "The direct mapping's advantage grows with the camera rate, as the paper argues."
-    elif fast_gap > 0:
-        text += "The direct mapping is ahead, but not more so with fast vision."
+        + ")"
+        if ahead
+        else ""
+    )
+    slowest = max(max(f) for (c, _), f in counts.items() if c == FREE)
+    span = min(spans[m] for m in ok) if ok else 0.0
+    if not ok:
+        verdict = "does not hold: without prediction the direct mapping does not catch"
+    elif len(ok) < len(works):
+        verdict = (
+            "holds only when "
+            + " and ".join(f"the motion is the {RATE_MOTIONS[m]}" for m in ok)
+            + (f" and the loop period is <= {span:g} ms" if span < slowest else "")
+            + beats
+        )
+    elif span < slowest:
+        verdict = f"holds only when the loop period is <= {span:g} ms" + beats
     else:
-        text += "The direct mapping is not ahead of the predictor here: the claim is not borne out."
-    return text
+        verdict = (
+            f"holds only in part: no prediction is needed, but no ~1 kHz loop either "
+            f"({slowest:g} ms ties with the fastest)"
+        )
+    return {"verdict": verdict, "numbers": "; ".join(parts) + ".", "figure": "catch_rate"}
+
+
+def summary_rate(rows: list[dict]) -> str:
+    said = thesis({"catch_rate": rows})
+    return f"The thesis {said['verdict']}. {said['numbers']}"
 
 
 # -- the shared throw set (issue #21): every controller on the same throws ---------------------

@@ -185,10 +185,9 @@ def test_grasp_fig9_footer_explains_only_what_is_drawn():
 # -- the ablation plots: rates as k/n with Wilson 95 % intervals -------------------------------
 
 ABLATIONS = [
-    ("analysis.ablation_catch", "plot_vision", "catch_vision"),
+    ("analysis.ablation_catch", "plot_rate", "catch_rate"),
     ("analysis.ablation_catch", "plot_throw_speed", "catch_throw_speed"),
     ("analysis.ablation_catch", "plot_arm_limits", "catch_arm_limits"),
-    ("analysis.ablation_catch", "plot_direct_vs_predictive", "catch_direct_vs_predictive"),
     ("analysis.ablation_stick", "plot_vision", "stick_vision"),
     ("analysis.ablation_grasp", "plot_loops", "grasp_loops"),
 ]

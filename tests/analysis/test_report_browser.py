@@ -43,7 +43,7 @@ def test_report_has_every_part(report):
         "### Claims",
         "### Ablations",
         "stick_friction",
-        "catch_direct_vs_predictive",
+        "catch_rate",
         "## Versions",
         "## Commands",
         "grasp_loops",

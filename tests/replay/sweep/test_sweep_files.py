@@ -17,10 +17,9 @@ NAMES = ablations.names()
 
 def test_there_are_catching_stick_and_grasping_ablations():
     assert {
-        "catch_vision",
+        "catch_rate",
         "catch_throw_speed",
         "catch_arm_limits",
-        "catch_direct_vs_predictive",
         "stick_friction",
         "stick_vision",
         "grasp_loops",
@@ -71,8 +70,9 @@ def _throws(sf):
 
 
 @pytest.mark.parametrize(
-    "name", [n for n in NAMES if n.startswith("catch_") and n != "catch_optimisation"]
-)  # (catch_optimisation's perturbed throws: tests/analysis/test_ablation_catch_opt.py)
+    "name",
+    [n for n in NAMES if n.startswith("catch_") and n not in ("catch_rate", "catch_optimisation")],
+)  # (their perturbed throws: tests/analysis/test_catch_rate.py, test_ablation_catch_opt.py)
 def test_throws_are_the_derived_ones(name):
     sf = ablations.load(name)
     for label, sets in _throws(sf):
