@@ -367,12 +367,16 @@ def thesis(tables: dict[str, list[dict]]) -> dict:
         works[motion] = n > 0 and k / n >= 0.5 and _against(f[fast], b[fast]) != "behind"
         spans[motion] = _ties_up_to(f)
         ahead_of_both[motion] = all(_against(f[fast], o[fast]) == "ahead of" for o in (b, p))
+        after = [x for x in sorted(f) if x > spans[motion]][:1]  # where it stops tying
         parts.append(
             f"{label}: at {fast:g} ms prediction-free {_k_n(f, fast)} ({_against(f[fast], b[fast])}"
             f" the ballistic fit's {_k_n(b, fast)}, {_against(f[fast], p[fast])} the predictor's "
-            f"{_k_n(p, fast)}); at {slow:g} ms {_k_n(f, slow)}, ballistic {_k_n(b, slow)}, "
-            f"predictor {_k_n(p, slow)}; prediction-free tied with its {fast:g} ms rate up to "
-            f"{spans[motion]:g} ms"
+            f"{_k_n(p, fast)}); tied with its {fast:g} ms rate up to {spans[motion]:g} ms; "
+            + "; ".join(
+                f"at {x:g} ms prediction-free {_k_n(f, x)}, ballistic {_k_n(b, x)}, predictor "
+                f"{_k_n(p, x)}"
+                for x in dict.fromkeys(after + [slow])
+            )
         )
     if not works:
         return {
@@ -382,15 +386,10 @@ def thesis(tables: dict[str, list[dict]]) -> dict:
         }
     ok = [m for m, w in works.items() if w]
     ahead = [m for m in ok if ahead_of_both.get(m)]
-    beats = (
-        " ("
-        + "; ".join(
-            f"under the {RATE_MOTIONS[m]} ahead of the ballistic fit and the predictor"
-            for m in ahead
-        )
-        + ")"
-        if ahead
-        else ""
+    beats = "".join(
+        f"; under the {RATE_MOTIONS[m]} the prediction-free mapping is ahead of the ballistic "
+        "fit and the predictor"
+        for m in ahead
     )
     slowest = max(max(f) for (c, _), f in counts.items() if c == FREE)
     span = min(spans[m] for m in ok) if ok else 0.0
