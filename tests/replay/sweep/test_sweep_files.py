@@ -28,24 +28,31 @@ def test_there_are_catching_stick_and_grasping_ablations():
 
 def test_grasp_loops_slows_every_loop_together(project_root):
     """Each loop period sets every task and the vision chip to the same rate (latency one frame),
-    each rate a whole number of 1 kHz physics steps, periods 1 to 33 ms."""
+    each rate a whole number of 1 kHz physics steps, periods 1 to 33 ms, and the gain rule of
+    the head, arm and hand tasks to that period (gain_rule.py); >= 2 motions, >= 20 seeds."""
     from replay.scenario.loader import load_scenario
 
     sf = ablations.load("grasp_loops")
     sc = load_scenario(sf.scenario)
     (axis,) = [a for a in sf.spec.grid if a.name == "loop_period_ms"]
     periods = [float(label) for label in axis.labels]
-    assert min(periods) == 1.0 and max(periods) == 33.0
+    assert periods == [1.0, 2.0, 5.0, 10.0, 15.0, 20.0, 33.0]
     for period, sets in zip(periods, axis.values):
-        assert {k for k in sets if k.startswith("tasks.")} == {f"tasks.{t}.rate" for t in sc.tasks}
-        rates = [v for k, v in sets.items() if k.endswith(".rate")]
-        np.testing.assert_allclose(rates, 1e3 / period, rtol=1e-9)
+        rates = {k for k in sets if k.startswith("tasks.") and k.endswith(".rate")}
+        assert rates == {f"tasks.{t}.rate" for t in sc.tasks}
+        np.testing.assert_allclose([sets[k] for k in rates], 1e3 / period, rtol=1e-9)
         assert sets["sensors.chip.rate"] == pytest.approx(1e3 / period, rel=1e-9)
         assert sets["sensors.chip.latency"] == pytest.approx(period * 1e-3, rel=1e-9)
+        for task in ("head", "arm", "hand"):
+            assert sets[f"tasks.{task}.params.gain_period"] == pytest.approx(period * 1e-3)
         steps = sc.timing.physics_rate * period * 1e-3
         assert steps == pytest.approx(round(steps), abs=1e-6)
-    (speeds,) = [a for a in sf.spec.grid if a.name == "plant.params.human_speed"]
-    assert len(speeds.values) >= 2
+    (motion,) = [a for a in sf.spec.grid if a.name == "motion"]
+    assert len(motion.values) >= 2
+    for label, sets in zip(motion.labels, motion.values):
+        assert sets["plant.params.human_speed"] == pytest.approx(float(label))
+    (seeds,) = [a for a in sf.spec.grid if a.name == "seed"]
+    assert len(seeds.values) >= 20
 
 
 @pytest.mark.parametrize("name", NAMES)
