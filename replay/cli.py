@@ -760,6 +760,23 @@ def claims(logs, markdown):
 
 
 @main.command()
+@click.option("--stored", is_flag=True, help="only the stored tables (data/ablations/)")
+@click.option("--markdown", is_flag=True, help="as the Markdown table README.md shows")
+def theses(stored, markdown):
+    """Each paper's thesis and its verdict, decided by its ablations' tables (this machine's
+    runs under out/ablations/ first, else the stored ones)."""
+    from analysis import theses as th
+
+    rows = th.verdicts(stored_only=stored)
+    if markdown:
+        say(th.markdown(rows))
+        return
+    for v in rows:
+        say(f"{v.thesis.paper}: {v.thesis.claim}")
+        say(f"  {v.verdict}: {v.numbers} ({v.figure}, {v.source})")
+
+
+@main.command()
 @click.argument("logs", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option(
     "-o",

@@ -268,8 +268,27 @@ def _build(out: Path, logs_dir: Path) -> None:
         (out / "tables").mkdir(exist_ok=True)
         shutil.copy(data_path("ablations", f"{TABLE}.csv"), out / "tables" / f"{TABLE}.csv")
     left = [f"Log left out: {d}" for d in dropped]  # (a log that is no run's is said, not lost)
-    (out / "index.md").write_text(_markdown(sections, info, commands, left), encoding="utf-8")
-    (out / "index.html").write_text(_html(sections, info, commands, left), encoding="utf-8")
+    said = _theses(left)
+    (out / "index.md").write_text(_markdown(sections, info, commands, left, said), encoding="utf-8")
+    (out / "index.html").write_text(_html(sections, info, commands, left, said), encoding="utf-8")
+
+
+def _theses(notes: list[str]) -> list:
+    """Each paper's thesis with its verdict from the ablation tables (analysis/theses.py); a
+    table that cannot be read is a note, not a failed report."""
+    from analysis import theses
+
+    try:
+        return theses.verdicts()
+    except Exception as exc:  # noqa: BLE001 - a damaged table: said, not fatal
+        notes.append(f"No theses: their tables could not be read: {exc!r}")
+        return []
+
+
+THESES_NOTE = (
+    "Each verdict is computed from the ablation tables named in its row (this machine's "
+    "replay ablate runs, else the stored ones), drawn below under Ablations."
+)
 
 
 def _ablation(sf, out: Path, ablations) -> Ablation:
@@ -424,7 +443,7 @@ HEADLINE_NOTE = (
 # -- Markdown --------------------------------------------------------------------------------
 
 
-def _markdown(sections, info, commands, notes=()) -> str:
+def _markdown(sections, info, commands, notes=(), said=()) -> str:
     lines = [
         "# paper-replay: reproduction report",
         "",
@@ -433,6 +452,10 @@ def _markdown(sections, info, commands, notes=()) -> str:
         "",
     ]
     lines += [x for n in notes for x in (f"> {md(n)}", "")]
+    if said:
+        from analysis.theses import markdown as theses_markdown
+
+        lines += ["## Theses", "", theses_markdown(list(said)), "", md(THESES_NOTE), ""]
     headline = _headline(sections)
     if headline:
         lines += ["## Summary", "", "| " + " | ".join(HEADLINE) + " |"]
@@ -542,7 +565,7 @@ _CSP = (
 )
 
 
-def _html(sections, info, commands, notes=()) -> str:
+def _html(sections, info, commands, notes=(), said=()) -> str:
     h = [
         "<!doctype html>",
         '<html lang="en"><head><meta charset="utf-8">',
@@ -557,6 +580,8 @@ def _html(sections, info, commands, notes=()) -> str:
         "<nav><ul>",
     ]
     headline = _headline(sections)
+    if said:
+        h.append('<li><a href="#theses">Theses</a></li>')
     if headline:
         h.append('<li><a href="#summary">Summary</a></li>')
     h += [f'<li><a href="#{_e(s.key)}">{_e(s.title)}</a></li>' for s in sections]
@@ -565,6 +590,10 @@ def _html(sections, info, commands, notes=()) -> str:
         '<li><a href="#commands">Commands</a></li>',
         "</ul></nav>",
     ]
+    if said:
+        from analysis.theses import html as theses_html
+
+        h += ['<h2 id="theses">Theses</h2>', theses_html(list(said)), f"<p>{_e(THESES_NOTE)}</p>"]
     if headline:
         h += [
             '<h2 id="summary">Summary</h2>',
