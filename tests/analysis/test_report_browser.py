@@ -47,7 +47,11 @@ def test_report_has_every_part(report):
         "## Versions",
         "## Commands",
         "grasp_loops",
-        "Grasp rate against loop period",
+        "Grasp rate (k/n with Wilson 95 % intervals)",
+        "## Theses",
+        "grasp_components",
+        "stick_conditions",
+        "catch_optimisation",
         "replay ablate",
     ):
         assert part in md, part

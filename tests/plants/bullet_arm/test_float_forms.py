@@ -104,7 +104,7 @@ def test_human_offset_equals_the_array_form():
         w, a, phi = band_limited_path(
             rng, components=components, f_min=0.1, f_max=1.0, rms_rate=0.1, axes=3
         )
-        h.start = 0.05
+        h.start, h.kicks = 0.05, None  # (no kicks: the band-limited path alone)
         h._W, h._A, h._PHI, h._S0 = w, a, phi, np.sin(phi)
         h._rows = [
             list(zip(*row)) for row in zip(w.tolist(), a.tolist(), phi.tolist(), h._S0.tolist())
