@@ -206,8 +206,9 @@ def plot_gain_rule(out: Path, stem: str = "catch_rate_steps") -> list[Path]:
     scenarios' fixed 1 ms gains at 33 ms (docs/catching.md)."""
     from replay.scenario import load_scenario
 
-    root = Path(__file__).resolve().parents[1]
-    controller: Any = load_scenario(root / "scenarios" / f"{BALLISTIC}.yaml").controller
+    from replay.resources import scenario_dir
+
+    controller: Any = load_scenario(scenario_dir() / f"{BALLISTIC}.yaml").controller
     params = controller.params
     inertias = joint_inertias()
     fig, axes = plt.subplots(1, len(inertias), sharey=True, figsize=(10.0, 3.4))
@@ -253,8 +254,9 @@ def joint_inertias(scenario: str = "catch_optimised") -> dict[int, float]:
     from replay.runner import Runner
     from replay.scenario import load_scenario
 
-    root = Path(__file__).resolve().parents[1]
-    ctl: Any = Runner(load_scenario(root / "scenarios" / f"{scenario}.yaml")).controller
+    from replay.resources import scenario_dir
+
+    ctl: Any = Runner(load_scenario(scenario_dir() / f"{scenario}.yaml")).controller
     model = ctl.model
     act = [int(i) for i in model.active]
     mass = model.mass(np.asarray(ctl.q_init, float)[act])
@@ -476,7 +478,8 @@ def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, 
     from replay.runner import Runner
     from replay.scenario import load_scenario
 
-    root = Path(__file__).resolve().parents[1]
+    from replay.resources import scenario_dir
+
     cells = cells or list(SHARED_CELLS)
     controllers = controllers or SHARED_CONTROLLERS
     rows = []
@@ -488,7 +491,7 @@ def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, 
             for label, name in controllers.items():
                 for i, th in enumerate(throws):
                     sc = load_scenario(
-                        root / "scenarios" / f"{name}.yaml",
+                        scenario_dir() / f"{name}.yaml",
                         throw_overrides(th)
                         + sets
                         + list(extra)

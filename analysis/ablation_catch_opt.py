@@ -36,15 +36,16 @@ import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
 from analysis.ablation_catch import wilson  # noqa: E402
+from replay.resources import data_path, scenario_dir  # noqa: E402
 from analysis.ablation_plot import plain_log_ticks, plot_rates, shifts  # noqa: E402
 from analysis.ablation_table import caught  # noqa: E402
 from analysis.figure_files import save  # noqa: E402
 from replay.sweep.table import as_float  # noqa: E402
 
 NAME = "catch_optimisation"
-ROOT = Path(__file__).resolve().parents[1]
-SCENARIO = ROOT / "scenarios" / "catch_optimised.yaml"
-ALPHA_DIR = ROOT / "data" / "catching"
+ROOT = Path(__file__).resolve().parents[1]  # (a checkout: where `sweep` and `store` write)
+SCENARIO = scenario_dir() / "catch_optimised.yaml"
+ALPHA_DIR = data_path("catching")
 # alpha files as the sweep names them: relative to the scenario's folder, as a scenario file
 # writes them (a sweep's worker resolves them there: replay.scenario.loader.file_dirs); a
 # missing file would be recomputed as eq. 25's optimum, so every run logs the model cost of the
@@ -159,7 +160,7 @@ def write_slow_falsifier(dest: Path = ALPHA_DIR) -> dict:
     with ``controller.params.alpha_file``). Returns its cost record."""
     from replay.control.catching.optimise import OptimResult, load_alpha, project_eq13, save_alpha
 
-    runner = _controller({}, ROOT / "scenarios" / "catch_5ms_optimised.yaml")
+    runner = _controller({}, scenario_dir() / "catch_5ms_optimised.yaml")
     try:
         ctrl = runner.controller
         prob = ctrl.problem
