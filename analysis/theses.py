@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 NOT_RUN = "not run"
+UNREAD = "not decided"
 
 
 @dataclass(frozen=True)
@@ -90,10 +91,14 @@ def decide(thesis: Thesis, stored_only: bool = False) -> Verdict:
     if source == NOT_RUN:
         run = "; ".join(f"replay ablate {n}" for n in thesis.tables)
         return Verdict(thesis, NOT_RUN, f"run `{run}`", thesis.tables[0], NOT_RUN)
-    said = load_function(thesis.verdict)(tables)
-    return Verdict(
-        thesis, str(said["verdict"]), _text(said["numbers"]), str(said["figure"]), source
-    )
+    try:
+        said = load_function(thesis.verdict)(tables)
+        return Verdict(
+            thesis, str(said["verdict"]), _text(said["numbers"]), str(said["figure"]), source
+        )
+    except Exception as exc:  # noqa: BLE001 - a damaged or foreign table: said, not fatal
+        why = f"its table ({source}) could not be read: {type(exc).__name__}: {exc}"
+        return Verdict(thesis, UNREAD, why, thesis.tables[0], source)
 
 
 def _text(numbers) -> str:

@@ -773,7 +773,7 @@ def theses(stored, markdown):
         return
     for v in rows:
         say(f"{v.thesis.paper}: {v.thesis.claim}")
-        say(f"  {v.verdict}: {v.numbers} ({v.figure}, {v.source})")
+        say(one_line(f"  {v.verdict}: {v.numbers} ({v.figure}, {v.source})"))
 
 
 @main.command()

@@ -51,3 +51,15 @@ def test_the_markdown_escapes_what_a_table_says():
     v = theses.Verdict(theses.THESES[0], "holds | <b>", "1/2 [x](y)", "fig", "stored")
     line = theses.markdown([v]).splitlines()[-1]
     assert "<b>" not in line and "\\|" in line and "](" not in line
+
+
+def test_a_damaged_fresh_table_is_said_not_a_traceback(tmp_path, monkeypatch):
+    from cli_checks import invoke
+
+    monkeypatch.chdir(tmp_path)
+    fresh = tmp_path / "out" / "ablations" / "catch_rate"
+    fresh.mkdir(parents=True)
+    (fresh / "table.csv").write_text("index,key,success\n0,abc,True\n", encoding="utf-8")
+    r = invoke("theses")
+    assert r.exit_code == 0 and "Traceback" not in r.output, r.output
+    assert f"{theses.UNREAD}: its table (run here) could not be read: KeyError" in r.output
