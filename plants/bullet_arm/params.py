@@ -302,16 +302,17 @@ class GraspParams(Params):
         0.0,
         unit="1/s",
         ge=0.0,
+        le=100.0,  # (each kick is summed at every step: a bound, far above a human's)
         omit_empty=True,
         doc="sudden kicks of the human's path: a Poisson process of this mean rate (0: none), "
         "each a step of human_kick_speed in the path's in-plane velocity, in a random direction, "
         "lasting human_kick_duration (plants/bullet_arm/human_path.py)",
     )
     human_kick_speed: float = param(
-        0.0, unit="m/s", ge=0.0, omit_empty=True, doc="a kick's step in the path's speed"
+        0.0, unit="m/s", ge=0.0, le=10.0, omit_empty=True, doc="a kick's step in the path's speed"
     )
     human_kick_duration: float = param(
-        0.0, unit="s", ge=0.0, omit_empty=True, doc="how long a kick's velocity step lasts"
+        0.0, unit="s", ge=0.0, le=10.0, omit_empty=True, doc="how long a kick's velocity step lasts"
     )
     head_position: list = param(
         [0.0, 0.0, 1.0], unit="m", length=3, doc="world point where the pan and tilt axes meet"

@@ -59,3 +59,16 @@ def test_each_kick_steps_the_velocity_and_displaces_the_path_by_speed_times_dura
 def test_kicks_need_a_speed_and_a_duration():
     with pytest.raises(ValueError, match="kick"):
         path(kick_rate=1.0, kick_speed=0.0, kick_duration=0.1)
+
+
+@pytest.mark.parametrize(
+    "field,value",
+    [("human_kick_rate", "1e9"), ("human_kick_speed", "1e6"), ("human_kick_duration", "1e6")],
+)
+def test_a_kick_beyond_its_bound_is_one_line_before_anything_runs(field, value):
+    """A rate of 1e9 kicks a second would draw (and sum at every step) ~1e9 kicks: refused at
+    its field by the loader, as every bounded parameter is."""
+    from cli_checks import invoke
+
+    r = invoke("validate", "grasp_hexahedron", "--set", f"plant.params.{field}={value}")
+    assert r.exit_code == 2 and f"plant.params.{field}: expected a number" in r.output, r.output
