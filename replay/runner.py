@@ -15,6 +15,7 @@ until :attr:`Runner.done`, then :meth:`Runner.finish`, which a caller may drive 
 from __future__ import annotations
 
 import functools
+import os
 import heapq
 import platform
 import time
@@ -28,6 +29,7 @@ import numpy as np
 from replay import __version__, registry, version
 from replay.foxglove.run import RunTopics
 from replay.log import LogWriter, NonFiniteValueError
+from replay.log.unwritten import NoTopics, UnwrittenLog
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
 from replay.scenario import Scenario, resolved_yaml
 from replay.tasks import Task, TaskSet
@@ -94,7 +96,7 @@ def _divider(physics_rate: int, rate: float) -> int:
 
 
 class Runner:
-    viz: RunTopics  # the run's Foxglove topics, from start()
+    viz: RunTopics | NoTopics  # the run's Foxglove topics, from start()
 
     def __init__(
         self,
@@ -153,9 +155,10 @@ class Runner:
 
     # -- the run, step by step: start(out), step() until done, finish() ----------------------
 
-    def run(self, out: str | Path) -> RunResult:
-        """The whole run into the log ``out``: :meth:`start`, :meth:`step` until :attr:`done`,
-        :meth:`finish`. Ctrl-C closes the log (kept) and raises :class:`RunInterrupted`."""
+    def run(self, out: str | Path | None) -> RunResult:
+        """The whole run into the log ``out`` (None: no log, the outcome and events alike):
+        :meth:`start`, :meth:`step` until :attr:`done`, :meth:`finish`. Ctrl-C closes the log
+        (kept) and raises :class:`RunInterrupted`."""
         self.start(out)
         progress_div = max(1, self.rate // 20)
         try:
@@ -172,11 +175,11 @@ class Runner:
             self.plant.close()
             raise
 
-    def start(self, out: str | Path) -> None:
+    def start(self, out: str | Path | None) -> None:
         """Open the log ``out`` and write what a run starts with (its provenance, the resolved
         scenario, the robot's description); the run is at step 0."""
         sc = self.sc
-        self.result = RunResult(path=Path(out))
+        self.result = RunResult(path=Path(out if out is not None else os.devnull))
         self._wall0 = time.perf_counter()
         self.k = 0
         self._n_steps = int(round(sc.timing.duration * self.rate))
@@ -186,7 +189,7 @@ class Runner:
         # (deliver at step, sequence, topic, payload), delivered in that order whatever the
         # sensors' order and latencies
         self._pending: list = []
-        log = self.log = LogWriter(out)
+        log = self.log = LogWriter(out) if out is not None else UnwrittenLog()
         commit = _git_commit() or "unknown"
         log.metadata("provenance", provenance(sc, commit))
         text = resolved_yaml(sc)
@@ -194,7 +197,11 @@ class Runner:
         version = f"{__version__}+{commit}"
         self._emit = self._emitter(log)
         self._emit_all = self._emitter_all(log)
-        self.viz = RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
+        self.viz = (
+            RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
+            if out is not None
+            else NoTopics()
+        )
         self._write(TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0)
         self.viz.start(0)
 
@@ -317,7 +324,7 @@ class Runner:
         result.wall_time = time.perf_counter() - self._wall0
         return result
 
-    def _emitter(self, log: LogWriter) -> Callable[[str, object, int], None]:
+    def _emitter(self, log: LogWriter | UnwrittenLog) -> Callable[[str, object, int], None]:
         """``write(topic, payload, t_ns)``: the log's own write, and the observers' after it."""
         if not self.observers:
             return log.write
@@ -330,7 +337,7 @@ class Runner:
 
         return write
 
-    def _emitter_all(self, log: LogWriter) -> Callable[[dict, int], None]:
+    def _emitter_all(self, log: LogWriter | UnwrittenLog) -> Callable[[dict, int], None]:
         """``write_all(messages, t_ns)``: each (topic, payload) of a dict written, a list payload
         as its items' messages; the log's own compiled write_all without observers."""
         if not self.observers:

@@ -69,7 +69,12 @@ DEFAULT_SWEEP_OUT = Path("out/sweeps")
     help="Ray cluster to join (auto or HOST:PORT); default: a private Ray on 127.0.0.1, "
     "ended with the sweep",
 )
-@click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
+@click.option(
+    "--no-logs",
+    is_flag=True,
+    help="keep no variant's MCAP log: none is written (a temporary one only where the sweep's "
+    "metrics function reads it); the rows are the same",
+)
 @click.option(
     "--retry-failed",
     is_flag=True,
@@ -199,7 +204,12 @@ def _run(
     "(what the report plots without a fresh run)",
 )
 @click.option("--plot-only", is_flag=True, help="no runs: redraw from the freshest table")
-@click.option("--no-logs", is_flag=True, help="do not keep each variant's MCAP log")
+@click.option(
+    "--no-logs",
+    is_flag=True,
+    help="keep no variant's MCAP log: none is written (a temporary one only where the sweep's "
+    "metrics function reads it); the rows are the same",
+)
 @click.option("--retry-failed", is_flag=True, help="re-run variants that failed to run")
 @click.option("-q", "--quiet", is_flag=True, help="no progress bar")
 def ablate(

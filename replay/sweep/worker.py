@@ -33,7 +33,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         return row
     log: str = task.get("log") or ""
     tmp = ""
-    if not log:  # a folder of its own: the log is made there (an empty file is no output)
+    if not log and task.get("metrics"):  # its metrics read a log: made in a folder of its own
         tmp = str(Path(tempfile.mkdtemp(prefix="sweep-")) / "variant.mcap")
     cwd = task.get("cwd")
     if cwd and Path(cwd).is_dir() and os.getcwd() != cwd:
@@ -50,7 +50,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         set_file_dirs(sc, task.get("file_dirs") or {})
         if log:
             Path(log).parent.mkdir(parents=True, exist_ok=True)
-        result = Runner(sc).run(log or tmp)
+        result = Runner(sc).run(log or tmp or None)  # (None: no log is kept or read)
         outcome = dict(result.outcome)
         row["success"] = bool(outcome.pop("success", False))
         row["reason"] = str(outcome.pop("reason", ""))
