@@ -69,10 +69,10 @@ test-pure: $(STAMP)
 	REPLAY_NO_ACCEL=1 $(REPLAY) golden check
 
 bench: $(STAMP)
-	$(PY) -m replay.bench
-	$(PY) -m replay.log.bench
-	$(PY) -m replay.viewer.bench
-	$(PY) -m replay.sweep.bench
+	$(PY) -m tools.bench.runs
+	$(PY) -m tools.bench.log_costs
+	$(PY) -m tools.bench.viewer_load
+	$(PY) -m tools.bench.sweep_costs
 
 golden-check: $(STAMP)
 	$(REPLAY) golden check

@@ -7,7 +7,7 @@ files.
 
 Measured against the ``mcap`` library's ``Writer`` it replaces (same messages, one process):
 ~2.0 against ~6.5 us a ~60-byte JSON message, ~7 against ~17 us a 16 KiB image; in a run
-(``python -m replay.bench``, stick_3step, alternated on a loaded host) a JSON message 10.4 /
+(``python -m tools.bench.runs``, stick_3step, alternated on a loaded host) a JSON message 10.4 /
 7.6 / 9.9 -> 6.5 / 4.3 / 5.3 us. Its ``Writer`` still
 writes test files (tests/) and ``mcap``'s reader reads every log.
 

@@ -195,7 +195,7 @@ def test_golden_is_small(project_root):
 
 def test_bench_grasp_measures_against_bare_stepping(monkeypatch):
     """One short run: the ratio is full CPU time over bare stepSimulation of the same bodies."""
-    from replay import bench
+    from tools.bench import runs as bench
 
     monkeypatch.chdir(ROOT)
     path = ROOT / "scenarios" / "grasp_hexahedron.yaml"

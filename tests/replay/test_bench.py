@@ -2,7 +2,7 @@
 
 import pytest
 
-from replay.bench import COMPONENTS, bare_stepper, engine_in_run, report, timed_run
+from tools.bench.runs import COMPONENTS, bare_stepper, engine_in_run, report, timed_run
 from replay.runner import Runner
 from replay.scenario import load_scenario
 
@@ -92,7 +92,7 @@ def test_an_engine_step_the_bench_cannot_see_is_said_not_measured():
 
 
 def test_the_logging_costs_count_every_logged_item_and_restore_the_classes(tmp_path):
-    from replay.bench import LOGGED, logging_costs
+    from tools.bench.runs import LOGGED, logging_costs
     from replay.log import LogReader
 
     sc = load_scenario("scenarios/catch_optimised.yaml", sets=["timing.duration=0.03"])
@@ -120,7 +120,7 @@ def test_the_logging_costs_count_every_logged_item_and_restore_the_classes(tmp_p
 def test_short_runs_are_repeated_until_they_took_the_minimum_time(monkeypatch):
     """A short scenario's few runs would all fall in one slow spell of a shared host: the bench
     runs more of them until they have taken ``min_time`` CPU seconds."""
-    from replay import bench
+    from tools.bench import runs as bench
 
     short = load_scenario("scenarios/stick_3step.yaml", sets=["timing.duration=0.02"])
     monkeypatch.setattr(bench, "load_scenario", lambda path: short)
@@ -150,7 +150,7 @@ def test_short_runs_are_repeated_until_they_took_the_minimum_time(monkeypatch):
     ],
 )
 def test_bad_bench_arguments_are_usage_errors_not_tracebacks(argv, says, capsys):
-    from replay import bench
+    from tools.bench import runs as bench
 
     with pytest.raises(SystemExit) as exc:
         bench.main(argv)

@@ -1,6 +1,6 @@
-"""`python -m replay.log.bench` runs: its stages cost something for real messages."""
+"""`python -m tools.bench.log_costs` runs: its stages cost something for real messages."""
 
-from replay.log.bench import capture, costs
+from tools.bench.log_costs import capture, costs
 
 
 def test_the_log_bench_times_each_stage_of_a_real_runs_messages(project_root):

@@ -2,7 +2,7 @@
 overlays, plots, errors, port handling, the CLI and ``run --view``.
 
 Servers bind to 127.0.0.1 on a free port (port 0) and are stopped by each test; no test here
-asserts on timing (``python -m replay.viewer.bench`` measures the load time; one test prints it).
+asserts on timing (``python -m tools.bench.viewer_load`` measures the load time; one test prints it).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from plants.airtable.viewer_scene import AirTableScene, StickGeometry
 from plants.bullet_arm.viewer_scene import ArmScene, plant_models_urdf
 from replay.viewer.geometry import cameras
 from replay.viewer.scenes import RunScene, scene_class
-from replay.viewer.synthetic import write_arm_log, write_stick_log
+from synthetic_logs import write_arm_log, write_stick_log
 from replay.viewer.timeline import speed_value
 
 
@@ -490,7 +490,7 @@ def test_a_log_missing_some_topics_shows_the_rest_and_says_so(viewer_factory, tm
 
 
 def test_load_time_of_a_2s_1khz_log_is_printed(tmp_path, capsys):
-    """Measured, not asserted (see replay.viewer.bench)."""
+    """Measured, not asserted (see tools/bench/viewer_load.py)."""
     path = write_stick_log(tmp_path / "bench.mcap", duration=2.0, rate=1000)
     t0 = time.perf_counter()
     run = load_run(path)

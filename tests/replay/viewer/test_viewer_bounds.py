@@ -28,7 +28,7 @@ from replay.viewer import ViewerError, load_run
 from replay.viewer.app import Viewer, free_port
 from replay.viewer.data import EVENT_FIELD_BYTES, LABEL_BYTES, RunAccumulator
 from replay.viewer.markup import LABEL_CHARS
-from replay.viewer.synthetic import write_hostile_log
+from synthetic_logs import write_hostile_log
 
 REPLAY = [sys.executable, "-m", "replay.cli"]
 

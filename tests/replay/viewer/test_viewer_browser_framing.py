@@ -24,7 +24,7 @@ Image = pytest.importorskip("PIL.Image")
 
 from replay.viewer import Viewer  # noqa: E402
 from replay.viewer.scenes import run_color  # noqa: E402
-from replay.viewer.synthetic import write_arm_log  # noqa: E402
+from synthetic_logs import write_arm_log  # noqa: E402
 from chromium import FLAGS, _ensure_chromium  # noqa: E402
 from grasp_synthetic import write_grasp_log  # noqa: E402
 

@@ -14,7 +14,7 @@ from plants.bullet_arm.viewer_scene import ArmScene
 from replay import registry
 from replay.viewer.app import Viewer
 from replay.viewer.scenes import FIT_MIN_SIZE, Body, fit_bounds, run_color
-from replay.viewer.synthetic import write_arm_log, write_stick_log
+from synthetic_logs import write_arm_log, write_stick_log
 from replay.viewer.timeline import (
     ALL_KINDS,
     MAX_EVENT_BUTTONS,

@@ -32,7 +32,7 @@ from replay.viewer import app as viewer_app
 from replay.viewer import guard
 from replay.viewer.app import Viewer
 from replay.viewer.markup import clean, plain
-from replay.viewer.synthetic import write_hostile_log
+from synthetic_logs import write_hostile_log
 from replay.viewer.timeline import DEFAULT_SPEED
 
 SUBPROTOCOL = f"viser-v{viser.__version__}"

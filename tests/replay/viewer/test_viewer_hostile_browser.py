@@ -24,7 +24,7 @@ playwright_api = pytest.importorskip("playwright.sync_api")
 
 from replay.viewer import Viewer, guard  # noqa: E402
 from replay.viewer.markup import clean  # noqa: E402
-from replay.viewer.synthetic import write_hostile_log  # noqa: E402
+from synthetic_logs import write_hostile_log  # noqa: E402
 from chromium import FLAGS, _ensure_chromium  # noqa: E402
 
 REBIND = "rebind.test"  # a name the browser resolves to 127.0.0.1, as DNS rebinding does

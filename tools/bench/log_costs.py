@@ -1,4 +1,4 @@
-"""``python -m replay.log.bench [SCENARIO ...]``: what a log message costs, in one process.
+"""``python -m tools.bench.log_costs [SCENARIO ...]``: what a log message costs, in one process.
 
 The messages of a short run of each scenario are kept (deep copies, as the observers saw them),
 then written again and again, CPU time (``time.process_time``), best of ``--repeat``: the JSON

@@ -1,11 +1,11 @@
 """What the Foxglove topics cost a run: CPU time per simulated second with and without them.
 
-``python -m replay.foxglove.bench [SCENARIO...] [--runs N] [--duration S]``: in one process, for
+``python -m tools.bench.foxglove_costs [SCENARIO...] [--runs N] [--duration S]``: in one process, for
 each scenario, alternately runs it as it is (``/tf``, ``/scene``, ``/joint_states`` at
 ``timing.frame_rate``, camera images where ``log_images``) and with them off
 (``timing.frame_rate=0`` and every sensor's ``log_images=false``), and prints the median CPU
 seconds (``time.process_time``) per simulated second of each, their difference, the log sizes
-and the time in logging (``replay.bench.timed_run``). It prints; it does not judge.
+and the time in logging (``tools.bench.runs.timed_run``). It prints; it does not judge.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def off_sets(path: str) -> list[str]:
 
 def one(path: str, sets: list[str], out: Path) -> tuple[float, float, int, float]:
     """(CPU s, simulated s, log bytes, wall s in logging) of one run."""
-    from replay.bench import timed_run
+    from tools.bench.runs import timed_run
 
     sc = load_scenario(path, sets)
     runner = Runner(sc)

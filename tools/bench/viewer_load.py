@@ -1,4 +1,4 @@
-"""``python -m replay.viewer.bench``: how long the viewer takes to open a 2-s, 1 kHz log.
+"""``python -m tools.bench.viewer_load``: how long the viewer takes to open a 2-s, 1 kHz log.
 
 Writes synthetic logs (air table; arm with hand and ball) of that size, then times reading
 them into arrays (``load_run``) and the whole open (arrays, server start, scene, URDF, GUI,
@@ -12,7 +12,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from replay.viewer.synthetic import write_arm_log, write_stick_log
+from tests.synthetic_logs import write_arm_log, write_stick_log
 
 
 def _best(fn, repeat: int) -> float:
