@@ -90,12 +90,13 @@ def swap_in(work: Path, target: Path) -> None:
         target.rename(old / "report")
     work.rename(target)
     target.chmod(0o755)  # (mkdtemp made it 0700)
-    if old is not None:
+    if old is not None:  # (made just above by mkdtemp, holding only the old report)
         shutil.rmtree(old)
 
 
 def discard(work: Path) -> None:
     """Remove a staging folder of :func:`staging` (its marker inside) after a failed build;
     anything else at that path is left alone."""
-    if not work.is_symlink() and (work / MARKER).is_file():
+    made = work.name.startswith(".") and work.name.endswith(".part")  # (staging's mkdtemp name)
+    if made and not work.is_symlink() and (work / MARKER).is_file():
         shutil.rmtree(work, ignore_errors=True)

@@ -40,17 +40,30 @@ CLOSE_WAIT = 10.0  # s the sweep waits for the keeper to clear the cluster
 
 
 TEMP_PREFIX = "replay-ray-"  # the cluster's folder: tempfile.mkdtemp(prefix=TEMP_PREFIX)
+MARKER = (
+    ".paper-replay-ray"  # written into it at once: a folder of that name without it is not ours
+)
+
+
+def make_temp() -> str:
+    """A new cluster folder in the temporary directory, marked as this module's."""
+    path = tempfile.mkdtemp(prefix=TEMP_PREFIX)
+    (Path(path) / MARKER).write_text("made by paper-replay's private Ray cluster\n")
+    return path
 
 
 def made_here(path: str) -> bool:
-    """Whether ``path`` is a cluster folder of this module's making: a real folder named
-    ``TEMP_PREFIX...`` directly in the temporary directory (never a path given otherwise)."""
+    """Whether ``path`` is a cluster folder of this module's making (:func:`make_temp`): a real
+    folder named ``TEMP_PREFIX...`` directly in the temporary directory, holding its marker file
+    (never a path given otherwise, nor another program's folder of that name)."""
     p = Path(path)
     return (
         p.name.startswith(TEMP_PREFIX)
         and not p.is_symlink()
         and p.is_dir()
         and p.parent.resolve() == Path(tempfile.gettempdir()).resolve()
+        and (p / MARKER).is_file()
+        and not (p / MARKER).is_symlink()
     )
 
 
@@ -68,7 +81,7 @@ class PrivateRay:
     """The sweep's handle on its keeper: ``address`` to join; :meth:`close` ends the cluster."""
 
     def __init__(self, workers: int) -> None:
-        self.temp_dir = tempfile.mkdtemp(prefix=TEMP_PREFIX)
+        self.temp_dir = make_temp()
         env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}
         env.setdefault("RAY_agent_register_timeout_ms", "120000")  # slow agents on a busy host
         env.update(ENV)

@@ -241,6 +241,18 @@ def test_the_keeper_removes_only_a_folder_it_was_made_for(tmp_path):
     (mine / "keep.txt").write_text("keep")
     assert not made_here(str(mine)) and not made_here(str(tmp_path))
     remove_temp(str(mine))
+    # the right name in the temporary directory, but another program's (no marker): kept
+    import tempfile
+
+    theirs = Path(tempfile.mkdtemp(prefix="replay-ray-"))
+    try:
+        (theirs / "keep.txt").write_text("keep")
+        assert not made_here(str(theirs))
+        remove_temp(str(theirs))
+        assert (theirs / "keep.txt").read_text() == "keep"
+    finally:
+        (theirs / "keep.txt").unlink()
+        theirs.rmdir()
     r = subprocess.run(
         [sys.executable, "-m", "replay.sweep.ray_local", "1", str(mine)],
         capture_output=True,
