@@ -20,8 +20,8 @@
 - No prediction of the object's motion: x^o is the latest measurement.
 - Per step: the chain and Jg (:meth:`ArmControlTask._chain`, floats; :meth:`kinematics` is its
   NumPy reference), eq. 2's terms (:func:`eq2_terms`) and F^a (:func:`wrench_reference`,
-  floats); :meth:`reference_command` is eq. 2 written out in NumPy, the formula a seeded test
-  holds the task's command to.
+  floats); eq. 2 written out in NumPy, the formula a seeded test holds the task's command to, is
+  the tests' oracle (tests/replay/control/grasping/oracles.py).
 """
 
 from __future__ import annotations
@@ -474,37 +474,6 @@ class ArmControlTask(Controller):
             dr_[i] += b * (e_reach[i] - dr_[i])
             e_track[i] -= dt_[i]
             e_reach[i] -= dr_[i]
-
-    def reference_command(self, q, qd, obj, state, F) -> dict[str, np.ndarray]:
-        """Eq. 2's terms the NumPy way (the reference of the compiled path in :meth:`update`):
-        ``F`` the external wrench as :meth:`external_wrench` gives it."""
-        P = self.params
-        T, J = self.kinematics(q)
-        R = T[:3, :3]
-        gp = T[:3, 3] + P.grasp_point * R[:, 2]
-        r = gp - T[:3, 3]
-        Jg = J.copy()
-        Jg[:3] -= cross3(r[:, None], J[3:])
-        e_track = np.zeros(6)
-        if obj is not None:
-            e_track[:3] = np.asarray(obj.position, float) - gp
-            if obj.roll is not None and obj.shape != "circle":
-                e_track[3] = wrap_half_pi(obj.roll - math.atan2(float(R[2, 1]), float(R[1, 1])))
-        e_reach = np.zeros(6)
-        e_reach[:3] = np.asarray(state.x_d, float)[:3] - gp
-        e_reach[3:] = cross3(R[:, 2], self._n_plane)
-        JJt = Jg @ Jg.T + P.damping**2 * np.eye(6)
-        Jpinv = Jg.T @ np.linalg.solve(JJt, np.eye(6))
-        share = P.reach_tracking if state.phase == "reach" else 1.0
-        out = {
-            "track": P.K_ap * Jpinv @ (share * S_DIAG * self.K_a1 * e_track),
-            "reach": P.K_ap * Jpinv @ ((1.0 - S_DIAG) * self.K_a2 * e_reach),
-            "damp": -P.K_av * np.asarray(qd, float),
-            "force": self.K_af * (J.T @ np.asarray(F, float)),
-        }
-        out["command"] = np.clip(sum(out.values()), -self.vlim, self.vlim)
-        out["x_a"] = gp
-        return out
 
     def telemetry(self, t: float) -> dict:
         return {TOPIC_GRASP_ARM: self._out} if self._out is not None else {}

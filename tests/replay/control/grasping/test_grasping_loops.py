@@ -27,6 +27,8 @@ from replay.messages import (
 )
 from replay.sensors.force import JointTorque, WristWrench  # noqa: E402
 
+from tests.replay.control.grasping.oracles import eq2_reference
+
 
 @pytest.fixture(scope="module")
 def spec():
@@ -183,7 +185,7 @@ def test_arm_task_kinematics_match_the_chains_fk_and_jacobian_over_random_postur
 
 def test_arm_task_eq2_matches_its_numpy_reference_over_random_inputs(spec):
     """The task's chain, grasp-point Jacobian, damped pseudo-inverse, J^T F and F^a against
-    eq. 2 written out in NumPy (``reference_command``), at seeded
+    eq. 2 written out in NumPy (``oracles.eq2_reference``), at seeded
     random postures, rates, objects, targets and wrenches: agreement within 1e-9 (rad/s, N)."""
     rng = np.random.default_rng(11)
     lo, hi = np.asarray(spec.lower), np.asarray(spec.upper)
@@ -220,7 +222,7 @@ def test_arm_task_eq2_matches_its_numpy_reference_over_random_inputs(spec):
         w_hand, r = task.hand.mass * task.g, R @ np.asarray(task.hand.com, float)
         F_ref = np.concatenate([R @ f1 - w_hand, R @ m1 - np.cross(r, w_hand)])
         good = np.allclose(out.wrench, F_ref, atol=1e-9, rtol=0.0)
-        ref = task.reference_command(q, qd, o, st, out.wrench)
+        ref = eq2_reference(task, q, qd, o, st, out.wrench)
         good &= np.allclose(cmd.arm, ref["command"], atol=1e-9, rtol=0.0)
         good &= np.allclose(out.x_a[:3], ref["x_a"], atol=1e-12, rtol=0.0)
         for name, term in out.terms.items():
