@@ -366,7 +366,7 @@ class StickCaptureController(Controller):
         if broke:
             self._on_break(t)
         if fresh and self.est.ready():
-            self._on_estimate(t)
+            self._on_estimate(t, self.est.current())
         self._command(t)
         self._check_capture(t)
         return self.model.target.command
@@ -557,8 +557,7 @@ class StickCaptureController(Controller):
             self.plan = None
             self.phase = "observe"
 
-    def _on_estimate(self, t: float) -> None:
-        est = self.est.estimate()
+    def _on_estimate(self, t: float, est: StickEstimate) -> None:
         p = self.params
         if self.phase in ("observe", "approach"):
             if self.plan is not None and est.t_ref > self.plan.t + p.detect_window:
@@ -584,7 +583,7 @@ class StickCaptureController(Controller):
             elif t < self.plan.t - p.freeze:
                 # staged routes too: a plan made from the few samples after a collision
                 # extrapolates a noisy velocity (e.g. 0.05 m/s from 6 samples: 2 cm in 0.4 s)
-                self._refine(t, est)
+                self._refine(t, est, self.plan)
         elif self.phase == "close":
             if (
                 self.close is not None
@@ -756,10 +755,9 @@ class StickCaptureController(Controller):
         self.step = self.n_steps + 1
         self.phase = "close"
 
-    def _refine(self, t: float, est: StickEstimate) -> None:
-        """Re-solve the committed crossing and finger with the new estimate; keep the old plan
-        when the refined one does not work."""
-        old = self.plan
+    def _refine(self, t: float, est: StickEstimate, old: ContactPlan) -> None:
+        """Re-solve the committed crossing and finger (``old``, the plan in force) with the new
+        estimate; keep the old plan when the refined one does not work."""
         options = self._contacts(est, old.index)
         ox, oy = sc.normal(old.sol.theta, old.sol.side)
         for sol in options:
@@ -856,7 +854,7 @@ class StickCaptureController(Controller):
         if self.phase != "close" or self.close is None or not self.est.ready():
             return
         p, hand = self.params, self.hand
-        est = self.est.estimate()
+        est = self.est.current()
         x, y, th = est.at(t)
         ok = (
             est.speed < p.capture_speed

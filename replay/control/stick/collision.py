@@ -238,7 +238,7 @@ def contact_options(
     for side in sides:
         if omega is not None:
             roots = f_omega(m, inertia, e, theta, side, u, omega)
-        else:
+        elif speed is not None:
             roots = f_v(m, inertia, e, theta, side, u, speed)
         roots = tuple(float(r) for r in roots)
         for r in roots:

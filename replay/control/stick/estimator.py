@@ -151,6 +151,12 @@ class StickEstimator:
         """The current fit (None before the first sample)."""
         return self._fit
 
+    def current(self) -> StickEstimate:
+        """The current fit, which :meth:`ready` promises."""
+        if self._fit is None:
+            raise RuntimeError("no samples yet")
+        return self._fit
+
     def predict(self, t: float) -> tuple[float, float, float]:
         """(x, y, theta) at ``t``, theta continuous."""
         if self._fit is None:
@@ -167,7 +173,7 @@ class StickEstimator:
 
     def _deviates(self, sample) -> bool:
         t, x, y, th = sample
-        px, py, pth = self._fit.at(t)
+        px, py, pth = self.current().at(t)
         return math.hypot(x - px, y - py) > self.pos_tol or abs(th - pth) > self.theta_tol
 
     def _append(self, sample) -> None:

@@ -55,9 +55,10 @@ class Config:
     @functools.cached_property
     def command(self) -> HandCommand:
         """This configuration as the plant's command (made once per configuration)."""
+        (a1, a2), (b1, b2) = self.joints  # the two fingers' (q1, q2)
         return HandCommand(
             base=(float(self.base[0]), float(self.base[1])),
-            joints=tuple((float(q[0]), float(q[1])) for q in self.joints),
+            joints=((float(a1), float(a2)), (float(b1), float(b2))),
         )
 
 

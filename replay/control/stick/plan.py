@@ -130,7 +130,7 @@ class ContactPlan:
             "contact": [float(x) for x in self.contact],
             "tip": [float(x) for x in self.tip],
             "clamped": self.clamped,
-            "r_x_solved": f * (self.raw_r_x if self.clamped else self.sol.r_x),
+            "r_x_solved": f * (self.raw_r_x if self.raw_r_x is not None else self.sol.r_x),
         }
 
 
