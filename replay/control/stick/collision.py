@@ -1,6 +1,7 @@
 """Friction independent collision of a stick with a fixed fingertip (Higashimori et al. 2007, Sec. II).
 
-Pure NumPy. Velocities u = [vx, vy, omega] of the stick's centre of mass in the reference frame
+Closed forms in floats (the matrix forms of eqs. 3-5, 9, 22 and 26 are the tests' oracles,
+tests/replay/control/stick/oracles.py). Velocities u = [vx, vy, omega] of the stick's centre of mass in the reference frame
 Sigma_R; theta is the stick's orientation (its x_B axis along the length); the contact point
 ^B r = [r_x, r_y] is in the stick frame Sigma_B. ``side`` = +1 for a fingertip touching from
 y_B >= 0 (^B r_y = +W/2), -1 from y_B <= 0 (^B r_y = -W/2).
@@ -11,15 +12,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
 from replay.robot.stick_impact import quadratic_roots as _roots
-
-
-def rotation(theta: float) -> np.ndarray:
-    """R_B(theta): the posture of Sigma_B in Sigma_R."""
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s], [s, c]])
 
 
 def normal(theta: float, side: int) -> tuple[float, float]:
@@ -28,26 +22,12 @@ def normal(theta: float, side: int) -> tuple[float, float]:
     return (s, -c) if side > 0 else (-s, c)
 
 
-def tangent_normal(theta: float, side: int) -> tuple[np.ndarray, np.ndarray]:
-    """s_i and n_i in Sigma_R (eqs. 3, 4): n_i points from the fingertip into the stick."""
-    c, s = math.cos(theta), math.sin(theta)
-    if side > 0:
-        return np.array([c, s]), np.array([s, -c])
-    return np.array([-c, -s]), np.array([-s, c])
-
-
-def contact_jacobian(theta: float, r_b) -> np.ndarray:
-    """H_i of eq. 5: v_C = H_i u (eqs. 6, 7), with [a x] = [-a_y, a_x]."""
-    a = rotation(theta) @ np.asarray(r_b, dtype=float)
-    return np.array([[1.0, 0.0, -a[1]], [0.0, 1.0, a[0]]])
-
-
 def _impulse_terms(
     m: float, inertia: float, theta: float, r_x: float, r_y: float, side: int
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """(g, h) with J_i = E_3 - (1 + e) g h^T (eq. 22), in closed form: h = H_i^T n_i and
     g = M^-1 H_i^T K_i^-1 n_i, M = diag(m, m, I) and K_i = H_i M^-1 H_i^T (eqs. 5, 9), K_i
-    inverted as a 2 x 2 (the matrix form is the reference in tests/.../test_stick_fast_paths)."""
+    inverted as a 2 x 2."""
     return _terms(m, inertia, math.cos(theta), math.sin(theta), r_x, r_y, side)
 
 
@@ -69,16 +49,6 @@ def _after(g, h, e: float, u) -> tuple[float, float, float]:
     """u_i = J_i u_{i-1} = u - (1 + e) g (h . u) (eq. 22)."""
     k = (1.0 + e) * (h[0] * u[0] + h[1] * u[1] + h[2] * u[2])
     return (u[0] - k * g[0], u[1] - k * g[1], u[2] - k * g[2])
-
-
-def collision_map(m: float, inertia: float, e: float, theta: float, r_b, side: int) -> np.ndarray:
-    """J_i of eq. 22: u_i = J_i u_{i-1}, valid under the friction independent condition (eq. 12).
-
-    J_i = E_3 - (1 + e) M^-1 H_i^T K_i^-1 n_i n_i^T H_i, with K_i = H_i M^-1 H_i^T (eq. 9)
-    (closed form: :func:`_impulse_terms`).
-    """
-    g, h = _impulse_terms(m, inertia, theta, float(r_b[0]), float(r_b[1]), side)
-    return np.eye(3) - (1.0 + e) * np.outer(g, h)
 
 
 def alpha(a) -> float:
@@ -146,21 +116,6 @@ def f_v(
     return _roots(a2, b2, c2)
 
 
-def axis_map(m: float, inertia: float, e: float, theta: float, r_x: float, side: int) -> np.ndarray:
-    """J_i (eq. 22) for a contact on the stick's axis, ^B r = [r_x, 0] (W ~ 0, Assumption 5)."""
-    return collision_map(m, inertia, e, theta, (r_x, 0.0), side)
-
-
-def contact_condition(
-    m: float, inertia: float, e: float, theta: float, r_x: float, side: int, u_prev
-) -> float:
-    """C_i of eq. 26: n_i^T H_i J_i u_{i-1}, the normal velocity of the contact point after the
-    collision; > 0 when it leaves the fingertip (then it approached before: C_i = -e n^T H u)."""
-    g, h = _impulse_terms(m, inertia, theta, r_x, 0.0, side)
-    after = _after(g, h, e, _u3(u_prev))
-    return h[0] * after[0] + h[1] * after[1] + h[2] * after[2]
-
-
 def approach_speed(theta: float, r_x: float, side: int, u_prev) -> float:
     """-n_i^T H_i u_{i-1}: how fast the contact point moves into the fingertip before (m/s)."""
     vx, vy, w = _u3(u_prev)
@@ -204,10 +159,6 @@ class ContactSolution:
     def within(self) -> bool:
         """|r_x| <= L/2 (always True when no length was given)."""
         return self.length is None or abs(self.r_x) <= 0.5 * self.length + 1e-12
-
-    def r_b(self, width: float = 0.0) -> np.ndarray:
-        """^B r_i = [r_x, side W/2]."""
-        return np.array([self.r_x, 0.5 * width * self.side])
 
 
 def contact_options(
@@ -255,31 +206,6 @@ def contact_options(
             sign = 1 if side > 0 else -1
             out.append(ContactSolution(theta, sign, r, u, after, roots, condition, length))
     return out
-
-
-def solve_contact(
-    m: float,
-    inertia: float,
-    e: float,
-    theta: float,
-    side: int,
-    u_prev,
-    *,
-    omega: float | None = None,
-    speed: float | None = None,
-    length: float | None = None,
-) -> ContactSolution | None:
-    """The r_x on ``side`` giving omega_i = ``omega`` (eq. 25) or V_i = ``speed`` (eq. 28) with
-    C_i > 0 (eq. 26), and the predicted u_i = J_i u_{i-1}; None when no root passes.
-
-    When both roots pass, the one with the smaller |r_x| (see :func:`contact_options` for both).
-    A root beyond the stick (|r_x| > L/2 for the given ``length``) is still returned with
-    ``within`` False: the caller reports it.
-    """
-    opts = contact_options(
-        m, inertia, e, theta, u_prev, omega=omega, speed=speed, length=length, sides=(side,)
-    )
-    return min(opts, key=lambda s: abs(s.r_x)) if opts else None
 
 
 def contact_at(

@@ -1,16 +1,74 @@
-"""The stick planner's array oracles: each fast scalar path of ContactPlanner
-(replay/control/stick/plan.py) written again in whole-array NumPy, the formulation it replaced,
-for the tests that hold the fast path to it (test_sweep_paths.py, test_stick_fast_paths.py).
-Test-only: the package keeps one implementation of each."""
+"""Test oracles for the stick method, each written the plain way the package's fast path
+replaced; the tests hold the fast path to them. Test-only: the package keeps one implementation.
+
+- Sec. II of Higashimori et al. in matrix form (eqs. 3-5, 9, 22, 26), against the closed forms of
+  replay/control/stick/collision.py.
+- ContactPlanner's scalar paths (replay/control/stick/plan.py) in whole-array NumPy
+  (test_sweep_paths.py, test_stick_fast_paths.py).
+"""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from replay.control.stick import collision as sc
 from replay.control.stick.hand_model import Config, route_configs, route_tips
 from replay.control.stick.plan import CONTACT_GUARD
 from replay.control.stick.sweep import Motion, Sweep, covered_along, sample_times
 from replay.robot import hand2d
+
+
+# -- Sec. II in matrix form -----------------------------------------------------------------
+def rotation(theta: float) -> np.ndarray:
+    """R_B(theta): the posture of Sigma_B in Sigma_R."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def tangent_normal(theta: float, side: int) -> tuple[np.ndarray, np.ndarray]:
+    """s_i and n_i in Sigma_R (eqs. 3, 4): n_i = R_B [0, -side] points into the stick."""
+    n = rotation(theta) @ np.array([0.0, -1.0 if side > 0 else 1.0])
+    return np.array([-n[1], n[0]]), n  # s_i = n_i turned by -90 degrees
+
+
+def contact_jacobian(theta: float, r_b) -> np.ndarray:
+    """H_i of eq. 5: v_C = H_i u (eqs. 6, 7), with [a x] = [-a_y, a_x]."""
+    a = rotation(theta) @ np.asarray(r_b, dtype=float)
+    return np.array([[1.0, 0.0, -a[1]], [0.0, 1.0, a[0]]])
+
+
+def collision_map(m: float, inertia: float, e: float, theta: float, r_b, side: int) -> np.ndarray:
+    """Eq. 22 as written: J_i = E_3 - (1 + e) M^-1 H^T K^-1 n n^T H, K = H M^-1 H^T (eq. 9)."""
+    M_inv = np.linalg.inv(np.diag([m, m, inertia]))
+    H = contact_jacobian(theta, r_b)
+    n = tangent_normal(theta, side)[1]
+    K = H @ M_inv @ H.T
+    return np.eye(3) - (1.0 + e) * M_inv @ H.T @ np.linalg.solve(K, np.outer(n, n) @ H)
+
+
+def axis_map(m: float, inertia: float, e: float, theta: float, r_x: float, side: int):
+    """J_i for a contact on the stick's axis, ^B r = [r_x, 0] (W ~ 0, Assumption 5)."""
+    return collision_map(m, inertia, e, theta, (r_x, 0.0), side)
+
+
+def contact_condition(m, inertia, e, theta, r_x, side, u_prev) -> float:
+    """C_i of eq. 26: n_i^T H_i J_i u_{i-1}, the contact point's normal velocity after."""
+    n = tangent_normal(theta, side)[1]
+    H = contact_jacobian(theta, (r_x, 0.0))
+    J = axis_map(m, inertia, e, theta, r_x, side)
+    return float(n @ H @ J @ np.asarray(u_prev, dtype=float))
+
+
+def solve_contact(m, inertia, e, theta, side, u_prev, **target) -> sc.ContactSolution | None:
+    """The package's solutions on one ``side`` (omega= or speed=, length=), the one with the
+    smaller |r_x| (None when no root passes eq. 26)."""
+    opts = sc.contact_options(m, inertia, e, theta, u_prev, sides=(side,), **target)
+    return min(opts, key=lambda sol: abs(sol.r_x)) if opts else None
+
+
+# -- ContactPlanner's scalar paths in whole-array NumPy -------------------------------------
 
 
 def route_clear(

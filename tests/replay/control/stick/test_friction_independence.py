@@ -23,14 +23,15 @@ import numpy as np
 import pytest
 
 from plants.airtable import AirTablePlant, Params
-from replay.control.stick.collision import (
-    alpha,
+from replay.control.stick.collision import alpha
+from replay.robot.hand2d import finger_ik
+
+from tests.replay.control.stick.oracles import (
     collision_map,
     contact_jacobian,
     rotation,
     tangent_normal,
 )
-from replay.robot.hand2d import finger_ik
 
 DT = 1.0 / 3000.0  # the scenarios' physics rate
 N_BEFORE = 30  # steps of free flight before the contact step

@@ -22,40 +22,23 @@ from tests.replay.control.stick import oracles
 from tests.replay.control.stick.test_stick_method import V0, SyntheticStick, air_spec
 
 
-def j_reference(m, inertia, e, theta, r_b, side):
-    """Eq. 22 as written: J = E_3 - (1 + e) M^-1 H^T K^-1 n n^T H, K = H M^-1 H^T (eq. 9)."""
-    M_inv = np.linalg.inv(np.diag([m, m, inertia]))
-    c, s = math.cos(theta), math.sin(theta)
-    a = np.array([[c, -s], [s, c]]) @ np.asarray(r_b, dtype=float)
-    H = np.array([[1.0, 0.0, -a[1]], [0.0, 1.0, a[0]]])
-    n = np.array([s, -c]) if side > 0 else np.array([-s, c])
-    K = H @ M_inv @ H.T
-    return np.eye(3) - (1.0 + e) * M_inv @ H.T @ np.linalg.solve(K, np.outer(n, n) @ H)
-
-
-def test_closed_form_collision_map_is_eq_22():
+def test_closed_form_collision_is_eq_22():
+    """contact_at's u_i and C_i (closed forms, floats) against eqs. 22 and 26 in matrix form."""
     rng = np.random.default_rng(10)
-    worst = 0.0
     for _ in range(500):
         m, inertia, e = rng.uniform(0.005, 0.2), rng.uniform(5e-6, 2e-4), rng.uniform(0.0, 1.0)
         theta, side = rng.uniform(-math.pi, math.pi), int(rng.choice([1, -1]))
-        r_b, u = rng.uniform(-0.06, 0.06, 2), rng.normal(size=3) * [1.0, 1.0, 10.0]
-        J_ref = j_reference(m, inertia, e, theta, r_b, side)
-        worst = max(
-            worst, float(np.abs(sc.collision_map(m, inertia, e, theta, r_b, side) - J_ref).max())
+        r_x, u = rng.uniform(-0.06, 0.06), rng.normal(size=3) * [1.0, 1.0, 10.0]
+        sol = sc.contact_at(m, inertia, e, theta, side, u, r_x)
+        J = oracles.axis_map(m, inertia, e, theta, r_x, side)
+        np.testing.assert_allclose(sol.u_after, J @ u, rtol=0, atol=1e-9 * (1 + abs(u).max()))
+        assert sol.condition == pytest.approx(
+            oracles.contact_condition(m, inertia, e, theta, r_x, side, u), abs=1e-9
         )
-        # C_i (eq. 26) and the approach speed with the contact on the axis
-        J_ax = j_reference(m, inertia, e, theta, (r_b[0], 0.0), side)
-        n = np.array(sc.normal(theta, side))
-        c, s = math.cos(theta), math.sin(theta)
-        H = np.array([[1.0, 0.0, -s * r_b[0]], [0.0, 1.0, c * r_b[0]]])
-        assert sc.contact_condition(m, inertia, e, theta, r_b[0], side, u) == pytest.approx(
-            float(n @ H @ J_ax @ u), abs=1e-9
-        )
-        assert sc.approach_speed(theta, r_b[0], side, u) == pytest.approx(
-            -float(n @ H @ u), abs=1e-12
-        )
-    assert worst < 1e-9
+        n = oracles.tangent_normal(theta, side)[1]
+        H = oracles.contact_jacobian(theta, (r_x, 0.0))
+        assert sc.approach_speed(theta, r_x, side, u) == pytest.approx(-float(n @ H @ u), abs=1e-12)
+        assert sc.normal(theta, side) == pytest.approx(tuple(n), abs=1e-15)
 
 
 def lstsq_fit(samples) -> tuple[np.ndarray, np.ndarray, float, float]:

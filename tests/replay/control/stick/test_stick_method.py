@@ -27,6 +27,8 @@ from replay.robot.hand2d import AirTableSpec, HandSpec, StickSpec
 from replay.interfaces import Controller
 from replay.messages import VisionStick
 
+from tests.replay.control.stick import oracles
+
 # Sec. IV-A: L = 100 mm, W = 10 mm, m = 22.5 g, I = 32.0e3 g mm^2, e = 0.19
 M, INERTIA, E, L, W = 0.0225, 3.2e-5, 0.19, 0.100, 0.010
 V0 = 1.1  # m/s, Fig. 7
@@ -34,7 +36,7 @@ OMEGA_1 = -10.0  # rad/s, Fig. 7
 
 
 def J(theta, r_x, side, u, m=M, inertia=INERTIA, e=E):
-    return sc.axis_map(m, inertia, e, theta, r_x, side) @ np.asarray(u, dtype=float)
+    return oracles.axis_map(m, inertia, e, theta, r_x, side) @ np.asarray(u, dtype=float)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -86,7 +88,7 @@ def test_f_v_roots_give_the_desired_speed(m, inertia, e, heading, speed, w, side
         after = J(theta, r, side, u, m, inertia, e)
         V = -float(np.dot(v / speed, after[:2]))  # eq. 27
         assert V == pytest.approx(v_d, abs=1e-7 * (1 + speed + abs(v_d)))
-        s, _ = sc.tangent_normal(theta, side)
+        s, _ = oracles.tangent_normal(theta, side)
         assert float(np.dot(s, after[:2])) == pytest.approx(0.0, abs=1e-9 * (1 + speed))  # eq. 17
 
 
@@ -96,7 +98,7 @@ def test_paper_b1_holds_for_the_upper_side_only():
     u = np.array([V0, 0.0, 9.9])
     theta = sc.alpha(u[:2])
     for side in (1, -1):
-        _, n = sc.tangent_normal(theta, side)
+        _, n = oracles.tangent_normal(theta, side)
         a1, b1, c1 = M * (0 + E * u[2]), -(1 + E) * M * float(n @ u[:2]), INERTIA * (0 - u[2])
         printed = sorted(np.roots([a1, b1, c1]).real)
         ours = sc.f_omega(M, INERTIA, E, theta, side, u, 0.0)
@@ -113,11 +115,12 @@ def test_side_enters_only_through_the_approach():
     theta = 0.4
     for r in (-0.04, 0.01, 0.03):
         assert np.allclose(
-            sc.axis_map(M, INERTIA, E, theta, r, 1), sc.axis_map(M, INERTIA, E, theta, r, -1)
+            oracles.axis_map(M, INERTIA, E, theta, r, 1),
+            oracles.axis_map(M, INERTIA, E, theta, r, -1),
         )
         assert np.allclose(
-            sc.axis_map(M, INERTIA, E, theta, r, 1),
-            sc.axis_map(M, INERTIA, E, theta + math.pi, -r, -1),
+            oracles.axis_map(M, INERTIA, E, theta, r, 1),
+            oracles.axis_map(M, INERTIA, E, theta + math.pi, -r, -1),
         )
         up, down = sc.approach_speed(theta, r, 1, u), sc.approach_speed(theta, r, -1, u)
         assert up == pytest.approx(-down)
@@ -129,27 +132,27 @@ def test_condition_c_picks_the_approaching_root():
     for side in (1, -1):
         roots = sc.f_omega(M, INERTIA, E, theta, side, u, 0.0)
         assert len(roots) == 2
-        cs = [sc.contact_condition(M, INERTIA, E, theta, r, side, u) for r in roots]
+        cs = [oracles.contact_condition(M, INERTIA, E, theta, r, side, u) for r in roots]
         ap = [sc.approach_speed(theta, r, side, u) for r in roots]
         for c, a in zip(cs, ap):
             assert c == pytest.approx(E * a)  # eq. 10: C = -e n^T v_C,before
         assert sum(c > 0 for c in cs) == 1  # one approaching root per side
-        sol = sc.solve_contact(M, INERTIA, E, theta, side, u, omega=0.0, length=L)
+        sol = oracles.solve_contact(M, INERTIA, E, theta, side, u, omega=0.0, length=L)
         assert sol.condition > 0 and sc.approach_speed(theta, sol.r_x, side, u) > 0
     # the contact point of the rejected root moves away from the fingertip before the collision
     bad = [
         r
         for r in sc.f_omega(M, INERTIA, E, theta, -1, u, 0.0)
-        if sc.contact_condition(M, INERTIA, E, theta, r, -1, u) <= 0
+        if oracles.contact_condition(M, INERTIA, E, theta, r, -1, u) <= 0
     ]
     assert bad and sc.approach_speed(theta, bad[0], -1, u) < 0
 
 
 def test_solve_contact_without_a_valid_root():
     # a stick at rest: nothing approaches any fingertip
-    assert sc.solve_contact(M, INERTIA, E, 0.3, 1, [0.0, 0.0, 0.0], omega=1.0) is None
+    assert oracles.solve_contact(M, INERTIA, E, 0.3, 1, [0.0, 0.0, 0.0], omega=1.0) is None
     with pytest.raises(ValueError):
-        sc.solve_contact(M, INERTIA, E, 0.3, 1, [1.0, 0.0, 0.0])
+        oracles.solve_contact(M, INERTIA, E, 0.3, 1, [1.0, 0.0, 0.0])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -241,7 +244,9 @@ def test_second_collision_distance_with_the_stated_numbers():
     d = si.pure_rotation_stop_distance(M, INERTIA, E)
     assert d == pytest.approx(0.0865, abs=5e-4)
     assert d > L / 2
-    sol = sc.solve_contact(M, INERTIA, E, math.pi / 2, 1, [0.0, 0.0, OMEGA_1], omega=0.0, length=L)
+    sol = oracles.solve_contact(
+        M, INERTIA, E, math.pi / 2, 1, [0.0, 0.0, OMEGA_1], omega=0.0, length=L
+    )
     assert abs(sol.r_x) == pytest.approx(d) and not sol.within
     # what the stated 48.7 mm would need: e = I / (m r^2) = 0.60 with the same m and I
     assert INERTIA / (M * 0.0487**2) == pytest.approx(0.60, abs=0.01)
@@ -371,9 +376,9 @@ def test_first_collision_is_planned_at_alpha_and_the_right_spot(cls, params):
     flip = 1 if round((th - expected.theta) / math.pi) % 2 == 0 else -1
     assert intent["r_x"] == pytest.approx(flip * expected.r_x, abs=1e-6)
     assert intent["r_y"] == pytest.approx(flip * expected.side * W / 2)
-    contact = np.array([x, y]) + sc.rotation(th) @ np.array([intent["r_x"], intent["r_y"]])
+    contact = np.array([x, y]) + oracles.rotation(th) @ np.array([intent["r_x"], intent["r_y"]])
     assert np.allclose(intent["contact"], contact, atol=1e-6)
-    _, n = sc.tangent_normal(th, intent["side"])
+    _, n = oracles.tangent_normal(th, intent["side"])
     assert np.allclose(intent["tip"], contact - spec.hand.tip_radius * n, atol=1e-6)
     assert np.allclose(intent["v_after"], expected.u_after[:2], atol=1e-6)
     assert intent["omega_after"] == pytest.approx(expected.u_after[2], abs=1e-6)
@@ -479,7 +484,7 @@ class IdealTable:
                     if sc.approach_speed(self.s[2], xb, side, self.s[3:]) > 1e-9:
                         self.collisions.append((t, k, xb, self.s[3:].copy(), self.ctrl.intent()))
                         self.s[3:] = (
-                            sc.axis_map(
+                            oracles.axis_map(
                                 stick.mass, stick.inertia, stick.restitution, self.s[2], xb, side
                             )
                             @ self.s[3:]
