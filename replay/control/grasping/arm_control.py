@@ -18,8 +18,8 @@
   mass and centre of mass, open posture) and the sensor's bias at start (tare), about the
   flange: the external wrench on the hand (N, N m).
 - No prediction of the object's motion: x^o is the latest measurement.
-- Per step: the chain and Jg (:meth:`ArmControlTask._chain`, floats; :meth:`kinematics` is its
-  NumPy reference), eq. 2's terms (:func:`eq2_terms`) and F^a (:func:`wrench_reference`,
+- Per step: the chain and Jg (:meth:`ArmControlTask._chain`, floats; held by the tests to the
+  chain's matrix products), eq. 2's terms (:func:`eq2_terms`) and F^a (:func:`wrench_step`,
   floats); eq. 2 written out in NumPy, the formula a seeded test holds the task's command to, is
   the tests' oracle (tests/replay/control/grasping/oracles.py).
 """
@@ -45,7 +45,7 @@ from replay.messages import (
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.hand import hand_body
-from replay.spatial import cross3, wrap_half_pi
+from replay.spatial import wrap_half_pi
 
 S_DIAG = np.array([0.0, 1.0, 1.0, 1.0, 0.0, 0.0])  # eq. 3
 # 1/s: the wrist force loop's rate at 1 ms, K^af r^2 k_h (0.3 rad/(s N m), ~0.6 m from the
@@ -67,7 +67,7 @@ def eq2_terms(Jg, J, n, lam2, b1, b2, qd, F, K_ap, K_av, K_af, vlim) -> tuple[li
     return tr[:, 0].tolist(), tr[:, 1].tolist(), damp.tolist(), force.tolist(), cmd.tolist()
 
 
-def wrench_reference(R, force, torque, w_hand, com, bias, filtered, a, deadband):
+def wrench_step(R, force, torque, w_hand, com, bias, filtered, a, deadband):
     """(ext, filtered, F): the wrist sensor's wrench turned into the world (R: the tool's
     rotation, row-major 9 floats) minus the hand's weight ``w_hand`` acting at R com, ext = (R f
     - w, R m - (R com) x w); ``bias`` None: this ext is the tare (the filter restarts at 0);
@@ -179,30 +179,24 @@ class ArmControlTask(Controller):
     def __init__(self, params: ArmParams, *, spec: GraspSpec) -> None:
         super().__init__(params, spec=spec)
         self.chain = spec.model
-        self.dh = [(r.alpha, r.a, r.d, r.theta_offset) for r in self.chain.dh]
-        # dh_transform's constant entries (alpha, a, d) per joint, filled once: a step only
-        # writes the cos/sin of theta (the same products as dh_transform's, so the same floats)
-        alpha = np.array([r[0] for r in self.dh])
-        self._a = np.array([r[1] for r in self.dh])
-        self._off = np.array([r[3] for r in self.dh])
-        self._ca, self._sa = np.cos(alpha), np.sin(alpha)
-        self._M = np.zeros((len(self.dh), 4, 4))
-        self._M[:, 2, 1], self._M[:, 2, 2] = self._sa, self._ca
-        self._M[:, 2, 3] = [r[2] for r in self.dh]
-        self._M[:, 3, 3] = 1.0
-        # the same as floats for the per-step chain (cos alpha, sin alpha, a, d, theta offset
-        # per joint; base and tool as their top 3 rows), the Jacobians a step fills (tool, grasp
-        # point; J also as rows of floats) and eq. 2's gains on the task vectors
-        n = self._n = len(self.dh)
+        # the chain as floats for the per-step products (cos alpha, sin alpha, a, d, theta
+        # offset per joint; base and tool as their top 3 rows), the Jacobians a step fills (tool,
+        # grasp point; J also as rows of floats) and eq. 2's gains on the task vectors
+        n = self._n = len(self.chain.dh)
         self._dh_f = [
-            (float(ca), float(sa), float(a), float(d), float(off))
-            for ca, sa, a, d, off in zip(self._ca, self._sa, self._a, self._M[:, 2, 3], self._off)
+            (
+                float(np.cos(r.alpha)),
+                float(np.sin(r.alpha)),
+                float(r.a),
+                float(r.d),
+                float(r.theta_offset),
+            )
+            for r in self.chain.dh
         ]
         self._base_f = np.asarray(self.chain.base, float)[:3].ravel().tolist()
         self._tool_f = np.asarray(self.chain.tool, float)[:3].ravel().tolist()
         self._J, self._Jg = np.zeros((6, n)), np.zeros((6, n))
         self._J_rows: list[list[float]] = [[0.0] * n for _ in range(6)]
-        self.tool = self.chain.tool
         if spec.plane is None or spec.hand is None:
             raise ValueError("arm control needs a plant with a hand and a constraint plane")
         self.n_plane = np.asarray(spec.plane.normal, float)
@@ -238,40 +232,11 @@ class ArmControlTask(Controller):
         self._out: ArmLoop | None = None
         self.track_sq: dict[str, list] = {}
 
-    def kinematics(self, q):
-        """(tool transform, 6 x n geometric Jacobian at the tool origin)."""
-        n = len(self.dh)
-        theta = np.asarray(q, float)[:n] + self._off
-        ct, st = np.cos(theta), np.sin(theta)
-        M = self._M  # every joint's dh_transform(alpha, a, d, q + offset)
-        M[:, 0, 0], M[:, 0, 1], M[:, 0, 2], M[:, 0, 3] = (
-            ct,
-            -st * self._ca,
-            st * self._sa,
-            self._a * ct,
-        )
-        M[:, 1, 0], M[:, 1, 1], M[:, 1, 2], M[:, 1, 3] = (
-            st,
-            ct * self._ca,
-            -ct * self._sa,
-            self._a * st,
-        )
-        T = self.chain.base
-        Z, O = np.empty((3, n)), np.empty((3, n))
-        for i in range(n):
-            Z[:, i] = T[:3, 2]
-            O[:, i] = T[:3, 3]
-            T = T @ M[i]
-        T = T @ self.tool
-        p = T[:3, 3]
-        J = np.vstack([cross3(Z, p[:, None] - O), Z])
-        return T, J
-
     def _chain(self, grasp_point: float) -> tuple[float, ...]:
         """(R row-major, p, grasp point g = p + grasp_point R[:, 2]) of the tool at ``self.q``;
         sets ``self._J`` (the tool's geometric Jacobian, rows vx vy vz wx wy wz) and
-        ``self._Jg`` (the grasp point's: v_g = v + w x (g - p)). :meth:`kinematics` in floats
-        (3 x 4 rigid transforms as 12 floats; the reference a seeded test holds it to)."""
+        ``self._Jg`` (the grasp point's: v_g = v + w x (g - p)). The chain's transforms in floats (3 x 4
+        rigid transforms as 12 floats), held by a seeded test to SerialChain.fk and .jacobian."""
         T = self._base_f
         Z, O = [], []
         for (ca, sa, a, d, off), q in zip(self._dh_f, self.q):
@@ -355,13 +320,13 @@ class ArmControlTask(Controller):
     def external_wrench(self, R) -> list[float]:
         """F^a (world, about the flange): the sensor's wrench minus the hand's gravity and
         inertial load m (g - a_com) (the sensor reads m g - m a + F_ext; a_com from the arm's
-        kinematics: :meth:`hand_acceleration`), low-passed, zero within the deadband (compiled). ``R``: the tool's rotation, row-major
+        kinematics: :meth:`hand_acceleration`), low-passed, zero within the deadband (:func:`wrench_step`). ``R``: the tool's rotation, row-major
         9 floats."""
         a = self.dt / (self.params.force_filter + self.dt)
         acc = self.hand_acceleration(R)
         m = self.hand.mass
         load = [m * (g - x) for g, x in zip(self._g, acc)]
-        ext, self.filtered, F = wrench_reference(
+        ext, self.filtered, F = wrench_step(
             R,
             self.wrench_raw.force,
             self.wrench_raw.torque,

@@ -62,7 +62,7 @@ _CIRC_PRE = [
 _CIRC_GRIP = [-0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80, 0.20, 1.20, 0.90, 0.80, 1.20, 0.90, 0.80]
 
 
-def eq4_reference(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax):
+def eq4_step(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax):
     """(theta_d^h, eq. 4's command clipped to +-vmax, max |theta_d^h - theta^h|) in floats, the
     task's per-step path (``grip`` None: theta_d^h = ``pre``)."""
     theta_d = list(pre) if grip is None else [p + c * (g - p) for p, g in zip(pre, grip)]
@@ -71,7 +71,7 @@ def eq4_reference(pre, grip, c, q, qd, load, K_hg, K_hv, K_hf, vmax):
     return theta_d, cmd, max(abs(td - x) for td, x in zip(theta_d, q))
 
 
-def lowpass_reference(load, torque, a) -> list[float]:
+def lowpass_step(load, torque, a) -> list[float]:
     """F^h (minus the drive's torque) first-order low-passed with gain ``a``: x + a (-tau - x)
     per joint."""
     return [x + a * (-t - x) for x, t in zip(load, torque)]
@@ -248,7 +248,7 @@ class HandControlTask(Controller):
                 if self._tare is None:
                     self._tare = list(m.torque)
                 tau = [x - x0 for x, x0 in zip(m.torque, self._tare)]
-                self.load = lowpass_reference(self.load, tau, a)
+                self.load = lowpass_step(self.load, tau, a)
             elif topic == TOPIC_GRASP_OBJECT:
                 self.shape = m.shape
                 if m.found and m.size and self.state is not None and self.state.phase == "track":
@@ -291,7 +291,7 @@ class HandControlTask(Controller):
         elif st.phase == "hold":
             c = 1.0
             vmax = min(vmax, P.touch_speed)
-        theta_d, cmd, deficit = eq4_reference(
+        theta_d, cmd, deficit = eq4_step(
             pre, grip, c, self.q, self.qd, self.load, self.K_hg, P.K_hv, self.K_hf, vmax
         )
         if st.phase == "hold":

@@ -1,5 +1,6 @@
-"""Eq. 2 of Namiki et al. 1999 written out in NumPy: the oracle the arm task's command is held to
-(test_grasping_loops.py). Moved out of the package: only the tests use it."""
+"""Oracles of the grasping arm task (test_grasping_loops.py), test-only: the arm's kinematics from
+the chain's matrix products, and eq. 2 of Namiki et al. 1999 written out in NumPy, against which
+the task's float paths and command are held."""
 
 from __future__ import annotations
 
@@ -11,11 +12,19 @@ from replay.control.grasping.arm_control import S_DIAG
 from replay.spatial import cross3, wrap_half_pi
 
 
+def kinematics(task, q) -> tuple[np.ndarray, np.ndarray]:
+    """(tool transform, 6 x n geometric Jacobian at the tool origin) of ``task``'s arm at ``q``,
+    from the chain's own matrix products (SerialChain.fk and .jacobian), against which the task's
+    per-step float chain (``ArmControlTask._chain``) is held."""
+    q = np.asarray(q, float)[: task.chain.n]
+    return task.chain.fk(q), task.chain.jacobian(q)
+
+
 def eq2_reference(task, q, qd, obj, state, F) -> dict[str, np.ndarray]:
     """Eq. 2's terms of ``task`` (an ArmControlTask) the NumPy way: ``F`` the external wrench
     as the task's ``external_wrench`` gives it."""
     P = task.params
-    T, J = task.kinematics(q)
+    T, J = kinematics(task, q)
     R = T[:3, :3]
     gp = T[:3, 3] + P.grasp_point * R[:, 2]
     r = gp - T[:3, 3]

@@ -27,7 +27,7 @@ from replay.messages import (
 )
 from replay.sensors.force import JointTorque, WristWrench  # noqa: E402
 
-from tests.replay.control.grasping.oracles import eq2_reference
+from tests.replay.control.grasping.oracles import eq2_reference, kinematics
 
 
 @pytest.fixture(scope="module")
@@ -64,8 +64,8 @@ def state(x_d, phase="track", s=0.0):
 
 def arm_velocity(spec, task, measurements):
     cmd = task.update(0.0, measurements)
-    _, J = task.kinematics(np.asarray(spec.initial_q))
-    T, _ = task.kinematics(np.asarray(spec.initial_q))
+    _, J = kinematics(task, np.asarray(spec.initial_q))
+    T, _ = kinematics(task, np.asarray(spec.initial_q))
     r = task.params.grasp_point * T[:3, 2]
     v = J[:3] @ cmd.arm + np.cross(J[3:] @ cmd.arm, r)  # the grasp point's velocity
     return v, J[3:] @ cmd.arm
@@ -75,7 +75,7 @@ def test_task_partition_tracks_in_the_plane_and_reaches_along_its_normal(spec):
     q0 = list(spec.initial_q)
     enc = JointState(0.0, list(spec.joint_names), q0, [0.0] * 7, [0.0] * 7)
     task = ArmControlTask(ArmParams(K_af=0.0, K_av=0.0), spec=spec)
-    T, _ = task.kinematics(np.asarray(q0))
+    T, _ = kinematics(task, np.asarray(q0))
     gp = T[:3, 3] + task.params.grasp_point * T[:3, 2]
     # the object 2 cm to +y and 5 cm beyond the hand along x; x_d^a at the hand: only y moves
     v, w = arm_velocity(
@@ -173,7 +173,7 @@ def test_arm_task_kinematics_match_the_chains_fk_and_jacobian_over_random_postur
     n = 50
     for _ in range(n):
         q = rng.uniform(lo, hi)
-        T, J = task.kinematics(q)
+        T, J = kinematics(task, q)
         T_ref = spec.model.fk(q)
         J_ref = spec.model.jacobian(q)
         ok += bool(
@@ -193,7 +193,7 @@ def test_arm_task_eq2_matches_its_numpy_reference_over_random_inputs(spec):
     for i in range(n):
         task = ArmControlTask(ArmParams(force_deadband=0.0, force_filter=0.0), spec=spec)
         q, qd = rng.uniform(lo, hi), rng.normal(0.0, 1.0, 7)
-        T, _ = task.kinematics(q)
+        T, _ = kinematics(task, q)
         gp = T[:3, 3] + task.params.grasp_point * T[:3, 2]
         roll = float(rng.uniform(-1.0, 1.0)) if i % 3 else None
         o = obj(gp + rng.normal(0.0, 0.05, 3), roll=roll, shape=("rectangle", "circle")[i % 2])
@@ -233,10 +233,10 @@ def test_arm_task_eq2_matches_its_numpy_reference_over_random_inputs(spec):
 
 
 def test_hand_task_eq4_and_lowpass_equal_the_numpy_formulas():
-    """``eq4_reference`` and ``lowpass_reference`` (the hand task's per-step path, in floats)
+    """``eq4_step`` and ``lowpass_step`` (the hand task's per-step path, in floats)
     against eq. 4 and the low-pass written in NumPy, over seeded random postures, rates, loads,
     closures and gains (some commands beyond the limit): equal within 1e-12."""
-    from replay.control.grasping.hand_control import eq4_reference, lowpass_reference
+    from replay.control.grasping.hand_control import eq4_step, lowpass_step
 
     rng = np.random.default_rng(14)
     ok = clipped = 0
@@ -251,8 +251,8 @@ def test_hand_task_eq4_and_lowpass_equal_the_numpy_formulas():
         td_ref = pre if g is None else pre + c * (grip - pre)
         cmd_ref = np.clip(K_hg * (td_ref - q) - K_hv * qd + K_hf * load, -vmax, vmax)
         args = (pre.tolist(), None if g is None else g.tolist(), c, q.tolist(), qd.tolist())
-        td, cmd, deficit = eq4_reference(*args, load.tolist(), K_hg, K_hv, K_hf, vmax)
-        low = lowpass_reference(load.tolist(), tau.tolist(), a)
+        td, cmd, deficit = eq4_step(*args, load.tolist(), K_hg, K_hv, K_hf, vmax)
+        low = lowpass_step(load.tolist(), tau.tolist(), a)
         ok += bool(
             np.allclose(td, td_ref, rtol=0.0, atol=1e-12)
             and np.allclose(cmd, cmd_ref, rtol=0.0, atol=1e-12)
@@ -272,7 +272,7 @@ def test_arm_wrench_below_the_deadband_is_zero_and_the_filter_lags(spec):
     for deadband, expect_zero in ((0.0, False), (50.0, True)):
         task = ArmControlTask(ArmParams(force_deadband=deadband, force_filter=0.009), spec=spec)
         # the hand hanging still reads its weight (palm frame): F^a = 0; then 10 N more
-        T, _ = task.kinematics(np.asarray(spec.initial_q))
+        T, _ = kinematics(task, np.asarray(spec.initial_q))
         R = T[:3, :3]
         w = task.hand.mass * task.g
         f_w = R.T @ w
@@ -306,7 +306,7 @@ def test_arm_wrench_removes_the_hands_inertial_load(spec):
         qd0, qd1 = rng.normal(0.0, 0.5, 7), rng.normal(0.0, 0.5, 7)
         extra = 5.0 if k % 2 else 0.0
         task = ArmControlTask(ArmParams(force_deadband=0.0, force_filter=0.0), spec=spec)
-        T, J = task.kinematics(q)
+        T, J = kinematics(task, q)
         R = T[:3, :3]
         r = R @ np.asarray(task.hand.com, float)
 
@@ -336,7 +336,7 @@ def test_hold_keeps_the_grasp_time_offset_instead_of_chasing(spec):
     q0 = list(spec.initial_q)
     enc = JointState(0.0, list(spec.joint_names), q0, [0.0] * 7, [0.0] * 7)
     task = ArmControlTask(ArmParams(K_af=0.0, K_av=0.0), spec=spec)
-    T, _ = task.kinematics(np.asarray(q0))
+    T, _ = kinematics(task, np.asarray(q0))
     gp = T[:3, 3] + task.params.grasp_point * T[:3, 2]
     hold = state(gp, phase="hold", s=1.0)
     v, _ = arm_velocity(
