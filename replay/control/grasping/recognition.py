@@ -29,7 +29,7 @@ from replay.interfaces import Controller, Occurrence
 from replay.messages import TOPIC_GRASP_OBJECT, TOPIC_HEAD_ENCODERS, TOPIC_VISION_CHIP
 from replay.params import param
 from replay.robot.arm_types import GraspSpec, ServoCommand
-from replay.robot.head import HeadSpec, camera_pose
+from replay.robot.head import HeadSpec
 from replay.spatial import wrap_half_pi
 
 HEAD_READINGS = 1024  # the head encoder readings kept at most: a chip latency up to ~1 s at 1 kHz
@@ -91,50 +91,14 @@ def plane_basis(normal) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 class Camera:
-    """The chip's pinhole model on the head: pixel rays and projections at given head angles."""
+    """The chip's pinhole model on the head: focal length ``f`` (pixels) and centre ``c``. (Its
+    rays, projections and image Jacobian in NumPy are the tests' oracle,
+    tests/replay/control/grasping/oracles.py; the task writes them out in floats.)"""
 
     def __init__(self, head: HeadSpec, fov: float, width: int, height: int) -> None:
         self.head = head
         self.f = (width / 2.0) / math.tan(fov / 2.0)
         self.c = np.array([(width - 1) / 2.0, (height - 1) / 2.0])
-
-    def ray(self, angles, pixel, pose=None) -> tuple[np.ndarray, np.ndarray]:
-        """(origin, direction) of the ray through ``pixel``; ``pose``: the camera pose at
-        ``angles`` if already known (``camera_pose(head, *angles)``)."""
-        R, o = pose if pose is not None else camera_pose(self.head, *angles)
-        d = R @ np.array([(pixel[0] - self.c[0]) / self.f, (pixel[1] - self.c[1]) / self.f, 1.0])
-        return o, d
-
-    def project(self, angles, point) -> np.ndarray:
-        R, o = camera_pose(self.head, *angles)
-        pc = R.T @ (np.asarray(point, float) - o)
-        return self.c + self.f * pc[:2] / pc[2]
-
-    def jacobian(self, angles, point, pose=None) -> np.ndarray:
-        """d pixel / d (pan, tilt) at ``angles`` for a fixed world point. The camera turns about
-        the head's centre h: about world z (pan) and the panned y axis (tilt, positive down), so
-        the point in the camera frame moves by -R^T (k x (X - h)) per radian about axis k."""
-        R, o = pose if pose is not None else camera_pose(self.head, *angles)
-        X = np.asarray(point, float)
-        pc = R.T @ (X - o)
-        r = X - np.asarray(self.head.position, float)
-        a = self.head.yaw + angles[0]
-        J = np.zeros((2, 2))
-        for i, k in enumerate(((0.0, 0.0, 1.0), (-math.sin(a), math.cos(a), 0.0))):
-            kxr = np.array(
-                [k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2], k[0] * r[1] - k[1] * r[0]]
-            )
-            d = -(R.T @ kxr)
-            J[:, i] = self.f * (d[:2] * pc[2] - pc[:2] * d[2]) / (pc[2] * pc[2])
-        return J
-
-
-def meet_plane(o, d, point, normal) -> np.ndarray | None:
-    denom = float(d @ normal)
-    if abs(denom) < 1e-12:
-        return None
-    s = float((np.asarray(point) - o) @ normal) / denom
-    return o + s * d if s > 0.0 else None
 
 
 class RecognitionTask(Controller):
@@ -267,8 +231,8 @@ class RecognitionTask(Controller):
         distance, J00, J01, J10, J11): X where that ray meets the constraint plane, axis =
         atan2(e . pv, e . pu) of e = X' - X, X' that of (u + cos phi, v + sin phi) (NaN if it
         misses), distance = |X - o|, J = d (u, v) / d (pan, tilt) of X. In floats, per frame:
-        Camera.ray, meet_plane and Camera.jacobian (NumPy, the reference a test holds it to)
-        with camera_pose's R and o written out."""
+        the pinhole ray, its meeting with the plane and the image Jacobian, with camera_pose's
+        R and o written out (a seeded test holds them to the NumPy forms)."""
         cam, h = self.camera, self._head_position
         f, (cx, cy) = cam.f, self._c
         a = cam.head.yaw + angles[0]

@@ -13,44 +13,20 @@ tests/replay/control/grasping/test_grasping_vision.py and stated in docs/graspin
 makes the algorithm work: 1 pixel a millisecond is fast (here ~13 mrad/ms, 10 m/s at 0.8 m).
 
 When the window holds nothing (the target lost, or the first frame), the whole image is the
-window: the algorithm re-acquires whatever is bright (:func:`track`).
+window: the algorithm re-acquires whatever is bright.
 
-:func:`track_rows` is the same on the chip's packed rows (``rows[v]`` an int whose bit ``u`` is
+:func:`track_rows` runs it on the chip's packed rows (``rows[v]`` an int whose bit ``u`` is
 pixel (u, v), as ``/vision/chip`` carries them): a row's dilation is a few shifts and ORs, like
-the PEs' neighbour exchange. The array functions are its reference.
+the PEs' neighbour exchange. (The same in NumPy arrays, as the equations above read, is the
+tests' oracle: tests/replay/control/grasping/oracles.py.)
 """
 
 from __future__ import annotations
 
-import numpy as np
-
-
-def dilate4(img: np.ndarray) -> np.ndarray:
-    """Binary dilation by one pixel with the 4-neighbourhood (the chip's PE grid)."""
-    out = img.copy()
-    out[1:, :] |= img[:-1, :]
-    out[:-1, :] |= img[1:, :]
-    out[:, 1:] |= img[:, :-1]
-    out[:, :-1] |= img[:, 1:]
-    return out
-
-
-def self_window(previous: np.ndarray, image: np.ndarray) -> np.ndarray:
-    """The new target image: ``dilate4(previous) & image``."""
-    return dilate4(previous) & image
-
-
-def track(previous: np.ndarray | None, image: np.ndarray) -> tuple[np.ndarray, bool]:
-    """(target, reacquired): Self Windowing, or the whole image when there is no previous target
-    (``reacquired`` is then True)."""
-    if previous is None or not previous.any():
-        return image.copy(), True
-    return self_window(previous, image), False
-
 
 def track_rows(previous: list[int] | None, rows: list[int], width: int) -> tuple[list[int], bool]:
-    """:func:`track` on packed rows (bit u of ``rows[v]`` = pixel (u, v)): (target rows,
-    reacquired)."""
+    """(target rows, reacquired): Self Windowing on packed rows (bit u of ``rows[v]`` = pixel
+    (u, v)), or the whole image when there is no previous target (``reacquired`` then True)."""
     if not previous or not any(previous):
         return list(rows), True
     mask = (1 << width) - 1

@@ -28,12 +28,7 @@ from replay.control.grasping.recognition import (
     RecognitionTask,  # noqa: E402
     shape_of,
 )
-from replay.control.grasping.self_window import (  # noqa: E402
-    dilate4,
-    self_window,
-    track,
-    track_rows,
-)
+from replay.control.grasping.self_window import track_rows  # noqa: E402
 from replay.messages import (
     TOPIC_GRASP_OBJECT,
     TOPIC_HEAD_ENCODERS,
@@ -45,6 +40,14 @@ from replay.messages import (
 from replay.robot.head import camera_pose, look_angles  # noqa: E402
 from replay.scene import Box, Scene, Sphere  # noqa: E402
 from replay.sensors.vision_chip import VisionChipParams, VisionChipSensor  # noqa: E402
+
+from tests.replay.control.grasping.oracles import (  # noqa: E402
+    NumpyCamera,
+    dilate4,
+    meet_plane,
+    self_window,
+    track,
+)
 
 FOV = math.radians(12.0)
 
@@ -272,10 +275,8 @@ def test_recognised_pose_and_jacobian_equal_the_numpy_camera_over_random_views(s
     """The task's x_o, roll, size and image Jacobian (its plane geometry) against the
     NumPy ``Camera`` (ray, meet_plane, jacobian) at the target's own moments, for seeded random
     boxes (rolled, off centre) and head angles off the line of sight: equal within 1e-9."""
-    from replay.control.grasping.recognition import Camera, meet_plane
-
     rng = np.random.default_rng(15)
-    cam = Camera(spec.head, FOV, 16, 16)
+    cam = NumpyCamera(spec.head, FOV, 16, 16)
     centre = np.array([0.75, 0.0, 0.55])
     ok, n = 0, 40
     for _ in range(n):
@@ -335,9 +336,7 @@ def test_head_loop_centres_the_target(spec):
 
 
 def test_image_jacobian_is_the_head_models(spec):
-    from replay.control.grasping.recognition import Camera
-
-    cam = Camera(spec.head, FOV, 16, 16)
+    cam = NumpyCamera(spec.head, FOV, 16, 16)
     X = np.array([0.75, 0.03, 0.52])
     a = np.array(look_angles(spec.head, X)) + [0.02, -0.03]
     J = cam.jacobian(a, X)
