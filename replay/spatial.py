@@ -104,12 +104,6 @@ def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
     return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
 
 
-def quaternion_yaw(q) -> float:
-    """Yaw (rad) of a rotation that is about +z only."""
-    qx, qy, qz, qw = q
-    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
-
-
 # ------------------------------------------------------------------ Viser's order [w, x, y, z]
 def xyzw_to_wxyz(q) -> tuple[float, float, float, float]:
     """[qx, qy, qz, qw] -> a unit [w, x, y, z]."""

@@ -568,11 +568,6 @@ class DirectMapping:
         G = np.eye(3) + np.einsum("njk,ji->nik", f.dm, self.A)
         return G @ np.linalg.inv(f.Jc)
 
-    def Fdot_rd(self, r, rd) -> np.ndarray:
-        """Fdot(r_o) r_o' (eq. 16): the part of qdd_d not due to r_o''."""
-        _, _, qdd, _ = self.evaluate(r, rd, np.zeros_like(np.atleast_2d(rd)))
-        return qdd
-
     def constraint(self, r0, rd0, p_start, pd_start=(0.0, 0.0, 0.0)):
         """C and the right-hand side of eq. 13 for the initial object state (r0, rd0).
 

@@ -14,9 +14,14 @@ from replay.robot.hand2d import AirTableSpec, HandCommand, finger_ik, finger_tip
 from replay.interfaces import Plant
 from replay.messages import FingersState, StickState, to_dict
 from replay.scene import Box, Cylinder
-from replay.spatial import quaternion_yaw
 
 DT = 1.0 / 3000.0
+
+
+def quaternion_yaw(q) -> float:
+    """Yaw (rad) of a rotation that is about +z only."""
+    qx, qy, qz, qw = q
+    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
 
 
 def far_stick_params(**initial) -> Params:
