@@ -3,6 +3,7 @@ directory (no checkout on the path), finds its scenarios, robot tables, claims a
 
 import os
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -20,33 +21,55 @@ def _sh(args, cwd, timeout=900, env=None):
     return r.stdout + r.stderr
 
 
+def _sources(base: Path) -> Path:
+    """A copy of the checkout (its .git too: the wheel records the commit): no build/ of an
+    earlier build (setuptools would reuse its stale files, e.g. a removed sweep), no in-place
+    .so files, no venv."""
+    skip = shutil.ignore_patterns(
+        ".venv", "build", "out", "*.egg-info", "*.so", "*.pyd", "__pycache__"
+    )
+    shutil.copytree(ROOT, base / "src", ignore=skip)
+    return base / "src"
+
+
+def _venv_with_this_interpreters_packages(venv: Path) -> Path:
+    """A venv without pip whose site-packages also sees this interpreter's (the dependencies:
+    installing them again from the index took ~70 s of the suite), returning its site-packages;
+    that folder's own .pth files are not read, so the checkout's editable install stays out."""
+    _sh([sys.executable, "-m", "venv", "--without-pip", venv], cwd=venv.parent)
+    site = next((venv / "lib").glob("python3*/site-packages"))
+    here = next(p for p in sys.path if p.endswith("site-packages"))
+    (site / "deps.pth").write_text(here + "\n")
+    return site
+
+
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory):
+    """The wheel (with its accelerator) installed in a fresh venv: (its ``replay`` command, an
+    empty folder, the environment)."""
     base = tmp_path_factory.mktemp("wheel")
     dist, venv, work = base / "dist", base / "venv", base / "empty"
     work.mkdir()
     _sh(
-        [
-            sys.executable,
-            "-m",
-            "pip",
-            "wheel",
-            "-q",
-            "--no-deps",
-            "--no-build-isolation",
-            "-w",
-            dist,
-            ROOT,
-        ],
+        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation"]
+        + ["-w", dist, _sources(base)],
         cwd=base,
     )
     wheel = next(dist.glob("paper_replay-*.whl"))
     # (no PYTHONPATH: a checkout on it, with the egg-info the wheel build leaves there, would
     # make pip take the package as installed already)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
-    _sh([sys.executable, "-m", "venv", venv], cwd=base, env=env)
-    _sh([venv / "bin" / "python", "-m", "pip", "install", "-q", wheel], cwd=base, env=env)
-    return venv / "bin" / "replay", work, env
+    site = _venv_with_this_interpreters_packages(venv)
+    _sh([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", site, wheel], base)
+    # the console script pip writes from the wheel's entry point, for this venv's python
+    script = venv / "bin" / "replay"
+    script.write_text(f"#!{venv / 'bin' / 'python'}\nfrom replay.entry import main\nmain()\n")
+    script.chmod(0o755)
+    probe = "import replay, analysis, plants; print(replay.__file__, analysis.__file__)"
+    assert all(
+        str(site) in p for p in _sh([venv / "bin" / "python", "-c", probe], work, env=env).split()
+    )
+    return script, work, env
 
 
 def test_the_wheel_ships_its_data(installed):
@@ -121,7 +144,6 @@ def test_a_user_scenario_builds_on_a_shipped_one(installed):
 def test_a_controller_from_a_file_runs_and_its_log_is_analysed_elsewhere(installed, tmp_path):
     """examples/my_controller.py beside its scenario in a user's folder (no packaging); the log
     then read by figures, claims and report from a folder where that file is absent."""
-    import shutil
 
     replay, _, env = installed
     mine, other = tmp_path / "mine", tmp_path / "other"
@@ -142,17 +164,11 @@ def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_pa
     """``CC=/bin/false``: every accelerator fails to build and is left out (setup.py), the
     wheel still builds, holds no compiled module, and one short run of each paper, ``replay
     claims`` and ``replay report`` work on the pure-Python paths."""
-    import shutil
     import zipfile
 
     dist, venv, work = tmp_path / "dist", tmp_path / "venv", tmp_path / "empty"
     work.mkdir()
-    # the sources alone (no build/ of an earlier build, no in-place .so files)
-    src = tmp_path / "src"
-    skip = shutil.ignore_patterns(
-        ".git", ".venv", "build", "out", "*.egg-info", "*.so", "*.pyd", "__pycache__"
-    )
-    shutil.copytree(ROOT, src, ignore=skip)
+    src = _sources(tmp_path)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     out = _sh(
         [sys.executable, "-m", "pip", "wheel", "-v", "--no-deps", "--no-build-isolation"]
@@ -164,11 +180,7 @@ def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_pa
     wheel = next(dist.glob("paper_replay-*.whl"))
     compiled = [n for n in zipfile.ZipFile(wheel).namelist() if n.endswith((".so", ".pyd"))]
     assert compiled == []
-    # the dependencies from this interpreter's site-packages: only the package is new
-    _sh([sys.executable, "-m", "venv", "--without-pip", venv], cwd=tmp_path)
-    site = next((venv / "lib").glob("python3*/site-packages"))
-    here = next(p for p in sys.path if p.endswith("site-packages"))
-    (site / "deps.pth").write_text(here + "\n")
+    site = _venv_with_this_interpreters_packages(venv)  # only the package is new
     _sh([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", site, wheel], work)
 
     def replay(*args) -> str:
