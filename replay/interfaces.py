@@ -112,7 +112,7 @@ class Plant(ABC):
 
 class Sensor(ABC):
     Params: ClassVar[type]
-    topic: ClassVar[str]
+    topic: str  # a class default; an instance may publish on its params' ``topic``
     description: ClassVar[str] = ""
     spec_type: ClassVar[type | None] = None  # the plant spec it needs, or None
 

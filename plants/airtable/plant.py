@@ -43,7 +43,7 @@ from replay.spatial import yaw_quaternion
 
 from plants.airtable import body_state, settings, throw
 from plants.airtable.hand import HandServo
-from plants.airtable.params import Params
+from plants.airtable.params import Params as AirTableParams
 
 STICK_TYPE = 1
 TIP_TYPE = 2
@@ -57,7 +57,7 @@ def _vec(v) -> list[float]:
 class AirTablePlant(Plant):
     """Stick on an air table and a two-fingered hand on an XY slider (Pymunk)."""
 
-    Params = Params
+    Params = AirTableParams
     spec_type = AirTableSpec
     command_types = (HandCommand,)
     description = (
@@ -66,9 +66,13 @@ class AirTablePlant(Plant):
     )
 
     def __init__(
-        self, params: Params | None = None, *, dt: float, rng: np.random.Generator | None = None
+        self,
+        params: AirTableParams | None = None,
+        *,
+        dt: float,
+        rng: np.random.Generator | None = None,
     ) -> None:
-        params = params if params is not None else Params()
+        params = params if params is not None else AirTableParams()
         super().__init__(params, dt=dt, rng=rng if rng is not None else np.random.default_rng(0))
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
@@ -95,6 +99,7 @@ class AirTablePlant(Plant):
         body.velocity = (init["vx"], init["vy"])
         body.angular_velocity = init["omega"]
         half = st.length / 2.0
+        shape: pymunk.Shape
         if st.collision_width > 0.0:
             shape = pymunk.Poly.create_box(body, (st.length, st.collision_width), radius=0.0)
         else:
@@ -109,7 +114,7 @@ class AirTablePlant(Plant):
 
         # The fingertips: kinematic discs (infinite mass, Assumption 8).
         self.tip_bodies: list[pymunk.Body] = []
-        self.tip_shapes: list[pymunk.Circle] = []
+        self.tip_shapes: list[pymunk.Shape] = []  # discs, found by the arbiter's shapes
         for k, tip in enumerate(self.hand.tips()):
             tb = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
             tb.position = (float(tip[0]), float(tip[1]))

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import viser
 
 from plants.airtable.params import Params
 from plants.airtable.settings import hand_spec
@@ -154,8 +155,8 @@ class AirTableScene(RunScene):
                 visible=False,
             )
         )
-        self.fingers = None
-        self.markers = []
+        self.fingers: viser.LineSegmentsHandle | None = None
+        self.markers: list[tuple[float, viser.IcosphereHandle]] = []  # (time, marker)
         for e in self.run.events:
             c = (e.get("data") or {}).get("contact")
             if e.get("kind") == "collision" and isinstance(c, list) and len(c) == 2:
@@ -200,7 +201,7 @@ class AirTableScene(RunScene):
         st = run.track(TOPIC_STICK_STATE)
         i = st.index(t) if st is not None else -1
         self.stick.visible = i >= 0
-        if i >= 0:
+        if st is not None and i >= 0:
             x, y, th = (float(st.fields[k][i]) for k in ("x", "y", "theta"))
             self.stick.position = (x, y, 0.0)
             self.stick.wxyz = yaw_wxyz(th)
@@ -213,7 +214,7 @@ class AirTableScene(RunScene):
         vs = run.track(TOPIC_VISION_STICK)
         j = vs.index(t) if vs is not None else -1
         self.vision.visible = j >= 0
-        if j >= 0:
+        if vs is not None and j >= 0:
             self.vision.position = (
                 float(vs.fields["x"][j]),
                 float(vs.fields["y"][j]),
@@ -224,13 +225,13 @@ class AirTableScene(RunScene):
         j = fi.index(t) if fi is not None and fi.has("tips") else -1
         for k, tip in enumerate(self.tips):
             tip.visible = j >= 0
-            if j >= 0:
+            if fi is not None and j >= 0:
                 x, y = fi.fields["tips"][j, k]
                 tip.position = (float(x), float(y), g.tip_height / 2.0)
         hs = run.track(TOPIC_HAND_STATE)
         j = hs.index(t) if hs is not None and hs.has("base") and hs.has("joints") else -1
         self.base.visible = j >= 0
-        if j >= 0:
+        if hs is not None and j >= 0:
             base = hs.fields["base"][j]
             pts = g.finger_points(base, hs.fields["joints"][j])
             z = g.tip_height

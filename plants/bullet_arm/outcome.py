@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 
@@ -70,7 +71,7 @@ class CatchWatch:
         palm_quat,
         palm_vel,
         palm_omega,
-        parts: list,
+        parts: Sequence[str],
         caught: bool,
     ) -> None:
         """One step: the object's and the palm's state (world) and the parts touching now.

@@ -13,7 +13,7 @@ class AppliedTorque:
 
     t: float
     name: list[str]
-    commanded: list[float]
+    commanded: list[float | None]  # None: a non-finite command (no torque applied)
     applied: list[float]
     clamped: list[bool]  # bool per joint: the command was cut to the torque/velocity limit
 

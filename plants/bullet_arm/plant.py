@@ -22,7 +22,7 @@ import numpy as np
 from plants.bullet_arm.arm_state import TorqueLimits, joint_state, limit_flags
 from plants.bullet_arm.impulse import ImpulseSchedule
 from plants.bullet_arm.outcome import CatchWatch
-from plants.bullet_arm.params import Params
+from plants.bullet_arm.params import Params as ArmParams
 from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
 from plants.bullet_arm.reach import robot_reach
@@ -42,7 +42,7 @@ from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
 from replay.robot.hand import hand_mass
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
-from replay.scene import Box, Frame, Scene, Sphere
+from replay.scene import Box, Frame, Primitive, Scene, Sphere
 
 from plants.bullet_arm.engine import bullet_client
 from plants.bullet_arm.engine import pybullet as p
@@ -57,6 +57,12 @@ PER_STEP_CALLS = (
     "changeConstraint",
     "getConstraintState",
 )
+
+
+def _vec3(values) -> tuple[float, float, float]:
+    """Three numbers as a tuple of floats (a scene primitive's or a frame's position, a size)."""
+    x, y, z = values
+    return float(x), float(y), float(z)
 
 
 def _floats(values, n: int, what: str) -> list[float]:
@@ -74,13 +80,13 @@ def _floats(values, n: int, what: str) -> list[float]:
 
 
 class BulletArmPlant(TorqueLimits, Plant):
-    Params = Params
+    Params = ArmParams
     spec_type = ArmSpec
     command_types = (ArmCommand,)
     description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"
     hold_event = "catch"  # the event kind of "held by the hand" (the grasping rig: "grasp")
 
-    def __init__(self, params: Params, *, dt: float, rng: np.random.Generator) -> None:
+    def __init__(self, params: ArmParams, *, dt: float, rng: np.random.Generator) -> None:
         super().__init__(params, dt=dt, rng=rng)
         P = params
         S = self.settings = resolve(P)  # every default worked out (also for the viewer)
@@ -126,7 +132,8 @@ class BulletArmPlant(TorqueLimits, Plant):
         self._parent_link = [
             int(bc.getJointInfo(self.robot, j)[16]) for j in range(bc.getNumJoints(self.robot))
         ]
-        self._base_pose = (tuple(float(x) for x in P.base_position), tuple(orn))
+        qx, qy, qz, qw = orn
+        self._base_pose = (_vec3(P.base_position), (qx, qy, qz, qw))
         self._all_links = list(range(len(self._parent_link)))
         self.active = tuple(i for i, n in enumerate(names) if n not in self.locked)
         self._arm_j = [self._jidx[names[i]] for i in self.active]
@@ -243,13 +250,14 @@ class BulletArmPlant(TorqueLimits, Plant):
         self._lower_l, self._upper_l = self._lower_in.tolist(), self._upper_in.tolist()
         self._locked_l = [n in self.locked for n in self.joint_names]
         self._enforce_vlim = bool(P.enforce_velocity_limits)
-        self._contact_summary = (None, (), (), 0.0)  # (contacts list it is of, parts, links, N)
+        # (the contacts list it is of, parts, links, N)
+        self._contact_summary: tuple[list | None, tuple, tuple, float] = (None, (), (), 0.0)
         self._contact_key: tuple = ()  # the touching links of the last summary, and their names
         self._contact_names: tuple = ((), ())
         # the scene's primitive sizes as floats, once
         self._obj_radius = float(P.object_radius)
         self._obj_albedo = float(P.object_albedo)
-        self._obj_size = tuple(float(s) for s in P.object_size)
+        self._obj_size = _vec3(P.object_size)
         self._torque_episode = [False] * dof
         self._obj_vel_before = (
             tuple(float(x) for x in P.object_velocity) if self.obj is not None else (0.0,) * 3
@@ -263,7 +271,8 @@ class BulletArmPlant(TorqueLimits, Plant):
         )
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
         self._cache: tuple | None = None
-        self._effector = None  # (step, the tool link's state): read at most once a step
+        # (step, the tool link's state): read at most once a step
+        self._effector: tuple[int, tuple] | None = None
         self._spec = self._make_spec(q0)
         ht = self.hand_table  # the catch verdict (outcome.py): a free object and a hand
         self._watch = (
@@ -366,7 +375,8 @@ class BulletArmPlant(TorqueLimits, Plant):
         return np.array(q), np.array(qd)
 
     def hand_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return tuple(np.array(a, dtype=float) for a in self._state()[1])
+        q, qd, effort = self._state()[1]
+        return np.array(q, dtype=float), np.array(qd, dtype=float), np.array(effort, dtype=float)
 
     def object_state(self):
         return tuple(np.array(a) for a in self._state()[2])
@@ -541,7 +551,7 @@ class BulletArmPlant(TorqueLimits, Plant):
                     self._events.append(Occurrence("nan", {"step": self._steps}))
                 return
             self._limit_events(ql, qdl, over, at)
-        if obj is None:
+        if pos is None or v is None:  # no object
             return
         contacts = self._robot_contacts(pos, v)
         self._contacts = contacts
@@ -696,7 +706,7 @@ class BulletArmPlant(TorqueLimits, Plant):
 
     def scene(self) -> Scene:
         (q, qd), _, obj = self._state()
-        prims = []
+        prims: list[Primitive] = []
         if obj is not None:
             P = self.params
             if P.object == "ball":

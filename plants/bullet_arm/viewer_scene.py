@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
+import viser
 
 from plants.bullet_arm.params import Params
 from plants.bullet_arm.settings import resolve
@@ -28,6 +29,12 @@ from replay.spatial import rpy_to_wxyz, xyzw_to_wxyz
 from replay.viewer.data import RunData, Track
 from replay.viewer.errors import ViewerError
 from replay.viewer.scenes import PlotSeries, PlotSpec, RunScene
+
+
+def _xyz(v) -> tuple[float, float, float]:
+    """A 3-vector as three floats (viser's positions and sizes)."""
+    x, y, z = v
+    return float(x), float(y), float(z)
 
 
 def plant_models_urdf(p: dict, params_cls: type = Params) -> Path:
@@ -109,14 +116,16 @@ class ArmScene(RunScene):
                 )
             )
         self.urdf = None
-        self.urdf_color: tuple | None = None  # the arm's colour override (RGBA, 0-1)
+        self.urdf_color: tuple[float, float, float, float] | None = (
+            None  # the arm's colour (RGBA, 0-1)
+        )
         self._names: tuple[str, ...] = ()
         self._maps: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._add(
             sc.add_frame(  # the base plate's pose; the URDF hangs here
                 f"{r}/arm",
                 show_axes=False,
-                position=tuple(float(v) for v in p.base_position),
+                position=_xyz(p.base_position),
                 wxyz=rpy_to_wxyz(p.base_rpy),
             )
         )
@@ -124,7 +133,8 @@ class ArmScene(RunScene):
             try:
                 path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
                 opacity = 0.5 if self.ghost else 1.0  # overlaid: every run in its colour
-                override = None if not self.tint else (*(c / 255 for c in self.color), opacity)
+                red, green, blue = (c / 255 for c in self.color)
+                override = None if not self.tint else (red, green, blue, opacity)
                 self.urdf_color = override
                 self.urdf = ViserUrdf(
                     self.server, path, root_node_name=f"{r}/arm", mesh_color_override=override
@@ -143,7 +153,7 @@ class ArmScene(RunScene):
                 sc.add_box(
                     f"{r}/object",
                     color=color,
-                    dimensions=tuple(float(s) for s in p.object_size),
+                    dimensions=_xyz(p.object_size),
                     opacity=0.6 if self.ghost else None,
                     visible=False,
                 )
@@ -171,7 +181,7 @@ class ArmScene(RunScene):
                 visible=False,
             )
         )
-        self.markers = []
+        self.markers: list[tuple[float, viser.IcosphereHandle]] = []  # (time, marker)
         for e in self.run.events:
             pos = (e.get("data") or {}).get("position")
             if isinstance(pos, list) and len(pos) == 3:
@@ -181,7 +191,7 @@ class ArmScene(RunScene):
                         radius=0.012,
                         color=(220, 30, 30) if e.get("kind") != "catch" else (30, 180, 60),
                         opacity=0.7,
-                        position=tuple(float(v) for v in pos),
+                        position=_xyz(pos),
                         visible=False,
                     )
                 )
@@ -244,6 +254,17 @@ class ArmScene(RunScene):
                 slots.append(self._names.index(n))
         return np.array(cols, dtype=int), np.array(slots, dtype=int)
 
+    @staticmethod
+    def _goal(ef: Track | None, t: float) -> tuple[float, float, float] | None:
+        """The effector's commanded position at ``t`` (finite, 3-D), or None."""
+        if ef is None or not ef.has("desired_position"):
+            return None
+        j = ef.index(t)
+        goal = ef.fields["desired_position"]
+        if j < 0 or goal.shape[1:] != (3,) or not np.all(np.isfinite(goal[j])):
+            return None
+        return _xyz(goal[j])
+
     def update(self, run: RunData, t: float) -> None:
         if self.urdf is not None:
             changed = False
@@ -265,7 +286,7 @@ class ArmScene(RunScene):
         ob = run.track(TOPIC_OBJECT_STATE)
         i = ob.index(t) if ob is not None and ob.has("position") else -1
         self.body.visible = i >= 0
-        if i >= 0:
+        if ob is not None and i >= 0:
             self.body.position = tuple(float(v) for v in ob.fields["position"][i])
             if ob.has("orientation"):
                 self.body.wxyz = xyzw_to_wxyz(ob.fields["orientation"][i])
@@ -275,18 +296,12 @@ class ArmScene(RunScene):
         vo = run.track(TOPIC_VISION_OBJECT)
         j = vo.index(t) if vo is not None and vo.has("position") else -1
         self.seen.visible = j >= 0
-        if j >= 0:
+        if vo is not None and j >= 0:
             self.seen.position = tuple(float(v) for v in vo.fields["position"][j])
-        ef = run.track(TOPIC_EFFECTOR_STATE)
-        j = ef.index(t) if ef is not None and ef.has("desired_position") else -1
-        ok = (
-            j >= 0
-            and ef.fields["desired_position"].shape[1:] == (3,)
-            and bool(np.all(np.isfinite(ef.fields["desired_position"][j])))
-        )
-        self.target.visible = ok
-        if ok:
-            self.target.position = tuple(float(v) for v in ef.fields["desired_position"][j])
+        goal = self._goal(run.track(TOPIC_EFFECTOR_STATE), t)
+        self.target.visible = goal is not None
+        if goal is not None:
+            self.target.position = goal
         for te, h in self.markers:
             h.visible = t >= te
 

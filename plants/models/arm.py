@@ -108,7 +108,8 @@ def build_arm(
     col = segment_cylinder(
         (0.0, 0.0, 0.02), (0.0, 0.0, h - 0.1), 0.06, rgba=_ARM_RGBA, material="wam_grey"
     )
-    base_geo.append(col)
+    if col is not None:  # None only if the column has no length
+        base_geo.append(col)
     links.append(Link("wam_base", None, base_geo))
     arm_links = []
     parent, origin = "wam_base", transform(translation=(0.0, 0.0, h))

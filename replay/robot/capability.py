@@ -17,7 +17,7 @@ import numpy as np
 from replay.robot.serial_chain import SerialChain, active_block
 
 
-def _vertices(limits: Sequence[float]) -> np.ndarray:
+def _vertices(limits: np.ndarray) -> np.ndarray:
     return np.array(list(itertools.product(*[(-float(l), float(l)) for l in limits])))
 
 

@@ -112,7 +112,7 @@ def cylinder_inertia(mass: float, radius: float, length: float) -> np.ndarray:
 def palm_body(hand: HandTable) -> RigidBody:
     """The palm's mass properties in the palm frame."""
     sx, sy, sz = hand.palm_size
-    com = (0.0, 0.0, sz / 2.0)
+    com = np.array([0.0, 0.0, sz / 2.0])
     if hand.palm_shape == "cylinder":
         return RigidBody(hand.palm_mass, com, cylinder_inertia(hand.palm_mass, sx, sz))
     return RigidBody(hand.palm_mass, com, box_inertia(hand.palm_mass, hand.palm_size))
@@ -122,9 +122,11 @@ def link_body(j: HandJoint) -> RigidBody:
     """A finger link's mass properties in its joint frame (a uniform box along z)."""
     if j.length <= 0.0:  # a knuckle without length: a small cube
         w = j.width
-        return RigidBody(j.mass, (0.0, 0.0, 0.0), box_inertia(j.mass, (w, w, w)))
+        return RigidBody(j.mass, np.zeros(3), box_inertia(j.mass, (w, w, w)))
     return RigidBody(
-        j.mass, (0.0, 0.0, j.length / 2.0), box_inertia(j.mass, (j.width, j.width, j.length))
+        j.mass,
+        np.array([0.0, 0.0, j.length / 2.0]),
+        box_inertia(j.mass, (j.width, j.width, j.length)),
     )
 
 

@@ -91,7 +91,7 @@ class SerialChain:
         *,
         base: np.ndarray | None = None,
         tool: np.ndarray | None = None,
-        gravity: Sequence[float] = (0.0, 0.0, -9.81),
+        gravity: Sequence[float] | np.ndarray = (0.0, 0.0, -9.81),
         joint_names: Sequence[str] | None = None,
     ) -> None:
         if len(dh) != len(links):
@@ -261,11 +261,11 @@ class SerialChain:
         return p, v + np.cross(w, r), a + np.cross(dw, r) + np.cross(w, np.cross(w, r))
 
     # ------------------------------------------------------------------ dynamics
-    def rnea(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> np.ndarray:
+    def rnea(self, q, qd, qdd, gravity: Sequence[float] | np.ndarray | None = None) -> np.ndarray:
         """Inverse dynamics tau = M qdd + H qd + g (n,): :meth:`rnea_tuple` as an array."""
         return np.array(self.rnea_tuple(q, qd, qdd, gravity))
 
-    def rnea_tuple(self, q, qd, qdd, gravity: Sequence[float] | None = None) -> tuple:
+    def rnea_tuple(self, q, qd, qdd, gravity: Sequence[float] | np.ndarray | None = None) -> tuple:
         """Inverse dynamics tau = M qdd + H qd + g as a tuple of n floats (q, qd, qdd: n floats
         each, lists or arrays): recursive Newton–Euler in world coordinates.
 
@@ -442,7 +442,9 @@ class SerialChain:
         Jv, _, _ = self._link_jacobians_batch(Q)
         return -np.einsum("i,nijk,k->nj", self._masses, Jv, self.gravity)
 
-    def rnea_batch(self, Q, QD, QDD, gravity: Sequence[float] | None = None) -> np.ndarray:
+    def rnea_batch(
+        self, Q, QD, QDD, gravity: Sequence[float] | np.ndarray | None = None
+    ) -> np.ndarray:
         """tau = M qdd + H qd + g for many states: each (N, n) -> (N, n). Same recursion as
         :meth:`rnea`, vectorised over the leading axis."""
         Q = np.asarray(Q, dtype=float).reshape(-1, self.n)

@@ -77,7 +77,7 @@ def look_at_rotation(eye, target, up=(0.0, 0.0, 1.0)) -> np.ndarray:
     z = z / n
     x = np.cross(-up, z)
     nx = np.linalg.norm(x)
-    if nx < 1e-9 * max(np.linalg.norm(up), 1e-300):
+    if nx < 1e-9 * max(float(np.linalg.norm(up)), 1e-300):
         raise ValueError("look_at: 'up' is parallel to the viewing direction; choose another 'up'")
     x = x / nx
     y = np.cross(z, x)

@@ -239,7 +239,9 @@ class StereoBallCamera(Sensor):
         self._axes = [
             (tuple(c.position.tolist()), tuple(c.rotation[:, 2].tolist())) for c in self.cameras
         ]
-        self._background_level = int(quantise(np.float32([255.0 * params.background]))[0])
+        self._background_level = int(
+            quantise(np.array([255.0 * params.background], dtype=np.float32))[0]
+        )
         # the per-frame path's constants: ball_blob's settings, the cameras' principal points
         self._blob_args = (
             float(params.threshold),

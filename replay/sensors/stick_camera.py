@@ -346,7 +346,7 @@ class StickCamera(Sensor):
         self.camera = self.make_camera(params)
         self._R = tuple(tuple(float(v) for v in row) for row in self.camera.rotation)
         self._o = tuple(float(v) for v in self.camera.position)
-        self._last = None
+        self._last: tuple[np.ndarray, tuple[int, int, int, int]] | None = None  # (crop, window)
         # by name: (the primitive, its _silhouette): a primitive object seen again (a frozen
         # one the plant keeps while it does not move, e.g. a still fingertip) is not projected
         # again (the camera does not move either)

@@ -232,16 +232,6 @@ class Params:
     )
     scenario_dir: str = field(default="", metadata={"internal": True})  # set by the loader
 
-
-def alpha_path(params: Params) -> Path | None:
-    """``alpha_file`` resolved against the scenario file's directory (absolute paths kept)."""
-    if not params.alpha_file:
-        return None
-    path = Path(params.alpha_file)
-    return (
-        path if path.is_absolute() or not params.scenario_dir else Path(params.scenario_dir) / path
-    )
-
     def __post_init__(self) -> None:
         if self.selected_joint in self.held_joints:
             raise ParamError(
@@ -252,6 +242,16 @@ def alpha_path(params: Params) -> Path | None:
             raise ParamError(
                 "kd", f"expected one value per joint as kp ({len(self.kp)}), got {len(self.kd)}"
             )
+
+
+def alpha_path(params: Params) -> Path | None:
+    """``alpha_file`` resolved against the scenario file's directory (absolute paths kept)."""
+    if not params.alpha_file:
+        return None
+    path = Path(params.alpha_file)
+    return (
+        path if path.is_absolute() or not params.scenario_dir else Path(params.scenario_dir) / path
+    )
 
 
 def _saturated(tau, limit) -> list[float]:
@@ -285,8 +285,12 @@ class CatchingState:
     holding: bool
 
 
+# the annotations' name for Params (inside the controller, ``Params`` is its class attribute)
+CatchingParams = Params
+
+
 class CatchingController(Controller):
-    Params = Params
+    Params = CatchingParams
     spec_type = ArmSpec
     command_type = ArmCommand
     reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)  # the stereo ball, the joint encoders
@@ -295,7 +299,7 @@ class CatchingController(Controller):
         "positions to joint targets, PD + dynamics feed-forward, hand timed by TTC"
     )
 
-    def __init__(self, params: Params, *, spec, model: ArmModel | None = None) -> None:
+    def __init__(self, params: CatchingParams, *, spec, model: ArmModel | None = None) -> None:
         super().__init__(params, spec=spec)
         P = params
         names = tuple(spec.joint_names)
@@ -347,7 +351,7 @@ class CatchingController(Controller):
         )
         self.problem = build_problem(model, self.config)
         self.history: list[CostRecord] = []
-        self.result = None
+        self.result: OptimResult | None = None
         self.alpha0 = initial_alpha(self.problem.C, self.problem.rhs)
         self.alpha_opt = None
         self._events: list[Occurrence] = []
@@ -401,8 +405,8 @@ class CatchingController(Controller):
         self._in_domain = True
         self._warned_state = False
         self._t = 0.0
-        self._names_seen = None  # joint-name layout of the last joint state message
-        self._idx = None
+        self._names_seen: list[str] | None = None  # joint-name layout of the last joint state
+        self._idx: list[int] | None = None  # our joints in that layout (None: taken as it is)
         self._identity = list(range(self.n))
         # the feed-forward of the current desired state (q_d, qd_d, qdd_d); None when the
         # update set a new one (before the ball is seen and while holding, it is computed once)
@@ -549,9 +553,9 @@ class CatchingController(Controller):
         ff: list[float] | tuple
         mode = self.params.feedforward
         if mode == "dynamics":  # eqs. 17-21: M(q_d) qdd_d + H(q_d, qd_d) qd_d + g(q_d)
+            if self._ff is None:
+                self._ff = self.model.inverse_dynamics_tuple(self.q_d, self.qd_d, qdd_d)
             ff = self._ff
-            if ff is None:
-                ff = self._ff = self.model.inverse_dynamics_tuple(self.q_d, self.qd_d, qdd_d)
         elif mode == "gravity":
             ff = self.model.gravity_full(self.q if self.q is not None else self.q_d).tolist()
         else:

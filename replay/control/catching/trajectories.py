@@ -57,7 +57,7 @@ def sample_throw(start, v0, T: float, n: int, gravity, speed: float = 0.0) -> Th
 
 @dataclass
 class ThrowSet:
-    throws: list
+    throws: list[Throw]
     nominal: int  # index of the nominal throw (centre arrival, middle speed)
 
     def stacked(self):
@@ -88,7 +88,8 @@ def throw_set(
     lateral = lateral / nl if nl > 0 else np.array([0.0, 1.0, 0.0])
     ticks = np.linspace(-spread, spread, grid) if grid > 1 else np.zeros(1)
     speeds = list(speeds)
-    throws, nominal = [], 0
+    throws: list[Throw] = []
+    nominal = 0
     for v in speeds:
         for dy in ticks:
             for dz in ticks:

@@ -15,7 +15,7 @@ from pybullet_utils import bullet_client
 from plants.bullet_arm import BulletArmPlant, Params
 from plants.models import build_arm
 from replay.interfaces import Plant
-from replay.messages import JointState, ObjectState, to_dict
+from replay.messages import JointState, ObjectState, json_schema, to_dict
 from replay.robot.arm_types import ArmCommand, ArmSpec
 from replay.robot.capability import max_tool_speed, tool_acceleration_from_rest
 from replay.robot.hand import CATCH3, GRASP4, hand_body
@@ -549,6 +549,8 @@ def test_urdf_loads_in_viewer_loader_with_same_kinematics():
 def test_non_finite_command_gives_no_torque_and_is_logged_json_safe():
     import json
 
+    import jsonschema
+
     plant = make(**CATCHING)
     plant.apply(ArmCommand([float("nan"), 0.0, 0.0, 0.0]))
     plant.step()
@@ -557,4 +559,6 @@ def test_non_finite_command_gives_no_torque_and_is_logged_json_safe():
     ev = plant.pop_events()
     assert [e.kind for e in ev] == ["torque_limit"]
     json.dumps([to_dict(tr)] + [e.data for e in ev], allow_nan=False)
+    # the null command is what the topic's schema (in the log) allows
+    jsonschema.validate(to_dict(tr), json_schema(type(tr)))
     plant.close()

@@ -21,6 +21,7 @@ from replay.control.catching import (
 )
 from replay.control.catching.optimise import initial_alpha
 from replay.control.catching.trajectories import sample_throw
+from replay.params import ParamError
 from replay.messages import EffectorState, JointCommand, JointState, OptimizationCost, VisionObject
 from replay.robot import ArmCommand, ArmSpec, HandSpec, ObjectSpec, wam_chain
 from replay.robot.hand import CATCH3, hand_body, hand_mass
@@ -428,6 +429,18 @@ def test_controller_holds_pose_before_the_ball_is_seen():
     assert np.allclose(np.asarray(cmd.torque)[[0, 1, 3]], g[[0, 1, 3]], atol=1e-9)
     assert np.allclose(cmd.hand, spec.hand.open_posture)
     assert "/catching/state" not in ctl.telemetry(0.0)
+
+
+def test_params_refuse_a_held_selected_joint_and_unpaired_gains():
+    """Checked on the params themselves (so ``replay validate --static`` and the scenario's
+    line:col point at them), not only when the controller is built."""
+    with pytest.raises(ParamError) as held:
+        Params(selected_joint="J4", held_joints=["J3", "J4"])
+    assert held.value.field == "selected_joint"
+    with pytest.raises(ParamError) as gains:
+        Params(kp=[1.0, 2.0, 3.0, 4.0], kd=[1.0, 2.0])
+    assert gains.value.field == "kd" and "(4), got 2" in gains.value.message
+    assert Params(selected_joint="J4", held_joints=["J3"]).selected_joint == "J4"
 
 
 # ---------------------------------------------------------------------------- approach (extension)
