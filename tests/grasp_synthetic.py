@@ -32,6 +32,7 @@ from analysis.grasp_run import (
 from replay.log import LogWriter, seconds_to_ns
 from replay.messages import Event, JointState, ObjectState, ScenarioInfo
 from replay.spatial import matrix_to_quaternion
+from tests.replay.robot.oracles import tool_position
 
 PLANE_X = 0.65
 STANDOFF = 0.15  # m, the hand's distance from the plane while only tracking
@@ -166,9 +167,9 @@ def write_grasp_log(
             goal = np.array([_reach_x(t), lagged[1], lagged[2]])
             for _ in range(1 if k else 60):  # damped least squares to the goal
                 J = chain.position_jacobian(q)
-                e = goal - chain.tool_position(q)
+                e = goal - tool_position(chain, q)
                 q = q + J.T @ np.linalg.solve(J @ J.T + 1e-4 * np.eye(3), e)
-            hand = chain.tool_position(q)
+            hand = tool_position(chain, q)
             if ph != prev_phase:
                 log.write("/events", Event(t, "phase", {"phase": ph, "cycle": 0}), ns)
                 kind = {HOLDING: "grasp", RELEASING: "release"}.get(ph)

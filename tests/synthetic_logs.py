@@ -40,6 +40,7 @@ from replay.messages import (
     VisionObject,
     VisionStick,
 )
+from tests.replay.robot.oracles import tool_position
 
 
 def _scenario(name: str, paper: str, duration: float, rate: int, plant: dict, sensors: dict) -> str:
@@ -263,7 +264,7 @@ def write_arm_log(
         q[moving] += swing * s * np.array([0.4, 0.3, -0.8])
         return q
 
-    grip = chain.tool_position(q_at(t_catch))
+    grip = tool_position(chain, q_at(t_catch))
     p0 = np.array(params["object_position"])
     g = np.array([0.0, 0.0, -9.81])
     v0 = (grip - p0 - 0.5 * g * t_catch**2) / t_catch
@@ -293,7 +294,7 @@ def write_arm_log(
                     t_ns,
                 )
             log.write(TOPIC_ARM_JOINT_COMMAND, JointCommand(t, q.tolist(), tau.tolist()), t_ns)
-            tool = chain.tool_position(q)
+            tool = tool_position(chain, q)
             log.write(TOPIC_EFFECTOR_STATE, EffectorState(t, tool.tolist(), grip.tolist()), t_ns)
             if obj == "none":
                 continue

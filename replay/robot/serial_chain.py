@@ -222,9 +222,6 @@ class SerialChain:
         """World transform of the tool frame."""
         return self.frames(q)[-1] @ self.tool
 
-    def tool_position(self, q) -> np.ndarray:
-        return self.fk(q)[:3, 3]
-
     def jacobian(self, q, point_in_tool=(0.0, 0.0, 0.0)) -> np.ndarray:
         """Geometric Jacobian (6 x n: linear velocity of the point, then angular velocity)."""
         Ts = self.frames(q)
@@ -239,26 +236,6 @@ class SerialChain:
     def position_jacobian(self, q, point_in_tool=(0.0, 0.0, 0.0)) -> np.ndarray:
         """d(point)/dq, 3 x n."""
         return self.jacobian(q, point_in_tool)[:3]
-
-    def tool_motion(self, q, qd, qdd=None, point_in_tool=(0.0, 0.0, 0.0)):
-        """World position, velocity (J qd) and acceleration (J qdd + Jdot qd) of a tool point."""
-        q, qd = self._q(q), self._q(qd)
-        qdd = np.zeros(self.n) if qdd is None else self._q(qdd)
-        Ts = self.frames(q)
-        w = np.zeros(3)
-        dw = np.zeros(3)
-        v = np.zeros(3)  # of the origin o_{i-1}
-        a = np.zeros(3)
-        for i in range(self.n):
-            z, o0, o1 = Ts[i][:3, 2], Ts[i][:3, 3], Ts[i + 1][:3, 3]
-            dw = dw + z * qdd[i] + np.cross(w, z * qd[i])
-            w = w + z * qd[i]
-            r = o1 - o0
-            v = v + np.cross(w, r)
-            a = a + np.cross(dw, r) + np.cross(w, np.cross(w, r))
-        p = (Ts[-1] @ self.tool @ np.array([*point_in_tool, 1.0]))[:3]
-        r = p - Ts[-1][:3, 3]
-        return p, v + np.cross(w, r), a + np.cross(dw, r) + np.cross(w, np.cross(w, r))
 
     # ------------------------------------------------------------------ dynamics
     def rnea(self, q, qd, qdd, gravity: Sequence[float] | np.ndarray | None = None) -> np.ndarray:
@@ -375,128 +352,10 @@ class SerialChain:
         )
         return 0.5 * (M + M.T)
 
-    def coriolis(self, q, qd) -> np.ndarray:
-        """H(q, qd) qd: Coriolis and centrifugal torques."""
-        return self.rnea(q, qd, np.zeros(self.n), gravity=np.zeros(3))
-
     def gravity_torque(self, q) -> np.ndarray:
         """g(q) = dV/dq = -sum_i m_i Jv_i^T g: the joint torques that hold the chain still."""
         Jv, _, _ = self._link_jacobians(self._q(q))
         return -np.einsum("i,ijk,k->j", self._masses, Jv, self.gravity)
-
-    def forward_dynamics(self, q, qd, tau) -> np.ndarray:
-        """qdd = M^-1 (tau - H qd - g)."""
-        return np.linalg.solve(
-            self.mass_matrix(q), np.asarray(tau, float) - self.rnea(q, qd, np.zeros(self.n))
-        )
-
-    # ------------------------------------------------------------------ batched (leading axis)
-    def frames_batch(self, Q) -> np.ndarray:
-        """World transforms of frames 0..n for many configurations: Q (N, n) -> (N, n+1, 4, 4)."""
-        Q = np.asarray(Q, dtype=float).reshape(-1, self.n)
-        N = Q.shape[0]
-        out = np.empty((N, self.n + 1, 4, 4))
-        out[:, 0] = self.base
-        for i, row in enumerate(self.dh):
-            th = Q[:, i] + row.theta_offset
-            ct, st = np.cos(th), np.sin(th)
-            ca, sa = math.cos(row.alpha), math.sin(row.alpha)
-            A = np.zeros((N, 4, 4))
-            A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = ct, -st * ca, st * sa, row.a * ct
-            A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = st, ct * ca, -ct * sa, row.a * st
-            A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, row.d
-            A[:, 3, 3] = 1.0
-            out[:, i + 1] = out[:, i] @ A
-        return out
-
-    def tool_position_batch(self, Q) -> np.ndarray:
-        """(N, n) -> (N, 3)."""
-        return (self.frames_batch(Q)[:, -1] @ self.tool)[:, :3, 3]
-
-    def _link_jacobians_batch(self, Q):
-        Ts = self.frames_batch(Q)
-        n = self.n
-        z = Ts[:, :-1, :3, 2]  # (N, n, 3) axes z_0..z_{n-1}
-        o = Ts[:, :-1, :3, 3]
-        R = Ts[:, 1:, :3, :3]  # (N, n, 3, 3)
-        c = np.einsum("lijk,ik->lij", R, self._coms) + Ts[:, 1:, :3, 3]
-        mask = np.tril(np.ones((n, n)))[None, :, :, None]
-        zb = np.broadcast_to(z[:, None, :, :], (z.shape[0], n, n, 3))
-        Jv = np.cross(zb, c[:, :, None, :] - o[:, None, :, :]) * mask  # (N, link, joint, 3)
-        Jw = zb * mask
-        Iw = np.einsum("liab,ibc,lidc->liad", R, self._inertias, R)
-        return Jv, Jw, Iw
-
-    def mass_matrix_batch(self, Q) -> np.ndarray:
-        """M for many configurations: (N, n) -> (N, n, n)."""
-        Jv, Jw, Iw = self._link_jacobians_batch(Q)
-        Jv_t = np.swapaxes(Jv, 2, 3)  # (N, link, 3, joint)
-        Jw_t = np.swapaxes(Jw, 2, 3)
-        M = np.einsum("i,nikj,nikl->njl", self._masses, Jv_t, Jv_t, optimize=True) + (
-            np.swapaxes(Jw_t, 2, 3) @ (Iw @ Jw_t)
-        ).sum(axis=1)
-        return 0.5 * (M + np.swapaxes(M, 1, 2))
-
-    def gravity_torque_batch(self, Q) -> np.ndarray:
-        """g for many configurations: (N, n) -> (N, n)."""
-        Jv, _, _ = self._link_jacobians_batch(Q)
-        return -np.einsum("i,nijk,k->nj", self._masses, Jv, self.gravity)
-
-    def rnea_batch(
-        self, Q, QD, QDD, gravity: Sequence[float] | np.ndarray | None = None
-    ) -> np.ndarray:
-        """tau = M qdd + H qd + g for many states: each (N, n) -> (N, n). Same recursion as
-        :meth:`rnea`, vectorised over the leading axis."""
-        Q = np.asarray(Q, dtype=float).reshape(-1, self.n)
-        QD = np.asarray(QD, dtype=float).reshape(Q.shape)
-        QDD = np.asarray(QDD, dtype=float).reshape(Q.shape)
-        g = self.gravity if gravity is None else np.asarray(gravity, dtype=float)
-        Ts = self.frames_batch(Q)
-        N, n = Q.shape
-        w = np.zeros((N, 3))
-        dw = np.zeros((N, 3))
-        a_o = np.broadcast_to(-g, (N, 3)).copy()
-        keep = []
-        for i in range(n):
-            z, o0, o1 = Ts[:, i, :3, 2], Ts[:, i, :3, 3], Ts[:, i + 1, :3, 3]
-            R1 = Ts[:, i + 1, :3, :3]
-            zq = z * QD[:, i : i + 1]
-            dw = dw + z * QDD[:, i : i + 1] + np.cross(w, zq)
-            w = w + zq
-            c = R1 @ self.links[i].com + o1
-            rc = c - o0
-            a_c = a_o + np.cross(dw, rc) + np.cross(w, np.cross(w, rc))
-            Iw = R1 @ self.links[i].inertia @ np.swapaxes(R1, 1, 2)
-            keep.append((z, o0, o1, c, a_c, w, dw, Iw))
-            r = o1 - o0
-            a_o = a_o + np.cross(dw, r) + np.cross(w, np.cross(w, r))
-        tau = np.zeros((N, n))
-        f_next = np.zeros((N, 3))
-        n_next = np.zeros((N, 3))
-        for i in reversed(range(n)):
-            z, o0, o1, c, a_c, w_i, dw_i, Iw = keep[i]
-            ma = self.links[i].mass * a_c
-            f = ma + f_next
-            nm = (
-                np.einsum("nab,nb->na", Iw, dw_i)
-                + np.cross(w_i, np.einsum("nab,nb->na", Iw, w_i))
-                + np.cross(c - o0, ma)
-                + n_next
-                + np.cross(o1 - o0, f_next)
-            )
-            tau[:, i] = np.einsum("na,na->n", z, nm)
-            f_next, n_next = f, nm
-        return tau
-
-    def coriolis_batch(self, Q, QD) -> np.ndarray:
-        """H(q, qd) qd for many states: (N, n) -> (N, n)."""
-        Q = np.asarray(Q, dtype=float).reshape(-1, self.n)
-        return self.rnea_batch(Q, QD, np.zeros_like(Q), gravity=np.zeros(3))
-
-    def link_bodies_world(self, q) -> list[RigidBody]:
-        """Each link's mass properties in world coordinates (for checks and drawing)."""
-        Ts = self.frames(q)
-        return [b.transformed(Ts[i + 1]) for i, b in enumerate(self.links)]
 
 
 def active_block(x: np.ndarray, active: Sequence[int]) -> np.ndarray:

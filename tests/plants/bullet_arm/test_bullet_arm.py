@@ -24,6 +24,7 @@ from replay.robot.wam import TORQUE_LIMIT_SETS, wam_chain, wam_joint_limits
 from replay.scene import Sphere
 
 import bullet_checks  # tests/bullet_checks.py (conftest puts tests/ on the path)
+from tests.replay.robot.oracles import tool_position
 
 DT = 1e-3
 START = [0.0, math.pi / 4, 0.0, 0.0]  # Namiki & Ishikawa IV-A
@@ -335,7 +336,7 @@ def test_truth_scene_spec_payloads():
     assert isinstance(obj, ObjectState) and obj.orientation == [0.0, 0.0, 0.0, 1.0]
     assert "/effector/state" not in tr  # the controller's topic (actual and desired)
     eff = tr["/effector/motion"]
-    np.testing.assert_allclose(eff.position, plant.spec().model.tool_position(START), atol=1e-4)
+    np.testing.assert_allclose(eff.position, tool_position(plant.spec().model, START), atol=1e-4)
     import json
 
     for payload in tr.values():

@@ -24,6 +24,7 @@ from replay.robot.hand import CATCH3
 from replay.robot.serial_chain import active_block
 from replay.robot.wam import TORQUE_LIMIT_SETS, wam_joint_limits
 from replay.scene import Sphere
+from tests.replay.robot.oracles import tool_position
 
 ROOT = Path(__file__).resolve().parents[3]
 DT = 1e-3
@@ -346,7 +347,7 @@ def test_truth_payloads_and_frames_match_the_pybullet_plant():
         tm["/arm/joint_state"].position, tb["/arm/joint_state"].position, atol=1e-6
     )
     np.testing.assert_allclose(
-        tm["/effector/motion"].position, m.spec().model.tool_position(START), atol=1e-4
+        tm["/effector/motion"].position, tool_position(m.spec().model, START), atol=1e-4
     )
     assert isinstance(m.scene().get("ball"), Sphere)
     fb = {f.child: f for f in b.frames()}
