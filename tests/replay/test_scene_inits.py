@@ -13,7 +13,7 @@ import inspect
 import numpy as np
 import pytest
 
-from replay.control.stick.sweep import Motion
+from replay.control.stick.coverage import Motion
 
 
 def assert_generated_init(cls, rng, n: int = 20) -> None:

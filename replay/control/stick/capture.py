@@ -4,7 +4,7 @@ Sec. III) share: phases, planned collisions, events and the capture check.
 :class:`StickCaptureController` runs the cycle below; the strategies
 (``strategy``) give the contact of each collision. The hand plans are made by
 ``plan`` (collisions) and ``close`` (the closing), with the hand model of
-``hand_model`` and the predicted sweep of ``sweep``.
+``hand_model`` and the predicted sweep of ``coverage``.
 
 Pure NumPy. The controller sees only ``/vision/stick`` measurements (x, y, theta mod pi; already
 delayed by the camera latency) and the :class:`~replay.robot.hand2d.AirTableSpec` (hand kinematics and
@@ -105,7 +105,7 @@ from replay.control.stick.close import ClosePlan, ClosePlanner
 from replay.control.stick.estimator import StickEstimate, StickEstimator
 from replay.control.stick.hand_model import Config, HandModel
 from replay.control.stick.plan import ContactPlan, ContactPlanner, Shortfall
-from replay.control.stick.sweep import Motion
+from replay.control.stick.coverage import Motion
 from replay.messages import TOPIC_STICK_ESTIMATE, TOPIC_VISION_STICK
 
 

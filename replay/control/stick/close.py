@@ -36,7 +36,7 @@ from replay.control.stick import collision as sc
 from replay.control.stick.estimator import StickEstimate, StickEstimator
 from replay.control.stick.hand_model import Config, close_bases, route_target, travel
 from replay.control.stick.plan import CONTACT_GUARD, ContactPlanner, Shortfall
-from replay.control.stick.sweep import Motion
+from replay.control.stick.coverage import Motion
 
 
 @dataclass

@@ -23,7 +23,7 @@ The result is a :class:`ContactPlan` (the approach phase's plan; its ``intent`` 
 event's data). :class:`Shortfall` keeps the best time needed vs available of failed attempts
 (the ``unreachable`` report).
 
-NumPy (the sampled sweep checks: ``sweep``).
+NumPy (the sampled sweep checks: ``coverage``).
 """
 
 from __future__ import annotations
@@ -48,9 +48,9 @@ from replay.control.stick.hand_model import (
     route_target,
     travel,
 )
-from replay.control.stick.sweep import (
+from replay.control.stick.coverage import (
     Motion,
-    Sweep,
+    Coverage,
     count_before,
     covered_fixed,
     covered_samples,
@@ -238,7 +238,7 @@ class ContactPlanner:
         contact, tip, n = self.spot(est, sol, t_c)
         motion = Motion(est, t_c, sol.u_after)
         now = self.model.config
-        sweep_all = Sweep(motion, t, t_c + p.post_horizon)
+        sweep_all = Coverage(motion, t, t_c + p.post_horizon)
         # Every base is tried and the quickest arrival wins (ties: the earlier finger, then the
         # earlier base). A route arrives no sooner than t + the travel time to the contact
         # posture with the idle finger unmoved (``need``: travel times obey the triangle
@@ -365,7 +365,7 @@ class ContactPlanner:
         tip (``sweep_margin`` clear) until t_c + post_horizon. Else None. The answer of the
         array oracle (tests/replay/control/stick/oracles.py): the samples while the hand moves
         in whole arrays, those after it stands still (on its last waypoint) as fixed points
-        (``sweep.covered_fixed``: only the samples near the stick made)."""
+        (``coverage.covered_fixed``: only the samples near the stick made)."""
         p, st, hand = self.params, self.stick, self.hand
         timed = self._route_timing(now, route, t_c)
         if timed is None:
@@ -501,7 +501,7 @@ class ContactPlanner:
             cfg, moved = cfg.with_finger(k, q), True
         return cfg if moved else None
 
-    def _passive(self, cfg: Config, j: int, sweep: Sweep, active_tip):
+    def _passive(self, cfg: Config, j: int, sweep: Coverage, active_tip):
         """The idle finger's joints nearest its current ones whose tip stays clear of the
         predicted sweep (and of the active tip); None when no posture is clear. Postures are
         checked nearest first (ties: current, then grid order), the first clear one wins; a

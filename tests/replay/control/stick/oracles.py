@@ -4,7 +4,7 @@ replaced; the tests hold the fast path to them. Test-only: the package keeps one
 - Sec. II of Higashimori et al. in matrix form (eqs. 3-5, 9, 22, 26), against the closed forms of
   replay/control/stick/collision.py.
 - ContactPlanner's scalar paths (replay/control/stick/plan.py) in whole-array NumPy
-  (test_sweep_paths.py, test_stick_fast_paths.py).
+  (test_coverage_paths.py, test_stick_fast_paths.py).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 from replay.control.stick import collision as sc
 from replay.control.stick.hand_model import Config, route_configs, route_tips
 from replay.control.stick.plan import CONTACT_GUARD
-from replay.control.stick.sweep import Motion, Sweep, covered_along, sample_times
+from replay.control.stick.coverage import Motion, Coverage, covered_along, sample_times
 from replay.robot import hand2d
 
 
@@ -88,7 +88,7 @@ def route_clear(
         return None
     arrival, starts, frm, to = timed
     # sampled every SAMPLE_DT from t: the hand along the route (route_configs, route_tips);
-    # finger k's tip must stay out of the sweep (sweep.covered_along) until CONTACT_GUARD
+    # finger k's tip must stay out of the sweep (coverage.covered_along) until CONTACT_GUARD
     # before t_c; the idle tip, with check_idle, until t_c + post_horizon, keeping
     # sweep_margin, or on the way at least the clearance it has now
     times = sample_times(t, t_c + (p.post_horizon if check_idle else 0.0))
@@ -129,7 +129,7 @@ def exit_config(planner, t: float, now: Config, motion: Motion) -> Config | None
     return cfg if moved else None
 
 
-def passive(planner, cfg: Config, j: int, sweep: Sweep, active_tip):
+def passive(planner, cfg: Config, j: int, sweep: Coverage, active_tip):
     """``planner._passive`` on arrays: every posture's tip and distance, then the first clear
     one in order."""
     hand, st, p = planner.hand, planner.stick, planner.params

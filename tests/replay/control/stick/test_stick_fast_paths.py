@@ -16,7 +16,7 @@ from replay.control.stick.estimator import StickEstimate, StickEstimator
 from replay.control.stick.hand_model import base_candidates
 from replay.control.stick.plan import Shortfall
 from replay.control.stick.strategy import ThreeStepController, ThreeStepParams
-from replay.control.stick.sweep import Motion, Sweep, covered, sample_times
+from replay.control.stick.coverage import Motion, Coverage, covered, sample_times
 
 from tests.replay.control.stick import oracles
 from tests.replay.control.stick.test_stick_method import V0, SyntheticStick, air_spec
@@ -96,7 +96,7 @@ def test_sweep_answers_as_sampling_every_time():
         motion = Motion(e, rng.uniform(0.0, 0.3), tuple(rng.normal(size=3) * [0.3, 0.3, 4.0]))
         t1 = rng.uniform(0.05, 0.6)
         times = sample_times(0.0, t1)
-        sweep = Sweep(motion, 0.0, t1)
+        sweep = Coverage(motion, 0.0, t1)
         for p in rng.uniform(-0.15, 0.15, (10, 2)):
             grow = rng.uniform(0.0, 0.01)
             ref = bool(covered(motion, times, [p], 0.05, 0.005, grow).any())
@@ -239,7 +239,7 @@ def test_passive_posture_search_is_the_array_references():
         est = StickEstimate(
             0.0, x, y, 0.0, *rng.normal(0.0, 0.3, 2), rng.normal(0.0, 30.0), 6, 0, 0
         )
-        sweep = Sweep(Motion(est, 0.1, tuple(rng.normal(0.0, 1.0, 3))), 0.0, 0.3)
+        sweep = Coverage(Motion(est, 0.1, tuple(rng.normal(0.0, 1.0, 3))), 0.0, 0.3)
         active = cfg.tip(hand, 1 - j) + rng.normal(0.0, 0.01, 2)
         got = planner._passive(cfg, j, sweep, active)
         assert got == oracles.passive(planner, cfg, j, sweep, active)

@@ -12,8 +12,7 @@ the references). The checks the planners repeat most (:func:`first_covered`, ``C
 the stick's centre (linear in time on each side of ``t_switch``) can be within the grown
 rectangle's corner reach of the point are looked at (:func:`near_samples` solves for them),
 one by one, skipping those the stick cannot reach the point by (:func:`covered_fixed`): the
-same answers as the references (tests/replay/control/stick/test_sweep_paths.py). (This replaced
-a compiled ``_sweep.c``: stick_3step's sweep checks take ~15 ms a run here against its ~5.)
+same answers as the references (tests/replay/control/stick/test_coverage_paths.py).
 """
 
 from __future__ import annotations
@@ -290,7 +289,7 @@ def covered_fixed(
     which the fixed ``point`` is within ``grow`` of the stick rectangle (:func:`covered`), or
     None. Only the samples :func:`near_samples` finds are looked at, one at a time in order,
     each as :func:`covered` does it (the pose of :meth:`Motion.poses`, cos and sin, whose
-    float64 values are libm's, as math's: test_sweep_paths.py); from one not covered, the
+    float64 values are libm's, as math's: test_coverage_paths.py); from one not covered, the
     samples the stick cannot reach the point by are skipped: the point's margin outside the
     grown rectangle (or the centre's distance beyond its corner reach) shrinks no faster than
     the centre's speed plus the spin times the distance."""
@@ -364,7 +363,7 @@ def first_covered(
     return None if i is None else sample_time(t0, t1, i)
 
 
-class Sweep:
+class Coverage:
     """The stick's sweep over :func:`sample_times` (t0, t1), for many "is this fixed point ever
     covered" questions (the same answer as :func:`covered`, asked one point at a time)."""
 

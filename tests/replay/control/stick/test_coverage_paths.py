@@ -1,7 +1,7 @@
 """The stick planners' sweep checks against their whole-array NumPy references: sweep
 .first_covered (sweep.covered_fixed: only the samples near the point, looked at one by one with
 the skips the stick's speed and spin allow) against sweep.covered for a fixed point (first /
-last covered sample; Sweep.hits is that too, tests/.../test_stick_fast_paths.py), and
+last covered sample; Coverage.hits is that too, tests/.../test_stick_fast_paths.py), and
 ContactPlanner.route_clear (the moving hand in arrays, each finger's tips only where its check
 needs them, the standing hand as fixed points) against oracles.route_clear. The same
 operations on the samples they look at, so the answers agree exactly on seeded random motions,
@@ -14,12 +14,12 @@ import math
 import numpy as np
 import pytest
 
-from replay.control.stick import sweep as sweeps
+from replay.control.stick import coverage as sweeps
 from replay.control.stick.hand_model import Config, HandModel, travel
 from replay.control.stick.plan import ContactPlanner
 from replay.control.stick.estimator import StickEstimate
 from replay.control.stick.strategy import ThreeStepParams
-from replay.control.stick.sweep import (
+from replay.control.stick.coverage import (
     Motion,
     covered,
     first_covered,
