@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 matplotlib.rcParams["text.parse_math"] = False
 import matplotlib.pyplot as plt  # noqa: E402
 
-from replay.log.writer import check_output, write_output  # noqa: E402
+from replay.log.output import check_output, write_output  # noqa: E402
 
 # what an earlier figure starts with: the only file a figure overwrites
 MAGIC = {".png": b"\x89PNG\r\n\x1a\n", ".svg": b"<?xml"}

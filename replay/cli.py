@@ -26,9 +26,8 @@ from replay.console import (
 from replay.foxglove.layouts import PAPERS as LAYOUT_PAPERS
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
-from replay.log.errors import LogLimitError
-from replay.log.writer import (
-    LogWriteError,
+from replay.log.errors import LogLimitError, LogWriteError
+from replay.log.output import (
     OutputConflictError,
     check_output,
     live_writers,

@@ -88,7 +88,7 @@ def _output(log: Path, folder: Path | None, suffix: str) -> Path:
     path = (folder / log.name if folder else log).with_suffix(suffix)
     if folder is None:
         from replay.log import LogError
-        from replay.log.writer import check_output
+        from replay.log.output import check_output
 
         try:
             check_output(path, kind="Rerun file", magic=RRD_MAGIC)
@@ -250,7 +250,7 @@ def screenshot(url: str, out: Path, wait: float) -> None:
             time.sleep(wait / 4)
         png = page.screenshot(timeout=180_000)
         browser.close()
-    from replay.log.writer import write_output
+    from replay.log.output import write_output
 
     write_output(out, lambda tmp: tmp.write_bytes(png))  # (never through a link)
 
@@ -272,7 +272,7 @@ def view(
         raise RerunError("--shot needs --web")
     if shot is not None:  # (before anything starts)
         from replay.log import LogError
-        from replay.log.writer import check_output
+        from replay.log.output import check_output
 
         try:
             check_output(shot, kind="screenshot", magic=PNG_MAGIC)

@@ -39,3 +39,12 @@ def _non_finite_paths(value, path=""):
     elif isinstance(value, (list, tuple)):
         for i, v in enumerate(value):
             yield from _non_finite_paths(v, f"{path}[{i}]")
+
+
+class LogWriteError(LogError):
+    """Writing or finishing a log failed (a full disk, an I/O error): a system fault, not bad
+    input; ``errno`` says which."""
+
+    def __init__(self, message: str, errno: int | None = None) -> None:
+        super().__init__(message)
+        self.errno = errno

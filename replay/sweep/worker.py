@@ -87,7 +87,8 @@ def _drop_part_on_full_disk(exc: BaseException, log: str) -> None:
     is not worth the disk it fills."""
     import errno
 
-    from replay.log.writer import LogWriteError, own_part
+    from replay.log.errors import LogWriteError
+    from replay.log.output import own_part
 
     if log and isinstance(exc, LogWriteError) and exc.errno in (errno.ENOSPC, errno.EDQUOT):
         part = own_part(Path(log))

@@ -13,7 +13,7 @@ import pytest
 
 from analysis.figure_files import MAGIC
 from replay.log import LogError, LogReader, LogWriter
-from replay.log.writer import check_output, write_output
+from replay.log.output import check_output, write_output
 from replay.messages import TOPIC_SCENARIO
 from replay.report.markup import md, pre
 

@@ -79,7 +79,7 @@ def test_a_failed_write_raises_from_the_write_that_made_it(tmp_path, monkeypatch
 
     from conftest import fail_writes_after
 
-    from replay.log.writer import LogWriteError
+    from replay.log.errors import LogWriteError
 
     fail_writes_after(monkeypatch, 4)  # the header and a chunk fit, the next does not
     caplog.set_level(logging.DEBUG)

@@ -17,7 +17,7 @@ from conftest import fail_writes_after
 
 from replay.cli import main
 from replay.log import LogError, LogReader, LogWriter
-from replay.log.writer import OutputConflictError, live_writers, part_paths
+from replay.log.output import OutputConflictError, live_writers, part_paths
 from replay.messages import Event
 
 HOLDER = r"""
