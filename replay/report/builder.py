@@ -32,7 +32,7 @@ from analysis.needs import figure_notes, skipped_notes
 from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
-from replay.report.captions import CAPTIONS, DRAWN_FOR
+from replay.report.captions import CAPTIONS, DRAWN_FOR, NAMED
 from replay.report.folder import check_folder, discard, staging, swap_in
 from replay.report.markup import e as _e
 from replay.report.markup import md, md_code, md_fence, pre, url
@@ -129,12 +129,14 @@ def _shows(runs: Sequence[str], readers: dict[str, LogReader]) -> str:
 
 
 def _caption(paper: str, stem: str, shows: str, controllers: Collection[str] = ()) -> str:
-    """The paper's caption of the figure ``stem`` draws again, and the runs it ``shows``; "cf."
-    when a run's ``controllers`` are not the method the paper's figure is drawn for."""
+    """The paper's caption of the figure ``stem`` draws again (for a figure that draws none,
+    what it shows: ``NAMED``), and the runs it ``shows``; "cf." when a run's ``controllers`` are
+    not the method the paper's figure is drawn for."""
     m = re.search(r"fig(\d+)", stem)
     num = int(m.group(1)) if m else 0
     quoted = CAPTIONS.get(paper, {}).get(num)
-    base = f"Fig. {num}" if num else stem
+    named = next((t for end, t in NAMED.get(paper, {}).items() if stem.endswith(end)), stem)
+    base = f"Fig. {num}" if num else named
     drawn_for = DRAWN_FOR.get((paper, num))
     others = sorted(c for c in controllers if c != drawn_for)
     if quoted and drawn_for and others:

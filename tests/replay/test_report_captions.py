@@ -62,6 +62,11 @@ def test_every_caption_names_the_runs_its_figure_shows(logs, tmp_path):
         named = set(re.findall(r"'([^']+)'", caption.replace("\\_", "_")))
         assert named == _expected(stem), (stem, caption)
     assert "in no figure" not in md  # every log is in a figure
+    for caption, stem in figures:  # a figure of no one figure of the paper says what it shows
+        assert not caption.replace("\\_", "_").startswith(stem), caption
+    said = {stem: caption for caption, stem in figures}
+    assert said["stick_3step_friction"].startswith("Friction independence: the velocities")
+    assert said["grasp_sphere_filmstrip"].startswith("The run as a filmstrip of close-ups")
     # the paper's Fig. 7 is drawn for the 3-step strategy: a 2-step run's is a "cf."
     two = next(c for c, stem in figures if stem == "stick_2step_fig7").replace("\\_", "_")
     three = next(c for c, stem in figures if stem == "stick_3step_fig7")
