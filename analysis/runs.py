@@ -6,7 +6,8 @@ Each run gets a key unique among the logs given (the scenario name; for a second
 the name and its label, ``catch_optimised (stereo latency 10 ms)``) and a label: a short diff
 of its stored, resolved scenario against the shipped scenario of the same name, or for a name
 that is not shipped against the nearest shipped scenario of its paper (its experiment: a renamed
-variant ``catch_lat10`` is a variant of ``catch_optimised``).
+variant ``catch_lat10`` is a variant of ``catch_optimised``; of equally near ones the fewest
+``extends:`` steps from the paper's own).
 
 The paper's own rows look their runs up by scenario name: the log that matches the shipped
 scenario keeps the plain name.
