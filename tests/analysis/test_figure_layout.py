@@ -96,6 +96,12 @@ def test_fig6_footer_is_inside_the_figure(pair):
     try:
         assert_readable(fig)
         assert any("ω_max" in t.get_text() for t in fig.texts)
+        for ax in fig.axes:  # each run named, as in Figs. 7-9
+            said = [t.get_text() for t in ax.get_legend().get_texts()]
+            assert said == [
+                "catch_optimised: optimisation (eq. 25)",
+                "catch_initial: initial parameters",
+            ]
     finally:
         plt.close(fig)
 
