@@ -81,6 +81,7 @@ def test_stick_runs_of_one_name_each_get_a_figure_and_the_overlay(stick, tmp_pat
     assert "stick_3step_variants.png" in pngs  # Fig. 7's velocities, each run labelled
     svg = (tmp_path / "stick_3step_variants.svg").read_text()
     assert "friction 1" in svg and "duration 300 ms" in svg
+    assert "stick_3step (duration 300 ms)" in svg  # as every run is named: name (label)
     assert "warning" not in r.stderr, r.stderr
 
 
