@@ -30,8 +30,8 @@ DRAWN_FOR = {
 # stick strategy's runs at several frictions, an experiment's variants, a grasp run's filmstrip)
 NAMED = {
     "higashimori2007": {
-        "_friction": "Friction independence: the velocities of the runs at each friction μ, "
-        "one plan (cf. Fig. 7)",
+        "_friction": "Friction independence: the velocities of the runs of one strategy at "
+        "each friction μ (cf. Fig. 7)",
         "_variants": "The runs of one experiment overlaid, each labelled by what it sets "
         "differently (cf. Fig. 7)",
     },
