@@ -139,12 +139,12 @@ def _marks(ax, run: CatchRun, style: dict) -> list[tuple[float, str]]:
 
 def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, ...] = ()):
     fig, (ax_t, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.0, 5.0))
+    pair = ((opt, "tab:blue", "optimisation (eq. 25)"), (ini, "tab:red", "initial parameters"))
     for run, color, label in (
-        (opt, "tab:blue", "optimisation (eq. 25)"),
-        (ini, "tab:red", "initial parameters (unoptimised run)"),
+        *((r, c, f"{r.name}: {what}") for r, c, what in pair if r is not None),
         *((r, _color(r), _label(r)) for r in variants),
     ):
-        if run is None or not run.costs:
+        if not run.costs:
             continue
         it = [c["iteration"] for c in run.costs]
         marker = "o" if len(it) > 1 else "s"

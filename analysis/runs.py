@@ -6,7 +6,8 @@ Each run gets a key unique among the logs given (the scenario name; for a second
 the name and its label, ``catch_optimised (stereo latency 10 ms)``) and a label: a short diff
 of its stored, resolved scenario against the shipped scenario of the same name, or for a name
 that is not shipped against the nearest shipped scenario of its paper (its experiment: a renamed
-variant ``catch_lat10`` is a variant of ``catch_optimised``).
+variant ``catch_lat10`` is a variant of ``catch_optimised``; of equally near ones the fewest
+``extends:`` steps from the paper's own).
 
 The paper's own rows look their runs up by scenario name: the log that matches the shipped
 scenario keeps the plain name.
@@ -82,6 +83,26 @@ def _shipped_of(paper: str) -> tuple[str, ...]:
     return tuple(n for n in sorted(_shipped_names()) if (_shipped(n) or {}).get("paper") == paper)
 
 
+@lru_cache(maxsize=None)
+def _depth(name: str) -> int:
+    """How many ``extends:`` steps the shipped scenario ``name`` is from one that extends none
+    (catch_optimised 0, catch_initial 1): the paper's own set-up is the shallowest."""
+    from replay.resources import scenario_dir
+
+    seen: list[str] = []
+    while name in _shipped_names() and name not in seen:
+        seen.append(name)
+        try:
+            text = (scenario_dir() / f"{name}.yaml").read_text(encoding="utf-8")
+            base = (yaml.safe_load(text) or {}).get("extends")
+        except (OSError, ValueError, yaml.YAMLError, AttributeError):
+            break
+        if not isinstance(base, str):
+            break
+        name = base.removesuffix(".yaml")
+    return max(len(seen) - 1, 0)
+
+
 def _short(v: Any) -> str:
     if isinstance(v, float):
         return f"{v:g}"
@@ -133,16 +154,17 @@ def _label(items: list[str]) -> str:
 
 def _compare(stored: dict[str, Any], name: str, paper: str) -> tuple[str, list[str]]:
     """(the experiment, the differences from it): the shipped scenario of the same name, else
-    the shipped scenario of the paper with the fewest differences."""
+    the shipped scenario of the paper with the fewest differences, of those the one fewest
+    ``extends:`` steps from the paper's own (a controller swapped in leaves every scenario that
+    differs only in controller params tied: it is a variant of catch_optimised, not of the
+    first name in the alphabet)."""
     ref = _shipped(name)
     if ref is not None:
         return name, differences(stored, ref)
-    best: tuple[str, list[str]] | None = None
-    for other in _shipped_of(paper):
-        d = differences(stored, _shipped(other) or {})
-        if best is None or len(d) < len(best[1]):
-            best = (other, d)
-    return best or ("", [])
+    found = [(o, differences(stored, _shipped(o) or {})) for o in _shipped_of(paper)]
+    if not found:
+        return "", []
+    return min(found, key=lambda f: (len(f[1]), _depth(f[0]), f[0]))
 
 
 def describe(reader: LogReader, key: str | None = None) -> Run:

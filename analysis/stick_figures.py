@@ -135,7 +135,7 @@ def _variant_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
         for n in keys[MAX_VARIANTS:]:
             skip(f"{n}: not in {experiment}'s variants overlay (at most {MAX_VARIANTS} runs)")
         shown = {n: group[n] for n in keys[:MAX_VARIANTS]}
-        legend = {n: f"{n}: {labels[n]}" if labels[n] not in n else n for n in shown}
+        legend = {n: run_labels.titled(n, log) for n, log in shown.items()}  # name (label)
         legend.update({n: f"{n} (as shipped)" for n in shown if not labels[n]})
         title = f"{experiment} and its variants: velocities vs time (cf. Fig. 7)"
         fig = friction_overlay(shown, legend, title)

@@ -32,7 +32,7 @@ from analysis.needs import figure_notes, skipped_notes
 from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
-from replay.report.captions import CAPTIONS, DRAWN_FOR
+from replay.report.captions import CAPTIONS, DRAWN_FOR, NAMED
 from replay.report.folder import check_folder, discard, staging, swap_in
 from replay.report.markup import e as _e
 from replay.report.markup import md, md_code, md_fence, pre, url
@@ -82,7 +82,8 @@ class PaperSection:
     title: str
     authors: str
     runs: list = field(default_factory=list)  # (run key, seed, log path)
-    scenarios: dict = field(default_factory=dict)  # run key -> (scenario name, its label)
+    # run key -> (scenario name, its label, the shipped scenario the label is against)
+    scenarios: dict = field(default_factory=dict)
     figures: list = field(default_factory=list)
     claims: list = field(default_factory=list)
     claims_md: str = ""
@@ -128,12 +129,14 @@ def _shows(runs: Sequence[str], readers: dict[str, LogReader]) -> str:
 
 
 def _caption(paper: str, stem: str, shows: str, controllers: Collection[str] = ()) -> str:
-    """The paper's caption of the figure ``stem`` draws again, and the runs it ``shows``; "cf."
-    when a run's ``controllers`` are not the method the paper's figure is drawn for."""
+    """The paper's caption of the figure ``stem`` draws again (for a figure that draws none,
+    what it shows: ``NAMED``), and the runs it ``shows``; "cf." when a run's ``controllers`` are
+    not the method the paper's figure is drawn for."""
     m = re.search(r"fig(\d+)", stem)
     num = int(m.group(1)) if m else 0
     quoted = CAPTIONS.get(paper, {}).get(num)
-    base = f"Fig. {num}" if num else stem
+    named = next((t for end, t in NAMED.get(paper, {}).items() if stem.endswith(end)), stem)
+    base = f"Fig. {num}" if num else named
     drawn_for = DRAWN_FOR.get((paper, num))
     others = sorted(c for c in controllers if c != drawn_for)
     if quoted and drawn_for and others:
@@ -200,7 +203,7 @@ def _build(out: Path, logs_dir: Path) -> None:
             sc = r.scenario()
             sec.runs.append((name, sc.get("seed", "?"), str(getattr(r, "path", name))))
             run = describe(r, name)
-            sec.scenarios[name] = (run.name, run.label)
+            sec.scenarios[name] = (run.name, run.label, run.experiment)
         if readers:
             figure_skips: list[str] = []
             try:
@@ -346,15 +349,25 @@ def _provenance(version: str) -> dict[str, str]:
     return info
 
 
+def _shipped_run(name: str, label: str, shipped: str) -> tuple[str, str]:
+    """The shipped scenario to run for a run of scenario ``name`` (its nearest, ``shipped``, when
+    no shipped scenario has that name) and a comment saying what the run sets differently."""
+    if not shipped:
+        return name, f"   # {name} is not shipped; its scenario is in its log (replay info)"
+    if shipped == name:
+        return name, f"   # differs from the shipped {name}: {label}" if label else ""
+    what = f"differs from it: {label}" if label else "sets nothing differently"
+    return shipped, f"   # {name} is not shipped, its nearest is {shipped}; it {what}"
+
+
 def _commands(sections, logs) -> list[str]:
     cmds = []
     for sec in sections:
         for key, seed, _ in sec.runs:  # (a log's name and seed quoted for the shell)
             log = f"out/logs/{file_stem(key)}.mcap"
-            name, label = sec.scenarios.get(key, (key, ""))
-            differs = f"   # differs from the shipped {name}: {label}" if label else ""
+            name, why = _shipped_run(*sec.scenarios.get(key, (key, "", key)))
             cmds.append(
-                f"replay run {shlex.quote(name)} --seed {shlex.quote(str(seed))} -o {log}{differs}"
+                f"replay run {shlex.quote(name)} --seed {shlex.quote(str(seed))} -o {log}{why}"
             )
     if logs:
         cmds += [
@@ -377,7 +390,7 @@ def _commands(sections, logs) -> list[str]:
 
 def _differs(sec: PaperSection, key: str) -> str:
     """'; LABEL' for a run that differs from its shipped scenario, unless its key says it."""
-    label = sec.scenarios.get(key, (key, ""))[1]
+    label = sec.scenarios.get(key, (key, "", key))[1]
     return f"; {label}" if label and label not in key else ""
 
 

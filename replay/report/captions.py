@@ -13,7 +13,7 @@ CAPTIONS = {
         9: "Time response of joint command torques.",
     },
     "namiki1999": {
-        # (Figs. 6-8 are drawn as one filmstrip of the run, captioned by its file name)
+        # (Figs. 6-8, photo sequences, are drawn as one filmstrip of the run: NAMED)
         9: "Feedback Response",
     },
 }
@@ -24,4 +24,19 @@ CAPTIONS = {
 DRAWN_FOR = {
     ("higashimori2007", 6): "stick_3step",
     ("higashimori2007", 7): "stick_3step",
+}
+
+# the figures that draw no one figure of the paper, by paper and how their file name ends (a
+# stick strategy's runs at several frictions, an experiment's variants, a grasp run's filmstrip)
+NAMED = {
+    "higashimori2007": {
+        "_friction": "Friction independence: the velocities of the runs of one strategy at "
+        "each friction μ (cf. Fig. 7)",
+        "_variants": "The runs of one experiment overlaid, each labelled by what it sets "
+        "differently (cf. Fig. 7)",
+    },
+    "namiki1999": {
+        "_filmstrip": "The run as a filmstrip of close-ups (cf. Figs. 6-8, the paper’s photo "
+        "sequences “Experimental Result: Grasping of a Hexahedron” and “… of a Sphere”)",
+    },
 }

@@ -81,6 +81,7 @@ def test_stick_runs_of_one_name_each_get_a_figure_and_the_overlay(stick, tmp_pat
     assert "stick_3step_variants.png" in pngs  # Fig. 7's velocities, each run labelled
     svg = (tmp_path / "stick_3step_variants.svg").read_text()
     assert "friction 1" in svg and "duration 300 ms" in svg
+    assert "stick_3step (duration 300 ms)" in svg  # as every run is named: name (label)
     assert "warning" not in r.stderr, r.stderr
 
 
@@ -229,3 +230,23 @@ def test_label_runs_gives_each_log_its_key_and_label(stick, catch):
     ]
     assert labels["catch_lat10"] == "stereo latency 10 ms"
     assert runs.titled("catch_lat10", logs[2]) == "catch_lat10 (stereo latency 10 ms)"
+
+
+def test_a_renamed_run_with_another_controller_is_a_variant_of_the_papers_own():
+    """A user's scenario ``extends: catch_optimised`` with its own controller is as far from
+    every catch scenario that differs only in controller params: it is compared with the
+    paper's own (fewest ``extends:`` steps), not the first such name in the alphabet."""
+    stored = {
+        k: v
+        for k, v in (runs._shipped("catch_optimised") or {}).items()
+        if not k.startswith("controller.params.")
+    }
+    stored.update({"name": "catch_mine", "controller.type": "my_module:MyController"})
+    assert runs._compare(stored, "catch_mine", "namiki2003") == (
+        "catch_optimised",
+        ["controller my_module:MyController"],
+    )
+    stick = dict(runs._shipped("stick_3step") or {}, name="stick_mine")
+    assert runs._compare(stick, "stick_mine", "higashimori2007") == ("stick_3step", [])
+    assert runs._depth("catch_optimised") == 0 and runs._depth("catch_initial") == 1
+    assert runs._depth("stick_3step_width10_long") == 2 and runs._depth("no_such") == 0

@@ -96,6 +96,12 @@ def test_fig6_footer_is_inside_the_figure(pair):
     try:
         assert_readable(fig)
         assert any("ω_max" in t.get_text() for t in fig.texts)
+        for ax in fig.axes:  # each run named, as in Figs. 7-9
+            said = [t.get_text() for t in ax.get_legend().get_texts()]
+            assert said == [
+                "catch_optimised: optimisation (eq. 25)",
+                "catch_initial: initial parameters",
+            ]
     finally:
         plt.close(fig)
 
@@ -231,3 +237,32 @@ def test_ablation_rates_have_n_and_wilson_error_bars(module, func, table, monkey
             assert not any("$" in t.get_text() for t in a.get_xticklabels())
     finally:
         plt.close(fig)
+
+
+PLOTTED = sorted(
+    p.stem for p in (ROOT / "sweeps").glob("*.yaml") if "\nplot: " in p.read_text(encoding="utf-8")
+)
+
+
+@pytest.mark.parametrize("sweep", PLOTTED)
+def test_every_ablation_plot_keeps_its_text_inside(sweep, monkeypatch, tmp_path):
+    """Each sweep's plot from its stored table: no title, label or legend runs off the figure
+    (grasp_components' title over axes pushed right by long part names did)."""
+    import importlib
+
+    import yaml
+
+    from replay.sweep.table import read_table
+
+    spec = yaml.safe_load((ROOT / "sweeps" / f"{sweep}.yaml").read_text(encoding="utf-8"))
+    module, func = spec["plot"].split(":")
+    mod = importlib.import_module(module)
+    drawn = []
+    monkeypatch.setattr(mod, "save", lambda fig, out, stem: drawn.append(fig) or [])
+    getattr(mod, func)(read_table(ROOT / "data" / "ablations" / f"{sweep}.csv"), tmp_path, sweep)
+    assert drawn
+    for fig in drawn:
+        try:
+            assert_readable(fig)
+        finally:
+            plt.close(fig)

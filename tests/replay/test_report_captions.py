@@ -62,6 +62,11 @@ def test_every_caption_names_the_runs_its_figure_shows(logs, tmp_path):
         named = set(re.findall(r"'([^']+)'", caption.replace("\\_", "_")))
         assert named == _expected(stem), (stem, caption)
     assert "in no figure" not in md  # every log is in a figure
+    for caption, stem in figures:  # a figure of no one figure of the paper says what it shows
+        assert not caption.replace("\\_", "_").startswith(stem), caption
+    said = {stem: caption for caption, stem in figures}
+    assert said["stick_3step_friction"].startswith("Friction independence: the velocities")
+    assert said["grasp_sphere_filmstrip"].startswith("The run as a filmstrip of close-ups")
     # the paper's Fig. 7 is drawn for the 3-step strategy: a 2-step run's is a "cf."
     two = next(c for c, stem in figures if stem == "stick_2step_fig7").replace("\\_", "_")
     three = next(c for c, stem in figures if stem == "stick_3step_fig7")
@@ -100,3 +105,38 @@ def test_a_variant_is_captioned_with_its_label_and_no_log_is_lost(logs, tmp_path
     variant = [c for c, stem in captions if "friction 1" in c and "_fig7" in stem]
     assert len(variant) == 1 and "'stick_3step (friction 1, duration 300 ms)'" in variant[0]
     assert "Log left out: junk.mcap" in md
+
+
+def test_the_commands_run_a_shipped_scenario_and_say_what_differs():
+    """A run whose scenario name is not shipped (a user's file ``extends: catch_optimised``) is
+    re-run from its nearest shipped scenario, never by a name ``replay run`` cannot find."""
+    from types import SimpleNamespace
+
+    from replay.report.builder import _commands
+
+    sec = SimpleNamespace(
+        key="namiki2003",
+        runs=[(k, 0, "") for k in ("catch_optimised", "catch_lat", "catch_mine", "catch_x", "z")],
+        scenarios={
+            "catch_optimised": ("catch_optimised", "", "catch_optimised"),
+            "catch_lat": ("catch_optimised", "stereo latency 10 ms", "catch_optimised"),
+            "catch_mine": ("catch_mine", "controller my_module:Mine", "catch_optimised"),
+            "catch_x": ("catch_x", "", "catch_optimised"),
+            "z": ("z", "", ""),
+        },
+        falsifiers=(),
+        ablations=[],
+        claims=[],
+    )
+    runs = [c for c in _commands([sec], []) if c.startswith("replay run")]
+    assert runs == [
+        "replay run catch_optimised --seed 0 -o out/logs/catch_optimised.mcap",
+        "replay run catch_optimised --seed 0 -o out/logs/catch_lat.mcap"
+        "   # differs from the shipped catch_optimised: stereo latency 10 ms",
+        "replay run catch_optimised --seed 0 -o out/logs/catch_mine.mcap   # catch_mine is not"
+        " shipped, its nearest is catch_optimised; it differs from it: controller my_module:Mine",
+        "replay run catch_optimised --seed 0 -o out/logs/catch_x.mcap   # catch_x is not"
+        " shipped, its nearest is catch_optimised; it sets nothing differently",
+        "replay run z --seed 0 -o out/logs/z.mcap   # z is not shipped; its scenario is in its"
+        " log (replay info)",
+    ]

@@ -142,8 +142,10 @@ def test_a_user_scenario_builds_on_a_shipped_one(installed):
 
 
 def test_a_controller_from_a_file_runs_and_its_log_is_analysed_elsewhere(installed, tmp_path):
-    """examples/my_controller.py beside its scenario in a user's folder (no packaging); the log
-    then read by figures, claims and report from a folder where that file is absent."""
+    """Issue #37's plug-in "done when": examples/my_controller.py beside its scenario in a user's
+    folder (no packaging) runs; ``figures``, ``claims``, ``report`` and ``compare`` succeed on
+    its log beside the paper's run and say what they skipped, in that folder and in one where
+    the file is absent."""
 
     replay, _, env = installed
     mine, other = tmp_path / "mine", tmp_path / "other"
@@ -151,13 +153,32 @@ def test_a_controller_from_a_file_runs_and_its_log_is_analysed_elsewhere(install
     other.mkdir()
     for f in ("my_controller.py", "my_controller.yaml"):
         shutil.copy(ROOT / "examples" / f, mine)
-    log = other / "keeper.mcap"
-    _sh([replay, "run", "my_controller.yaml", "--quiet", "-o", log], cwd=mine, env=env)
-    for args in (["figures", log, "-o", other / "figs"], ["claims", log], ["info", log]):
-        out = _sh([replay, *args], cwd=other, env=env)
-        assert "Traceback" not in out and "not imported" not in out, out[-2000:]
-    _sh([replay, "report", "-o", other / "report", "--logs", other], cwd=other, env=env)
-    assert (other / "report" / "index.html").is_file()
+    _sh([replay, "run", "my_controller.yaml", "--quiet", "-o", "keeper.mcap"], cwd=mine, env=env)
+    _sh([replay, "run", "catch_optimised", "--quiet", "-o", "opt.mcap"], cwd=mine, env=env)
+    for f in ("keeper.mcap", "opt.mcap"):
+        shutil.copy(mine / f, other)
+    skipped = "catch Fig. 7 left out: the log has no /effector/state, /arm/joint_command"
+    for folder in (mine, other):
+        logs = ["keeper.mcap", "opt.mcap"]
+        said = {
+            "figures": _sh([replay, "figures", *logs, "-o", "figs"], cwd=folder, env=env),
+            "claims alone": _sh([replay, "claims", "keeper.mcap"], cwd=folder, env=env),
+            "claims": _sh([replay, "claims", *logs], cwd=folder, env=env),
+            "compare": _sh([replay, "compare", *logs, "-o", "cmp"], cwd=folder, env=env),
+            "info": _sh([replay, "info", "keeper.mcap"], cwd=folder, env=env),
+        }
+        _sh([replay, "report", "-o", "report", "--logs", "."], cwd=folder, env=env)
+        said["report"] = (folder / "report" / "index.md").read_text(encoding="utf-8")
+        for what, out in said.items():
+            assert "Traceback" not in out and "unknown controller" not in out, (what, out[-2000:])
+        for what in ("figures", "compare", "report"):  # the paper's overlay, Figs. 6-9
+            assert "catch_goalkeeper: in no figure (catch Fig. 6 left out" in said[what], what
+            assert skipped in said[what], (what, said[what][-2000:])
+        assert "claims (arm capability rows) left out: the log has no" in said["claims alone"]
+        assert "catch_goalkeeper: 90° in" in said["claims"]  # (a row that reads what it has)
+        assert "controller my_controller:GoalKeeper" in said["compare"]
+        assert "catch_goalkeeper is not shipped, its nearest is catch_optimised" in said["report"]
+        assert (folder / "figs" / "catch_fig7.png").is_file()
 
 
 def test_a_wheel_built_without_a_c_compiler_has_no_compiled_code_and_runs(tmp_path):
@@ -235,7 +256,9 @@ def test_variants_of_an_experiment_are_overlaid_and_labelled_from_an_empty_folde
     `compare` puts the variant beside the paper's run."""
     replay, _, env = installed
     work = tmp_path / "runs"
-    work.mkdir()
+    for decoy in ("analysis", "plants"):  # a user's folders of the installed packages' names
+        (work / decoy).mkdir(parents=True)
+        (work / decoy / "__init__.py").write_text("MINE = True\n")
     runs = {
         "catch_optimised": ["catch_optimised"],
         "catch_initial": ["catch_initial"],
