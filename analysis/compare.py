@@ -157,11 +157,11 @@ def text(c: Comparison) -> str:
 
 
 def markdown(c: Comparison, figures: Sequence[tuple[str, str]] = ()) -> str:
-    """The comparison as Markdown, every cell escaped (:func:`replay.report.markup.md`);
+    """The comparison as Markdown, every cell escaped (:func:`analysis.report.markup.md`);
     ``figures``: (caption, link) of the overlaid figures, links relative to the file."""
     from urllib.parse import quote
 
-    from replay.report.markup import md
+    from analysis.report.markup import md
 
     n = len(c.keys)
     cols = [f"#{i + 1}" for i in range(n)]

@@ -121,7 +121,7 @@ def verdicts(stored_only: bool = False) -> list[Verdict]:
 def markdown(rows: list[Verdict]) -> str:
     """The theses as a Markdown table (cells escaped: a table's text is data)."""
     from replay.papers import PAPERS
-    from replay.report.markup import md
+    from analysis.report.markup import md
 
     lines = [
         "| paper | thesis | verdict | the numbers that decide it | figure |",
@@ -137,7 +137,7 @@ def markdown(rows: list[Verdict]) -> str:
 def html(rows: list[Verdict]) -> str:
     """The theses as an HTML table (every cell escaped)."""
     from replay.papers import PAPERS
-    from replay.report.markup import e
+    from analysis.report.markup import e
 
     head = (
         "<tr><th>paper</th><th>thesis</th><th>verdict</th><th>the numbers</th><th>figure</th></tr>"

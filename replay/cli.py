@@ -19,14 +19,15 @@ from replay.console import (
     fail,
     note,
     printable_streams,
-    quoted_warnings,
+    read_log,
     say,
     warn,
+    write_text,
 )
 from replay.foxglove.layouts import PAPERS as LAYOUT_PAPERS
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
-from replay.log.errors import LogLimitError, LogWriteError
+from replay.log.errors import LogWriteError
 from replay.log.output import (
     OutputConflictError,
     check_output,
@@ -34,19 +35,10 @@ from replay.log.output import (
     own_part,
     part_pid,
 )
-from replay.papers import PAPERS
-from replay.resources import find_scenario, scenario_dir
+from replay.resources import DEFAULT_LOG_DIR, find_scenario, scenario_dir
 from replay.scenario import ScenarioError, load_scenario
 from replay.scenario.yamlio import one_line
 from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
-
-DEFAULT_LOG_DIR = Path("out/logs")
-DEFAULT_FIGURE_DIR = Path("out/figures")
-# the first line of a `claims --markdown` file: what it may overwrite (an earlier claims table)
-CLAIMS_HEADER = "<!-- paper-replay claims table -->"
-DEFAULT_COMPARE_DIR = Path("out/compare")
-# the first line of a `compare --markdown` file: what it may overwrite (an earlier comparison)
-COMPARE_HEADER = "<!-- paper-replay comparison -->"
 
 
 _NoArgsIsHelp = getattr(click.exceptions, "NoArgsIsHelpError", ())  # click >= 8.2
@@ -373,16 +365,16 @@ def validate(scenarios, sets, static):
 
 
 def _warn_unpublished(path: str, sc) -> None:
-    """A warning when ``sc`` will not publish topics its paper's figures and claims read (a
-    brief trial run against its experiment's: analysis/published.py)."""
-    from analysis.published import unmet
-
-    try:
-        text = unmet(sc)
-    except Exception as exc:  # noqa: BLE001 - a plug-in failing in its first steps: one line
-        text = f"its trial run failed, so what it publishes is unknown: {type(exc).__name__}: {exc}"
-    if text:
-        warn(f"{path}: {text}")
+    """A warning from each installed scenario check (the ``paper_replay.checks`` entry points,
+    e.g. analysis/published.py: the topics its paper's figures and claims read that ``sc``
+    will not publish, from a brief trial run)."""
+    for name in registry.names("check"):
+        try:
+            text = registry.load("check", name)(sc)
+        except Exception as exc:  # noqa: BLE001 - a plug-in failing in its first steps: one line
+            text = f"its trial run failed, so what it publishes is unknown: {type(exc).__name__}: {exc}"
+        if text:
+            warn(f"{path}: {text}")
 
 
 @main.command("list")
@@ -466,13 +458,6 @@ def describe():
     click.echo(params_markdown(), nl=False)
 
 
-def _reader(path: str) -> LogReader:
-    try:
-        return LogReader(path).check()
-    except LogError as exc:
-        fail(str(exc))
-
-
 def _log_notes(name: str, r: LogReader) -> list[str]:
     """One line per thing a reader of this log must know (truncated, damaged, missing)."""
     return [f"{name}: {n}" for n in r.describe_problems()]
@@ -494,7 +479,7 @@ def info(log, kinds, no_events):
     wanted = None if kinds is None else {k.strip() for k in kinds.split(",") if k.strip()}
     if wanted is not None and not wanted:
         fail("--events: give one or more event kinds, e.g. --events outcome,collision")
-    r = _reader(log)
+    r = read_log(log)
     try:
         sc = r.scenario()
         click.echo(
@@ -617,311 +602,6 @@ def _short(v) -> str:
     return text if len(text) <= 80 else f"{text[:60]}…({len(text):,} characters)"
 
 
-def _logs_by_paper(logs) -> dict[str, dict[str, LogReader]]:
-    paths = logs or sorted(str(p) for p in DEFAULT_LOG_DIR.glob("*.mcap"))
-    if not paths:
-        fail(f"no logs given and none in {DEFAULT_LOG_DIR}/ (run `replay run SCENARIO` first)")
-    from analysis import runs
-
-    readers = []
-    for p in paths:
-        r = _reader(p)
-        why = runs.unreadable(r)
-        if why:  # (a colleague's log this version cannot type: the others are still analysed)
-            warn(f"left out: {p}: {why}")
-            continue
-        readers.append(r)
-    if not readers:
-        fail("none of the logs given is a run log this version reads (see the warnings)")
-    return runs.by_paper(readers)  # one key per log: two logs of one name are two runs
-
-
-def _partial(readers: dict[str, LogReader]) -> dict[str, list[str]]:
-    """name -> notes, for the logs that are truncated or damaged."""
-    out = {}
-    for name, r in readers.items():
-        notes = r.describe_problems()
-        if notes:
-            out[name] = notes
-    return out
-
-
-def _analysis_failed(what: str, paper: str, readers, exc: Exception) -> None:
-    partial = _partial(readers)
-    why = f" (partial logs: {', '.join(partial)})" if partial else ""
-    fail(
-        f"{what} for {paper} could not be made from {', '.join(readers)}{why}: "
-        f"{type(exc).__name__}: {exc}",
-        code=1,
-    )
-
-
-@main.command()
-@click.argument("logs", nargs=-1, type=click.Path(dir_okay=False))
-@click.option(
-    "-o",
-    "--out",
-    type=click.Path(file_okay=False),
-    default=str(DEFAULT_FIGURE_DIR),
-    show_default=True,
-)
-def figures(logs, out):
-    """Regenerate the papers' figures (PNG and SVG) from LOGS (default: out/logs/*.mcap)."""
-    for paper, readers in _logs_by_paper(logs).items():
-        for path in _paper_figures(paper, readers, Path(out)):
-            say(f"figure: {path}")
-
-
-def _paper_figures(paper: str, readers: dict[str, LogReader], out: Path) -> list[Path]:
-    """``paper``'s figures of ``readers`` written to ``out``; what they leave out warned."""
-    from analysis.figure_files import runs_of
-    from analysis.needs import figure_notes, skipped_notes
-
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        fail(f"cannot write figures to {out}: {exc.strerror or exc}")
-    try:
-        make = registry.load("figures", paper)
-    except registry.UnknownPlugin:
-        warn(f"{paper}: no figures defined yet ({', '.join(readers)})")
-        return []
-    try:
-        with quoted_warnings(), skipped_notes() as skipped:
-            paths = make(readers, out)
-    except OSError as exc:
-        fail(f"cannot write figures to {out}: {exc.strerror or exc}")
-    except LogError as exc:  # (a file there that is not an earlier figure)
-        fail(str(exc))
-    except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
-        _analysis_failed("figures", paper, readers, exc)
-    paths = [p if isinstance(p, Path) else Path(p) for p in paths]
-    shown = {k for p in paths for k in runs_of(p, readers)}
-    for text in figure_notes(readers, shown, skipped):
-        warn(text)
-    for name, notes in _partial(readers).items():
-        for text in notes:
-            warn(f"{name} is not a finished run ({text}): its figures show only what was logged")
-    return paths
-
-
-@main.command()
-@click.argument("logs", nargs=-1, type=click.Path(dir_okay=False))
-@click.option("--markdown", type=click.Path(dir_okay=False), help="also write the table here")
-def claims(logs, markdown):
-    """The papers' stated numbers against the runs in LOGS (default: out/logs/*.mcap)."""
-    from analysis.claims import falsifiers_of, format_table, shown
-    from analysis.engines import evaluate_runs
-    from analysis.needs import skipped_notes
-    from replay.report.builder import claims_markdown
-    from replay.report.markup import md
-
-    sections, md_sections = [], []
-    by_paper = _logs_by_paper(logs)
-    inputs = {Path(r.path).resolve() for readers in by_paper.values() for r in readers.values()}
-    if markdown and (
-        Path(markdown).resolve() in inputs or Path(markdown).suffix in (".mcap", ".yaml", ".yml")
-    ):
-        fail(f"will not write the claims table over {markdown} (a log or a scenario)")
-    if markdown:  # (before the analysis: only a new file or an earlier claims table)
-        try:
-            check_output(Path(markdown), kind="claims table", magic=CLAIMS_HEADER.encode())
-        except LogError as exc:
-            fail(str(exc))
-    for paper, readers in by_paper.items():
-        try:
-            evaluate = registry.load("claims", paper)
-        except registry.UnknownPlugin:
-            warn(f"{paper}: no claims defined yet")
-            continue
-        try:
-            with skipped_notes() as skipped:  # (rows left out for a topic a log lacks)
-                rows, engines_note = evaluate_runs(evaluate, readers)  # both engines, if both ran
-        except LogLimitError as exc:  # a log asking for more than a limit: the input's fault
-            fail(str(exc))
-        except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
-            _analysis_failed("claims", paper, readers, exc)
-        for text in skipped:
-            warn(text)
-        title = PAPERS[paper].title if paper in PAPERS else paper
-        partial, falsifiers = _partial(readers), falsifiers_of(evaluate)
-        record = shown(paper)  # (what `replay falsify --store` showed flipping)
-        closing = f"\n\n{engines_note}" if engines_note else ""
-        sections.append(format_table(title, rows, partial, falsifiers, record) + closing)
-        left = "".join(f"\n\n> {md(t)}" for t in skipped)  # (a topic a log lacks)
-        md_sections.append(
-            claims_markdown(title, rows, falsifiers, partial, record) + closing + left
-        )
-    say("\n\n".join(sections))
-    if markdown:  # (the log's names escaped: no raw HTML where the Markdown is rendered)
-        text = "\n\n".join([CLAIMS_HEADER, *md_sections]) + "\n"
-        _write_output(Path(markdown), text, kind="claims table", magic=CLAIMS_HEADER.encode())
-
-
-@main.command()
-@click.option("--stored", is_flag=True, help="only the stored tables (data/ablations/)")
-@click.option("--markdown", is_flag=True, help="as the Markdown table README.md shows")
-def theses(stored, markdown):
-    """Each paper's thesis and its verdict, decided by its ablations' tables (this machine's
-    runs under out/ablations/ first, else the stored ones)."""
-    from analysis import theses as th
-
-    rows = th.verdicts(stored_only=stored)
-    if markdown:
-        say(th.markdown(rows))
-        return
-    for v in rows:
-        say(f"{v.thesis.paper}: {v.thesis.claim}")
-        say(one_line(f"  {v.verdict}: {v.numbers} ({v.figure}, {v.source})"))
-
-
-@main.command()
-@click.argument("logs", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option(
-    "-o",
-    "--out",
-    type=click.Path(file_okay=False),
-    default=str(DEFAULT_COMPARE_DIR),
-    show_default=True,
-    help="where the overlaid figures go",
-)
-@click.option("--no-figures", is_flag=True, help="only the tables (faster: no figures made)")
-@click.option("--markdown", type=click.Path(dir_okay=False), help="also write it here")
-def compare(logs, out, no_figures, markdown):
-    """Runs side by side, from their LOGS (2 or more; normally runs of one experiment): the
-    scenario fields that differ, each run's outcome and metrics, and the papers' figures
-    overlaying them (in -o)."""
-    from analysis.compare import MAX_RUNS, compare, markdown as compare_md, text
-    from analysis.runs import unreadable
-
-    readers, seen = [], set()
-    for p in logs:
-        try:
-            r = LogReader(p).check()
-        except LogError as exc:
-            warn(f"left out: {exc}")
-            continue
-        why = unreadable(r)
-        if why:
-            warn(f"left out: {p}: {why}")
-            continue
-        if r.path.resolve() in seen:
-            warn(f"left out: {p}: given twice")
-            continue
-        seen.add(r.path.resolve())
-        readers.append(r)
-    if len(readers) > MAX_RUNS:
-        for r in readers[MAX_RUNS:]:
-            warn(f"left out: {r.path}: at most {MAX_RUNS} runs are compared")
-        readers = readers[:MAX_RUNS]
-    if len(readers) < 2:
-        fail(
-            f"compare needs 2 readable run logs; {len(readers)} of {len(logs)} given could be read"
-        )
-    md_path = Path(markdown) if markdown else None
-    if md_path is not None:  # (before the analysis: only a new file or an earlier comparison)
-        if md_path.resolve() in seen or md_path.suffix in (".mcap", ".yaml", ".yml"):
-            fail(f"will not write the comparison over {markdown} (a log or a scenario)")
-        try:
-            check_output(md_path, kind="comparison", magic=COMPARE_HEADER.encode())
-        except LogError as exc:
-            fail(str(exc))
-    c = compare(readers)
-    say(text(c))
-    for t in c.notes:
-        warn(t)
-    made: list[Path] = []
-    if not no_figures:
-        from analysis import runs
-
-        for paper, keyed in runs.by_paper(readers).items():
-            made += _paper_figures(paper, keyed, Path(out))
-        for path in made:
-            say(f"figure: {path}")
-    if md_path is not None:
-        import os
-
-        base = md_path.resolve().parent
-        shown = [
-            (p.stem, Path(os.path.relpath(p.resolve(), base)).as_posix())
-            for p in made
-            if p.suffix == ".png"
-        ]
-        body = compare_md(c, shown)
-        _write_output(
-            md_path, f"{COMPARE_HEADER}\n{body}", kind="comparison", magic=COMPARE_HEADER.encode()
-        )
-        say(f"markdown: {md_path}")
-
-
-@main.command()
-@click.argument("papers", nargs=-1)
-@click.option(
-    "--logs",
-    "logs_dir",
-    type=click.Path(file_okay=False, exists=True),
-    help="baseline logs from this folder (e.g. out/logs) instead of fresh runs",
-)
-@click.option(
-    "--keep",
-    type=click.Path(file_okay=False),
-    help="write the runs here and keep them (default: a temporary folder)",
-)
-@click.option(
-    "--store",
-    is_flag=True,
-    help="record the verdicts (when, code version, rows flipped) in data/claims/falsified.json",
-)
-def falsify(papers, logs_dir, keep, store):
-    """Run each claims row's falsifier (a variant under which the paper's claim is false) and
-    require its row to read "differs"; one line per falsifier (row | variant | verdict). Exits 1
-    if a measured reproduced row has no falsifier or is not flipped by it. PAPERS default to
-    every paper with a claims table. With --store the result is kept, and the claims table
-    counts a reproduced row only if it is recorded as flipped."""
-    import tempfile
-
-    from analysis import falsify as fz
-
-    names = list(papers) or [p for p in PAPERS if _has_claims(p)]
-    for p in names:
-        if not _has_claims(p):
-            fail(f"{p}: no claims table (known: {', '.join(q for q in PAPERS if _has_claims(q))})")
-    failed = 0
-    with tempfile.TemporaryDirectory(prefix="replay-falsify-") as tmp:
-        work = Path(keep) if keep else Path(tmp)
-        for paper in names:
-            try:
-                verdicts = fz.falsify_paper(
-                    paper,
-                    work / paper,
-                    Path(logs_dir) if logs_dir else None,
-                    progress=note,
-                )
-            except (LogError, ScenarioError) as exc:
-                fail(f"{paper}: {one_line(str(exc))}", code=1)
-            click.echo(f"## {paper}")
-            for v in verdicts:
-                say(v.line())
-            bad = sum(not v.ok for v in verdicts)
-            ran = sum(bool(v.status) for v in verdicts)
-            click.echo(f"{paper}: {ran} falsifiers run, {bad} failing")
-            if store:
-                how = f" --logs {logs_dir}" if logs_dir else ""
-                path = fz.store(paper, verdicts, f"replay falsify {paper}{how} --store")
-                note(f"{paper}: stored in {path}")
-            failed += bad
-    if failed:
-        sys.exit(1)
-
-
-def _has_claims(paper: str) -> bool:
-    try:
-        registry.load("claims", paper)
-    except registry.UnknownPlugin:
-        return False
-    return True
-
-
 @main.group()
 def golden():
     """Golden-log regression: `check` compares fresh runs, `update` rewrites them."""
@@ -996,28 +676,6 @@ def golden_update(names, quiet):
     note("commit the golden logs with the reason for the change in the commit message")
 
 
-def _write_output(path: Path, text: str, *, kind: str, magic: bytes) -> None:
-    """Write ``text`` to ``path`` (mode 0644, atomically); never over a scenario, a log or a
-    file that is not an earlier output of this kind (one that starts with ``magic``)."""
-    import os
-    import tempfile
-
-    if path.suffix in (".yaml", ".yml", ".mcap"):
-        fail(f"will not write the {kind} over {path} (a scenario or a log): give another -o")
-    try:
-        check_output(path, kind=kind, magic=magic)
-    except LogError as exc:
-        fail(str(exc))
-    try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except OSError as exc:
-        fail(f"cannot write {path}: {exc.strerror or exc}")
-
-
 @main.command()
 @click.option(
     "-o",
@@ -1036,7 +694,7 @@ def schema(out):
     if not out:
         click.echo(text, nl=False)
         return
-    _write_output(Path(out), text, kind="JSON Schema", magic=b"{")
+    write_text(Path(out), text, kind="JSON Schema", magic=b"{")
     click.echo(f"wrote {out}")
 
 
@@ -1064,7 +722,7 @@ def urdf(scenario, out, sets):
         plant.close()
     if not text:
         fail(f"{scenario}: plant {sc.plant.type!r} has no URDF")
-    _write_output(Path(out), text, kind="URDF", magic=b"<?xml")
+    write_text(Path(out), text, kind="URDF", magic=b"<?xml")
     click.echo(f"wrote {out}")
 
 
@@ -1113,7 +771,7 @@ def layout(paper, out):
     if not out:
         click.echo(text, nl=False)
         return
-    _write_output(Path(out), text, kind="Foxglove layout", magic=b"{")
+    write_text(Path(out), text, kind="Foxglove layout", magic=b"{")
     click.echo(f"wrote {out}")
 
 
@@ -1139,9 +797,11 @@ def rerun(log, web, port, at, shot):
         fail(str(exc))
 
 
-from replay.sweep.commands import register  # noqa: E402  (replay sweep, ablate, report)
+from replay.sweep.commands import register  # noqa: E402  (replay sweep, ablate)
 
 register(main)
+for _name in registry.names("commands"):  # installed packages' commands (analysis: figures, ...)
+    registry.load("commands", _name)(main)
 
 if __name__ == "__main__":
     main()

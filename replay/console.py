@@ -10,14 +10,19 @@ from __future__ import annotations
 
 import codecs
 import contextlib
+import errno
 import sys
 import time
 import warnings
-from typing import IO, Any, NoReturn
+from pathlib import Path
+from typing import IO, TYPE_CHECKING, Any, NoReturn
 
 import click
 
 from replay.scenario.yamlio import one_line
+
+if TYPE_CHECKING:
+    from replay.log import LogReader
 
 REDRAW = 0.1  # s of wall time between redraws of a bar
 
@@ -202,3 +207,37 @@ class RunProgress:
         if self._bar is not None:
             self._bar.close()
             self._bar = None
+
+
+# -- files the commands read and write, their failures one line ------------------------------
+def read_log(path: str | Path) -> LogReader:
+    """A checked :class:`~replay.log.LogReader` of ``path``, or the one-line error."""
+    from replay.log import LogError, LogReader
+
+    try:
+        return LogReader(path).check()
+    except LogError as exc:
+        fail(str(exc))
+
+
+def write_text(path: Path, text: str, *, kind: str, magic: bytes) -> None:
+    """Write ``text`` to ``path`` (mode 0644, whole: :func:`replay.log.output.write_output`);
+    never over a scenario, a log or a file that is not an earlier output of this ``kind`` (one
+    that starts with ``magic``)."""
+    from replay.log import LogError
+    from replay.log.output import check_output, write_output
+
+    if path.suffix in (".yaml", ".yml", ".mcap"):
+        fail(f"will not write the {kind} over {path} (a scenario or a log): give another -o")
+    try:
+        check_output(path, kind=kind, magic=magic)
+        write_output(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    except LogError as exc:
+        fail(str(exc))
+    except OSError as exc:
+        fail(f"cannot write {path}: {exc.strerror or exc}", code=exit_code(exc))
+
+
+def exit_code(exc: OSError) -> int:
+    """Exit code of a failed write: 1 for the disk (full, I/O error), 2 for the place given."""
+    return 1 if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO) else 2

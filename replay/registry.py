@@ -28,6 +28,8 @@ GROUPS = {
     "figures": "paper_replay.figures",  # paper key -> make(logs_by_name, outdir) -> paths
     "claims": "paper_replay.claims",  # paper key -> evaluate(logs_by_name) -> [Claim]
     "viewer_scene": "paper_replay.viewer_scenes",  # plant type -> replay.viewer RunScene class
+    "commands": "paper_replay.commands",  # name -> register(click group): more `replay` commands
+    "check": "paper_replay.checks",  # name -> check(scenario) -> a warning for `validate`, or ""
 }
 
 

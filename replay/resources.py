@@ -13,6 +13,9 @@ from pathlib import Path
 
 _CHECKOUT = Path(__file__).resolve().parents[1]
 
+# where `replay run` writes a log by default, and where the analysis commands look for logs
+DEFAULT_LOG_DIR = Path("out/logs")
+
 
 def _root(kind: str) -> Path:
     local = _CHECKOUT / kind

@@ -1,16 +1,15 @@
-"""``replay sweep``, ``replay ablate`` and ``replay report``: registered into replay.cli by
+"""``replay sweep`` and ``replay ablate``: registered into replay.cli by
 :func:`register`. Bad input gets one line and exit code 2."""
 
 from __future__ import annotations
 
-import errno
 import sys
 from pathlib import Path
 
 import click
 
 from replay import completion as complete
-from replay.console import fail, note, quoted_warnings, say
+from replay.console import exit_code, fail, note
 from replay.log import LogError
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.lock import SweepOutputError
@@ -261,53 +260,24 @@ def ablate(
                 try:
                     click.echo(f"stored: {ablations.store(sf.name, table)}")
                 except OSError as exc:
-                    fail(f"cannot store {sf.name}'s table: {exc.strerror or exc}", code=_code(exc))
+                    fail(
+                        f"cannot store {sf.name}'s table: {exc.strerror or exc}",
+                        code=exit_code(exc),
+                    )
         try:
             plots = ablations.plot(sf, table, out)
         except LogError as exc:  # a link or another program's file at a plot's path
             fail(f"{sf.name}: {exc}")
         except OSError as exc:
-            fail(f"cannot write {sf.name}'s plots to {out}: {exc.strerror or exc}", code=_code(exc))
+            fail(
+                f"cannot write {sf.name}'s plots to {out}: {exc.strerror or exc}",
+                code=exit_code(exc),
+            )
         for path in plots:
             click.echo(f"plot: {path}")
-
-
-@click.command()
-@click.option(
-    "-o", "--out", type=click.Path(file_okay=False), default="out/report", show_default=True
-)
-@click.option(
-    "--logs",
-    type=click.Path(file_okay=False),
-    default="out/logs",
-    show_default=True,
-    help="the runs whose figures and claims go in",
-)
-def report(out, logs):
-    """Write the reproduction report (index.html and index.md): per paper the regenerated
-    figures, the claims table and the ablation plots; versions, seeds and commands."""
-    from replay.report import ReportFolderError, build_report
-
-    if not Path(logs).is_dir():
-        note(f"no {logs}/: the report has no figures or claims (run `make run`)")
-    try:
-        with quoted_warnings():
-            path = build_report(out, logs)
-    except ReportFolderError as exc:  # (nothing touched)
-        fail(str(exc))
-    except OSError as exc:  # a read-only or full disk: one line (1: the disk, 2: the folder)
-        where = f" ({exc.filename})" if exc.filename else ""
-        fail(f"cannot write the report to {out}{where}: {exc.strerror or exc}", code=_code(exc))
-    say(f"report: {path} (and {path.with_suffix('.md')})")
-
-
-def _code(exc: OSError) -> int:
-    """Exit code of a failed write: 1 for the disk (full, I/O error), 2 for the place given."""
-    return 1 if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO) else 2
 
 
 def register(group: click.Group) -> None:
     """Add this package's commands to the ``replay`` group."""
     group.add_command(sweep)
     group.add_command(ablate)
-    group.add_command(report)

@@ -155,7 +155,7 @@ def test_claims_show_the_rates_only_beside_both_engines(stored):
 def test_the_report_names_the_mujoco_version():
     from importlib import metadata
 
-    from replay.report.builder import _provenance
+    from analysis.report.builder import _provenance
 
     assert _provenance("x")["mujoco"] == metadata.version("mujoco")
 
@@ -164,7 +164,7 @@ def test_the_report_names_the_command_of_the_stored_rates():
     from types import SimpleNamespace
 
     from analysis.engine_rates import COMMAND
-    from replay.report.builder import _commands
+    from analysis.report.builder import _commands
 
     rows = stored_rate_rows("namiki2003", STORED)
     with_rates = [SimpleNamespace(runs=[], falsifiers=(), ablations=[], key="k", claims=rows)]
@@ -175,7 +175,7 @@ def test_the_report_names_the_command_of_the_stored_rates():
 
 def test_the_reports_engine_note_keeps_its_lines():
     """The closing note's three lines (both, one, neither) stay three in Markdown and HTML."""
-    from replay.report.builder import PaperSection, _html, _markdown
+    from analysis.report.builder import PaperSection, _html, _markdown
 
     sec = PaperSection("k", "T", "A", notes=["Hold in both: a\nHold in one: b\nneither: c"])
     md = _markdown([sec], {}, [])

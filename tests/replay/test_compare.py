@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from replay.cli import COMPARE_HEADER
+from analysis.commands import COMPARE_HEADER
 from replay.log import LogReader, LogWriter
 from replay.messages import TOPIC_SCENARIO
 

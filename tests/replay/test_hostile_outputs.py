@@ -15,10 +15,10 @@ from pathlib import Path
 import pytest
 
 from analysis.figure_files import STEM_LENGTH, file_stem
-from replay.cli import CLAIMS_HEADER
+from analysis.commands import CLAIMS_HEADER
 from replay.log import LogReader, LogWriter
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
-from replay.report.folder import MARKER
+from analysis.report.folder import MARKER
 
 from cli_checks import invoke, one_error
 
@@ -149,7 +149,7 @@ def test_info_escapes_what_an_outcome_event_holds(stick_3step_log, tmp_path):
 def site(stick_3step_log, tmp_path, monkeypatch):
     """tmp/work (the working folder, with files of its own) and tmp/work/logs with one log;
     the report's content is a stub (the folder is what these tests are about: ms, not s)."""
-    import replay.report.builder as builder
+    import analysis.report.builder as builder
 
     def stub(out, logs_dir):
         (out / "figures").mkdir()
@@ -212,7 +212,7 @@ def test_report_replaces_its_own_folder_and_keeps_it_when_a_build_fails(site, mo
     assert not stale.exists() and (site / "rep" / "index.html").is_file()  # replaced whole
     good = tree(site / "rep")
 
-    import replay.report.builder as builder
+    import analysis.report.builder as builder
 
     def broken(out, logs_dir):
         (out / "index.html").write_text("half a report")
@@ -328,8 +328,10 @@ def test_report_escapes_every_payload_in_markdown(hostile_report):
     for line in inner.splitlines():  # a name and a seed are one shell word each
         if line.startswith("replay run "):
             assert "rm -rf ~'" in line or "rm -rf" not in line, line
-            log = line.split(" -o ", 1)[1]
+            log = line.split(" -o ", 1)[1].partition("   # ")[0]  # (then what it differs in)
             assert log.startswith("out/logs/") and SAFE_FILE.fullmatch(log[len("out/logs/") :])
+    block = inner[: inner.index(fence.group(1))].splitlines()
+    assert all(line.startswith("replay ") for line in block if line), block  # no line broken off
 
 
 # -- claims --markdown ------------------------------------------------------------------------
@@ -378,7 +380,7 @@ def test_validate_names_a_hostile_file_name_without_its_escapes(tmp_path):
 def test_the_report_removes_only_what_it_made(tmp_path):
     """swap_in checks the old folder again (it may change during a build): a folder that became
     foreign is not removed; discard removes a staging folder only (its marker inside)."""
-    from replay.report.folder import MARKER, ReportFolderError, discard, staging, swap_in
+    from analysis.report.folder import MARKER, ReportFolderError, discard, staging, swap_in
 
     target = tmp_path / "report"
     target.mkdir()

