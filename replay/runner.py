@@ -29,6 +29,7 @@ import numpy as np
 from replay import __version__, registry, version
 from replay.foxglove.run import RunTopics
 from replay.log import LogWriter, NonFiniteValueError
+from replay.log.memory import KeptLog
 from replay.log.unwritten import NoTopics, UnwrittenLog
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
 from replay.scenario import Scenario, resolved_yaml
@@ -155,11 +156,12 @@ class Runner:
 
     # -- the run, step by step: start(out), step() until done, finish() ----------------------
 
-    def run(self, out: str | Path | None) -> RunResult:
-        """The whole run into the log ``out`` (None: no log, the outcome and events alike):
-        :meth:`start`, :meth:`step` until :attr:`done`, :meth:`finish`. Ctrl-C closes the log
-        (kept) and raises :class:`RunInterrupted`."""
-        self.start(out)
+    def run(self, out: str | Path | None, *, keep: bool = False) -> RunResult:
+        """The whole run into the log ``out`` (None: no log, the outcome and events alike;
+        with ``keep`` its messages kept in memory instead, read as a log's through
+        ``self.log.reader()``): :meth:`start`, :meth:`step` until :attr:`done`, :meth:`finish`.
+        Ctrl-C closes the log (kept) and raises :class:`RunInterrupted`."""
+        self.start(out, keep=keep)
         progress_div = max(1, self.rate // 20)
         try:
             while not self.done:
@@ -175,9 +177,10 @@ class Runner:
             self.plant.close()
             raise
 
-    def start(self, out: str | Path | None) -> None:
-        """Open the log ``out`` and write what a run starts with (its provenance, the resolved
-        scenario, the robot's description); the run is at step 0."""
+    def start(self, out: str | Path | None, *, keep: bool = False) -> None:
+        """Open the log ``out`` (None: none; with ``keep``, the messages kept in memory: a
+        :class:`~replay.log.memory.KeptLog`) and write what a run starts with (its provenance,
+        the resolved scenario, the robot's description); the run is at step 0."""
         sc = self.sc
         self.result = RunResult(path=Path(out if out is not None else os.devnull))
         self._wall0 = time.perf_counter()
@@ -189,7 +192,9 @@ class Runner:
         # (deliver at step, sequence, topic, payload), delivered in that order whatever the
         # sensors' order and latencies
         self._pending: list = []
-        log = self.log = LogWriter(out) if out is not None else UnwrittenLog()
+        log = self.log = (
+            LogWriter(out) if out is not None else KeptLog() if keep else UnwrittenLog()
+        )
         commit = _git_commit() or "unknown"
         log.metadata("provenance", provenance(sc, commit))
         text = resolved_yaml(sc)
