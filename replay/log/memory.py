@@ -14,9 +14,14 @@ from collections import Counter
 from pathlib import Path
 from typing import Any, Iterator
 
+import yaml
+
 from replay.log.reader import LogMessages, RawMessage
 from replay.log.unwritten import UnwrittenLog
 from replay.log.writer import encode
+
+
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 class KeptLog(UnwrittenLog):
@@ -62,6 +67,12 @@ class MemoryReader(LogMessages):
         for m in self._kept:
             if m[0] in wanted:
                 yield m
+
+    def _stored_config(self, text) -> dict:
+        """The run's own resolved scenario as data: the text the runner wrote (a scenario that
+        loaded, so within every bound a log's is checked against), read by libyaml where PyYAML
+        has it (~10x the pure-Python parser a log's text is checked with; the same data)."""
+        return yaml.load(text, Loader=_LOADER)
 
     @property
     def status(self) -> str:

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
+import orjson
 import yaml
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import RecordLengthLimitExceeded
@@ -45,6 +46,10 @@ from replay.log.chunks import MAGIC
 from replay.log.errors import LogError, LogLimitError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
+_loads = orjson.loads
+# every digit as "0", every other byte as " ": a run of 20 digits is then a plain substring
+_DIGITS_ONLY = bytes(0x30 if 0x30 <= i <= 0x39 else 0x20 for i in range(256))
+_TWENTY_DIGITS = b"0" * 20
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
 _OPCODES = range(0x01, 0x10)  # MCAP's record opcodes (0x00 is none: zeros are not records)
 _HEAD = struct.Struct("<BQ")  # a record's opcode and length
@@ -181,10 +186,20 @@ def _fields(data: dict) -> dict:
 
 
 def _decode(data: bytes) -> dict | None:
+    """A message's JSON object (None if it is not one). orjson first (~4x the standard
+    decoder's speed: a sweep's metrics decode thousands of messages a variant); what it refuses
+    (a lone surrogate, ``NaN``, UTF-16 text, deep nesting) or reads otherwise (a whole number
+    past 64 bits, which it makes a float: any run of 20 digits is left to the other) is read by
+    the standard decoder, so every message reads as ``json.loads`` reads it."""
     try:
-        value = json.loads(data)
-    except (ValueError, UnicodeDecodeError, RecursionError):
-        return None
+        if _TWENTY_DIGITS in data.translate(_DIGITS_ONLY):  # (~0.3 us: no regex scan)
+            raise ValueError
+        value = _loads(data)
+    except ValueError:  # (orjson.JSONDecodeError is one)
+        try:
+            value = json.loads(data)
+        except (ValueError, UnicodeDecodeError, RecursionError):
+            return None
     return value if isinstance(value, dict) else None
 
 
