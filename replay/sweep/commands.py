@@ -12,6 +12,7 @@ import click
 from replay import completion as complete
 from replay.console import fail, note, quoted_warnings, say
 from replay.log import LogError
+from replay.scenario.schema import LOG_LEVELS
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.lock import SweepOutputError
 from replay.sweep.spec import SweepSpecError
@@ -72,8 +73,13 @@ DEFAULT_SWEEP_OUT = Path("out/sweeps")
 @click.option(
     "--no-logs",
     is_flag=True,
-    help="keep no variant's MCAP log: none is written (a temporary one only where the sweep's "
-    "metrics function reads it); the rows are the same",
+    help="keep no variant's MCAP log: none is written (a metrics function reads the run's "
+    "messages in memory); the rows are the same",
+)
+@click.option(
+    "--log-level",
+    type=click.Choice(LOG_LEVELS),
+    help="what each variant's log holds (as --set log.level=LEVEL; default: the scenario's log:)",
 )
 @click.option(
     "--retry-failed",
@@ -93,6 +99,7 @@ def sweep(
     executor,
     address,
     no_logs,
+    log_level,
     retry_failed,
     quiet,
 ):
@@ -103,6 +110,7 @@ def sweep(
     from replay.sweep.spec import check_seed, from_options
 
     scenario = find_scenario(scenario)
+    sets = (*sets, f"log.level={log_level}") if log_level else sets
     try:
         spec = from_options(grids, randoms, n)
     except SweepSpecError as exc:
