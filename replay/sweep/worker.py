@@ -42,7 +42,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
 
         for kind, name, folder in task.get("plugins", ()):  # (a forked worker has them already)
             registry.import_plugin(kind, name, folder)
-        sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>")
+        sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>", resolved=True)
         set_file_dirs(sc, task.get("file_dirs") or {})
         if log:
             Path(log).parent.mkdir(parents=True, exist_ok=True)
