@@ -27,6 +27,7 @@ from typing import Any, Iterable
 from replay import registry
 from replay.sweep.executors import WORKER_DIED, default_workers, run_local, run_ray
 from replay.sweep.lock import FolderLock, SweepOutputError
+from replay.sweep.results import SUMMARY, write_summary
 from replay.sweep.table import as_bool, param_columns, read_table, refuse_link, write_table
 from replay.sweep.variants import Variant
 from replay.sweep.worker import INTERRUPTED
@@ -190,7 +191,12 @@ def _run_locked(
     retry_failed,
 ) -> SweepSummary:
     table = out_dir / TABLE
-    for path in (table, out_dir / STALE, *([out_dir / "logs"] if keep_logs else [])):
+    for path in (
+        table,
+        out_dir / STALE,
+        out_dir / SUMMARY,
+        *([out_dir / "logs"] if keep_logs else []),
+    ):
         refuse_link(path)  # (before anything is read from them)
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
@@ -277,7 +283,9 @@ def _run_locked(
         bar.close()
         if ran:
             save()  # (every finished row, whatever the last writes left out)
-    done = list(_with_params(rows.values(), by_key))
+    done = sorted(_with_params(rows.values(), by_key), key=lambda r: int(r["index"]))
+    if done:
+        write_summary(out_dir / SUMMARY, done, params)  # (the rate of each cell)
     ok = sum(as_bool(r.get("success")) for r in done)
     return SweepSummary(
         total=len(variants),
@@ -287,7 +295,7 @@ def _run_locked(
         failed=len(done) - ok,
         wall_time=time.perf_counter() - t0,
         table=table,
-        rows=sorted(done, key=lambda r: int(r["index"])),
+        rows=done,
         interrupted=interrupted,
         stale=len(stale),
     )

@@ -142,7 +142,7 @@ def test_the_lock_is_removed_when_the_sweep_ends_and_a_stale_one_taken_over(toy_
     out.mkdir()
     (out / "sweep.lock").write_text("12345\n0\nreplay sweep (killed)\n")  # (unlocked: stale)
     assert _sweep(toy_yaml, out, grid="plant.params.mass=1,2", keep_logs=False).ran == 2
-    assert sorted(p.name for p in out.iterdir()) == ["table.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["summary.csv", "table.csv"]
 
 
 def test_a_lock_file_removed_under_a_sweep_is_opened_again(tmp_path, monkeypatch):
