@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from replay import completion as complete
-from replay.console import fail, note, quoted_warnings, say
+from replay.console import fail, note, quoted_warnings, say, warn
 from replay.log import LogError
 from replay.scenario.schema import LOG_LEVELS
 from replay.sweep.executors import EXECUTORS, ExecutorError
@@ -139,9 +139,22 @@ def sweep(
         not quiet,
         retry_failed=retry_failed,
     )
+    if summary.rows:
+        _plot(out)
     click.echo(summary.line())
     if summary.interrupted:
         sys.exit(143 if summary.terminated else 130)
+
+
+def _plot(out: Path) -> None:
+    """``out/summary.png``/``.svg``: each cell's rate (analysis/sweep_plot.py); a plot that
+    cannot be written is a warning, the sweep's table and summary being written already."""
+    from analysis.sweep_plot import plot_summary
+
+    try:
+        plot_summary(out / "summary.csv", out)
+    except (LogError, OSError, TableError) as exc:
+        warn(f"no plot of the sweep: {exc}")
 
 
 def _run(

@@ -50,3 +50,24 @@ def test_a_sweep_writes_each_cell_s_rate_with_its_interval(toy_yaml, tmp_path):
         assert float(c["rate"]) == pytest.approx(ok / 3, abs=1e-3)
         got = (float(c["rate_lo_95"]), float(c["rate_hi_95"]))
         assert got == pytest.approx((lo, hi), abs=1e-3) and lo > 0.4  # (3/3: 0.44-1)
+
+
+@pytest.mark.parametrize(
+    "grid",
+    [
+        ["plant.params.mass=1,2,4", "seed=1,2"],  # one numeric axis: the x axis
+        ["plant.params.mass=1,2", "plant.params.blow_up_at=-1,5", "seed=1"],  # cells named
+    ],
+)
+def test_any_sweep_draws_its_cells_rates(toy_yaml, tmp_path, grid):
+    from click.testing import CliRunner
+
+    from replay.cli import main
+
+    out = tmp_path / "sweep"
+    args = ["sweep", str(toy_yaml), *[a for g in grid for a in ("--grid", g)], "-o", str(out)]
+    r = CliRunner().invoke(main, [*args, "--no-logs", "-q", "--workers", "1"])
+    assert r.exit_code == 0, r.output
+    assert len(r.output.strip().splitlines()) == 1  # (the summary line: the plot says nothing)
+    assert (out / "summary.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert b"success rate" in (out / "summary.svg").read_bytes()
