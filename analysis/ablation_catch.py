@@ -26,6 +26,7 @@ from analysis.ablation_plot import (  # noqa: E402
     shifts,
 )
 from analysis.figure_files import save  # noqa: E402
+from replay.sweep.results import wilson  # noqa: E402
 
 
 def catch_metrics(log) -> dict:
@@ -444,17 +445,6 @@ SHARED_CELLS: dict[str, dict] = {
     "latency 5 ms (1 kHz)": {"throws": {}, "set": {"sensors.stereo.latency": 0.005}},
     "mid-flight kick": {"throws": {}, "set": {"plant.params.object_impulses": KICK}},
 }
-
-
-def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
-    """The Wilson score 95 % interval of a rate k/n (Wilson 1927)."""
-    if n == 0:
-        return 0.0, 1.0
-    p = k / n
-    den = 1.0 + z * z / n
-    mid = (p + z * z / (2 * n)) / den
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return float(max(0.0, mid - half)), float(min(1.0, mid + half))
 
 
 def rate_cell(k: int, n: int, why) -> str:

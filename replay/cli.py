@@ -37,6 +37,7 @@ from replay.log.output import (
 )
 from replay.resources import DEFAULT_LOG_DIR, find_scenario, scenario_dir
 from replay.scenario import ScenarioError, load_scenario
+from replay.scenario.schema import LOG_LEVELS
 from replay.scenario.yamlio import one_line
 from replay.viewer.timeline import DEFAULT_SPEED, SPEEDS
 
@@ -100,6 +101,11 @@ def _load(path: str, sets=(), seed=None):
     help="override a scenario field (repeatable)",
 )
 @click.option("--seed", type=int, help="override the scenario's seed")
+@click.option(
+    "--log-level",
+    type=click.Choice(LOG_LEVELS),
+    help="what the log holds (as --set log.level=LEVEL; default: the scenario's log:, else full)",
+)
 @click.option("-q", "--quiet", is_flag=True, help="no progress bar and no summary, only errors")
 @click.option(
     "--view",
@@ -107,10 +113,11 @@ def _load(path: str, sets=(), seed=None):
     help="show the run live in the browser viewer "
     "(http://127.0.0.1:8080, or the next free port), then stay for replay (Ctrl-C)",
 )
-def run(scenario, out, sets, seed, quiet, view):
+def run(scenario, out, sets, seed, log_level, quiet, view):
     """Run SCENARIO and write its MCAP log."""
     from replay.runner import RunInterrupted, Runner
 
+    sets = (*sets, f"log.level={log_level}") if log_level else sets
     sc = _load(scenario, sets, seed)
     out = Path(out) if out else DEFAULT_LOG_DIR / f"{sc.name}.mcap"
     _check_log_path(out, sc)
@@ -400,7 +407,14 @@ def params_markdown() -> str:
     import dataclasses
 
     from replay.params import describe
-    from replay.scenario.schema import ControllerSpec, PlantSpec, Scenario, SensorSpec, TaskSpec
+    from replay.scenario.schema import (
+        ControllerSpec,
+        LogSpec,
+        PlantSpec,
+        Scenario,
+        SensorSpec,
+        TaskSpec,
+    )
 
     def table(cls, prefix: str) -> list[str]:
         rows = ["| field | unit | default | allowed | meaning |", "|---|---|---|---|---|"]
@@ -438,6 +452,7 @@ def params_markdown() -> str:
         ("sensors.NAME", SensorSpec),
         ("controller", ControllerSpec),
         ("tasks.NAME", TaskSpec),
+        ("log", LogSpec),
     ):
         lines += ["", f"### `{title}`", ""] + table(cls, f"{title}.")
     for kind in ("plant", "sensor", "controller"):

@@ -29,9 +29,11 @@ import numpy as np
 from replay import __version__, registry, version
 from replay.foxglove.run import RunTopics
 from replay.log import LogWriter, NonFiniteValueError
+from replay.log.memory import KeptLog
 from replay.log.unwritten import NoTopics, UnwrittenLog
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
 from replay.scenario import Scenario, resolved_yaml
+from replay.scenario.schema import LogSpec
 from replay.tasks import Task, TaskSet
 
 
@@ -149,17 +151,24 @@ class Runner:
         )
         fr = scenario.timing.frame_rate  # the 3-D viewer topics (replay/foxglove)
         self.frame_div = _divider(rate, fr) if fr else 0
+        self.level = level = scenario.log or LogSpec()  # what the log holds (scenario ``log:``)
+        self.image_div = 1  # steps between a camera's logged images (at least its captures')
+        if level.level == "decimated":
+            self.log_div = max(self.log_div, _divider(rate, level.state_rate))
+            self.image_div = _divider(rate, level.image_rate)
+            self.frame_div = max(self.frame_div, self.image_div) if self.frame_div else 0
 
     def t_ns(self, k: int) -> int:
         return k * 1_000_000_000 // self.sc.timing.physics_rate
 
     # -- the run, step by step: start(out), step() until done, finish() ----------------------
 
-    def run(self, out: str | Path | None) -> RunResult:
-        """The whole run into the log ``out`` (None: no log, the outcome and events alike):
-        :meth:`start`, :meth:`step` until :attr:`done`, :meth:`finish`. Ctrl-C closes the log
-        (kept) and raises :class:`RunInterrupted`."""
-        self.start(out)
+    def run(self, out: str | Path | None, *, keep: bool = False) -> RunResult:
+        """The whole run into the log ``out`` (None: no log, the outcome and events alike;
+        with ``keep`` its messages kept in memory instead, read as a log's through
+        ``self.log.reader()``): :meth:`start`, :meth:`step` until :attr:`done`, :meth:`finish`.
+        Ctrl-C closes the log (kept) and raises :class:`RunInterrupted`."""
+        self.start(out, keep=keep)
         progress_div = max(1, self.rate // 20)
         try:
             while not self.done:
@@ -175,9 +184,10 @@ class Runner:
             self.plant.close()
             raise
 
-    def start(self, out: str | Path | None) -> None:
-        """Open the log ``out`` and write what a run starts with (its provenance, the resolved
-        scenario, the robot's description); the run is at step 0."""
+    def start(self, out: str | Path | None, *, keep: bool = False) -> None:
+        """Open the log ``out`` (None: none; with ``keep``, the messages kept in memory: a
+        :class:`~replay.log.memory.KeptLog`) and write what a run starts with (its provenance,
+        the resolved scenario, the robot's description); the run is at step 0."""
         sc = self.sc
         self.result = RunResult(path=Path(out if out is not None else os.devnull))
         self._wall0 = time.perf_counter()
@@ -189,17 +199,23 @@ class Runner:
         # (deliver at step, sequence, topic, payload), delivered in that order whatever the
         # sensors' order and latencies
         self._pending: list = []
-        log = self.log = LogWriter(out) if out is not None else UnwrittenLog()
+        log = self.log = (
+            LogWriter(out) if out is not None else KeptLog() if keep else UnwrittenLog()
+        )
         commit = _git_commit() or "unknown"
         log.metadata("provenance", provenance(sc, commit))
         text = resolved_yaml(sc)
         log.metadata("scenario", {"yaml": text})
         version = f"{__version__}+{commit}"
         self._emit = self._emitter(log)
-        self._emit_all = self._emitter_all(log)
+        outcome_only = self.level.level == "outcome"
+        # the measurements, telemetry and state: logged, or (outcome only) checked and dropped
+        data = UnwrittenLog() if outcome_only else log
+        self._emit_data, self._emit_all_data = self._emitter(data), self._emitter_all(data)
+        self._image_at = dict.fromkeys((s[0] for s in self.sensors), 0)  # next image's step
         self.viz = (
             RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
-            if out is not None
+            if out is not None and not outcome_only
             else NoTopics()
         )
         self._write(TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0)
@@ -224,15 +240,17 @@ class Runner:
             if scene is None:
                 scene = plant.scene()
             m = sensor.measure(t, scene)
-            self.viz.sensor(name, sensor, t_ns)  # its frame, for Foxglove / Rerun
+            if k >= self._image_at[name]:
+                self._image_at[name] = k + self.image_div
+                self.viz.sensor(name, sensor, t_ns)  # its frame, for Foxglove / Rerun
             if m is not None:
-                self._emit(sensor.topic, m, t_ns)
+                self._emit_data(sensor.topic, m, t_ns)
                 heapq.heappush(self._pending, (k + latency, self._seq, sensor.topic, m))
                 self._seq += 1
         if k % self.ctrl_div == 0:
             self._control(t, t_ns)
         if k % self.log_div == 0:
-            self._emit_all(plant.truth(t), t_ns)
+            self._emit_all_data(plant.truth(t), t_ns)
         if self.frame_div and k % self.frame_div == 0:  # the 3-D topics (replay/foxglove)
             self.viz.frame(scene if scene is not None else plant.scene(), t_ns)
         plant.step()
@@ -265,13 +283,13 @@ class Runner:
         for occ in occurrences:
             self._event(occ, t, t_ns)
         if telemetry:
-            self._emit_all(telemetry, t_ns)
+            self._emit_all_data(telemetry, t_ns)
 
     def finish(self) -> RunResult:
         """The final state (so the log ends where the run ended), the ``outcome`` event, the
         log closed; the run's result."""
         k, t_ns = self.k, self.t_ns(self.k)
-        self._emit_all(self.plant.truth(k / self.rate), t_ns)
+        self._emit_all_data(self.plant.truth(k / self.rate), t_ns)
         if self.frame_div:
             self.viz.frame(self.plant.scene(), t_ns)
         self._outcome(self._verdict(k / self.rate))

@@ -37,7 +37,13 @@ from replay import registry
 from replay.limits import LimitError, check
 from replay.params import MAX_CHARS, MAX_FLOAT, MAX_INT, MAX_ITEMS, ParamError
 from replay.scenario.schema import NAME_PATTERN, Scenario
-from replay.scenario.yamlio import ScenarioError, compose, read_text, show
+from replay.scenario.yamlio import (
+    ScenarioError,
+    compose,
+    compose_resolved,
+    read_text,
+    show,
+)
 
 __all__ = [
     "ScenarioError",
@@ -61,8 +67,8 @@ _PLAIN_FLOAT = re.compile(r"[-+]?(\d[\d_]*\.?\d*|\.\d+)[eE][-+]?\d+")  # 1e-3: Y
 # -- reading YAML into node trees ----------------------------------------------------------------
 
 
-def _compose_root(text: str, name: str) -> yaml.MappingNode:
-    node = compose(text, name)
+def _compose_root(text: str, name: str, *, resolved: bool = False) -> yaml.MappingNode:
+    node = compose_resolved(text, name) if resolved else compose(text, name)
     if node is None:
         raise ScenarioError("empty scenario", file=name)
     if not isinstance(node, yaml.MappingNode):  # (not quoted: the file may be no scenario at all)
@@ -766,6 +772,7 @@ def scenario_from_text(
     seed: int | None = None,
     base_dir: str | Path | None = None,
     plugins: str = "installed",
+    resolved: bool = False,
 ) -> Scenario:
     """A scenario text (e.g. a log's resolved /scenario message) into a Scenario. Its
     ``extends`` is honoured as a file's is: a bare name is a shipped scenario (or NAME.yaml
@@ -774,8 +781,10 @@ def scenario_from_text(
     imported already), importing nothing; "import" imports a ``module:Class`` from the cwd, for a
     text about to run; "known-only" reads a log: a plug-in not available here keeps its
     ``params`` as plain data, and nothing is imported, port-checked or extended (an
-    ``extends`` in a log's text is ignored: docs/security.md)."""
-    root = _compose_root(text, name)
+    ``extends`` in a log's text is ignored: docs/security.md). ``resolved``: a text that
+    :func:`resolved_yaml` wrote in this sweep (a variant's), parsed by libyaml
+    (:func:`~replay.scenario.yamlio.compose_resolved`)."""
+    root = _compose_root(text, name, resolved=resolved)
     inputs: list[Path] = []
     if plugins == "known-only":  # a log's text is resolved: reading it reads no other file
         _pop(root, "extends")

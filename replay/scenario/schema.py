@@ -100,6 +100,39 @@ class Stop:
     )
 
 
+LOG_LEVELS = ("full", "decimated", "outcome")
+
+
+@dataclass(kw_only=True)
+class LogSpec:
+    """What a run's log holds (and a sweep's metrics read without a log): a choice a sweep of
+    thousands of runs makes to pay only for what it keeps."""
+
+    level: str = param(
+        "full",
+        choices=LOG_LEVELS,
+        doc="full: every topic; decimated: the plant's state, the camera images and the 3-D "
+        "viewer topics at the rates below, the rest in full; outcome: the scenario and the "
+        "events (the outcome last) only, every other message still checked for non-finite values",
+    )
+    state_rate: float = param(
+        100.0,
+        unit="Hz",
+        gt=0,
+        le=100_000,
+        doc="decimated: rate of the plant's state topics (never above timing.state_log_rate), "
+        "rounded to whole physics steps",
+    )
+    image_rate: float = param(
+        10.0,
+        unit="Hz",
+        gt=0,
+        le=100_000,
+        doc="decimated: rate of each camera's images and of the 3-D viewer topics (never above "
+        "timing.frame_rate), rounded to whole physics steps",
+    )
+
+
 @dataclass(kw_only=True)
 class Scenario:
     name: str = param(
@@ -122,6 +155,9 @@ class Scenario:
         omit_empty=True,
     )
     stop: Stop = field(default_factory=Stop)
+    log: LogSpec | None = param(
+        None, doc="what the run's log holds (none: level full)", omit_empty=True
+    )
     notes: str = param(
         "", doc="free text: derivations, assumptions, deviations", max_length=100_000
     )

@@ -16,6 +16,7 @@ scenario is data, never code.
 
 from __future__ import annotations
 
+import io
 import os
 import re
 from pathlib import Path
@@ -189,6 +190,62 @@ def compose(text: str, name: str, *, what: str = "a scenario") -> yaml.Node | No
     if node is not None:
         check_shape(node)
     return node
+
+
+_C_LOADER = getattr(yaml, "CSafeLoader", None)  # libyaml's, where PyYAML was built with it
+_NESTING = {
+    yaml.MappingStartEvent: 1,
+    yaml.SequenceStartEvent: 1,
+    yaml.MappingEndEvent: -1,
+    yaml.SequenceEndEvent: -1,
+}
+
+
+class _NamedText(io.StringIO):
+    """A text with a name: what libyaml's parser puts in its marks (``file:line:col``)."""
+
+    def __init__(self, text: str, name: str) -> None:
+        super().__init__(text)
+        self.name = name
+
+
+def compose_resolved(text: str, name: str) -> yaml.Node | None:
+    """:func:`compose` of a text that :func:`replay.scenario.resolved_yaml` wrote (a sweep's
+    variant, handed to its worker), by libyaml where PyYAML has it: the same nodes and marks,
+    ~30x faster (a catch variant: 10 -> 0.3 ms). Its nesting is counted from libyaml's events
+    first (its composer recurses in C, with no depth check of its own); a text that is too deep,
+    or not YAML, goes to :func:`compose`, which says what is wrong as for any text."""
+    if _C_LOADER is None:
+        return compose(text, name)
+    check_text(text, name)
+    try:
+        depth = 0
+        for event in yaml.parse(_NamedText(text, name), Loader=_C_LOADER):
+            depth += _NESTING.get(type(event), 0)
+            if depth > MAX_DEPTH:
+                return compose(text, name)
+        node = yaml.compose(_NamedText(text, name), Loader=_C_LOADER)
+    except yaml.YAMLError:
+        return compose(text, name)
+    if node is not None:
+        _plain_style(node)
+        check_shape(node)
+    return node
+
+
+def _plain_style(node: yaml.Node) -> None:
+    """A plain scalar's style as the pure-Python composer gives it (None; libyaml's is ""):
+    the loader reads a plain ``1e-3`` by it."""
+    if isinstance(node, yaml.ScalarNode):
+        if node.style == "":
+            node.style = None
+    elif isinstance(node, yaml.SequenceNode):
+        for item in node.value:
+            _plain_style(item)
+    elif isinstance(node, yaml.MappingNode):
+        for key, value in node.value:
+            _plain_style(key)
+            _plain_style(value)
 
 
 def check_shape(root: yaml.Node) -> None:

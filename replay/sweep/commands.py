@@ -9,8 +9,9 @@ from pathlib import Path
 import click
 
 from replay import completion as complete
-from replay.console import exit_code, fail, note
+from replay.console import exit_code, fail, note, warn
 from replay.log import LogError
+from replay.scenario.schema import LOG_LEVELS
 from replay.sweep.executors import EXECUTORS, ExecutorError
 from replay.sweep.lock import SweepOutputError
 from replay.sweep.spec import SweepSpecError
@@ -71,8 +72,13 @@ DEFAULT_SWEEP_OUT = Path("out/sweeps")
 @click.option(
     "--no-logs",
     is_flag=True,
-    help="keep no variant's MCAP log: none is written (a temporary one only where the sweep's "
-    "metrics function reads it); the rows are the same",
+    help="keep no variant's MCAP log: none is written (a metrics function reads the run's "
+    "messages in memory); the rows are the same",
+)
+@click.option(
+    "--log-level",
+    type=click.Choice(LOG_LEVELS),
+    help="what each variant's log holds (as --set log.level=LEVEL; default: the scenario's log:)",
 )
 @click.option(
     "--retry-failed",
@@ -92,6 +98,7 @@ def sweep(
     executor,
     address,
     no_logs,
+    log_level,
     retry_failed,
     quiet,
 ):
@@ -102,6 +109,7 @@ def sweep(
     from replay.sweep.spec import check_seed, from_options
 
     scenario = find_scenario(scenario)
+    sets = (*sets, f"log.level={log_level}") if log_level else sets
     try:
         spec = from_options(grids, randoms, n)
     except SweepSpecError as exc:
@@ -130,9 +138,22 @@ def sweep(
         not quiet,
         retry_failed=retry_failed,
     )
+    if summary.rows:
+        _plot(out)
     click.echo(summary.line())
     if summary.interrupted:
         sys.exit(143 if summary.terminated else 130)
+
+
+def _plot(out: Path) -> None:
+    """``out/summary.png``/``.svg``: each cell's rate (analysis/sweep_plot.py); a plot that
+    cannot be written is a warning, the sweep's table and summary being written already."""
+    from analysis.sweep_plot import plot_summary
+
+    try:
+        plot_summary(out / "summary.csv", out)
+    except (LogError, OSError, TableError) as exc:
+        warn(f"no plot of the sweep: {exc}")
 
 
 def _run(

@@ -1,8 +1,9 @@
 """A sweep, start to end: expand, skip what the table already holds, run the rest, keep the table.
 
 ``run_sweep`` writes ``DIR/table.csv`` (and ``DIR/logs/KEY.mcap`` per variant unless
-``keep_logs=False``), rewriting the table after every finished variant, so a killed or interrupted
-sweep resumes where it stopped and a rerun of a finished one runs nothing but the variants that
+``keep_logs=False``), rewriting the table after every finished variant (unless that would spend
+more than ``SAVE_SHARE`` of the sweep's time: then when it would not, and at the end), so a killed
+or interrupted sweep resumes where it stopped and a rerun of a finished one runs nothing but the variants that
 did not finish (a worker died under it, its log is gone); ``retry_failed``: also the variants
 that failed to run at all, e.g. after installing a missing plug-in.
 
@@ -26,12 +27,14 @@ from typing import Any, Iterable
 from replay import registry
 from replay.sweep.executors import WORKER_DIED, default_workers, run_local, run_ray
 from replay.sweep.lock import FolderLock, SweepOutputError
+from replay.sweep.results import SUMMARY, write_summary
 from replay.sweep.table import as_bool, param_columns, read_table, refuse_link, write_table
 from replay.sweep.variants import Variant
 from replay.sweep.worker import INTERRUPTED
 
 TABLE = "table.csv"
 STALE = "table.stale.csv"
+SAVE_SHARE = 0.05  # of a sweep's time at most spent rewriting its table after finished variants
 
 
 @dataclass
@@ -188,7 +191,12 @@ def _run_locked(
     retry_failed,
 ) -> SweepSummary:
     table = out_dir / TABLE
-    for path in (table, out_dir / STALE, *([out_dir / "logs"] if keep_logs else [])):
+    for path in (
+        table,
+        out_dir / STALE,
+        out_dir / SUMMARY,
+        *([out_dir / "logs"] if keep_logs else []),
+    ):
         refuse_link(path)  # (before anything is read from them)
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
@@ -233,8 +241,17 @@ def _run_locked(
         for v in todo
     ]
 
-    def save() -> None:
+    last = [0.0, 0.0]  # when the table was last written, and how long that took
+
+    def save(now: bool = True) -> None:
+        """The table written; unless ``now``, only if the time since the last write is at least
+        that write's cost over SAVE_SHARE (a table of 10,000 rows takes ~60 ms to write: after
+        each variant, the sweep would be quadratic in its size)."""
+        t = time.perf_counter()
+        if not now and t - last[0] < last[1] / SAVE_SHARE:
+            return
         write_table(table, [*_with_params(rows.values(), by_key), *others], columns)
+        last[:] = [time.perf_counter(), time.perf_counter() - t]
 
     t0 = time.perf_counter()
     ran = failed_now = 0
@@ -254,7 +271,7 @@ def _run_locked(
             rows[row["key"]] = row
             ran += 1
             failed_now += not as_bool(row.get("success"))
-            save()
+            save(now=False)
             bar.update(1)
             if failed_now:
                 bar.set_postfix_str(f" {failed_now} failed", refresh=False)
@@ -264,7 +281,11 @@ def _run_locked(
         if stream is not None:
             stream.close()  # (its workers stopped before the folder is let go)
         bar.close()
-    done = list(_with_params(rows.values(), by_key))
+        if ran:
+            save()  # (every finished row, whatever the last writes left out)
+    done = sorted(_with_params(rows.values(), by_key), key=lambda r: int(r["index"]))
+    if done:
+        write_summary(out_dir / SUMMARY, done, params)  # (the rate of each cell)
     ok = sum(as_bool(r.get("success")) for r in done)
     return SweepSummary(
         total=len(variants),
@@ -274,7 +295,7 @@ def _run_locked(
         failed=len(done) - ok,
         wall_time=time.perf_counter() - t0,
         table=table,
-        rows=sorted(done, key=lambda r: int(r["index"])),
+        rows=done,
         interrupted=interrupted,
         stale=len(stale),
     )

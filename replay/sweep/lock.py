@@ -3,11 +3,15 @@
 The lock is held by an open file, so it dies with the sweep whatever kills it (no stale lock to
 clear by hand), and the sweep's forked workers share it: a rerun is refused as long as any
 process of the old sweep still runs, so it never races a survivor for the same logs and rows.
-The file says who holds it (process, command, start time) for the refusal's one line.
+The file says who holds it (process, command, start time) for the refusal's one line. A sweep
+that ends removes it (its workers stopped first); one killed leaves it, unlocked, for the next.
+A sweep that locked a file another one removed meanwhile (opened before that one's end) sees
+that its name is no longer that file, and opens the name again.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 import sys
@@ -20,6 +24,7 @@ except ImportError:  # (Windows: no flock; one sweep per folder is then up to th
     fcntl = None  # type: ignore[assignment]
 
 LOCK = "sweep.lock"
+_ATTEMPTS = 8  # opens of the lock's name, each file removed by the sweep that held it
 
 
 class SweepOutputError(Exception):
@@ -50,6 +55,33 @@ class FolderLock:
         self._fd: int | None = None
 
     def __enter__(self) -> "FolderLock":
+        for _ in range(_ATTEMPTS):
+            fd = self._lock()
+            if self._named(fd):
+                break
+            os.close(fd)  # (the file was removed by the sweep that held it: open the name again)
+        else:
+            raise SweepOutputError(f"sweep folder {self.folder}: its {LOCK} keeps being replaced")
+        try:
+            os.ftruncate(fd, 0)
+            text = f"{os.getpid()}\n{time.time():.0f}\n{' '.join(sys.argv)}\n"
+            os.write(fd, text.encode("utf-8", "replace"))
+        except OSError:
+            pass  # (who holds it is a courtesy; the lock is what counts)
+        self._fd = fd
+        return self
+
+    def _named(self, fd: int) -> bool:
+        """``fd`` is still the file at the lock's name."""
+        try:
+            st = os.stat(self.path, follow_symlinks=False)
+        except OSError:
+            return False
+        mine = os.fstat(fd)
+        return (st.st_dev, st.st_ino) == (mine.st_dev, mine.st_ino)
+
+    def _lock(self) -> int:
+        """The lock file opened and locked (SweepOutputError if it cannot be, or is held)."""
         # never through a link: a folder shipped with sweep.lock -> a file of yours would have
         # it truncated (O_NOFOLLOW: ELOOP); nor a FIFO, a device or a hard link's other name
         flags = os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
@@ -81,14 +113,7 @@ class FolderLock:
                     f"sweep folder {self.folder} is in use by {holder}; wait for it to end or "
                     "give another -o"
                 ) from None
-        try:
-            os.ftruncate(fd, 0)
-            text = f"{os.getpid()}\n{time.time():.0f}\n{' '.join(sys.argv)}\n"
-            os.write(fd, text.encode("utf-8", "replace"))
-        except OSError:
-            pass  # (who holds it is a courtesy; the lock is what counts)
-        self._fd = fd
-        return self
+        return fd
 
     @staticmethod
     def _holder(fd: int) -> str:
@@ -106,5 +131,8 @@ class FolderLock:
 
     def __exit__(self, *exc) -> None:
         if self._fd is not None:
+            if self._named(self._fd):  # (removed while held: a sweep that opens it next
+                with contextlib.suppress(OSError):  # sees the name is no longer its file)
+                    os.unlink(self.path)
             os.close(self._fd)  # (the lock goes when the workers, which share it, are gone)
             self._fd = None

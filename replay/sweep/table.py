@@ -5,7 +5,8 @@ Columns: ``index``, ``key``, the varied parameters, ``seed``, ``success``, ``rea
 (``x.NAME``), the count of each event kind (``e.KIND``), ``stopped_by``, ``t_end``,
 ``wall_time``, ``cpu_time``, ``log`` and ``version`` (the code version that ran it). The file is
 the sweep's memory: rows whose key is still a variant of the sweep are done; a killed sweep loses
-at most the variants that were running; rows of other sweeps into the same folder stay.
+at most the variants that were running and those finished since the table was last written
+(``engine.SAVE_SHARE``); rows of other sweeps into the same folder stay.
 """
 
 from __future__ import annotations

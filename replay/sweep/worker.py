@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
-import tempfile
 import time
 import traceback
 from pathlib import Path
@@ -23,8 +21,9 @@ INTERRUPTED = "interrupted"
 
 def run_variant(task: dict[str, Any]) -> dict[str, Any]:
     """task: key, index, resolved, file_dirs (where relative ``*_file`` parameters resolve), error,
-    log (path or ""), cwd, metrics ("module:function" of a LogReader -> extra columns, or "") ->
-    a row (without the params)."""
+    log (path or ""), cwd, metrics ("module:function" of a log's reader -> extra columns, or "")
+    -> a row (without the params). Without a log the metrics read the run's messages kept in
+    memory (:mod:`replay.log.memory`): the same numbers, no file written."""
     wall0 = time.perf_counter()
     cpu0 = time.process_time()
     row: dict[str, Any] = {"key": task["key"], "index": task["index"]}
@@ -32,9 +31,6 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         row.update(success=False, reason=task["error"], wall_time=0.0, cpu_time=0.0, log="")
         return row
     log: str = task.get("log") or ""
-    tmp = ""
-    if not log and task.get("metrics"):  # its metrics read a log: made in a folder of its own
-        tmp = str(Path(tempfile.mkdtemp(prefix="sweep-")) / "variant.mcap")
     cwd = task.get("cwd")
     if cwd and Path(cwd).is_dir() and os.getcwd() != cwd:
         os.chdir(cwd)  # relative data paths (alpha files) as in the scenario
@@ -46,11 +42,12 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
 
         for kind, name, folder in task.get("plugins", ()):  # (a forked worker has them already)
             registry.import_plugin(kind, name, folder)
-        sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>")
+        sc = scenario_from_text(task["resolved"], name=f"<variant {task['key']}>", resolved=True)
         set_file_dirs(sc, task.get("file_dirs") or {})
         if log:
             Path(log).parent.mkdir(parents=True, exist_ok=True)
-        result = Runner(sc).run(log or tmp or None)  # (None: no log is kept or read)
+        runner = Runner(sc)
+        result = runner.run(log or None, keep=not log and bool(task.get("metrics")))
         outcome = dict(result.outcome)
         row["success"] = bool(outcome.pop("success", False))
         row["reason"] = str(outcome.pop("reason", ""))
@@ -62,7 +59,7 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         row.update({f"e.{k}": n for k, n in sorted(result.events.items())})
         if task.get("metrics"):
             row.update(
-                {f"x.{k}": _cell(v) for k, v in _extract(task["metrics"], log or tmp).items()}
+                {f"x.{k}": _cell(v) for k, v in _extract(task["metrics"], runner, log).items()}
             )
     except (RunInterrupted, KeyboardInterrupt):
         row.update(success=False, reason=INTERRUPTED)  # not a result: the engine drops it
@@ -73,9 +70,6 @@ def run_variant(task: dict[str, Any]) -> dict[str, Any]:
         row["reason"] = (
             f"error: {type(exc).__name__}: {exc} ({Path(last.filename).name}:{last.lineno})"
         ).replace("\n", " ")
-    finally:
-        if tmp:
-            shutil.rmtree(Path(tmp).parent, ignore_errors=True)
     row["wall_time"] = round(time.perf_counter() - wall0, 4)
     row["cpu_time"] = round(time.process_time() - cpu0, 4)
     row["log"] = log if log and Path(log).is_file() else ""
@@ -104,11 +98,15 @@ def load_function(ref: str):
     return getattr(importlib.import_module(module), name)
 
 
-def _extract(ref: str, log: str) -> dict:
-    """Extra table columns read from the variant's log by the sweep's ``metrics`` function."""
+def _extract(ref: str, runner, log: str) -> dict:
+    """Extra table columns read by the sweep's ``metrics`` function from the variant's log, or
+    from its messages kept in memory when it has none."""
     from replay.log import LogReader
+    from replay.log.memory import KeptLog
 
-    return dict(load_function(ref)(LogReader(log)) or {})
+    kept = runner.log
+    reader = kept.reader() if isinstance(kept, KeptLog) else LogReader(log)
+    return dict(load_function(ref)(reader) or {})
 
 
 def _cell(v: Any) -> Any:

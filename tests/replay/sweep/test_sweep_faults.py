@@ -137,6 +137,36 @@ def test_a_locked_folder_says_who_holds_it(toy_yaml, tmp_path):
     assert _sweep(toy_yaml, out, grid="plant.params.mass=1,2", keep_logs=False).ran == 2
 
 
+def test_the_lock_is_removed_when_the_sweep_ends_and_a_stale_one_taken_over(toy_yaml, tmp_path):
+    out = tmp_path / "D"
+    out.mkdir()
+    (out / "sweep.lock").write_text("12345\n0\nreplay sweep (killed)\n")  # (unlocked: stale)
+    assert _sweep(toy_yaml, out, grid="plant.params.mass=1,2", keep_logs=False).ran == 2
+    assert sorted(p.name for p in out.iterdir()) == ["summary.csv", "table.csv"]
+
+
+def test_a_lock_file_removed_under_a_sweep_is_opened_again(tmp_path, monkeypatch):
+    """A sweep that opened the lock file just before the sweep holding it ended (and removed
+    it) must not hold a lock on a file without a name: it opens the name again."""
+    out = tmp_path / "D"
+    out.mkdir()
+    lock, opened = FolderLock(out), []
+    real = FolderLock._lock
+
+    def removed_once(self):
+        fd = real(self)
+        if not opened:
+            os.unlink(self.path)  # (as the sweep that held it does when it ends)
+        opened.append(fd)
+        return fd
+
+    monkeypatch.setattr(FolderLock, "_lock", removed_once)
+    with lock:
+        assert len(opened) == 2 and (out / "sweep.lock").is_file()
+        assert os.fstat(opened[1]).st_ino == os.stat(out / "sweep.lock").st_ino
+    assert not (out / "sweep.lock").exists()
+
+
 def test_a_full_disk_is_one_line_exit_1_and_no_tmp_left(toy_yaml, tmp_path, monkeypatch):
     import replay.sweep.table as table
 
@@ -153,7 +183,7 @@ def test_a_full_disk_is_one_line_exit_1_and_no_tmp_left(toy_yaml, tmp_path, monk
     assert r.output.strip() == f"error: cannot write table {out / 'table.csv'}: " + os.strerror(
         errno.ENOSPC
     )
-    assert sorted(p.name for p in out.iterdir()) == ["sweep.lock"]
+    assert sorted(p.name for p in out.iterdir()) == []  # (no table, no tmp, the lock removed)
     monkeypatch.setattr(table.os, "replace", real)
 
 
