@@ -30,6 +30,7 @@ GROUPS = {
     "viewer_scene": "paper_replay.viewer_scenes",  # plant type -> replay.viewer RunScene class
     "commands": "paper_replay.commands",  # name -> register(click group): more `replay` commands
     "check": "paper_replay.checks",  # name -> check(scenario) -> a warning for `validate`, or ""
+    "sweep_plot": "paper_replay.sweep_plots",  # name -> plot(summary.csv, out folder) -> paths
 }
 
 

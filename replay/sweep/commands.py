@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from replay import completion as complete
+from replay import registry
 from replay.console import exit_code, fail, note, warn
 from replay.log import LogError
 from replay.scenario.schema import LOG_LEVELS
@@ -146,14 +147,14 @@ def sweep(
 
 
 def _plot(out: Path) -> None:
-    """``out/summary.png``/``.svg``: each cell's rate (analysis/sweep_plot.py); a plot that
+    """Each installed sweep plot (the ``paper_replay.sweep_plots`` entry points; analysis's
+    draws ``out/summary.png``/``.svg``, each cell's rate) from ``out/summary.csv``; a plot that
     cannot be written is a warning, the sweep's table and summary being written already."""
-    from analysis.sweep_plot import plot_summary
-
-    try:
-        plot_summary(out / "summary.csv", out)
-    except (LogError, OSError, TableError) as exc:
-        warn(f"no plot of the sweep: {exc}")
+    for name in registry.names("sweep_plot"):
+        try:
+            registry.load("sweep_plot", name)(out / "summary.csv", out)
+        except (LogError, OSError, TableError) as exc:
+            warn(f"no plot of the sweep: {exc}")
 
 
 def _run(
