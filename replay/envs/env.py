@@ -67,8 +67,10 @@ class ScenarioEnv(gymnasium.Env):
         self.scenario_name, self.seed0 = sc.name, sc.seed
         probe = Runner(sc)
         try:
+            # what a policy may know, as a controller does: the nominal robot and object
+            self.plant_spec = probe.plant.spec()
             command_type = type(probe.plant).command_types[0]
-            self.layout: ActionLayout = action_layout(command_type, probe.plant.spec())
+            self.layout: ActionLayout = action_layout(command_type, self.plant_spec)
             self._sizes = self._observation_sizes(probe)
         finally:
             probe.plant.close()
