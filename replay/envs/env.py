@@ -182,6 +182,7 @@ class ScenarioEnv(gymnasium.Env):
         return {"t": runner.k / runner.rate, "measurements": list(self._delivered)}
 
     def _close_run(self) -> None:
-        """An episode left unfinished is finished as a run (its log closed)."""
+        """An episode left unfinished (reset or close before its end) is closed as an
+        interrupted run: its log kept as ``STEM.interrupted.mcap``, never as a finished one."""
         if self.runner is not None and self.result is None:
-            self.result = self.runner.finish()
+            self.result = self.runner._interrupted()

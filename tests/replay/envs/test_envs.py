@@ -86,3 +86,14 @@ def test_a_policy_outside_changes_the_run():
             break
     assert info["outcome"]["success"] is False
     assert reward == 0.0
+
+
+def test_an_episode_left_unfinished_keeps_its_log_as_interrupted(tmp_path):
+    env = ScenarioEnv("stick_3step", set={"timing.duration": 0.05}, log=tmp_path / "ep{seed}.mcap")
+    env.reset(seed=1)
+    env.step(env.layout.action_of(None))
+    env.reset(seed=2)  # episode 1 abandoned
+    while not any(env.step(env.layout.action_of(None))[2:4]):
+        pass
+    env.close()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ep1.interrupted.mcap", "ep2.mcap"]
