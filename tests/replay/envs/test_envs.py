@@ -97,3 +97,24 @@ def test_an_episode_left_unfinished_keeps_its_log_as_interrupted(tmp_path):
         pass
     env.close()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ep1.interrupted.mcap", "ep2.mcap"]
+
+
+def test_async_vector_env_over_processes():
+    """Gymnasium's async vector env runs the environment in worker processes: two seeds at
+    once, each ending at the duration with its own verdict."""
+    envs = gymnasium.make_vec(
+        "paper_replay/StickCapture-v0",
+        num_envs=2,
+        vectorization_mode="async",
+        set={"timing.duration": 0.02},
+    )
+    try:
+        obs, _ = envs.reset(seed=[1, 2])
+        assert obs["/vision/stick"].shape == (2, 4)
+        hold = np.stack([envs.single_action_space.low] * 2)
+        for _ in range(20):  # 0.02 s of 1 ms steps
+            obs, reward, terminated, truncated, info = envs.step(hold)
+        assert truncated.all() and not terminated.any()
+        assert info["_outcome"].all() and (info["outcome"]["success"] == (reward == 1.0)).all()
+    finally:
+        envs.close()
