@@ -812,9 +812,11 @@ def rerun(log, web, port, at, shot):
         fail(str(exc))
 
 
+from replay.evaluate import evaluate_command  # noqa: E402
 from replay.sweep.commands import register  # noqa: E402  (replay sweep, ablate)
 
 register(main)
+main.add_command(evaluate_command)  # replay evaluate (replay/evaluate.py)
 for _name in registry.names("commands"):  # installed packages' commands (analysis: figures, ...)
     registry.load("commands", _name)(main)
 

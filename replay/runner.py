@@ -22,7 +22,7 @@ import time
 from dataclasses import dataclass, field
 from importlib import metadata as importlib_metadata
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -199,6 +199,7 @@ class Runner:
         # (deliver at step, sequence, topic, payload), delivered in that order whatever the
         # sensors' order and latencies
         self._pending: list = []
+        self._sensed: tuple = (-1, None, [])  # (k, scene, delivered) of sense() at step k
         log = self.log = (
             LogWriter(out) if out is not None else KeptLog() if keep else UnwrittenLog()
         )
@@ -226,19 +227,18 @@ class Runner:
         """The run's duration is over, or ``stop.after`` seconds after a stopping event."""
         return self.k >= self._n_steps or (self._stop_at is not None and self.k >= self._stop_at)
 
-    def step(self) -> None:
-        """One physics step k: the sensors due capture the scene (logged now, delivered
-        ``latency`` later), the controller due reads what was delivered and commands the
-        plant, the plant's state is logged, the plant steps, and its events are logged at the
-        step's end (a collision with the controller's intent)."""
-        k, plant = self.k, self.plant
+    def sense(self) -> list:
+        """The first part of step k: the sensors due capture the scene (logged now, delivered
+        ``latency`` later); at a control step, the measurements delivered by now, which the
+        controller reads (``[(topic, payload)]``), else []. :meth:`step` calls it if not done."""
+        k = self.k
         t, t_ns = k / self.rate, self.t_ns(k)
         scene = None
         for name, sensor, div, latency in self.sensors:
             if k % div:
                 continue
             if scene is None:
-                scene = plant.scene()
+                scene = self.plant.scene()
             m = sensor.measure(t, scene)
             if k >= self._image_at[name]:
                 self._image_at[name] = k + self.image_div
@@ -247,8 +247,27 @@ class Runner:
                 self._emit_data(sensor.topic, m, t_ns)
                 heapq.heappush(self._pending, (k + latency, self._seq, sensor.topic, m))
                 self._seq += 1
+        delivered, pending = [], self._pending
         if k % self.ctrl_div == 0:
-            self._control(t, t_ns)
+            while pending and pending[0][0] <= k:
+                _, _, topic, m = heapq.heappop(pending)
+                delivered.append((topic, m))
+        self._sensed = (k, scene, delivered)
+        return delivered
+
+    def step(self, command: Any = None) -> None:
+        """One physics step k: :meth:`sense`, then at a control step the controller reads what
+        was delivered and commands the plant (``command`` given: that command instead of the
+        controller's, which is not asked; the rest is the same), the plant's state is logged,
+        the plant steps, and its events are logged at the step's end (a collision with the
+        controller's intent)."""
+        k, plant = self.k, self.plant
+        t, t_ns = k / self.rate, self.t_ns(k)
+        if self._sensed[0] != k:
+            self.sense()
+        _, scene, delivered = self._sensed
+        if k % self.ctrl_div == 0:
+            self._control(t, t_ns, delivered, command)
         if k % self.log_div == 0:
             self._emit_all_data(plant.truth(t), t_ns)
         if self.frame_div and k % self.frame_div == 0:  # the 3-D topics (replay/foxglove)
@@ -266,13 +285,11 @@ class Runner:
                 }
             self._event(occ, t1, t1_ns)
 
-    def _control(self, t: float, t_ns: int) -> None:
-        """The controller's turn: what the sensors delivered by now in, the command out."""
-        delivered, pending = [], self._pending
-        while pending and pending[0][0] <= self.k:
-            _, _, topic, m = heapq.heappop(pending)
-            delivered.append((topic, m))
-        command = self.controller.update(t, delivered)
+    def _control(self, t: float, t_ns: int, delivered: list, command: Any = None) -> None:
+        """The controller's turn: what the sensors delivered by now in, the command out (or
+        the ``command`` given from outside)."""
+        if command is None:
+            command = self.controller.update(t, delivered)
         if isinstance(command, list):  # parallel tasks' partial commands
             for c in command:
                 self.plant.apply(c)

@@ -30,10 +30,12 @@ def test_examples_are_numbered_and_all_tested():
         "02_read_a_log.py",
         "03_write_a_plugin_plant.py",
         "04_python_api.py",  # (run by tests/replay/test_api.py)
+        "05_evaluate_a_policy.py",  # (run by tests/replay/test_evaluate.py)
     ]
-    # the one module that is no script: the controller examples/my_controller.yaml names by
-    # file (type: my_controller:GoalKeeper; tests/replay/test_plugins_from_files.py)
-    assert sorted(set(names) - set(scripts)) == ["my_controller.py"]
+    # the modules that are no script: the controller examples/my_controller.yaml names by
+    # file (type: my_controller:GoalKeeper; tests/replay/test_plugins_from_files.py) and the
+    # policies `replay evaluate my_policy:catch` names (tests/replay/test_evaluate.py)
+    assert sorted(set(names) - set(scripts)) == ["my_controller.py", "my_policy.py"]
     assert "my_controller:" in (EXAMPLES / "my_controller.yaml").read_text(encoding="utf-8")
 
 

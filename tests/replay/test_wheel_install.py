@@ -284,3 +284,60 @@ def test_variants_of_an_experiment_are_overlaid_and_labelled_from_an_empty_folde
         env=env,
     )
     assert "latency" in out and "Traceback" not in out, out[-2000:]
+
+
+def test_the_environments_from_the_wheel(installed):
+    """Gymnasium's check_env for the three tasks; the paper's method through each environment
+    gives replay run's outcome and log (zero tolerance) on two seeds; `replay evaluate` prints
+    the example policy's and the paper's rates with intervals for each task."""
+    pytest.importorskip("gymnasium")
+    replay, work, env = installed
+    here = work / "envs"
+    here.mkdir()
+    code = (
+        "import warnings, gymnasium, replay.envs\n"
+        "from gymnasium.utils.env_checker import check_env\n"
+        "from replay.envs.policies import PaperPolicy\n"
+        "from replay.golden import compare_logs\n"
+        "from replay.runner import Runner\n"
+        "from replay.scenario import load_scenario\n"
+        "short = {'stick': 0.4, 'catch': 0.4, 'grasp': 0.1}\n"
+        "for task, (env_id, name) in sorted(replay.envs.TASKS.items()):\n"
+        "    with warnings.catch_warnings():\n"
+        "        warnings.simplefilter('ignore')\n"
+        "        check_env(gymnasium.make(env_id, set={'timing.duration': 0.02}).unwrapped)\n"
+        "    for seed in (2, 5):\n"
+        "        d = short[task]\n"
+        "        e = gymnasium.make(env_id, set={'timing.duration': d}, log=f'{task}{seed}.mcap')\n"
+        "        policy = PaperPolicy(e)\n"
+        "        obs, info = e.reset(seed=seed, options=policy.reset_options)\n"
+        "        done = False\n"
+        "        while not done:\n"
+        "            obs, r, term, trunc, info = e.step(policy(obs, info))\n"
+        "            done = term or trunc\n"
+        "        sc = load_scenario(name, [f'timing.duration={d}'], seed)\n"
+        "        run = Runner(sc).run(f'run_{task}{seed}.mcap')\n"
+        "        assert info['outcome'] == run.outcome, (task, seed)\n"
+        "        exact = {'abs': 0, 'rel': 0}\n"
+        "        assert compare_logs(run.path, info['result'].path, {}, exact) == [], (task, seed)\n"
+        "    print('env ok', task)\n"
+    )
+    out = _sh([replay.parent / "python", "-c", code], cwd=here, env=env)
+    assert [line for line in out.splitlines() if line.startswith("env ok")] == [
+        "env ok catch",
+        "env ok grasp",
+        "env ok stick",
+    ], out[-2000:]
+    shutil.copy(ROOT / "examples" / "my_policy.py", here)
+    for task, sets in (
+        ("catch", []),
+        ("stick", ["--set", "timing.duration=0.5"]),
+        ("grasp", ["--set", "timing.duration=0.2"]),
+    ):
+        out = _sh(
+            [replay, "evaluate", f"my_policy:{task}", "--task", task, "--n", "2", *sets],
+            cwd=here,
+            env=env,
+        )
+        rows = re.findall(r"^(\S.*?)\s+\d+/2\s+[\d.]+ %\s+\[\s*[\d.]+,\s*[\d.]+\] %$", out, re.M)
+        assert rows == [f"my_policy:{task}", "paper (the paper's method)"], out
