@@ -218,13 +218,16 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     vi = log.series(TOPIC_VISION_OBJECT)
     cs = log.series(TOPIC_CATCHING_STATE)
     ev = events(log)
+    ctrl, plant = typed.controller, typed.plant.params
+    if ctrl is None or isinstance(plant, dict):  # (tasks, or a plant this version lacks)
+        raise ValueError("not a catch run: its scenario has no controller or no known arm plant")
     run = CatchRun(
         name=name or log.scenario().get("name") or "?",  # (clipped by the reader)
         scenario=sc,
         # the typed scenario: no default here; a run of another controller (the feedback
         # baseline) has no mapping and is named by its controller
-        mapping=str(getattr(typed.controller.params, "mapping", typed.controller.type)),
-        dt=1.0 / float(typed.controller.rate),
+        mapping=str(getattr(ctrl.params, "mapping", ctrl.type)),
+        dt=1.0 / float(ctrl.rate),
         t_ctrl=_vec(eff, "t"),
         effector=_vec(eff, "position").reshape(-1, 3),
         effector_desired=_vec(eff, "desired_position").reshape(-1, 3),
@@ -247,7 +250,7 @@ def load_run(log: LogReader, name: str | None = None) -> CatchRun:
         cs_t=_vec(cs, "t"),
         cs_qd_desired=_vec(cs, "velocity_desired"),
         cs_r_o=_vec(cs, "r_o").reshape(-1, 3),
-        settings=resolve(typed.plant.params),
+        settings=resolve(plant),
         events=ev,
     )
     run.t0 = float(cs[0]["t"]) if cs else None
@@ -715,7 +718,8 @@ def _eq4_row(run: CatchRun) -> Claim:
             kind=kind,
             measures=measures,
         )
-    ball = float(np.linalg.norm(run.first_event("contact")["data"]["object_velocity_before"]))
+    touch = run.first_event("contact")  # (there: c is not None)
+    ball = float(np.linalg.norm((touch or {}).get("data", {})["object_velocity_before"]))
     radius = float(run.plant_params.get("object_radius", 0.0175))
     ok = c["speed"] <= 0.1 * ball and o["contact_offset"] <= radius
     return Claim(
@@ -752,7 +756,11 @@ def _range_row(runs: dict[str, CatchRun]) -> list[Claim]:
         touch = _touch(o)
         parts.append(
             f"{sp[0] if sp else float('nan'):.2f} m/s: "
-            + (f"caught at t = {catch['t']:.3f} s" if caught else o.get("reason", "not caught"))
+            + (
+                f"caught at t = {catch['t']:.3f} s"
+                if caught and catch is not None
+                else o.get("reason", "not caught")
+            )
             + (f" ({touch})" if touch else "")
         )
     return [
@@ -998,7 +1006,7 @@ def _vision_rows(run: CatchRun, st: dict) -> list[Claim]:
     if va is None:
         return []
     sens = run.scenario.get("sensors", {})
-    stereo = next((s for s in sens.values() if s.get("type") == "stereo_ball"), {})
+    stereo: dict = next((s for s in sens.values() if s.get("type") == "stereo_ball"), {})
     w = stereo.get("params", {}).get("width", "?")
     h = stereo.get("params", {}).get("height", "?")
     lat = stereo.get("latency", 0.0)

@@ -34,6 +34,7 @@ from typing import Any, Iterator
 import yaml
 
 from replay import registry
+from replay.interfaces import Controller, Plant, Sensor
 from replay.limits import LimitError, check
 from replay.params import MAX_CHARS, MAX_FLOAT, MAX_INT, MAX_ITEMS, ParamError
 from replay.scenario.schema import NAME_PATTERN, Scenario
@@ -214,6 +215,7 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
     value = compose(text if text.strip() else "''", f"<--set {key_path}>", what="a value")
     if value is None:  # "key=" followed by a comment only
         value = compose("''", f"<--set {key_path}>")
+    assert value is not None  # ('' composes to an empty scalar)
     node = root
     for depth, key in enumerate(keys):
         last = depth == len(keys) - 1
@@ -390,7 +392,7 @@ def build(node: yaml.Node, tp: Any, path: str, meta: dict | None = None) -> Any:
             return None
         tp = next(a for a in args if a is not type(None))
         return build(node, tp, path, meta)
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         return build_dataclass(node, tp, path)
     if origin in (list, tuple):
         return _build_list(node, tp, path, meta)
@@ -608,7 +610,9 @@ def set_file_dirs(sc: Scenario, dirs: dict[str, str]) -> None:
 PLUGIN_MODES = ("import", "installed", "known-only")
 
 
-def _plugin_class(kind: str, spec: Any, path: str, root: yaml.Node, plugins: str) -> type | None:
+def _plugin_class(
+    kind: str, spec: Any, path: str, root: yaml.Node, plugins: str
+) -> type[Plant | Sensor | Controller] | None:
     """The class of a plug-in section. ``plugins``: "import" imports a ``module:Class`` type
     from the folder of the file that wrote it (the cwd for ``--set`` or a text); "installed"
     finds installed (and already imported) ones only; "known-only" (reading a log) answers None
