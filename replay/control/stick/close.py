@@ -104,63 +104,19 @@ class ClosePlanner:
     ) -> ClosePlan | None:
         """The closing plan (number ``index``; the estimator has seen ``n_breaks`` breaks), or
         None with the closest miss noted in ``shortfall``. ``last_finger`` made the last
-        collision (None: none did)."""
+        collision (None: none did). The first meeting time on the stick's path (every 20 ms up
+        to ``horizon``; now, for a stick at rest) that some base posture reaches in time wins."""
         p, st, hand = self.params, self.stick, self.hand
-        x, y, th = est.at(t)
-        c_now = np.array([x, y])
-        speed = est.speed
-        moving = speed >= p.capture_speed
-        if moving:
-            d = np.array([est.vx, est.vy]) / speed
-        else:
-            d = np.array([-math.sin(th), math.cos(th)])
-        rear = last_finger
-        if rear is None:
-            proj = [float(np.dot(hand.root_offsets[k], d)) for k in (0, 1)]
-            rear = int(np.argmin(proj))
-        elif not moving:
-            if np.dot(d, c_now - self.model.config.tip(hand, rear)) < 0.0:
-                d = -d
-        front = 1 - rear
+        moving, d, front, rear = self._closing_direction(t, est, last_finger)
         h = 0.5 * st.width + hand.tip_radius + 0.5 * p.grip_clearance
-        now = self.model.config
         # a spin left by a clamped contact is ignored here: the sweep of a spinning stick covers
         # every spot near the line, so the closing could never be planned (not friction free)
         pre = Motion(dataclasses.replace(est, omega=0.0))
         taus = np.arange(0.02, p.horizon + 1e-9, 0.02) if moving else np.array([0.02])
         for tau in taus:
             t_m = t + float(tau)
-            meet = pre.pose(t_m)[0] if moving else c_now
-            F, Rr = meet + d * h, meet - d * h
-            best = None
-            for base in close_bases(hand, F, Rr, front, rear, tuple(self.model.target.base)):
-                qf = hand2d.finger_ik(hand, base, front, F, q_near=now.joints[front])
-                qr = hand2d.finger_ik(hand, base, rear, Rr, q_near=now.joints[rear])
-                if qf is None or qr is None:
-                    continue
-                cfg = Config(tuple(base), now.joints).with_finger(front, qf)
-                need = travel(hand, now, cfg)
-                if t + need > t_m - p.arrive_margin and moving:
-                    shortfall.note(need + p.arrive_margin, t_m - t)
-                    continue
-                if not moving:
-                    best = (need, cfg.with_finger(rear, qr), [(t, cfg.with_finger(rear, qr))])
-                    break
-                # while the base moves the rear finger is parked behind the stick (its joints
-                # cannot hold the tip still against a moving slider); it follows once the
-                # base has arrived
-                park = pre.pose(t + need)[0] - d * (h + p.follow_gap)
-                qp = hand2d.finger_ik(hand, base, rear, park, q_near=now.joints[rear])
-                if qp is None:
-                    continue
-                cfg = cfg.with_finger(rear, qp)
-                for route in [[(t, cfg)]] + self.around(t, now, cfg, front, F, pre):
-                    arrival = self.planner.route_clear(t, now, route, front, pre, t_m)
-                    if arrival is not None:
-                        best = (arrival, cfg, route)
-                        break
-                if best is not None:
-                    break
+            meet = pre.pose(t_m)[0] if moving else np.array(est.at(t)[:2])
+            best = self._reach_meeting(t, t_m, meet, d, h, front, rear, pre, moving, shortfall)
             if best is not None:
                 sol = (
                     sc.closing_contact(st.mass, st.inertia, st.restitution, est.u, st.length)
@@ -181,6 +137,62 @@ class ClosePlanner:
                     n_breaks,
                     best[2],
                 )
+        return None
+
+    def _closing_direction(
+        self, t: float, est: StickEstimate, last_finger: int | None
+    ) -> tuple[bool, np.ndarray, int, int]:
+        """(moving, d, front, rear): the direction the fingers close along (the stick's motion,
+        or across it at rest) and which finger meets the stick first (``front``) and which
+        closes behind it (``rear``: the one that made the last collision)."""
+        p, hand = self.params, self.hand
+        x, y, th = est.at(t)
+        speed = est.speed
+        moving = speed >= p.capture_speed
+        if moving:
+            d = np.array([est.vx, est.vy]) / speed
+        else:
+            d = np.array([-math.sin(th), math.cos(th)])
+        rear = last_finger
+        if rear is None:
+            proj = [float(np.dot(hand.root_offsets[k], d)) for k in (0, 1)]
+            rear = int(np.argmin(proj))
+        elif not moving:
+            if np.dot(d, np.array([x, y]) - self.model.config.tip(hand, rear)) < 0.0:
+                d = -d
+        return moving, d, 1 - rear, rear
+
+    def _reach_meeting(self, t, t_m, meet, d, h, front, rear, pre, moving, shortfall):
+        """(arrival, configuration, route) of the first base posture whose front tip is at
+        ``meet + d h`` and rear tip at ``meet - d h`` by ``t_m`` along a clear route, else
+        None."""
+        p, hand = self.params, self.hand
+        now = self.model.config
+        F, Rr = meet + d * h, meet - d * h
+        for base in close_bases(hand, F, Rr, front, rear, tuple(self.model.target.base)):
+            qf = hand2d.finger_ik(hand, base, front, F, q_near=now.joints[front])
+            qr = hand2d.finger_ik(hand, base, rear, Rr, q_near=now.joints[rear])
+            if qf is None or qr is None:
+                continue
+            cfg = Config(tuple(base), now.joints).with_finger(front, qf)
+            need = travel(hand, now, cfg)
+            if t + need > t_m - p.arrive_margin and moving:
+                shortfall.note(need + p.arrive_margin, t_m - t)
+                continue
+            if not moving:
+                return (need, cfg.with_finger(rear, qr), [(t, cfg.with_finger(rear, qr))])
+            # while the base moves the rear finger is parked behind the stick (its joints
+            # cannot hold the tip still against a moving slider); it follows once the base has
+            # arrived
+            park = pre.pose(t + need)[0] - d * (h + p.follow_gap)
+            qp = hand2d.finger_ik(hand, base, rear, park, q_near=now.joints[rear])
+            if qp is None:
+                continue
+            cfg = cfg.with_finger(rear, qp)
+            for route in [[(t, cfg)]] + self.around(t, now, cfg, front, F, pre):
+                arrival = self.planner.route_clear(t, now, route, front, pre, t_m)
+                if arrival is not None:
+                    return (arrival, cfg, route)
         return None
 
     def around(self, t: float, now: Config, cfg: Config, k: int, target, motion: Motion) -> list:
