@@ -247,19 +247,7 @@ class ContactPlanner:
         best: tuple | None = None  # (arrival, finger rank, base rank, k, cfg, route)
         for rank, k in enumerate(fingers):
             j = 1 - k
-            cands = []
-            for i, base in enumerate(
-                bases
-                if bases is not None
-                else base_candidates(hand, k, tip, tuple(self.model.target.base))
-            ):
-                q = hand2d.finger_ik(hand, base, k, tip, q_near=now.joints[k])
-                if q is None:
-                    continue
-                cfg = Config(tuple(base), now.joints).with_finger(k, q)
-                cands.append((travel(hand, now, cfg), i, cfg))
-            cands.sort(key=lambda c: (c[0], c[1]))
-            for need, i, cfg in cands:
+            for need, i, cfg in self._postures(k, tip, now, bases):
                 if best is not None and t + need > best[0]:
                     break  # no later base can arrive sooner
                 if (
@@ -300,6 +288,23 @@ class ContactPlanner:
             route,
             self._exit_after(cfg, k, motion, t_c, tip, n),
         )
+
+    def _postures(self, k: int, tip, now: Config, bases) -> list[tuple[float, int, Config]]:
+        """(travel time, base rank, configuration) of each base (``bases``, else the candidates
+        near ``tip``) from which finger k's tip reaches ``tip``, the idle finger unmoved; the
+        quickest first (ties: the earlier base)."""
+        hand = self.hand
+        if bases is None:
+            bases = base_candidates(hand, k, tip, tuple(self.model.target.base))
+        cands = []
+        for i, base in enumerate(bases):
+            q = hand2d.finger_ik(hand, base, k, tip, q_near=now.joints[k])
+            if q is None:
+                continue
+            cfg = Config(tuple(base), now.joints).with_finger(k, q)
+            cands.append((travel(hand, now, cfg), i, cfg))
+        cands.sort(key=lambda c: (c[0], c[1]))
+        return cands
 
     def find_route(
         self, t: float, now: Config, cfg: Config, k: int, motion: Motion, t_c: float, tip, c_c
