@@ -273,6 +273,7 @@ PAYLOADS = {
         "a`<script>alert(4)</script>`b\n\n<script>alert(5)</script>",
         "```\n<script>alert(6)</script>",
         "[link](javascript:alert(7))",
+        "evil\u202egnp.exe\x1b]0;TITLE\x07\x1b[2J",  # bidi override, OSC, clear screen
     ],
     "seed": ["<script>alert(1)</script>", "1; rm -rf ~", {"a": "<b>"}],
 }
@@ -310,6 +311,15 @@ def test_report_escapes_every_payload_in_html(hostile_report):
         assert ":" not in link and not link.startswith("/") and ".." not in link.split("/")
         assert (hostile_report / link).resolve().is_relative_to(hostile_report.resolve())
         assert (hostile_report / link).is_file(), link
+
+
+def test_report_html_holds_no_control_or_format_character(hostile_report):
+    """A name's ESC, BEL and U+202E are shown escaped in the page (the run list too), never
+    raw: they would reorder the text around them or reach a terminal that prints the page."""
+    text = (hostile_report / "index.html").read_text(encoding="utf-8")
+    raw = re.findall(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u200b-\u200f\u202a-\u202e\u2066-\u2069]", text)
+    assert not raw, raw
+    assert "<code>evil\\u202egnp.exe\\x1b]0;TITLE\\x07\\x1b[2J</code>" in text
 
 
 def test_report_escapes_every_payload_in_markdown(hostile_report):
