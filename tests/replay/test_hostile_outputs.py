@@ -427,3 +427,81 @@ def test_a_stored_name_no_scenario_may_have_does_not_sink_the_paper(stick_3step_
     assert r.exit_code == 0, r.output
     html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
     assert "<img src=x" not in html and "Log left out" not in html
+
+
+# -- a log's event count does not set a figure's cost ----------------------------------------
+
+
+def _with_events(base: Path, out: Path, kind: str, n: int, t0: float, t1: float) -> Path:
+    """A copy of the log ``base`` with ``n`` more events of ``kind`` between ``t0`` and ``t1``."""
+    with LogWriter(out) as w:
+        for m in LogReader(base).messages():
+            w.write(m.topic, m.data, m.t_ns)
+        for i in range(n):
+            t = t0 + (t1 - t0) * i / n
+            w.write(TOPIC_EVENTS, {"t": t, "kind": kind, "data": {"index": i}}, int(t * 1e9))
+    return out
+
+
+def test_a_log_full_of_collisions_draws_a_bounded_fig7(stick_3step_log, tmp_path):
+    """A log of 3,000 forged collision events: every one was a dashed line on both panels and
+    a label placed against all others (~190 s, quadratic); now the first MAX_MARKS are drawn
+    and the footer says so, and `figures` stays quick."""
+    from analysis import stick_figures
+    from analysis.line_labels import MAX_MARKS, MORE
+
+    log = _with_events(stick_3step_log, tmp_path / "many.mcap", "collision", 3000, 0.1, 1.8)
+    fig = stick_figures.fig7(LogReader(log))
+    for ax in fig.axes:
+        assert len([x for x in ax.lines if x.get_linestyle() == "--"]) == MAX_MARKS
+    assert len(fig.axes[0].texts) <= MAX_MARKS
+    assert any(MORE in t.get_text() for t in fig.texts)
+    r = invoke("figures", log, "-o", tmp_path / "figs")
+    assert r.exit_code == 0, r.output
+    assert len(list((tmp_path / "figs").glob("*fig7*"))) == 2
+
+
+def test_a_good_runs_fig7_is_not_capped(stick_3step_log):
+    from analysis import stick_figures
+    from analysis.line_labels import MORE
+
+    fig = stick_figures.fig7(LogReader(stick_3step_log))
+    collisions = [e for e in LogReader(stick_3step_log).events() if e["kind"] == "collision"]
+    dashed = [x for x in fig.axes[0].lines if x.get_linestyle() == "--"]
+    assert 0 < len(dashed) == len(collisions)
+    assert not any(MORE in t.get_text() for t in fig.texts)
+
+
+def test_catch_and_grasp_marks_are_bounded_too():
+    """Catch figures' catch/miss/drop lines, grasp Fig. 9's phases, events and slip ticks: at
+    most MAX_MARKS of a kind, and the footer says so."""
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+
+    from analysis import catch_figures, grasp_figures
+    from analysis.grasp_run import RELEASING, REACHING, Phase
+    from analysis.line_labels import MAX_MARKS, MORE
+
+    n = 5 * MAX_MARKS
+    evs = [{"t": 0.2 + 0.5 * i / n, "kind": k, "data": {}} for i in range(n) for k in ("miss",)]
+    catch = SimpleNamespace(t0=0.1, t_c=0.15, events=evs, first_event=lambda kind: None)
+    fig, ax = plt.subplots()
+    ax.set_xlim(0.0, 1.0)
+    drawn: set[str] = set()
+    marks = catch_figures._marks(ax, catch, {}, drawn)
+    assert len(marks) == len(ax.lines) == 2 + MAX_MARKS
+    assert MORE in catch_figures._lines_said(drawn)
+    plt.close(fig)
+
+    names = [REACHING, RELEASING] * n
+    phases = [Phase(name, i * 0.01, (i + 1) * 0.01) for i, name in enumerate(names)]
+    kinds = [{"t": i * 0.01, "kind": k, "data": {}} for i in range(n) for k in ("grasp", "slip")]
+    grasp = SimpleNamespace(phases=phases, events=kinds)
+    fig, ax = plt.subplots()
+    drawn = grasp_figures._shade(ax, grasp)
+    assert len(ax.patches) == MAX_MARKS  # the shaded phases
+    assert len(ax.lines) == MAX_MARKS + 1  # grasp events, one rug of slips
+    assert len(ax.lines[-1].get_xdata()) == MAX_MARKS
+    assert MORE in grasp_figures._footer(drawn)
+    plt.close(fig)
