@@ -459,6 +459,8 @@ def test_a_log_full_of_collisions_draws_a_bounded_fig7(stick_3step_log, tmp_path
     r = invoke("figures", log, "-o", tmp_path / "figs")
     assert r.exit_code == 0, r.output
     assert len(list((tmp_path / "figs").glob("*fig7*"))) == 2
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "security.md").read_text("utf-8")
+    assert f"draws at most {MAX_MARKS} event marks of a kind" in doc
 
 
 def test_a_good_runs_fig7_is_not_capped(stick_3step_log):
