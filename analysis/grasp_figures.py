@@ -37,6 +37,7 @@ from analysis.grasp_run import (
     load_run,
 )
 from replay.log import LogReader  # noqa: E402
+from replay.scenario.yamlio import one_line  # noqa: E402
 from replay.spatial import quaternion_matrix  # noqa: E402
 
 C_OBJ, C_HAND, C_TARGET = "tab:orange", "tab:blue", "tab:green"
@@ -152,7 +153,7 @@ def fig9(run: GraspRun):
         ax.set_xlim(0.0, run.t_end)
         drawn |= _shade(ax, run, labels=ax is ax_y)
     ax_f.set_xlabel("time [s]")
-    ax_y.set_title(f"Feedback response: {run.name} (cf. Fig. 9)", fontsize=10)
+    ax_y.set_title(f"Feedback response: {one_line(run.name)} (cf. Fig. 9)", fontsize=10)
     fig.text(
         0.01,
         0.005,

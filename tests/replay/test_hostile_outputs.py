@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from analysis import runs as run_labels
 from analysis.figure_files import STEM_LENGTH, file_stem
 from replay.cli import CLAIMS_HEADER
 from replay.log import LogReader, LogWriter
@@ -507,3 +508,16 @@ def test_catch_and_grasp_marks_are_bounded_too():
     assert len(ax.lines[-1].get_xdata()) == MAX_MARKS
     assert MORE in grasp_figures._footer(drawn)
     plt.close(fig)
+
+
+def test_a_figure_title_shows_a_names_control_characters_escaped(stick_3step_log, tmp_path):
+    """Fig. 7's title of a run named with ESC/OSC/CR: escaped text, no raw control character
+    (matplotlib had none of their glyphs and warned once for each)."""
+    from analysis import stick_figures
+
+    log = forge(stick_3step_log, tmp_path / "esc.mcap", name=ESCAPES)
+    r = invoke("figures", log, "-o", tmp_path / "figs")
+    assert r.exit_code == 0 and "Glyph" not in r.output, r.output
+    title = stick_figures.fig7(LogReader(log), run_labels.titled(ESCAPES, LogReader(log)))
+    text = title.axes[0].get_title()
+    assert not CONTROL.search(text) and "\\x1b]0;PWNED TITLE" in text
