@@ -111,6 +111,7 @@ MARKS = {  # what a vertical line is, in a figure's footer
     "catch": "catch",
     "miss": "miss",
     "drop": "drop",
+    "more": line_labels.MORE,
 }
 
 
@@ -120,20 +121,25 @@ def _lines_said(drawn: set[str]) -> str:
     return "vertical lines: " + ", ".join(said) if said else "no event in the time span"
 
 
-def _marks(ax, run: CatchRun, style: dict) -> list[tuple[float, str]]:
+def _marks(ax, run: CatchRun, style: dict, drawn: set[str]) -> list[tuple[float, str]]:
     """Draw t0 (mapping starts), t_c (catch surface), first contact and catch/miss within the
-    axes' time span; returns them for :func:`analysis.line_labels.place` (after the layout)."""
+    axes' time span (at most :data:`~analysis.line_labels.MAX_MARKS` of a kind); returns them
+    for :func:`analysis.line_labels.place` (after the layout) and adds what it drew to
+    ``drawn`` (for the footer)."""
     marks = [(run.t0, "t₀"), (run.t_c, "t_c")]
     c = first_contact(run)
     if c is not None:
         marks.append((c["t"], "contact"))
-    for e in run.events:
-        if e["kind"] in ("catch", "miss", "drop"):
-            marks.append((e["t"], e["kind"]))
     lo, hi = ax.get_xlim()
+    for kind in ("catch", "miss", "drop"):
+        inside = (e for e in run.events if e["kind"] == kind and lo <= e["t"] <= hi)
+        shown, more = line_labels.first(inside)
+        marks += [(e["t"], kind) for e in shown]
+        drawn.update(("more",) if more else ())
     marks = [m for m in marks if m[0] is not None and lo <= m[0] <= hi]
     for t, _ in marks:
         ax.axvline(t, color="0.55", lw=0.7, ls=style.get("ls", "-"))
+    drawn.update(name for _, name in marks)
     return marks
 
 
@@ -216,8 +222,7 @@ def fig7(runs: list[CatchRun], title: str):
             ax.plot(tb, ball[:, i], color=C_BALL, **st)
             ax.plot(run.t_ctrl[wc], run.effector_desired[wc, i], color=C_DES, **st)
             ax.plot(run.t_ctrl[wc], run.effector[wc, i], color=C_ACT, **st)
-            marks = _marks(ax, run, st)
-            drawn.update(name for _, name in marks)
+            marks = _marks(ax, run, st, drawn)
             if run is runs[0] and i == 0:
                 named = marks
         side.plot(ball[:, 0], ball[:, 2], color=C_BALL, **st)
@@ -334,8 +339,7 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
                     **st,
                 )
                 ax.set_ylabel(f"τ{name[1]} [N·m]")
-            marks = _marks(ax, run, st)
-            drawn.update(name for _, name in marks)
+            marks = _marks(ax, run, st, drawn)
             if run is runs[0] and j == 0:
                 named = marks
     if what == "torques":

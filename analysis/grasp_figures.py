@@ -23,6 +23,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
+from analysis.line_labels import MORE, first  # noqa: E402
 from analysis.needs import has  # noqa: E402
 from analysis.grasp_run import (
     GRASP_PHASES,
@@ -36,6 +37,7 @@ from analysis.grasp_run import (
     load_run,
 )
 from replay.log import LogReader  # noqa: E402
+from replay.scenario.yamlio import one_line  # noqa: E402
 from replay.spatial import quaternion_matrix  # noqa: E402
 
 C_OBJ, C_HAND, C_TARGET = "tab:orange", "tab:blue", "tab:green"
@@ -51,10 +53,14 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> set[str]:
     """Shade the grasp and releasing phases, draw the plant's events and slip ticks; returns
     what was drawn (for the figure's footer: it explains only those)."""
     drawn: set[str] = set()
-    for p in run.phases:
-        key = "grasp" if p.name in GRASP_PHASES else p.name if p.name == RELEASING else None
-        if key is None:
-            continue
+    keys = ((p, _shade_key(p.name)) for p in run.phases)
+    phases, more = first((p, key) for p, key in keys if key is not None)
+    marked, more_marked = first(
+        e for e in run.events if e["kind"] in EVENT_KINDS and e["kind"] != "slip"
+    )
+    slips, more_slips = first(e["t"] for e in run.events if e["kind"] == "slip")
+    drawn.update(("more",) if more or more_marked or more_slips else ())
+    for p, key in phases:
         color, alpha = SHADE[key]
         ax.axvspan(p.t0, p.t1, color=color, alpha=alpha, lw=0)
         drawn.add(key)
@@ -68,11 +74,9 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> set[str]:
                 fontsize=7,
                 color="0.3",
             )
-    for e in run.events:
-        if e["kind"] in EVENT_KINDS and e["kind"] != "slip":
-            ax.axvline(e["t"], color="0.45", lw=0.7, ls=":" if e["kind"] != "drop" else "-")
-            drawn.add(e["kind"])
-    slips = [e["t"] for e in run.events if e["kind"] == "slip"]
+    for e in marked:
+        ax.axvline(e["t"], color="0.45", lw=0.7, ls=":" if e["kind"] != "drop" else "-")
+        drawn.add(e["kind"])
     if slips:  # a rug along the bottom edge
         ax.plot(
             slips,
@@ -84,6 +88,11 @@ def _shade(ax, run: GraspRun, labels: bool = False) -> set[str]:
         )
         drawn.add("slip")
     return drawn
+
+
+def _shade_key(phase: str) -> str | None:
+    """What a phase is shaded as: a grasp phase, releasing, or not shaded (None)."""
+    return "grasp" if phase in GRASP_PHASES else phase if phase == RELEASING else None
 
 
 def _footer(drawn: set[str]) -> str:
@@ -99,6 +108,7 @@ def _footer(drawn: set[str]) -> str:
     if "drop" in drawn:
         said.append("solid grey: drop")
     said.append("red ticks at the bottom: slip events" if "slip" in drawn else "no slip event")
+    said += [MORE] if "more" in drawn else []
     return (
         "Y: tracking on the constraint plane (S = 1); X: reaching along its normal (S = 0).\n"
         + "; ".join(said)
@@ -143,7 +153,7 @@ def fig9(run: GraspRun):
         ax.set_xlim(0.0, run.t_end)
         drawn |= _shade(ax, run, labels=ax is ax_y)
     ax_f.set_xlabel("time [s]")
-    ax_y.set_title(f"Feedback response: {run.name} (cf. Fig. 9)", fontsize=10)
+    ax_y.set_title(f"Feedback response: {one_line(run.name)} (cf. Fig. 9)", fontsize=10)
     fig.text(
         0.01,
         0.005,

@@ -222,9 +222,10 @@ def label_runs(readers: Iterable[LogReader]) -> dict[str, str]:
 
 
 def titled(key: str, reader: LogReader) -> str:
-    """``key``, with its label when the key does not already say it: a figure's run name."""
+    """``key``, with its label when the key does not already say it: a figure's run name, its
+    control and format characters escaped (a log's ESC is no glyph)."""
     label = describe(reader, key).label
-    return f"{key} ({label})" if label and label not in key else key
+    return one_line(f"{key} ({label})" if label and label not in key else key)
 
 
 def by_paper(readers: Iterable[LogReader]) -> dict[str, dict[str, LogReader]]:

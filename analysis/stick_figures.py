@@ -35,11 +35,13 @@ def fig7(log: LogReader, title: str = ""):
     ax_v.plot(s["t"], speed, color="tab:blue", lw=1.4, label="simulated (Pymunk)")
     ax_w.plot(s["t"], s["omega"], color="tab:red", lw=1.4, label="simulated (Pymunk)")
     marks = []
-    for e in events(log, "collision"):
+    collisions, more = line_labels.first(events(log, "collision"))
+    captures, more_captures = line_labels.first(events(log, "capture"))
+    for e in collisions:
         for ax in (ax_v, ax_w):
             ax.axvline(e["t"], color="0.4", lw=0.8, ls="--")
         marks.append((e["t"], f"#{e['data'].get('index', '')}"))
-    for e in events(log, "capture"):
+    for e in captures:
         for ax in (ax_v, ax_w):
             ax.axvline(e["t"], color="tab:green", lw=1.0)
     ax_v.set_ylabel("translational speed |v| [m/s]")
@@ -52,7 +54,8 @@ def fig7(log: LogReader, title: str = ""):
     fig.text(
         0.01,
         0.005,
-        "dashed: fingertip-stick collisions #index (from /events); green: capture",
+        "dashed: fingertip-stick collisions #index (from /events); green: capture"
+        + (f" ({line_labels.MORE})" if more or more_captures else ""),
         fontsize=7,
         color="0.35",
         va="bottom",

@@ -626,7 +626,7 @@ def _html(sections, info, commands, notes=(), said=()) -> str:
             h.append(
                 "<p>Runs: "
                 + ", ".join(
-                    f"<code>{_e(n)}</code> (seed {_e(s)}{_e(_differs(sec, n))})"
+                    f"<code>{_e(one_line(n))}</code> (seed {_e(s)}{_e(_differs(sec, n))})"
                     for n, s, _ in sec.runs
                 )
                 + "</p>"

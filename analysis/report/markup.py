@@ -14,8 +14,10 @@ _MD_ENTITY = {"<": "&lt;", ">": "&gt;", "&": "&amp;"}
 
 
 def e(text) -> str:
-    """HTML text or a double-quoted attribute value: ``& < > " '`` escaped."""
-    return html.escape(str(text), quote=True)
+    """HTML text or a double-quoted attribute value: ``& < > " '`` escaped, and every control
+    or format character but the line break shown escaped (``\\x1b``, ``\\u202e``: a log's
+    name cannot reorder or hide the text around it, nor reach a terminal that prints the page)."""
+    return html.escape("\n".join(map(one_line, str(text).split("\n"))), quote=True)
 
 
 def url(path: str) -> str:

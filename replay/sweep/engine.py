@@ -28,7 +28,14 @@ from replay import registry
 from replay.sweep.executors import WORKER_DIED, default_workers, run_local, run_ray
 from replay.sweep.lock import FolderLock, SweepOutputError
 from replay.sweep.results import SUMMARY, write_summary
-from replay.sweep.table import as_bool, param_columns, read_table, refuse_link, write_table
+from replay.sweep.table import (
+    as_bool,
+    param_columns,
+    read_table,
+    refuse_foreign,
+    refuse_link,
+    write_table,
+)
 from replay.sweep.variants import Variant
 from replay.sweep.worker import INTERRUPTED
 
@@ -198,6 +205,8 @@ def _run_locked(
         *([out_dir / "logs"] if keep_logs else []),
     ):
         refuse_link(path)  # (before anything is read from them)
+    for path in (table, out_dir / STALE):
+        refuse_foreign(path)  # (a table.csv of the user's is not replaced)
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
     versions = {v.version for v in variants}

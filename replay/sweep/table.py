@@ -14,6 +14,8 @@ from __future__ import annotations
 import csv
 import errno
 import os
+import re
+import stat
 import tempfile
 from pathlib import Path
 from typing import Any, Iterable
@@ -48,6 +50,27 @@ def refuse_link(path: Path) -> None:
         raise TableError(
             f"will not write {path} through a symbolic link (to {os.readlink(path)}); "
             "remove the link or give another -o",
+            2,
+        )
+
+
+def refuse_foreign(path: Path) -> None:
+    """:class:`TableError` (exit 2) when ``path`` exists and is not a sweep's table (a regular
+    file, empty or whose first line starts ``index,key``): the sweep rewrites its table whole,
+    so ``-o`` at a folder holding a ``table.csv`` of the user's must not replace it."""
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise TableError(f"will not write {path}: it is not a regular file; give another -o", 2)
+        with path.open("rb") as f:
+            head = f.readline(4096)
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise TableError(f"cannot read table {path}: {exc.strerror or exc}", 2) from None
+    if head and not re.match(rb"index,key(,|\r?\n|$)", head):
+        raise TableError(
+            f"will not overwrite {path}: it is not a sweep's table (its first line does not "
+            "start 'index,key'); give another -o",
             2,
         )
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from analysis import runs as run_labels
 from analysis.figure_files import STEM_LENGTH, file_stem
 from analysis.commands import CLAIMS_HEADER
 from replay.log import LogReader, LogWriter
@@ -273,6 +274,7 @@ PAYLOADS = {
         "a`<script>alert(4)</script>`b\n\n<script>alert(5)</script>",
         "```\n<script>alert(6)</script>",
         "[link](javascript:alert(7))",
+        "evil\u202egnp.exe\x1b]0;TITLE\x07\x1b[2J",  # bidi override, OSC, clear screen
     ],
     "seed": ["<script>alert(1)</script>", "1; rm -rf ~", {"a": "<b>"}],
 }
@@ -310,6 +312,15 @@ def test_report_escapes_every_payload_in_html(hostile_report):
         assert ":" not in link and not link.startswith("/") and ".." not in link.split("/")
         assert (hostile_report / link).resolve().is_relative_to(hostile_report.resolve())
         assert (hostile_report / link).is_file(), link
+
+
+def test_report_html_holds_no_control_or_format_character(hostile_report):
+    """A name's ESC, BEL and U+202E are shown escaped in the page (the run list too), never
+    raw: they would reorder the text around them or reach a terminal that prints the page."""
+    text = (hostile_report / "index.html").read_text(encoding="utf-8")
+    raw = re.findall(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u200b-\u200f\u202a-\u202e\u2066-\u2069]", text)
+    assert not raw, raw
+    assert "<code>evil\\u202egnp.exe\\x1b]0;TITLE\\x07\\x1b[2J</code>" in text
 
 
 def test_report_escapes_every_payload_in_markdown(hostile_report):
@@ -419,3 +430,96 @@ def test_a_stored_name_no_scenario_may_have_does_not_sink_the_paper(stick_3step_
     assert r.exit_code == 0, r.output
     html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
     assert "<img src=x" not in html and "Log left out" not in html
+
+
+# -- a log's event count does not set a figure's cost ----------------------------------------
+
+
+def _with_events(base: Path, out: Path, kind: str, n: int, t0: float, t1: float) -> Path:
+    """A copy of the log ``base`` with ``n`` more events of ``kind`` between ``t0`` and ``t1``."""
+    with LogWriter(out) as w:
+        for m in LogReader(base).messages():
+            w.write(m.topic, m.data, m.t_ns)
+        for i in range(n):
+            t = t0 + (t1 - t0) * i / n
+            w.write(TOPIC_EVENTS, {"t": t, "kind": kind, "data": {"index": i}}, int(t * 1e9))
+    return out
+
+
+def test_a_log_full_of_collisions_draws_a_bounded_fig7(stick_3step_log, tmp_path):
+    """A log of 3,000 forged collision events: every one was a dashed line on both panels and
+    a label placed against all others (~190 s, quadratic); now the first MAX_MARKS are drawn
+    and the footer says so, and `figures` stays quick."""
+    from analysis import stick_figures
+    from analysis.line_labels import MAX_MARKS, MORE
+
+    log = _with_events(stick_3step_log, tmp_path / "many.mcap", "collision", 3000, 0.1, 1.8)
+    fig = stick_figures.fig7(LogReader(log))
+    for ax in fig.axes:
+        assert len([x for x in ax.lines if x.get_linestyle() == "--"]) == MAX_MARKS
+    assert len(fig.axes[0].texts) <= MAX_MARKS
+    assert any(MORE in t.get_text() for t in fig.texts)
+    r = invoke("figures", log, "-o", tmp_path / "figs")
+    assert r.exit_code == 0, r.output
+    assert len(list((tmp_path / "figs").glob("*fig7*"))) == 2
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "security.md").read_text("utf-8")
+    assert f"draws at most {MAX_MARKS} event marks of a kind" in doc
+
+
+def test_a_good_runs_fig7_is_not_capped(stick_3step_log):
+    from analysis import stick_figures
+    from analysis.line_labels import MORE
+
+    fig = stick_figures.fig7(LogReader(stick_3step_log))
+    collisions = [e for e in LogReader(stick_3step_log).events() if e["kind"] == "collision"]
+    dashed = [x for x in fig.axes[0].lines if x.get_linestyle() == "--"]
+    assert 0 < len(dashed) == len(collisions)
+    assert not any(MORE in t.get_text() for t in fig.texts)
+
+
+def test_catch_and_grasp_marks_are_bounded_too():
+    """Catch figures' catch/miss/drop lines, grasp Fig. 9's phases, events and slip ticks: at
+    most MAX_MARKS of a kind, and the footer says so."""
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+
+    from analysis import catch_figures, grasp_figures
+    from analysis.grasp_run import RELEASING, REACHING, Phase
+    from analysis.line_labels import MAX_MARKS, MORE
+
+    n = 5 * MAX_MARKS
+    evs = [{"t": 0.2 + 0.5 * i / n, "kind": k, "data": {}} for i in range(n) for k in ("miss",)]
+    catch = SimpleNamespace(t0=0.1, t_c=0.15, events=evs, first_event=lambda kind: None)
+    fig, ax = plt.subplots()
+    ax.set_xlim(0.0, 1.0)
+    drawn: set[str] = set()
+    marks = catch_figures._marks(ax, catch, {}, drawn)
+    assert len(marks) == len(ax.lines) == 2 + MAX_MARKS
+    assert MORE in catch_figures._lines_said(drawn)
+    plt.close(fig)
+
+    names = [REACHING, RELEASING] * n
+    phases = [Phase(name, i * 0.01, (i + 1) * 0.01) for i, name in enumerate(names)]
+    kinds = [{"t": i * 0.01, "kind": k, "data": {}} for i in range(n) for k in ("grasp", "slip")]
+    grasp = SimpleNamespace(phases=phases, events=kinds)
+    fig, ax = plt.subplots()
+    drawn = grasp_figures._shade(ax, grasp)
+    assert len(ax.patches) == MAX_MARKS  # the shaded phases
+    assert len(ax.lines) == MAX_MARKS + 1  # grasp events, one rug of slips
+    assert len(ax.lines[-1].get_xdata()) == MAX_MARKS
+    assert MORE in grasp_figures._footer(drawn)
+    plt.close(fig)
+
+
+def test_a_figure_title_shows_a_names_control_characters_escaped(stick_3step_log, tmp_path):
+    """Fig. 7's title of a run named with ESC/OSC/CR: escaped text, no raw control character
+    (matplotlib had none of their glyphs and warned once for each)."""
+    from analysis import stick_figures
+
+    log = forge(stick_3step_log, tmp_path / "esc.mcap", name=ESCAPES)
+    r = invoke("figures", log, "-o", tmp_path / "figs")
+    assert r.exit_code == 0 and "Glyph" not in r.output, r.output
+    title = stick_figures.fig7(LogReader(log), run_labels.titled(ESCAPES, LogReader(log)))
+    text = title.axes[0].get_title()
+    assert not CONTROL.search(text) and "\\x1b]0;PWNED TITLE" in text

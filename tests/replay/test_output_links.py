@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -151,6 +153,45 @@ def test_sweep_refuses_a_lock_file_with_another_name(tmp_path):
     os.link(victim, out / "sweep.lock")
     assert "hard links" in one_error(_sweep(out, "--no-logs"))
     assert victim.read_text() == "precious\n"
+
+
+@pytest.mark.parametrize("name", ["table.csv", "table.stale.csv"])
+@pytest.mark.parametrize("text", ["a,b\n", "my notes\nline 2\n", "key,version\nprecious,data\n"])
+def test_sweep_does_not_replace_a_table_it_did_not_make(tmp_path, name, text):
+    """`sweep -o .` in a folder holding a table.csv of the user's replaced it (a header-only
+    one silently; rows were moved to table.stale.csv): a file whose first line does not start
+    'index,key' is refused before anything runs, and left as it was."""
+    out = tmp_path / "sweep"
+    out.mkdir()
+    (out / name).write_text(text)
+    error = one_error(_sweep(out, "--no-logs"))
+    assert "not a sweep's table" in error and name in error
+    assert (out / name).read_text() == text
+    assert sorted(p.name for p in out.iterdir()) == sorted({name, "sweep.lock"})
+
+
+def test_sweep_refuses_a_fifo_as_its_table_without_waiting(tmp_path):
+    out = tmp_path / "sweep"
+    out.mkdir()
+    os.mkfifo(out / "table.csv")
+    r = subprocess.run(  # (in a child: opening the FIFO to read it would wait for a writer)
+        [sys.executable, "-m", "replay.entry", "sweep", "stick_3step", "--grid", "seed=0"]
+        + ["-q", "--no-logs", "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        stdin=subprocess.DEVNULL,
+    )
+    assert r.returncode == 2 and "not a regular file" in r.stderr, r.stderr
+
+
+def test_a_sweep_takes_its_own_table_and_an_empty_one(tmp_path):
+    out = tmp_path / "sweep"
+    out.mkdir()
+    (out / "table.csv").write_text("")
+    assert _sweep(out, "--no-logs").exit_code == 0
+    r = invoke("sweep", "stick_3step", "--grid", "seed=0,1", "-q", "-o", out, "--no-logs")
+    assert r.exit_code == 0 and "1 skipped" in r.output, r.output
 
 
 def test_a_sweep_without_links_runs(tmp_path):

@@ -77,3 +77,15 @@ def test_validate_prints_a_file_name_with_a_newline_on_one_line(tmp_path, projec
     shutil.copy(base, name)
     r = CliRunner().invoke(main, ["validate", "--static", str(name)], prog_name="replay")
     assert r.exit_code == 0 and r.output.count("\n") == 1, r.output
+
+
+def test_info_figures_and_claims_print_a_log_file_name_escaped(tmp_path, stick_3step_log):
+    """A log *file* named with an OSC title, a bell, a line break and bidi controls: every
+    command that names the file prints it inert (the file name is the user's, but a colleague
+    may have chosen it)."""
+    path = tmp_path / f"evil\x1b]0;T\x07\n{TRICKS}.mcap"
+    shutil.copy(stick_3step_log, path)
+    for args in (["info"], ["figures", "-o", str(tmp_path / "figs")], ["claims"]):
+        r = CliRunner().invoke(main, [*args, str(path)], prog_name="replay")
+        assert r.exit_code in (0, 1), r.output  # (claims: 1 when a claim fails)
+        assert _hidden(r.output) == [], (args, r.output)

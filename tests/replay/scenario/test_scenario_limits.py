@@ -281,6 +281,19 @@ def test_extends_etc_shadow_quotes_nothing(tmp_path):
         assert "root:" not in line and ":0:" not in line
 
 
+@pytest.mark.parametrize("kind", ["fifo", "folder"])
+def test_extends_of_a_fifo_or_a_folder_named_yaml_is_one_line_and_reads_nothing(tmp_path, kind):
+    """A FIFO named secret.yaml would block a reader forever; a folder cannot be read: both
+    are 'no such scenario file', and the FIFO is never opened (no writer is waiting on it)."""
+    target = tmp_path / "secret.yaml"
+    if kind == "fifo":
+        os.mkfifo(target)
+    else:
+        target.mkdir()
+    line = _extends(tmp_path, "secret.yaml")
+    assert "no such scenario file 'secret.yaml'" in line
+
+
 @pytest.mark.parametrize("link", ["secret.yaml", "secret.yml"])
 def test_extends_refuses_a_yaml_link_to_another_file(tmp_path, link):
     (tmp_path / "shadow").write_text(SECRET)
