@@ -27,7 +27,7 @@ from typing import Any, Iterable
 from replay import registry
 from replay.sweep.executors import WORKER_DIED, default_workers, run_local, run_ray
 from replay.sweep.lock import FolderLock, SweepOutputError
-from replay.sweep.results import SUMMARY, write_summary
+from replay.sweep.results import SUMMARY, refuse_foreign_summary, write_summary
 from replay.sweep.table import (
     as_bool,
     param_columns,
@@ -207,6 +207,7 @@ def _run_locked(
         refuse_link(path)  # (before anything is read from them)
     for path in (table, out_dir / STALE):
         refuse_foreign(path)  # (a table.csv of the user's is not replaced)
+    refuse_foreign_summary(out_dir / SUMMARY)
     params = list(dict.fromkeys(k for v in variants for k in v.params))
     by_key = {v.key: v for v in variants}
     versions = {v.version for v in variants}

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import csv
 import math
-import os
-import tempfile
+import re
 from pathlib import Path
 from typing import Any
 
-from replay.sweep.table import TableError, as_bool
+from replay.log.output import write_output
+from replay.sweep.table import TableError, as_bool, refuse_foreign
 
 SUMMARY = "summary.csv"
 COLUMNS = ["runs", "successes", "rate", "rate_lo_95", "rate_hi_95", "not_run"]
@@ -48,19 +48,30 @@ def cells(rows: list[dict[str, Any]], params: list[str]) -> list[dict[str, Any]]
     return out
 
 
+def refuse_foreign_summary(path: Path) -> None:
+    """:class:`TableError` (exit 2) when ``path`` holds a file that is not a sweep's summary
+    (its header ends with :data:`COLUMNS`): never replaced."""
+    tail = ",".join(COLUMNS).encode()
+    refuse_foreign(
+        path,
+        rb"(.*,)?" + re.escape(tail) + rb"\r?\n",
+        f"a sweep's summary (a header ending {tail!r})",
+    )
+
+
 def write_summary(path: Path, rows: list[dict[str, Any]], params: list[str]) -> None:
-    """``cells(rows, params)`` to ``path`` atomically (TableError when it cannot be written)."""
+    """``cells(rows, params)`` to ``path``, written beside it and renamed onto it, over nothing
+    but an earlier summary (TableError when it cannot be written)."""
     axes = [p for p in params if p != "seed"]
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-        with os.fdopen(fd, "w", newline="", encoding="utf-8") as f:
+
+    def write(tmp: Path) -> None:
+        with tmp.open("w", newline="", encoding="utf-8") as f:
             w = csv.DictWriter(f, fieldnames=axes + COLUMNS)
             w.writeheader()
             w.writerows(cells(rows, params))
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
+
+    refuse_foreign_summary(path)
+    try:
+        write_output(path, write)
     except OSError as exc:
-        if tmp is not None:
-            Path(tmp).unlink(missing_ok=True)
         raise TableError(f"cannot write summary {path}: {exc.strerror or exc}", 1) from None

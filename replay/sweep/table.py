@@ -54,10 +54,15 @@ def refuse_link(path: Path) -> None:
         )
 
 
-def refuse_foreign(path: Path) -> None:
-    """:class:`TableError` (exit 2) when ``path`` exists and is not a sweep's table (a regular
-    file, empty or whose first line starts ``index,key``): the sweep rewrites its table whole,
-    so ``-o`` at a folder holding a ``table.csv`` of the user's must not replace it."""
+def refuse_foreign(
+    path: Path,
+    first: bytes = rb"index,key(,|\r?\n|$)",
+    what: str = "a sweep's table (its first line does not start 'index,key')",
+) -> None:
+    """:class:`TableError` (exit 2) when ``path`` exists and is not a sweep's own file (a
+    regular file, empty or whose first line matches ``first``): the sweep rewrites its table
+    and summary whole, so ``-o`` at a folder holding a ``table.csv`` of the user's must not
+    replace it."""
     try:
         if not stat.S_ISREG(os.stat(path).st_mode):
             raise TableError(f"will not write {path}: it is not a regular file; give another -o", 2)
@@ -66,13 +71,9 @@ def refuse_foreign(path: Path) -> None:
     except FileNotFoundError:
         return
     except OSError as exc:
-        raise TableError(f"cannot read table {path}: {exc.strerror or exc}", 2) from None
-    if head and not re.match(rb"index,key(,|\r?\n|$)", head):
-        raise TableError(
-            f"will not overwrite {path}: it is not a sweep's table (its first line does not "
-            "start 'index,key'); give another -o",
-            2,
-        )
+        raise TableError(f"cannot read {path}: {exc.strerror or exc}", 2) from None
+    if head and not re.match(first, head):
+        raise TableError(f"will not overwrite {path}: it is not {what}; give another -o", 2)
 
 
 def param_columns(row: dict[str, Any]) -> list[str]:

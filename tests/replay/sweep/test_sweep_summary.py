@@ -71,3 +71,27 @@ def test_any_sweep_draws_its_cells_rates(toy_yaml, tmp_path, grid):
     assert len(r.output.strip().splitlines()) == 1  # (the summary line: the plot says nothing)
     assert (out / "summary.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert b"success rate" in (out / "summary.svg").read_bytes()
+
+
+def test_a_summary_csv_of_the_users_is_never_replaced(toy_yaml, tmp_path):
+    """``-o`` at a folder holding the user's own ``summary.csv`` (or a link named so): the sweep
+    stops before running anything, the file as it was; its own earlier summary it rewrites."""
+    from replay.sweep.table import TableError
+
+    variants = expand(toy_yaml, from_options(["seed=1,2"], [], None), 0, version="test")
+    out = tmp_path / "sweep"
+    out.mkdir()
+    mine = out / "summary.csv"
+    mine.write_text("my,notes\n1,2\n")
+    with pytest.raises(TableError, match="not a sweep's summary"):
+        run_sweep(variants, out, workers=1, keep_logs=False, progress=False)
+    assert mine.read_text() == "my,notes\n1,2\n" and not (out / "table.csv").exists()
+    mine.unlink()
+    mine.symlink_to(tmp_path / "elsewhere.csv")
+    with pytest.raises(TableError, match="symbolic link"):
+        run_sweep(variants, out, workers=1, keep_logs=False, progress=False)
+    mine.unlink()
+    run_sweep(variants, out, workers=1, keep_logs=False, progress=False)
+    first = mine.read_text()
+    run_sweep(variants, out, workers=1, keep_logs=False, progress=False)  # its own: rewritten
+    assert mine.read_text() == first and first.startswith("runs,successes,rate")
