@@ -19,6 +19,9 @@ Before the ball is seen the arm holds its initial posture. Once the ball reaches
 surface the desired posture is frozen (``after_catch: hold``), because past it the ball sits in
 the hand and the mapping would chase the hand itself.
 
+The set-up, the joint state, the PD law, the hand's command and the arm's telemetry are the
+catch-family base's (:mod:`.base`), shared with the predictive and feedback baselines.
+
 Mapping parameters (``mapping``): "optimised" = alpha minimising eq. 25 under eq. 13 (computed at
 start-up, ~3 s, or read from ``alpha_file``); "initial" = the paper's unoptimised parameters, which
 we define as the minimum-norm alpha satisfying only the initial constraint C alpha = rhs (eq. 13).
@@ -32,8 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
+from replay.control.catching.base import CatchArmController
 from replay.control.catching.estimator import BallisticEstimator, LastFrameEstimator
-from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
 from replay.control.catching.optimise import (
     CostRecord,
     OptimResult,
@@ -42,20 +45,8 @@ from replay.control.catching.optimise import (
     save_alpha,
 )
 from replay.control.catching.problem import ProblemConfig, build_problem
-from replay.interfaces import Controller, Occurrence
-from replay.messages import (
-    TOPIC_ARM_ENCODERS,
-    TOPIC_ARM_JOINT_COMMAND,
-    TOPIC_ARM_JOINT_STATE,
-    TOPIC_CATCHING_STATE,
-    TOPIC_EFFECTOR_STATE,
-    TOPIC_OPTIMIZATION_COST,
-    TOPIC_VISION_OBJECT,
-    EffectorState,
-    JointCommand,
-    OptimizationCost,
-    Vec3,
-)
+from replay.interfaces import Occurrence
+from replay.messages import TOPIC_CATCHING_STATE, TOPIC_OPTIMIZATION_COST, OptimizationCost, Vec3
 from replay.params import ParamError, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
@@ -254,19 +245,37 @@ def alpha_path(params: Params) -> Path | None:
     )
 
 
-def _saturated(tau, limit) -> list[float]:
-    """tau saturated at +-limit (np.minimum(np.maximum(tau, -limit), limit))."""
-    return [lim if x > lim else (-lim if x < -lim else x) for x, lim in zip(tau, limit)]
-
-
-def pd_reference(ff, kp, q_d, q, kd, qd_d, qd, limit) -> list[float]:
-    """tau = ff + Kp (q_d - q) + Kd (qd_d - qd), saturated (step 4 above)."""
-    return _saturated(
-        [
-            f + p * (a - b) + d * (c - e)
-            for f, p, a, b, d, c, e in zip(ff, kp, q_d, q, kd, qd_d, qd)
-        ],
-        limit,
+def problem_config(
+    P: Params, q_start: np.ndarray, *, tau_max: np.ndarray, omega_max: np.ndarray, gravity: float
+) -> ProblemConfig:
+    """The offline problem of eq. 25 under eq. 13 as the parameters state it; ``tau_max`` (eq.
+    22) and ``omega_max`` (eq. 24), the spec's limits of the active joints, stand where the
+    parameters leave them empty; ``gravity`` in m/s^2."""
+    if P.opt_torque_limits:
+        tau_max = np.asarray(P.opt_torque_limits, float)
+    if P.opt_velocity_limits:
+        omega_max = np.asarray(P.opt_velocity_limits, float)
+    return ProblemConfig(
+        q_alpha=P.q_alpha,
+        order=P.order,
+        q_start=tuple(q_start.tolist()),
+        catch_q=tuple(P.catch_q),
+        throw_start=tuple(P.throw_start),
+        speeds=tuple(P.throw_speeds),
+        spread=P.throw_spread,
+        grid=P.throw_grid,
+        n_samples=P.samples_per_throw,
+        gravity=gravity,
+        tau_max=tuple(tau_max.tolist()),
+        omega_max=tuple(omega_max.tolist()),
+        w_tau=P.w_tau,
+        w_omega=P.w_omega,
+        penalty=P.limit_penalty,
+        torque_penalty=P.torque_limit_penalty,
+        approach_weight=P.approach_weight,
+        max_iter=P.max_iterations,
+        torque_cost=P.torque_cost,
+        excess_weight=P.excess_weight,
     )
 
 
@@ -289,72 +298,30 @@ class CatchingState:
 CatchingParams = Params
 
 
-class CatchingController(Controller):
+class CatchingController(CatchArmController):
     Params = CatchingParams
-    spec_type = ArmSpec
-    command_type = ArmCommand
-    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)  # the stereo ball, the joint encoders
     description = (
         "Namiki & Ishikawa: direct mapping q_d = g o l_c^-1(r_o) from stereo "
         "positions to joint targets, PD + dynamics feed-forward, hand timed by TTC"
     )
 
-    def __init__(self, params: CatchingParams, *, spec, model: ArmModel | None = None) -> None:
-        super().__init__(params, spec=spec)
+    def __init__(self, params: CatchingParams, *, spec: ArmSpec) -> None:
+        super().__init__(params, spec=spec, who="the catching mapping")
         P = params
-        names = tuple(spec.joint_names)
-        self.names = names
-        self.n = len(names)
-        self.active = active_joints(names, P.held_joints, P.selected_joint, "the catching mapping")
-        self.q_init = np.asarray(spec.initial_q, float).copy()
-        self.tau_limit = np.asarray(spec.torque_limits, float)
-        self.gravity = np.array([0.0, 0.0, -float(getattr(spec, "gravity", 9.81))])
-        if model is None:
-            off = catch_point_offset(spec, P.catch_offset)
-            self.catch_offset = off
-            model = ArmModel.from_chain(
-                spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)
-            )
-        else:
-            self.catch_offset = P.catch_offset
-        self.model = model
         act = list(self.active)
-        tau_max = (
-            np.asarray(P.opt_torque_limits, float) if P.opt_torque_limits else self.tau_limit[act]
-        )
-        om_max = (
-            np.asarray(P.opt_velocity_limits, float)
-            if P.opt_velocity_limits
-            else np.asarray(spec.velocity_limits, float)[act]
-        )
-        self.config = ProblemConfig(
-            q_alpha=P.q_alpha,
-            order=P.order,
-            q_start=tuple(self.q_init.tolist()),
-            catch_q=tuple(P.catch_q),
-            throw_start=tuple(P.throw_start),
-            speeds=tuple(P.throw_speeds),
-            spread=P.throw_spread,
-            grid=P.throw_grid,
-            n_samples=P.samples_per_throw,
+        self.config = problem_config(
+            P,
+            self.q_init,
+            tau_max=self.tau_limit[act],
+            omega_max=np.asarray(spec.velocity_limits, float)[act],
             gravity=-float(self.gravity[2]),
-            tau_max=tuple(tau_max.tolist()),
-            omega_max=tuple(om_max.tolist()),
-            w_tau=P.w_tau,
-            w_omega=P.w_omega,
-            penalty=P.limit_penalty,
-            torque_penalty=P.torque_limit_penalty,
-            approach_weight=P.approach_weight,
-            max_iter=P.max_iterations,
-            torque_cost=P.torque_cost,
-            excess_weight=P.excess_weight,
         )
-        self.problem = build_problem(model, self.config)
+        self.problem = build_problem(self.model, self.config)
+        self.geo = self.problem.geometry
         self.history: list[CostRecord] = []
         self.result: OptimResult | None = None
         self.alpha0 = initial_alpha(self.problem.C, self.problem.rhs)
         self.alpha_opt = None
-        self._events: list[Occurrence] = []
         if P.mapping == "optimised":
             self.alpha_opt = self._optimised_alpha()
             alpha = self.alpha_opt
@@ -363,55 +330,26 @@ class CatchingController(Controller):
             alpha = self.alpha0
         self.mapping = self.problem.mapping
         self.mapping.A = np.asarray(alpha, float).reshape(self.mapping.A.shape)
-        self.geo = self.problem.geometry
-
-        self.kp = np.asarray(P.kp, float)
-        self.kd = np.asarray(P.kd, float)
-        if self.kp.shape != (self.n,) or self.kd.shape != (self.n,):
-            raise ValueError(f"kp and kd need {self.n} values")
         self.est: BallisticEstimator | LastFrameEstimator = (
             BallisticEstimator(self.gravity, P.fit_window)
             if P.estimator == "ballistic"
             else LastFrameEstimator()
         )
-        hand = getattr(spec, "hand", None)
-        self.hand = hand
-        if hand is not None:
-            self.hand_open = np.asarray(hand.open_posture, float)
-            self.hand_closed = np.asarray(hand.closed_posture, float)
-            self.close_time = float(
-                np.max(np.abs(self.hand_closed - self.hand_open)) / hand.closing_speed
-            )
-            self._hand_open_l = self.hand_open.tolist()
-            self._hand_closed_l = self.hand_closed.tolist()
-        else:
-            self.close_time = 0.0
         # the per-step path works on Python floats: joint vectors are lists of n floats
         self._act = tuple(int(i) for i in self.model.active)
         self._q_fixed = self.model.q_fixed.tolist()
-        self._kp, self._kd = self.kp.tolist(), self.kd.tolist()
-        self._tau_limit = self.tau_limit.tolist()
         self._origin = tuple(self.geo.origin.tolist())
-        self._zeros = [0.0] * self.n
         # run-time state
-        self.q: list[float] | None = None
-        self.qd: list[float] | None = None
         self.q_d: list[float] = self.q_init.tolist()
         self.qd_d: list[float] = list(self._zeros)
         self.tau: list[float] = list(self._zeros)
         self.t_catch = None
-        self.closing = False
         self.holding = False
         self._in_domain = True
         self._warned_state = False
-        self._t = 0.0
-        self._names_seen: list[str] | None = None  # joint-name layout of the last joint state
-        self._idx: list[int] | None = None  # our joints in that layout (None: taken as it is)
-        self._identity = list(range(self.n))
         # the feed-forward of the current desired state (q_d, qd_d, qdd_d); None when the
         # update set a new one (before the ball is seen and while holding, it is computed once)
         self._ff: tuple | None = None
-        self._fk_desired: tuple = (None, [])  # (the q_d list it is of, l(q_d))
         self._state_lists: tuple | None = None  # (r_o, r_o', q_o) lists of /catching/state
         self._costs_logged = False  # /optimization/cost goes out with the first telemetry
 
@@ -463,15 +401,12 @@ class CatchingController(Controller):
         ]
 
     # ------------------------------------------------------------------ control
+    def _see(self, m) -> None:
+        self.est.add(m.t, m.position)
+
     def update(self, t: float, measurements: list) -> ArmCommand:
-        self._t = t
-        est = self.est
-        for topic, m in measurements:
-            if topic == TOPIC_VISION_OBJECT:
-                est.add(m.t, m.position)
-            elif topic == TOPIC_ARM_ENCODERS or topic == TOPIC_ARM_JOINT_STATE:
-                self._joint_state(m)
-        P = self.params
+        self._measure(measurements)
+        P, est = self.params, self.est
         qdd_d = self._zeros
         if est.buf and not self.holding:
             r, v, a = est.state_f(t) if P.latency_compensation else est.state_f(est.buf[-1][0])
@@ -516,38 +451,11 @@ class CatchingController(Controller):
             and self.t_catch is not None
             and t >= self.t_catch - self.close_time - P.close_lead - 1e-9
         ):
-            self.closing = True
-            self._events.append(
-                Occurrence(
-                    "hand_close",
-                    {"predicted_catch_time": self.t_catch, "closing_time": self.close_time},
-                )
+            self._close_hand(
+                {"predicted_catch_time": self.t_catch, "closing_time": self.close_time}
             )
         self.tau = self._torque(qdd_d)
-        hand = None
-        if self.hand is not None:
-            hand = list(self._hand_closed_l if self.closing else self._hand_open_l)
-        return ArmCommand(torque=list(self.tau), hand=hand)
-
-    def _joint_state(self, m) -> None:
-        names = getattr(m, "name", None) or []
-        if names != self._names_seen and list(names) != self._names_seen:  # once per layout
-            self._names_seen = list(names)
-            idx = (
-                [names.index(n) for n in self.names]
-                if names and set(self.names) <= set(names)
-                else None
-            )
-            self._idx = idx if idx is not None and idx != self._identity else None
-        idx = self._idx
-        pos, vel = m.position, m.velocity
-        if idx is not None:  # reordered to ours
-            pos = [pos[i] for i in idx]
-            vel = [vel[i] for i in idx] if len(vel) == len(names) else []
-        else:
-            pos, vel = list(pos), list(vel)
-        if len(pos) == self.n:
-            self.q, self.qd = pos, (vel if len(vel) == self.n else list(self._zeros))
+        return self._command(self.tau)
 
     def _torque(self, qdd_d: list[float]) -> list[float]:
         ff: list[float] | tuple
@@ -560,10 +468,7 @@ class CatchingController(Controller):
             ff = self.model.gravity_full(self.q if self.q is not None else self.q_d).tolist()
         else:
             ff = self._zeros
-        q, qd = self.q, self.qd
-        if q is not None:
-            return pd_reference(ff, self._kp, self.q_d, q, self._kd, self.qd_d, qd, self._tau_limit)
-        if not self._warned_state:
+        if self.q is None and not self._warned_state:
             self._warned_state = True
             self._events.append(
                 Occurrence(
@@ -571,7 +476,7 @@ class CatchingController(Controller):
                     {"reason": "no /arm/joint_state delivered: feed-forward torque only"},
                 )
             )
-        return _saturated(ff, self._tau_limit)
+        return self._pd(ff, self.q_d, self.qd_d)
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:
@@ -596,23 +501,10 @@ class CatchingController(Controller):
             out["predicted_catch_time"] = round(float(self.t_catch), 6)
         return out
 
-    def pop_events(self) -> list[Occurrence]:
-        ev, self._events = self._events, []
-        return ev
-
     def telemetry(self, t: float) -> dict:
         # The messages take the controller's lists as they are: update never changes one in
         # place (it makes new q_d, qd_d, tau and /catching/state lists), so none is copied here.
-        q_d, q = self.q_d, self.q
-        fk_d = self._fk_desired  # l(q_d) once per desired posture
-        if fk_d[0] is not q_d:
-            fk_d = self._fk_desired = (q_d, list(self.model.fk_tuple(q_d)))
-        out = {
-            TOPIC_ARM_JOINT_COMMAND: JointCommand(t, q_d, self.tau),
-            TOPIC_EFFECTOR_STATE: EffectorState(
-                t, list(self.model.fk_tuple(q)) if q is not None else [], fk_d[1]
-            ),
-        }
+        out = self._arm_telemetry(t, self.q_d, self.tau)
         if not self._costs_logged:  # the offline optimisation's history, once (t = 0)
             self._costs_logged = True
             out[TOPIC_OPTIMIZATION_COST] = self.optimization_costs()

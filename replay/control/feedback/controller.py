@@ -22,18 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replay.control.catching.base import CatchArmController
 from replay.control.catching.mapping import CatchGeometry
-from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
-from replay.interfaces import Controller, Occurrence
-from replay.messages import (
-    TOPIC_ARM_ENCODERS,
-    TOPIC_ARM_JOINT_COMMAND,
-    TOPIC_ARM_JOINT_STATE,
-    TOPIC_EFFECTOR_STATE,
-    TOPIC_VISION_OBJECT,
-    EffectorState,
-    JointCommand,
-)
 from replay.params import param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
@@ -79,51 +69,24 @@ class FeedbackParams:
 Params = FeedbackParams
 
 
-class FeedbackController(Controller):
+class FeedbackController(CatchArmController):
     Params = FeedbackParams
-    spec_type = ArmSpec
-    command_type = ArmCommand
-    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)
     description = (
         "feedback only: joint PD toward l_c^-1 of the ball as seen now, gravity compensated"
     )
 
-    def __init__(self, params: FeedbackParams, *, spec) -> None:
-        super().__init__(params, spec=spec)
-        P = params
-        names = tuple(spec.joint_names)
-        self.names = names
-        self.n = len(names)
-        self.active = active_joints(names, P.held_joints, P.selected_joint, "the feedback baseline")
-        self.q_init = np.asarray(spec.initial_q, float).copy()
-        self.tau_limit = np.asarray(spec.torque_limits, float)
-        off = catch_point_offset(spec, P.catch_offset)
-        self.model = ArmModel.from_chain(
-            spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)
-        )
-        self.geo = CatchGeometry.from_fk(self.model.fk, P.q_alpha, p_ref=tuple(P.catch_q))
-        self.kp = np.asarray(P.kp, dtype=float)
-        self.kd = np.asarray(P.kd, dtype=float)
-        if self.kp.shape != (self.n,) or self.kd.shape != (self.n,):
-            raise ValueError(f"kp and kd need {self.n} values")
-        self.hand = spec.hand
-        if self.hand is not None:
-            self.hand_open = np.asarray(self.hand.open_posture, float).tolist()
-            self.hand_closed = np.asarray(self.hand.closed_posture, float).tolist()
-        self.q: np.ndarray | None = None
-        self.qd: np.ndarray | None = None
+    def __init__(self, params: FeedbackParams, *, spec: ArmSpec) -> None:
+        super().__init__(params, spec=spec, who="the feedback baseline")
+        self.geo = CatchGeometry.from_fk(self.model.fk, params.q_alpha, p_ref=tuple(params.catch_q))
         self.r_o: np.ndarray | None = None
         self.q_d = self.q_init.copy()
-        self.tau = np.zeros(self.n)
-        self.closing = False
-        self._events: list[Occurrence] = []
+        self.tau: list[float] = list(self._zeros)
+
+    def _see(self, m) -> None:
+        self.r_o = np.asarray(m.position, float)
 
     def update(self, t: float, measurements: list) -> ArmCommand:
-        for topic, m in measurements:
-            if topic == TOPIC_VISION_OBJECT:
-                self.r_o = np.asarray(m.position, float)
-            elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
-                self._joint_state(m)
+        self._measure(measurements)
         if self.r_o is not None:
             inv = self.geo.inverse(self.r_o)
             if bool(inv.in_domain[0]) and np.all(np.isfinite(inv.p[0])):
@@ -136,50 +99,27 @@ class FeedbackController(Controller):
         ):
             d = float(np.linalg.norm(self.r_o - self.model.fk(self.q)))
             if d <= self.params.close_distance:
-                self.closing = True
-                self._events.append(Occurrence("hand_close", {"distance": d}))
+                self._close_hand({"distance": d})
         self.tau = self._torque()
-        hand = None
-        if self.hand is not None:
-            hand = list(self.hand_closed if self.closing else self.hand_open)
-        return ArmCommand(torque=self.tau.tolist(), hand=hand)
+        return self._command(self.tau)
 
-    def _joint_state(self, m) -> None:
-        pos, vel = np.asarray(m.position, float), np.asarray(m.velocity, float)
-        names = list(getattr(m, "name", []) or [])
-        if names and set(self.names) <= set(names):
-            idx = [names.index(n) for n in self.names]
-            pos, vel = pos[idx], vel[idx]
-        if pos.shape == (self.n,):
-            self.q, self.qd = pos, (vel if vel.shape == (self.n,) else np.zeros(self.n))
-
-    def _torque(self) -> np.ndarray:
+    def _torque(self) -> list[float]:
+        """tau = g(q) + Kp (q_o - q) - Kd qd, saturated (g(q_o) alone before the first joint
+        state): no qd_d, no qdd_d."""
         zero = np.zeros(self.n)
         if self.q is None or self.qd is None:
             ff = self.model.inverse_dynamics_full(self.q_d, zero, zero)
-            return np.clip(ff, -self.tau_limit, self.tau_limit)
-        ff = self.model.inverse_dynamics_full(self.q, zero, zero)  # gravity at the posture
-        tau = ff + self.kp * (self.q_d - self.q) - self.kd * self.qd
-        return np.clip(tau, -self.tau_limit, self.tau_limit)
+            return np.clip(ff, -self.tau_limit, self.tau_limit).tolist()
+        q, qd = np.asarray(self.q, float), np.asarray(self.qd, float)
+        ff = self.model.inverse_dynamics_full(q, zero, zero)  # gravity at the posture
+        tau = ff + self.kp * (self.q_d - q) - self.kd * qd
+        return np.clip(tau, -self.tau_limit, self.tau_limit).tolist()
 
     def intent(self) -> dict:
         return {"method": "feedback", "hand_closing": self.closing}
-
-    def pop_events(self) -> list[Occurrence]:
-        ev, self._events = self._events, []
-        return ev
 
     def outcome(self, t: float) -> dict:
         return {"hand_closed": self.closing}
 
     def telemetry(self, t: float) -> dict:
-        return {
-            TOPIC_ARM_JOINT_COMMAND: JointCommand(
-                t, position=self.q_d.tolist(), torque=self.tau.tolist()
-            ),
-            TOPIC_EFFECTOR_STATE: EffectorState(
-                t,
-                position=self.model.fk(self.q).tolist() if self.q is not None else [],
-                desired_position=self.model.fk(self.q_d).tolist(),
-            ),
-        }
+        return self._arm_telemetry(t, self.q_d.tolist(), self.tau)

@@ -25,19 +25,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replay.control.catching.model import ArmModel, active_joints, catch_point_offset
+from replay.control.catching.base import CatchArmController
 from replay.control.predictive.intercept import FeasiblePlan, Intercept, choose_intercept
 from replay.control.predictive.kalman import BallKalman
-from replay.interfaces import Controller, Occurrence
-from replay.messages import (
-    TOPIC_ARM_ENCODERS,
-    TOPIC_ARM_JOINT_COMMAND,
-    TOPIC_ARM_JOINT_STATE,
-    TOPIC_EFFECTOR_STATE,
-    TOPIC_VISION_OBJECT,
-    EffectorState,
-    JointCommand,
-)
+from replay.interfaces import Occurrence
 from replay.params import check_limit, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
@@ -143,46 +134,23 @@ class PredictiveParams:
 Params = PredictiveParams
 
 
-class PredictiveController(Controller):
+class PredictiveController(CatchArmController):
     Params = PredictiveParams
-    spec_type = ArmSpec
-    command_type = ArmCommand
-    reads = (TOPIC_VISION_OBJECT, TOPIC_ARM_ENCODERS)
     description = (
         "predict-then-intercept baseline: Kalman filter, intercept chosen for reach, palm "
         "alignment and torque feasibility, move-glide-brake plan with velocity matching, PD + "
         "dynamics"
     )
 
-    def __init__(self, params: PredictiveParams, *, spec) -> None:
-        super().__init__(params, spec=spec)
+    def __init__(self, params: PredictiveParams, *, spec: ArmSpec) -> None:
+        super().__init__(params, spec=spec, who="the predictive baseline")
         P = params
-        names = tuple(spec.joint_names)
-        self.names = names
-        self.n = len(names)
-        self.active = active_joints(
-            names, P.held_joints, P.selected_joint, "the predictive baseline"
-        )
-        self.q_init = np.asarray(spec.initial_q, float).copy()
-        self.tau_limit = np.asarray(spec.torque_limits, float)
         self.lower, self.upper = np.asarray(spec.lower, float), np.asarray(spec.upper, float)
-        self.gravity = np.array([0.0, 0.0, -float(spec.gravity)])
-        off = catch_point_offset(spec, P.catch_offset)
-        self.model = ArmModel.from_chain(
-            spec.model, active=self.active, q_fixed=self.q_init, point_in_tool=(0.0, 0.0, off)
-        )
-        self.kp = np.asarray(P.kp, dtype=float)
-        self.kd = np.asarray(P.kd, dtype=float)
-        if self.kp.shape != (self.n,) or self.kd.shape != (self.n,):
-            raise ValueError(f"kp and kd need {self.n} values")
         self.kf = BallKalman(self.gravity, meas_sigma=P.meas_sigma, accel_sigma=P.accel_sigma)
-        self.hand = spec.hand
-        self.q: np.ndarray | None = None
-        self.qd: np.ndarray | None = None
         self.q_d = self.q_init.copy()
         self.qd_d = np.zeros(self.n)
         self.qdd_d = np.zeros(self.n)
-        self.tau = np.zeros(self.n)
+        self.tau: list[float] = list(self._zeros)
         self.plan: FeasiblePlan | None = None
         self.intercept: Intercept | None = None
         self.p_catch: np.ndarray = np.zeros(3)
@@ -190,17 +158,14 @@ class PredictiveController(Controller):
         self.replans = 0
         self._t_plan = 0.0
         self._t_first: float | None = None
-        self.closing = False
-        self._events: list[Occurrence] = []
 
     # ------------------------------------------------------------------ control
+    def _see(self, m) -> None:
+        self.kf.add(m.t, m.position)
+
     def update(self, t: float, measurements: list) -> ArmCommand:
         P = self.params
-        for topic, m in measurements:
-            if topic == TOPIC_VISION_OBJECT:
-                self.kf.add(m.t, m.position)
-            elif topic in (TOPIC_ARM_ENCODERS, TOPIC_ARM_JOINT_STATE):
-                self._joint_state(m)
+        self._measure(measurements)
         if self.kf.n == 1 and self._t_first is None:
             self._t_first = self.kf.t
         if (
@@ -216,14 +181,10 @@ class PredictiveController(Controller):
             and not self.closing
             and self.t_catch is not None
             and t >= self.t_catch + P.close_delay - 1e-9
-        ):
-            self.closing = True  # closure on arrival (close_delay after it)
-            self._events.append(Occurrence("hand_close", {"predicted_catch_time": self.t_catch}))
+        ):  # closure on arrival (close_delay after it)
+            self._close_hand({"predicted_catch_time": self.t_catch})
         self.tau = self._torque()
-        hand = None
-        if self.hand is not None:
-            hand = list(self.hand.closed_posture if self.closing else self.hand.open_posture)
-        return ArmCommand(torque=self.tau.tolist(), hand=hand)
+        return self._command(self.tau)
 
     def _maybe_replan(self, t: float) -> None:
         P = self.params
@@ -291,21 +252,11 @@ class PredictiveController(Controller):
             )
         )
 
-    def _joint_state(self, m) -> None:
-        pos, vel = np.asarray(m.position, float), np.asarray(m.velocity, float)
-        names = list(getattr(m, "name", []) or [])
-        if names and set(self.names) <= set(names):
-            idx = [names.index(n) for n in self.names]
-            pos, vel = pos[idx], vel[idx]
-        if pos.shape == (self.n,):
-            self.q, self.qd = pos, (vel if vel.shape == (self.n,) else np.zeros(self.n))
-
-    def _torque(self) -> np.ndarray:
+    def _torque(self) -> list[float]:
+        """The plan tracked by PD + inverse dynamics: tau = M(q_d) qdd_d + H qd_d + g(q_d)
+        + Kp (q_d - q) + Kd (qd_d - qd), saturated (the direct controller's law)."""
         ff = self.model.inverse_dynamics_full(self.q_d, self.qd_d, self.qdd_d)
-        if self.q is None or self.qd is None:
-            return np.clip(ff, -self.tau_limit, self.tau_limit)
-        tau = ff + self.kp * (self.q_d - self.q) + self.kd * (self.qd_d - self.qd)
-        return np.clip(tau, -self.tau_limit, self.tau_limit)
+        return self._pd(ff.tolist(), self.q_d.tolist(), self.qd_d.tolist())
 
     # ------------------------------------------------------------------ reporting
     def intent(self) -> dict:
@@ -313,10 +264,6 @@ class PredictiveController(Controller):
         if self.t_catch is not None:
             out.update(catch_time=self.t_catch, catch_point=self.p_catch.tolist())
         return out
-
-    def pop_events(self) -> list[Occurrence]:
-        ev, self._events = self._events, []
-        return ev
 
     def outcome(self, t: float) -> dict:
         out: dict = {"replans": self.replans}
@@ -327,13 +274,4 @@ class PredictiveController(Controller):
         return out
 
     def telemetry(self, t: float) -> dict:
-        return {
-            TOPIC_ARM_JOINT_COMMAND: JointCommand(
-                t, position=self.q_d.tolist(), torque=self.tau.tolist()
-            ),
-            TOPIC_EFFECTOR_STATE: EffectorState(
-                t,
-                position=self.model.fk(self.q).tolist() if self.q is not None else [],
-                desired_position=self.model.fk(self.q_d).tolist(),
-            ),
-        }
+        return self._arm_telemetry(t, self.q_d.tolist(), self.tau)

@@ -175,10 +175,10 @@ def test_time_to_radius_newton_equals_the_eigenvalue_roots():
 
 
 def test_torque_equals_the_numpy_formula():
-    """pd_reference (the controller's per-step torque, in floats) against the NumPy
+    """pd_torque (the catch controllers' per-step torque, in floats) against the NumPy
     np.clip(ff + Kp (q_d - q) + Kd (qd_d - qd), -limit, limit) on seeded random states of 1-7
     joints, a third of them beyond the limits: the same floats to the bit."""
-    from replay.control.catching.controller import pd_reference
+    from replay.control.catching.base import pd_torque
 
     rng = np.random.default_rng(17)
     saturated = 0
@@ -188,7 +188,7 @@ def test_torque_equals_the_numpy_formula():
         limit = rng.uniform(1.0, 60.0 if k % 3 else 5.0, size=n)
         ff, kp, q_d, q, kd, qd_d, qd = args
         ref = np.clip(ff + kp * (q_d - q) + kd * (qd_d - qd), -limit, limit).tolist()
-        got = pd_reference(*(a.tolist() for a in args), limit.tolist())
+        got = pd_torque(*(a.tolist() for a in args), limit.tolist())
         assert got == ref and all(type(x) is float for x in got)
         saturated += sum(abs(x) == lim for x, lim in zip(got, limit))
     print(f"torque: 300 states equal, {saturated} joint torques at their limit")
