@@ -136,11 +136,11 @@ def _marks(ax, run: CatchRun, style: dict, drawn: set[str]) -> list[tuple[float,
         shown, more = line_labels.first(inside)
         marks += [(e["t"], kind) for e in shown]
         drawn.update(("more",) if more else ())
-    marks = [m for m in marks if m[0] is not None and lo <= m[0] <= hi]
-    for t, _ in marks:
+    kept = [(t, name) for t, name in marks if t is not None and lo <= t <= hi]
+    for t, _ in kept:
         ax.axvline(t, color="0.55", lw=0.7, ls=style.get("ls", "-"))
-    drawn.update(name for _, name in marks)
-    return marks
+    drawn.update(name for _, name in kept)
+    return kept
 
 
 def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, ...] = ()):

@@ -14,7 +14,7 @@ import socket
 import threading
 import time
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -97,6 +97,15 @@ def start_server(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT):
     return server, note
 
 
+def _shows(scene) -> Callable[[Any], None]:
+    """A run's "show" checkbox handler: its whole frame shown or hidden."""
+
+    def show(ev) -> None:
+        scene.root_frame.visible = ev.target.value
+
+    return show
+
+
 class Viewer:
     """A browser replay of one or more runs, overlaid and in step on one timeline."""
 
@@ -120,13 +129,13 @@ class Viewer:
         self.images: ImagePanel | None = None
         self.notes: list[str] = []
         self.run_toggles: list = []
-        self.follow = None  # the "follow object" checkbox
+        self.follow: Any = None  # the "follow object" checkbox
         self.camera_home: tuple = ((1.0, 1.0, 1.0), (0.0, 0.0, 0.0))
         self.time = 0.0
         self._lock = threading.RLock()
         self._last_plot = 0.0
         self._stopped = threading.Event()
-        self._status = None
+        self._status: Any = None  # the live run's status line
         self.server.scene.set_up_direction("+z")
         runs = list(runs)
         if runs:
@@ -254,10 +263,10 @@ class Viewer:
                 if self.follow_point(t0) is not None or any(
                     s.focus(s.run, t1) is not None for s in self.scenes
                 ):
-                    self.follow = gui.add_checkbox(
+                    follow = self.follow = gui.add_checkbox(
                         "follow object", False, hint="keep the camera on the object"
                     )
-                    self.follow.on_update(guard.safe(lambda _: self.show(self.time)))
+                    follow.on_update(guard.safe(lambda _: self.show(self.time)))
                 home = gui.add_button("fit view", hint="back to the fitted view at load")
                 home.on_click(guard.safe(lambda _: self._home()))
             self.run_toggles = []
@@ -265,11 +274,7 @@ class Viewer:
                 with gui.add_folder("Runs"):
                     for s in self.scenes:
                         cb = gui.add_checkbox(f"show {s.run.label}", True)
-                        cb.on_update(
-                            guard.safe(
-                                lambda ev, s=s: setattr(s.root_frame, "visible", ev.target.value)
-                            )
-                        )
+                        cb.on_update(guard.safe(_shows(s)))
                         self.run_toggles.append(cb)
             run0 = self.runs[0]  # its cameras' images (the first run's, when overlaid)
             tracks = load_image_tracks(run0.path, run0.sensors) if run0.path else []

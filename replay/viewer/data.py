@@ -163,10 +163,11 @@ class _TrackBuilder:
         t = np.empty(cap)
         t[: self.n] = self.t[: self.n]
         self.t = t
-        for name, col in (self.cols or {}).items():
+        cols = self.cols or {}
+        for name, col in cols.items():
             new = np.empty((cap, *col.shape[1:]))
             new[: self.n] = col[: self.n]
-            self.cols[name] = new
+            cols[name] = new
         self.cap = cap
 
     def add(self, t_ns: int, data: dict) -> None:

@@ -34,7 +34,7 @@ class Plot:
     def __init__(self, gui, spec: PlotSpec, runs: list[RunData], grid: np.ndarray) -> None:
         self.grid = grid
         self.ys: list[np.ndarray] = []
-        series = [{"label": "t (s)"}]
+        series: list[dict[str, object]] = [{"label": "t (s)"}]
         many = len(runs) > 1
         for k, run in enumerate(runs):
             for s_i, s in enumerate(spec.series):

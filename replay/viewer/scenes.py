@@ -98,6 +98,7 @@ class RunScene:
         self.run = run
         self.k = index
         self.root = f"/run{index}"
+        self.root_frame: Any = None  # the run's frame in the scene (the viewer makes it)
         self.color = run_color(index)
         self.ghost = index > 0  # see-through
         self.tint = bool(options.get("overlaid", index > 0))  # drawn in self.color
