@@ -1,7 +1,9 @@
 """A scenario as a Gymnasium environment, over the runner's own loop (``Runner.sense`` /
 ``Runner.step(command)``): one environment step is one control period of the scenario.
 
-``reset(seed)`` builds the run of the scenario with that seed (as ``replay run --seed``); each
+``reset(seed)`` builds the run of the scenario with that seed (as ``replay run --seed``), and
+``reset(seed, options={"set": [...]})`` that episode's run with more overrides (``--set`` strings
+or a mapping, applied after the environment's own: another throw, another human path); each
 step the action is the plant's command (``replay.envs.spaces``), the plant runs to the next
 control step and the observation is what the controller would receive then. The episode ends
 as ``replay run`` ends: ``terminated`` after a stopping event of the scenario (``stop.on_events``,
@@ -86,8 +88,9 @@ class ScenarioEnv(gymnasium.Env):
         self.result: RunResult | None = None
 
     # -- what the environment is made of ---------------------------------------------------
-    def _scenario(self, seed: int | None) -> Scenario:
-        return _scenario(self._source, self._set, seed)
+    def _scenario(self, seed: int | None, episode: Any = None) -> Scenario:
+        """The scenario with the environment's overrides, then the episode's (``episode``)."""
+        return _scenario(self._source, self._set + _sets(episode), seed)
 
     def _observation_sizes(self, probe: Runner) -> dict[str, int]:
         """``{"time": 1, topic: 1 + n, ...}`` from the sensors' first measurements."""
@@ -116,9 +119,10 @@ class ScenarioEnv(gymnasium.Env):
         self._close_run()
         if seed is None:
             seed = int(self.np_random.integers(2**31))
-        sc = self._scenario(seed)
+        options = options or {}
+        sc = self._scenario(seed, options.get("set"))
         self.runner = runner = Runner(sc)
-        if not (options or {}).get("method", False):
+        if not options.get("method", False):
             runner.controller = _NoMethod()  # type: ignore[assignment]  # (a Controller too)
         self.result = None
         self._obs = {key: np.zeros(n) for key, n in self._sizes.items()}
