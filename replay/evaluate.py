@@ -68,8 +68,8 @@ def input_set(name: str, task: str, n: int, first: int = 0) -> list[Episode]:
         )
     try:
         raw = registry.load("input_sets", name)(task, first + n)
-    except ValueError as exc:
-        raise InputSetError(f"input set {name!r}: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - the plug-in's own code failed: one line
+        raise InputSetError(f"input set {name!r}: {str(exc)[:200]}") from None
     if not isinstance(raw, list) or len(raw) < first + n:
         raise InputSetError(f"input set {name!r} gave fewer than {first + n} episodes for {task}")
     return [_episode(name, k, raw[k]) for k in range(first, first + n)]
@@ -82,14 +82,16 @@ def _episode(name: str, k: int, raw: Any) -> Episode:
     if (
         not isinstance(seed, int)
         or isinstance(seed, bool)
+        or not 0 <= seed < 2**31
         or not isinstance(sets, list)
         or len(sets) > MAX_OVERRIDES
         or not all(isinstance(x, str) for x in sets)
     ):
         raise InputSetError(
-            f"input set {name!r}: episode {k} is not {{'seed': int, 'set': [str], 'input': str}}"
+            f"input set {name!r}: episode {k} is not {{'seed': 0 <= int < 2**31, 'set': [str],"
+            " 'input': str}"
         )
-    return Episode(k, seed, tuple(sets), show(str(raw.get("input", f"seed {seed}")), 80))
+    return Episode(k, seed, tuple(sets), str(raw.get("input", f"seed {seed}"))[:200])
 
 
 @dataclass
@@ -214,7 +216,13 @@ def evaluate(
     show_default=True,
     help="episodes: the input set's FIRST .. FIRST+N-1",
 )
-@click.option("--first", type=click.IntRange(0, 100_000), default=0, show_default=True)
+@click.option(
+    "--first",
+    type=click.IntRange(0, 100_000),
+    default=0,
+    show_default=True,
+    help="the first episode's number in the input set",
+)
 @click.option(
     "--set-of",
     "set_of",

@@ -145,3 +145,20 @@ def test_the_command_line_does_not_import_gymnasium():
     code = "import sys, replay.cli; print('gymnasium' in sys.modules)"
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize(
+    "made, message",
+    [
+        (lambda task, n: [{"seed": -1, "set": []}] * n, "episode 0 is not"),
+        (lambda task, n: [{"seed": 1, "set": "x=1"}] * n, "episode 0 is not"),
+        (lambda task, n: [{"seed": 1}] * (n - 1), "gave fewer than 2 episodes"),
+        (lambda task, n: 1 / 0, "division by zero"),
+    ],
+)
+def test_a_bad_input_set_plugin_is_a_one_line_error(monkeypatch, made, message):
+    from replay import registry
+
+    monkeypatch.setitem(registry._registered["input_sets"], "bad", made)
+    with pytest.raises(InputSetError, match=message):
+        input_set("bad", "catch", 2)
