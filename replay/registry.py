@@ -31,6 +31,7 @@ GROUPS = {
     "commands": "paper_replay.commands",  # name -> register(click group): more `replay` commands
     "check": "paper_replay.checks",  # name -> check(scenario) -> a warning for `validate`, or ""
     "sweep_plot": "paper_replay.sweep_plots",  # name -> plot(summary.csv, out folder) -> paths
+    "input_sets": "paper_replay.input_sets",  # name -> episodes(task, n) for `replay evaluate`
 }
 
 

@@ -1,5 +1,5 @@
-"""``replay evaluate``: a policy beside the paper's method on the same seeds, rates with Wilson
-intervals; bad policies are one-line errors."""
+"""``replay evaluate``: a policy beside the paper's method on the same inputs of a named set,
+rates with Wilson intervals; bad policies and unknown sets are one-line errors."""
 
 from __future__ import annotations
 
@@ -14,9 +14,20 @@ from click.testing import CliRunner
 pytest.importorskip("gymnasium")
 
 from replay.cli import main  # noqa: E402
-from replay.evaluate import PolicyError, Tally, evaluate, load_policy  # noqa: E402
+from replay.api import run  # noqa: E402
+from replay.evaluate import (  # noqa: E402
+    InputSetError,
+    PolicyError,
+    Tally,
+    evaluate,
+    input_set,
+    load_policy,
+)
+from replay.golden import compare_logs  # noqa: E402
+from replay.log import LogReader  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+EXACT = {"abs": 0, "rel": 0}
 ROW = re.compile(r"^(\S.*?)\s+(\d+)/(\d+)\s+([\d.]+) %\s+\[\s*([\d.]+),\s*([\d.]+)\] %$", re.M)
 
 
@@ -33,27 +44,59 @@ def _cli(*args, cwd: Path):
 def test_evaluate_prints_both_rates_with_intervals():
     r = _cli("evaluate", "my_policy:catch", "--task", "catch", "--n", "2", cwd=EXAMPLES)
     assert r.returncode == 0, r.stderr
+    assert "input set held-out, episodes 0..1: 2 distinct physical inputs" in r.stdout
     rows = ROW.findall(r.stdout)
     assert [row[0] for row in rows] == ["my_policy:catch", "paper (the paper's method)"]
     for name, wins, n, rate, lo, hi in rows:
         assert int(n) == 2
         assert float(rate) == pytest.approx(100 * int(wins) / 2, abs=0.05)
         assert float(lo) <= float(rate) <= float(hi)
-    assert rows[1][1] == "2"  # the paper's method catches the nominal throw at seeds 0 and 1
+    # the paper's method catches held-out throws 0 and 1 (data/ablations/engine_rates.csv)
+    assert rows[1][1] == "2"
 
 
-def test_the_paper_and_the_policy_see_the_same_seeds(tmp_path):
+def test_the_episodes_and_their_logs_follow_the_set(tmp_path):
     seen = []
     tallies = evaluate(
         "paper",
         "stick",
-        [3, 4],
-        sets=["timing.duration=0.05"],
+        input_set("held-out", "stick", 2, first=3),
+        sets=["timing.duration=0.05"],  # (after the set's 3.0 s: it wins)
         logs=tmp_path,
-        progress=lambda name, seed, outcome: seen.append((name, seed)),
+        progress=lambda name, ep, outcome: seen.append((name, ep.number, ep.seed)),
     )
-    assert seen == [("paper", 3), ("paper", 4)] and len(tallies) == 1
+    assert seen == [("paper", 3, 3), ("paper", 4, 4)] and len(tallies) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["paper-3.mcap", "paper-4.mcap"]
+    for k in (3, 4):
+        yaml = LogReader(tmp_path / f"paper-{k}.mcap").scenario()["yaml"]
+        assert "random: true" in yaml and "duration: 0.05" in yaml, yaml
+
+
+def test_the_paper_through_evaluate_equals_replay_run_on_held_out_throws(tmp_path):
+    """The paper's method on 3 held-out catch episodes: the outcome and the log of
+    ``replay run --seed S --set ...`` with that episode's overrides (zero tolerance)."""
+    episodes = input_set("held-out", "catch", 3)
+    outcomes = {}
+    evaluate(
+        "paper",
+        "catch",
+        episodes,
+        logs=tmp_path,
+        progress=lambda name, ep, outcome: outcomes.setdefault(ep.number, outcome),
+    )
+    for ep in episodes:
+        r = run("catch_optimised", seed=ep.seed, set=list(ep.set), log=tmp_path / "run.mcap")
+        assert outcomes[ep.number] == r.outcome, ep.input
+        assert compare_logs(r.path, tmp_path / f"paper-{ep.number}.mcap", {}, EXACT) == []
+    assert len({o["first_contact_time"] for o in outcomes.values()}) == 3  # three throws
+
+
+def test_an_unknown_input_set_is_a_one_line_error_listing_the_known_ones():
+    with pytest.raises(InputSetError, match=r"unknown input set 'nope' \(known: .*held-out"):
+        input_set("nope", "catch", 1)
+    r = CliRunner().invoke(main, ["evaluate", "paper", "--task", "catch", "--set-of", "nope"])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    assert r.output.strip().splitlines() == ["error: unknown input set 'nope' (known: held-out)"]
 
 
 def test_wilson_interval_of_a_tally():
@@ -102,3 +145,20 @@ def test_the_command_line_does_not_import_gymnasium():
     code = "import sys, replay.cli; print('gymnasium' in sys.modules)"
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize(
+    "made, message",
+    [
+        (lambda task, n: [{"seed": -1, "set": []}] * n, "episode 0 is not"),
+        (lambda task, n: [{"seed": 1, "set": "x=1"}] * n, "episode 0 is not"),
+        (lambda task, n: [{"seed": 1}] * (n - 1), "gave fewer than 2 episodes"),
+        (lambda task, n: 1 / 0, "division by zero"),
+    ],
+)
+def test_a_bad_input_set_plugin_is_a_one_line_error(monkeypatch, made, message):
+    from replay import registry
+
+    monkeypatch.setitem(registry._registered["input_sets"], "bad", made)
+    with pytest.raises(InputSetError, match=message):
+        input_set("bad", "catch", 2)

@@ -289,7 +289,8 @@ def test_variants_of_an_experiment_are_overlaid_and_labelled_from_an_empty_folde
 def test_the_environments_from_the_wheel(installed):
     """Gymnasium's check_env for the three tasks; the paper's method through each environment
     gives replay run's outcome and log (zero tolerance) on two seeds; `replay evaluate` prints
-    the example policy's and the paper's rates with intervals for each task."""
+    the example policy's and the paper's rates with intervals for each task, on two held-out
+    inputs."""
     pytest.importorskip("gymnasium")
     replay, work, env = installed
     here = work / "envs"
@@ -341,3 +342,5 @@ def test_the_environments_from_the_wheel(installed):
         )
         rows = re.findall(r"^(\S.*?)\s+\d+/2\s+[\d.]+ %\s+\[\s*[\d.]+,\s*[\d.]+\] %$", out, re.M)
         assert rows == [f"my_policy:{task}", "paper (the paper's method)"], out
+        # the held-out inputs come from the wheel's analysis through its entry point
+        assert "input set held-out, episodes 0..1: 2 distinct physical inputs" in out, out
