@@ -216,11 +216,6 @@ def keyed(readers: Iterable[LogReader]) -> dict[str, LogReader]:
     return out
 
 
-def label_runs(readers: Iterable[LogReader]) -> dict[str, str]:
-    """Each log's key (:func:`keyed`) and what its run sets differently from its experiment."""
-    return {key: describe(r, key).label for key, r in keyed(readers).items()}
-
-
 def titled(key: str, reader: LogReader) -> str:
     """``key``, with its label when the key does not already say it: a figure's run name, its
     control and format characters escaped (a log's ESC is no glyph)."""

@@ -220,9 +220,9 @@ def test_a_logs_name_never_makes_a_path_and_a_label_stays_one_bounded_line(stick
     assert label.startswith("controller \\x1b]0;PWNED")
 
 
-def test_label_runs_gives_each_log_its_key_and_label(stick, catch):
+def test_each_log_gets_its_key_and_label(stick, catch):
     logs = [LogReader(stick["mu03"]), LogReader(stick["mu1"]), LogReader(catch["renamed"])]
-    labels = runs.label_runs(logs)
+    labels = {key: runs.describe(r, key).label for key, r in runs.keyed(logs).items()}
     assert list(labels) == [
         "stick_3step",
         "stick_3step (friction 1, duration 300 ms)",
