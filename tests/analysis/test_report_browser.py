@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-playwright_api = pytest.importorskip("playwright.sync_api")
+import playwright.sync_api as playwright_api  # noqa: E402
 
 from replay.cli import main  # noqa: E402
 from chromium import FLAGS, _ensure_chromium  # noqa: E402

@@ -11,8 +11,6 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-pytest.importorskip("gymnasium")
-
 from replay.cli import main  # noqa: E402
 from replay.api import run  # noqa: E402
 from replay.evaluate import (  # noqa: E402

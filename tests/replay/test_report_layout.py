@@ -113,7 +113,6 @@ def test_falsifier_tables_give_the_explanation_room(report):
 
 
 def test_falsifier_explanation_is_wide_in_chromium(report):
-    pytest.importorskip("playwright.sync_api")
     from playwright.sync_api import sync_playwright
 
     from chromium import FLAGS, _ensure_chromium

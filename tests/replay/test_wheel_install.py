@@ -291,7 +291,6 @@ def test_the_environments_from_the_wheel(installed):
     gives replay run's outcome and log (zero tolerance) on two seeds; `replay evaluate` prints
     the example policy's and the paper's rates with intervals for each task, on two held-out
     inputs."""
-    pytest.importorskip("gymnasium")
     replay, work, env = installed
     here = work / "envs"
     here.mkdir()

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-gymnasium = pytest.importorskip("gymnasium")
+import gymnasium  # noqa: E402
 
 import replay.envs  # noqa: E402 - registers the environments
 from replay.envs.policies import PaperPolicy  # noqa: E402

@@ -9,7 +9,6 @@ import math
 import numpy as np
 import pytest
 
-pytest.importorskip("gymnasium")
 
 from replay.envs.env import ScenarioEnv  # noqa: E402
 from replay.envs.policies import PaperPolicy  # noqa: E402

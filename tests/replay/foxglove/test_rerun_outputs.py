@@ -23,7 +23,7 @@ from replay.foxglove.rerun_view import RerunError
 
 from conftest import ROOT
 
-pytest.importorskip("rerun")
+import rerun  # noqa: E402, F401  (the rerun extra, which make test installs)
 
 GOLDEN = ROOT / "data" / "golden" / "catch_optimised.mcap"
 REPLAY = str(Path(sys.executable).with_name("replay"))

@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-playwright_api = pytest.importorskip("playwright.sync_api")
-Image = pytest.importorskip("PIL.Image")
+import playwright.sync_api as playwright_api  # noqa: E402
+from PIL import Image  # noqa: E402
 
 from replay.viewer import Viewer  # noqa: E402
 from synthetic_logs import write_arm_log, write_stick_log  # noqa: E402

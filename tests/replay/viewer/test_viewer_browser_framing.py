@@ -19,8 +19,8 @@ import time
 import numpy as np
 import pytest
 
-playwright_api = pytest.importorskip("playwright.sync_api")
-Image = pytest.importorskip("PIL.Image")
+import playwright.sync_api as playwright_api  # noqa: E402
+from PIL import Image  # noqa: E402
 
 from replay.viewer import Viewer  # noqa: E402
 from replay.viewer.scenes import run_color  # noqa: E402

@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 import viser
 
-playwright_api = pytest.importorskip("playwright.sync_api")
+import playwright.sync_api as playwright_api  # noqa: E402
 
 from replay.viewer import Viewer, guard  # noqa: E402
 from replay.viewer.markup import clean  # noqa: E402
