@@ -250,8 +250,9 @@ class SerialChain:
         (on joint i's axis, fixed in links i-1 and i); gravity enters as a base acceleration -g.
         Backward pass: force and moment (about o_{i-1}) that link i-1 exerts on link i.
         One configuration in Python floats on the frames of :meth:`_frames_f` (inertia applied
-        as R I R^T v without forming R I R^T); :meth:`rnea_batch` is the same recursion in NumPy
-        over many states, and the tests hold the two together.
+        as R I R^T v without forming R I R^T); the same recursion in NumPy matrices over many
+        states is the tests' oracle (tests/replay/robot/oracles.py). One function, 86 lines: the
+        two passes read as the recursive Newton–Euler algorithm only together.
         """
         qf, qdf, qddf = self._floats(q), self._floats(qd), self._floats(qdd)
         gx, gy, gz = self._g_f if gravity is None else (float(x) for x in gravity)
