@@ -409,74 +409,8 @@ def _captured_row(log: LogReader, name: str, st: dict) -> Claim:
 
 def _three_step_rows(log: LogReader, st: dict) -> list[Claim]:
     r = st["results"]
-    rows: list[Claim] = []
-    c1, c2 = _collision(log, 1), _collision(log, 2)
-    half = _params(log).stick.length / 2
-    if c1 is None:
-        rows.append(
-            Claim("first collision", f"t = {r['t_collision_1']['value']} s", "none", "differs")
-        )
-    else:
-        d = c1["data"]
-        v1 = _speed(d["v_after"])
-        rows.append(
-            Claim(
-                "translation after collision 1",
-                "eliminated (pure rotation, v_1 = 0, eq. 34)",
-                f"‖v_1‖ = {v1:.4f} m/s",
-                "reproduced" if v1 < V_RES else "differs",
-                f"tolerance {V_RES:g} m/s: 2 px of drift over the 0.2 s to collision 2 at 300 fps",
-            )
-        )
-        w0, w1 = d["omega_before"], d["omega_after"]
-        rows.append(
-            Claim(
-                "spin reversed at collision 1 (eq. 35)",
-                st["statements"]["sign_rule"]["value"],
-                f"ω_0 = {w0:.2f} → ω_1 = {w1:.2f} rad/s",
-                "reproduced" if w0 * w1 < 0 and abs(w1) > W_RES else "differs",
-                f"‖ω_1‖ must exceed {W_RES:g} rad/s (1 px at the tip over 0.1 s) to have a sign",
-            )
-        )
-    if c2 is None:
-        rows.append(
-            Claim("second collision", f"t = {r['t_collision_2']['value']} s", "none", "differs")
-        )
-    else:
-        d = c2["data"]
-        planned: dict = next(
-            (e["data"] for e in events(log, "plan") if e["data"].get("index") == 2), {}
-        )
-        solved = abs(planned.get("r_x_solved", float("nan")))
-        rows += [
-            Claim(
-                "time of collision 2",
-                f"{r['t_collision_2']['value']} s",
-                f"{c2['t']:.3f} s",
-                within(c2["t"], r["t_collision_2"]["value"], abs_=T_RES),
-                f"tolerance {T_RES:g} s (the paper gives 0.01 s)",
-            ),
-            Claim(
-                "fingertip position r_x,2",
-                f"{r['r_x_2']['value'] * 1e3:.1f} mm",
-                f"hit at {abs(d['r_x']) * 1e3:.1f} mm",
-                within(abs(d["r_x"]), r["r_x_2"]["value"], abs_=0.002),
-                f"tolerance 2 mm (1 px); the plan solved F_ω,2(0) = {solved * 1e3:.1f} mm"
-                + (
-                    f", beyond L/2 = {half * 1e3:.0f} mm: it falls back to "
-                    f"{abs(planned.get('r_x', float('nan'))) * 1e3:.1f} mm"
-                    if solved > half
-                    else ""
-                ),
-            ),
-            Claim(
-                "rotation after collision 2",
-                "eliminated (pure translation, ω_2 = 0, eq. 36)",
-                f"ω_2 = {d['omega_after']:.2f} rad/s",
-                "reproduced" if abs(d["omega_after"]) < W_RES else "differs",
-                f"tolerance {W_RES:g} rad/s (1 px at the tip over 0.1 s)",
-            ),
-        ]
+    rows = _collision_1_rows(_collision(log, 1), st)
+    rows += _collision_2_rows(log, _collision(log, 2), r)
     rows.append(_reversal_row(log, "3-step", 3))
     t_stop = _t_stopped(log)
     rows.append(
@@ -491,6 +425,75 @@ def _three_step_rows(log: LogReader, st: dict) -> list[Claim]:
         )
     )
     return rows
+
+
+def _collision_1_rows(c1: dict | None, st: dict) -> list[Claim]:
+    """The 3-step's first collision: translation eliminated (eq. 34), spin reversed (eq. 35)."""
+    r = st["results"]
+    if c1 is None:
+        return [Claim("first collision", f"t = {r['t_collision_1']['value']} s", "none", "differs")]
+    d = c1["data"]
+    v1 = _speed(d["v_after"])
+    w0, w1 = d["omega_before"], d["omega_after"]
+    return [
+        Claim(
+            "translation after collision 1",
+            "eliminated (pure rotation, v_1 = 0, eq. 34)",
+            f"‖v_1‖ = {v1:.4f} m/s",
+            "reproduced" if v1 < V_RES else "differs",
+            f"tolerance {V_RES:g} m/s: 2 px of drift over the 0.2 s to collision 2 at 300 fps",
+        ),
+        Claim(
+            "spin reversed at collision 1 (eq. 35)",
+            st["statements"]["sign_rule"]["value"],
+            f"ω_0 = {w0:.2f} → ω_1 = {w1:.2f} rad/s",
+            "reproduced" if w0 * w1 < 0 and abs(w1) > W_RES else "differs",
+            f"‖ω_1‖ must exceed {W_RES:g} rad/s (1 px at the tip over 0.1 s) to have a sign",
+        ),
+    ]
+
+
+def _collision_2_rows(log: LogReader, c2: dict | None, r: dict) -> list[Claim]:
+    """The 3-step's second collision: its time, where it hit, rotation eliminated (eq. 36)."""
+    if c2 is None:
+        return [
+            Claim("second collision", f"t = {r['t_collision_2']['value']} s", "none", "differs")
+        ]
+    half = _params(log).stick.length / 2
+    d = c2["data"]
+    planned: dict = next(
+        (e["data"] for e in events(log, "plan") if e["data"].get("index") == 2), {}
+    )
+    solved = abs(planned.get("r_x_solved", float("nan")))
+    return [
+        Claim(
+            "time of collision 2",
+            f"{r['t_collision_2']['value']} s",
+            f"{c2['t']:.3f} s",
+            within(c2["t"], r["t_collision_2"]["value"], abs_=T_RES),
+            f"tolerance {T_RES:g} s (the paper gives 0.01 s)",
+        ),
+        Claim(
+            "fingertip position r_x,2",
+            f"{r['r_x_2']['value'] * 1e3:.1f} mm",
+            f"hit at {abs(d['r_x']) * 1e3:.1f} mm",
+            within(abs(d["r_x"]), r["r_x_2"]["value"], abs_=0.002),
+            f"tolerance 2 mm (1 px); the plan solved F_ω,2(0) = {solved * 1e3:.1f} mm"
+            + (
+                f", beyond L/2 = {half * 1e3:.0f} mm: it falls back to "
+                f"{abs(planned.get('r_x', float('nan'))) * 1e3:.1f} mm"
+                if solved > half
+                else ""
+            ),
+        ),
+        Claim(
+            "rotation after collision 2",
+            "eliminated (pure translation, ω_2 = 0, eq. 36)",
+            f"ω_2 = {d['omega_after']:.2f} rad/s",
+            "reproduced" if abs(d["omega_after"]) < W_RES else "differs",
+            f"tolerance {W_RES:g} rad/s (1 px at the tip over 0.1 s)",
+        ),
+    ]
 
 
 def _two_step_rows(log2: LogReader) -> list[Claim]:
