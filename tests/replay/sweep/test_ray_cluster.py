@@ -140,6 +140,17 @@ def _ended(sweep: subprocess.Popen) -> str:
     return out
 
 
+@contextlib.contextmanager
+def _stopped(proc: subprocess.Popen):
+    """A process the test did not see to its end is killed."""
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+
+
 def _outcomes(folder: Path) -> list[dict]:
     """The table's rows in order, without what differs between two runs of the same variant."""
     rows = sorted(read_table(folder / "table.csv"), key=lambda r: int(r["index"]))
@@ -187,26 +198,26 @@ def test_a_lost_node_is_named_in_one_line():
 
 def test_a_cluster_gives_the_local_table_and_a_lost_node_only_its_variant(tmp_path):
     local = _sweep(tmp_path / "local")  # (runs while the cluster starts)
-    with _cluster() as (address, temp, head, second):
+    with _stopped(local), _cluster() as (address, temp, head, second):
         ray = ["--executor", "ray", "--address", address]
-        sweep = _sweep(tmp_path / "cluster", *ray, env=_env(temp))
         seen: dict[str, set[str]] = {}  # process name -> its listening addresses
-        while sweep.poll() is None:
-            ours = session(head) | session(second) | {sweep.pid: "sweep"}
-            for pid, where, line in listeners():
-                if pid in ours:
-                    seen.setdefault(ours[pid], set()).add(where)
-                    assert loopback(where), f"a Ray listener not on loopback: {line}"
-            time.sleep(0.2)
-        assert "6 ran" in _ended(sweep)
+        with _stopped(_sweep(tmp_path / "cluster", *ray, env=_env(temp))) as sweep:
+            while sweep.poll() is None:
+                ours = session(head) | session(second) | {sweep.pid: "sweep"}
+                for pid, where, line in listeners():
+                    if pid in ours:
+                        seen.setdefault(ours[pid], set()).add(where)
+                        assert loopback(where), f"a Ray listener not on loopback: {line}"
+                time.sleep(0.2)
+            assert "6 ran" in _ended(sweep)
         assert {"gcs_server", "raylet"} <= set(seen), seen  # (the watch saw them)
         assert "6 ran" in _ended(local)
         assert _outcomes(tmp_path / "cluster") == _outcomes(tmp_path / "local")
 
-        killed = _sweep(tmp_path / "killed", *ray, env=_env(temp))
-        t0 = time.monotonic()
-        running = _kill_while_running(second, killed)
-        _ended(killed)
+        with _stopped(_sweep(tmp_path / "killed", *ray, env=_env(temp))) as killed:
+            t0 = time.monotonic()
+            running = _kill_while_running(second, killed)
+            _ended(killed)
         print(f"the sweep ended {time.monotonic() - t0:.1f} s after the node was killed")
         assert wait_for(lambda: not session(second), 30.0), session(second)
         rows = read_table(tmp_path / "killed" / "table.csv")
