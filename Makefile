@@ -77,6 +77,7 @@ bench: $(STAMP)
 	$(PY) -m tools.bench.log_costs
 	$(PY) -m tools.bench.viewer_load
 	$(PY) -m tools.bench.sweep_costs
+	$(PY) -m tools.bench.research_sweeps
 
 golden-check: $(STAMP)
 	$(REPLAY) golden check

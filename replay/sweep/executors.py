@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import multiprocessing as mp
 import os
+import re
 import signal
 import sys
 import threading
@@ -48,6 +49,7 @@ def crashed(task: dict, exc: BaseException | str) -> dict:
 
 
 WORKER_DIED = "error: worker died: "  # a row's reason: the variant did not finish (rerun it)
+_RAY_NODE = re.compile(r"Node IP: ([0-9A-Fa-f.:\[\]]+), node ID: ([0-9a-f]+)")
 STOP_GRACE = 5.0  # s a worker has to close its log as interrupted before it is killed
 
 
@@ -228,6 +230,15 @@ def _start_ray(ray, workers: int, address: str | None):
     return cluster
 
 
+def _lost(exc: Exception) -> Exception | str:
+    """A Ray error that names a lost node (``NodeDiedError``: the node's raylet was killed, the
+    machine went away) as one short line naming it; any other error as it is."""
+    node = _RAY_NODE.search(str(exc))
+    if node is None:
+        return exc
+    return f"node {node[1]} (ID {node[2]}) is dead or unavailable ({type(exc).__name__})"
+
+
 def run_ray(tasks: list[dict], workers: int, address: str | None = None) -> Iterator[dict]:
     try:
         import ray
@@ -252,7 +263,7 @@ def run_ray(tasks: list[dict], workers: int, address: str | None = None) -> Iter
                 try:
                     yield ray.get(ref)
                 except Exception as exc:  # noqa: BLE001 - a dead worker or a lost node
-                    yield crashed(of[ref], exc)
+                    yield crashed(of[ref], _lost(exc))
     finally:
         if started:
             try:

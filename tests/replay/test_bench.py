@@ -156,3 +156,25 @@ def test_bad_bench_arguments_are_usage_errors_not_tracebacks(argv, says, capsys)
         bench.main(argv)
     assert exc.value.code == 2
     assert says in capsys.readouterr().err
+
+
+def test_the_research_bench_quick_mode_prints_every_workload_with_its_ratios(capsys):
+    """``make bench``'s research workloads (issue #41), tiny: each workload's sweep ran, and its
+    ratios to a full-log run and to the bare engine are finite positive numbers."""
+    import math
+    import re
+
+    from tools.bench import research_sweeps
+
+    research_sweeps.main(["--quick"])
+    out = capsys.readouterr().out
+    for name in ("catch_optimised", "grasp_hexahedron", "stick_3step"):
+        block = "\n".join(out.split(f"{name}: ", 1)[1].splitlines()[:5])  # (its report)
+        n = research_sweeps.QUICK["n"]
+        assert f"sweep: {n} variants" in block and ", 0 errors)" in block
+        ratios = re.search(
+            r"sweep / full-log run (\S+) \(per variant (\S+);.*sweep / bare engine (\S+)x", block
+        )
+        assert ratios, block
+        values = [float(x) for x in ratios.groups()]
+        assert all(math.isfinite(x) and x > 0.0 for x in values), values

@@ -6,14 +6,18 @@ sweep starts leads one, and every Ray process lives in it (see replay/sweep/ray_
 from __future__ import annotations
 
 import contextlib
-import ipaddress
 import os
-import re
 import signal
 import subprocess
 import sys
 import time
 from pathlib import Path
+
+from ray_procs import listeners as _listeners
+from ray_procs import loopback as _loopback
+from ray_procs import procs as _procs
+from ray_procs import session as _session
+from ray_procs import wait_for as _wait
 
 from replay.sweep import ray_local
 from replay.sweep.table import read_table
@@ -21,22 +25,6 @@ from replay.sweep.table import read_table
 ROOT = Path(__file__).resolve().parents[3]
 GONE_WITHIN = 30.0  # s after the sweep ends or dies
 STARTS_WITHIN = 120.0  # s for Ray to come up on a loaded machine
-
-
-def _procs() -> dict[int, tuple[int, int, str, str]]:
-    """pid -> (parent, session, state, name) of every live process (zombies left out)."""
-    out = {}
-    for pid in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            with open(f"/proc/{pid}/stat", "rb") as f:
-                stat = f.read()
-        except OSError:
-            continue
-        name, rest = stat.split(b"(", 1)[1].rsplit(b")", 1)
-        fields = rest.split()
-        if fields[0] != b"Z":
-            out[int(pid)] = (int(fields[1]), int(fields[3]), fields[0].decode(), name.decode())
-    return out
 
 
 def _keeper(sweep: int) -> int | None:
@@ -55,35 +43,8 @@ def _cmdline(pid: int) -> list[str]:
         return []
 
 
-def _session(sid: int) -> dict[int, str]:
-    return {p: name for p, (_, s, _, name) in _procs().items() if s == sid}
-
-
 def _temp_dir(keeper: int) -> Path:
     return Path(_cmdline(keeper)[4])  # python -m replay.sweep.ray_local WORKERS TEMP_DIR
-
-
-def _listeners() -> list[tuple[int, str, str]]:
-    """(pid, local address, ss line) of every TCP/UDP listener, from ``ss -Hltunp``."""
-    text = subprocess.run(
-        ["ss", "-Hltunp"], capture_output=True, text=True, check=True, timeout=10
-    ).stdout
-    return [
-        (int(pid), line.split()[4], line)
-        for line in text.splitlines()
-        for pid in re.findall(r"pid=(\d+)", line)
-    ]
-
-
-def _loopback(address: str) -> bool:
-    host = address.rsplit(":", 1)[0].strip("[]").split("%")[0]
-    try:
-        ip = ipaddress.ip_address(host)
-    except ValueError:
-        return False  # "*", "0.0.0.0" is parsed; a name is not loopback
-    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped:
-        ip = ip.ipv4_mapped
-    return ip.is_loopback
 
 
 def _sweep(out: Path, frictions: int, *extra: str, env=None) -> subprocess.Popen:
@@ -109,18 +70,6 @@ def _ending(proc: subprocess.Popen):
         if proc.poll() is None:
             proc.kill()
             proc.communicate()
-
-
-def _wait(what, within: float, proc: subprocess.Popen | None = None):
-    end = time.monotonic() + within
-    while time.monotonic() < end:
-        got = what()
-        if got:
-            return got
-        if proc is not None and proc.poll() is not None:
-            break
-        time.sleep(0.1)
-    return what()
 
 
 def test_loopback_is_a_loopback_address():
