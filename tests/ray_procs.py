@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import ipaddress
 import os
 import re
@@ -66,3 +67,15 @@ def wait_for(what, within: float, proc: subprocess.Popen | None = None):
             break
         time.sleep(0.1)
     return what()
+
+
+@contextlib.contextmanager
+def ending(proc: subprocess.Popen):
+    """A process the test did not see to its end is killed (a sweep's keeper then clears its
+    Ray)."""
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()

@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 import pytest
-from ray_procs import listeners, loopback, session, wait_for
+from ray_procs import ending, listeners, loopback, session, wait_for
 
 from replay.sweep.executors import WORKER_DIED, _lost
 from replay.sweep.ray_local import kill_session
@@ -140,17 +140,6 @@ def _ended(sweep: subprocess.Popen) -> str:
     return out
 
 
-@contextlib.contextmanager
-def _stopped(proc: subprocess.Popen):
-    """A process the test did not see to its end is killed."""
-    try:
-        yield proc
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-
-
 def _outcomes(folder: Path) -> list[dict]:
     """The table's rows in order, without what differs between two runs of the same variant."""
     rows = sorted(read_table(folder / "table.csv"), key=lambda r: int(r["index"]))
@@ -198,10 +187,10 @@ def test_a_lost_node_is_named_in_one_line():
 
 def test_a_cluster_gives_the_local_table_and_a_lost_node_only_its_variant(tmp_path):
     local = _sweep(tmp_path / "local")  # (runs while the cluster starts)
-    with _stopped(local), _cluster() as (address, temp, head, second):
+    with ending(local), _cluster() as (address, temp, head, second):
         ray = ["--executor", "ray", "--address", address]
         seen: dict[str, set[str]] = {}  # process name -> its listening addresses
-        with _stopped(_sweep(tmp_path / "cluster", *ray, env=_env(temp))) as sweep:
+        with ending(_sweep(tmp_path / "cluster", *ray, env=_env(temp))) as sweep:
             while sweep.poll() is None:
                 ours = session(head) | session(second) | {sweep.pid: "sweep"}
                 for pid, where, line in listeners():
@@ -214,7 +203,7 @@ def test_a_cluster_gives_the_local_table_and_a_lost_node_only_its_variant(tmp_pa
         assert "6 ran" in _ended(local)
         assert _outcomes(tmp_path / "cluster") == _outcomes(tmp_path / "local")
 
-        with _stopped(_sweep(tmp_path / "killed", *ray, env=_env(temp))) as killed:
+        with ending(_sweep(tmp_path / "killed", *ray, env=_env(temp))) as killed:
             t0 = time.monotonic()
             running = _kill_while_running(second, killed)
             _ended(killed)

@@ -5,7 +5,6 @@ sweep starts leads one, and every Ray process lives in it (see replay/sweep/ray_
 
 from __future__ import annotations
 
-import contextlib
 import os
 import signal
 import subprocess
@@ -18,6 +17,7 @@ from ray_procs import loopback as _loopback
 from ray_procs import procs as _procs
 from ray_procs import session as _session
 from ray_procs import wait_for as _wait
+from ray_procs import ending
 
 from replay.sweep import ray_local
 from replay.sweep.table import read_table
@@ -61,17 +61,6 @@ def _sweep(out: Path, frictions: int, *extra: str, env=None) -> subprocess.Popen
     )
 
 
-@contextlib.contextmanager
-def _ending(proc: subprocess.Popen):
-    """A sweep the test did not see to its end is killed (its keeper then clears its Ray)."""
-    try:
-        yield proc
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-
-
 def test_loopback_is_a_loopback_address():
     assert all(
         map(_loopback, ["127.0.0.1:80", "[::1]:80", "[::ffff:127.0.0.1]:80", "127.0.0.53%lo:53"])
@@ -106,7 +95,7 @@ def test_the_keeper_clears_its_session_and_the_orphans_that_left_it():
         text=True,
         start_new_session=True,
     )
-    with _ending(keeper):
+    with ending(keeper):
         inside, escaped = map(int, keeper.stdout.readline().split())  # type: ignore[union-attr]
         procs = _procs()
         assert procs[inside][1] == keeper.pid and procs[escaped][1] != keeper.pid
@@ -117,7 +106,7 @@ def test_the_keeper_clears_its_session_and_the_orphans_that_left_it():
 
 
 def test_private_ray_listens_on_loopback_only_and_ends_with_the_sweep(tmp_path):
-    with _ending(_sweep(tmp_path / "S", 3)) as sweep:
+    with ending(_sweep(tmp_path / "S", 3)) as sweep:
         keeper = _wait(lambda: _keeper(sweep.pid), STARTS_WITHIN, sweep)
         assert keeper, sweep.communicate()
         temp_dir = _temp_dir(keeper)
@@ -138,7 +127,7 @@ def test_private_ray_listens_on_loopback_only_and_ends_with_the_sweep(tmp_path):
 
 
 def test_a_sigkilled_sweep_leaves_no_ray_process(tmp_path):
-    with _ending(_sweep(tmp_path / "K", 40)) as sweep:
+    with ending(_sweep(tmp_path / "K", 40)) as sweep:
         keeper = _wait(lambda: _keeper(sweep.pid), STARTS_WITHIN, sweep)
         assert keeper, sweep.communicate()
         temp_dir = _temp_dir(keeper)
@@ -168,7 +157,7 @@ def test_address_joins_a_running_cluster_and_leaves_it_running(tmp_path):
         # its servers and agents (an idle worker may be retired at any time)
         cluster = {p: n for p, n in _session(theirs.keeper.pid).items() if n != "ray::IDLE"}
         env = dict(os.environ, RAY_AUTH_MODE="token", **ray_local.ENV)  # (how one joins it)
-        with _ending(_sweep(tmp_path / "J", 2, "--address", theirs.address, env=env)) as sweep:
+        with ending(_sweep(tmp_path / "J", 2, "--address", theirs.address, env=env)) as sweep:
             out, err = sweep.communicate(timeout=STARTS_WITHIN)
         assert sweep.returncode == 0, err
         assert "2 ran" in out
