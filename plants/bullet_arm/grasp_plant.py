@@ -23,14 +23,14 @@ from __future__ import annotations
 import numpy as np
 from plants.bullet_arm.engine import pybullet as p
 
-from plants.bullet_arm.arm_state import joint_state
+from plants.arm_rig.arm_state import joint_state
 from plants.bullet_arm.ft_sensor import WristFT
-from plants.bullet_arm.grasp_setup import head_setup, human_args, plane_setup
-from plants.bullet_arm.grasp_topics import GraspRigTopics
-from plants.bullet_arm.grasp_verdict import GraspVerdict
-from plants.bullet_arm.head import HeadServo
+from plants.arm_rig.grasp_setup import head_setup, human_args, plane_setup
+from plants.arm_rig.grasp_topics import GraspRigTopics
+from plants.arm_rig.grasp_verdict import GraspVerdict
+from plants.arm_rig.head import HeadServo
 from plants.bullet_arm.human_hand import HumanHand
-from plants.bullet_arm.params import GraspParams
+from plants.arm_rig.params import GraspParams
 from plants.bullet_arm.plant import BulletArmPlant
 from plants.bullet_arm.servo import VelocityMotors, VelocityServos
 from replay.interfaces import Occurrence

@@ -19,14 +19,14 @@ import math
 
 import numpy as np
 
-from plants.bullet_arm.arm_state import TorqueLimits, joint_state, limit_flags
-from plants.bullet_arm.impulse import ImpulseSchedule
-from plants.bullet_arm.outcome import CatchWatch
-from plants.bullet_arm.params import Params as ArmParams
-from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
+from plants.arm_rig.arm_state import TorqueLimits, joint_state, limit_flags
+from plants.arm_rig.impulse import ImpulseSchedule
+from plants.arm_rig.outcome import CatchWatch
+from plants.arm_rig.params import Params as ArmParams
+from plants.arm_rig.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.bullet_arm.quiet import quiet_c_output
 from plants.bullet_arm.reach import robot_reach
-from plants.bullet_arm.settings import resolve
+from plants.arm_rig.settings import resolve
 from replay.interfaces import Occurrence, Plant
 from replay.messages import (
     TOPIC_ARM_APPLIED_TORQUE,
@@ -619,7 +619,7 @@ class BulletArmPlant(TorqueLimits, Plant):
         return ev
 
     def outcome(self, t: float) -> dict | None:
-        """Caught or not, and why, with the first touch's metrics (plants/bullet_arm/outcome.py)."""
+        """Caught or not, and why, with the first touch's metrics (plants/arm_rig/outcome.py)."""
         if self._watch is None:
             return None
         return self._watch.verdict(caught=self.caught, ever_caught=self._ever_caught)

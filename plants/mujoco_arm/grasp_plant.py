@@ -19,11 +19,11 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from plants.bullet_arm.grasp_setup import head_setup, human_args, plane_setup
-from plants.bullet_arm.grasp_topics import GraspRigTopics
-from plants.bullet_arm.grasp_verdict import GraspVerdict
-from plants.bullet_arm.head import HeadServo
-from plants.bullet_arm.human_path import HumanPath
+from plants.arm_rig.grasp_setup import head_setup, human_args, plane_setup
+from plants.arm_rig.grasp_topics import GraspRigTopics
+from plants.arm_rig.grasp_verdict import GraspVerdict
+from plants.arm_rig.head import HeadServo
+from plants.arm_rig.human_path import HumanPath
 from plants.bullet_arm.servo import VelocityServos
 from plants.mujoco_arm.human import drive_human
 from plants.mujoco_arm.params import GraspParams

@@ -20,11 +20,11 @@ from typing import cast
 import mujoco
 import numpy as np
 
-from plants.bullet_arm.arm_state import TorqueLimits, limit_flags
-from plants.bullet_arm.impulse import ImpulseSchedule
-from plants.bullet_arm.outcome import CatchWatch
-from plants.bullet_arm.payloads import AppliedTorque, EffectorMotion, ObjectContacts
-from plants.bullet_arm.settings import resolve
+from plants.arm_rig.arm_state import TorqueLimits, limit_flags
+from plants.arm_rig.impulse import ImpulseSchedule
+from plants.arm_rig.outcome import CatchWatch
+from plants.arm_rig.payloads import AppliedTorque, EffectorMotion, ObjectContacts
+from plants.arm_rig.settings import resolve
 from plants.mujoco_arm.params import Params as MujocoParams
 from plants.mujoco_arm.world import NEAR, build_world, free_velocity
 from replay.interfaces import Occurrence, Plant
@@ -424,7 +424,7 @@ class MujocoArmPlant(TorqueLimits, Plant):
         if obj is not None:
             v = obj[2]
             J = self._impulses.pop(self._steps) if self._impulses.due else None
-            if J is not None:  # a scenario-set kick (plants/bullet_arm/impulse.py)
+            if J is not None:  # a scenario-set kick (plants/arm_rig/impulse.py)
                 b = self.world.object_dof
                 v = (np.asarray(v) + J / self.params.object_mass).tolist()
                 d.qvel[b : b + 3] = v
@@ -610,7 +610,7 @@ class MujocoArmPlant(TorqueLimits, Plant):
         return ev
 
     def outcome(self, t: float) -> dict | None:
-        """Caught or not, and why (plants/bullet_arm/outcome.py, the same judge)."""
+        """Caught or not, and why (plants/arm_rig/outcome.py, the same judge)."""
         if self._watch is None:
             return None
         return self._watch.verdict(caught=self.caught, ever_caught=self._ever_caught)

@@ -11,9 +11,9 @@ import pybullet as p
 import pytest
 
 from plants.bullet_arm.grasp_plant import BulletGraspPlant
-from plants.bullet_arm.head import HeadServo
+from plants.arm_rig.head import HeadServo
 from plants.bullet_arm.human_hand import band_limited_path
-from plants.bullet_arm.params import GraspParams
+from plants.arm_rig.params import GraspParams
 from replay.robot.arm_types import ServoCommand
 from replay.robot.hand import GRASP4, hand_body, hand_mass
 from replay.robot.head import HeadSpec, camera_pose, look_angles
@@ -132,7 +132,7 @@ def test_head_servo_reaches_its_rate_within_its_torque_limit():
 
 
 def _head_step_reference(servo, q, qd, cmd):
-    """The head servo's step on 2-vectors (module docstring of plants/bullet_arm/head.py)."""
+    """The head servo's step on 2-vectors (module docstring of plants/arm_rig/head.py)."""
     dt, J, K = servo.dt, servo.J, servo.K
     qd_new = (J * qd + dt * K * cmd) / (J + dt * K)
     tau = K * (cmd - qd_new)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from plants.bullet_arm import BulletArmPlant, Params
-from plants.bullet_arm.arm_state import limit_torque, limit_torque_loop
+from plants.arm_rig.arm_state import limit_torque, limit_torque_loop
 from plants.bullet_arm.plant import _floats
 from replay.robot.arm_types import ArmCommand
 from replay.runner import Runner

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Callable
 
-from plants.bullet_arm.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
+from plants.arm_rig.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
 from replay.messages import JointState
 from replay.robot.arm_types import GraspSpec
 from replay.scene import Frame, Scene
