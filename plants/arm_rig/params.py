@@ -253,7 +253,7 @@ class GraspParams(Params):
         gt=0.0,
         le=1500.0,
         doc="closed-loop bandwidth of the arm's AC servo velocity loops (inertia-decoupled, "
-        "plants/bullet_arm/servo.py: every joint's; assumed ~80 Hz)",
+        "plants/arm_rig/servo.py: every joint's; assumed ~80 Hz)",
     )
     plane_normal: list = param(
         [1.0, 0.0, 0.0],

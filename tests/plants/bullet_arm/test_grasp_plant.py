@@ -280,7 +280,7 @@ def test_frames_read_once_a_step_equal_pybullets_own_reads_while_moving():
             )
             point = plant.object_state()[0]
             want = np.array(palm[6]) + np.cross(np.array(palm[7]), point - np.array(palm[0]))
-            got = plant._link_point_velocity(plant._palm_link, point)
+            got = plant._point_velocity(plant._palm_link, point)
             np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
             np.testing.assert_allclose(plant._frames_now()[0][0], tool[4], rtol=0.0, atol=1e-12)
     finally:
