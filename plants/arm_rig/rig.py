@@ -8,7 +8,8 @@ spec, the torque limiting, the command, the truth topics, the events (``contact`
 (``plants.bullet_arm``, ``plants.mujoco_arm``) subclasses it, builds its world after
 ``ArmRig.__init__`` and answers the engine questions below (``_state``, ``_effector_now``,
 ``_point_velocity``, ``_object_contacts``, ``_touch``, ``_contact_summary_now``,
-``_set_object_velocity``, ``_engine_notes``, ``frames``, ``step``).
+``_set_object_velocity``, ``_engine_notes``, ``_apply_torques``, ``_drive_hand``,
+``_hold_object``, ``_advance``, ``frames``).
 """
 
 from __future__ import annotations
@@ -100,6 +101,7 @@ class ArmRig(Plant):
         self._upper_l = (self.upper - 1e-3).tolist()
         self._locked_l = [n in self.locked for n in self.joint_names]
         self._enforce_vlim = bool(P.enforce_velocity_limits)
+        self._hand_speed = float(P.hand_closing_speed)
         self._events: list[Occurrence] = []
         self._t = 0.0
         self._steps = 0
@@ -118,6 +120,7 @@ class ArmRig(Plant):
         self._obj_albedo = float(P.object_albedo)
         self._obj_size = _vec3(P.object_size)
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
+        self._cache: tuple | None = None  # the engine's state read this step (_state)
         self._spec = self._make_spec(S.initial_q.copy())
         self._watch = (  # the catch verdict (outcome.py): a free object and a hand
             CatchWatch(
@@ -168,6 +171,24 @@ class ArmRig(Plant):
     @abstractmethod
     def _engine_notes(self) -> dict:
         """The spec's notes on the engine."""
+
+    @abstractmethod
+    def _apply_torques(self, tau: list) -> None:
+        """Apply the arm's torques (N*m, one per active joint) over the coming step."""
+
+    @abstractmethod
+    def _drive_hand(self, v: list, qd: list) -> None:
+        """Drive the hand's servos at the speeds ``v`` (rad/s) over the coming step; ``qd``:
+        the hand joints' speeds now."""
+
+    @abstractmethod
+    def _hold_object(self, obj: tuple) -> None:
+        """Before the step: the forces the engine applies to the object itself (none, or
+        gravity's cancelled where ``object_gravity`` is off and the engine needs a force)."""
+
+    @abstractmethod
+    def _advance(self) -> bool:
+        """Step the engine by ``dt``; True when the run has diverged (the engine says so)."""
 
     # ------------------------------------------------------------------ spec
     def _make_spec(self, q0: np.ndarray) -> ArmSpec:
@@ -279,6 +300,29 @@ class ArmRig(Plant):
             self.invalidate_state()
             self._events.append(Occurrence("impulse", {"impulse": J.tolist(), "velocity_after": v}))
         self._obj_vel_before = tuple(v)
+
+    def step(self) -> None:
+        (_, qd), hand, obj = self._state()
+        self._limit_torque(qd)
+        applied = self._tau_applied
+        self._apply_torques(applied if self._all_active else [applied[i] for i in self.active])
+        if self.hand_names:
+            speed, dt = self._hand_speed, self.dt
+            # rate-limited position servo: reach the target at most at the closing speed, the
+            # last step landing on it
+            v = [min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])]
+            self._drive_hand(v, hand[1])
+        if obj is not None:
+            self._kick(obj)
+            self._hold_object(obj)
+        diverged = self._advance()
+        self._cache = None
+        self._steps += 1
+        self._t = self._steps * self.dt
+        if diverged:
+            self._diverge()
+            return
+        self._check_events()
 
     # ------------------------------------------------------------------ events
     def _diverge(self) -> None:

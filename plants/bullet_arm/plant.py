@@ -134,7 +134,6 @@ class BulletArmPlant(ArmRig):
         self._get_link_states = bc.getLinkStates
         self._get_contact_points = bc.getContactPoints
         self._set_motors = bc.setJointMotorControlArray
-        self._hand_speed = float(P.hand_closing_speed)
         self._hand_forces = [float(P.hand_max_torque)] * len(self._hand_j)
         self._hand_v: list | None = None  # the hand motors' last targets (None: none set yet)
 
@@ -178,7 +177,6 @@ class BulletArmPlant(ArmRig):
             + (self._obj_radius if P.object == "ball" else 0.5 * math.hypot(*self._obj_size))
             + 0.05
         )
-        self._cache: tuple | None = None
         # (step, the tool link's state): read at most once a step
         self._effector: tuple[int, tuple] | None = None
 
@@ -234,48 +232,32 @@ class BulletArmPlant(ArmRig):
         return {}
 
     # ------------------------------------------------------------------ step
-    def step(self) -> None:
-        bc = self.bc
-        (_, qd), hand, obj = self._state()
-        self._limit_torque(qd)
-        applied = self._tau_applied
-        self._set_motors(
-            self.robot,
-            self._arm_j,
-            p.TORQUE_CONTROL,
-            forces=applied if self._all_active else [applied[i] for i in self.active],
-        )
-        if self._hand_j:
-            speed, dt = self._hand_speed, self.dt
-            # rate-limited position servo: reach the target at most at the closing speed, the
-            # last step landing on it (PyBullet's velocity motor is implicit, so this is stable)
-            v = [min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])]
-            # PyBullet keeps a velocity motor's target and force until set again: the same
-            # targets as last step (closing at full speed, at rest) need no call
-            if v != self._hand_v:
-                self._set_motors(
-                    self.robot,
-                    self._hand_j,
-                    p.VELOCITY_CONTROL,
-                    targetVelocities=v,
-                    forces=self._hand_forces,
-                )
-                self._hand_v = v
-        if obj is not None:
-            self._kick(obj)
-            if not self.params.object_gravity:
-                bc.applyExternalForce(
-                    self.obj,
-                    -1,
-                    [0.0, 0.0, self.params.object_mass * self.params.gravity],
-                    list(obj[0]),
-                    p.WORLD_FRAME,
-                )
-        bc.stepSimulation()
-        self._cache = None
-        self._steps += 1
-        self._t = self._steps * self.dt
-        self._check_events()
+    def _apply_torques(self, tau: list) -> None:
+        self._set_motors(self.robot, self._arm_j, p.TORQUE_CONTROL, forces=tau)
+
+    def _drive_hand(self, v: list, qd: list) -> None:
+        # PyBullet's velocity motor is implicit (the rig's rate-limited servo is stable); it keeps
+        # its target and force until set again: the same targets as last step (closing at full
+        # speed, at rest) need no call
+        if v != self._hand_v:
+            self._set_motors(
+                self.robot,
+                self._hand_j,
+                p.VELOCITY_CONTROL,
+                targetVelocities=v,
+                forces=self._hand_forces,
+            )
+            self._hand_v = v
+
+    def _hold_object(self, obj: tuple) -> None:
+        if not self.params.object_gravity:
+            P = self.params
+            force = [0.0, 0.0, P.object_mass * P.gravity]
+            self.bc.applyExternalForce(self.obj, -1, force, list(obj[0]), p.WORLD_FRAME)
+
+    def _advance(self) -> bool:
+        self.bc.stepSimulation()
+        return False  # a non-finite state is the rig's check (limit_flags)
 
     # ------------------------------------------------------------------ events
     def _object_contacts(self, pos, v) -> list:

@@ -79,7 +79,6 @@ class MujocoArmPlant(ArmRig):
             if W.part_of_body[i] is not None
         ]
         self._f6 = np.zeros(6)
-        self._hand_speed = float(P.hand_closing_speed)
         # the hand servos' torque cap (N*m) and, per joint, the torque per rad/s of speed change
         # in one step, I / dt (I: its inertia about its axis; a finger joint's link is a leaf:
         # M_ii is constant), its link's body (contacts)
@@ -120,7 +119,6 @@ class MujocoArmPlant(ArmRig):
             )
         ]
         # _contacts: the step's rows (body, position, normal robot->object, normal force)
-        self._cache: tuple | None = None
 
     # ------------------------------------------------------------------ state
     def _state(self) -> tuple:
@@ -246,34 +244,23 @@ class MujocoArmPlant(ArmRig):
             ]
             self._hand_capped = capped
 
-    def step(self) -> None:
+    def _apply_torques(self, tau: list) -> None:
+        self.md.qfrc_applied[self._arm_dof_ix] = tau
+
+    def _drive_hand(self, v: list, qd: list) -> None:
+        self.md.ctrl[self._hand_act_ix] = v
+        self._hand_caps(v, qd)
+
+    def _hold_object(self, obj: tuple) -> None:
+        pass  # object_gravity off: the world's gravity compensation (world.py)
+
+    def _advance(self) -> bool:
         m, d = self.mj, self.md
-        (_, qd), hand, obj = self._state()
-        self._limit_torque(qd)
-        applied = self._tau_applied
-        d.qfrc_applied[self._arm_dof_ix] = [applied[i] for i in self.active]
-        if self._hand_act:
-            speed, dt = self._hand_speed, self.dt
-            # rate-limited position servo (as PyBullet's): reach the target at most at the
-            # closing speed, the last step landing on it
-            v_cmd = [
-                min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])
-            ]
-            d.ctrl[self._hand_act_ix] = v_cmd
-            self._hand_caps(v_cmd, hand[1])
-        if obj is not None:
-            self._kick(obj)
         mujoco.mj_step2(m, d)
         self._read_contacts()
         mujoco.mj_step1(m, d)
-        self._cache = None
-        self._steps += 1
-        self._t = self._steps * self.dt
-        if not self.diverged and self._warned():
-            self._diverge()  # MuJoCo found a non-finite or huge state and reset it
-        if self.diverged:
-            return
-        self._check_events()
+        # MuJoCo found a non-finite or huge state and reset it: the run has diverged
+        return self.diverged or self._warned()
 
     # ------------------------------------------------------------------ events
     def _warned(self) -> bool:
