@@ -57,7 +57,8 @@ class GraspRig(ArmRig):
     # ------------------------------------------------------------------ the engine's answers
     @abstractmethod
     def _grasp_engine_setup(self) -> None:
-        """The engine's drives, wrist sensor and the servos' preload (``arm_servos`` made)."""
+        """The engine's drives, wrist sensor (``_wrench``), the servos' preload (``arm_servos``
+        made) and the state read."""
 
     @abstractmethod
     def _make_human(self, rng: np.random.Generator, args: dict) -> Any:

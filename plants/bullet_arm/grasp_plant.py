@@ -42,10 +42,6 @@ class BulletGraspPlant(GraspVerdict, GraspRigTopics, BulletArmPlant):
         "an object moved by a human hand on a constraint plane"
     )
 
-    def __init__(self, params: GraspParams, *, dt: float, rng: np.random.Generator) -> None:
-        super().__init__(params, dt=dt, rng=rng)  # the rig in PyBullet
-        self._read()
-
     def _grasp_engine_setup(self) -> None:
         bc = self.bc
         self._palm_j = self._jidx["palm_joint"]
@@ -74,6 +70,7 @@ class BulletGraspPlant(GraspVerdict, GraspRigTopics, BulletArmPlant):
         tau0 = {j: g[i] for i, j in enumerate(dofs)}
         self._dof_pos = pos
         self.arm_servos.preload([tau0[j] for j in self._arm_j], self.arm_mass_matrix())
+        self._read()
 
     def _make_human(self, rng: np.random.Generator, args: dict) -> HumanHand:
         assert self.obj is not None and self._palm_link is not None

@@ -35,10 +35,6 @@ class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
         "an object moved by a human hand on a constraint plane"
     )
 
-    def __init__(self, params: GraspParams, *, dt: float, rng: np.random.Generator) -> None:
-        super().__init__(params, dt=dt, rng=rng)  # the rig in MuJoCo
-        self._wrench = wrist_wrench(self.world, self.md)
-
     def _grasp_engine_setup(self) -> None:
         m, d, W = self.mj, self.md, self.world
         # the hand servos: never clipped by MuJoCo (_hand_caps clips their command)
@@ -53,6 +49,7 @@ class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
         # initial posture (qfrc_bias at zero velocity)
         self.arm_servos.preload(d.qfrc_bias[list(W.arm_dof)].tolist(), self.arm_mass_matrix())
         self._read_servos()
+        self._wrench = wrist_wrench(W, d)
 
     def _make_human(self, rng: np.random.Generator, args: dict) -> HumanPath:
         return HumanPath(rng, **args)
