@@ -34,7 +34,7 @@ from analysis import catch_thesis_claims as thesis
 from analysis.claims import Claim, Falsifier, agrees, merge
 from analysis.needs import has
 from analysis.series import events
-from plants.bullet_arm.settings import ArmSettings, resolve
+from plants.arm_rig.settings import ArmSettings, resolve
 from replay.log import LogReader
 from replay.messages import (
     TOPIC_ARM_JOINT_COMMAND,

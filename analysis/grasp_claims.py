@@ -298,7 +298,7 @@ def _arm_top_speed(run: GraspRun) -> float | None:
     """The run's arm model's top tool speed with its joint speed limits (over a sample of its
     joint box), as the catching claims compute it, from the rig's own settings."""
     from analysis.catch_claims import arm_capability
-    from plants.bullet_arm.settings import resolve
+    from plants.arm_rig.settings import resolve
 
     try:
         arm = resolve(run.params)

@@ -180,7 +180,7 @@ class _Robot:
     resolver on the log's ``plant.params``)."""
 
     def __init__(self, params) -> None:
-        from plants.bullet_arm.settings import resolve
+        from plants.arm_rig.settings import resolve
 
         arm = resolve(params)
         self.chain = arm.chain()

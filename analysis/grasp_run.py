@@ -106,7 +106,7 @@ class GraspRun:
         """The rig's typed ``GraspParams``, rebuilt from the log's resolved scenario (every
         default the plant's own): the PyBullet rig's, or the MuJoCo rig's (its contact settings
         added) for a ``mujoco_grasp`` run."""
-        from plants.bullet_arm.params import GraspParams
+        from plants.arm_rig.params import GraspParams
         from plants.mujoco_arm.params import GraspParams as MujocoGraspParams
         from replay.scenario import params_from_data
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from plants.bullet_arm.grasp_plant import BulletGraspPlant
-from plants.bullet_arm.params import GraspParams
+from plants.arm_rig.params import GraspParams
 
 DT = 1e-3
 Q0 = [0.0, 0.533482, 0.0, 2.134676, 0.0, -1.0973, 0.0]  # scenarios/grasp_hexahedron.yaml

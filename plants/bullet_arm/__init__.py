@@ -1,10 +1,10 @@
 """PyBullet arm plant: a WAM (4/7 axes, torque control), a hand (position control), an object.
 
-``params``, ``settings`` and ``viewer_scene`` import no simulator; ``BulletArmPlant`` (PyBullet)
-is imported when first asked for.
+Its ``Params``, settings and viewer scene are the engine-free rig's (``plants.arm_rig``);
+``BulletArmPlant`` (PyBullet) is imported when first asked for.
 """
 
-from plants.bullet_arm.params import Params
+from plants.arm_rig.params import Params
 
 __all__ = ["BulletArmPlant", "Params"]
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from plants.bullet_arm.engine import pybullet as p
 
-from plants.bullet_arm.human_path import HumanPath, band_limited_path, numpy_row_sum
+from plants.arm_rig.human_path import HumanPath, band_limited_path, numpy_row_sum
 
 __all__ = ["HumanHand", "HumanPath", "band_limited_path", "numpy_row_sum"]
 

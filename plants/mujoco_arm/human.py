@@ -1,5 +1,5 @@
 """The grasping rig's human hand in MuJoCo: the engine-free path and spring-damper coupling
-(``plants.bullet_arm.human_path.HumanPath``, the PyBullet rig's) applied to the object's free body
+(``plants.arm_rig.human_path.HumanPath``, the PyBullet rig's) applied to the object's free body
 through ``xfrc_applied`` (a world-frame force at the body's centre of mass and a world torque:
 PyBullet's ``applyExternalForce`` at the base's position with ``WORLD_FRAME``).
 """
@@ -9,7 +9,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from plants.bullet_arm.human_path import HumanPath
+from plants.arm_rig.human_path import HumanPath
 
 
 def object_pose_velocity(data: mujoco.MjData, qpos: int, dof: int, body: int) -> tuple:

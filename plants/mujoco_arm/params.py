@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from plants.bullet_arm.params import GraspParams as BulletGraspParams
-from plants.bullet_arm.params import Params as ArmParams
+from plants.arm_rig.params import GraspParams as BulletGraspParams
+from plants.arm_rig.params import Params as ArmParams
 from replay.params import ParamError, param
 
 
@@ -95,6 +95,6 @@ class Params(ArmParams):
 
 @dataclass
 class GraspParams(BulletGraspParams, Params):
-    """The grasping rig's parameters (plants/bullet_arm/params.py ``GraspParams``: servos, head,
+    """The grasping rig's parameters (plants/arm_rig/params.py ``GraspParams``: servos, head,
     human, verdict) with MuJoCo's contact and solver settings (``Params`` above), so a grasp
     scenario changes only ``plant.type``."""

@@ -5,8 +5,8 @@ Registered under the plants' types (``paper_replay.viewer_scenes`` ``mujoco_arm`
 
 from __future__ import annotations
 
-from plants.bullet_arm.grasp_viewer_scene import GraspScene
-from plants.bullet_arm.viewer_scene import ArmScene
+from plants.arm_rig.grasp_viewer_scene import GraspScene
+from plants.arm_rig.viewer_scene import ArmScene
 from plants.mujoco_arm.params import GraspParams, Params
 
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from plants.bullet_arm.settings import ArmSettings
+from plants.arm_rig.settings import ArmSettings
 from plants.models.arm import ArmModel
 from plants.mujoco_arm.params import Params
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix

@@ -1,11 +1,11 @@
-"""The bullet_arm plant's catch verdict (plants/bullet_arm/outcome.py): every outcome says why."""
+"""The bullet_arm plant's catch verdict (plants/arm_rig/outcome.py): every outcome says why."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from plants.bullet_arm.outcome import CatchWatch
+from plants.arm_rig.outcome import CatchWatch
 
 IDENT = [0.0, 0.0, 0.0, 1.0]  # palm frame = world: the palm normal is +z
 THICK, RADIUS = 0.012, 0.045

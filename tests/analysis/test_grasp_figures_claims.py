@@ -164,7 +164,7 @@ def test_no_prediction_the_hand_follows_the_object(rows, logs):
 
 def test_the_viewer_draws_the_real_run(logs):
     from replay.viewer import Viewer
-    from plants.bullet_arm.grasp_viewer_scene import GraspScene
+    from plants.arm_rig.grasp_viewer_scene import GraspScene
 
     v = Viewer.open([Path(logs["grasp_sphere"].path)], port=0)
     try:

@@ -111,7 +111,7 @@ def test_urdf_of_the_arm_is_written_readable_by_all(project_root, tmp_path):
     joints = {j.get("name"): j.get("type") for j in robot.iter("joint")}
     assert sum(t == "revolute" for t in joints.values()) >= 3  # the arm's active joints
     # the same robot the plant loads into PyBullet
-    from plants.bullet_arm.settings import resolve
+    from plants.arm_rig.settings import resolve
     from replay.scenario import load_scenario
 
     sc = load_scenario("scenarios/catch_optimised.yaml")

@@ -9,7 +9,7 @@ import numpy as np
 
 from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.human_hand import band_limited_path, numpy_row_sum
-from plants.bullet_arm.servo import VelocityServos
+from plants.arm_rig.servo import VelocityServos
 from replay.spatial import cross3
 
 

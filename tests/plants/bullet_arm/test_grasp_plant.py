@@ -11,9 +11,9 @@ import pybullet as p
 import pytest
 
 from plants.bullet_arm.grasp_plant import BulletGraspPlant
-from plants.bullet_arm.head import HeadServo
+from plants.arm_rig.head import HeadServo
 from plants.bullet_arm.human_hand import band_limited_path
-from plants.bullet_arm.params import GraspParams
+from plants.arm_rig.params import GraspParams
 from replay.robot.arm_types import ServoCommand
 from replay.robot.hand import GRASP4, hand_body, hand_mass
 from replay.robot.head import HeadSpec, camera_pose, look_angles
@@ -132,7 +132,7 @@ def test_head_servo_reaches_its_rate_within_its_torque_limit():
 
 
 def _head_step_reference(servo, q, qd, cmd):
-    """The head servo's step on 2-vectors (module docstring of plants/bullet_arm/head.py)."""
+    """The head servo's step on 2-vectors (module docstring of plants/arm_rig/head.py)."""
     dt, J, K = servo.dt, servo.J, servo.K
     qd_new = (J * qd + dt * K * cmd) / (J + dt * K)
     tau = K * (cmd - qd_new)
@@ -280,7 +280,7 @@ def test_frames_read_once_a_step_equal_pybullets_own_reads_while_moving():
             )
             point = plant.object_state()[0]
             want = np.array(palm[6]) + np.cross(np.array(palm[7]), point - np.array(palm[0]))
-            got = plant._link_point_velocity(plant._palm_link, point)
+            got = plant._point_velocity(plant._palm_link, point)
             np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
             np.testing.assert_allclose(plant._frames_now()[0][0], tool[4], rtol=0.0, atol=1e-12)
     finally:

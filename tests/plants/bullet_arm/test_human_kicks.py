@@ -1,4 +1,4 @@
-"""The human path's kicks (plants/bullet_arm/human_path.py, issue #38): a velocity step of the
+"""The human path's kicks (plants/arm_rig/human_path.py, issue #38): a velocity step of the
 path for a set time at Poisson times, off by default without touching the path."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from plants.bullet_arm.human_path import HumanPath
+from plants.arm_rig.human_path import HumanPath
 
 BASE = dict(
     origin=[0.75, 0.0, 0.55], rpy0=[0.0, 0.0, 0.0], u=[0.0, 1.0, 0.0], v=[0.0, 0.0, 1.0],

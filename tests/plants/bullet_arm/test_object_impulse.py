@@ -1,4 +1,4 @@
-"""The bullet_arm plant's scenario-set impulse on the object (plants/bullet_arm/impulse.py)."""
+"""The bullet_arm plant's scenario-set impulse on the object (plants/arm_rig/impulse.py)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from plants.bullet_arm import BulletArmPlant, Params
-from plants.bullet_arm.impulse import ImpulseSchedule
+from plants.arm_rig.impulse import ImpulseSchedule
 
 DT = 1e-3
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from plants.bullet_arm import BulletArmPlant, Params
-from plants.bullet_arm.arm_state import limit_torque, limit_torque_loop
-from plants.bullet_arm.plant import _floats
+from plants.arm_rig.arm_state import limit_torque, limit_torque_loop
+from plants.arm_rig.rig import floats
 from replay.robot.arm_types import ArmCommand
 from replay.runner import Runner
 from replay.scenario import load_scenario
@@ -45,21 +45,21 @@ def test_commands_read_as_numpy_reads_them():
         else:
             v = list(x.astype(np.float32))
         want = np.asarray(v, dtype=float).reshape(-1).tolist()
-        got = _floats(v, 4, "torque")
+        got = floats(v, 4, "torque")
         assert [type(a) for a in got] == [float] * 4
         assert [a.hex() for a in got] == [a.hex() for a in want]
         forms += 1
     assert forms == 300
     with pytest.raises(ValueError, match="torque needs 4 values, got 3"):
-        _floats([1.0, 2.0, 3.0], 4, "torque")
+        floats([1.0, 2.0, 3.0], 4, "torque")
     with pytest.raises(ValueError):
-        _floats(["a", 1.0, 2.0, 3.0], 4, "torque")
+        floats(["a", 1.0, 2.0, 3.0], 4, "torque")
 
 
 def test_torque_limits_one_pass_equals_the_joint_loop():
     """Seeded random commands (within and beyond the limits, NaN, inf, signed zeros): the one
     pass over finite commands (arm_state.limit_torque) gives the loop's applied torques and
-    clamps; the plant's step gives them and their events (both plants share TorqueLimits)."""
+    clamps; the plant's step gives them and their events (both plants share the rig's _limit_torque)."""
     plant = make(**CATCHING)
     rng = np.random.default_rng(17)
     tlim, vlim, locked = plant._tlim_l, plant._vlim_l, plant._locked_l
@@ -167,7 +167,7 @@ def test_contacts_skipped_only_where_pybullet_has_none(project_root, name, tmp_p
         return ask(**kw)
 
     plant._get_contact_points = counted
-    check = plant._robot_contacts
+    check = plant._object_contacts
     steps = [0]
 
     def both(pos, v):
@@ -177,7 +177,7 @@ def test_contacts_skipped_only_where_pybullet_has_none(project_root, name, tmp_p
         steps[0] += 1
         return got
 
-    plant._robot_contacts = both
+    plant._object_contacts = both
     result = runner.run(tmp_path / "run.mcap")
     print(f"{name}: contacts asked for at {asked[0]} of {steps[0]} steps")
     assert result.outcome["success"]

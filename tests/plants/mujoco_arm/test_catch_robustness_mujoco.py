@@ -88,7 +88,7 @@ def test_mujoco_catches_the_perturbed_throws(outcomes):
 
 
 def test_both_engines_judge_by_the_same_criterion(outcomes):
-    """Every outcome says why, in the same vocabulary (plants/bullet_arm/outcome.py)."""
+    """Every outcome says why, in the same vocabulary (plants/arm_rig/outcome.py)."""
     _, table = outcomes
     for res in table.values():
         for o in res:

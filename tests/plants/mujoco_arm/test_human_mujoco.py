@@ -1,4 +1,4 @@
-"""The grasping rig's human hand (plants.bullet_arm.human_path, engine-free) in both engines: a
+"""The grasping rig's human hand (plants.arm_rig.human_path, engine-free) in both engines: a
 free 100 g box held only by the spring-damper to its seeded path (seeds no scenario uses) follows
 the path, in position and roll, the same way in MuJoCo (xfrc_applied) and PyBullet
 (applyExternalForce), with the force within its limit."""
@@ -13,7 +13,7 @@ import pytest
 from plants.bullet_arm.engine import pybullet as p
 
 from plants.bullet_arm.human_hand import HumanHand
-from plants.bullet_arm.human_path import HumanPath
+from plants.arm_rig.human_path import HumanPath
 from plants.mujoco_arm.human import drive_human, object_pose_velocity
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 

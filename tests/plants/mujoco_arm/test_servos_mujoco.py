@@ -1,4 +1,4 @@
-"""The grasping arm's velocity servos (plants/bullet_arm/servo.py ``VelocityServos``: engine-free
+"""The grasping arm's velocity servos (plants/arm_rig/servo.py ``VelocityServos``: engine-free
 maths, inertia-decoupled by the arm's mass matrix) on the MuJoCo arm with the 14-joint hand: the
 PyBullet rig's step test (tests/plants/bullet_arm/test_grasp_servos.py) passes in MuJoCo too:
 every joint reaches its command with the stated bandwidth (+-20 %), settles on it and leaves the
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from grasp_rig import DT, Q0, rise_bandwidth
 
-from plants.bullet_arm.servo import VelocityServos
+from plants.arm_rig.servo import VelocityServos
 from plants.mujoco_arm import Params
 from plants.mujoco_arm.plant import MujocoArmPlant
 from replay.robot.arm_types import ArmCommand

@@ -1,4 +1,4 @@
-"""The viewer's grasping scene (plants/bullet_arm/grasp_viewer_scene.py) without a browser: a grasping log
+"""The viewer's grasping scene (plants/arm_rig/grasp_viewer_scene.py) without a browser: a grasping log
 (the synthetic one of grasp_synthetic.py, with the contract's topics) is drawn with the WAM-7 and
 the 14-joint hand from the plant's URDF, the head camera at its logged pose with the chip's
 image on its frustum, the recognised object, the reaching target and the phase."""
@@ -10,7 +10,7 @@ import pytest
 
 from grasp_synthetic import write_grasp_log
 from replay.viewer.app import Viewer
-from plants.bullet_arm.grasp_viewer_scene import GraspScene, chip_image
+from plants.arm_rig.grasp_viewer_scene import GraspScene, chip_image
 from replay.spatial import xyzw_to_wxyz
 
 

@@ -30,7 +30,7 @@ from replay.viewer import app as viewer_app
 from replay.viewer.app import Viewer, free_port
 from plants.airtable import Params as AirTableParams
 from plants.airtable.viewer_scene import AirTableScene, StickGeometry
-from plants.bullet_arm.viewer_scene import ArmScene, plant_models_urdf
+from plants.arm_rig.viewer_scene import ArmScene, plant_models_urdf
 from replay.viewer.geometry import cameras
 from replay.viewer.scenes import RunScene, scene_class
 from synthetic_logs import write_arm_log, write_stick_log

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plants.bullet_arm.viewer_scene import ArmScene
+from plants.arm_rig.viewer_scene import ArmScene
 from replay import registry
 from replay.viewer.app import Viewer
 from replay.viewer.scenes import FIT_MIN_SIZE, Body, fit_bounds, run_color

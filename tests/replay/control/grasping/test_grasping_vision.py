@@ -20,7 +20,7 @@ from replay.scenario import load_scenario
 sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 from grasp_rig import rig  # noqa: E402
 
-from plants.bullet_arm.head import HeadServo  # noqa: E402
+from plants.arm_rig.head import HeadServo  # noqa: E402
 from replay.control.grasping.features import blob, blob_rows  # noqa: E402
 from replay.control.grasping.head_tracking import HeadParams, HeadTrackingTask  # noqa: E402
 from replay.control.grasping.recognition import (

@@ -4,39 +4,28 @@ plane, slips, the tracking error before the grasp) and the run's ``outcome``. Sh
 PyBullet rig (``grasp_plant.BulletGraspPlant``) and the MuJoCo one, so both engines are judged
 by the same criterion.
 
-The host plant provides: ``params`` (GraspParams), ``plane`` (PlaneSpec), ``_n_l``, ``_u_l``,
-``_v_l`` (the plane's normal and in-plane axes), ``human`` (human_path.HumanPath), ``caught``,
-``_t``, ``_events``, ``_state()`` (its [2]: the object's (pos, orn, v, w)), ``_frames_now()``
-(its [0]: the tool frame's (pos, [x, y, z, w], ...)) and ``_contact_summary_now()`` (the sorted
-parts touching the object, their links, the total normal force in N).
+Its state is the rig's (``grasp_rig.GraspRig``, its base): the plane, the human, the object's
+state, the tool frame (``_effector_now``) and the contacts (``_contact_summary_now``).
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
-from typing import Any, Callable
+import numpy as np
 
+from plants.arm_rig.grasp_rig import GraspRig
+from plants.arm_rig.params import GraspParams
 from replay.interfaces import Occurrence
 
 
-class GraspVerdict:
-    # the host plant's (annotations only: no attribute or method is defined here)
-    params: Any
-    plane: Any
-    human: Any
-    caught: bool
-    _t: float
-    _events: list
-    _n_l: list
-    _u_l: list
-    _v_l: list
-    _state: Callable[[], tuple]
-    _frames_now: Callable[[], tuple]
-    _contact_summary_now: Callable[[], tuple]
+class GraspVerdict(GraspRig):
+    def __init__(self, params: GraspParams, *, dt: float, rng: np.random.Generator) -> None:
+        super().__init__(params, dt=dt, rng=rng)
+        self._start_verdict(params.slip_time, dt)
 
     def _start_verdict(self, slip_time: float, dt: float) -> None:
-        """The verdict's record, empty (called by the plant's __init__)."""
+        """The verdict's record, empty."""
         self._grasps: list[dict] = []
         self._grasp_start = 0.0
         self._slipping = False
@@ -53,7 +42,7 @@ class GraspVerdict:
 
     def _in_hand_position(self, pos) -> list[float]:
         """The object's centre in the tool (= hand) frame (m): R^T (x - p)."""
-        (px, py, pz), (qx, qy, qz, qw), _, _ = self._frames_now()[0]
+        (px, py, pz), (qx, qy, qz, qw), _, _ = self._effector_now()
         dx, dy, dz = pos[0] - px, pos[1] - py, pos[2] - pz
         # the columns of R(q) dotted with d
         return [
@@ -68,7 +57,15 @@ class GraspVerdict:
             + (1 - 2 * (qx * qx + qy * qy)) * dz,
         ]
 
-    def _grasp_bookkeeping(self, was_held: bool, n_before: int) -> None:
+    def _judge_step(self) -> None:
+        """After a step: the servos' torque_limit events, the arm rig's events and the
+        verdict's record."""
+        self._servo_limit_events()
+        n_before = len(self._events)
+        self._check_events()
+        self._grasp_bookkeeping(n_before)
+
+    def _grasp_bookkeeping(self, n_before: int) -> None:
         """The physical verdict's record, from the truth of this step: each grasp's drift in
         the hand, its distance to the human's path, the run's distance off the plane, slips."""
         pos, _, v, _ = self._state()[2]
@@ -134,7 +131,7 @@ class GraspVerdict:
         else:
             self._slipping = False
             self._in_hand.clear()
-            ex, ey, ez = self._frames_now()[0][0]
+            ex, ey, ez = self._effector_now()[0]
             dx, dy, dz = ox - ex, oy - ey, oz - ez
             (ux, uy, uz), (vx, vy, vz) = self._u_l, self._v_l
             du = dx * ux + dy * uy + dz * uz

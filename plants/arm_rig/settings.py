@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from plants.bullet_arm.params import Params
+from plants.arm_rig.params import Params
 from plants.models.arm import ArmModel, build_arm
 from replay.robot.hand import HANDS, HandTable, hand_body
 from replay.robot.serial_chain import SerialChain

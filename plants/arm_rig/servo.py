@@ -1,4 +1,4 @@
-"""Velocity-command servos (the arm's AC servos, the hand's DC servos) on PyBullet joints.
+"""The arm's velocity-command servos (its AC servos), engine-free: a plant applies their torques.
 
 A servo amplifier takes a joint velocity command and closes its own velocity loop, whose torque
 the motor limits. The arm's loops are **inertia-decoupled** (a computed-torque velocity loop:
@@ -14,8 +14,9 @@ approximation), ``w_i = bandwidth / 10`` (the integral removes the droop under g
 steady load without changing the step response much: <10 % overshoot) and each joint's integral
 held while a torque is at its limit (anti-windup; past a limit the proportional torques are
 scaled down together, see :meth:`VelocityServos.torques`). The torque is applied as a joint torque
-(``TORQUE_CONTROL``), so the arm's dynamics, gravity and contacts act on it and a saturated joint
-lags its command. The torque given is what a strain gauge on the drive reads.
+(PyBullet's ``TORQUE_CONTROL``, MuJoCo's ``qfrc_applied``), so the arm's dynamics, gravity and
+contacts act on it and a saturated joint lags its command. The torque given is what a strain
+gauge on the drive reads.
 
 (Issue #20: the former per-joint gains from ``1 / (M^-1)_jj`` divided by a coupling factor left
 J1 at ~45 rad/s and J3 at ~33 rad/s against the stated 500; tests/plants/bullet_arm/
@@ -27,7 +28,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from plants.bullet_arm.engine import pybullet as p
 
 INTEGRAL_RATIO = 10.0  # bandwidth / w_i
 
@@ -93,38 +93,3 @@ class VelocityServos:
         self.torque_l = tau.tolist()
         self.saturated_l = (np.abs(tau) >= lim * (1.0 - 1e-12)).tolist()
         return self.torque_l  # the integral stays (anti-windup)
-
-
-class VelocityMotors:
-    """Stiff geared velocity servos: PyBullet's velocity motor (solved implicitly with the
-    contacts) drives each joint at its commanded rate with at most its torque limit. A finger's
-    geared DC motor reflects an inertia far above the light finger link's, so a velocity loop
-    on the link's own inertia would let the fingers flop under the arm's accelerations; the
-    implicit motor is that stiff drive. The torque it gave (``appliedJointMotorTorque``) is what
-    the joint's strain gauge reads."""
-
-    def __init__(self, bc, body: int, joints, torque_limits) -> None:
-        self.bc, self.body, self.joints = bc, body, list(joints)
-        self.limits = np.asarray(torque_limits, float).reshape(-1)
-        self._forces = [float(x) for x in self.limits]
-        self.command = [0.0] * len(self.joints)
-        self.torque = [0.0] * len(self.joints)  # N m per joint, floats
-
-    def set_command(self, qd) -> None:
-        v = np.asarray(qd, float).reshape(-1)
-        if v.shape != (len(self.joints),):
-            raise ValueError(f"velocity command needs {len(self.joints)} values, got {v.shape[0]}")
-        self.command = [x if math.isfinite(x) else 0.0 for x in v.tolist()]
-
-    def actuate(self) -> None:
-        self.bc.setJointMotorControlArray(
-            self.body,
-            self.joints,
-            p.VELOCITY_CONTROL,
-            targetVelocities=self.command,
-            forces=self._forces,
-        )
-
-    def read(self, torques) -> None:
-        """The motors' torques of this step (the joint states' appliedJointMotorTorque)."""
-        self.torque = list(torques)

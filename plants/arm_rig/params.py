@@ -159,7 +159,7 @@ class Params:
         [],
         doc="external impulses on the object, [[t, Jx, Jy, Jz], "
         "...] (s, N*s, world): a disturbance such as a "
-        "mid-flight kick (plants/bullet_arm/impulse.py)",
+        "mid-flight kick (plants/arm_rig/impulse.py)",
     )
     object_gravity: bool = param(True, doc="gravity acts on the object (false: it floats)")
     object_albedo: float = param(0.9, unit="1", ge=0.0, le=1.0, doc="brightness seen by cameras")
@@ -253,7 +253,7 @@ class GraspParams(Params):
         gt=0.0,
         le=1500.0,
         doc="closed-loop bandwidth of the arm's AC servo velocity loops (inertia-decoupled, "
-        "plants/bullet_arm/servo.py: every joint's; assumed ~80 Hz)",
+        "plants/arm_rig/servo.py: every joint's; assumed ~80 Hz)",
     )
     plane_normal: list = param(
         [1.0, 0.0, 0.0],
@@ -306,7 +306,7 @@ class GraspParams(Params):
         omit_empty=True,
         doc="sudden kicks of the human's path: a Poisson process of this mean rate (0: none), "
         "each a step of human_kick_speed in the path's in-plane velocity, in a random direction, "
-        "lasting human_kick_duration (plants/bullet_arm/human_path.py)",
+        "lasting human_kick_duration (plants/arm_rig/human_path.py)",
     )
     human_kick_speed: float = param(
         0.0, unit="m/s", ge=0.0, le=10.0, omit_empty=True, doc="a kick's step in the path's speed"

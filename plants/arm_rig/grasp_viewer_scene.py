@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 import numpy as np
 
-from plants.bullet_arm.params import GraspParams
-from plants.bullet_arm.viewer_scene import ArmScene
+from plants.arm_rig.params import GraspParams
+from plants.arm_rig.viewer_scene import ArmScene
 from replay.spatial import xyzw_to_wxyz
 from replay.viewer.data import RunData
 from replay.viewer.scenes import Body, PlotSeries, PlotSpec

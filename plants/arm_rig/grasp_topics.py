@@ -5,61 +5,25 @@ hand, head and wrist readings and the rig's GraspSpec. Shared by the PyBullet ri
 (``grasp_plant.BulletGraspPlant``) and the MuJoCo one, so both log the same topics from one
 source.
 
-The host plant provides, besides its arm plant's ``truth``/``joints``/``frames``/``scene``:
-``arm_servos`` (servo.VelocityServos), ``head_servo`` (head.HeadServo), ``head`` and ``plane``
-(the rig's specs), ``human`` (human_path.HumanPath), ``joint_names``, ``hand_names``, ``dof``,
-``active``, ``_all_active``, ``_tau_applied``, ``_clamped``, ``_wrench`` (the wrist's true
-wrench, [F, M]), ``_state()`` (its [1]: the hand's (q, qd, torque), [2]: the object's (pos, ...))
-and ``_head_reading()`` ((R, c, quaternion) of the head camera).
+Its state is the rig's (``grasp_rig.GraspRig``, its base): the servos, head, human, applied
+torques, the wrist's wrench and the arm rig's state; ``super()`` reaches the arm rig's topics.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Callable
-
-from plants.bullet_arm.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
+from plants.arm_rig.grasp_rig import GraspRig
+from plants.arm_rig.payloads import HeadState, HumanState, HumanWrench, ServoState, Wrench
 from replay.messages import JointState
-from replay.robot.arm_types import GraspSpec
 from replay.scene import Frame, Scene
 
 HEAD_JOINTS = ("pan", "tilt")
 
-if TYPE_CHECKING:
-    from replay.interfaces import Plant as _ArmPlant
-else:
-    _ArmPlant = object
 
-
-class GraspRigTopics(_ArmPlant):
-    """Mixin before the arm plant in the rig's bases (its ``super()`` calls reach the arm plant)."""
-
-    # the host plant's (annotations only: no attribute or method is defined here)
-    arm_servos: Any
-    head_servo: Any
-    head: Any
-    plane: Any
-    human: Any
-    joint_names: Any
-    hand_names: Any
-    dof: int
-    active: Any
-    _all_active: bool
-    _tau_applied: list
-    _clamped: list
-    _wrench: list
-    _state: Callable[[], tuple]
-    _head_reading: Callable[[], tuple]
-
-    def _grasp_spec(self, base) -> GraspSpec:
-        fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
-        fields["notes"] = {
-            **base.notes,
-            "arm": "WAM-7 stands in for the paper's unnamed 7-axis arm; velocity servos",
-        }
-        return GraspSpec(**fields, head=self.head, plane=self.plane)
+class GraspRigTopics(GraspRig):
+    """The grasping rig's truth topics, joints, frames and scene readings."""
 
     def truth(self, t: float) -> dict:
-        out = super().truth(t)  # type: ignore[safe-super]  # the arm plant's, not Plant's
+        out = super().truth(t)
         del out["/arm/applied_torque"]
         servos = self.arm_servos
         out["/arm/servo"] = ServoState(
@@ -122,7 +86,7 @@ class GraspRigTopics(_ArmPlant):
         return out
 
     def scene(self) -> Scene:
-        sc = super().scene()  # type: ignore[safe-super]  # the arm plant's, not Plant's
+        sc = super().scene()
         hs = self.head_servo
         R, c, _ = self._head_reading()
         hq, hqd, htau = self._state()[1]

@@ -1,6 +1,6 @@
 """The arm plant's once-a-step state arithmetic in Python floats (``joint_state``,
-``limit_flags``, ``limit_torque`` and ``torque_limit_events``, the ``TorqueLimits`` step of
-both): the PyBullet and MuJoCo arm plants run them."""
+``limit_flags``, ``limit_torque`` and ``torque_limit_events``, the rig's ``_limit_torque``
+step): the arm rig (rig.py) and its PyBullet plant run them."""
 
 from __future__ import annotations
 
@@ -70,37 +70,6 @@ def limit_torque_loop(cmd: list, tlim: list, locked: list, enforce: bool, vlim: 
             a, c = 0.0, True
         applied[i], clamped[i] = a, c
     return applied, clamped
-
-
-class TorqueLimits:
-    """The arm plants' torque limiting, one home for the PyBullet and MuJoCo plants: each step
-    the command ``_tau_cmd`` becomes ``_tau_applied`` and ``_clamped`` (:func:`limit_torque`),
-    with a ``torque_limit`` event per joint clamped anew and the count ``clamp_count``."""
-
-    _tau_cmd: list
-    _tau_applied: list
-    _clamped: list
-    _torque_episode: list
-    _tlim_l: list
-    _vlim_l: list
-    _locked_l: list
-    _enforce_vlim: bool
-    _events: list
-    joint_names: tuple[str, ...]
-    clamp_count: int
-
-    def _limit_torque(self, qdl: list) -> None:
-        cmd = self._tau_cmd
-        applied, clamped = limit_torque(
-            cmd, self._tlim_l, self._locked_l, self._enforce_vlim, self._vlim_l, qdl
-        )
-        self._tau_applied = applied
-        if True in clamped:
-            self._events += torque_limit_events(
-                clamped, self._torque_episode, cmd, applied, self.joint_names, self._tlim_l
-            )
-            self.clamp_count += sum(clamped)
-        self._clamped = self._torque_episode = clamped
 
 
 def torque_limit_events(clamped, episode, cmd, applied, names, tlim) -> list[Occurrence]:

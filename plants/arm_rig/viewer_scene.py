@@ -3,7 +3,7 @@
 Registered under the plant's type in ``pyproject.toml``
 (``[project.entry-points."paper_replay.viewer_scenes"] bullet_arm = ...``). Sizes and the URDF
 come from the plant's typed ``Params``, rebuilt from the run's resolved scenario, through the
-plant's resolver (``plants.bullet_arm.settings``): no default is retyped here. No simulator is
+plant's resolver (``plants.arm_rig.settings``): no default is retyped here. No simulator is
 imported (the URDF is built by ``plants.models``, pure NumPy).
 """
 
@@ -15,8 +15,8 @@ from typing import Callable
 import numpy as np
 import viser
 
-from plants.bullet_arm.params import Params
-from plants.bullet_arm.settings import resolve
+from plants.arm_rig.params import Params
+from plants.arm_rig.settings import resolve
 from replay.messages import (
     TOPIC_ARM_JOINT_STATE,
     TOPIC_EFFECTOR_STATE,

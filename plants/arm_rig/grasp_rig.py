@@ -1,0 +1,142 @@
+"""The grasping rig (Namiki, Nakabo, Ishii & Ishikawa 1999), engine-free: the arm rig with the
+arm's 7 AC servos on velocity commands (``ServoCommand``; ``servo.VelocityServos``), the hand's
+14 DC servos, a pan/tilt head (``head.HeadServo``) carrying the vision chip's camera, the wrist's
+F/T sensor and a human hand moving the object on its constraint plane.
+
+``GraspRig`` owns, once for every engine: the head, the plane, the arm servos and their torques,
+``torque_limit`` events and the command; its logged topics are ``grasp_topics.GraspRigTopics``'s
+and its verdict ``grasp_verdict.GraspVerdict``'s (both subclasses). An engine's grasp plant
+answers the questions below (``_grasp_engine_setup``, ``_make_human``, ``arm_mass_matrix``,
+``_hand_velocity``) and sets ``_wrench`` (the wrist's true wrench, [F, M]) each step.
+"""
+
+from __future__ import annotations
+
+from abc import abstractmethod
+from typing import Any
+
+import numpy as np
+
+from plants.arm_rig.grasp_setup import head_setup, human_args, plane_setup
+from plants.arm_rig.head import HeadServo
+from plants.arm_rig.params import GraspParams
+from plants.arm_rig.rig import ArmRig
+from plants.arm_rig.servo import VelocityServos
+from replay.interfaces import Occurrence
+from replay.robot.arm_types import GraspSpec, ServoCommand
+from replay.robot.head import camera_pose
+from replay.spatial import matrix_to_quaternion
+
+
+class GraspRig(ArmRig):
+    spec_type = GraspSpec
+    command_types = (ServoCommand,)  # type: ignore[assignment]
+    hold_event = "grasp"
+
+    _wrench: list  # the wrist's true wrench [Fx, Fy, Fz, Mx, My, Mz]: the engine's plant's
+
+    def __init__(self, params: GraspParams, *, dt: float, rng: np.random.Generator) -> None:
+        if params.object == "none" or params.hand == "none":
+            raise ValueError("the grasping rig needs a hand and an object")
+        super().__init__(params, dt=dt, rng=rng)  # the arm rig in its engine
+        self._watch = None  # the catch verdict's watcher: this rig's is outcome()
+        P = params
+        self.arm_servos = VelocityServos(
+            self.torque_limits[list(self.active)], P.arm_servo_bandwidth, dt
+        )
+        self._grasp_engine_setup()
+        # the head, the constraint plane and the human (grasp_setup)
+        self.head, h0 = head_setup(P)
+        self.head_servo = HeadServo(self.head, P.head_servo_bandwidth, dt, h0)
+        self.plane, u, v, n = plane_setup(P)
+        self._u_l, self._v_l, self._n_l = u.tolist(), v.tolist(), [float(x) for x in n]
+        self.human = self._make_human(rng, human_args(P, u, v, n))
+        self._head_pose: tuple | None = None
+        self._spec = self._grasp_spec(self._spec)
+
+    # ------------------------------------------------------------------ the engine's answers
+    @abstractmethod
+    def _grasp_engine_setup(self) -> None:
+        """The engine's drives, wrist sensor (``_wrench``), the servos' preload (``arm_servos``
+        made) and the state read."""
+
+    @abstractmethod
+    def _make_human(self, rng: np.random.Generator, args: dict) -> Any:
+        """The human hand (a ``human_path.HumanPath`` the engine applies) from ``args``."""
+
+    @abstractmethod
+    def arm_mass_matrix(self) -> np.ndarray:
+        """The arm joints' block of the joint-space mass matrix now (kg m^2)."""
+
+    @abstractmethod
+    def _hand_velocity(self, hand) -> None:
+        """The hand servos' velocity command (rad/s per hand joint)."""
+
+    # ------------------------------------------------------------------ spec
+    def _grasp_spec(self, base) -> GraspSpec:
+        fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
+        fields["notes"] = {
+            **base.notes,
+            "arm": "WAM-7 stands in for the paper's unnamed 7-axis arm; velocity servos",
+        }
+        return GraspSpec(**fields, head=self.head, plane=self.plane)
+
+    # ------------------------------------------------------------------ command
+    def apply(self, command: ServoCommand) -> None:  # type: ignore[override]
+        if not isinstance(command, ServoCommand):
+            raise TypeError(f"the grasping rig takes ServoCommand, got {type(command).__name__}")
+        if command.arm is not None:
+            qd = np.asarray(command.arm, float).reshape(-1)
+            if qd.shape != (self.dof,):
+                raise ValueError(f"ServoCommand.arm needs {self.dof} values, got {qd.shape[0]}")
+            self.arm_servos.set_command(qd if self._all_active else qd[list(self.active)])
+        if command.hand is not None:
+            self._hand_velocity(command.hand)
+        if command.head is not None:
+            self.head_servo.set_command(command.head)
+
+    def _servo_torques(self, qd: list) -> list:
+        """The arm servos' torques for the coming step (active joints), at joint speeds ``qd``."""
+        return self.arm_servos.torques(
+            qd if self._all_active else [qd[i] for i in self.active], self.arm_mass_matrix()
+        )
+
+    def _read_servos(self) -> None:
+        """The servos' torques as the arm's applied torques (full joint list)."""
+        s = self.arm_servos
+        if self._all_active:
+            tau, clamped = s.torque_l[:], s.saturated_l[:]
+        else:
+            tau, clamped = [0.0] * self.dof, [False] * self.dof
+            for k, i in enumerate(self.active):
+                tau[i], clamped[i] = s.torque_l[k], s.saturated_l[k]
+        self._tau_applied = self._tau_cmd = tau
+        self._clamped = clamped
+
+    def _servo_limit_events(self) -> None:
+        """A ``torque_limit`` event per servo saturated anew this step."""
+        clamped, episode = self._clamped, self._torque_episode
+        if True in clamped:
+            for i, c in enumerate(clamped):
+                if c and not episode[i]:
+                    self._events.append(
+                        Occurrence(
+                            "torque_limit",
+                            {
+                                "joint": self.joint_names[i],
+                                "applied": self._tau_applied[i],
+                                "limit": self._tlim_l[i],
+                            },
+                        )
+                    )
+            self.clamp_count += sum(clamped)
+        self._torque_episode = clamped
+
+    # ------------------------------------------------------------------ log and scene
+    def _head_reading(self):
+        """(R, c, [qx, qy, qz, qw]) of the head camera now (computed once a step: the log, the
+        scene and the 3-D frames)."""
+        if self._head_pose is None:
+            R, c = camera_pose(self.head, *self.head_servo.q_l)
+            self._head_pose = (R, c, [float(x) for x in matrix_to_quaternion(R)])
+        return self._head_pose

@@ -1,0 +1,49 @@
+"""The arm rig is written once and engine-free (issue #39): its modules import no physics engine,
+and each engine's plant takes the rig's spec, truth, events, limit checks and step order rather
+than a copy of its own."""
+
+from __future__ import annotations
+
+import pkgutil
+import subprocess
+import sys
+
+import plants.arm_rig
+
+RIG_METHODS = ("_make_spec", "_check_events", "_limit_events", "_limit_torque")
+
+
+def test_no_arm_rig_module_imports_an_engine():
+    names = [f"plants.arm_rig.{m.name}" for m in pkgutil.iter_modules(plants.arm_rig.__path__)]
+    assert "plants.arm_rig.rig" in names and "plants.arm_rig.grasp_rig" in names
+    code = (
+        "import importlib, sys\n"
+        f"for n in {names!r}: importlib.import_module(n)\n"
+        "print(sorted(m for m in ('pybullet', 'mujoco') if m in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_every_engine_plant_runs_the_rigs_own_methods():
+    from plants.arm_rig.grasp_rig import GraspRig
+    from plants.arm_rig.rig import ArmRig
+    from plants.bullet_arm.grasp_plant import BulletGraspPlant
+    from plants.bullet_arm.plant import BulletArmPlant
+    from plants.mujoco_arm.grasp_plant import MujocoGraspPlant
+    from plants.mujoco_arm.plant import MujocoArmPlant
+
+    for cls in (BulletArmPlant, MujocoArmPlant):
+        assert issubclass(cls, ArmRig)
+        for name in RIG_METHODS + ("truth", "scene", "outcome", "step", "apply"):
+            assert getattr(cls, name) is getattr(ArmRig, name), (cls.__name__, name)
+    for cls in (BulletGraspPlant, MujocoGraspPlant):
+        assert issubclass(cls, GraspRig)
+        for name in RIG_METHODS:
+            assert getattr(cls, name) is getattr(ArmRig, name), (cls.__name__, name)
+        # the grasp rig's own truth, scene, command, verdict: one of each for both engines
+        assert cls.truth.__module__ == cls.scene.__module__ == "plants.arm_rig.grasp_topics"
+        assert cls.apply is GraspRig.apply
+        assert (
+            cls.outcome.__module__ == cls._judge_step.__module__ == "plants.arm_rig.grasp_verdict"
+        )
