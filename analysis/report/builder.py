@@ -617,85 +617,7 @@ def _html(sections, info, commands, notes=(), said=()) -> str:
         h += ["<tr>" + "".join(f"<td>{_e(x)}</td>" for x in row) + "</tr>" for row in headline]
         h += ["</table>", f"<p>{_e(HEADLINE_NOTE)}</p>"]
     for sec in sections:
-        h += [
-            f'<section id="{_e(sec.key)}">',
-            f"<h2>{_e(sec.title)}</h2>",
-            f"<p><em>{_e(sec.authors)}</em> (<code>{_e(sec.key)}</code>)</p>",
-        ]
-        if sec.runs:
-            h.append(
-                "<p>Runs: "
-                + ", ".join(
-                    f"<code>{_e(one_line(n))}</code> (seed {_e(s)}{_e(_differs(sec, n))})"
-                    for n, s, _ in sec.runs
-                )
-                + "</p>"
-            )
-        h += [f'<p class="note">{"<br>".join(map(_e, n.splitlines()))}</p>' for n in sec.notes]
-        if sec.figures:
-            h.append("<h3>Figures</h3>")
-            for f in sec.figures:
-                svg = f' <a href="{url(f.svg)}">SVG</a>' if f.svg else ""
-                h.append(
-                    f'<figure><img src="{url(f.png)}" alt="{_e(f.caption)}">'
-                    f"<figcaption>{_e(f.caption)}{svg}</figcaption></figure>"
-                )
-        if sec.claims:
-            h += [
-                "<h3>Claims</h3>",
-                "<table><tr><th>quantity</th><th>kind</th><th>paper states</th>"
-                "<th>this run</th><th>status</th><th>note</th></tr>",
-            ]
-            from analysis.claims import row_note, shown_status
-
-            for c in sec.claims:
-                status = shown_status(c, sec.shown)
-                h.append(
-                    f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.kind)}</td><td>{_e(c.stated)}</td>"
-                    f'<td>{_e(c.measured)}</td><td class="{_e(c.status)}"><b>'
-                    f"{_e(status)}</b></td><td>{_e(row_note(c, sec.falsifiers, sec.shown))}"
-                    "</td></tr>"
-                )
-            h += ["</table>", f"<p>{_e(sec.claims_summary)}</p>"]
-            if sec.falsifiers:
-                h += [
-                    "<h4>Falsifiers</h4>",
-                    "<p>Each reproduced measured row counts only with a variant under which the "
-                    "paper's claim is false in the simulation; <code>replay falsify --store"
-                    "</code> runs them, requires the row to read <i>differs</i> and records it. "
-                    f"This report lists them and reads the record: {_e(_ran(sec))}</p>",
-                    '<table class="falsifiers"><colgroup><col class="row"><col class="variant">'
-                    '<col class="why"></colgroup><tr><th>row</th><th>variant (the run it '
-                    "replaces: overrides)</th><th>why the claim is false under it</th></tr>",
-                ]
-                for f in sec.falsifiers:
-                    sets = ", ".join(f"{k}={v}" for k, v in f.overrides.items())
-                    run = f"{f.scenario} " if f.scenario else ""
-                    h.append(
-                        f"<tr><td>{_e(f.row)}</td><td><b>{_e(f.name)}</b><br>replaces "
-                        f"{_e(f.replaces)}: <code>{_e(run + sets)}</code></td>"
-                        f"<td>{_e(f.why)}</td></tr>"
-                    )
-                h.append("</table>")
-        if sec.ablations:
-            h.append("<h3>Ablations</h3>")
-            for a in sec.ablations:
-                h.append(f'<h4 id="ablation-{_e(a.name)}">{_e(a.name)}</h4>')
-                if a.png:
-                    svg = f' <a href="{url(a.svg)}">SVG</a>' if a.svg else ""
-                    h.append(
-                        f'<figure><img src="{url(a.png)}" alt="{_e(a.caption)}"><figcaption>'
-                        f"{_e(a.caption)} <strong>{_e(a.shows)}</strong>{svg}</figcaption>"
-                        "</figure>"
-                    )
-                else:
-                    h.append(f"<p>{_e(a.caption)} {_e(a.shows)}</p>")
-                table = f'<a href="{url(a.table)}">table</a> ({_e(a.source)}), ' if a.table else ""
-                h.append(
-                    f'<p>{table}<a href="{url(a.sweep)}">sweep file</a>; '
-                    f"<code>{_e(a.command)}</code></p>"
-                )
-        h.append("</section>")
+        h += _html_section(sec)
     h += ['<h2 id="versions">Versions</h2>', "<table><tr><th>package</th><th>version</th></tr>"]
     h += [f"<tr><td>{_e(k)}</td><td>{_e(v)}</td></tr>" for k, v in info.items()]
     h += [
@@ -705,3 +627,101 @@ def _html(sections, info, commands, notes=(), said=()) -> str:
         "</body></html>",
     ]
     return "\n".join(h) + "\n"
+
+
+def _html_section(sec) -> list[str]:
+    """A paper's section: its runs, notes, figures, claims and ablations."""
+    h: list[str] = []
+    h += [
+        f'<section id="{_e(sec.key)}">',
+        f"<h2>{_e(sec.title)}</h2>",
+        f"<p><em>{_e(sec.authors)}</em> (<code>{_e(sec.key)}</code>)</p>",
+    ]
+    if sec.runs:
+        h.append(
+            "<p>Runs: "
+            + ", ".join(
+                f"<code>{_e(one_line(n))}</code> (seed {_e(s)}{_e(_differs(sec, n))})"
+                for n, s, _ in sec.runs
+            )
+            + "</p>"
+        )
+    h += [f'<p class="note">{"<br>".join(map(_e, n.splitlines()))}</p>' for n in sec.notes]
+    if sec.figures:
+        h.append("<h3>Figures</h3>")
+        for f in sec.figures:
+            svg = f' <a href="{url(f.svg)}">SVG</a>' if f.svg else ""
+            h.append(
+                f'<figure><img src="{url(f.png)}" alt="{_e(f.caption)}">'
+                f"<figcaption>{_e(f.caption)}{svg}</figcaption></figure>"
+            )
+    h += _html_claims(sec) + _html_ablations(sec)
+    h.append("</section>")
+    return h
+
+
+def _html_claims(sec) -> list[str]:
+    """The claims table and, when the paper has them, its falsifiers."""
+    h: list[str] = []
+    if sec.claims:
+        h += [
+            "<h3>Claims</h3>",
+            "<table><tr><th>quantity</th><th>kind</th><th>paper states</th>"
+            "<th>this run</th><th>status</th><th>note</th></tr>",
+        ]
+        from analysis.claims import row_note, shown_status
+
+        for c in sec.claims:
+            status = shown_status(c, sec.shown)
+            h.append(
+                f"<tr><td>{_e(c.quantity)}</td><td>{_e(c.kind)}</td><td>{_e(c.stated)}</td>"
+                f'<td>{_e(c.measured)}</td><td class="{_e(c.status)}"><b>'
+                f"{_e(status)}</b></td><td>{_e(row_note(c, sec.falsifiers, sec.shown))}"
+                "</td></tr>"
+            )
+        h += ["</table>", f"<p>{_e(sec.claims_summary)}</p>"]
+        if sec.falsifiers:
+            h += [
+                "<h4>Falsifiers</h4>",
+                "<p>Each reproduced measured row counts only with a variant under which the "
+                "paper's claim is false in the simulation; <code>replay falsify --store"
+                "</code> runs them, requires the row to read <i>differs</i> and records it. "
+                f"This report lists them and reads the record: {_e(_ran(sec))}</p>",
+                '<table class="falsifiers"><colgroup><col class="row"><col class="variant">'
+                '<col class="why"></colgroup><tr><th>row</th><th>variant (the run it '
+                "replaces: overrides)</th><th>why the claim is false under it</th></tr>",
+            ]
+            for f in sec.falsifiers:
+                sets = ", ".join(f"{k}={v}" for k, v in f.overrides.items())
+                run = f"{f.scenario} " if f.scenario else ""
+                h.append(
+                    f"<tr><td>{_e(f.row)}</td><td><b>{_e(f.name)}</b><br>replaces "
+                    f"{_e(f.replaces)}: <code>{_e(run + sets)}</code></td>"
+                    f"<td>{_e(f.why)}</td></tr>"
+                )
+            h.append("</table>")
+    return h
+
+
+def _html_ablations(sec) -> list[str]:
+    """The paper's ablation plots with their tables and sweep files."""
+    h: list[str] = []
+    if sec.ablations:
+        h.append("<h3>Ablations</h3>")
+        for a in sec.ablations:
+            h.append(f'<h4 id="ablation-{_e(a.name)}">{_e(a.name)}</h4>')
+            if a.png:
+                svg = f' <a href="{url(a.svg)}">SVG</a>' if a.svg else ""
+                h.append(
+                    f'<figure><img src="{url(a.png)}" alt="{_e(a.caption)}"><figcaption>'
+                    f"{_e(a.caption)} <strong>{_e(a.shows)}</strong>{svg}</figcaption>"
+                    "</figure>"
+                )
+            else:
+                h.append(f"<p>{_e(a.caption)} {_e(a.shows)}</p>")
+            table = f'<a href="{url(a.table)}">table</a> ({_e(a.source)}), ' if a.table else ""
+            h.append(
+                f'<p>{table}<a href="{url(a.sweep)}">sweep file</a>; '
+                f"<code>{_e(a.command)}</code></p>"
+            )
+    return h
