@@ -111,6 +111,24 @@ class Timeline:
         dt = float(np.median(np.diff(self.frames))) if len(self.frames) > 1 else 1e-3
         self.dt = dt if dt > 0 else 1e-3
         step = 10.0 ** np.floor(np.log10(self.dt))  # a decade at or below a frame
+        self._add_controls(gui, events, step, speed)
+        self.events = list(events)
+        self.multi = len({label for label, _ in self.events}) > 1
+        self.counts = kind_counts(self.events)
+        self.milestone_buttons: list = []  # (t, button): always listed
+        self.event_buttons: list = []  # (t, button): the filter's choice
+        self._listed: list = []  # the filter's handles (buttons, the "more" note)
+        self.kind: Any = None  # the kind dropdown, the filter text box, the "N more" note
+        self.filter: Any = None
+        self.more: Any = None
+        if self.events:
+            self._add_events_panel(gui)
+        self._thread = threading.Thread(target=self._run, name="replay-viewer-player", daemon=True)
+        self._thread.start()
+
+    def _add_controls(self, gui, events, step: float, speed: str) -> None:
+        """The time slider (its marks at the milestones first), play, frame steps, speed, loop
+        and the status line."""
         marked = milestones(events)[:12]  # the slider marks the milestones first
         marked += [le for le in events if le[1].get("kind") not in MILESTONES][: 12 - len(marked)]
         marks = sorted({(round(e.get("t", 0.0), 6), "") for _, e in marked})
@@ -141,44 +159,38 @@ class Timeline:
         self.play.on_click(safe(lambda _: self.toggle()))
         self.back.on_click(safe(lambda _: self.step(-1)))
         self.fwd.on_click(safe(lambda _: self.step(+1)))
-        self.events = list(events)
-        self.multi = len({label for label, _ in self.events}) > 1
-        self.counts = kind_counts(self.events)
-        self.milestone_buttons: list = []  # (t, button): always listed
-        self.event_buttons: list = []  # (t, button): the filter's choice
-        self._listed: list = []  # the filter's handles (buttons, the "more" note)
-        self.kind: Any = None  # the kind dropdown, the filter text box, the "N more" note
-        self.filter: Any = None
-        self.more: Any = None
-        if self.events:
-            with gui.add_folder("Events", expand_by_default=True):
-                kinds = list(self.counts.items())[:MAX_KINDS]
-                more = len(self.counts) - len(kinds)
-                gui.add_markdown(
-                    f"{len(self.events)} events: "
-                    + " · ".join(f"{plain(k)} × {n}" for k, n in kinds)
-                    + (f" · {more} more kinds" if more > 0 else "")
-                )
-                stones = milestones(self.events)
-                if stones:
-                    gui.add_markdown("**milestones**")
-                for label, e in stones[:MAX_EVENT_BUTTONS]:
-                    self.milestone_buttons.append(self._button(label, e, icon=viser.Icon.FLAG))
-                self.kind = gui.add_dropdown(
-                    "kind",
-                    (ALL_KINDS, *(kind_option(k, n) for k, n in kinds)),
-                    initial_value=ALL_KINDS,
-                    hint="list the events of one kind",
-                )
-                self.filter = gui.add_text(
-                    "filter", "", hint="list the events whose label holds these words"
-                )
-                self._list_folder = gui.add_folder("listed", expand_by_default=True)
-                self.kind.on_update(safe(lambda _: self.relist()))
-                self.filter.on_update(safe(lambda _: self.relist()))
-                self.relist()
-        self._thread = threading.Thread(target=self._run, name="replay-viewer-player", daemon=True)
-        self._thread.start()
+
+    def _add_events_panel(self, gui) -> None:
+        """The events folder: counts by kind, the milestones' buttons, and the kind and text
+        filters over the listed events."""
+        import viser
+
+        with gui.add_folder("Events", expand_by_default=True):
+            kinds = list(self.counts.items())[:MAX_KINDS]
+            more = len(self.counts) - len(kinds)
+            gui.add_markdown(
+                f"{len(self.events)} events: "
+                + " · ".join(f"{plain(k)} × {n}" for k, n in kinds)
+                + (f" · {more} more kinds" if more > 0 else "")
+            )
+            stones = milestones(self.events)
+            if stones:
+                gui.add_markdown("**milestones**")
+            for label, e in stones[:MAX_EVENT_BUTTONS]:
+                self.milestone_buttons.append(self._button(label, e, icon=viser.Icon.FLAG))
+            self.kind = gui.add_dropdown(
+                "kind",
+                (ALL_KINDS, *(kind_option(k, n) for k, n in kinds)),
+                initial_value=ALL_KINDS,
+                hint="list the events of one kind",
+            )
+            self.filter = gui.add_text(
+                "filter", "", hint="list the events whose label holds these words"
+            )
+            self._list_folder = gui.add_folder("listed", expand_by_default=True)
+            self.kind.on_update(safe(lambda _: self.relist()))
+            self.filter.on_update(safe(lambda _: self.relist()))
+            self.relist()
 
     def _button(self, label: str, e: dict, icon=None):
         b = self.server.gui.add_button(
