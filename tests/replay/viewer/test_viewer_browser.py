@@ -132,7 +132,9 @@ def _moved_to(page, viewer: Viewer, ref: np.ndarray, fractions, least: float, de
     t0, t1 = viewer.timeline.t0, viewer.timeline.t1
     for k, f in enumerate(fractions):
         last = k == len(fractions) - 1
-        share = deadline if last else min(deadline, time.monotonic() + 30.0)
+        # (an earlier position where nothing in view moves yet, e.g. a catch before the ball is
+        # seen, is given up after 8 s: the next one is tried with the rest of the deadline)
+        share = deadline if last else min(deadline, time.monotonic() + 8.0)
         _set_time(page, viewer, t0 + f * (t1 - t0), deadline)
         try:
             return _poll(
