@@ -177,9 +177,9 @@ class Runner:
                     self.progress(self.k / self.rate, self.sc.timing.duration)
             return self.finish()
         except NonFiniteValueError as exc:
-            return self._failed(exc)
+            return self.fail(exc)
         except KeyboardInterrupt:
-            raise RunInterrupted(self._interrupted()) from None
+            raise RunInterrupted(self.interrupt()) from None
         except BaseException:
             self.plant.close()
             raise
@@ -312,8 +312,9 @@ class Runner:
         self._outcome(self._verdict(k / self.rate))
         return self._finish()
 
-    def _failed(self, exc: NonFiniteValueError) -> RunResult:
-        """A non-finite value on a topic: an ``error`` event and a failed outcome."""
+    def fail(self, exc: NonFiniteValueError) -> RunResult:
+        """End the run at a non-finite value on a topic (what :meth:`step` raised): an
+        ``error`` event and a failed outcome."""
         self.result.stopped_by = "error"
         self.result.error = str(exc)
         data = {"reason": "non-finite value", "topic": exc.topic, "fields": exc.fields}
@@ -322,7 +323,9 @@ class Runner:
         self._outcome({"success": False, "reason": reason})
         return self._finish()
 
-    def _interrupted(self) -> RunResult:
+    def interrupt(self) -> RunResult:
+        """End the run here as interrupted (Ctrl-C, or an environment's episode left before its
+        end): an ``interrupted`` event, a failed outcome, the log kept as interrupted."""
         self.result.stopped_by = "interrupted"
         self._write(TOPIC_EVENTS, Event(self.k / self.rate, "interrupted", {}), self.t_ns(self.k))
         self._outcome({"success": False, "reason": "interrupted"})

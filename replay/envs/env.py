@@ -157,7 +157,7 @@ class ScenarioEnv(gymnasium.Env):
             if self.shaped:
                 shaped = -self.dt * (gap(runner.plant.truth(runner.k / runner.rate)) or 0.0)
         except NonFiniteValueError as exc:
-            self.result = runner._failed(exc)
+            self.result = runner.fail(exc)
         if self.result is None and runner.done:
             self.result = runner.finish()
         obs = self._observe()
@@ -201,4 +201,4 @@ class ScenarioEnv(gymnasium.Env):
         """An episode left unfinished (reset or close before its end) is closed as an
         interrupted run: its log kept as ``STEM.interrupted.mcap``, never as a finished one."""
         if self.runner is not None and self.result is None:
-            self.result = self.runner._interrupted()
+            self.result = self.runner.interrupt()
