@@ -26,6 +26,8 @@ def test_grid_values_are_yaml_and_lists_stay_whole():
     a = parse_grid("plant.params.x=1, 2.5e-3 ,[1, 2],true,abc")
     assert a.name == "plant.params.x"
     assert a.values == [1, 2.5e-3, [1, 2], True, "abc"]
+    # YAML 1.1 reads 1:30 as 90 (base 60): kept as written, as --set keeps it
+    assert parse_grid("x=1:30,0:0:1").values == ["1:30", "0:0:1"]
 
 
 def test_random_draws_are_seeded_and_in_range():
@@ -54,6 +56,8 @@ def test_grid_times_random_is_the_product():
         (["a.b=[1,2"], [], None, "not valid YAML"),
         ([], ["a.b=1"], None, "lo:hi"),
         ([], ["a.b=x:2"], None, "expected a number"),
+        ([], ["a.b=0:1:2"], None, "lo:hi"),  # not [0, 62] by YAML 1.1's base 60
+        ([], ["a.b=0:1:2:3"], None, "lo:hi"),
         ([], ["a.b=2:1"], None, "lo < hi"),
         ([], ["a.b=0:1"], 0, "at least 1"),
         (["a.b=1,2"], [], 3, "--random"),
