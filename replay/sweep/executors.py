@@ -197,14 +197,6 @@ def _stop(procs: dict) -> None:
             p.join()
 
 
-def ray_available() -> bool:
-    try:
-        import ray  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
 last_ray_init = float("nan")  # s starting or joining Ray took (bench, tests)
 
 
