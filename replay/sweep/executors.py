@@ -198,14 +198,6 @@ def _stop(procs: dict) -> None:
             p.join()
 
 
-def ray_available() -> bool:
-    try:
-        import ray  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
 last_ray_init = float("nan")  # s starting or joining Ray took (bench, tests)
 PROBE_TIMEOUT = 5.0  # s to wait for a cluster's head to accept a connection
 

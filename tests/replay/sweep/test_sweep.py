@@ -3,6 +3,7 @@ reruns that skip, resumed sweeps, and failing variants as rows."""
 
 from __future__ import annotations
 
+import importlib.util
 import time
 
 import pytest
@@ -10,7 +11,6 @@ from click.testing import CliRunner
 
 from replay.cli import main
 from replay.sweep.engine import run_sweep
-from replay.sweep.executors import ray_available
 from replay.sweep.spec import SweepSpecError, from_options, parse_grid
 from replay.sweep.table import read_table
 from replay.sweep.variants import expand
@@ -92,7 +92,9 @@ def _friction(values, seed=0):
 
 
 def test_stick_friction_grid_local_then_ray_same_table(project_root, tmp_path):
-    assert ray_available(), "the test extra installs paper-replay[cluster] (Ray)"
+    assert importlib.util.find_spec("ray") is not None, (
+        "the test extra installs paper-replay[cluster] (Ray)"
+    )
     local, ray_dir = tmp_path / "local", tmp_path / "ray"
     # an interrupted sweep: two of the three variants done ...
     first = run_sweep(_friction(["0.0", "1.0"]), local, workers=2, progress=False)
