@@ -1,0 +1,61 @@
+"""The drake_arm plant's scenario parameters: the arm rig's (the same robot, hand, object, limits
+and catch criterion, so a scenario changes only ``plant.type``) and Drake's contact and solver
+settings. The PyBullet-only fields (``solver_iterations``, ``*_restitution``,
+``contact_stiffness``/``contact_damping``, rolling/spinning friction) are accepted and not used:
+Drake's point contact has no restitution coefficient; the bounce is set by its Hunt-Crossley
+dissipation (docs/drake.md)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from plants.arm_rig.params import GraspParams as RigGraspParams
+from plants.arm_rig.params import Params as ArmParams
+from replay.params import param
+
+
+@dataclass
+class Params(ArmParams):
+    dk_contact_approximation: str = param(
+        "lagged",
+        choices=("sap", "similar", "lagged"),
+        doc="Drake's discrete contact approximation, all solved by its SAP solver (convex: joint "
+        "limits and the hand's PD servos are constraints solved with the contacts, implicitly, "
+        "as PyBullet's; TAMSI would integrate them explicitly). lagged (Drake's default) and "
+        "similar use the Hunt-Crossley dissipation below; sap a linear model (dissipation unused)",
+    )
+    dk_point_stiffness: float = param(
+        1.0e5,
+        unit="N/m",
+        gt=0.0,
+        le=1e9,
+        doc="point contact stiffness of every object-robot contact (the pair's, after Drake's "
+        "series combination). Assumed: a 25 g ball at 9.5 m/s would sink 4.8 mm and rebound "
+        "within 1.6 ms; stiffer is no stiffer at 1 ms steps (SAP's near-rigid regime then "
+        "bounds it: 2.5e4 N/m for 25 g). x0.5 and x2 in docs/drake.md",
+    )
+    dk_dissipation: float = param(
+        10.0,
+        unit="s/m",
+        ge=0.0,
+        le=1e4,
+        doc="Hunt-Crossley dissipation of every object-robot contact (Drake's documentation: "
+        "values of 1-50 s/m are physical). Assumed: a ball dropped on the palm at 1.3 m/s "
+        "comes back slower than at ~0.3 m/s, as PyBullet's (docs/drake.md)",
+    )
+    dk_hand_servo_gain: float = param(
+        100.0,
+        unit="N*m*s/rad",
+        gt=0.0,
+        le=1e6,
+        doc="velocity gain (Kd) of each hand joint's PD servo (Kp = 0), implicit in SAP and "
+        "capped at hand_max_torque in the same solve as the contacts: PyBullet's velocity motor "
+        "(a capped constraint); the MuJoCo plant's gain",
+    )
+
+
+@dataclass
+class GraspParams(RigGraspParams, Params):
+    """The grasping rig's parameters (plants/arm_rig/params.py ``GraspParams``: servos, head,
+    human, verdict) with Drake's contact settings (``Params`` above), so a grasp scenario changes
+    only ``plant.type``."""
