@@ -19,10 +19,10 @@ class Params(ArmParams):
     dk_contact_approximation: str = param(
         "lagged",
         choices=("sap", "similar", "lagged"),
-        doc="Drake's discrete contact approximation, all solved by its SAP solver (convex: joint "
+        doc="Drake's discrete contact approximation, each solved by its SAP solver (convex: joint "
         "limits and the hand's PD servos are constraints solved with the contacts, implicitly, "
-        "as PyBullet's; TAMSI would integrate them explicitly). lagged (Drake's default) and "
-        "similar use the Hunt-Crossley dissipation below; sap a linear model (dissipation unused)",
+        "as PyBullet's). lagged (Drake's default) and similar use the Hunt-Crossley "
+        "dissipation below; sap its own linear model",
     )
     dk_point_stiffness: float = param(
         1.0e5,
