@@ -24,6 +24,23 @@ class Params(ArmParams):
         "as PyBullet's). lagged (Drake's default) and similar use the Hunt-Crossley "
         "dissipation below; sap its own linear model",
     )
+    dk_contact_model: str = param(
+        "point",
+        choices=("point", "hydroelastic"),
+        doc="point: one contact point per geometry pair (Drake's point contact, the stiffness "
+        "and dissipation below); hydroelastic: pressure-field contact patches between "
+        "compliant geometries (every robot geometry and the object, the modulus below; "
+        "~2.3x the grasp's CPU). Point chosen; hydroelastic holds the box where point contact "
+        "lets it walk along the hand at 0.3 m/s (docs/drake.md)",
+    )
+    dk_hydroelastic_modulus: float = param(
+        5.0e6,
+        unit="Pa",
+        gt=0.0,
+        le=1e12,
+        doc="hydroelastic modulus of every geometry (dk_contact_model: hydroelastic only). "
+        "Assumed: hard rubber (a few MPa), meshes refined to 1 cm",
+    )
     dk_point_stiffness: float = param(
         1.0e5,
         unit="N/m",

@@ -179,25 +179,48 @@ class DrakeArmPlant(ArmRig):
     def _read_contacts(self) -> None:
         """The step's object-robot contacts (the robot touches nothing else): body, point,
         normal from the robot towards the object, normal force (N)."""
-        W = self.world
-        out = []
-        if W.object_body is not None:
+        out: list = []
+        if self.world.object_body is not None:
             res: Any = self.mbp.get_contact_results_output_port().Eval(self.ctx)
-            ob, index = int(W.object_body.index()), W.body_of_drake
-            for i in range(res.num_point_pair_contacts()):
-                c = res.point_pair_contact_info(i)
-                a, b = int(c.bodyA_index()), int(c.bodyB_index())
-                n = c.point_pair().nhat_BA_W.tolist()  # from B into A
-                f = c.contact_force().tolist()  # on B
-                pt = c.contact_point().tolist()
-                if b == ob:  # the robot is A: robot -> object is -n; the force on B pushes
-                    n = [-n[0], -n[1], -n[2]]
-                    fn = f[0] * n[0] + f[1] * n[1] + f[2] * n[2]
-                    out.append((index[a], pt, n, fn))
-                elif a == ob:
-                    fn = -(f[0] * n[0] + f[1] * n[1] + f[2] * n[2])
-                    out.append((index[b], pt, n, fn))
+            self._point_rows(res, out)
+            if res.num_hydroelastic_contacts():
+                self._patch_rows(res, out)
         self._contacts = out
+
+    def _point_rows(self, res: Any, out: list) -> None:
+        """Point contacts: Drake's normal from B into A, its force on B."""
+        ob, index = int(self.world.object_body.index()), self.world.body_of_drake
+        for i in range(res.num_point_pair_contacts()):
+            c = res.point_pair_contact_info(i)
+            a, b = int(c.bodyA_index()), int(c.bodyB_index())
+            n = c.point_pair().nhat_BA_W.tolist()
+            f = c.contact_force().tolist()
+            pt = c.contact_point().tolist()
+            if b == ob:  # the robot is A: robot -> object is -n; the force on B pushes
+                n = [-n[0], -n[1], -n[2]]
+                out.append((index[a], pt, n, f[0] * n[0] + f[1] * n[1] + f[2] * n[2]))
+            elif a == ob:
+                out.append((index[b], pt, n, -(f[0] * n[0] + f[1] * n[1] + f[2] * n[2])))
+
+    def _patch_rows(self, res: Any, out: list) -> None:
+        """Hydroelastic patches: at the patch's centroid, the net force's direction on the
+        object as the normal and its size as the normal force (friction included)."""
+        p, W = self.mbp, self.world
+        inspector = W.scene_graph.model_inspector()
+        ob, index = int(W.object_body.index()), W.body_of_drake
+        for i in range(res.num_hydroelastic_contacts()):
+            c = res.hydroelastic_contact_info(i)
+            s = c.contact_surface()
+            m = int(p.GetBodyFromFrameId(inspector.GetFrameId(s.id_M())).index())
+            n_ = int(p.GetBodyFromFrameId(inspector.GetFrameId(s.id_N())).index())
+            f = c.F_Ac_W().translational()  # on M's body, at the centroid
+            robot = n_ if m == ob else m
+            if ob not in (m, n_) or robot not in index:
+                continue
+            f_obj = f if m == ob else -f
+            size = float(np.linalg.norm(f_obj))
+            n = (f_obj / size).tolist() if size > 0.0 else [0.0, 0.0, 0.0]
+            out.append((index[robot], s.centroid().tolist(), n, size))
 
     def _object_contacts(self, pos, v) -> list:
         return self._contacts  # read within the step (_read_contacts)

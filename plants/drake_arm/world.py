@@ -8,9 +8,9 @@ Drake facts used (drake 1.51, checked by tests/plants/drake_arm):
   ``base_position``/``base_rpy``;
 - the robot's geometries collide only with the object (one collision filter over all of them;
   PyBullet does not collide a body's links with each other, there is no floor);
-- point contact (``contact_model: point``): the object is a sphere or a box against the robot's
-  boxes, cylinders and spheres, a few points a step; hydroelastic contact needs compliant meshes
-  of every robot geometry and would change the model more than the contact law;
+- point contact (``contact_model: point``; ``dk_contact_model``): the object is a sphere or a
+  box against the robot's boxes, cylinders and spheres, one point per geometry pair; or
+  hydroelastic (``hydroelastic_with_fallback``: every geometry compliant, contact patches);
 - Drake combines two geometries' stiffness in series and their friction as 2 mu1 mu2 / (mu1 +
   mu2): both get 2 k and mu = hand_lateral_friction * object_lateral_friction (PyBullet's
   product), so the pair has k and mu; the dissipation of equal ones is theirs;
@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
     AddContactMaterial,
     Box,
     CollisionFilterDeclaration,
@@ -62,6 +63,7 @@ class World:
 
     diagram: Diagram
     plant: MultibodyPlant
+    scene_graph: Any  # SceneGraph (its model inspector: the hydroelastic patches' bodies)
     context: Context  # the plant's (within the diagram's)
     root: Context  # the diagram's
     robot: Any  # ModelInstanceIndex
@@ -84,18 +86,23 @@ def vec(values) -> Any:
     return np.asarray(values, dtype=float)
 
 
-def _material(k: float, d: float, mu: float) -> ProximityProperties:
+def _material(P: Params) -> ProximityProperties:
     """Proximity properties whose pair with another of the same gives (k, d, mu): Drake
-    combines stiffness in series, so each geometry gets 2 k."""
+    combines stiffness in series, so each geometry gets 2 k; with hydroelastic contact each is
+    also compliant (modulus E, tessellated to 1 cm)."""
+    k, d = float(P.dk_point_stiffness), float(P.dk_dissipation)
+    mu = float(P.hand_lateral_friction) * float(P.object_lateral_friction)  # PyBullet's product
     props = ProximityProperties()
     AddContactMaterial(d, 2.0 * k, CoulombFriction(mu, mu), props)
+    if P.dk_contact_model == "hydroelastic":
+        AddCompliantHydroelasticProperties(0.01, float(P.dk_hydroelastic_modulus), props)
     return props
 
 
 def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
     config = MultibodyPlantConfig(
         time_step=dt,
-        contact_model="point",
+        contact_model="point" if P.dk_contact_model == "point" else "hydroelastic_with_fallback",
         discrete_contact_approximation=P.dk_contact_approximation,
         use_sampled_output_ports=False,
     )
@@ -111,8 +118,7 @@ def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
             f"{name}_servo", plant.GetJointByName(name, robot), float(P.hand_max_torque)
         )
         a.set_controller_gains(PdControllerGains(p=0.0, d=float(P.dk_hand_servo_gain)))
-    mu = float(P.hand_lateral_friction) * float(P.object_lateral_friction)
-    props = _material(float(P.dk_point_stiffness), float(P.dk_dissipation), mu)
+    props = _material(P)
     body_ids = plant.GetBodyIndices(robot)
     robot_geoms = [
         g for b in body_ids for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))
@@ -156,6 +162,7 @@ def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
     return World(
         diagram=diagram,
         plant=plant,
+        scene_graph=scene_graph,
         context=ctx,
         root=root,
         robot=robot,

@@ -31,7 +31,7 @@ START = [0.0, math.pi / 4, 0.0, 0.0]  # Namiki & Ishikawa IV-A
 CATCHING = dict(initial_q=START, locked_joints=["J3"])
 G = np.array([0.0, 0.0, -9.81])
 DK_FIELDS = {"dk_contact_approximation", "dk_point_stiffness", "dk_dissipation"}
-DK_FIELDS |= {"dk_hand_servo_gain"}
+DK_FIELDS |= {"dk_hand_servo_gain", "dk_contact_model", "dk_hydroelastic_modulus"}
 
 
 def make(**kw) -> DrakeArmPlant:
@@ -124,16 +124,21 @@ def test_ballistic_ball_flies_mujocos_path():
     np.testing.assert_allclose(p[:, 3:], v0 + G * t, atol=1e-9)
 
 
-def test_fast_ball_is_stopped_by_the_palm():
-    """A 9 m/s ball thrown at the palm's face: a contact event on the palm, the ball turned back
-    (its speed along the face normal reversed or stopped), never through the palm."""
+@pytest.mark.parametrize("model", ["point", "hydroelastic"])
+def test_fast_ball_is_stopped_by_the_palm(model):
+    """A 9 m/s ball thrown at the palm's face: a contact event on the palm (a point contact's or
+    a hydroelastic patch's row), the ball turned back (its speed along the face normal reversed
+    or stopped), never through the palm."""
     plant = make(**CATCHING)
     spec = plant.spec()
     T = spec.model.fk(np.asarray(START))
     n = T[:3, 2]
     face = T[:3, 3] + n * spec.hand.table.palm_thickness
     r0 = face + n * 0.1
-    plant = make(object_position=r0.tolist(), object_velocity=(-9.0 * n).tolist(), **CATCHING)
+    plant = make(
+        object_position=r0.tolist(), object_velocity=(-9.0 * n).tolist(),
+        dk_contact_model=model, **CATCHING,
+    )  # fmt: skip
     contact = None
     for _ in range(60):
         plant.apply(ArmCommand(hold_torque(plant, START)))
@@ -143,6 +148,7 @@ def test_fast_ball_is_stopped_by_the_palm():
                 contact = e.data
     pos, _, v, _ = plant.object_state()
     assert contact is not None and "palm" in contact["parts"]
+    assert contact["normal_speed"] > 5.0  # the normal points from the palm towards the ball
     assert float(v @ n) >= -0.5  # stopped or bounced back
     assert float((pos - face) @ n) > 0.0  # the ball's centre never passed the face
 
