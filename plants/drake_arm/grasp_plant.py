@@ -12,8 +12,9 @@ rig's contract (plants/bullet_arm/grasp_plant.py ``BulletGraspPlant``) on ``Drak
 - the same truth topics, events and ``outcome`` (``GraspRigTopics``, ``GraspVerdict``).
 
 Besides the arm plant's (plant.py), the rig state this reads: ``arm_servos``, ``head_servo``,
-``human``, ``_t``; it sets ``_wrench``, ``_obj_vel_before`` and ``_head_pose`` (None a step),
-and steps the rig's ``_steps``/``_t`` as the MuJoCo grasp plant does.
+``human``, ``_t``, ``_steps``, ``diverged``; it calls the rig's ``_servo_torques``,
+``_read_servos``, ``_diverge`` and ``_judge_step``; it sets ``_wrench``, ``_obj_vel_before``,
+``_head_pose`` (None a step) and advances ``_steps``/``_t``, as the MuJoCo grasp plant does.
 """
 
 from __future__ import annotations

@@ -12,10 +12,9 @@ results, the hand servos' torques and the joints' reaction forces read between t
 step's own (computed once, with the update), the kinematics read after it the new state's.
 
 The rig's state this plant reads (for the lead's adapter conversion): ``settings``, ``model``,
-``params``, ``dt``, ``dof``, ``active``, ``locked``, ``joint_names``, ``hand_names``,
-``_steps`` (the step count: per-step caches), ``diverged``; it sets ``_cache`` (the rig's state
-cache, ``None`` after a step), ``_palm_id`` and ``_contacts`` (the step's contact rows, which it
-also returns from ``_object_contacts``).
+``dt``, ``dof``, ``active``, ``locked``, ``joint_names``, ``diverged``; it sets ``_cache`` (the
+rig's state cache, ``None`` after a step), ``_palm_id`` and ``_contacts`` (the step's contact
+rows, which it also returns from ``_object_contacts``).
 """
 
 from __future__ import annotations
