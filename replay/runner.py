@@ -69,6 +69,7 @@ def _versions() -> tuple[tuple[str, str], ...]:
         "pymunk",
         "pybullet",
         "mujoco",
+        "drake",
         "opencv-python-headless",
         "mcap",
         "foxglove-sdk",  # (the log's writer)

@@ -112,6 +112,9 @@ def test_provenance_in_metadata_and_scenario_topic(toy_yaml, tmp_path):
     meta = log.metadata()
     assert meta["provenance"]["seed"] == "3" and "numpy" in meta["provenance"]
     assert "foxglove-sdk" in meta["provenance"]  # (the log's writer)
+    from importlib import metadata
+
+    assert meta["provenance"]["drake"] == metadata.version("drake")  # the third arm engine
     sc = log.scenario()
     assert sc["name"] == "toy" and "kp: 100.0" in sc["yaml"] and sc["seed"] == 3
 

@@ -1,0 +1,78 @@
+"""The drake_arm plant's scenario parameters: the arm rig's (the same robot, hand, object, limits
+and catch criterion, so a scenario changes only ``plant.type``) and Drake's contact and solver
+settings. The PyBullet-only fields (``solver_iterations``, ``*_restitution``,
+``contact_stiffness``/``contact_damping``, rolling/spinning friction) are accepted and not used:
+Drake's point contact has no restitution coefficient; the bounce is set by its Hunt-Crossley
+dissipation (docs/drake.md)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from plants.arm_rig.params import GraspParams as RigGraspParams
+from plants.arm_rig.params import Params as ArmParams
+from replay.params import param
+
+
+@dataclass
+class Params(ArmParams):
+    dk_contact_approximation: str = param(
+        "lagged",
+        choices=("sap", "similar", "lagged"),
+        doc="Drake's discrete contact approximation, each solved by its SAP solver (convex: joint "
+        "limits and the hand's PD servos are constraints solved with the contacts, implicitly, "
+        "as PyBullet's). lagged (Drake's default) and similar use the Hunt-Crossley "
+        "dissipation below; sap its own linear model",
+    )
+    dk_contact_model: str = param(
+        "point",
+        choices=("point", "hydroelastic"),
+        doc="point: one contact point per geometry pair (Drake's point contact, the stiffness "
+        "and dissipation below); hydroelastic: pressure-field contact patches between "
+        "compliant geometries (every robot geometry and the object, the modulus below; "
+        "~2.3x the grasp's CPU). Point chosen; hydroelastic holds the box where point contact "
+        "lets it walk along the hand at 0.3 m/s (docs/drake.md)",
+    )
+    dk_hydroelastic_modulus: float = param(
+        5.0e6,
+        unit="Pa",
+        gt=0.0,
+        le=1e12,
+        doc="hydroelastic modulus of every geometry (dk_contact_model: hydroelastic only). "
+        "Assumed: hard rubber (a few MPa), meshes refined to 1 cm",
+    )
+    dk_point_stiffness: float = param(
+        1.0e5,
+        unit="N/m",
+        gt=0.0,
+        le=1e9,
+        doc="point contact stiffness of every object-robot contact (the pair's, after Drake's "
+        "series combination). Assumed: a 25 g ball at 9.5 m/s would sink 4.8 mm, its contact "
+        "lasting 1.6 ms (two steps); x0.5 and x2 catch and grasp alike (docs/drake.md)",
+    )
+    dk_dissipation: float = param(
+        10.0,
+        unit="s/m",
+        ge=0.0,
+        le=1e4,
+        doc="Hunt-Crossley dissipation of every object-robot contact (Drake's documentation: "
+        "1-50 s/m are physical). Assumed 10: a ball driven at the held arm's palm at 1.3 m/s "
+        "comes back at 0.08 of its speed, as in the MuJoCo plant (0.08); at 6 m/s at 0.02 "
+        "(MuJoCo 0.11): Hunt-Crossley's bounce falls with the speed (0 s/m: 0.22 at both)",
+    )
+    dk_hand_servo_gain: float = param(
+        100.0,
+        unit="N*m*s/rad",
+        gt=0.0,
+        le=1e6,
+        doc="velocity gain (Kd) of each hand joint's PD servo (Kp = 0), implicit in SAP and "
+        "capped at hand_max_torque in the same solve as the contacts: PyBullet's velocity motor "
+        "(a capped constraint); the MuJoCo plant's gain",
+    )
+
+
+@dataclass
+class GraspParams(RigGraspParams, Params):
+    """The grasping rig's parameters (plants/arm_rig/params.py ``GraspParams``: servos, head,
+    human, verdict) with Drake's contact settings (``Params`` above), so a grasp scenario changes
+    only ``plant.type``."""

@@ -1,0 +1,251 @@
+"""A torque-controlled arm with a position-controlled hand and one free object, in Drake.
+
+The engine-free arm rig (plants/arm_rig/rig.py ``ArmRig``) in pydrake's MultibodyPlant, as the
+PyBullet and MuJoCo plants are in theirs: the same ``Params`` (plus Drake's contact settings),
+commands, limits, truth topics, events and ``outcome`` are the rig's, so a scenario differs from
+its PyBullet twin only in ``plant.type``. This plant builds the world (world.py) and answers the
+rig's engine questions. Physics only: it knows nothing of any paper's method.
+
+Stepping: the plant's context is advanced directly, one discrete update a step
+(``EvalUniquePeriodicDiscreteUpdate``, then the new state set), no Simulator: the contact
+results, the hand servos' torques and the joints' reaction forces read between the two are the
+step's own (computed once, with the update), the kinematics read after it the new state's.
+
+The rig's state this plant reads (for the lead's adapter conversion): ``settings``, ``model``,
+``dt``, ``dof``, ``active``, ``locked``, ``joint_names``, ``diverged``; it sets ``_cache`` (the
+rig's state cache, ``None`` after a step), ``_palm_id`` and ``_contacts`` (the step's contact
+rows, which it also returns from ``_object_contacts``).
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+from typing import Any
+
+
+import numpy as np
+from pydrake.multibody.math import SpatialVelocity
+
+from plants.arm_rig.rig import ArmRig
+from plants.drake_arm.params import Params as DrakeParams
+from plants.drake_arm.world import build_world, set_object, vec
+from replay.scene import Frame
+
+VERSION = importlib.metadata.version("drake")
+
+
+def _pose(X) -> tuple:
+    """(position, orientation [x, y, z, w]) of a RigidTransform, as floats."""
+    q = X.rotation().ToQuaternion()
+    x, y, z = X.translation().tolist()
+    return (x, y, z), (float(q.x()), float(q.y()), float(q.z()), float(q.w()))
+
+
+class DrakeArmPlant(ArmRig):
+    Params = DrakeParams
+    description = "Drake WAM arm (torque control) + hand (velocity servos) + a free object"
+
+    def __init__(self, params: DrakeParams, *, dt: float, rng: np.random.Generator) -> None:
+        super().__init__(params, dt=dt, rng=rng)  # the engine-free rig
+        P, S = params, self.settings
+        W = self.world = build_world(P, S, self.model, dt)
+        p, ctx = self.mbp, self.ctx = W.plant, W.context
+        # ---- the initial state
+        q = p.GetPositions(ctx)
+        v = p.GetVelocities(ctx)
+        for k, i in enumerate(self.active):
+            q[W.arm_q[k]], v[W.arm_v[k]] = S.initial_q[i], S.initial_qd[i]
+        for a, x in zip(W.hand_q, S.hand_initial):
+            q[a] = x
+        p.SetPositions(ctx, q)
+        p.SetVelocities(ctx, v)
+        if W.object_body is not None:
+            set_object(W, P.object_position, P.object_rpy, P.object_velocity,
+                       P.object_angular_velocity)  # fmt: skip
+        self._q_locked = [float(self.locked.get(n, 0.0)) for n in self.joint_names]
+        self._arm_slots = [(i, W.arm_q[k], W.arm_v[k]) for k, i in enumerate(self.active)]
+        names = W.body_names
+        self._tool = W.bodies[names.index("wam_tool")]
+        self._palm_id = names.index("palm") if "palm" in names else None
+        self._nv = p.num_velocities()
+        self._tau = [0.0] * self._nv  # the generalized forces of the coming step
+        self._tau_port = p.get_applied_generalized_force_input_port()
+        self._tau_port.FixValue(ctx, np.zeros(self._nv))
+        self._desired_port = p.get_desired_state_input_port(W.robot)
+        nh = len(W.hand_v)
+        self._desired_port.FixValue(ctx, np.zeros(2 * nh))
+        p.get_actuation_input_port().FixValue(ctx, np.zeros(p.num_actuators()))
+        self._hand_tau = [0.0] * nh  # the hand servos' torques of the last step
+        self._motions: dict = {}  # body index -> (pos, orn, v, w) this step
+        # frames(): per robot body, its parent's and its own Drake body and names
+        self._frame_rows = []
+        for j in p.GetJointIndices(W.robot):
+            joint = p.get_joint(j)
+            self._frame_rows.append(
+                (joint.parent_body(), joint.child_body(), joint.parent_body().name(),
+                 joint.child_body().name())
+            )  # fmt: skip
+        self._contacts = []
+
+    # ------------------------------------------------------------------ state
+    def _state(self) -> tuple:
+        """((q, qd), hand (q, qd, effort), object (pos, orn xyzw, v, w world) or None) as
+        plain floats, read once after each step; shared, never mutated."""
+        if self._cache is None:
+            W, p, ctx = self.world, self.mbp, self.ctx
+            qp, qv = p.GetPositions(ctx).tolist(), p.GetVelocities(ctx).tolist()
+            q, qd = self._q_locked[:], [0.0] * self.dof
+            for i, a, b in self._arm_slots:
+                q[i], qd[i] = qp[a], qv[b]
+            hand = ([qp[a] for a in W.hand_q], [qv[b] for b in W.hand_v], self._hand_tau[:])
+            obj = None
+            if W.object_body is not None:
+                a, b = W.object_q, W.object_v
+                qw, qx, qy, qz, x, y, z = qp[a : a + 7]
+                wx, wy, wz, vx, vy, vz = qv[b : b + 6]  # Drake's free body: w, v in the world
+                obj = ((x, y, z), (qx, qy, qz, qw), (vx, vy, vz), (wx, wy, wz))
+            self._cache = ((q, qd), hand, obj)
+        return self._cache
+
+    def invalidate_state(self) -> None:
+        """Forget the state read (after setting the context other than by stepping)."""
+        self._cache = None
+        self._motions.clear()
+
+    def _body_motion(self, k: int) -> tuple:
+        """(position, orientation xyzw, v, w) of robot body ``k``'s frame (world), once a step."""
+        got = self._motions.get(k)
+        if got is None:
+            body = self.world.bodies[k] if k >= 0 else self._tool
+            X = self.mbp.EvalBodyPoseInWorld(self.ctx, body)
+            V = self.mbp.EvalBodySpatialVelocityInWorld(self.ctx, body)
+            pos, orn = _pose(X)
+            got = (pos, orn, tuple(V.translational().tolist()), tuple(V.rotational().tolist()))
+            self._motions[k] = got
+        return got
+
+    def _effector_now(self) -> tuple:
+        return self._body_motion(-1)
+
+    def _point_velocity(self, link: int, point) -> tuple[float, float, float]:
+        """v + w x (point - body origin) of a robot body now (world)."""
+        (cx, cy, cz), _, (vx, vy, vz), (wx, wy, wz) = self._body_motion(link)
+        rx, ry, rz = (float(point[0]) - cx, float(point[1]) - cy, float(point[2]) - cz)
+        return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx)
+
+    def _set_object_velocity(self, v: list, w) -> None:
+        V = SpatialVelocity(vec(w), vec(v))
+        self.mbp.SetFreeBodySpatialVelocity(self.ctx, self.world.object_body, V)
+
+    def _engine_notes(self) -> dict:
+        return {"engine": f"drake {VERSION}"}
+
+    # ------------------------------------------------------------------ command
+    def _apply_torques(self, tau: list) -> None:
+        for (_, _, b), x in zip(self._arm_slots, tau):
+            self._tau[b] = x
+
+    def _drive_hand(self, v: list, qd: list) -> None:
+        # desired positions: unused (Kp = 0); desired velocities: the servos' speeds
+        self._desired_port.FixValue(self.ctx, np.array(self._state()[1][0] + list(v)))
+
+    def _hold_object(self, obj: tuple) -> None:
+        pass  # object_gravity off: the object's model instance has no gravity (world.py)
+
+    def _advance(self) -> bool:
+        p, ctx = self.mbp, self.ctx
+        self._tau_port.FixValue(ctx, np.array(self._tau))
+        try:
+            x = p.EvalUniquePeriodicDiscreteUpdate(ctx)
+            self._read_step()
+            ctx.SetDiscreteState(x)
+        except RuntimeError:  # SAP found no solution (a non-finite state): diverged
+            return True
+        root = self.world.root
+        root.SetTime(root.get_time() + self.dt)
+        self._motions.clear()
+        return self.diverged
+
+    def _read_step(self) -> None:
+        """The step's own contact rows and hand servo torques (before its state is set)."""
+        p, ctx = self.mbp, self.ctx
+        if self.world.hand_v:
+            tau: Any = p.get_net_actuation_output_port().Eval(ctx)
+            self._hand_tau = tau.tolist()
+        self._read_contacts()
+
+    # ------------------------------------------------------------------ events
+    def _read_contacts(self) -> None:
+        """The step's object-robot contacts (the robot touches nothing else): body, point,
+        normal from the robot towards the object, normal force (N)."""
+        out: list = []
+        if self.world.object_body is not None:
+            res: Any = self.mbp.get_contact_results_output_port().Eval(self.ctx)
+            self._point_rows(res, out)
+            if res.num_hydroelastic_contacts():
+                self._patch_rows(res, out)
+        self._contacts = out
+
+    def _point_rows(self, res: Any, out: list) -> None:
+        """Point contacts: Drake's normal from B into A, its force on B."""
+        ob, index = int(self.world.object_body.index()), self.world.body_of_drake
+        for i in range(res.num_point_pair_contacts()):
+            c = res.point_pair_contact_info(i)
+            a, b = int(c.bodyA_index()), int(c.bodyB_index())
+            n = c.point_pair().nhat_BA_W.tolist()
+            f = c.contact_force().tolist()
+            pt = c.contact_point().tolist()
+            if b == ob:  # the robot is A: robot -> object is -n; the force on B pushes
+                n = [-n[0], -n[1], -n[2]]
+                out.append((index[a], pt, n, f[0] * n[0] + f[1] * n[1] + f[2] * n[2]))
+            elif a == ob:
+                out.append((index[b], pt, n, -(f[0] * n[0] + f[1] * n[1] + f[2] * n[2])))
+
+    def _patch_rows(self, res: Any, out: list) -> None:
+        """Hydroelastic patches: at the patch's centroid, the net force's direction on the
+        object as the normal and its size as the normal force (friction included)."""
+        p, W = self.mbp, self.world
+        inspector = W.scene_graph.model_inspector()
+        ob, index = int(W.object_body.index()), W.body_of_drake
+        for i in range(res.num_hydroelastic_contacts()):
+            c = res.hydroelastic_contact_info(i)
+            s = c.contact_surface()
+            m = int(p.GetBodyFromFrameId(inspector.GetFrameId(s.id_M())).index())
+            n_ = int(p.GetBodyFromFrameId(inspector.GetFrameId(s.id_N())).index())
+            f = c.F_Ac_W().translational()  # on M's body, at the centroid
+            robot = n_ if m == ob else m
+            if ob not in (m, n_) or robot not in index:
+                continue
+            f_obj = f if m == ob else -f
+            size = float(np.linalg.norm(f_obj))
+            n = (f_obj / size).tolist() if size > 0.0 else [0.0, 0.0, 0.0]
+            out.append((index[robot], s.centroid().tolist(), n, size))
+
+    def _object_contacts(self, pos, v) -> list:
+        return self._contacts  # read within the step (_read_contacts)
+
+    def _touch(self, contacts: list) -> tuple:
+        c = max(contacts, key=lambda c: c[3])
+        return c[0], c[1], c[2]
+
+    def _contact_summary_now(self) -> tuple[list, list, float]:
+        """(parts, links, total normal force) of the step's contacts."""
+        if not self._contacts:
+            return [], [], 0.0
+        W = self.world
+        bodies = {c[0] for c in self._contacts}
+        links = sorted(W.body_names[b] for b in bodies)
+        parts = sorted({W.part_of_body[b] for b in bodies})
+        return parts, links, float(sum(c[3] for c in self._contacts))
+
+    # ------------------------------------------------------------------ log and scene
+    def frames(self) -> list[Frame]:
+        """Every URDF link in its parent link, the base in ``world`` (the robot's bodies; the
+        free object is the scene's), in plain floats."""
+        p, ctx = self.mbp, self.ctx
+        out = []
+        for parent, child, pn, cn in self._frame_rows:
+            X = p.CalcRelativeTransform(ctx, parent.body_frame(), child.body_frame())
+            pos, orn = _pose(X)
+            out.append(Frame(pn, cn, pos, orn))
+        return out
