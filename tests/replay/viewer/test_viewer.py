@@ -11,6 +11,7 @@ import math
 import socket
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -410,6 +411,36 @@ def test_arm_scene_from_the_plants_urdf_with_logged_angles(viewer_factory, arm_l
     assert len([h for h in scene.handles if "cameras" in h.name]) == 4  # 2 frusta + labels
     # the same file the arm plant loads (plants.models' cache, by content)
     assert plant_models_urdf(run.plant_params) == plant_models_urdf(run.plant_params)
+
+
+GOLDENS = sorted((Path(__file__).resolve().parents[3] / "data" / "golden").glob("*.mcap"))
+
+
+def _poses(scene) -> dict:
+    """Every handle's position and orientation, rounded (what a seek moves)."""
+    out = {}
+    for h in scene.handles:
+        for a in ("position", "wxyz"):
+            value = getattr(h, a, None)
+            if value is not None:
+                out[(h.name, a)] = tuple(np.round(np.asarray(value, float), 6))
+    return out
+
+
+@pytest.mark.parametrize("path", GOLDENS, ids=[p.stem for p in GOLDENS])
+def test_every_golden_is_drawn_and_moves(viewer_factory, path):
+    """Each golden by its plant type's own scene, its object moved by the slider (the browser
+    test draws one golden of each scene that draws differently)."""
+    v = viewer_factory([path])
+    plant = LogReader(path).scenario_config()["plant"]["type"]
+    assert type(v.scenes[0]) is registry.load("viewer_scene", plant)
+    t0, t1 = v.timeline.t0, v.timeline.t1
+    v.seek(t0 + 0.2 * (t1 - t0))
+    a = _poses(v.scenes[0])
+    v.seek(t0 + 0.9 * (t1 - t0))
+    b = _poses(v.scenes[0])
+    moved = {name for (name, _), pose in a.items() if b.get((name, _)) != pose}
+    assert any(n.endswith(("/object", "/stick")) for n in moved), sorted(moved)
 
 
 TEST_URDF = """<?xml version="1.0"?>

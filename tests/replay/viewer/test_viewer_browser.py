@@ -1,6 +1,7 @@
 """The replay viewer in a real browser: Debian's headless Chromium driven by Playwright.
 
-For each log (synthetic air-table and arm logs written here; every ``data/golden/*.mcap``; and
+For each log (synthetic air-table and arm logs written here; a ``data/golden/*.mcap`` of each scene
+that draws differently; and
 any listed in ``PAPER_REPLAY_VIEWER_LOGS``, ``:``-separated): serve it on 127.0.0.1, open the
 page, wait for the 3-D scene to be drawn (screenshots polled against a deadline), move the time
 slider through its number box to two positions, and check that the canvas is drawn and that the
@@ -25,6 +26,8 @@ import pytest
 import playwright.sync_api as playwright_api  # noqa: E402
 from PIL import Image  # noqa: E402
 
+from replay import registry  # noqa: E402
+from replay.log import LogReader  # noqa: E402
 from replay.viewer import Viewer  # noqa: E402
 from synthetic_logs import write_arm_log, write_stick_log  # noqa: E402
 from chromium import FLAGS, _ensure_chromium  # noqa: E402
@@ -70,10 +73,22 @@ def _cases() -> list[tuple[str, object]]:
             ],
         ),
     ]
-    extra = sorted((ROOT / "data" / "golden").glob("*.mcap"))
+    extra = _one_golden_per_drawing()
     extra += [Path(p) for p in os.environ.get("PAPER_REPLAY_VIEWER_LOGS", "").split(":") if p]
     cases += [(p.stem, lambda d, p=p: [p]) for p in extra]
     return cases
+
+
+def _one_golden_per_drawing() -> list[Path]:
+    """The shortest-named golden of each scene that draws differently: an engine's scene that
+    only reads its own Params draws as its rig's (every golden is drawn and moved server-side in
+    test_viewer.py's ``test_every_golden_is_drawn_and_moves``)."""
+    kept: dict[type, Path] = {}
+    for path in sorted((ROOT / "data" / "golden").glob("*.mcap"), key=lambda p: (len(p.stem), p)):
+        plant = LogReader(path).scenario_config()["plant"]["type"]
+        cls = registry.load("viewer_scene", plant)
+        kept.setdefault(next(c for c in cls.__mro__ if "build" in vars(c)), path)
+    return sorted(kept.values())
 
 
 def _image(png: bytes) -> np.ndarray:
