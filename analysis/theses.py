@@ -39,28 +39,28 @@ THESES: tuple[Thesis, ...] = (
         "Vision at ~1 kHz steering a direct mapping to joint commands catches a ball thrown at "
         "8-10 m/s, without predicting its path.",
         ("catch_rate",),
-        "analysis.ablation_catch:thesis",
+        "analysis.catching.ablations:thesis",
     ),
     Thesis(
         "namiki2003",
         "Optimising the mapping's polynomial offline under torque and velocity limits reduces "
         "the joints' torque and travel (Figs. 6, 8, 9).",
         ("catch_optimisation",),
-        "analysis.ablation_catch_opt:thesis",
+        "analysis.catching.ablation_opt:thesis",
     ),
     Thesis(
         "namiki1999",
         "Closing every loop (vision, head, arm, hand) at 1 ms lets the hand grasp an object a "
         "human moves irregularly, without predicting its motion.",
         ("grasp_loops", "grasp_components"),
-        "analysis.ablation_grasp:thesis",
+        "analysis.grasping.ablations:thesis",
     ),
     Thesis(
         "higashimori2007",
         "The 2-step and 3-step strategies stop a sliding, spinning stick whatever the "
         "fingertip-stick friction.",
         ("stick_conditions", "stick_factors", "stick_workspace", "stick_vision"),
-        "analysis.ablation_stick:thesis",
+        "analysis.stick.ablations:thesis",
     ),
 )
 

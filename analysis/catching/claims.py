@@ -3,7 +3,7 @@
 Logs are recognised by their scenario, not only their name: a run whose controller uses
 ``mapping: optimised`` is an optimised run, ``initial`` an unoptimised one. Figs. 8/9 (the
 optimised against the initial mapping, windows ending at the first contact) are the rows of
-``analysis.catch_thesis_claims``, one set per speed regime.
+``analysis.catching.thesis_claims``, one set per speed regime.
 
 Which rows count (analysis/claims.py): only those measured on the paper's own experiment,
 :data:`PAPER_RUNS` (Sec. IV: throws at 8-10 m/s, the direct mapping, the stated arm and hand);
@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import yaml
 
-from analysis import catch_thesis_claims as thesis
+from analysis.catching import thesis_claims as thesis
 from analysis.claims import Claim, Falsifier, agrees, merge
 from analysis.needs import has
 from analysis.series import events

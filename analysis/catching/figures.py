@@ -21,7 +21,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from analysis.catch_claims import (
+from analysis.catching.claims import (
     ACTIVE,
     JOINTS,
     CatchRun,

@@ -1,5 +1,5 @@
 """The grasping claims table: what Namiki, Nakabo, Ishii & Ishikawa 1999 state against the runs'
-logs (``analysis.grasp_run`` reads them). Every number here comes from a log, except the arm's
+logs (``analysis.grasping.run`` reads them). Every number here comes from a log, except the arm's
 top speed, which comes from the arm model the run's scenario names (``replay.robot``).
 
 Quantities (all from the log):
@@ -28,7 +28,7 @@ import yaml
 
 from analysis.claims import Claim, Falsifier, agrees, merge
 from analysis.needs import has
-from analysis.grasp_run import (
+from analysis.grasping.run import (
     T_ARM_TASK,
     T_OBJECT,
     GRASP_PHASES,
@@ -297,7 +297,7 @@ def cycle_timing(run: GraspRun) -> dict | None:
 def _arm_top_speed(run: GraspRun) -> float | None:
     """The run's arm model's top tool speed with its joint speed limits (over a sample of its
     joint box), as the catching claims compute it, from the rig's own settings."""
-    from analysis.catch_claims import arm_capability
+    from analysis.catching.claims import arm_capability
     from plants.arm_rig.settings import resolve
 
     try:

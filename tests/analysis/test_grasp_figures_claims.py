@@ -37,7 +37,7 @@ def logs(tmp_path_factory):
 @pytest.fixture(scope="module")
 def rows(logs):
     """The table's rows (one per claim, over every run) and each run's own, "<run>: <claim>"."""
-    from analysis.grasp_claims import evaluate, per_run
+    from analysis.grasping.claims import evaluate, per_run
 
     table = {r.quantity: r for r in evaluate(logs)}
     for own in per_run(logs).values():
@@ -50,8 +50,8 @@ def _row(rows, name, what):
 
 
 def test_fig9_and_filmstrip_from_each_run(logs, tmp_path):
-    from analysis.grasp_figures import filmstrip_times, make_figures
-    from analysis.grasp_run import load_run
+    from analysis.grasping.figures import filmstrip_times, make_figures
+    from analysis.grasping.run import load_run
 
     paths = make_figures(logs, tmp_path)
     names = {p.name for p in paths}
@@ -70,7 +70,7 @@ def test_fig9_and_filmstrip_from_each_run(logs, tmp_path):
 
 
 def test_fig9_shades_grasp_and_release_phases_of_the_cycle(logs):
-    from analysis.grasp_run import load_run
+    from analysis.grasping.run import load_run
 
     run = load_run(logs["grasp_cycle"])
     names = [p.name for p in run.phases]
@@ -89,8 +89,8 @@ def test_loops_run_every_1ms_with_latency_under_1_5ms(rows):
 
 
 def test_timing_read_as_ms_is_inconsistent_with_the_arm(rows, logs):
-    from analysis.grasp_claims import cycle_timing
-    from analysis.grasp_run import load_run
+    from analysis.grasping.claims import cycle_timing
+    from analysis.grasping.run import load_run
 
     ct = cycle_timing(load_run(logs["grasp_hexahedron"]))
     assert ct["track"] == pytest.approx(0.5, abs=1e-3)
@@ -115,8 +115,8 @@ def test_preshape_matches_the_shape(rows, name, shape):
 def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
     """The hold row is reproduced exactly when the plant saw a grasp with no slip or drop and
     the object stayed with the hand: the row is the log's, whichever way it goes."""
-    from analysis.grasp_claims import HOLD_DRIFT, holds
-    from analysis.grasp_run import load_run
+    from analysis.grasping.claims import HOLD_DRIFT, holds
+    from analysis.grasping.run import load_run
 
     h = holds(load_run(logs[name]))
     row = _row(rows, name, "the grasp holds while the human keeps moving the object")
@@ -134,8 +134,8 @@ def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
 
 
 def test_release_phase_tracking_error_is_measured(rows, logs):
-    from analysis.grasp_claims import tracking_error
-    from analysis.grasp_run import load_run
+    from analysis.grasping.claims import tracking_error
+    from analysis.grasping.run import load_run
 
     run = load_run(logs["grasp_cycle"])
     te = tracking_error(run, ("release",))
@@ -152,8 +152,8 @@ def test_release_phase_tracking_error_is_measured(rows, logs):
 
 
 def test_no_prediction_the_hand_follows_the_object(rows, logs):
-    from analysis.grasp_claims import tracking_lag
-    from analysis.grasp_run import load_run
+    from analysis.grasping.claims import tracking_lag
+    from analysis.grasping.run import load_run
 
     for name in RUNS:
         lag = tracking_lag(load_run(logs[name]))
@@ -217,7 +217,7 @@ def test_every_falsifier_names_a_measured_row_and_the_new_rows_are_there(rows):
     """FALSIFIERS (replay falsify runs them) name measured rows of these runs; the rows of
     eqs. 1, 3, 4 / compliance, x^o and Fig. 9's X are in the table with a verdict from the
     truth topics, and no configuration echo is marked reproduced."""
-    from analysis.grasp_claims import FALSIFIERS
+    from analysis.grasping.claims import FALSIFIERS
 
     table = rows  # quantity -> row
     for f in FALSIFIERS:
@@ -237,7 +237,7 @@ def test_every_falsifier_names_a_measured_row_and_the_new_rows_are_there(rows):
 def test_every_reproduced_measured_row_has_a_falsifier(rows):
     """What `replay falsify` requires: no measured row of these runs reads "reproduced" without
     a declared variant that must turn it to "differs"."""
-    from analysis.grasp_claims import FALSIFIERS
+    from analysis.grasping.claims import FALSIFIERS
 
     covered = {f.row for f in FALSIFIERS}
     table = [q for q in rows if not q.startswith(tuple(f"{n}: " for n in RUNS))]  # (not per run)
@@ -248,7 +248,7 @@ def test_every_reproduced_measured_row_has_a_falsifier(rows):
 def test_look_then_move_breaks_eq3s_partition(rows, tmp_path):
     """The partition row's falsifier, run: without S K^a1 while reaching (a sequential
     controller) the hand leaves the moving box behind in the plane during the reach."""
-    from analysis.grasp_claims import FALSIFIERS, evaluate
+    from analysis.grasping.claims import FALSIFIERS, evaluate
     from replay.log import LogReader
     from replay.runner import Runner
     from replay.scenario import load_scenario
