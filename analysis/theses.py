@@ -18,7 +18,7 @@ UNREAD = "not decided"
 
 @dataclass(frozen=True)
 class Thesis:
-    paper: str  # key in replay.papers.PAPERS
+    paper: str  # a registered paper's key (replay.papers)
     claim: str  # the thesis in one sentence
     tables: tuple[str, ...]  # the sweeps (sweeps/NAME.yaml) whose tables decide it
     verdict: str  # module:function({name: rows}) -> {"verdict", "numbers", "figure"}
@@ -120,7 +120,7 @@ def verdicts(stored_only: bool = False) -> list[Verdict]:
 
 def markdown(rows: list[Verdict]) -> str:
     """The theses as a Markdown table (cells escaped: a table's text is data)."""
-    from replay.papers import PAPERS
+    from replay.papers import papers
     from analysis.report.markup import md
 
     lines = [
@@ -128,7 +128,8 @@ def markdown(rows: list[Verdict]) -> str:
         "|---|---|---|---|---|",
     ]
     for v in rows:
-        paper = PAPERS[v.thesis.paper].title if v.thesis.paper in PAPERS else v.thesis.paper
+        known = papers()
+        paper = known[v.thesis.paper].title if v.thesis.paper in known else v.thesis.paper
         cells = (paper, v.thesis.claim, v.verdict, v.numbers, v.figure)
         lines.append("| " + " | ".join(md(c) for c in cells) + " |")
     return "\n".join(lines)
@@ -136,7 +137,7 @@ def markdown(rows: list[Verdict]) -> str:
 
 def html(rows: list[Verdict]) -> str:
     """The theses as an HTML table (every cell escaped)."""
-    from replay.papers import PAPERS
+    from replay.papers import papers
     from analysis.report.markup import e
 
     head = (
@@ -144,7 +145,8 @@ def html(rows: list[Verdict]) -> str:
     )
     body = []
     for v in rows:
-        paper = PAPERS[v.thesis.paper].title if v.thesis.paper in PAPERS else v.thesis.paper
+        known = papers()
+        paper = known[v.thesis.paper].title if v.thesis.paper in known else v.thesis.paper
         cells = (paper, v.thesis.claim, v.verdict, v.numbers, v.figure)
         body.append("<tr>" + "".join(f"<td>{e(c)}</td>" for c in cells) + "</tr>")
     return f'<table class="theses">{head}{"".join(body)}</table>'
