@@ -16,7 +16,7 @@ PAPER = Paper(
         "stick_3step": "replay.control.stick.strategy:ThreeStepController",
     },
     plants={"airtable": "plants.airtable:AirTablePlant"},
-    sensors={"stick_camera": "replay.sensors.stick_camera:StickCamera"},
+    sensors={"stick_camera": "plants.airtable.camera:StickCamera"},
     viewer_scenes={"airtable": "plants.airtable.viewer_scene:AirTableScene"},
     figures="analysis.stick.figures:make_figures",
     claims="analysis.stick.claims:evaluate",
