@@ -297,7 +297,7 @@ def cycle_timing(run: GraspRun) -> dict | None:
 def _arm_top_speed(run: GraspRun) -> float | None:
     """The run's arm model's top tool speed with its joint speed limits (over a sample of its
     joint box), as the catching claims compute it, from the rig's own settings."""
-    from analysis.catching.claims import arm_capability
+    from analysis.catching.metrics import arm_capability
     from plants.arm_rig.settings import resolve
 
     try:

@@ -121,7 +121,8 @@ def test_the_falsifier_turns_the_4_5_ms_rows_to_differs(logs, tmp_path):
 
 
 def test_figures_8_9_end_at_first_contact_and_exist_for_the_slow_pair(logs, tmp_path):
-    from analysis.catching.claims import first_contact, load_run
+    from analysis.catching.metrics import first_contact
+    from analysis.catching.run import load_run
     from analysis.catching.figures import _joint_figure, make_figures
 
     names = {p.name for p in make_figures(logs, tmp_path)}

@@ -15,7 +15,7 @@ from matplotlib.text import Annotation, Text
 from analysis.catching import figures as catch_figures
 from analysis.grasping import figures as grasp_figures
 from analysis.stick import figures as stick_figures
-from analysis.catching.claims import load_run
+from analysis.catching.run import load_run
 from analysis.grasping.run import load_run as load_grasp
 from replay.log import LogReader
 from replay.runner import Runner
