@@ -89,7 +89,7 @@ def test_loops_run_every_1ms_with_latency_under_1_5ms(rows):
 
 
 def test_timing_read_as_ms_is_inconsistent_with_the_arm(rows, logs):
-    from analysis.grasping.claims import cycle_timing
+    from analysis.grasping.metrics import cycle_timing
     from analysis.grasping.run import load_run
 
     ct = cycle_timing(load_run(logs["grasp_hexahedron"]))
@@ -115,7 +115,7 @@ def test_preshape_matches_the_shape(rows, name, shape):
 def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
     """The hold row is reproduced exactly when the plant saw a grasp with no slip or drop and
     the object stayed with the hand: the row is the log's, whichever way it goes."""
-    from analysis.grasping.claims import HOLD_DRIFT, holds
+    from analysis.grasping.metrics import HOLD_DRIFT, holds
     from analysis.grasping.run import load_run
 
     h = holds(load_run(logs[name]))
@@ -134,7 +134,7 @@ def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
 
 
 def test_release_phase_tracking_error_is_measured(rows, logs):
-    from analysis.grasping.claims import tracking_error
+    from analysis.grasping.metrics import tracking_error
     from analysis.grasping.run import load_run
 
     run = load_run(logs["grasp_cycle"])
@@ -152,7 +152,7 @@ def test_release_phase_tracking_error_is_measured(rows, logs):
 
 
 def test_no_prediction_the_hand_follows_the_object(rows, logs):
-    from analysis.grasping.claims import tracking_lag
+    from analysis.grasping.metrics import tracking_lag
     from analysis.grasping.run import load_run
 
     for name in RUNS:
