@@ -21,7 +21,7 @@ Times used throughout (all from the log):
 - first ``contact`` of ball and robot, and ``catch`` / ``miss`` / ``drop`` from the plant.
 
 A run's log is read by ``analysis.catching.run``, its quantities measured by
-``analysis.catching.metrics``, the falsifiers are ``analysis.catching.falsifiers``'; this module
+``analysis.catching.metrics``, the falsifiers are ``analysis.catching.falsifiers``; this module
 makes the rows.
 """
 

@@ -19,7 +19,7 @@ releases and tracks it: Fig. 9). Every shipped grasp scenario is the paper's exp
 own labels, and a wrong preshape still grasps.
 
 The quantities are measured by ``analysis.grasping.metrics``, the falsifiers are
-``analysis.grasping.falsifiers``'; this module makes the rows.
+``analysis.grasping.falsifiers``; this module makes the rows.
 """
 
 from __future__ import annotations
