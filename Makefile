@@ -58,10 +58,12 @@ lint: $(STAMP)
 
 # the suite in parallel (pytest-xdist): TEST_WORKERS processes (2: this project's CI machines have
 # 2 cores), each test file kept on one worker (--dist loadfile) so a module's fixtures (logs of
-# whole runs, a built wheel) are made once; `make test TEST_WORKERS=0` runs it in one process
+# whole runs, a built wheel) are made once, the longest files first (tests/conftest.py's
+# LONGEST_FIRST; xdist would order them by test count); `make test TEST_WORKERS=0` runs it in one
+# process
 TEST_WORKERS ?= 2
 test: $(STAMP)
-	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder
 
 # the pure-Python paths (replay.accel: the accelerators built but not used), what an install
 # without a C compiler runs. Only the cameras have an accelerator: their tests (which also hold

@@ -8,6 +8,29 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
+# The files that take the most CPU, longest first (those with a figure measured alone on this
+# project's 2-core machine, user+sys with the browser's and subprocesses' CPU, 2026-12-05; the
+# others ranked by the suite's --durations): they run before every other file, so that with
+# `make test`'s --dist loadfile --no-loadscope-reorder the two workers start on the two longest
+# and the short files fill the end, instead of a long one starting last (xdist's own order is by
+# test count).
+LONGEST_FIRST = (
+    "tests/replay/viewer/test_viewer_browser.py",  # ~150 s, most of it Chromium's software WebGL
+    "tests/analysis/test_falsify.py",  # ~100 s: `replay falsify` of the three papers
+    "tests/replay/test_wheel_install.py",  # ~87 s: two wheels built, runs from each
+    "tests/analysis/test_grasp_figures_claims.py",  # ~48 s
+    "tests/replay/viewer/test_viewer_browser_framing.py",
+    "tests/plants/mujoco_arm/test_grasp_mujoco.py",
+    "tests/replay/control/predictive/test_predictive.py",
+    "tests/replay/sweep/test_sweep_files.py",  # ~35 s
+)
+
+
+def pytest_collection_modifyitems(items):
+    rank = {path: k for k, path in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))  # (stable)
+
+
 @pytest.fixture(autouse=True, scope="session")
 def _toy_plugins():
     import toy_plugins

@@ -264,19 +264,6 @@ def joint_inertias(scenario: str = "catch_optimised") -> dict[int, float]:
     return {i: float(mass[k, k]) for k, i in enumerate(act)}
 
 
-def rate_cell_gains(period: float, kp, kd, inertias: dict[int, float]) -> tuple[list, list]:
-    """kp, kd for every arm joint at ``period`` by :func:`rate_gains` (rounded to 0.1 N*m/rad
-    and 0.001 N*m*s/rad as the sweep file stores them); a joint without an inertia (held by
-    the plant) keeps its gains."""
-    out_p, out_d = [], []
-    for i, (p, d) in enumerate(zip(kp, kd)):
-        if i in inertias:
-            p, d = rate_gains(p, d, inertias[i], period)
-        out_p.append(round(float(p), 1))
-        out_d.append(round(float(d), 3))
-    return out_p, out_d
-
-
 def _rate_counts(rows: list[dict]) -> dict[tuple[str, str], dict[float, tuple[int, int]]]:
     """{(scenario, motion): {period in ms: (caught k, runs n)}} of the catch_rate table."""
     out: dict = {}

@@ -54,6 +54,18 @@ def _vec(v) -> list[float]:
     return [float(v[0]), float(v[1])]
 
 
+def _space(solver) -> pymunk.Space:
+    """A Pymunk space without gravity, damping or sleep, with ``solver``'s settings."""
+    space = pymunk.Space()
+    space.gravity = (0.0, 0.0)
+    space.damping = 1.0  # no velocity damping
+    space.iterations = int(solver.iterations)
+    space.collision_slop = float(solver.collision_slop)
+    space.collision_bias = float(solver.collision_bias)
+    space.sleep_time_threshold = math.inf  # bodies never sleep
+    return space
+
+
 class AirTablePlant(Plant):
     """Stick on an air table and a two-fingered hand on an XY slider (Pymunk)."""
 
@@ -81,53 +93,10 @@ class AirTablePlant(Plant):
         self._hand_spec = settings.hand_spec(p)
         self.hand = HandServo(self._hand_spec, p.hand.base, [p.hand.joints0, p.hand.joints1])
 
-        space = pymunk.Space()
-        space.gravity = (0.0, 0.0)
-        space.damping = 1.0  # no velocity damping
-        space.iterations = int(p.solver.iterations)
-        space.collision_slop = float(p.solver.collision_slop)
-        space.collision_bias = float(p.solver.collision_bias)
-        space.sleep_time_threshold = math.inf  # bodies never sleep
-        self.space = space
-
-        # The stick: m and I set on the body; its shape has no mass or density.
-        st = p.stick
-        body = pymunk.Body(st.mass, st.inertia, body_type=pymunk.Body.DYNAMIC)
-        init = self._initial_state()
-        body.position = (init["x"], init["y"])
-        body.angle = init["theta"]
-        body.velocity = (init["vx"], init["vy"])
-        body.angular_velocity = init["omega"]
-        half = st.length / 2.0
-        shape: pymunk.Shape
-        if st.collision_width > 0.0:
-            shape = pymunk.Poly.create_box(body, (st.length, st.collision_width), radius=0.0)
-        else:
-            shape = pymunk.Segment(body, (-half, 0.0), (half, 0.0), 0.0)
-        shape.elasticity = st.restitution
-        shape.friction = st.friction
-        shape.collision_type = STICK_TYPE
-        space.add(body, shape)
-        self.stick_body, self.stick_shape = body, shape
-        if body.mass != st.mass or body.moment != st.inertia:  # pragma: no cover - guard
-            raise RuntimeError("Pymunk changed the stick's mass or inertia")
-
-        # The fingertips: kinematic discs (infinite mass, Assumption 8).
-        self.tip_bodies: list[pymunk.Body] = []
-        self.tip_shapes: list[pymunk.Shape] = []  # discs, found by the arbiter's shapes
-        for k, tip in enumerate(self.hand.tips()):
-            tb = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-            tb.position = (float(tip[0]), float(tip[1]))
-            ts = pymunk.Circle(tb, p.hand.tip_radius)
-            ts.elasticity = 1.0  # pair restitution = e * 1
-            ts.friction = 1.0  # pair friction = mu * 1
-            ts.collision_type = TIP_TYPE
-            ts.filter = pymunk.ShapeFilter(group=_TIP_GROUP)
-            space.add(tb, ts)
-            self.tip_bodies.append(tb)
-            self.tip_shapes.append(ts)
-
-        space.on_collision(TIP_TYPE, STICK_TYPE, begin=self._on_begin)
+        self.space = _space(p.solver)
+        self._add_stick(p.stick)
+        self._add_tips(p.hand.tip_radius)
+        self.space.on_collision(TIP_TYPE, STICK_TYPE, begin=self._on_begin)
 
         self._steps = 0
         self._pending: list[dict] = []
@@ -144,12 +113,51 @@ class AirTablePlant(Plant):
         self._read_state()
         self._reached = self._in_reach()  # the stick ever within the hand's reach
         # scene(): the boxes' centre heights and sizes, and the fingertips' last primitives
-        marker_h = 0.0005
+        marker_h, st = 0.0005, p.stick
         self._box_shapes = (
             (st.thickness / 2.0, (st.length, st.visual_width, st.thickness)),
             (st.thickness + marker_h / 2.0, (st.marker_length, st.marker_width, marker_h)),
         )
         self._tip_prims: list[Cylinder | None] = [None, None]
+
+    def _add_stick(self, st) -> None:
+        """The stick (``st``: its params) at its initial state: m and I set on the body; its
+        shape (a segment, or a box of the collision width) has no mass or density."""
+        body = pymunk.Body(st.mass, st.inertia, body_type=pymunk.Body.DYNAMIC)
+        init = self._initial_state()
+        body.position = (init["x"], init["y"])
+        body.angle = init["theta"]
+        body.velocity = (init["vx"], init["vy"])
+        body.angular_velocity = init["omega"]
+        half = st.length / 2.0
+        shape: pymunk.Shape
+        if st.collision_width > 0.0:
+            shape = pymunk.Poly.create_box(body, (st.length, st.collision_width), radius=0.0)
+        else:
+            shape = pymunk.Segment(body, (-half, 0.0), (half, 0.0), 0.0)
+        shape.elasticity = st.restitution
+        shape.friction = st.friction
+        shape.collision_type = STICK_TYPE
+        self.space.add(body, shape)
+        self.stick_body, self.stick_shape = body, shape
+        if body.mass != st.mass or body.moment != st.inertia:  # pragma: no cover - guard
+            raise RuntimeError("Pymunk changed the stick's mass or inertia")
+
+    def _add_tips(self, radius: float) -> None:
+        """The fingertips: kinematic discs (infinite mass, Assumption 8) at the hand's tips."""
+        self.tip_bodies: list[pymunk.Body] = []
+        self.tip_shapes: list[pymunk.Shape] = []  # discs, found by the arbiter's shapes
+        for tip in self.hand.tips():
+            tb = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+            tb.position = (float(tip[0]), float(tip[1]))
+            ts = pymunk.Circle(tb, radius)
+            ts.elasticity = 1.0  # pair restitution = e * 1
+            ts.friction = 1.0  # pair friction = mu * 1
+            ts.collision_type = TIP_TYPE
+            ts.filter = pymunk.ShapeFilter(group=_TIP_GROUP)
+            self.space.add(tb, ts)
+            self.tip_bodies.append(tb)
+            self.tip_shapes.append(ts)
 
     def _initial_state(self) -> dict[str, float]:
         """``initial``, or a seeded random throw (``throw.random``), said in a ``throw`` event."""

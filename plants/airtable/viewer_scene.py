@@ -81,28 +81,39 @@ class AirTableScene(RunScene):
         g = self.geo = StickGeometry.of(self.plant_params(Params))
         self._path_thickness = 2.5
         self.check_topics()
-        sc, r = self.scene, self.root
         opacity = 0.55 if self.ghost else None
         if self.k == 0:
-            lo, hi = self.bounds()
-            size = np.maximum(hi - lo, 0.3)[:2] + 0.1
-            centre = (lo + hi) / 2.0
-            self._add(
-                sc.add_grid(
-                    "/table",
-                    width=float(size[0]),
-                    height=float(size[1]),
-                    cell_size=0.05,
-                    section_size=0.1,
-                    plane="xy",
-                    position=(float(centre[0]), float(centre[1]), -0.0002),
-                    plane_color=(238, 242, 246),
-                    plane_opacity=1.0,
-                    cell_color=(205, 210, 220),
-                    section_color=(170, 178, 190),
-                    shadow_opacity=0.2,
-                )
+            self._add_table()
+        self._add_stick(g, opacity)
+        self._add_hand(g, opacity)
+        self._add_event_markers(g)
+        self._cameras(scale=0.05)
+
+    def _add_table(self) -> None:
+        """The air table: a grid under every run's moving parts (the first run's scene only)."""
+        lo, hi = self.bounds()
+        size = np.maximum(hi - lo, 0.3)[:2] + 0.1
+        centre = (lo + hi) / 2.0
+        self._add(
+            self.scene.add_grid(
+                "/table",
+                width=float(size[0]),
+                height=float(size[1]),
+                cell_size=0.05,
+                section_size=0.1,
+                plane="xy",
+                position=(float(centre[0]), float(centre[1]), -0.0002),
+                plane_color=(238, 242, 246),
+                plane_opacity=1.0,
+                cell_color=(205, 210, 220),
+                section_color=(170, 178, 190),
+                shadow_opacity=0.2,
             )
+        )
+
+    def _add_stick(self, g: StickGeometry, opacity) -> None:
+        """The stick with its marker, and the box of the stick as seen (hidden until seen)."""
+        sc, r = self.scene, self.root
         self.stick = self._add(sc.add_frame(f"{r}/stick", show_axes=False))
         body_color = (55, 55, 60) if not self.tint else self.color
         self._add(
@@ -132,6 +143,10 @@ class AirTableScene(RunScene):
                 visible=False,
             )
         )
+
+    def _add_hand(self, g: StickGeometry, opacity) -> None:
+        """The two fingertips and the slider's base (hidden until the log places them)."""
+        sc, r = self.scene, self.root
         tip_color = (30, 30, 30) if not self.tint else self.color
         self.tips = [
             self._add(
@@ -156,13 +171,16 @@ class AirTableScene(RunScene):
             )
         )
         self.fingers: viser.LineSegmentsHandle | None = None
+
+    def _add_event_markers(self, g: StickGeometry) -> None:
+        """A red dot at each logged collision's contact point (shown from its time)."""
         self.markers: list[tuple[float, viser.IcosphereHandle]] = []  # (time, marker)
         for e in self.run.events:
             c = (e.get("data") or {}).get("contact")
             if e.get("kind") == "collision" and isinstance(c, list) and len(c) == 2:
                 h = self._add(
-                    sc.add_icosphere(
-                        f"{r}/events/{len(self.markers)}",
+                    self.scene.add_icosphere(
+                        f"{self.root}/events/{len(self.markers)}",
                         radius=0.003,
                         color=(220, 30, 30),
                         position=(float(c[0]), float(c[1]), g.thickness),
@@ -170,7 +188,6 @@ class AirTableScene(RunScene):
                     )
                 )
                 self.markers.append((float(e["t"]), h))
-        self._cameras(scale=0.05)
 
     def bounds(self):
         pts = []

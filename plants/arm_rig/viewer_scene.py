@@ -96,25 +96,37 @@ class ArmScene(RunScene):
         return tuple(t for t in self.optional if t not in skip)
 
     def build(self) -> None:
-        from viser.extras import ViserUrdf
-
         p = self.params = self.plant_params(self.Params)
         self.check_topics()
         self._path_thickness = 3.0
-        sc, r = self.scene, self.root
         if self.k == 0:
-            lo, hi = self.bounds()
-            span = float(max(hi[0] - lo[0], hi[1] - lo[1], 2.0)) + 1.0
-            self._add(
-                sc.add_grid(
-                    "/floor",
-                    width=span,
-                    height=span,
-                    cell_size=0.25,
-                    section_size=1.0,
-                    position=((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, 0.0),
-                )
+            self._add_floor()
+        self._add_arm(p)
+        self._add_object(p)
+        self._add_event_markers()
+        self._cameras(scale=0.12)
+
+    def _add_floor(self) -> None:
+        """A floor grid under every run's moving parts (the first run's scene only)."""
+        lo, hi = self.bounds()
+        span = float(max(hi[0] - lo[0], hi[1] - lo[1], 2.0)) + 1.0
+        self._add(
+            self.scene.add_grid(
+                "/floor",
+                width=span,
+                height=span,
+                cell_size=0.25,
+                section_size=1.0,
+                position=((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, 0.0),
             )
+        )
+
+    def _add_arm(self, p) -> None:
+        """The base plate's frame and the arm's URDF hung from it (a note, not the arm, when
+        its URDF cannot be had or read)."""
+        from viser.extras import ViserUrdf
+
+        r = self.root
         self.urdf = None
         self.urdf_color: tuple[float, float, float, float] | None = (
             None  # the arm's colour (RGBA, 0-1)
@@ -122,31 +134,35 @@ class ArmScene(RunScene):
         self._names: tuple[str, ...] = ()
         self._maps: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._add(
-            sc.add_frame(  # the base plate's pose; the URDF hangs here
+            self.scene.add_frame(  # the base plate's pose; the URDF hangs here
                 f"{r}/arm",
                 show_axes=False,
                 position=_xyz(p.base_position),
                 wxyz=rpy_to_wxyz(p.base_rpy),
             )
         )
-        if self.run.track(TOPIC_ARM_JOINT_STATE) is not None or self.run.plant_type:
-            try:
-                path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
-                opacity = 0.5 if self.ghost else 1.0  # overlaid: every run in its colour
-                red, green, blue = (c / 255 for c in self.color)
-                override = None if not self.tint else (red, green, blue, opacity)
-                self.urdf_color = override
-                self.urdf = ViserUrdf(
-                    self.server, path, root_node_name=f"{r}/arm", mesh_color_override=override
-                )
-                self._names = self.urdf.get_actuated_joint_names()
-                self._cfg = np.zeros(len(self._names))
-            except ViewerError as exc:
-                self.notes.append(f"arm not drawn: {exc}")
-            except Exception as exc:  # noqa: BLE001 - a URDF yourdfpy cannot read
-                self.notes.append(
-                    f"arm not drawn: URDF unreadable ({exc.__class__.__name__}: {exc})"
-                )
+        if self.run.track(TOPIC_ARM_JOINT_STATE) is None and not self.run.plant_type:
+            return
+        try:
+            path = arm_urdf(self.run.plant_params, self.options.get("urdf_for"), self.Params)
+            opacity = 0.5 if self.ghost else 1.0  # overlaid: every run in its colour
+            red, green, blue = (c / 255 for c in self.color)
+            override = None if not self.tint else (red, green, blue, opacity)
+            self.urdf_color = override
+            self.urdf = ViserUrdf(
+                self.server, path, root_node_name=f"{r}/arm", mesh_color_override=override
+            )
+            self._names = self.urdf.get_actuated_joint_names()
+            self._cfg = np.zeros(len(self._names))
+        except ViewerError as exc:
+            self.notes.append(f"arm not drawn: {exc}")
+        except Exception as exc:  # noqa: BLE001 - a URDF yourdfpy cannot read
+            self.notes.append(f"arm not drawn: URDF unreadable ({exc.__class__.__name__}: {exc})")
+
+    def _add_object(self, p) -> None:
+        """The object (a box or a ball), where vision saw it and the effector's target (all
+        hidden until the log places them)."""
+        sc, r = self.scene, self.root
         color = (240, 120, 30) if not self.tint else self.color
         if p.object == "box":
             self.body = self._add(
@@ -181,13 +197,17 @@ class ArmScene(RunScene):
                 visible=False,
             )
         )
+
+    def _add_event_markers(self) -> None:
+        """A dot at each logged event's position (green a catch, red any other), shown from
+        its time."""
         self.markers: list[tuple[float, viser.IcosphereHandle]] = []  # (time, marker)
         for e in self.run.events:
             pos = (e.get("data") or {}).get("position")
             if isinstance(pos, list) and len(pos) == 3:
                 h = self._add(
-                    sc.add_icosphere(
-                        f"{r}/events/{len(self.markers)}",
+                    self.scene.add_icosphere(
+                        f"{self.root}/events/{len(self.markers)}",
                         radius=0.012,
                         color=(220, 30, 30) if e.get("kind") != "catch" else (30, 180, 60),
                         opacity=0.7,
@@ -196,7 +216,6 @@ class ArmScene(RunScene):
                     )
                 )
                 self.markers.append((float(e["t"]), h))
-        self._cameras(scale=0.12)
 
     def bounds(self):
         pts = [np.zeros((1, 3)), np.array([[0.0, 0.0, 1.2]])]

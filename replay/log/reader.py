@@ -414,7 +414,8 @@ class LogReader(LogMessages):
     def __init__(self, path: str | os.PathLike) -> None:
         self.path = Path(path)
         if not self.path.is_file():
-            raise LogError(f"{self.path}: no such log file")
+            what = "not a file" if self.path.exists() else "no such log file"
+            raise LogError(f"{self.path}: {what}")
         try:
             with open(self.path, "rb") as f:
                 head = f.read(len(MAGIC))

@@ -153,18 +153,6 @@ class PinholeCamera:
         uv[z <= 0.0] = np.nan
         return uv
 
-    def in_image(self, pixels) -> np.ndarray:
-        """Whether pixels lie on the sensor (``-0.5 <= u < width - 0.5``, likewise v)."""
-        uv = np.asarray(pixels, dtype=float)
-        w, h = self.intrinsics.width, self.intrinsics.height
-        with np.errstate(invalid="ignore"):
-            return (
-                (uv[..., 0] >= -0.5)
-                & (uv[..., 0] < w - 0.5)
-                & (uv[..., 1] >= -0.5)
-                & (uv[..., 1] < h - 0.5)
-            )
-
     # --- backward --------------------------------------------------------------------------
     def ray(self, pixels) -> tuple[np.ndarray, np.ndarray]:
         """The viewing ray(s) of pixel(s): ``(origin (3,), unit directions (N, 3) or (3,))``."""

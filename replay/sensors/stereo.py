@@ -253,12 +253,6 @@ class StereoBallCamera(Sensor):
         self._last: list = [None, None]
         self._found: tuple = (None, None)  # the blob kernels' tuples of the last frame
 
-    @property
-    def last_blobs(self) -> list[dict | None]:
-        """The last frame's blob in each camera (:meth:`blob`'s records), None where none."""
-        binary = bool(self._blob_args[2])
-        return [_blob(f, binary) for f in self._found]
-
     # --- helpers usable without a sensor instance -------------------------------------------
     @staticmethod
     def make_cameras(

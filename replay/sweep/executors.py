@@ -14,6 +14,7 @@ import multiprocessing as mp
 import os
 import re
 import signal
+import socket
 import sys
 import threading
 import time
@@ -197,15 +198,24 @@ def _stop(procs: dict) -> None:
             p.join()
 
 
-def ray_available() -> bool:
-    try:
-        import ray  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
 last_ray_init = float("nan")  # s starting or joining Ray took (bench, tests)
+PROBE_TIMEOUT = 5.0  # s to wait for a cluster's head to accept a connection
+
+
+def _check_reachable(address: str) -> None:
+    """Fail fast where nothing listens at ``HOST:PORT``: ``ray.init`` retries for minutes."""
+    if address == "auto" or "://" in address:
+        return  # (Ray finds "auto" itself; a ray:// client address is Ray's to check)
+    host, sep, port = address.rpartition(":")
+    host = host.strip("[]")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ExecutorError(f"--address {address!r}: expected HOST:PORT or auto")
+    try:
+        with socket.create_connection((host, int(port)), timeout=PROBE_TIMEOUT):
+            pass
+    except OSError as exc:
+        why = exc.strerror or type(exc).__name__
+        raise ExecutorError(f"no Ray cluster answers at {address!r}: {why}") from None
 
 
 def _start_ray(ray, workers: int, address: str | None):
@@ -213,6 +223,8 @@ def _start_ray(ray, workers: int, address: str | None):
     private cluster's handle (None when joining)."""
     where = f" at {address}" if address else ""
     cluster = None
+    if address:
+        _check_reachable(address)
     try:
         if address:
             ray.init(address=address, log_to_driver=False, logging_level="ERROR")

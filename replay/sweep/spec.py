@@ -132,9 +132,12 @@ def _key_path(text: str, option: str) -> str:
 
 def _yaml_value(text: str, option: str, key: str) -> Any:
     try:
-        return yaml.safe_load(text) if text.strip() else None
+        value = yaml.safe_load(text) if text.strip() else None
     except (yaml.YAMLError, ValueError):  # (ValueError: an integer of over 4300 digits)
         raise SweepSpecError(f"{option} {key}: value {_short(text)} is not valid YAML") from None
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and ":" in text:
+        return text.strip()  # YAML 1.1's base 60 ("1:30" is 90): a string, as --set reads it
+    return value
 
 
 def _split_values(text: str) -> list[str]:
@@ -190,7 +193,7 @@ def _short(text: str) -> str:
 
 def parse_random(text: str) -> RandomAxis:
     """``key.path=lo:hi`` -> a RandomAxis (whole numbers if both bounds are)."""
-    if "=" not in text or ":" not in text.split("=", 1)[1]:
+    if "=" not in text or text.split("=", 1)[1].count(":") != 1:
         raise SweepSpecError(f"--random expects key.path=lo:hi, got {text!r}")
     key, bounds = text.split("=", 1)
     key = _key_path(key, "--random")

@@ -16,7 +16,6 @@ from analysis.catching.ablations import (
     RATE_SPREAD,
     RATE_THROWS,
     joint_inertias,
-    rate_cell_gains,
     rate_gains,
     sampled_pd_poles,
     step_response,
@@ -30,6 +29,19 @@ KP, KD = [900.0, 1500.0, 300.0, 150.0], [30.0, 45.0, 10.0, 4.0]  # the scenarios
 @pytest.fixture(scope="module")
 def inertias():
     return joint_inertias()
+
+
+def rate_cell_gains(period: float, kp, kd, inertias: dict[int, float]) -> tuple[list, list]:
+    """The oracle of the sweep file's gains: kp, kd for every arm joint at ``period`` by
+    :func:`rate_gains`, rounded to 0.1 N*m/rad and 0.001 N*m*s/rad as the file stores them; a
+    joint without an inertia (held by the plant) keeps its gains."""
+    out_p, out_d = [], []
+    for i, (p, d) in enumerate(zip(kp, kd)):
+        if i in inertias:
+            p, d = rate_gains(p, d, inertias[i], period)
+        out_p.append(round(float(p), 1))
+        out_d.append(round(float(d), 3))
+    return out_p, out_d
 
 
 def _damping(kp, kd, inertia, period):

@@ -158,11 +158,22 @@ def falsified(tmp_path_factory):
     return {"result": res, "lines": lines, "keep": keep, "record": record}
 
 
-def _baseline(falsified, paper) -> dict[str, LogReader]:
-    return {p.stem: LogReader(p) for p in (falsified["keep"] / paper / "baseline").glob("*.mcap")}
+@pytest.fixture(scope="module")
+def baseline(falsified) -> dict[str, tuple[dict[str, LogReader], list[Claim]]]:
+    """Each paper's baseline logs and its claims table on them (evaluated once, for both
+    tests)."""
+    from replay import registry
+
+    out = {}
+    for paper in PAPERS:
+        logs = {
+            p.stem: LogReader(p) for p in (falsified["keep"] / paper / "baseline").glob("*.mcap")
+        }
+        out[paper] = (logs, registry.load("claims", paper)(logs))
+    return out
 
 
-def test_replay_falsify_flips_every_reproduced_row_and_stores_it(falsified):
+def test_replay_falsify_flips_every_reproduced_row_and_stores_it(falsified, baseline):
     res, lines = falsified["result"], falsified["lines"]
     assert res.exit_code == 0, res.output
     assert lines and not [ln for ln in lines if ln.startswith("FAIL")]
@@ -172,10 +183,8 @@ def test_replay_falsify_flips_every_reproduced_row_and_stores_it(falsified):
     assert any("translation after collision 1 | width10" in ln for ln in lines)
     # rows outside the paper's experiment: their falsifiers are listed, not run
     assert any(ln.startswith("skip  4.5 m/s") and "never counted" in ln for ln in lines)
-    from replay import registry
-
     for paper in PAPERS:
-        rows = registry.load("claims", paper)(_baseline(falsified, paper))
+        rows = baseline[paper][1]
         rec = shown(paper, falsified["record"])
         assert rec is not None and "--store" in rec.command and rec.code
         for r in rows:  # every measured row reproduced at baseline: flipped, and stored so
@@ -214,20 +223,20 @@ def _in_the_papers_experiment(paper: str, log: LogReader) -> bool:
     return sc["plant"]["params"].get("object") in ("box", "ball")  # Figs. 6-9's objects
 
 
-def test_claims_on_make_runs_logs_count_no_row_outside_the_paper_and_no_finding_twice(falsified):
+def test_claims_on_make_runs_logs_count_no_row_outside_the_paper_and_no_finding_twice(
+    falsified, baseline
+):
     """Issue #38: the paper's count comes only from its own experiment, one row per finding,
     and only rows that `replay falsify --store` showed flipping count (`replay claims` reads
     the record)."""
     from click.testing import CliRunner
 
     from analysis import claims
-    from replay import registry
     from replay.cli import main
 
     kinds_shown = set()
     for paper in PAPERS:
-        logs = _baseline(falsified, paper)
-        rows = registry.load("claims", paper)(logs)
+        logs, rows = baseline[paper]
         measured = [r for r in rows if r.kind == "measured"]
         kinds_shown |= {r.kind for r in rows}
         # no finding twice: no observable decides two measured rows, and each one names its own

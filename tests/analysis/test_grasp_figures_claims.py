@@ -5,6 +5,7 @@ golden log of the hexahedron run is checked."""
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -45,13 +46,20 @@ def rows(logs):
     return table
 
 
+@functools.cache
+def _run(log):
+    """A log's GraspRun, loaded once for the module (~1.2 s of CPU each): the tests only read it."""
+    from analysis.grasping.run import load_run
+
+    return load_run(log)
+
+
 def _row(rows, name, what):
     return rows[f"{name}: {what}"]
 
 
 def test_fig9_and_filmstrip_from_each_run(logs, tmp_path):
     from analysis.grasping.figures import filmstrip_times, make_figures
-    from analysis.grasping.run import load_run
 
     paths = make_figures(logs, tmp_path)
     names = {p.name for p in paths}
@@ -63,16 +71,15 @@ def test_fig9_and_filmstrip_from_each_run(logs, tmp_path):
         if p.suffix == ".svg":
             assert p.read_bytes() == (tmp_path / p.name).read_bytes()
     # the filmstrip shows the first cycle: tracking, the reach from 0.5 s, the plant's grasp
-    run = load_run(logs["grasp_hexahedron"])
+    run = _run(logs["grasp_hexahedron"])
     times = dict((label, t) for t, label in filmstrip_times(run))
     assert times["reaching starts"] == pytest.approx(0.5, abs=1e-3)
     assert times["grasped"] == pytest.approx(run.kinds("grasp")[0]["t"])
 
 
 def test_fig9_shades_grasp_and_release_phases_of_the_cycle(logs):
-    from analysis.grasping.run import load_run
 
-    run = load_run(logs["grasp_cycle"])
+    run = _run(logs["grasp_cycle"])
     names = [p.name for p in run.phases]
     assert names[:5] == ["track", "reach", "hold", "release", "track"]
     assert run.phases[3].t0 == pytest.approx(1.6, abs=1e-3)  # 0.5 + 0.3 + 0.8 s
@@ -90,9 +97,8 @@ def test_loops_run_every_1ms_with_latency_under_1_5ms(rows):
 
 def test_timing_read_as_ms_is_inconsistent_with_the_arm(rows, logs):
     from analysis.grasping.metrics import cycle_timing
-    from analysis.grasping.run import load_run
 
-    ct = cycle_timing(load_run(logs["grasp_hexahedron"]))
+    ct = cycle_timing(_run(logs["grasp_hexahedron"]))
     assert ct["track"] == pytest.approx(0.5, abs=1e-3)
     assert 0.05 < ct["travel"] < 0.3  # m: a reach of centimetres
     ms = _row(rows, "grasp_hexahedron", "the same times read as printed (ms)")
@@ -116,9 +122,8 @@ def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
     """The hold row is reproduced exactly when the plant saw a grasp with no slip or drop and
     the object stayed with the hand: the row is the log's, whichever way it goes."""
     from analysis.grasping.metrics import HOLD_DRIFT, holds
-    from analysis.grasping.run import load_run
 
-    h = holds(load_run(logs[name]))
+    h = holds(_run(logs[name]))
     row = _row(rows, name, "the grasp holds while the human keeps moving the object")
     ok = bool(h) and all(
         d["grasp"] is not None
@@ -135,9 +140,8 @@ def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
 
 def test_release_phase_tracking_error_is_measured(rows, logs):
     from analysis.grasping.metrics import tracking_error
-    from analysis.grasping.run import load_run
 
-    run = load_run(logs["grasp_cycle"])
+    run = _run(logs["grasp_cycle"])
     te = tracking_error(run, ("release",))
     assert te is not None and te["duration"] == pytest.approx(0.3, abs=0.01)
     # one row for Fig. 9's tracking, the releasing phase within it (one row per finding)
@@ -153,10 +157,9 @@ def test_release_phase_tracking_error_is_measured(rows, logs):
 
 def test_no_prediction_the_hand_follows_the_object(rows, logs):
     from analysis.grasping.metrics import tracking_lag
-    from analysis.grasping.run import load_run
 
     for name in RUNS:
-        lag = tracking_lag(load_run(logs[name]))
+        lag = tracking_lag(_run(logs[name]))
         assert lag is not None and lag >= 0.0
         row = _row(rows, name, "no prediction of the object's motion")
         assert row.status == "consistent" and row.kind == "configuration", row.measured

@@ -174,6 +174,8 @@ def test_other_misuse_says_what_was_expected(tmp_path):
         replay.run(3)  # type: ignore[arg-type]
     with pytest.raises(LogError, match="no such log file"):
         replay.open_log(tmp_path / "none.mcap")
+    with pytest.raises(LogError, match="not a file"):  # (there, but a folder or a device)
+        replay.open_log(tmp_path)
     run = replay.open_log(ROOT / "data" / "golden" / "stick_3step.mcap")
     with pytest.raises(KeyError, match="no topic '/nope' in this run") as info:
         run.table("/nope")

@@ -154,3 +154,20 @@ def test_info_filters_events(logs):
     assert r.exit_code == 0 and "no event of kind nope" in r.stderr and "collision" in r.stderr
     r = invoke("info", logs["base"], "--events", "outcome", "--no-events")
     assert r.exit_code == 2 and r.stderr.startswith("error: ")
+
+
+def test_figures_that_fail_leave_no_empty_folder(logs, tmp_path):
+    m = next(LogReader(logs["lat10"]).messages(TOPIC_SCENARIO))
+    assert "latency: 0.01" in m.data["yaml"]
+    bad = forge(
+        logs["lat10"],
+        tmp_path / "bad.mcap",
+        yaml=m.data["yaml"].replace("latency: 0.01", "latency: -5"),
+    )
+    r = invoke("compare", logs["catch"], bad, "-o", tmp_path / "figs" / "new")
+    assert r.exit_code == 1 and "could not be made" in r.stderr, r.output
+    assert not (tmp_path / "figs").exists()  # neither folder it made is left behind
+    kept = tmp_path / "mine"
+    kept.mkdir()
+    r = invoke("compare", logs["catch"], bad, "-o", kept)
+    assert r.exit_code == 1 and kept.is_dir()  # a folder the user made stays

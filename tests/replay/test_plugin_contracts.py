@@ -2,6 +2,9 @@
 robosuite's ``test_all_environments`` do for theirs), parametrised over the registry, so a new
 plant, sensor or controller is checked by being registered:
 
+- every entry point of the plant, sensor and controller groups is checked, read from the
+  installed metadata (a plug-in a test registers in-process is not), and the installed groups
+  are the ones pyproject.toml declares (a stale install would hide a new plug-in);
 - a shipped scenario uses it (the first in name order is its test scenario);
 - that scenario runs a short while through the runner: a plant's spec is its ``spec_type``, its
   truth topics are in the log and the run ends with a physics verdict; a sensor's topic is in the
@@ -11,6 +14,8 @@ plant, sensor or controller is checked by being registered:
 from __future__ import annotations
 
 import functools
+import tomllib
+from importlib.metadata import entry_points
 
 import numpy as np
 import pytest
@@ -19,6 +24,8 @@ import replay
 from replay import registry
 from replay.resources import scenario_dir
 from replay.scenario import load_scenario
+
+from conftest import ROOT
 
 DURATION = 0.15  # s simulated: every loop runs many times, and the thrown ball is in view (0.1 s)
 
@@ -50,7 +57,17 @@ def _short_run(scenario: str):
 
 
 def _plugins(kind: str) -> list[str]:
-    return sorted(n for n in registry.names(kind) if not registry.is_import_path(n))
+    """Every installed entry point of ``kind``'s group."""
+    return sorted(ep.name for ep in entry_points(group=registry.GROUPS[kind]))
+
+
+@pytest.mark.parametrize("kind", ["plant", "sensor", "controller"])
+def test_the_contracts_cover_every_entry_point_pyproject_declares(kind):
+    group = registry.GROUPS[kind]
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        declared = tomllib.load(f)["project"]["entry-points"][group]
+    assert _plugins(kind) == sorted(declared), f"reinstall: {group} differs from pyproject.toml"
+    assert set(_plugins(kind)) <= set(registry.names(kind))
 
 
 @pytest.mark.parametrize("name", _plugins("plant"))

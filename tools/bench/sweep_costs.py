@@ -10,11 +10,11 @@ ours. Nothing here is a test: it prints, it does not judge. ``--variants N`` set
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import tempfile
 import time
 
 from replay.sweep.engine import run_sweep
-from replay.sweep.executors import ray_available
 from replay.sweep.spec import from_options
 from replay.sweep.table import as_float
 from replay.sweep.variants import expand
@@ -55,7 +55,7 @@ def main(argv=None) -> None:
     ap.add_argument("--no-ray", action="store_true")
     args = ap.parse_args(argv)
     runs = [measure(args.variants, 1), measure(args.variants, 2)]
-    if ray_available() and not args.no_ray:
+    if importlib.util.find_spec("ray") is not None and not args.no_ray:
         from replay.sweep import executors
 
         runs.append(measure(args.variants, 2, "ray"))

@@ -44,14 +44,12 @@ from replay.control.catching.optimise import (
     load_alpha,
     save_alpha,
 )
+from replay.control.catching.model import ARM_JOINTS
 from replay.control.catching.problem import ProblemConfig, build_problem
 from replay.interfaces import Occurrence
 from replay.messages import TOPIC_CATCHING_STATE, TOPIC_OPTIMIZATION_COST, OptimizationCost, Vec3
 from replay.params import ParamError, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
-
-
-_JOINTS = tuple(f"J{i}" for i in range(1, 8))  # an arm's joints as ArmSpec names them
 
 
 @dataclass
@@ -77,11 +75,11 @@ class Params:
         doc="catching angle of the selected joint (Sec. IV-A: pi/2)",
     )
     selected_joint: str = param(
-        "J4", choices=_JOINTS, doc="the joint i of eq. 6 (Sec. IV-A: axis 4)"
+        "J4", choices=ARM_JOINTS, doc="the joint i of eq. 6 (Sec. IV-A: axis 4)"
     )
     held_joints: list[str] = param(
         ["J3"],
-        choices=_JOINTS,
+        choices=ARM_JOINTS,
         max_length=7,
         doc="joints held at their initial angle (Sec. IV-A: axis 3 "
         "at 0); with them the arm must keep 3 active joints",
@@ -411,7 +409,10 @@ class CatchingController(CatchArmController):
         if est.buf and not self.holding:
             r, v, a = est.state_f(t) if P.latency_compensation else est.state_f(est.buf[-1][0])
             # eqs. 7, 23, 16 (compiled, 3-tuples)
-            q_a, qd_a, qdd_a, q_o, in_dom = self.mapping.evaluate_one_tuple(r, v, a)
+            try:
+                q_a, qd_a, qdd_a, q_o, in_dom = self.mapping.evaluate_one_tuple(r, v, a)
+            except np.linalg.LinAlgError:  # the mapping's Jacobian is singular at r_o
+                return self._hold_singular(t, r)
             if in_dom != self._in_domain and not in_dom:
                 self._events.append(
                     Occurrence(
@@ -455,6 +456,17 @@ class CatchingController(CatchArmController):
                 {"predicted_catch_time": self.t_catch, "closing_time": self.close_time}
             )
         self.tau = self._torque(qdd_d)
+        return self._command(self.tau)
+
+    def _hold_singular(self, t: float, r) -> ArmCommand:
+        """Freeze q_d where the mapping cannot be inverted (``after_catch: track`` carries the
+        ball past the catch surface into the hand, where d(l_c^-1)/dr_o is singular): the arm
+        holds, said once by a ``mapping_singular`` event."""
+        self.holding = True
+        self.qd_d = list(self._zeros)
+        self._ff = None
+        self._events.append(Occurrence("mapping_singular", {"t": t, "r_o": list(r)}))
+        self.tau = self._torque(self._zeros)
         return self._command(self.tau)
 
     def _torque(self, qdd_d: list[float]) -> list[float]:

@@ -153,8 +153,17 @@ class ArmModel:
         return tau, Tq, Tqd, self.mass(p)
 
 
+ARM_JOINTS = tuple(f"J{i}" for i in range(1, 8))  # an arm's joints as ArmSpec names them
+
+
 def active_joints(names: tuple[str, ...], held, selected: str, who: str) -> tuple[int, ...]:
     """Indices of the three moving joints (Sec. IV-A: axes 1, 2, 4), the last being ``selected``."""
+    unknown = [j for j in [*held, selected] if j not in names]
+    if unknown:
+        raise ValueError(
+            f"{who}: the arm has no joint {', '.join(map(str, unknown))} (its joints: "
+            f"{', '.join(names)})"
+        )
     held_i = [names.index(j) for j in held]
     active = tuple(i for i in range(len(names)) if i not in held_i)
     if len(active) != 3 or names.index(selected) != active[-1]:

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from replay.control.catching.base import CatchArmController
+from replay.control.catching.model import ARM_JOINTS
 from replay.control.catching.mapping import CatchGeometry
 from replay.params import param
 from replay.robot.arm_types import ArmCommand, ArmSpec
@@ -35,9 +36,13 @@ class FeedbackParams:
         unit="rad",
         doc="selected joint's angle on the catch surface (as the mapping's)",
     )
-    selected_joint: str = param("J4", doc="the joint at q_alpha on the catch surface")
-    held_joints: list = param(["J3"], doc="joints held at their initial angle")
-    catch_q: list = param(
+    selected_joint: str = param(
+        "J4", choices=ARM_JOINTS, doc="the joint at q_alpha on the catch surface"
+    )
+    held_joints: list[str] = param(
+        ["J3"], choices=ARM_JOINTS, max_length=7, doc="joints held at their initial angle"
+    )
+    catch_q: list[float] = param(
         [0.0, math.pi / 4], unit="rad", length=2, doc="(q1, q2) the inverse prefers (branch)"
     )
     catch_offset: float = param(
@@ -45,16 +50,22 @@ class FeedbackParams:
         unit="m",
         doc="catch point this far along the tool z axis; negative = palm thickness + ball radius",
     )
-    kp: list = param(
+    kp: list[float] = param(
         [900.0, 1500.0, 300.0, 150.0],
         unit="N*m/rad",
         ge=0.0,
+        le=1e6,
+        min_length=1,
+        max_length=7,
         doc="PD stiffness per arm joint (as the direct controller's)",
     )
-    kd: list = param(
+    kd: list[float] = param(
         [30.0, 45.0, 10.0, 4.0],
         unit="N*m*s/rad",
         ge=0.0,
+        le=1e6,
+        min_length=1,
+        max_length=7,
         doc="PD damping per arm joint (as the direct controller's)",
     )
     close_distance: float = param(

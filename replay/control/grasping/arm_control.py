@@ -340,18 +340,7 @@ class ArmControlTask(Controller):
         return F
 
     def update(self, t: float, measurements) -> ServoCommand | None:
-        for topic, m in measurements:
-            if topic == TOPIC_ARM_ENCODERS:
-                self._enc_prev = (self._enc_t, self.qd)
-                self._enc_t = m.t
-                self.q, self.qd = m.position, m.velocity
-            elif topic == TOPIC_WRIST_WRENCH:
-                self.wrench_raw = m
-            elif topic == TOPIC_GRASP_OBJECT:
-                if m.found:
-                    self.obj = m
-            elif topic == TOPIC_GRASP_STATE:
-                self.state = m
+        self._read(measurements)
         if self._t_last is not None and t > self._t_last:
             self.dt = t - self._t_last
             check_period(self.params.gain_period, self.dt, "arm")
@@ -363,25 +352,8 @@ class ArmControlTask(Controller):
         k = self._chain(P.grasp_point)
         R = k[:9]
         gp = k[12:15]
-        n_palm, row = (R[2], R[5], R[8]), (R[1], R[4], R[7])
-        # x^a (the hand) and its errors to x^o and x_d^a, as world 6-vectors
-        e_track = [0.0] * 6
-        obj = self.obj
-        if obj is not None:
-            xo = obj.position
-            e_track[0], e_track[1], e_track[2] = xo[0] - gp[0], xo[1] - gp[1], xo[2] - gp[2]
-            if obj.roll is not None and obj.shape != "circle":
-                e_track[3] = wrap_half_pi(obj.roll - math.atan2(row[2], row[1]))
-        xd = self.state.x_d
-        npl = self._n_plane
-        e_reach = [
-            xd[0] - gp[0],
-            xd[1] - gp[1],
-            xd[2] - gp[2],
-            n_palm[1] * npl[2] - n_palm[2] * npl[1],
-            n_palm[2] * npl[0] - n_palm[0] * npl[2],
-            n_palm[0] * npl[1] - n_palm[1] * npl[0],
-        ]
+        obj, xd = self.obj, self.state.x_d
+        e_track, e_reach = self._errors(R, gp)
         self._hold_offsets(e_track, e_reach)
         F = self.external_wrench(R) if self.wrench_raw is not None else [0.0] * 6
         track, reach, damp, force, cmd = eq2_terms(
@@ -420,6 +392,45 @@ class ArmControlTask(Controller):
         acc[0] += e_track[1] ** 2 + e_track[2] ** 2
         acc[1] += 1
         return ServoCommand(arm=cmd)
+
+    def _read(self, measurements) -> None:
+        """Keep the latest encoders (and the previous sample's time and rates), wrench, seen
+        object (when found) and schedule state."""
+        for topic, m in measurements:
+            if topic == TOPIC_ARM_ENCODERS:
+                self._enc_prev = (self._enc_t, self.qd)
+                self._enc_t = m.t
+                self.q, self.qd = m.position, m.velocity
+            elif topic == TOPIC_WRIST_WRENCH:
+                self.wrench_raw = m
+            elif topic == TOPIC_GRASP_OBJECT:
+                if m.found:
+                    self.obj = m
+            elif topic == TOPIC_GRASP_STATE:
+                self.state = m
+
+    def _errors(self, R, gp) -> tuple[list, list]:
+        """The hand's (x^a: grasp point ``gp``, tool rotation ``R`` row-major) errors to the
+        object x^o and to the schedule's x_d^a, as world 6-vectors (e_track, e_reach)."""
+        n_palm, row = (R[2], R[5], R[8]), (R[1], R[4], R[7])
+        e_track = [0.0] * 6
+        obj = self.obj
+        if obj is not None:
+            xo = obj.position
+            e_track[0], e_track[1], e_track[2] = xo[0] - gp[0], xo[1] - gp[1], xo[2] - gp[2]
+            if obj.roll is not None and obj.shape != "circle":
+                e_track[3] = wrap_half_pi(obj.roll - math.atan2(row[2], row[1]))
+        xd = self.state.x_d
+        npl = self._n_plane
+        e_reach = [
+            xd[0] - gp[0],
+            xd[1] - gp[1],
+            xd[2] - gp[2],
+            n_palm[1] * npl[2] - n_palm[2] * npl[1],
+            n_palm[2] * npl[0] - n_palm[0] * npl[2],
+            n_palm[0] * npl[1] - n_palm[1] * npl[0],
+        ]
+        return e_track, e_reach
 
     def _hold_offsets(self, e_track: list, e_reach: list) -> None:
         """In the hold phase the translational errors count from where the object sat in the

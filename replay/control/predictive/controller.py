@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from replay.control.catching.base import CatchArmController
+from replay.control.catching.model import ARM_JOINTS
 from replay.control.predictive.intercept import FeasiblePlan, Intercept, choose_intercept
 from replay.control.predictive.kalman import BallKalman
 from replay.interfaces import Occurrence
@@ -41,8 +42,12 @@ class PredictiveParams:
         length=3,
         doc="(q1, q2, q4) the inverse kinematics starts from (the elbow branch: q4 > 0)",
     )
-    held_joints: list = param(["J3"], doc="joints held at their initial angle")
-    selected_joint: str = param("J4", doc="the last active joint (as the direct mapping's)")
+    held_joints: list[str] = param(
+        ["J3"], choices=ARM_JOINTS, max_length=7, doc="joints held at their initial angle"
+    )
+    selected_joint: str = param(
+        "J4", choices=ARM_JOINTS, doc="the last active joint (as the direct mapping's)"
+    )
     catch_offset: float = param(
         -1.0,
         unit="m",
@@ -103,16 +108,22 @@ class PredictiveParams:
     freeze_time: float = param(
         0.01, unit="s", ge=0.0, doc="no re-planning this close to the planned arrival"
     )
-    kp: list = param(
+    kp: list[float] = param(
         [900.0, 1500.0, 300.0, 150.0],
         unit="N*m/rad",
         ge=0.0,
+        le=1e6,
+        min_length=1,
+        max_length=7,
         doc="PD stiffness per arm joint (as the direct controller's)",
     )
-    kd: list = param(
+    kd: list[float] = param(
         [30.0, 45.0, 10.0, 4.0],
         unit="N*m*s/rad",
         ge=0.0,
+        le=1e6,
+        min_length=1,
+        max_length=7,
         doc="PD damping per arm joint (as the direct controller's)",
     )
     close_delay: float = param(

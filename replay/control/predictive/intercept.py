@@ -131,31 +131,13 @@ def choose_intercept(
     act = model.active
     lo, hi = np.asarray(lower, float)[act], np.asarray(upper, float)[act]
     tau_limit = np.asarray(tau_limit, float)
-    betas = (
-        [match_max * (1.0 - k / max(1, match_levels - 1)) for k in range(match_levels)]
-        if match_max > 0
-        else [0.0]
-    )
+    betas = _match_fractions(match_max, match_levels)
     best: Intercept | None = None
     best_cost = math.inf
-    p_seed = np.asarray(seed, float)
     q0, qd0, qdd0 = (np.asarray(x, float) for x in start)
-    cands = []  # pass 1: reachable points and the palm's alignment at their IK posture
-    for s in np.arange(s_min, s_max + 1e-12, step):
-        if window is not None and not (window[0] <= t + s <= window[1]):
-            continue
-        x = r + v * s + 0.5 * g * s * s
-        if x[2] < floor:
-            break
-        vb = v + g * s
-        p, err = solve_ik(model, x, p_seed)
-        if err > 1e-4 or np.any(p < lo) or np.any(p > hi):
-            continue
-        p_seed = p  # continuation along the arc
-        rank = palm_angle(model, p, vb)
-        if t_prev is not None:
-            rank += switch_weight * abs(t + s - t_prev)
-        cands.append((rank, float(s), x, vb, p))
+    cands = _aligned(model, t, (r, v, g), seed, (lo, hi), (s_min, s_max, step), window, floor)
+    if t_prev is not None:
+        cands = [(a + switch_weight * abs(t + s - t_prev), s, *c) for a, s, *c in cands]
     n_cand = len(cands)
     cands.sort(key=lambda c: c[0])
     for _, s, x, vb, p in cands[:refine]:  # pass 2: rollouts of the best-aligned few
@@ -188,6 +170,39 @@ def choose_intercept(
     if best is not None:
         best.candidates = n_cand
     return best
+
+
+def _match_fractions(match_max: float, levels: int) -> list[float]:
+    """The speed-matching fractions tried at each candidate: ``levels`` from ``match_max``
+    down to 0 (only 0 when ``match_max`` is 0)."""
+    if not match_max > 0:
+        return [0.0]
+    return [match_max * (1.0 - k / max(1, levels - 1)) for k in range(levels)]
+
+
+def _aligned(model, t, arc, seed, limits, times, window, floor) -> list[tuple]:
+    """Pass 1 of :func:`choose_intercept`: the arc's points at arrival times ``s`` from
+    ``times`` = (s_min, s_max, step) (within ``window``, above ``floor``) that the hand reaches
+    inside the joint ``limits`` (IK seeded along the arc), each as (the palm's misalignment at
+    its posture, s, the point, the ball's velocity there, the posture)."""
+    r, v, g = arc
+    lo, hi = limits
+    s_min, s_max, step = times
+    p_seed = np.asarray(seed, float)
+    cands = []
+    for s in np.arange(s_min, s_max + 1e-12, step):
+        if window is not None and not (window[0] <= t + s <= window[1]):
+            continue
+        x = r + v * s + 0.5 * g * s * s
+        if x[2] < floor:
+            break
+        vb = v + g * s
+        p, err = solve_ik(model, x, p_seed)
+        if err > 1e-4 or np.any(p < lo) or np.any(p > hi):
+            continue
+        p_seed = p  # continuation along the arc
+        cands.append((palm_angle(model, p, vb), float(s), x, vb, p))
+    return cands
 
 
 class FeasiblePlan:

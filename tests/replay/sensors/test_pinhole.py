@@ -10,6 +10,8 @@ from hypothesis import strategies as st
 
 from replay.sensors.pinhole import Intrinsics, PinholeCamera, look_at_rotation
 
+from pixel_checks import in_image
+
 
 def random_camera(rng, width=128, height=96):
     """A camera somewhere around the origin looking at a point near it."""
@@ -115,7 +117,7 @@ def test_behind_the_camera_and_off_the_sensor():
     )
     uv = cam.project([[0, 0, 2.0], [0, 0, 0.0]])
     assert np.all(np.isnan(uv[0])) and np.all(np.isfinite(uv[1]))
-    inside = cam.in_image([[-0.5, -0.5], [63.49, 47.49], [63.5, 10], [10, -0.51], [np.nan, 3]])
+    inside = in_image(cam, [[-0.5, -0.5], [63.49, 47.49], [63.5, 10], [10, -0.51], [np.nan, 3]])
     assert inside.tolist() == [True, True, False, False, False]
     # a pixel's ray that points away from the plane does not meet it
     assert np.all(np.isnan(cam.backproject_to_height([31.5, 23.5], 1.5)))
@@ -140,7 +142,7 @@ def test_stereo_triangulation_with_cv2():
     rng = np.random.default_rng(6)
     pts = target + rng.uniform(-0.2, 0.2, (50, 3))
     ul, ur = left.project(pts), right.project(pts)
-    assert np.all(left.in_image(ul)) and np.all(right.in_image(ur))
+    assert np.all(in_image(left, ul)) and np.all(in_image(right, ur))
     h = cv2.triangulatePoints(
         left.projection_matrix(),
         right.projection_matrix(),

@@ -25,6 +25,7 @@ from replay.sensors.silhouette import (
 )
 from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 
+from pixel_checks import in_image
 
 R_BALL = 0.0175  # the bullet_arm plant's ball (35 mm, assumed)
 START = np.array([3.2, 0.0, 1.0])  # release point of the catching problem's throw set
@@ -285,8 +286,7 @@ def test_noise_scatter_matches_the_moment_prediction():
     s = sensor(seed=7, noise_sigma=sigma)
     us_meas = []
     for _ in range(300):
-        s.measure(0.0, scene)
-        us_meas.append(s.last_blobs[0]["u"])
+        us_meas.append(s.measure(0.0, scene).features["centroids"][0][0])
     assert np.std(us_meas) == pytest.approx(pred, rel=0.25)
     assert abs(np.mean(us_meas) - ref["u"]) < 4 * pred / math.sqrt(300) + 0.01  # unbiased
 
@@ -348,12 +348,13 @@ def test_seen_by_one_camera_only_or_cut_by_the_border_gives_none():
     for y in np.linspace(-0.6, 0.0, 61):
         r = (2.35, y, 0.9)
         e0, e1 = (sphere_ellipse(c, r, R_BALL) for c in cams)
-        in0 = e0 is not None and cams[0].in_image((e0.u, e0.v))
+        in0 = e0 is not None and in_image(cams[0], (e0.u, e0.v))
         in1 = e1 is not None and min(e1.u, 127 - e1.u, e1.v, 127 - e1.v) - e1.a > 2.0  # whole
         if in1 and not in0:
             found = True
             assert s.measure(0.0, Scene([ball(r)])) is None
-            assert s.last_blobs[1] is not None and s.last_blobs[0] is None
+            blobs = [StereoBallCamera.blob(img, s.params) for img in s.last_images]
+            assert blobs[1] is not None and blobs[0] is None
     assert found
     # straddling camera 0's left border
     o, d = cams[0].ray((0.0, 64.0))

@@ -13,6 +13,8 @@ from replay.spatial import yaw_quaternion
 from replay.sensors.pinhole import PinholeCamera
 from plants.airtable.camera import StickCamera, StickCameraParams, render_scene, wrap_half_pi
 
+from pixel_checks import in_image
+
 STICK = (0.100, 0.010, 0.005)  # L x W (paper) x an assumed thickness (m)
 
 
@@ -57,7 +59,7 @@ def test_is_a_sensor_with_declared_params():
     # +-0.3 m of table is in view at the default resolution, with a margin
     cam = StickCamera.make_camera(p)
     corners = cam.project([[0.3, 0.3, 0.0], [-0.3, -0.3, 0.0], [0.3, -0.3, 0.0]])
-    assert np.all(cam.in_image(corners))
+    assert np.all(in_image(cam, corners))
     assert cam.position[2] == 1.0
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -200,3 +201,26 @@ def test_the_keeper_removes_only_a_folder_it_was_made_for(tmp_path):
     )
     assert r.returncode != 0 and "not a folder PrivateRay made" in r.stderr
     assert (mine / "keep.txt").read_text() == "keep"
+
+
+def test_an_address_nothing_answers_at_fails_in_seconds(tmp_path):
+    """``ray.init`` retries an unreachable head for minutes: the sweep says so at once."""
+    with socket.socket() as s:  # a loopback port that nobody listens on
+        s.bind(("127.0.0.1", 0))
+        free = s.getsockname()[1]
+    for address, words in [
+        (f"127.0.0.1:{free}", "no Ray cluster answers at '127.0.0.1:"),
+        ("999.1.1.1:1", "no Ray cluster answers at '999.1.1.1:1'"),
+        ("nonsense", "expected HOST:PORT or auto"),
+        ("127.0.0.1:99999", "expected HOST:PORT or auto"),
+    ]:
+        t0 = time.monotonic()
+        r = subprocess.run(
+            [sys.executable, "-m", "replay.entry", "sweep", "stick_3step", "--grid", "seed=1,2"]
+            + ["--executor", "ray", "--address", address, "--no-logs", "-o", str(tmp_path / "s")],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert r.returncode == 2 and words in r.stderr, (address, r.stderr)
+        assert time.monotonic() - t0 < 60.0 and "Traceback" not in r.stderr

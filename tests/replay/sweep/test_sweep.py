@@ -3,6 +3,7 @@ reruns that skip, resumed sweeps, and failing variants as rows."""
 
 from __future__ import annotations
 
+import importlib.util
 import time
 
 import pytest
@@ -10,7 +11,6 @@ from click.testing import CliRunner
 
 from replay.cli import main
 from replay.sweep.engine import run_sweep
-from replay.sweep.executors import ray_available
 from replay.sweep.spec import SweepSpecError, from_options, parse_grid
 from replay.sweep.table import read_table
 from replay.sweep.variants import expand
@@ -26,6 +26,8 @@ def test_grid_values_are_yaml_and_lists_stay_whole():
     a = parse_grid("plant.params.x=1, 2.5e-3 ,[1, 2],true,abc")
     assert a.name == "plant.params.x"
     assert a.values == [1, 2.5e-3, [1, 2], True, "abc"]
+    # YAML 1.1 reads 1:30 as 90 (base 60): kept as written, as --set keeps it
+    assert parse_grid("x=1:30,0:0:1").values == ["1:30", "0:0:1"]
 
 
 def test_random_draws_are_seeded_and_in_range():
@@ -54,6 +56,8 @@ def test_grid_times_random_is_the_product():
         (["a.b=[1,2"], [], None, "not valid YAML"),
         ([], ["a.b=1"], None, "lo:hi"),
         ([], ["a.b=x:2"], None, "expected a number"),
+        ([], ["a.b=0:1:2"], None, "lo:hi"),  # not [0, 62] by YAML 1.1's base 60
+        ([], ["a.b=0:1:2:3"], None, "lo:hi"),
         ([], ["a.b=2:1"], None, "lo < hi"),
         ([], ["a.b=0:1"], 0, "at least 1"),
         (["a.b=1,2"], [], 3, "--random"),
@@ -88,7 +92,9 @@ def _friction(values, seed=0):
 
 
 def test_stick_friction_grid_local_then_ray_same_table(project_root, tmp_path):
-    assert ray_available(), "the test extra installs paper-replay[cluster] (Ray)"
+    assert importlib.util.find_spec("ray") is not None, (
+        "the test extra installs paper-replay[cluster] (Ray)"
+    )
     local, ray_dir = tmp_path / "local", tmp_path / "ray"
     # an interrupted sweep: two of the three variants done ...
     first = run_sweep(_friction(["0.0", "1.0"]), local, workers=2, progress=False)

@@ -3,6 +3,8 @@ analysis/catching/throws.py derives, and their plots and sentences come from the
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -13,6 +15,13 @@ from replay.sweep.variants import check_keys, expand
 from replay.sweep.worker import load_function
 
 NAMES = ablations.names()
+
+
+@functools.cache
+def _variants(name: str) -> list:
+    """The sweep file's variants, expanded once for the module (catch_rate's 840 take ~7 s)."""
+    sf = ablations.load(name)
+    return expand(sf.scenario, sf.spec, sf.seed, sets=sf.sets, version="test")
 
 
 def test_there_are_catching_stick_and_grasping_ablations():
@@ -59,7 +68,7 @@ def test_grasp_loops_slows_every_loop_together(project_root):
 def test_sweep_file_expands_into_valid_variants(project_root, name):
     sf = ablations.load(name)
     check_keys(sf.scenario, sf.spec, sf.sets)
-    variants = expand(sf.scenario, sf.spec, sf.seed, sets=sf.sets, version="test")
+    variants = _variants(name)
     assert len(variants) >= 5
     assert not [v.error for v in variants if v.error]
     assert len({v.key for v in variants}) == len(variants)
@@ -96,7 +105,7 @@ def test_plot_and_sentence_from_the_stored_table(name, tmp_path):
     table = ablations.STORED_DIR / f"{name}.csv"
     assert table.is_file(), f"no stored table: run `replay ablate {name} --store`"
     rows = read_table(table)
-    assert len(rows) == len(expand(sf.scenario, sf.spec, sf.seed, sets=sf.sets, version="t"))
+    assert len(rows) == len(_variants(name))
     paths = ablations.plot(sf, table, tmp_path)
     assert [p.suffix for p in paths] == [".png", ".svg"] and all(p.stat().st_size for p in paths)
     sentence = load_function(sf.summary)(rows)
