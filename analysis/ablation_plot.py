@@ -19,7 +19,7 @@ def plot_rates(ax, xs, ks, ns, fmt: str, label: str, shift: float = 0.0, log_x=F
     """Rates k/n at ``xs`` with Wilson 95 % error bars, ``n`` in the legend entry; ``shift``
     moves the points sideways (a fraction of a decade on a log axis, else of x units) so that
     coinciding lines stay apart."""
-    from analysis.ablation_catch import wilson
+    from analysis.catching.ablations import wilson
 
     xs = np.asarray(xs, float)
     xs = xs * 10**shift if log_x else xs + shift

@@ -22,7 +22,7 @@ no observable decides two rows of one table (a claim measured on several runs is
 :func:`merge`). "paper states" holds only what the paper states; a project target or our
 tolerance goes in the note.
 
-A paper's claims module (the ``paper_replay.claims`` entry point's module) lists its falsifiers
+A paper's claims module (its registration's ``claims``, replay.papers) lists its falsifiers
 in ``FALSIFIERS``; ``replay falsify`` runs each variant and checks that its row then "differs".
 """
 

@@ -19,7 +19,7 @@ from replay.console import exit_code, fail, note, quoted_warnings, read_log, say
 from replay.log import LogError, LogReader
 from replay.log.errors import LogLimitError
 from replay.log.output import check_output
-from replay.papers import PAPERS
+from replay.papers import papers as registered
 from replay.resources import DEFAULT_LOG_DIR
 from replay.scenario import ScenarioError
 from replay.scenario.yamlio import one_line
@@ -164,7 +164,7 @@ def claims(logs, markdown):
             _analysis_failed("claims", paper, readers, exc)
         for text in skipped:
             warn(text)
-        title = PAPERS[paper].title if paper in PAPERS else paper
+        title = registered()[paper].title if paper in registered() else paper
         partial, falsifiers = _partial(readers), falsifiers_of(evaluate)
         record = shown(paper)  # (what `replay falsify --store` showed flipping)
         closing = f"\n\n{engines_note}" if engines_note else ""
@@ -302,10 +302,11 @@ def falsify(papers, logs_dir, keep, store):
 
     import tempfile
 
-    names = list(papers) or [p for p in PAPERS if _has_claims(p)]
+    names = list(papers) or [p for p in registered() if _has_claims(p)]
     for p in names:
         if not _has_claims(p):
-            fail(f"{p}: no claims table (known: {', '.join(q for q in PAPERS if _has_claims(q))})")
+            known = ", ".join(q for q in registered() if _has_claims(q))
+            fail(f"{p}: no claims table (known: {known})")
     failed = 0
     with tempfile.TemporaryDirectory(prefix="replay-falsify-") as tmp:
         work = Path(keep) if keep else Path(tmp)

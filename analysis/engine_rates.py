@@ -3,14 +3,14 @@ claims table and the report (analysis/engines.py's ``stored_rate_rows``).
 
 - catch (namiki2003): each catching scenario and its ``_mujoco`` twin on the same seeded
   perturbed throws, none of them a tuning throw: the shared throw set's base cell
-  (analysis.ablation_catch.run_shared: 8-10 m/s at first sight, tilted by up to 1 deg, r_o(t0)
+  (analysis.catching.ablations.run_shared: 8-10 m/s at first sight, tilted by up to 1 deg, r_o(t0)
   jittered by 5 mm; tests/analysis/test_catch_robustness.py's generator and seed), judged by the
   plant's catch verdict (the ball at rest in the hand, from the engine's contacts and the ball's
   true motion);
 - grasp (namiki1999): box and ball and their twins on the same human paths, seeds and speeds no
   scenario uses (they use seed 0 at 0.10 m/s): the seeds of tests/analysis/test_grasp_robustness.py,
   tests/plants/mujoco_arm/test_grasp_mujoco.py and docs/grasping.md's 30-run batch, judged by the
-  physical criterion from the truth topics (analysis/grasp_judge.py), never by the run's flag.
+  physical criterion from the truth topics (analysis/grasping/judge.py), never by the run's flag.
 
 Where the engines part, a probe (``PROBES``) runs the MuJoCo twin with one setting changed on the
 same inputs, so the table says what decides the difference. ``python -m analysis.engine_rates
@@ -31,7 +31,7 @@ from analysis.engines import SUFFIX
 TABLE = "engine_rates"  # data/ablations/engine_rates.csv and .md
 COMMAND = "python -m analysis.engine_rates"
 CATCH_SCENARIOS = ("catch_optimised", "catch_initial")
-CATCH_CELL = "base (8-10 m/s, 1 kHz)"  # analysis.ablation_catch.SHARED_CELLS' first
+CATCH_CELL = "base (8-10 m/s, 1 kHz)"  # analysis.catching.ablations.SHARED_CELLS' first
 GRASP_SCENARIOS = ("grasp_hexahedron", "grasp_sphere")
 # (seed, human speed m/s): docs/grasping.md's batch (seeds 101-105 x 0.05, 0.15, 0.3),
 # test_grasp_robustness.py's three, test_grasp_mujoco.py's five
@@ -65,7 +65,7 @@ def grasp_set(name: str, n: int) -> str:
 def run_catch(n: int = 30, names=CATCH_SCENARIOS, probes: bool = False) -> list[dict]:
     """Each catching scenario and its MuJoCo twin on the same ``n`` seeded perturbed throws;
     with ``probes`` only the twins' ``PROBES`` variants on them instead."""
-    from analysis.ablation_catch import run_shared
+    from analysis.catching.ablations import run_shared
 
     rows = []
     for name in names:
@@ -94,7 +94,7 @@ def run_catch(n: int = 30, names=CATCH_SCENARIOS, probes: bool = False) -> list[
 
 def run_grasp(paths=GRASP_PATHS, names=GRASP_SCENARIOS) -> list[dict]:
     """Each grasp scenario and its MuJoCo twin on the same human paths, judged physically."""
-    from analysis.grasp_judge import physical_verdict
+    from analysis.grasping.judge import physical_verdict
     from replay.log import LogReader
     from replay.resources import scenario_dir
     from replay.runner import Runner
@@ -148,7 +148,7 @@ def write(rows: list[dict], path: Path) -> None:
 
 def markdown(rows: list[dict]) -> str:
     """Per set and engine: k/n with its Wilson 95 % interval and the failures' reasons."""
-    from analysis.ablation_catch import rate_cell
+    from analysis.catching.ablations import rate_cell
 
     engines = list(dict.fromkeys(r["engine"] for r in rows))
     lines = ["| set | " + " | ".join(engines) + " |", "|---" * (len(engines) + 1) + "|"]

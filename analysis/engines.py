@@ -5,8 +5,8 @@ paths), and the closing note (which claims hold in both engines, which in one).
 A MuJoCo run is the scenario of the same name with ``_mujoco`` appended
 (``catch_optimised_mujoco`` is ``catch_optimised`` with ``plant.type: mujoco_arm``,
 ``grasp_hexahedron_mujoco`` is ``grasp_hexahedron`` with ``mujoco_grasp``). The paper's own
-``evaluate`` (``analysis.catch_claims.evaluate``, ``analysis.grasp_claims.evaluate``: a MuJoCo
-log's typed params are the MuJoCo rig's, analysis/grasp_run.py) is run once on each engine's
+``evaluate`` (``analysis.catching.claims.evaluate``, ``analysis.grasping.claims.evaluate``: a MuJoCo
+log's typed params are the MuJoCo rig's, analysis/grasping/run.py) is run once on each engine's
 logs, named without the suffix, so both give the same rows; the rows are then joined by quantity.
 Every verdict stays the paper module's, from each engine's truth topics.
 
@@ -128,7 +128,7 @@ def rate_row(
     interval. "reproduced" (the target met) when every engine reaches :data:`TARGET`; where the
     engines part the note says so (and whether their intervals overlap), then each engine's
     failures with their reasons."""
-    from analysis.ablation_catch import wilson
+    from analysis.catching.ablations import wilson
 
     parts, notes, passed, spans = [], [], {}, []
     for engine, res in outcomes.items():

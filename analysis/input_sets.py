@@ -7,7 +7,7 @@ function ``(task, n) -> [episode]``, an episode a mapping ``{"seed": int, "set":
 already judges them on:
 
 - catch (``catch_optimised``): the shared set's perturbed 8-10 m/s throws
-  (:func:`analysis.ablation_throws.perturbed_throws` with its seed 20030914: the engine rates'
+  (:func:`analysis.catching.throws.perturbed_throws` with its seed 20030914: the engine rates'
   and the ablations' base cell; the direct mapping was tuned on ``tuning_throws``, 8, 9, 10 m/s
   aimed at a 3 x 3 grid), released through ``plant.params.object_*``; the seed of episode ``i``
   is ``i`` (the stereo cameras' noise);
@@ -37,7 +37,7 @@ def held_out(task: str, n: int) -> list[dict[str, Any]]:
 
 
 def _catch(n: int) -> list[dict[str, Any]]:
-    from analysis.ablation_throws import perturbed_throws, throw_overrides
+    from analysis.catching.throws import perturbed_throws, throw_overrides
 
     return [
         {"seed": i, "set": throw_overrides(th), "input": f"throw {i} ({th['speed']:.2f} m/s)"}

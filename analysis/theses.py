@@ -18,7 +18,7 @@ UNREAD = "not decided"
 
 @dataclass(frozen=True)
 class Thesis:
-    paper: str  # key in replay.papers.PAPERS
+    paper: str  # a registered paper's key (replay.papers)
     claim: str  # the thesis in one sentence
     tables: tuple[str, ...]  # the sweeps (sweeps/NAME.yaml) whose tables decide it
     verdict: str  # module:function({name: rows}) -> {"verdict", "numbers", "figure"}
@@ -39,28 +39,28 @@ THESES: tuple[Thesis, ...] = (
         "Vision at ~1 kHz steering a direct mapping to joint commands catches a ball thrown at "
         "8-10 m/s, without predicting its path.",
         ("catch_rate",),
-        "analysis.ablation_catch:thesis",
+        "analysis.catching.ablations:thesis",
     ),
     Thesis(
         "namiki2003",
         "Optimising the mapping's polynomial offline under torque and velocity limits reduces "
         "the joints' torque and travel (Figs. 6, 8, 9).",
         ("catch_optimisation",),
-        "analysis.ablation_catch_opt:thesis",
+        "analysis.catching.ablation_opt:thesis",
     ),
     Thesis(
         "namiki1999",
         "Closing every loop (vision, head, arm, hand) at 1 ms lets the hand grasp an object a "
         "human moves irregularly, without predicting its motion.",
         ("grasp_loops", "grasp_components"),
-        "analysis.ablation_grasp:thesis",
+        "analysis.grasping.ablations:thesis",
     ),
     Thesis(
         "higashimori2007",
         "The 2-step and 3-step strategies stop a sliding, spinning stick whatever the "
         "fingertip-stick friction.",
         ("stick_conditions", "stick_factors", "stick_workspace", "stick_vision"),
-        "analysis.ablation_stick:thesis",
+        "analysis.stick.ablations:thesis",
     ),
 )
 
@@ -120,7 +120,7 @@ def verdicts(stored_only: bool = False) -> list[Verdict]:
 
 def markdown(rows: list[Verdict]) -> str:
     """The theses as a Markdown table (cells escaped: a table's text is data)."""
-    from replay.papers import PAPERS
+    from replay.papers import papers
     from analysis.report.markup import md
 
     lines = [
@@ -128,7 +128,8 @@ def markdown(rows: list[Verdict]) -> str:
         "|---|---|---|---|---|",
     ]
     for v in rows:
-        paper = PAPERS[v.thesis.paper].title if v.thesis.paper in PAPERS else v.thesis.paper
+        known = papers()
+        paper = known[v.thesis.paper].title if v.thesis.paper in known else v.thesis.paper
         cells = (paper, v.thesis.claim, v.verdict, v.numbers, v.figure)
         lines.append("| " + " | ".join(md(c) for c in cells) + " |")
     return "\n".join(lines)
@@ -136,7 +137,7 @@ def markdown(rows: list[Verdict]) -> str:
 
 def html(rows: list[Verdict]) -> str:
     """The theses as an HTML table (every cell escaped)."""
-    from replay.papers import PAPERS
+    from replay.papers import papers
     from analysis.report.markup import e
 
     head = (
@@ -144,7 +145,8 @@ def html(rows: list[Verdict]) -> str:
     )
     body = []
     for v in rows:
-        paper = PAPERS[v.thesis.paper].title if v.thesis.paper in PAPERS else v.thesis.paper
+        known = papers()
+        paper = known[v.thesis.paper].title if v.thesis.paper in known else v.thesis.paper
         cells = (paper, v.thesis.claim, v.verdict, v.numbers, v.figure)
         body.append("<tr>" + "".join(f"<td>{e(c)}</td>" for c in cells) + "</tr>")
     return f'<table class="theses">{head}{"".join(body)}</table>'

@@ -24,7 +24,6 @@ from replay.console import (
     warn,
     write_text,
 )
-from replay.foxglove.layouts import PAPERS as LAYOUT_PAPERS
 from replay.interfaces import Plant
 from replay.log import LogError, LogReader
 from replay.log.errors import LogWriteError
@@ -773,7 +772,7 @@ def show(name, out):
 
 
 @main.command()
-@click.argument("paper", type=click.Choice(LAYOUT_PAPERS))
+@click.argument("paper", type=click.Choice(registry.names("paper")))
 @click.option(
     "-o", "--out", type=click.Path(dir_okay=False), help="write it to this file (default: stdout)"
 )
@@ -782,7 +781,10 @@ def layout(paper, out):
     scene, camera images, the paper's quantities plotted, the events."""
     from replay.foxglove.layouts import layout_json  # noqa: PLC0415
 
-    text = layout_json(paper)
+    try:
+        text = layout_json(paper)
+    except KeyError as exc:  # a registered paper without a layout
+        fail(str(exc.args[0]))
     if not out:
         click.echo(text, nl=False)
         return

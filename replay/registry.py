@@ -1,5 +1,7 @@
 """Plug-ins found by name through entry points, so a new plant, sensor or controller needs no
-core edit: declare it in a package's ``pyproject.toml`` under one of these groups.
+core edit: declare it in a package's ``pyproject.toml`` under one of these groups. A paper
+registers once (group ``paper_replay.papers``, a :class:`replay.papers.Paper`): the plug-ins it
+names are found here as if each were in its group.
 
 A scenario may also name one by its import path, ``module:Class`` (a ``my_module.py`` beside the
 scenario file, or any importable module): :func:`import_plugin` imports it, for the scenario
@@ -25,13 +27,27 @@ GROUPS = {
     "plant": "paper_replay.plants",
     "sensor": "paper_replay.sensors",
     "controller": "paper_replay.controllers",
-    "figures": "paper_replay.figures",  # paper key -> make(logs_by_name, outdir) -> paths
-    "claims": "paper_replay.claims",  # paper key -> evaluate(logs_by_name) -> [Claim]
+    # paper key -> make(logs_by_name, outdir) -> paths / evaluate(logs_by_name) -> [Claim]: each
+    # paper's registration names its own; these groups stay for a figures/claims plug-in alone
+    "figures": "paper_replay.figures",
+    "claims": "paper_replay.claims",
     "viewer_scene": "paper_replay.viewer_scenes",  # plant type -> replay.viewer RunScene class
     "commands": "paper_replay.commands",  # name -> register(click group): more `replay` commands
     "check": "paper_replay.checks",  # name -> check(scenario) -> a warning for `validate`, or ""
     "sweep_plot": "paper_replay.sweep_plots",  # name -> plot(summary.csv, out folder) -> paths
     "input_sets": "paper_replay.input_sets",  # name -> episodes(task, n) for `replay evaluate`
+    "paper": "paper_replay.papers",  # paper key -> replay.papers.Paper: all of one paper, once
+}
+
+# what a paper's registration adds to a kind: the Paper field of its names -> "module:attr"
+# (figures and claims: the paper's own key)
+_FROM_PAPERS = {
+    "plant": "plants",
+    "sensor": "sensors",
+    "controller": "controllers",
+    "viewer_scene": "viewer_scenes",
+    "figures": "figures",
+    "claims": "claims",
 }
 
 
@@ -39,7 +55,7 @@ class UnknownPlugin(LookupError):
     pass
 
 
-_registered: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}
+_registered: dict[str, dict[str, Any]] = {kind: {} for kind in GROUPS}
 _imported: dict[str, dict[str, type]] = {kind: {} for kind in GROUPS}  # module:Class names
 _folders: dict[tuple[str, str], str] = {}  # (kind, module:Class) -> the folder it came from
 
@@ -48,15 +64,16 @@ _IMPORT_PATH = re.compile(IMPORT_PATH)
 
 
 class _Loaded:
-    def __init__(self, cls: type) -> None:
+    def __init__(self, cls: Any) -> None:
         self.cls = cls
 
-    def load(self) -> type:
+    def load(self) -> Any:
         return self.cls
 
 
-def register(kind: str, name: str, cls: type) -> None:
-    """Register a plug-in in this process only (tests, notebooks); entry points are for packages."""
+def register(kind: str, name: str, cls: Any) -> None:
+    """Register a plug-in (or a paper) in this process only (tests, notebooks); entry points are
+    for packages."""
     _registered[kind][name] = cls
 
 
@@ -67,8 +84,20 @@ def _installed(group: str) -> dict[str, EntryPoint]:
 
 
 def _entries(kind: str) -> dict[str, Any]:
-    found: dict[str, Any] = dict(_installed(GROUPS[kind]))
+    found: dict[str, Any] = _from_papers(kind) if kind in _FROM_PAPERS else {}
+    found.update(_installed(GROUPS[kind]))
     found.update({name: _Loaded(cls) for name, cls in _registered[kind].items()})
+    return found
+
+
+def _from_papers(kind: str) -> dict[str, EntryPoint]:
+    """The ``kind`` plug-ins the registered papers name (a group's entry of the same name wins)."""
+    found: dict[str, EntryPoint] = {}
+    for entry in _entries("paper").values():
+        paper = entry.load()
+        refs = getattr(paper, _FROM_PAPERS[kind])
+        refs = {paper.key: refs} if isinstance(refs, str) else refs
+        found.update({n: EntryPoint(n, ref, GROUPS[kind]) for n, ref in refs.items() if ref})
     return found
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from analysis.grasp_run import (
+from analysis.grasping.run import (
     HOLDING,
     REACHING,
     RELEASING,

@@ -31,8 +31,7 @@ from analysis.figure_files import file_stem, runs_of
 from analysis.needs import figure_notes, skipped_notes
 from replay import registry
 from replay.log import LogError, LogReader
-from replay.papers import PAPERS
-from analysis.report.captions import CAPTIONS, DRAWN_FOR, NAMED
+from replay.papers import Paper, papers
 from analysis.report.folder import check_folder, discard, staging, swap_in
 from analysis.report.markup import e as _e
 from analysis.report.markup import md, md_code, md_fence, pre, url
@@ -134,10 +133,11 @@ def _caption(paper: str, stem: str, shows: str, controllers: Collection[str] = (
     not the method the paper's figure is drawn for."""
     m = re.search(r"fig(\d+)", stem)
     num = int(m.group(1)) if m else 0
-    quoted = CAPTIONS.get(paper, {}).get(num)
-    named = next((t for end, t in NAMED.get(paper, {}).items() if stem.endswith(end)), stem)
+    registered = papers().get(paper) or Paper(paper, paper, "", "", 0)
+    quoted = registered.captions.get(num)
+    named = next((t for end, t in registered.named.items() if stem.endswith(end)), stem)
     base = f"Fig. {num}" if num else named
-    drawn_for = DRAWN_FOR.get((paper, num))
+    drawn_for = registered.drawn_for.get(num)
     others = sorted(c for c in controllers if c != drawn_for)
     if quoted and drawn_for and others:
         return (
@@ -196,7 +196,7 @@ def _build(out: Path, logs_dir: Path) -> None:
     logs = sorted(logs_dir.glob("*.mcap"))
     by_paper, dropped = _readers(logs)
     sections = []
-    for key, paper in PAPERS.items():
+    for key, paper in papers().items():
         sec = PaperSection(key, paper.title, paper.authors)
         readers = by_paper.get(key, {})
         for name, r in sorted(readers.items()):

@@ -5,7 +5,7 @@ A throw: speed and heading (from straight at the palm, -y), spin magnitude with 
 equal odds, orientation uniform in [0, pi), and a pass point: the stick's centre would cross
 y = ``pass_y`` (the paper's first collision at 0.12 m) at x in ``pass_x``, ``pass_time`` after
 the start. The draws are made in that order from the plant's generator (the run's seed), so
-``analysis.stick_throws.random_throw`` gives the same throws from the same generator.
+``analysis.stick.throws.random_throw`` gives the same throws from the same generator.
 """
 
 from __future__ import annotations

@@ -91,11 +91,20 @@ def _drop_part_on_full_disk(exc: BaseException, log: str) -> None:
 
 
 def load_function(ref: str):
-    """``package.module:function`` -> the function."""
+    """``package.module:function`` -> the function. A module its package lists as moved (a
+    ``MOVED = {old: new}`` in the top-level package, e.g. ``analysis``) is found at its new
+    name, so that an old sweep table or sweep file still loads."""
     import importlib
 
     module, _, name = ref.partition(":")
-    return getattr(importlib.import_module(module), name)
+    try:
+        found = importlib.import_module(module)
+    except ModuleNotFoundError as exc:
+        moved = getattr(importlib.import_module(module.split(".")[0]), "MOVED", {})
+        if exc.name != module or module not in moved:
+            raise
+        found = importlib.import_module(moved[module])
+    return getattr(found, name)
 
 
 def _extract(ref: str, runner, log: str) -> dict:

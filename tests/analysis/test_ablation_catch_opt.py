@@ -1,5 +1,5 @@
 """Catching's optimisation thesis at 8-10 m/s against the torque limits (issue #38,
-analysis/ablation_catch_opt.py, sweeps/catch_optimisation.yaml): the falsifiers meet eq. 13, the
+analysis/catching/ablation_opt.py, sweeps/catch_optimisation.yaml): the falsifiers meet eq. 13, the
 sweep file is the one the module makes, every run used the alpha its cell names, and the verdict
 is computed from the stored table."""
 
@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis import ablation_catch_opt as opt
+from analysis.catching import ablation_opt as opt
 from replay.control.catching.optimise import (
     initial_alpha,
     load_alpha,
@@ -177,7 +177,7 @@ def test_plot_is_readable_and_its_rates_carry_wilson_bars(rows, monkeypatch, tmp
     import matplotlib.pyplot as plt
     from matplotlib.container import ErrorbarContainer
 
-    from analysis.ablation_catch import wilson
+    from analysis.catching.ablations import wilson
 
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from test_figure_layout import assert_readable

@@ -1,4 +1,4 @@
-"""The grasp thesis's verdict and the component ablation's sentence (analysis/ablation_grasp.py),
+"""The grasp thesis's verdict and the component ablation's sentence (analysis/grasping/ablations.py),
 computed from rate tables: synthetic ones whose answer is known, and the stored ones."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import csv
 
 import pytest
 
-from analysis import ablation_grasp as ag
+from analysis.grasping import ablations as ag
 from replay.resources import data_path
 
 PERIODS = (1, 2, 5, 10, 15, 20, 33)

@@ -1,12 +1,12 @@
 """The stick's condition sweeps (sweeps/stick_*.yaml) and their reading
-(analysis/ablation_stick.py): the metrics from the truth, the eq.-29 check, the interval tie, the
+(analysis/stick/ablations.py): the metrics from the truth, the eq.-29 check, the interval tie, the
 thesis verdict, and the sweep files' fairness rules."""
 
 from __future__ import annotations
 
 import pytest
 
-from analysis import ablation_stick as ab
+from analysis.stick import ablations as ab
 from replay.sweep import ablations
 
 STICK_SWEEPS = ("stick_conditions", "stick_factors", "stick_workspace", "stick_vision")

@@ -86,7 +86,7 @@ def test_stick_runs_of_one_name_each_get_a_figure_and_the_overlay(stick, tmp_pat
 
 
 def test_catch_variants_are_overlaid_on_the_pair_and_labelled(catch, tmp_path):
-    from analysis.catch_figures import make_figures
+    from analysis.catching.figures import make_figures
 
     logs = runs.keyed(LogReader(catch[k]) for k in ("opt", "ini", "lat", "renamed"))
     paths = make_figures(logs, tmp_path)
@@ -136,12 +136,12 @@ def _doc_rows(doc: str) -> dict[str, str]:
 @pytest.mark.parametrize(
     "doc, module",
     [
-        ("catching.md", "catch_figures"),
-        ("catching.md", "catch_claims"),
-        ("grasping.md", "grasp_figures"),
-        ("grasping.md", "grasp_claims"),
-        ("stick.md", "stick_figures"),
-        ("stick.md", "stick_claims"),
+        ("catching.md", "catching.figures"),
+        ("catching.md", "catching.claims"),
+        ("grasping.md", "grasping.figures"),
+        ("grasping.md", "grasping.claims"),
+        ("stick.md", "stick.figures"),
+        ("stick.md", "stick.claims"),
     ],
 )
 def test_the_docs_list_what_each_figure_and_row_reads(doc, module):
@@ -160,7 +160,7 @@ def test_the_docs_list_what_each_figure_and_row_reads(doc, module):
 
 
 def test_variants_beyond_the_cap_get_a_figure_of_their_own_and_a_note(catch, tmp_path, monkeypatch):
-    from analysis import catch_figures
+    from analysis.catching import figures as catch_figures
     from analysis.needs import skipped_notes
 
     monkeypatch.setattr(catch_figures, "MAX_VARIANTS", 1)
@@ -192,10 +192,10 @@ READ = (
 def test_catch_figures_and_claims_survive_any_topic_missing(catch, tmp_path, topic):
     """Each topic the catch analysis reads, dropped from the optimised run: figures and claims
     are made from the rest; a topic a figure or row needs is named in a note."""
-    from analysis.catch_claims import TOPICS as ROWS
-    from analysis.catch_claims import evaluate
-    from analysis.catch_figures import TOPICS as FIGS
-    from analysis.catch_figures import make_figures
+    from analysis.catching.claims import TOPICS as ROWS
+    from analysis.catching.claims import evaluate
+    from analysis.catching.figures import TOPICS as FIGS
+    from analysis.catching.figures import make_figures
     from analysis.needs import skipped_notes
 
     log = LogReader(forge(catch["opt"], tmp_path / "a.mcap", topic, "catch_optimised"))

@@ -195,7 +195,8 @@ def test_log_has_the_contract_topics(runs, name):
 def test_optimised_run_catches_and_its_outcome_says_so(runs):
     """With eq. 24's omega_max that eq. 4 permits, the optimised mapping catches the 9 m/s throw;
     the run's last event is the outcome with the plant's first-touch metrics."""
-    from analysis.catch_claims import load_run, terminal_error
+    from analysis.catching.metrics import terminal_error
+    from analysis.catching.run import load_run
 
     log = runs["catch_optimised"]["log"]
     kinds = _kinds(log)
@@ -257,7 +258,8 @@ def test_unoptimised_run_catches(runs):
 
 
 def test_hand_closes_before_the_predicted_arrival(runs):
-    from analysis.catch_claims import hand_closing, load_run
+    from analysis.catching.metrics import hand_closing
+    from analysis.catching.run import load_run
 
     run = load_run(runs["catch_optimised"]["log"])
     e = run.first_event("hand_close")
@@ -273,7 +275,7 @@ def test_hand_closes_before_the_predicted_arrival(runs):
 
 # ------------------------------------------------------------------------------ analysis
 def test_figures_from_the_logs(runs, tmp_path):
-    from analysis.catch_figures import make_figures
+    from analysis.catching.figures import make_figures
 
     logs = {n: r["log"] for n, r in runs.items()}
     paths = make_figures(logs, tmp_path / "a")
@@ -294,8 +296,8 @@ def test_figures_from_the_logs(runs, tmp_path):
 
 
 def test_claims_from_the_logs(runs):
-    from analysis import catch_thesis_claims as thesis
-    from analysis.catch_claims import evaluate
+    from analysis.catching import thesis_claims as thesis
+    from analysis.catching.claims import evaluate
 
     logs = {n: r["log"] for n, r in runs.items()}
     rows = evaluate(logs)

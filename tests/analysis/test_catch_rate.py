@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.ablation_catch import (
+from analysis.catching.ablations import (
     BALLISTIC,
     FREE,
     PREDICTOR,
@@ -21,7 +21,7 @@ from analysis.ablation_catch import (
     step_response,
     thesis,
 )
-from analysis.ablation_throws import perturbed_throws
+from analysis.catching.throws import perturbed_throws
 
 KP, KD = [900.0, 1500.0, 300.0, 150.0], [30.0, 45.0, 10.0, 4.0]  # the scenarios' 1 ms gains
 

@@ -1,4 +1,4 @@
-"""Issue #21's thesis rows (analysis/catch_thesis_claims.py) on fresh runs of the four catch
+"""Issue #21's thesis rows (analysis/catching/thesis_claims.py) on fresh runs of the four catch
 scenarios: windows end at first contact, ties are ties, the clamped model predicts the run, and
 at 4.5 m/s (outside the paper's speeds) eq. 25 does what Figs. 6, 8 and 9 show."""
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from analysis import catch_thesis_claims as C
+from analysis.catching import thesis_claims as C
 from analysis.series import events
 from replay.log import LogReader
 
@@ -70,7 +70,7 @@ def test_every_pair_row_status_follows_its_numbers(logs, table):
 
 
 def test_the_paper_regime_restates_no_finding_of_the_catch_table(table):
-    """Fig. 6 and the catch at 8-10 m/s are rows of analysis.catch_claims (one row per
+    """Fig. 6 and the catch at 8-10 m/s are rows of analysis.catching.claims (one row per
     finding): the thesis rows of the paper's regime are Figs. 8, 9 and the model note only;
     the extension's rows are of kind "extension"."""
     paper = [q for q in table if q.startswith(C.PAIRS[0].regime)]
@@ -121,8 +121,9 @@ def test_the_falsifier_turns_the_4_5_ms_rows_to_differs(logs, tmp_path):
 
 
 def test_figures_8_9_end_at_first_contact_and_exist_for_the_slow_pair(logs, tmp_path):
-    from analysis.catch_claims import first_contact, load_run
-    from analysis.catch_figures import _joint_figure, make_figures
+    from analysis.catching.metrics import first_contact
+    from analysis.catching.run import load_run
+    from analysis.catching.figures import _joint_figure, make_figures
 
     names = {p.name for p in make_figures(logs, tmp_path)}
     for k in (6, 8, 9):

@@ -1,4 +1,4 @@
-"""The shared throw set of issue #21 (analysis.ablation_catch, analysis.ablation_throws): the same
+"""The shared throw set of issue #21 (analysis.catching.ablations, analysis.catching.throws): the same
 seeded throws for every catching controller, Wilson intervals, failure reasons, and the
 predict-then-intercept baseline's competence on throws it was not tuned to."""
 
@@ -12,14 +12,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.ablation_catch import (
+from analysis.catching.ablations import (
     SHARED_CELLS,
     SHARED_CONTROLLERS,
     run_shared,
     shared_table,
     wilson,
 )
-from analysis.ablation_throws import (
+from analysis.catching.throws import (
     CATCH_POINT,
     G,
     T0,

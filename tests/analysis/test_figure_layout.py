@@ -12,9 +12,11 @@ import matplotlib.pyplot as plt
 import pytest
 from matplotlib.text import Annotation, Text
 
-from analysis import catch_figures, grasp_figures, stick_figures
-from analysis.catch_claims import load_run
-from analysis.grasp_run import load_run as load_grasp
+from analysis.catching import figures as catch_figures
+from analysis.grasping import figures as grasp_figures
+from analysis.stick import figures as stick_figures
+from analysis.catching.run import load_run
+from analysis.grasping.run import load_run as load_grasp
 from replay.log import LogReader
 from replay.runner import Runner
 from replay.scenario import load_scenario
@@ -191,11 +193,11 @@ def test_grasp_fig9_footer_explains_only_what_is_drawn():
 # -- the ablation plots: rates as k/n with Wilson 95 % intervals -------------------------------
 
 ABLATIONS = [
-    ("analysis.ablation_catch", "plot_rate", "catch_rate"),
-    ("analysis.ablation_catch", "plot_throw_speed", "catch_throw_speed"),
-    ("analysis.ablation_catch", "plot_arm_limits", "catch_arm_limits"),
-    ("analysis.ablation_stick", "plot_vision", "stick_vision"),
-    ("analysis.ablation_grasp", "plot_loops", "grasp_loops"),
+    ("analysis.catching.ablations", "plot_rate", "catch_rate"),
+    ("analysis.catching.ablations", "plot_throw_speed", "catch_throw_speed"),
+    ("analysis.catching.ablations", "plot_arm_limits", "catch_arm_limits"),
+    ("analysis.stick.ablations", "plot_vision", "stick_vision"),
+    ("analysis.grasping.ablations", "plot_loops", "grasp_loops"),
 ]
 
 
@@ -205,7 +207,7 @@ def test_ablation_rates_have_n_and_wilson_error_bars(module, func, table, monkey
 
     from matplotlib.container import ErrorbarContainer
 
-    from analysis.ablation_catch import wilson
+    from analysis.catching.ablations import wilson
     from replay.sweep.table import read_table
 
     mod = importlib.import_module(module)

@@ -1,4 +1,4 @@
-"""The grasping figures (analysis/grasp_figures.py) and claims (analysis/grasp_claims.py) from
+"""The grasping figures (analysis/grasping/figures.py) and claims (analysis/grasping/claims.py) from
 synthetic logs with the contract's topics (grasp_synthetic.py): they read what the log holds, and
 each claim's status follows the numbers (a log that breaks a claim gets "differs")."""
 
@@ -14,7 +14,7 @@ from replay.log import LogReader
 
 def _rows(path) -> dict[str, object]:
     """The table's rows and the run's own (its "g: " dropped) by claim."""
-    from analysis.grasp_claims import evaluate, per_run
+    from analysis.grasping.claims import evaluate, per_run
 
     logs = {"g": LogReader(path)}
     table = {r.quantity: r for r in evaluate(logs)}
@@ -34,12 +34,12 @@ def logs(tmp_path_factory):
 
 
 def test_analysis_is_registered_under_the_papers_key():
-    assert registry.load("figures", "namiki1999").__module__ == "analysis.grasp_figures"
-    assert registry.load("claims", "namiki1999").__module__ == "analysis.grasp_claims"
+    assert registry.load("figures", "namiki1999").__module__ == "analysis.grasping.figures"
+    assert registry.load("claims", "namiki1999").__module__ == "analysis.grasping.claims"
 
 
 def test_phases_and_cycles_from_the_schedule(logs):
-    from analysis.grasp_run import load_run
+    from analysis.grasping.run import load_run
 
     run = load_run(LogReader(logs["box"]))
     assert [p.name for p in run.phases] == [
@@ -57,7 +57,7 @@ def test_phases_and_cycles_from_the_schedule(logs):
 
 
 def test_figures_png_and_svg_and_the_same_log_gives_the_same_svg(logs, tmp_path):
-    from analysis.grasp_figures import make_figures
+    from analysis.grasping.figures import make_figures
 
     a = make_figures({"box": LogReader(logs["box"])}, tmp_path / "a")
     b = make_figures({"box": LogReader(logs["box"])}, tmp_path / "b")
@@ -74,8 +74,8 @@ def test_figures_png_and_svg_and_the_same_log_gives_the_same_svg(logs, tmp_path)
 
 
 def test_filmstrip_frames_cover_the_first_cycle(logs):
-    from analysis.grasp_figures import filmstrip_times
-    from analysis.grasp_run import load_run
+    from analysis.grasping.figures import filmstrip_times
+    from analysis.grasping.run import load_run
 
     times = filmstrip_times(load_run(LogReader(logs["box"])))
     ts = [t for t, _ in times]

@@ -38,7 +38,7 @@ def logs(tmp_path_factory):
 @pytest.fixture(scope="module")
 def rows(logs):
     """The table's rows (one per claim, over every run) and each run's own, "<run>: <claim>"."""
-    from analysis.grasp_claims import evaluate, per_run
+    from analysis.grasping.claims import evaluate, per_run
 
     table = {r.quantity: r for r in evaluate(logs)}
     for own in per_run(logs).values():
@@ -49,7 +49,7 @@ def rows(logs):
 @functools.cache
 def _run(log):
     """A log's GraspRun, loaded once for the module (~1.2 s of CPU each): the tests only read it."""
-    from analysis.grasp_run import load_run
+    from analysis.grasping.run import load_run
 
     return load_run(log)
 
@@ -59,7 +59,7 @@ def _row(rows, name, what):
 
 
 def test_fig9_and_filmstrip_from_each_run(logs, tmp_path):
-    from analysis.grasp_figures import filmstrip_times, make_figures
+    from analysis.grasping.figures import filmstrip_times, make_figures
 
     paths = make_figures(logs, tmp_path)
     names = {p.name for p in paths}
@@ -96,7 +96,7 @@ def test_loops_run_every_1ms_with_latency_under_1_5ms(rows):
 
 
 def test_timing_read_as_ms_is_inconsistent_with_the_arm(rows, logs):
-    from analysis.grasp_claims import cycle_timing
+    from analysis.grasping.metrics import cycle_timing
 
     ct = cycle_timing(_run(logs["grasp_hexahedron"]))
     assert ct["track"] == pytest.approx(0.5, abs=1e-3)
@@ -121,7 +121,7 @@ def test_preshape_matches_the_shape(rows, name, shape):
 def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
     """The hold row is reproduced exactly when the plant saw a grasp with no slip or drop and
     the object stayed with the hand: the row is the log's, whichever way it goes."""
-    from analysis.grasp_claims import HOLD_DRIFT, holds
+    from analysis.grasping.metrics import HOLD_DRIFT, holds
 
     h = holds(_run(logs[name]))
     row = _row(rows, name, "the grasp holds while the human keeps moving the object")
@@ -139,7 +139,7 @@ def test_the_grasp_row_says_what_the_plant_saw(rows, logs, name):
 
 
 def test_release_phase_tracking_error_is_measured(rows, logs):
-    from analysis.grasp_claims import tracking_error
+    from analysis.grasping.metrics import tracking_error
 
     run = _run(logs["grasp_cycle"])
     te = tracking_error(run, ("release",))
@@ -156,7 +156,7 @@ def test_release_phase_tracking_error_is_measured(rows, logs):
 
 
 def test_no_prediction_the_hand_follows_the_object(rows, logs):
-    from analysis.grasp_claims import tracking_lag
+    from analysis.grasping.metrics import tracking_lag
 
     for name in RUNS:
         lag = tracking_lag(_run(logs[name]))
@@ -220,7 +220,7 @@ def test_every_falsifier_names_a_measured_row_and_the_new_rows_are_there(rows):
     """FALSIFIERS (replay falsify runs them) name measured rows of these runs; the rows of
     eqs. 1, 3, 4 / compliance, x^o and Fig. 9's X are in the table with a verdict from the
     truth topics, and no configuration echo is marked reproduced."""
-    from analysis.grasp_claims import FALSIFIERS
+    from analysis.grasping.claims import FALSIFIERS
 
     table = rows  # quantity -> row
     for f in FALSIFIERS:
@@ -240,7 +240,7 @@ def test_every_falsifier_names_a_measured_row_and_the_new_rows_are_there(rows):
 def test_every_reproduced_measured_row_has_a_falsifier(rows):
     """What `replay falsify` requires: no measured row of these runs reads "reproduced" without
     a declared variant that must turn it to "differs"."""
-    from analysis.grasp_claims import FALSIFIERS
+    from analysis.grasping.claims import FALSIFIERS
 
     covered = {f.row for f in FALSIFIERS}
     table = [q for q in rows if not q.startswith(tuple(f"{n}: " for n in RUNS))]  # (not per run)
@@ -251,7 +251,7 @@ def test_every_reproduced_measured_row_has_a_falsifier(rows):
 def test_look_then_move_breaks_eq3s_partition(rows, tmp_path):
     """The partition row's falsifier, run: without S K^a1 while reaching (a sequential
     controller) the hand leaves the moving box behind in the plane during the reach."""
-    from analysis.grasp_claims import FALSIFIERS, evaluate
+    from analysis.grasping.claims import FALSIFIERS, evaluate
     from replay.log import LogReader
     from replay.runner import Runner
     from replay.scenario import load_scenario

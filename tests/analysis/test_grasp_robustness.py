@@ -1,7 +1,7 @@
 """Issue #20: the grasp judged by its physics on inputs it was not tuned to. Box and sphere, on
 seeds the scenarios do not use (they use 0) and human speeds across 0.05-0.3 m/s (the
 scenarios': 0.10), judged from the truth topics alone by the test's own criterion
-(analysis/grasp_judge.py, shared with the MuJoCo rig's test), not by the run's outcome flag:
+(analysis/grasping/judge.py, shared with the MuJoCo rig's test), not by the run's outcome flag:
 
 - grasped: the plant's grasp event (contacts) and the object held for >= 0.5 s after it;
 - held: during that hold the object stays within 10 mm of where it sat in the true hand frame;
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.grasp_judge import physical_verdict
+from analysis.grasping.judge import physical_verdict
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = [

@@ -1,13 +1,13 @@
 """The theses' harder conditions never log a success the physics rejects: variants of the grasp's
 rate study at its faster motion (0.4 m/s RMS with kicks), at a fast and a slow loop, rerun and
-judged from the truth topics by the test's own criterion (analysis/grasp_judge.py), not by the
+judged from the truth topics by the test's own criterion (analysis/grasping/judge.py), not by the
 run's outcome flag; and every stored success of the new sweeps carries its physical evidence."""
 
 from __future__ import annotations
 
 import pytest
 
-from analysis.grasp_judge import physical_verdict
+from analysis.grasping.judge import physical_verdict
 from replay.log import LogReader
 from replay.sweep import ablations
 from replay.sweep.table import read_table

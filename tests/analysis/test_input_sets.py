@@ -36,7 +36,7 @@ def test_held_out_episodes_start_pairwise_different(task, scenario, tmp_path):
 
 
 def test_catch_held_out_throws_are_none_of_the_tuning_throws(tmp_path):
-    from analysis.ablation_throws import tuning_throws
+    from analysis.catching.throws import tuning_throws
 
     tuning = np.array([t["velocity"] for t in tuning_throws()])
     for ep in held_out("catch", 5):

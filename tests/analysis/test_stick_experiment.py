@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from analysis.stick_claims import evaluate
-from analysis.stick_figures import make_figures
+from analysis.stick.claims import evaluate
+from analysis.stick.figures import make_figures
 from replay.robot.stick_impact import spin_before_pure_rotation
 from replay.log import LogReader
 from replay.runner import Runner

@@ -2,10 +2,10 @@
 al. 2007 shows one throw each): the full pipeline (Pymunk air table, rendered 300 fps camera,
 the strategy), read through the run's ``outcome`` event.
 
-Throws (``analysis.stick_throws.random_throw``): speed 0.8-1.4 m/s, heading +-15 deg, spin
+Throws (``analysis.stick.throws.random_throw``): speed 0.8-1.4 m/s, heading +-15 deg, spin
 4-14 rad/s either way, any orientation, passing y = 0.12 m at x in +-6 cm 0.20-0.35 s after the
 start. Each strategy's capture rate is printed; it must stay >= 80 % here (90 % is the aim, met
-on the 20-throw audit: ``python -m analysis.stick_throws``), and every run that does not capture
+on the 20-throw audit: ``python -m analysis.stick.throws``), and every run that does not capture
 ends with an outcome whose reason says why. A throw that passes beyond the hand's reach says so.
 """
 
@@ -18,7 +18,7 @@ import pytest
 
 from click.testing import CliRunner
 
-from analysis.stick_throws import random_throw, run_throw
+from analysis.stick.throws import random_throw, run_throw
 from replay.cli import main
 
 N_THROWS = {"stick_2step": 14, "stick_3step": 10}  # ~2 s and ~4 s of CPU per run

@@ -450,7 +450,7 @@ def test_a_log_full_of_collisions_draws_a_bounded_fig7(stick_3step_log, tmp_path
     """A log of 3,000 forged collision events: every one was a dashed line on both panels and
     a label placed against all others (~190 s, quadratic); now the first MAX_MARKS are drawn
     and the footer says so, and `figures` stays quick."""
-    from analysis import stick_figures
+    from analysis.stick import figures as stick_figures
     from analysis.line_labels import MAX_MARKS, MORE
 
     log = _with_events(stick_3step_log, tmp_path / "many.mcap", "collision", 3000, 0.1, 1.8)
@@ -467,7 +467,7 @@ def test_a_log_full_of_collisions_draws_a_bounded_fig7(stick_3step_log, tmp_path
 
 
 def test_a_good_runs_fig7_is_not_capped(stick_3step_log):
-    from analysis import stick_figures
+    from analysis.stick import figures as stick_figures
     from analysis.line_labels import MORE
 
     fig = stick_figures.fig7(LogReader(stick_3step_log))
@@ -484,8 +484,9 @@ def test_catch_and_grasp_marks_are_bounded_too():
 
     import matplotlib.pyplot as plt
 
-    from analysis import catch_figures, grasp_figures
-    from analysis.grasp_run import RELEASING, REACHING, Phase
+    from analysis.catching import figures as catch_figures
+    from analysis.grasping import figures as grasp_figures
+    from analysis.grasping.run import RELEASING, REACHING, Phase
     from analysis.line_labels import MAX_MARKS, MORE
 
     n = 5 * MAX_MARKS
@@ -515,7 +516,7 @@ def test_catch_and_grasp_marks_are_bounded_too():
 def test_a_figure_title_shows_a_names_control_characters_escaped(stick_3step_log, tmp_path):
     """Fig. 7's title of a run named with ESC/OSC/CR: escaped text, no raw control character
     (matplotlib had none of their glyphs and warned once for each)."""
-    from analysis import stick_figures
+    from analysis.stick import figures as stick_figures
 
     log = forge(stick_3step_log, tmp_path / "esc.mcap", name=ESCAPES)
     r = invoke("figures", log, "-o", tmp_path / "figs")

@@ -30,6 +30,35 @@ def test_the_core_imports_no_analysis_and_no_plant():
     assert not {k: v for k, v in bad.items() if v}
 
 
+def _modules(path: Path) -> set[str]:
+    """The full name of every module ``path`` imports (module level or inside functions)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            found |= {node.module} | {f"{node.module}.{a.name}" for a in node.names}
+    return found
+
+
+def test_the_core_imports_no_paper():
+    """Outside the methods (replay/control/), the core reaches a paper only through its
+    registration (replay.papers, entry point paper_replay.papers)."""
+    control = ROOT / "replay" / "control"
+    bad = {
+        str(p.relative_to(ROOT)): sorted(m for m in _modules(p) if m.startswith("replay.control"))
+        for p in (ROOT / "replay").rglob("*.py")
+        if control not in p.parents
+    }
+    assert not {k: v for k, v in bad.items() if v}
+
+
+def test_the_paper_scan_sees_a_method_import(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text("def f():\n    from replay import control\n    import replay.control.stick\n")
+    assert {"replay.control", "replay.control.stick"} <= _modules(probe)
+
+
 def test_methods_import_no_simulator():
     bad = {
         str(p.relative_to(ROOT)): sorted(_imports(p) & SIMULATORS)

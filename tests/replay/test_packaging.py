@@ -37,7 +37,7 @@ def decoys(tmp_path_factory):
 
 def test_python_m_from_a_folder_with_decoys_uses_the_installed_packages(decoys):
     """``python -m`` puts the current directory first on sys.path: without the guard, the run
-    failed on ``plants.airtable`` and figures on ``analysis.stick_figures``."""
+    failed on ``plants.airtable`` and figures on ``analysis.stick.figures``."""
     for command in (["figures", "s.mcap", "-o", "figs"], ["claims", "s.mcap"]):
         r = subprocess.run(
             [sys.executable, "-m", "replay.cli", *command],
@@ -54,7 +54,7 @@ def test_python_m_from_a_folder_with_decoys_uses_the_installed_packages(decoys):
 def test_a_notebook_importing_replay_first_gets_the_installed_packages(decoys):
     code = (
         "import sys; sys.path.insert(0, '')\n"  # (a notebook's cwd first, as Jupyter puts it)
-        "import replay.registry, analysis.stick_figures, plants.airtable, analysis, plants\n"
+        "import replay.registry, analysis.stick.figures, plants.airtable, analysis, plants\n"
         "print(analysis.__file__); print(plants.__file__)\n"
     )
     r = subprocess.run(

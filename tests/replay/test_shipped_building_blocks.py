@@ -11,7 +11,8 @@ from click.testing import CliRunner
 
 from replay.cli import main
 from replay.control.catching.controller import alpha_path
-from replay.foxglove.layouts import PAPERS, layout
+from replay.foxglove.layouts import layout
+from replay.papers import papers
 from replay.resources import scenario_dir
 from replay.scenario import ScenarioError, load_scenario
 
@@ -79,7 +80,7 @@ def test_show_copies_of_extending_scenarios_still_load(tmp_path):
 
 
 def test_layouts_for_every_paper(tmp_path):
-    for paper in PAPERS:
+    for paper in papers():
         out = tmp_path / f"{paper}.json"
         r = cli("layout", paper, "-o", out)
         assert r.exit_code == 0, r.output

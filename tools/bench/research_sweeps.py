@@ -3,7 +3,7 @@ full-log ``replay run`` of the same scenario and against the bare engine.
 
 Three workloads, each a ``--no-logs`` sweep with 2 local workers into a fresh folder:
 
-- catch_optimised over N perturbed throws (``analysis.ablation_throws.perturbed_throws(N,
+- catch_optimised over N perturbed throws (``analysis.catching.throws.perturbed_throws(N,
   spread=0.1)``, the throws of sweeps/catch_rate.yaml's neighbourhood), 0.45 s each, stopped at
   the catch or miss (catch_rate's settings);
 - grasp_hexahedron over N human paths (the run's seed draws the human hand's path), each
@@ -59,7 +59,7 @@ class Workload:
 
 
 def _catch(n: int) -> Workload:
-    from analysis.ablation_throws import perturbed_throws
+    from analysis.catching.throws import perturbed_throws
 
     throws = [
         {

@@ -123,7 +123,7 @@ class ArmParams:
         unit="rad/(s*N*m)",
         ge=0.0,
         doc="eq. 2's K^af (scalar times I): compliance to the external wrench on the hand "
-        "(assumed; the ablation analysis/ablation_grasp.py compares 0, 0.3 and 0.6)",
+        "(assumed; the ablation analysis/grasping/ablations.py compares 0, 0.3 and 0.6)",
     )
     grasp_point: float = param(
         0.045,

@@ -171,7 +171,7 @@ class StickCaptureParams:
         le=0.01,
         doc="a new estimate re-plans a committed contact only when it moves the fingertip "
         "spot by more than this (our choice, ~0.03 px of the 512 px camera; on the seeded "
-        "20-throw audit, analysis.stick_throws, 3e-5 and 5e-5 m keep the 3-step's 19/20 of "
+        "20-throw audit, analysis.stick.throws, 3e-5 and 5e-5 m keep the 3-step's 19/20 of "
         "re-planning on every estimate, 1e-4 gives 18/20: one throw's closing meets the "
         "stick 20 ms later and its front tip is hit) ...",
     )

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.stick_throws import random_throw
+from analysis.stick.throws import random_throw
 from plants.airtable import AirTablePlant, Params, ThrowParams
 from plants.airtable.throw import draw
 from replay.params import ParamError
@@ -54,7 +54,7 @@ def test_a_throw_stays_in_its_ranges_and_crosses_the_pass_line(seed):
 def test_fixed_levels_and_the_audit_draw_the_same_throws():
     t = draw(np.random.default_rng(5), ThrowParams(speed=[1.6, 1.6], spin=[20.0, 20.0]))
     assert math.hypot(t["vx"], t["vy"]) == pytest.approx(1.6) and abs(t["omega"]) == 20.0
-    # analysis.stick_throws draws its audit throws with the plant's function
+    # analysis.stick.throws draws its audit throws with the plant's function
     th = random_throw(np.random.default_rng(7))
     assert (th.x, th.omega) == tuple(
         draw(np.random.default_rng(7), ThrowParams())[k] for k in ("x", "omega")

@@ -30,7 +30,7 @@ def logs(tmp_path_factory):
 
 
 def test_every_catch_row_shows_both_engines(logs):
-    from analysis.catch_claims import evaluate
+    from analysis.catching.claims import evaluate
 
     pb, mj = split_logs(logs)
     assert set(pb) == set(mj) == set(NAMES)

@@ -2,7 +2,7 @@
 their PyBullet twins only in the plant; the plant gives the PyBullet rig's truth topics with the
 same fields; box and ball are grasped and held on seeds and human speeds the scenarios do not use
 (they use seed 0 at 0.10 m/s), judged from the truth topics by the PyBullet robustness test's
-own criterion (analysis/grasp_judge.py), >= 90 %; and the contact stiffness chosen (solref) still
+own criterion (analysis/grasping/judge.py), >= 90 %; and the contact stiffness chosen (solref) still
 grasps at half and twice its value."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import pytest
 import yaml
 from grasp_rig import DT, rig
 
-from analysis.grasp_judge import physical_verdict
+from analysis.grasping.judge import physical_verdict
 from plants.mujoco_arm.grasp_plant import MujocoGraspPlant
 from plants.mujoco_arm.params import GraspParams
 from plants.mujoco_arm.viewer_scene import MujocoGraspScene
@@ -153,10 +153,10 @@ def test_contact_stiffness_neighbours_still_grasp(tmp_path, stiffness):
 
 
 def test_every_grasp_row_shows_both_engines(tmp_path):
-    """analysis/engines.py joins the grasp claims (analysis.grasp_claims) of both engines' runs
+    """analysis/engines.py joins the grasp claims (analysis.grasping.claims) of both engines' runs
     of the same scenarios, each decided on its own engine's truth; the hold holds in both."""
     from analysis.engines import closing_note, engine_rows, split_logs
-    from analysis.grasp_claims import STABLE, evaluate
+    from analysis.grasping.claims import STABLE, evaluate
     from replay.log import LogReader
     from replay.runner import Runner
     from replay.scenario import load_scenario

@@ -17,7 +17,7 @@ from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.sensors.raster import _pixels  # the accelerator, or None where not built
 from replay.sensors.silhouette import _body_points, project_hull
 from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
-from replay.sensors.stick_camera import (
+from plants.airtable.camera import (
     StickCamera,
     StickCameraParams,
     _moments_opencv,
@@ -221,7 +221,7 @@ def reference_measure(cam, scene):
 
 
 def test_stick_camera_accuracy_bias_and_noise_before_and_after():
-    """The stated accuracy (replay/sensors/stick_camera.py): noise-free, over 200 random poses
+    """The stated accuracy (plants/airtable/camera.py): noise-free, over 200 random poses
     of the stick_3step geometry (1.8 mm per pixel, no fingertips), the error of the measured
     (x, y, theta) against the true pose. Measured, after (the compiled kernels) and before (the
     closed-form coverage and OpenCV moments) alike: bias x +0.4, y -0.5 um, theta +0.0005 deg;

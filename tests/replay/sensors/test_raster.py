@@ -150,7 +150,7 @@ def kernel_error(call):
 print(kernel_error(lambda: coverage([poly], 0, 0, 8, 8)))
 print(kernel_error(lambda: composite(np.zeros((8, 8), np.float32), [poly], [200.0])))
 if which == 0:  # the stick camera's compiled frame, the stick and its marker at a bad place
-    from replay.sensors.stick_camera import StickCamera, StickCameraParams
+    from plants.airtable.camera import StickCamera, StickCameraParams
     cam = StickCamera(StickCameraParams(), rng=np.random.default_rng(0))
     marker = Box("marker", (bad, 0.0, 0.01), (0.0, 0.0, 0.0, 1.0), (0.08, 0.006, 0.002), 1.0)
     near = Box("stick", (bad, 0.0, 0.005), (0.0, 0.0, 0.0, 1.0), (0.2, 0.02, 0.01), 0.5)

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 
 import cv2
 import numpy as np
 import pytest
 import yaml
 
+from replay import registry
 from replay.interfaces import Sensor
 from replay.messages import VisionObject, to_dict
 from replay.scenario.loader import ScenarioError, build_dataclass
@@ -25,7 +25,6 @@ from replay.sensors.silhouette import (
 )
 from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 
-from conftest import ROOT
 from pixel_checks import in_image
 
 R_BALL = 0.0175  # the bullet_arm plant's ball (35 mm, assumed)
@@ -84,8 +83,7 @@ def test_is_a_sensor_with_declared_params_and_entry_point():
     p = StereoBallCameraParams()
     assert (p.width, p.height, p.noise_sigma, p.tracked) == (128, 128, 0.0, "ball")
     assert np.linalg.norm(np.subtract(p.cam0_position, p.cam1_position)) == pytest.approx(0.8)
-    eps = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"]
-    assert eps["paper_replay.sensors"]["stereo_ball"] == "replay.sensors.stereo:StereoBallCamera"
+    assert registry.load("sensor", "stereo_ball") is StereoBallCamera  # (the catch's registration)
 
 
 def test_params_load_strictly_from_yaml():

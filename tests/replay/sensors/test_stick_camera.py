@@ -11,7 +11,7 @@ from replay.messages import VisionStick
 from replay.scene import Box, Cylinder, Scene, Sphere
 from replay.spatial import yaw_quaternion
 from replay.sensors.pinhole import PinholeCamera
-from replay.sensors.stick_camera import StickCamera, StickCameraParams, render_scene, wrap_half_pi
+from plants.airtable.camera import StickCamera, StickCameraParams, render_scene, wrap_half_pi
 
 from pixel_checks import in_image
 

@@ -1,5 +1,5 @@
 """The ablations' sweep files (sweeps/*.yaml): they load, vary real fields, carry the throws that
-analysis/ablation_throws.py derives, and their plots and sentences come from their tables."""
+analysis/catching/throws.py derives, and their plots and sentences come from their tables."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import functools
 import numpy as np
 import pytest
 
-from analysis.ablation_throws import release
+from analysis.catching.throws import release
 from replay.sweep import ablations
 from replay.sweep.table import read_table
 from replay.sweep.variants import check_keys, expand

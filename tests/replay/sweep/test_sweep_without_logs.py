@@ -101,13 +101,13 @@ def _same(a: dict, b: dict) -> None:
 @pytest.mark.parametrize(
     "scenario,sets,metrics",
     [
-        ("stick_3step", ["timing.duration=1.0"], "analysis.ablation_stick:run_metrics"),
-        ("stick_3step", ["timing.duration=1.0"], "analysis.ablation_stick:first_collision"),
-        ("catch_optimised", ["timing.duration=0.5"], "analysis.ablation_catch:catch_metrics"),
+        ("stick_3step", ["timing.duration=1.0"], "analysis.stick.ablations:run_metrics"),
+        ("stick_3step", ["timing.duration=1.0"], "analysis.stick.ablations:first_collision"),
+        ("catch_optimised", ["timing.duration=0.5"], "analysis.catching.ablations:catch_metrics"),
         (
             "catch_optimised",  # (as sweeps/catch_optimisation.yaml's cells: torque limits)
             ["timing.duration=0.45", "plant.params.torque_limits=[60, 60, 45, 30]"],
-            "analysis.ablation_catch_opt:effort_metrics",
+            "analysis.catching.ablation_opt:effort_metrics",
         ),
         ("grasp_hexahedron", ["timing.duration=0.3"], f"{__name__}:every_topic"),
         ("catch_optimised_mujoco", ["timing.duration=0.45"], f"{__name__}:every_topic"),

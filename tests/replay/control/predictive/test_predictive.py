@@ -63,7 +63,7 @@ def test_plans_land_the_palm_on_the_true_arc_over_throws(spec):
     the plan ~0.1 s ahead; accel_sigma 2 m/s^2 lets the filter follow kicks), and the
     torque-feasible rollout puts the catch point l(q) within 1 cm of it, palm within 45 deg of
     the incoming ball (the arm cannot turn it further in time: the runs' approach angles)."""
-    from analysis.ablation_throws import CATCH_POINT, THROW_START
+    from analysis.catching.throws import CATCH_POINT, THROW_START
     from replay.control.catching.trajectories import launch_velocity
 
     arm, params = spec

@@ -13,7 +13,7 @@ start is then on the 300 fps camera's view).
 ``out_of_reach=True`` throws it across the table instead, along x at y = 0.50-0.58 m, where no
 fingertip can get (slider +-0.2 m, finger reach 0.14 m: y <= 0.34 m).
 
-    .venv/bin/python -m analysis.stick_throws --n 20 [--strategy stick_2step] [--seed 1] [-v]
+    .venv/bin/python -m analysis.stick.throws --n 20 [--strategy stick_2step] [--seed 1] [-v]
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 Logs are recognised by their scenario, not only their name: a run whose controller uses
 ``mapping: optimised`` is an optimised run, ``initial`` an unoptimised one. Figs. 8/9 (the
 optimised against the initial mapping, windows ending at the first contact) are the rows of
-``analysis.catch_thesis_claims``, one set per speed regime.
+``analysis.catching.thesis_claims``, one set per speed regime.
 
 Which rows count (analysis/claims.py): only those measured on the paper's own experiment,
 :data:`PAPER_RUNS` (Sec. IV: throws at 8-10 m/s, the direct mapping, the stated arm and hand);
@@ -19,407 +19,68 @@ Times used throughout (all from the log):
 - ``t_c`` the last control step before the mapping reached the catch surface |r_o - O| = |c|
   (the ``mapping_hold`` event; q4 = q_alpha there, eq. 4's t_c);
 - first ``contact`` of ball and robot, and ``catch`` / ``miss`` / ``drop`` from the plant.
+
+A run's log is read by ``analysis.catching.run``, its quantities measured by
+``analysis.catching.metrics``, the falsifiers are ``analysis.catching.falsifiers``; this module
+makes the rows.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
-from dataclasses import dataclass, field
 
 import numpy as np
 import yaml
 
-from analysis import catch_thesis_claims as thesis
-from analysis.claims import Claim, Falsifier, agrees, merge
+from analysis.catching import thesis_claims as thesis
+from analysis.catching.falsifiers import FALSIFIERS as FALSIFIERS  # (beside evaluate: claims.py)
+from analysis.catching.metrics import (
+    arm_capability,
+    arrival_speed,
+    closest_approach,
+    first_contact,
+    hand_closing,
+    initial_error,
+    opt_limits,
+    run_outcome,
+    terminal_error,
+    throw_speed,
+    tool_peaks,
+    vision_accuracy,
+)
+from analysis.catching.run import (
+    optimised_and_initial,
+    ACTIVE,
+    FEEDBACK,
+    LIMITED,
+    PAPER_THROWS,
+    CatchRun,
+    load_run,
+    scope,
+)
+from analysis.claims import Claim, agrees, merge
 from analysis.needs import has
-from analysis.series import events
-from plants.arm_rig.settings import ArmSettings, resolve
 from replay.log import LogReader
 from replay.messages import (
     TOPIC_ARM_JOINT_COMMAND,
     TOPIC_ARM_JOINT_STATE,
-    TOPIC_CATCHING_STATE,
     TOPIC_EFFECTOR_MOTION,
     TOPIC_EFFECTOR_STATE,
     TOPIC_HAND_JOINT_STATE,
     TOPIC_OBJECT_STATE,
-    TOPIC_OPTIMIZATION_COST,
-    TOPIC_VISION_OBJECT,
 )
 from replay.resources import data_path
-from replay.scenario import scenario_from_text
 
 STATED = data_path("claims", "namiki2003.yaml")
-ACTIVE = (0, 1, 3)  # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
-JOINTS = ("J1", "J2", "J4")
-# the paper's own throws (Sec. IV-B: "about 8 ~ 10 m/s"), all with the optimised mapping
-PAPER_THROWS = ("catch_8ms", "catch_optimised", "catch_10ms")
-LIMITED = "catch_enforced_limits"  # catch_optimised with the arm held to its speed limits
-FEEDBACK = "catch_feedback"  # the "simple feedback control" of Sec. IV-B (replay/control/feedback)
-# the paper's own experiment (Sec. IV): its throws, the unoptimised mapping of Figs. 8, 9, and its
-# arm held to the speed it states (5 m/s)
-PAPER_RUNS = (*PAPER_THROWS, "catch_initial", LIMITED)
-# methods the paper does not have: an approach-direction term, a clamp-aware eq. 25, and the
-# simple feedback control it says hardly catches but never specifies (ours: replay/control/feedback)
-EXTENSION_RUNS = ("catch_optimised_approach", "catch_optimised_clamped", FEEDBACK)
 # Sec. IV-A states 20 ms to two digits; the runs step at 1 ms and ramp the finger speed for one
 HAND_TOL = 0.0015  # s
 # "very little delay" (Sec. IV-B) has no number in the paper; our choice: 5 ms, in which the
 # 9 m/s ball moves 45 mm, the size of the palm
 DELAY_TOL = 0.005  # s
 
-_ENFORCED = {"plant.params.enforce_velocity_limits": True}
-_WHY_ENFORCED = (
-    "the arm held to the joint speed limits the plant otherwise only reports (the tool then "
-    "stays under the paper's 5 m/s): the hand does not meet the ball where and when it must"
-)
-FALSIFIERS: tuple[Falsifier, ...] = (
-    Falsifier(
-        "catch over the stated throws, 8 ~ 10 m/s",
-        "enforced_limits_10ms",
-        "catch_10ms",
-        _ENFORCED,
-        _WHY_ENFORCED,
-    ),
-    Falsifier(
-        "catch_optimised: the arm follows its trajectory with very little delay (Sec. IV-B)",
-        "enforced_limits",
-        "catch_optimised",
-        _ENFORCED,
-        "the arm held to its joint speed limits falls behind q_d near the catch",
-    ),
-    # (extension rows: listed, not run by replay falsify, never counted)
-    Falsifier(
-        "difficult to catch only using simple feedback control (Sec. IV-B)",
-        "slow_ball",
-        FEEDBACK,
-        {
-            "plant.params.object_velocity": [-2.6632, 0.0, -0.1502],
-            "plant.params.object_gravity": False,
-            "timing.duration": 2.0,
-        },
-        "the same feedback controller against a ball at 2.7 m/s (the 9 m/s throw's direction, "
-        "no gravity): it catches, so the row turns on the catch, not on the controller's name",
-    ),
-    Falsifier(
-        "catch_optimised_approach: ball caught",
-        "enforced_limits",
-        "catch_optimised_approach",
-        _ENFORCED,
-        _WHY_ENFORCED,
-    ),
-    Falsifier(
-        "catch_optimised_clamped: ball caught",
-        "enforced_limits",
-        "catch_optimised_clamped",
-        _ENFORCED,
-        _WHY_ENFORCED,
-    ),
-) + thesis.FALSIFIERS
-
 
 def _stated() -> dict:
     return yaml.safe_load(STATED.read_text())
-
-
-def scope(name: str) -> str:
-    """A run's rows' kind: "measured" for the paper's own experiment (:data:`PAPER_RUNS`),
-    "extension" for a method the paper does not have, else "other regime"."""
-    if name in PAPER_RUNS:
-        return "measured"
-    return "extension" if name in EXTENSION_RUNS else "other regime"
-
-
-def _scenario(log: LogReader) -> dict:
-    return yaml.safe_load(log.scenario()["yaml"])
-
-
-def _vec(rows: list[dict], key: str) -> np.ndarray:
-    return np.array([r[key] for r in rows], dtype=float)
-
-
-@dataclass
-class CatchRun:
-    """One catching run's log as arrays (SI units), plus its key instants."""
-
-    name: str
-    scenario: dict
-    mapping: str
-    dt: float
-    # controller side, every control step: l(q) and l(q_d) (the catch point of eqs. 2-3)
-    t_ctrl: np.ndarray
-    effector: np.ndarray  # l(q)  (n, 3)
-    effector_desired: np.ndarray  # l(q_d) (n, 3)
-    q_desired: np.ndarray  # q_d (n, 4), /arm/joint_command
-    torque: np.ndarray  # commanded tau (n, 4), /arm/joint_command
-    # plant side (ground truth)
-    t_arm: np.ndarray
-    q: np.ndarray  # (m, 4)
-    qd: np.ndarray
-    t_obj: np.ndarray
-    ball: np.ndarray  # (k, 3)
-    ball_velocity: np.ndarray
-    t_tool: np.ndarray
-    tool_velocity: np.ndarray  # tool-frame linear velocity (/effector/motion)
-    t_hand: np.ndarray
-    hand_q: np.ndarray
-    hand_qd: np.ndarray
-    t_vision: np.ndarray
-    vision: np.ndarray
-    settings: ArmSettings  # the arm plant's, from the log's resolved scenario
-    cs_t: np.ndarray = field(default_factory=lambda: np.zeros(0))  # /catching/state
-    cs_qd_desired: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
-    cs_r_o: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
-    costs: list = field(default_factory=list)
-    events: list = field(default_factory=list)
-    t0: float | None = None
-    t_c: float | None = None
-
-    # -------------------------------------------------------------- helpers
-    def first_event(self, kind: str) -> dict | None:
-        return next((e for e in self.events if e["kind"] == kind), None)
-
-    def ball_at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """True ball position and velocity at t (interpolated between logged states)."""
-        pos = np.array([np.interp(t, self.t_obj, self.ball[:, i]) for i in range(3)])
-        vel = np.array([np.interp(t, self.t_obj, self.ball_velocity[:, i]) for i in range(3)])
-        return pos, vel
-
-    def ctrl_index(self, t: float) -> int:
-        return int(np.argmin(np.abs(self.t_ctrl - t)))
-
-    def window(self, t: np.ndarray, start: float, end: float) -> np.ndarray:
-        return (t >= start - 1e-9) & (t <= end + 1e-9)
-
-    @property
-    def plant_params(self) -> dict:
-        return self.scenario["plant"]["params"]
-
-    @property
-    def controller_params(self) -> dict:
-        return self.scenario["controller"]["params"]
-
-
-def load_run(log: LogReader, name: str | None = None) -> CatchRun:
-    sc = _scenario(log)
-    typed = scenario_from_text(
-        log.scenario()["yaml"], name=f"{log.path.name}:/scenario", plugins="known-only"
-    )
-    eff = [m for m in log.series(TOPIC_EFFECTOR_STATE) if m["desired_position"] and m["position"]]
-    cmd = log.series(TOPIC_ARM_JOINT_COMMAND)
-    cmd_t = {round(m["t"], 9): m for m in cmd}
-    eff = [m for m in eff if round(m["t"], 9) in cmd_t]
-    cmd = [cmd_t[round(m["t"], 9)] for m in eff]
-    js = log.series(TOPIC_ARM_JOINT_STATE)
-    ob = log.series(TOPIC_OBJECT_STATE)
-    mo = log.series(TOPIC_EFFECTOR_MOTION)
-    hj = log.series(TOPIC_HAND_JOINT_STATE)
-    vi = log.series(TOPIC_VISION_OBJECT)
-    cs = log.series(TOPIC_CATCHING_STATE)
-    ev = events(log)
-    ctrl, plant = typed.controller, typed.plant.params
-    if ctrl is None or isinstance(plant, dict):  # (tasks, or a plant this version lacks)
-        raise ValueError("not a catch run: its scenario has no controller or no known arm plant")
-    run = CatchRun(
-        name=name or log.scenario().get("name") or "?",  # (clipped by the reader)
-        scenario=sc,
-        # the typed scenario: no default here; a run of another controller (the feedback
-        # baseline) has no mapping and is named by its controller
-        mapping=str(getattr(ctrl.params, "mapping", ctrl.type)),
-        dt=1.0 / float(ctrl.rate),
-        t_ctrl=_vec(eff, "t"),
-        effector=_vec(eff, "position").reshape(-1, 3),
-        effector_desired=_vec(eff, "desired_position").reshape(-1, 3),
-        q_desired=_vec(cmd, "position"),
-        torque=_vec(cmd, "torque"),
-        t_arm=_vec(js, "t"),
-        q=_vec(js, "position"),
-        qd=_vec(js, "velocity"),
-        t_obj=_vec(ob, "t"),
-        ball=_vec(ob, "position").reshape(-1, 3),
-        ball_velocity=_vec(ob, "velocity").reshape(-1, 3),
-        t_tool=_vec(mo, "t"),
-        tool_velocity=_vec(mo, "velocity").reshape(-1, 3),
-        t_hand=_vec(hj, "t"),
-        hand_q=_vec(hj, "position"),
-        hand_qd=_vec(hj, "velocity"),
-        t_vision=_vec(vi, "t"),
-        vision=_vec(vi, "position").reshape(-1, 3),
-        costs=sorted(log.series(TOPIC_OPTIMIZATION_COST), key=lambda c: c["iteration"]),
-        cs_t=_vec(cs, "t"),
-        cs_qd_desired=_vec(cs, "velocity_desired"),
-        cs_r_o=_vec(cs, "r_o").reshape(-1, 3),
-        settings=resolve(plant),
-        events=ev,
-    )
-    run.t0 = float(cs[0]["t"]) if cs else None
-    hold = run.first_event("mapping_hold")
-    if hold is not None:
-        run.t_c = float(hold["t"]) - run.dt
-    return run
-
-
-# ------------------------------------------------------------------------ per-run quantities
-def terminal_error(run: CatchRun) -> dict | None:
-    """Eq. 4 at t_c with eq. 5's r_e = l(q_d) - r_o, r_o being what the mapping used (from
-    ``/catching/state``): |r_e(t_c)| (m) and the mean |r_e'| over the last control step (m/s),
-    which falls to 0 as r_o reaches the catch surface (r_e vanishes to second order there).
-    Also |l(q_d) - r_o| with the *true* ball (vision error, latency compensation, a ball already
-    deflected by the hand) and the ball's arrival speed."""
-    if run.t_c is None or len(run.cs_t) < 2:
-        return None
-    k = run.ctrl_index(run.t_c)
-    i = int(np.argmin(np.abs(run.cs_t - run.t_ctrl[k])))
-    if k < 1 or i < 1 or abs(run.cs_t[i] - run.t_ctrl[k]) > 1e-9:
-        return None
-    re = run.effector_desired[k] - run.cs_r_o[i]
-    re_prev = run.effector_desired[k - 1] - run.cs_r_o[i - 1]
-    rate = float(np.linalg.norm(re - re_prev)) / (run.t_ctrl[k] - run.t_ctrl[k - 1])
-    ball, _ = run.ball_at(run.t_ctrl[k])
-    return {
-        "r_e": float(np.linalg.norm(re)),
-        "rate": rate,
-        "r_e_true": float(np.linalg.norm(run.effector_desired[k] - ball)),
-        "speed": arrival_speed(run),
-    }
-
-
-def initial_error(run: CatchRun) -> tuple[float, float, float] | None:
-    """Eq. 9 at t_0: max |q_d - q| (rad) at the first mapped step, and max |qd_d| (rad/s) at the
-    instant t_s the true ball passes r_o(t_0) = ``throw_start`` (where eq. 13 imposes it),
-    extrapolated linearly from the first two steps with a fitted ball velocity (the first step
-    has one frame: no velocity yet). Returns (dq, qd_d, t_s)."""
-    if run.t0 is None or len(run.cs_t) < 3:
-        return None
-    k = run.ctrl_index(run.t0)
-    j = int(np.argmin(np.abs(run.t_arm - run.t_ctrl[k])))
-    dq = float(np.max(np.abs(run.q_desired[k, list(ACTIVE)] - run.q[j, list(ACTIVE)])))
-    start = np.asarray(run.controller_params.get("throw_start", run.ball[0]), float)
-    t_s = float(run.t_obj[int(np.argmin(np.linalg.norm(run.ball - start, axis=1)))])
-    (t1, t2), (w1, w2) = run.cs_t[1:3], run.cs_qd_desired[1:3]
-    w_s = w1 + (w2 - w1) * (t_s - t1) / (t2 - t1)
-    return dq, float(np.max(np.abs(w_s[list(ACTIVE)]))), t_s
-
-
-def arrival_speed(run: CatchRun) -> float | None:
-    """The ball's speed as it reaches the hand: just before the first contact if that precedes
-    t_c (the ball is deflected then), else at t_c."""
-    c = run.first_event("contact")
-    if c is not None and (run.t_c is None or c["t"] <= run.t_c + 1e-9):
-        return float(np.linalg.norm(c["data"]["object_velocity_before"]))
-    if run.t_c is None:
-        return None
-    return float(np.linalg.norm(run.ball_at(run.t_c)[1]))
-
-
-def first_contact(run: CatchRun) -> dict | None:
-    """The first ball-robot contact: time, parts, relative speed, and |l(q) - r_o| there."""
-    c = run.first_event("contact")
-    if c is None:
-        return None
-    k = run.ctrl_index(c["t"])
-    ball, _ = run.ball_at(run.t_ctrl[k])
-    return {
-        "t": c["t"],
-        "parts": c["data"].get("parts", []),
-        "speed": c["data"].get("speed"),
-        "normal_speed": c["data"].get("normal_speed"),
-        "distance": float(np.linalg.norm(run.effector[k] - ball)),
-    }
-
-
-def closest_approach(run: CatchRun, until: float | None = None) -> tuple[float, float]:
-    """min of |l(q) - r_o| (m) up to ``until`` (default: the whole run) and when: how near the
-    palm's catch point came to the ball's centre."""
-    ball = np.column_stack([np.interp(run.t_ctrl, run.t_obj, run.ball[:, i]) for i in range(3)])
-    d = np.linalg.norm(run.effector - ball, axis=1)
-    if until is not None:
-        d = np.where(run.t_ctrl <= until + 1e-9, d, np.inf)
-    k = int(np.argmin(d))
-    return float(d[k]), float(run.t_ctrl[k])
-
-
-def throw_speed(run: CatchRun) -> tuple[float, float | None] | None:
-    """Ball speed when first seen (t0) and as it reaches the hand, from the plant's truth."""
-    if run.t0 is None:
-        return None
-    return float(np.linalg.norm(run.ball_at(run.t0)[1])), arrival_speed(run)
-
-
-def hand_closing(run: CatchRun) -> dict | None:
-    """From the hand_close command: when every finger joint reached 90 deg, or where the ball
-    stopped them, and the peak finger speed."""
-    e = run.first_event("hand_close")
-    if e is None or not len(run.t_hand):
-        return None
-    w = run.t_hand >= e["t"] - 1e-9
-    t, hq, hqd = run.t_hand[w], run.hand_q[w], run.hand_qd[w]
-    target = math.pi / 2
-    done = np.all(hq >= target - 1e-3, axis=1)
-    out = {"t_cmd": e["t"], "peak_speed": float(np.max(np.abs(hqd))) if len(hqd) else 0.0}
-    if done.any():
-        out["time"] = float(t[np.argmax(done)] - e["t"])
-    else:
-        out["stopped_at"] = float(np.degrees(np.max(hq[: int(min(len(hq), 0.03 / run.dt))])))
-    return out
-
-
-def tool_peaks(run: CatchRun, until: float | None) -> tuple[float, float]:
-    """Peak tool speed (m/s) and peak tool acceleration (m/s^2, over 5 ms differences) from the
-    start of the run until ``until`` (the first contact: no impact shocks)."""
-    w = run.t_tool <= (until if until is not None else np.inf) + 1e-9
-    v = run.tool_velocity[w]
-    t = run.t_tool[w]
-    speed = float(np.max(np.linalg.norm(v, axis=1))) if len(v) else float("nan")
-    n = 5
-    if len(v) > n:
-        acc = np.linalg.norm(v[n:] - v[:-n], axis=1) / (t[n:] - t[:-n])
-        return speed, float(np.max(acc))
-    return speed, float("nan")
-
-
-def vision_accuracy(run: CatchRun) -> tuple[float, float, float] | None:
-    """Measured rate (Hz), median and worst |r_o measured - truth| (m) at the capture times."""
-    if len(run.t_vision) < 2:
-        return None
-    truth = np.column_stack([np.interp(run.t_vision, run.t_obj, run.ball[:, i]) for i in range(3)])
-    err = np.linalg.norm(run.vision - truth, axis=1)
-    rate = (len(run.t_vision) - 1) / (run.t_vision[-1] - run.t_vision[0])
-    return float(rate), float(np.median(err)), float(np.max(err))
-
-
-# ------------------------------------------------------------------------ the arm model
-def arm_capability(arm: ArmSettings) -> dict:
-    """What the scenario's arm model can do at the tool: max speed with its joint-speed limits
-    (at q0 and over a sample of the joint-limit box, locked axes at q0) and acceleration from
-    rest at q0 with its torque limits (replay.robot.capability)."""
-    from replay.robot.capability import max_tool_speed, tool_acceleration_from_rest
-
-    dof = arm.dof
-    chain = arm.chain()
-    vel = arm.velocity_limits.tolist()
-    tau = arm.torque_limits.tolist()
-    q0 = arm.initial_q
-    act = list(arm.active)
-    rng = np.random.default_rng(0)
-    Q = rng.uniform(arm.lower, arm.upper, size=(400, dof))
-    for i in range(dof):
-        if i not in act:
-            Q[:, i] = q0[i]
-    v_q0 = max_tool_speed(chain, q0, vel, act)
-    v_max = max(max_tool_speed(chain, q, vel, act) for q in Q)
-    per_rad = max_tool_speed(chain, q0, [1.0] * dof, act)
-    acc = tool_acceleration_from_rest(chain, q0, tau, act)
-    return {
-        "v_q0": v_q0,
-        "v_max": v_max,
-        "per_rad": per_rad,
-        "vel_limits": vel,
-        "tau_limits": tau,
-        "acc_peak": acc["peak"],
-        "acc_iso": acc["isotropic"],
-    }
 
 
 # ------------------------------------------------------------------------ the rows
@@ -438,23 +99,6 @@ _CATCH_DECIDED = (
 
 def _runs(logs: dict[str, LogReader]) -> dict[str, CatchRun]:
     return {name: load_run(log, name) for name, log in sorted(logs.items())}
-
-
-def _pair(runs: dict[str, CatchRun]) -> tuple[CatchRun | None, CatchRun | None]:
-    opt, ini = runs.get("catch_optimised"), runs.get("catch_initial")
-    if opt is None:
-        opt = next((r for r in runs.values() if r.mapping == "optimised"), None)
-    if ini is None and opt is not None:
-        v = opt.plant_params.get("object_velocity")
-        ini = next(
-            (
-                r
-                for r in runs.values()
-                if r.mapping == "initial" and r.plant_params.get("object_velocity") == v
-            ),
-            None,
-        )
-    return opt, ini
 
 
 def _cost_rows(opt: CatchRun | None, st: dict) -> list[Claim]:
@@ -493,26 +137,12 @@ def _cost_rows(opt: CatchRun | None, st: dict) -> list[Claim]:
             "reproduced" if not up_t and not up_v else "differs",
             "the optimiser (Levenberg-Marquardt) accepts steps that lower the sum "
             "E = torque + velocity cost (+ eq. 24's hinge), so either cost alone may rise; "
-            f"K = diag(1/limit²): torque limits {_fmt3(_opt_limits(opt)[0])} N·m, speed limits "
-            f"{_fmt3(_opt_limits(opt)[1])} rad/s, weights 1",
+            f"K = diag(1/limit²): torque limits {_fmt3(opt_limits(opt)[0])} N·m, speed limits "
+            f"{_fmt3(opt_limits(opt)[1])} rad/s, weights 1",
             kind=scope(opt.name),
             measures=(f"{opt.name}:optimisation costs",),
         )
     ]
-
-
-def _opt_limits(run: CatchRun) -> tuple[list, list]:
-    cp = run.controller_params
-    tau, vel = run.settings.torque_limits.tolist(), run.settings.velocity_limits.tolist()
-    t = cp.get("opt_torque_limits") or [tau[i] for i in ACTIVE]
-    w = cp.get("opt_velocity_limits") or [vel[i] for i in ACTIVE]
-    return t, w
-
-
-def run_outcome(run: CatchRun) -> dict | None:
-    """The run's ``outcome`` event data (the plant's verdict with its first-touch metrics)."""
-    ev = [e for e in run.events if e["kind"] == "outcome"]
-    return ev[-1]["data"] if ev else None
 
 
 def _touch(o: dict) -> str:
@@ -933,7 +563,7 @@ def _capability_rows(run: CatchRun, st: dict) -> list[Claim]:
     if run.t_c is not None and len(run.cs_t):
         i = int(np.argmin(np.abs(run.cs_t - run.t_c)))
         w_c = np.abs(run.cs_qd_desired[i, list(ACTIVE)])
-        w_max = np.asarray(_opt_limits(run)[1], float)
+        w_max = np.asarray(opt_limits(run)[1], float)
         rows.append(
             Claim(
                 "joint speed limits (eq. 24) at the catch, given eq. 4",
@@ -1054,7 +684,7 @@ def evaluate(logs: dict[str, LogReader]) -> list[Claim]:
             and has({n: logs[n]}, TOPICS[group], f"claims ({group})")
         }
 
-    opt, ini = _pair(runs)
+    opt, ini = optimised_and_initial(runs)
     rows: list[Claim] = []
     per_run = [n for n, r in runs.items() if r.mapping in ("optimised", "initial")]
     mapped = fit("per-run rows (throw, catch, eq. 4, eq. 9)", per_run)

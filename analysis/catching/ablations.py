@@ -451,7 +451,7 @@ def run_shared(n: int = 20, seed: int = 20030914, cells=None, controllers=None, 
     import tempfile
     from pathlib import Path
 
-    from analysis.ablation_throws import perturbed_throws, throw_overrides
+    from analysis.catching.throws import perturbed_throws, throw_overrides
     from replay.runner import Runner
     from replay.scenario import load_scenario
 
@@ -516,7 +516,7 @@ def shared_table(rows: list[dict]) -> str:
 
 if (
     __name__ == "__main__"
-):  # python -m analysis.ablation_catch [n]: data/ablations/catch_shared_throws.*
+):  # python -m analysis.catching.ablations [n]: data/ablations/catch_shared_throws.*
     import sys
 
     from replay.resources import data_path

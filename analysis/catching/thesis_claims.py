@@ -3,7 +3,7 @@ movement") tested fairly, in two regimes (issue #21):
 
 - the paper's 8-10 m/s (``catch_optimised`` vs ``catch_initial``, the 9 m/s throw), where no
   alpha meets eq. 22 under the assumed (60, 60, 30) N*m limits: rows of kind "measured" (they
-  count), Figs. 8 and 9 only (Fig. 6 and the catch are rows of ``analysis.catch_claims``);
+  count), Figs. 8 and 9 only (Fig. 6 and the catch are rows of ``analysis.catching.claims``);
 - 4-5 m/s (``catch_5ms_optimised`` vs ``catch_5ms_initial``), OUTSIDE the paper's stated speeds,
   where eq. 22 can hold: rows of kind "other regime" (shown, never counted).
 
@@ -36,7 +36,7 @@ from replay.messages import TOPIC_ARM_JOINT_STATE, TOPIC_CATCHING_STATE, TOPIC_O
 
 ACTIVE = [0, 1, 3]  # J1, J2, J4 (J3 locked, Sec. IV-A)
 TIE = 0.02  # relative difference below which optimised and initial are a tie (our choice)
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 class Pair(NamedTuple):
@@ -214,7 +214,7 @@ def _pair_rows(pair: Pair, opt: LogReader, ini: LogReader) -> list[Claim]:
             measures=tuple(f"{n}:applied torque" for n in both),
         ),
     ]
-    if kind == "measured":  # (the paper's catches are analysis.catch_claims' rows)
+    if kind == "measured":  # (the paper's catches are analysis.catching.claims' rows)
         return rows
     return rows + [
         Claim(
@@ -291,7 +291,7 @@ def rows(logs: dict[str, LogReader]) -> list[Claim]:
         opt, ini = logs.get(pair.optimised), logs.get(pair.initial)
         if opt is None or ini is None:
             continue
-        if pair.kind != "measured":  # (the paper's Fig. 6 is analysis.catch_claims' row)
+        if pair.kind != "measured":  # (the paper's Fig. 6 is analysis.catching.claims' row)
             out.append(_cost_row(opt, pair.regime, pair.kind))
         out += _pair_rows(pair, opt, ini)
         out += _model_rows(pair, opt, ini)

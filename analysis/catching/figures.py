@@ -21,14 +21,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from analysis.catch_claims import (
+from analysis.catching.metrics import first_contact, opt_limits  # noqa: E402
+from analysis.catching.run import (  # noqa: E402
     ACTIVE,
     JOINTS,
     CatchRun,
-    _opt_limits,
-    _pair,  # noqa: E402
-    first_contact,
     load_run,
+    optimised_and_initial,
 )
 from analysis import line_labels  # noqa: E402
 from analysis import runs as run_labels  # noqa: E402
@@ -177,7 +176,7 @@ def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, .
     ax_w.set_xlabel("optimisation iteration")
     ref = opt or ini
     if ref is not None:
-        tau, w = _opt_limits(ref)
+        tau, w = opt_limits(ref)
         fig.text(
             0.01,
             0.005,
@@ -343,7 +342,7 @@ def _joint_figure(runs: list[CatchRun], title: str, what: str):
             if run is runs[0] and j == 0:
                 named = marks
     if what == "torques":
-        tau, _ = _opt_limits(runs[0])
+        tau, _ = opt_limits(runs[0])
         for ax, lim in zip(axes, tau):
             for s in (-1, 1):
                 ax.axhline(s * lim, color="0.6", lw=0.8, ls=":")
@@ -437,7 +436,7 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     _VARIANT.clear()
     slow = [runs[n] for n in SLOW_PAIR if n in runs]
     rest = {n: r for n, r in runs.items() if n not in SLOW_PAIR}
-    opt, ini = _pair(rest) if rest else (None, None)
+    opt, ini = optimised_and_initial(rest) if rest else (None, None)
     pair = [r for r in (opt, ini) if r is not None]
     groups = [(pair, "catch", ""), (slow, "catch_5ms", " (4.5 m/s, not the paper's)")]
     paths: list[Path] = []

@@ -25,7 +25,7 @@ import numpy as np  # noqa: E402
 from analysis.figure_files import save  # noqa: E402
 from analysis.line_labels import MORE, first  # noqa: E402
 from analysis.needs import has  # noqa: E402
-from analysis.grasp_run import (
+from analysis.grasping.run import (
     GRASP_PHASES,
     REACHING,
     RELEASING,

@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
-from analysis.ablation_catch import wilson  # noqa: E402
+from analysis.catching.ablations import wilson  # noqa: E402
 from analysis.ablation_table import counts_by, grasped, mean_by, pct, rate_by  # noqa: E402
 from analysis.ablation_plot import RATE_NOTE, plot_rates, shifts  # noqa: E402
 from analysis.figure_files import save  # noqa: E402

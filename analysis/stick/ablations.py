@@ -183,7 +183,7 @@ def summary_friction(rows: list[dict]) -> str:
 
 
 def _wilson(k: int, n: int) -> tuple[float, float]:
-    from analysis.ablation_catch import wilson
+    from analysis.catching.ablations import wilson
 
     return wilson(k, n)
 

@@ -2,10 +2,10 @@
 Figs. 6, 8, 9): does optimising alpha offline (eq. 25 under eqs. 13, 22, 24) reduce the joint
 torques and travel at 8-10 m/s, and at which torque limits?
 
-The sweep (``sweeps/catch_optimisation.yaml``, made by ``python -m analysis.ablation_catch_opt
+The sweep (``sweeps/catch_optimisation.yaml``, made by ``python -m analysis.catching.ablation_opt
 sweep``) crosses one linked axis ``cell`` -- a torque-limit scale s of the assumed public_urdf
 set (60, 60, 45, 30) N*m with one alpha -- with the shared perturbed throws
-(:func:`analysis.ablation_throws.perturbed_throws`, 8-10 m/s). The alphas (``ALPHAS``):
+(:func:`analysis.catching.throws.perturbed_throws`, 8-10 m/s). The alphas (``ALPHAS``):
 
 - ``initial``: the minimum-norm alpha meeting eq. 13 only (no cost): the paper's unoptimised one;
 - ``optimised``: eq. 25 re-optimised at the level, eq. 22's hinge on at s x (60, 60, 30) N*m;
@@ -14,7 +14,7 @@ set (60, 60, 45, 30) N*m with one alpha -- with the shared perturbed throws
   but were not optimised for these throws (``optimise.project_eq13``, ``null_space_alpha``).
 
 The run quantities come from the plant's truth over t0 (first ball measurement) -> the first
-ball-robot ``contact`` event (``analysis.catch_thesis_claims.window_effort``): joint travel
+ball-robot ``contact`` event (``analysis.catching.thesis_claims.window_effort``): joint travel
 sum |dq| and sum tau^2 dt of the applied torque on J1, J2, J4, and the share of those steps with
 a joint at its torque limit. Optimised against initial is compared throw by throw (the same
 throws): the ratio of the means with a paired bootstrap 95 % interval; an interval that holds
@@ -35,7 +35,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
-from analysis.ablation_catch import wilson  # noqa: E402
+from analysis.catching.ablations import wilson  # noqa: E402
 from replay.resources import data_path, scenario_dir  # noqa: E402
 from analysis.ablation_plot import plain_log_ticks, plot_rates, shifts  # noqa: E402
 from analysis.ablation_table import caught  # noqa: E402
@@ -43,7 +43,7 @@ from analysis.figure_files import save  # noqa: E402
 from replay.sweep.table import as_float  # noqa: E402
 
 NAME = "catch_optimisation"
-ROOT = Path(__file__).resolve().parents[1]  # (a checkout: where `sweep` and `store` write)
+ROOT = Path(__file__).resolve().parents[2]  # (a checkout: where `sweep` and `store` write)
 SCENARIO = scenario_dir() / "catch_optimised.yaml"
 ALPHA_DIR = data_path("catching")
 # alpha files as the sweep names them: relative to the scenario's folder, as a scenario file
@@ -56,7 +56,7 @@ PLANT_TAU = (60.0, 60.0, 45.0, 30.0)  # N*m: public_urdf (assumed, scenarios/cat
 OPT_TAU = (60.0, 60.0, 30.0)  # N*m: eq. 22's tau_max on J1, J2, J4 at scale 1
 SCALES = (0.5, 1.0, 2.0, 3.0, 4.0, 8.0)  # torque-limit scales swept
 N_THROWS = 30  # shared perturbed throws, 8-10 m/s (>= 20 a cell)
-THROW_SEED = 20030914  # analysis.ablation_throws.perturbed_throws' default: the shared set
+THROW_SEED = 20030914  # analysis.catching.throws.perturbed_throws' default: the shared set
 RANDOM_SEED = 2003  # the random null-space direction of the 'eq13 random' falsifier
 N_BOOT = 2000
 INITIAL, OPTIMISED, SHIPPED = "initial", "optimised", "optimised, eq. 22 off"
@@ -129,7 +129,7 @@ def parse_cell(label: str) -> tuple[float, str]:
 
 
 def throws(n: int = N_THROWS) -> list[dict]:
-    from analysis.ablation_throws import perturbed_throws
+    from analysis.catching.throws import perturbed_throws
 
     return perturbed_throws(n, THROW_SEED)
 
@@ -290,13 +290,13 @@ def model_costs(dest: Path = ALPHA_DIR) -> dict[str, dict]:
 _HEADER = """\
 # Namiki & Ishikawa 2003, Figs. 6, 8, 9 (issue #38): does optimising alpha offline (eq. 25 under
 # eqs. 13, 22, 24) reduce joint torque and travel at the paper's 8-10 m/s, and at which torque
-# limits? MADE BY `python -m analysis.ablation_catch_opt sweep` (do not edit by hand).
+# limits? MADE BY `python -m analysis.catching.ablation_opt sweep` (do not edit by hand).
 #
 # Torque limits (assumed: the paper gives none): the plant's public_urdf (60, 60, 45, 30) N*m
 # scaled by s in {scales}; eq. 22's tau_max = s x (60, 60, 30) N*m on J1, J2, J4.
 # The rule that keeps the comparison fair at every level:
 # - 'optimised': eq. 25 re-optimised offline at the level (data/catching/alpha_catchopt_xS.json,
-#   `python -m analysis.ablation_catch_opt alphas`) with eq. 22's hinge ON (weight 100, as eq.
+#   `python -m analysis.catching.ablation_opt alphas`) with eq. 22's hinge ON (weight 100, as eq.
 #   24's) and K_tau held at s = 1's normalisers (w_tau = s^2): only the constraint moves;
 #   its neighbour 'optimised, K_tau per level' (w_tau = 1: K_tau normalised by the level's
 #   limits, so the torque term weighs 1/s^2 as much) at s = 2, 4, 8 (_ktau_level.json);
@@ -310,8 +310,8 @@ _HEADER = """\
 #   direction at the optimum's length (breaks eq. 24: a strawman, only at x1 and x4)
 #   (data/catching/alpha_eq13_*.json, keyed to the shipped configuration);
 # - PD gains, velocity limits (eq. 24 at (3, 13.5, 37) rad/s) and the hand unchanged.
-# Throws: the shared perturbed set (analysis.ablation_throws.perturbed_throws, seed {seed}):
-# {n} throws at 8-10 m/s, the same for every cell. Metrics (analysis.ablation_catch_opt:
+# Throws: the shared perturbed set (analysis.catching.throws.perturbed_throws, seed {seed}):
+# {n} throws at 8-10 m/s, the same for every cell. Metrics (analysis.catching.ablation_opt:
 # effort_metrics): plant truth from the first ball measurement to the first ball-robot contact.
 """
 
@@ -338,14 +338,14 @@ def sweep_data() -> dict:
         "seed": 0,
         "set": {"timing.duration": 0.45, "stop.after": 0.0},
         "grid": {"cell": cells, "throw": grid_throws},
-        "metrics": "analysis.ablation_catch_opt:effort_metrics",
-        "plot": "analysis.ablation_catch_opt:plot_catch_opt",
+        "metrics": "analysis.catching.ablation_opt:effort_metrics",
+        "plot": "analysis.catching.ablation_opt:plot_catch_opt",
         "caption": (
             "At 8-10 m/s, sum tau^2 dt and joint travel before first contact of each alpha "
             "relative to the initial one on the same throws (paired bootstrap 95 % intervals), "
             "and the catch rate (Wilson 95 %), against the torque-limit scale."
         ),
-        "summary": "analysis.ablation_catch_opt:summary_catch_opt",
+        "summary": "analysis.catching.ablation_opt:summary_catch_opt",
     }
 
 
@@ -366,7 +366,7 @@ def effort_metrics(log) -> dict:
     limit (the applied torque within 0.1 % of it: the arm could not deliver more); and which
     alpha the run used: its model torque cost and iterations as the run logged them
     (``/optimization/cost``; a stored alpha keeps its file's history)."""
-    from analysis.catch_thesis_claims import ACTIVE, window_effort
+    from analysis.catching.thesis_claims import ACTIVE, window_effort
     from replay.messages import TOPIC_ARM_JOINT_STATE
 
     from replay.messages import TOPIC_OPTIMIZATION_COST
@@ -400,7 +400,7 @@ def effort_profile(log) -> dict:
     """Sum tau^2 dt of the applied torque on J1, J2, J4 (plant truth, N^2 m^2 s) from t0 (first
     ball measurement) to: the first contact, the mapping's hold (q_d frozen at the catch surface,
     the end of the trajectory eq. 25 samples) and the log's end; with those instants (s)."""
-    from analysis.catch_thesis_claims import ACTIVE
+    from analysis.catching.thesis_claims import ACTIVE
     from analysis.series import events
     from replay.messages import TOPIC_ARM_JOINT_STATE, TOPIC_CATCHING_STATE
 
@@ -712,7 +712,7 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":  # python -m analysis.ablation_catch_opt alphas|sweep|table|mechanism
+if __name__ == "__main__":  # python -m analysis.catching.ablation_opt alphas|sweep|table|mechanism
     import sys
 
     what = sys.argv[1] if len(sys.argv) > 1 else ""
@@ -735,4 +735,4 @@ if __name__ == "__main__":  # python -m analysis.ablation_catch_opt alphas|sweep
         (ROOT / "data" / "ablations" / f"{NAME}.md").write_text(text + "\n", encoding="utf-8")
         print(text)
     else:
-        sys.exit("usage: python -m analysis.ablation_catch_opt alphas|sweep|table|mechanism")
+        sys.exit("usage: python -m analysis.catching.ablation_opt alphas|sweep|table|mechanism")

@@ -15,7 +15,7 @@ import numpy as np
 
 
 def physical_verdict(log) -> tuple[bool, str]:
-    from analysis.grasp_run import load_run
+    from analysis.grasping.run import load_run
 
     run = load_run(log)
     grasps = run.kinds("grasp")

@@ -16,6 +16,9 @@ already decides it, and the 2 s 10 mm run's only where the 4 s one is absent. ``
 that can read "reproduced", a variant under which the paper's claim is false in the simulation
 (``replay falsify higashimori2007`` runs them).
 
+The log is read by ``analysis.stick.run``, the falsifiers are ``analysis.stick.falsifiers``;
+this module makes the rows.
+
 Tolerances are what the paper's own measurement can tell apart (Sec. IV-A: 300 fps vision over
 0.9 m of table in 512 px, 1.8 mm per pixel):
 """
@@ -29,11 +32,19 @@ import yaml
 
 from dataclasses import replace
 
-from analysis.claims import Claim, Falsifier, agrees, merge, within
-from analysis.series import arrays, events
-from plants.airtable.params import Params as AirTableParams
+from analysis.claims import Claim, agrees, merge, within
+from analysis.series import events
 from replay.log import LogReader
 from analysis.needs import has
+from analysis.stick.falsifiers import FALSIFIERS as FALSIFIERS  # (beside evaluate: claims.py)
+from analysis.stick.run import (
+    collision,
+    collisions,
+    controller_params,
+    outcome,
+    plant_params,
+    time_stopped,
+)
 from replay.messages import TOPIC_STICK_STATE
 from replay.resources import data_path
 from replay.scenario import scenario_from_text
@@ -64,147 +75,17 @@ MU_RUNS = (  # each strategy at the paper's μ = 0.3 and two others (friction in
     ("stick_2step", "stick_2step_mu0", "stick_2step_mu1"),
 )
 
-_CAM_OFF = {"sensors.camera.params.position_offset": [0.005, 0.0]}
-_SLOW = {"plant.params.hand.joint_speed": 2.0}
-_WIDE = {"plant.params.stick.collision_width": 0.010}
-FALSIFIERS: tuple[Falsifier, ...] = (
-    Falsifier(
-        "translation after collision 1",
-        "width10",
-        "stick_3step",
-        _WIDE,
-        "the real 10 mm width: contact on the face at W/2 lets friction act (Assumption 5 "
-        "dropped), so collision 1 leaves the stick translating",
-    ),
-    Falsifier(
-        "spin reversed at collision 1 (eq. 35)",
-        "omega0_30",
-        "stick_3step",
-        {"plant.params.initial.omega": 30.0},
-        "at ω_0 = 30 rad/s the opposite-sign root of eq. 34 needs |r_x| > L/2: the plan keeps the "
-        "same-sign one",
-    ),
-    Falsifier(
-        "3-step: translation reversed at each closing collision (eq. 33, i ≥ 3)",
-        "camera_offset_2mm_y",
-        "stick_3step",
-        {"sensors.camera.params.position_offset": [0.0, 0.002]},
-        "a camera 2 mm (1 px) off along the stick's axis after collision 2: the closing hits "
-        "miss the centre of mass (eq. 32's r_x = 0), so they leave spin and turn the stick",
-    ),
-    Falsifier(
-        "stick_3step: captured",
-        "slow_fingers",
-        "stick_3step",
-        _SLOW,
-        "finger joints at 2 rad/s instead of 14: the fingertips cannot reach the closing spots",
-    ),
-    Falsifier(
-        "v_2 along an arbitrary ±λ_2, stick perpendicular to it (eqs. 17, 37)",
-        "camera_offset_5mm",
-        "stick_3step",
-        _CAM_OFF,
-        "a camera 5 mm off (3 px): collision 1 leaves translation, so collision 2 is not the "
-        "friction-independent one eq. 37 plans",
-    ),
-    Falsifier(
-        "stick_3step_width10_long: captured",
-        "slow_fingers",
-        "stick_3step_width10_long",
-        _SLOW,
-        "finger joints at 2 rad/s instead of 14: the fingertips cannot reach the closing spots",
-    ),
-    Falsifier(
-        "stick_2step: captured",
-        "slow_fingers",
-        "stick_2step",
-        _SLOW,
-        "finger joints at 2 rad/s instead of 14: the hand cannot follow the stick (the 2-step "
-        "needs a quick hand, Sec. III-B)",
-    ),
-    Falsifier(
-        "2-step: collision 1",
-        "camera_offset_5mm",
-        "stick_2step",
-        _CAM_OFF,
-        "a camera 5 mm off (3 px): the fingertip hits off the r_x of eq. 30, spin remains",
-    ),
-    Falsifier(
-        "2-step: translation reversed at each closing collision (eq. 33, i ≥ 2)",
-        "camera_offset_5mm",
-        "stick_2step",
-        _CAM_OFF,
-        "a camera 5 mm off (3 px): spin left by collision 1, closing hits not through the "
-        "centre of mass",
-    ),
-    Falsifier(
-        "first collision outcome across μ",
-        "width10_mu1",
-        "stick_3step_mu1",
-        _WIDE,
-        "μ = 1 on the real 10 mm width: the contact on the face slides, friction acts",
-    ),
-    Falsifier(
-        "3-step strategy across μ (captured at every μ)",
-        "width10_mu1",
-        "stick_3step_mu1",
-        _WIDE,
-        "μ = 1 on the real 10 mm width: the contact on the face slides, friction acts",
-    ),
-    Falsifier(
-        "2-step strategy across μ (collision 1 and capture at every μ)",
-        "slow_fingers_mu1",
-        "stick_2step_mu1",
-        _SLOW,
-        "no variant of μ or width alone breaks the 2-step here (μ = 1 at W = 30 mm changes "
-        "collision 1 by < 0.005 m/s); slow fingers at μ = 1 show the row can fail",
-    ),
-)
-
 
 def _stated() -> dict:
     return yaml.safe_load(STATED.read_text())
-
-
-def _collision(log: LogReader, index: int) -> dict | None:
-    for e in events(log, "collision"):
-        if e["data"].get("index") == index:
-            return e
-    return None
 
 
 def _speed(v) -> float:
     return float(math.hypot(v[0], v[1]))
 
 
-def _t_stopped(log: LogReader, speed: float = 0.02) -> float | None:
-    """First time after which the stick's speed stays below ``speed`` m/s."""
-    s = arrays(log, TOPIC_STICK_STATE, ["vx", "vy"])
-    moving = np.hypot(s["vx"], s["vy"]) >= speed
-    if not len(moving) or moving[-1]:
-        return None
-    last = np.nonzero(moving)[0]
-    return float(s["t"][last[-1] + 1]) if len(last) else float(s["t"][0])
-
-
 def _not_run(quantity: str, stated: str, name: str, kind: str = "measured") -> Claim:
     return Claim(quantity, stated, f"(no {name} log)", "not run", kind=kind)
-
-
-def _params(log: LogReader) -> AirTableParams:
-    text = log.scenario()["yaml"]
-    plant = scenario_from_text(text, plugins="known-only").plant.params  # typed by the loader
-    assert isinstance(plant, AirTableParams)
-    return plant
-
-
-def _collisions(log: LogReader) -> list[dict]:
-    return sorted(events(log, "collision"), key=lambda e: e["data"]["index"])
-
-
-def _outcome(log: LogReader) -> dict:
-    ev = events(log, "outcome")
-    return ev[-1]["data"] if ev else {}
 
 
 def _angle(a, b) -> float:
@@ -244,8 +125,8 @@ def _omega_band(m: float, inertia: float, e: float, v0: float, half: float, targ
 
 def _configuration_rows(log: LogReader, st: dict) -> list[Claim]:
     r, p = st["results"], st["parameters"]
-    c1 = _collision(log, 1)
-    ini = _params(log).initial
+    c1 = collision(log, 1)
+    ini = plant_params(log).initial
     v0 = math.hypot(ini.vx, ini.vy)
     rows = [
         Claim(
@@ -308,7 +189,7 @@ def _reversal_row(log: LogReader, name: str, first: int) -> Claim:
     """Eq. 33: for closing collisions i ≥ ``first``, v_i / |v_i| = -v_{i-1} / |v_{i-1}| and the
     stick keeps translating only (|ω_i| below W_RES)."""
     quantity = f"{name}: translation reversed at each closing collision (eq. 33, i ≥ {first})"
-    cs = [c for c in _collisions(log) if c["data"]["index"] >= first]
+    cs = [c for c in collisions(log) if c["data"]["index"] >= first]
     cs = [c for c in cs if _speed(c["data"]["v_before"]) >= V_RES / 2]  # a resolvable motion
     if not cs:
         return Claim(quantity, "v_i ∥ −v_{i−1}, ω_i = 0", "no closing collision", "differs")
@@ -347,9 +228,9 @@ def _lambda_rows(logs: dict[str, LogReader]) -> list[Claim]:
 
 def _lambda_row(log: LogReader, name: str) -> Claim:
     quantity = f"{name}: v_2 along ±λ_2, stick perpendicular to it (eqs. 17, 37)"
-    lam = _params_ctrl(log).get("lambda_2", [1.0, 0.0])
+    lam = controller_params(log).get("lambda_2", [1.0, 0.0])
     stated = f"v_2/‖v_2‖ = λ_2 = ({lam[0]:g}, {lam[1]:g}) (eq. 37), s_2ᵀv_2 = 0 (eq. 17)"
-    c2 = _collision(log, 2)
+    c2 = collision(log, 2)
     on = (f"{name}:collision 2 velocity",)
     if c2 is None:
         return Claim(quantity, stated, "no second collision", "differs", measures=on)
@@ -372,10 +253,6 @@ def _lambda_row(log: LogReader, name: str) -> Claim:
     )
 
 
-def _params_ctrl(log: LogReader) -> dict:
-    return yaml.safe_load(log.scenario()["yaml"])["controller"].get("params", {}) or {}
-
-
 def _capture_decided(name: str, logs: dict[str, LogReader]) -> bool:
     """Whether another row decides ``name``'s capture: an across-μ row (its μ variants ran),
     or, for the 2 s 10 mm run, the 4 s one (which lasts long enough to finish)."""
@@ -386,7 +263,7 @@ def _capture_decided(name: str, logs: dict[str, LogReader]) -> bool:
 
 
 def _captured_row(log: LogReader, name: str, st: dict) -> Claim:
-    o = _outcome(log)
+    o = outcome(log)
     dur = scenario_from_text(log.scenario()["yaml"], plugins="known-only").timing.duration
     t_stated = st["results"]["t_stopped"]["value"]
     if o.get("captured"):
@@ -396,7 +273,7 @@ def _captured_row(log: LogReader, name: str, st: dict) -> Claim:
     else:
         measured = f"not captured within the run's {dur:g} s: {o.get('reason', 'no outcome')}"
         status = "differs"
-    w = _params(log).stick.collision_width
+    w = plant_params(log).stick.collision_width
     return Claim(
         f"{name}: captured",
         f"{st['statements']['captured']['value']} (Sec. IV-B, Fig. 6(f))",
@@ -409,10 +286,10 @@ def _captured_row(log: LogReader, name: str, st: dict) -> Claim:
 
 def _three_step_rows(log: LogReader, st: dict) -> list[Claim]:
     r = st["results"]
-    rows = _collision_1_rows(_collision(log, 1), st)
-    rows += _collision_2_rows(log, _collision(log, 2), r)
+    rows = _collision_1_rows(collision(log, 1), st)
+    rows += _collision_2_rows(log, collision(log, 2), r)
     rows.append(_reversal_row(log, "3-step", 3))
-    t_stop = _t_stopped(log)
+    t_stop = time_stopped(log)
     rows.append(
         Claim(
             "translation eliminated",
@@ -459,7 +336,7 @@ def _collision_2_rows(log: LogReader, c2: dict | None, r: dict) -> list[Claim]:
         return [
             Claim("second collision", f"t = {r['t_collision_2']['value']} s", "none", "differs")
         ]
-    half = _params(log).stick.length / 2
+    half = plant_params(log).stick.length / 2
     d = c2["data"]
     planned: dict = next(
         (e["data"] for e in events(log, "plan") if e["data"].get("index") == 2), {}
@@ -498,7 +375,7 @@ def _collision_2_rows(log: LogReader, c2: dict | None, r: dict) -> list[Claim]:
 
 def _two_step_rows(log2: LogReader) -> list[Claim]:
     rows = []
-    c1 = _collision(log2, 1)
+    c1 = collision(log2, 1)
     if c1 is None:
         rows.append(Claim("2-step: collision 1", "ω_1 = 0 (eq. 30)", "no collision", "differs"))
     else:
@@ -526,13 +403,13 @@ def _across_mu(logs: dict[str, LogReader], names: tuple[str, ...]) -> dict[float
     out: dict[float, LogReader] = {}
     for n in names:
         if n in logs:
-            out[_params(logs[n]).stick.friction] = logs[n]
+            out[plant_params(logs[n]).stick.friction] = logs[n]
     return out
 
 
 def _runs_text(runs: dict[float, LogReader]) -> str:
     return ", ".join(
-        f"μ = {mu:g} (W = {1000 * _params(log).stick.collision_width:g} mm)"
+        f"μ = {mu:g} (W = {1000 * plant_params(log).stick.collision_width:g} mm)"
         for mu, log in sorted(runs.items())
     )
 
@@ -544,8 +421,8 @@ def _friction_rows(logs: dict[str, LogReader]) -> list[Claim]:
     if len(runs) < 2:
         rows.append(_not_run(q1, "same for any μ (eq. 22, Sec. II-C)", "stick_3step_mu0/mu1"))
     else:
-        half = _params(next(iter(runs.values()))).stick.length / 2
-        us = {mu: _collision(log, 1) for mu, log in runs.items()}
+        half = plant_params(next(iter(runs.values()))).stick.length / 2
+        us = {mu: collision(log, 1) for mu, log in runs.items()}
         if any(c is None for c in us.values()):
             rows.append(Claim(q1, "same for any μ", "a run has no collision 1", "differs"))
         else:
@@ -566,7 +443,7 @@ def _friction_rows(logs: dict[str, LogReader]) -> list[Claim]:
     if len(runs) < 2:
         rows.append(_not_run(q2, "friction independent (conclusion 2)", "stick_3step_mu0/mu1"))
     else:
-        got = {mu: _outcome(log) for mu, log in runs.items()}
+        got = {mu: outcome(log) for mu, log in runs.items()}
         text = "; ".join(
             f"μ = {mu:g}: "
             + (f"captured from {o['t_capture']:.3f} s" if o.get("captured") else "not captured")
@@ -586,9 +463,9 @@ def _friction_rows(logs: dict[str, LogReader]) -> list[Claim]:
     if len(runs2) < 2:
         rows.append(_not_run(q3, "friction independent (Sec. III-B)", "stick_2step_mu0/mu1"))
     else:
-        half = _params(next(iter(runs2.values()))).stick.length / 2
-        cs = {mu: _collision(log, 1) for mu, log in runs2.items()}
-        got = {mu: _outcome(log) for mu, log in runs2.items()}
+        half = plant_params(next(iter(runs2.values()))).stick.length / 2
+        cs = {mu: collision(log, 1) for mu, log in runs2.items()}
+        got = {mu: outcome(log) for mu, log in runs2.items()}
         if any(c is None for c in cs.values()):
             spread = float("inf")
         else:
@@ -614,7 +491,7 @@ def _width_rows(logs: dict[str, LogReader]) -> list[Claim]:
     q = "effect of the real 10 mm width on collision 1"
     if "stick_3step" not in logs or "stick_3step_width10" not in logs:
         return [_not_run(q, "W ≈ 0 assumed (Assumption 5)", "stick_3step_width10")]
-    thin, wide = _collision(logs["stick_3step"], 1), _collision(logs["stick_3step_width10"], 1)
+    thin, wide = collision(logs["stick_3step"], 1), collision(logs["stick_3step_width10"], 1)
     if thin is None or wide is None:
         return [Claim(q, "W ≈ 0 assumed", "a run has no collision 1", "differs")]
     d_w = wide["data"]["omega_after"] - thin["data"]["omega_after"]
