@@ -1,6 +1,6 @@
 """The grasp in Drake (plants/drake_arm/grasp_plant.py) on seeds and human speeds the scenarios do
 not use (they use seed 0 at 0.10 m/s), judged from the truth topics by the PyBullet robustness
-test's own criterion (analysis/grasp_judge.py): the ball is held >= 90 %; the box is held at the
+test's own criterion (analysis/grasping/judge.py): the ball is held >= 90 %; the box is held at the
 slower human speeds, and where not (docs/drake.md: 20/23 on analysis/engine_rates.py's paths, all
 three failures at 0.3 m/s) the box slides along the hand while the human pulls with ~3 N against
 a grip of > 100 N, a contact-model difference measured there, not a method's. The truth topics
@@ -18,7 +18,7 @@ import pytest
 import yaml
 from grasp_rig import DT, rig
 
-from analysis.grasp_judge import physical_verdict
+from analysis.grasping.judge import physical_verdict
 from plants.drake_arm.grasp_plant import DrakeGraspPlant
 from plants.drake_arm.params import GraspParams
 from replay.robot.arm_types import ServoCommand
