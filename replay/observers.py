@@ -72,17 +72,20 @@ class LogObserver:
             self.topics.start(0)  # the robot's description
 
     def record(self, rec: StepRecord) -> None:
-        t_ns, topics = rec.t_ns, self.topics
-        self.events(rec.events, t_ns)
+        t_ns, topics, data = rec.t_ns, self.topics, self.data
+        if rec.events:
+            self.events(rec.events, t_ns)
         for c in rec.captures:
             if c.image and topics is not None:
                 topics.sensor(c.name, c.sensor, t_ns)
             if c.measurement is not None:
-                self.data.write(c.topic, c.measurement, t_ns)
-        self.events(rec.control, t_ns)
-        for data in (rec.telemetry, rec.state):
-            if data:
-                self.data.write_all(data, t_ns)
+                data.write(c.topic, c.measurement, t_ns)
+        if rec.control:
+            self.events(rec.control, t_ns)
+        if rec.telemetry:
+            data.write_all(rec.telemetry, t_ns)
+        if rec.state:
+            data.write_all(rec.state, t_ns)
         if rec.scene is not None and topics is not None:
             topics.frame(rec.scene, t_ns)
 

@@ -382,7 +382,8 @@ class Runner:
             self._hand()
             self._record.events = events
         rec, self._record = self._record, StepRecord(0, 0)
-        rec.k, rec.t_ns = self.k, self.t_ns(self.k)
+        rec.k = k = self.k
+        rec.t_ns = k * 1_000_000_000 // self.rate  # (self.t_ns(k))
         for watcher in self.watchers:
             watcher.record(rec)
 
