@@ -5,7 +5,8 @@ Columns: ``index``, ``key``, the varied parameters, ``seed``, ``success``, ``rea
 (``x.NAME``), the count of each event kind (``e.KIND``), ``stopped_by``, ``t_end``,
 ``wall_time``, ``cpu_time``, ``log`` and ``version`` (the code version that ran it). A column
 with a known unit says it in its header (``t_end [s]``, ``e.catch [1]``, ``m.contact_speed [m/s]``:
-:data:`UNITS`); :func:`read_table` reads a header with or without units alike. The file is
+:data:`UNITS`); :func:`read_table` reads a header with or without units alike. Measured numbers
+(metrics, ``t_end``) are written to 6 significant digits, varied parameters as given. The file is
 the sweep's memory: rows whose key is still a variant of the sweep are done; a killed sweep loses
 at most the variants that were running and those finished since the table was last written
 (``engine.SAVE_SHARE``); rows of other sweeps into the same folder stay.
@@ -139,7 +140,7 @@ def write_table(path: str | Path, rows: Iterable[dict[str, Any]], params: list[s
             csv.writer(f).writerow([header(c) for c in columns + extra])
             w = csv.DictWriter(f, fieldnames=columns + extra, extrasaction="ignore")
             for r in rows:
-                w.writerow({k: _text(v) for k, v in r.items()})
+                w.writerow({k: _cell(k, v) for k, v in r.items()})
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except OSError as exc:
@@ -151,8 +152,14 @@ def write_table(path: str | Path, rows: Iterable[dict[str, Any]], params: list[s
         ) from None
 
 
-def _text(v: Any) -> Any:
-    return "" if v is None else v
+def _cell(column: str, v: Any) -> Any:
+    """A value as written: a measured number (a metric, ``t_end``) to 6 significant digits,
+    a varied parameter as given, None as empty."""
+    if v is None:
+        return ""
+    if type(v) is float and (column[:2] in ("m.", "x.") or column == "t_end"):
+        return float(f"{v:.6g}")
+    return v
 
 
 def as_bool(cell: Any) -> bool:

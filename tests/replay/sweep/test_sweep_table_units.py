@@ -38,6 +38,15 @@ def test_the_header_has_units_and_the_rows_read_back_by_name(tmp_path):
     assert set(row) == set(ROW)
 
 
+def test_measured_numbers_have_six_significant_digits_and_parameters_stay(tmp_path):
+    path = tmp_path / "table.csv"
+    row = {**ROW, "mass": 1.23456789012, "m.contact_speed": 2.735147272497597, "t_end": 0.1 + 0.2}
+    write_table(path, [row], ["mass"])
+    (back,) = read_table(path)
+    assert back["m.contact_speed"] == "2.73515" and back["t_end"] == "0.3"
+    assert float(back["mass"]) == row["mass"]  # (a cell's key: never rounded)
+
+
 def test_a_header_without_units_reads_the_same(tmp_path):
     path = tmp_path / "table.csv"
     write_table(path, [ROW], ["mass"])
