@@ -5,7 +5,9 @@ step: cameras due at k capture the plant's scene (logged at the capture time, de
 controller ``latency`` later), the controller due at k reads what was delivered and commands the
 plant (or, with ``tasks:``, each due task reads its inputs and writes its part of the command:
 ``replay.tasks``), the plant's state is logged, the plant steps, and the physics events of that step are
-logged at its end, collisions with the controller's intent attached. The run stops at
+logged at its end, collisions with the controller's intent attached. What a step makes is one
+record handed once to the run's observers (``replay.observers``: the log, a live viewer's
+callables). The run stops at
 ``timing.duration`` or ``stop.after`` seconds after one of ``stop.on_events``.
 
 ``Runner(scenario).run(out)`` is the whole run; it is :meth:`Runner.start`, :meth:`Runner.step`
@@ -30,8 +32,9 @@ from replay import __version__, registry, version
 from replay.foxglove.run import RunTopics
 from replay.log import LogWriter, NonFiniteValueError
 from replay.log.memory import KeptLog
-from replay.log.unwritten import NoTopics, UnwrittenLog
-from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, Event, ScenarioInfo
+from replay.log.unwritten import UnwrittenLog
+from replay.messages import TOPIC_EVENTS, Event, ScenarioInfo
+from replay.observers import Capture, LogObserver, MessageObserver, RunObserver, StepRecord
 from replay.scenario import Scenario, resolved_yaml
 from replay.scenario.schema import LogSpec
 from replay.tasks import Task, TaskSet
@@ -99,7 +102,7 @@ def _divider(physics_rate: int, rate: float) -> int:
 
 
 class Runner:
-    viz: RunTopics | NoTopics  # the run's Foxglove topics, from start()
+    watchers: list[RunObserver]  # who is handed each step's record, from start()
 
     def __init__(
         self,
@@ -110,7 +113,7 @@ class Runner:
     ) -> None:
         self.sc = scenario
         self.progress = progress
-        self.observers = observers  # callables(topic, payload, t) — e.g. a live viewer
+        self.observers = observers  # callables(topic, payload, t_ns) — e.g. a live viewer
         self.rate = rate = scenario.timing.physics_rate
         self.dt = 1.0 / rate
         seeds = np.random.SeedSequence(scenario.seed).spawn(2 + len(scenario.sensors))
@@ -196,6 +199,7 @@ class Runner:
         self._n_steps = int(round(sc.timing.duration * self.rate))
         self._stop_at: int | None = None
         self._collisions = 0
+        self._nan: dict | None = None  # a ``nan`` event's data, until the run ends on it
         self._seq = 0
         # (deliver at step, sequence, topic, payload), delivered in that order whatever the
         # sensors' order and latencies
@@ -209,19 +213,23 @@ class Runner:
         text = resolved_yaml(sc)
         log.metadata("scenario", {"yaml": text})
         version = f"{__version__}+{commit}"
-        self._emit = self._emitter(log)
         outcome_only = self.level.level == "outcome"
         # the measurements, telemetry and state: logged, or (outcome only) checked and dropped
         data = UnwrittenLog() if outcome_only else log
-        self._emit_data, self._emit_all_data = self._emitter(data), self._emitter_all(data)
         self._image_at = dict.fromkeys((s[0] for s in self.sensors), 0)  # next image's step
-        self.viz = (
+        topics = (
             RunTopics(log, self.plant, [(s[0], s[1]) for s in self.sensors])
             if out is not None and not outcome_only
-            else NoTopics()
+            else None
         )
-        self._write(TOPIC_SCENARIO, ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version), 0)
-        self.viz.start(0)
+        self._frames = topics is not None  # (a scene only for topics that draw it)
+        self.watchers = [LogObserver(log, data, topics)]
+        if self.observers:
+            self.watchers.append(MessageObserver(tuple(self.observers)))
+        self._record = StepRecord(0, 0)
+        info = ScenarioInfo(0.0, sc.name, sc.paper, text, sc.seed, version)
+        for watcher in self.watchers:
+            watcher.start(info)
 
     @property
     def done(self) -> bool:
@@ -233,19 +241,20 @@ class Runner:
         ``latency`` later); at a control step, the measurements delivered by now, which the
         controller reads (``[(topic, payload)]``), else []. :meth:`step` calls it if not done."""
         k = self.k
-        t, t_ns = k / self.rate, self.t_ns(k)
+        t = k / self.rate
         scene = None
+        captures = self._record.captures
         for name, sensor, div, latency in self.sensors:
             if k % div:
                 continue
             if scene is None:
                 scene = self.plant.scene()
             m = sensor.measure(t, scene)
-            if k >= self._image_at[name]:
+            image = k >= self._image_at[name]  # its frame drawn (Foxglove / Rerun)
+            if image:
                 self._image_at[name] = k + self.image_div
-                self.viz.sensor(name, sensor, t_ns)  # its frame, for Foxglove / Rerun
+            captures.append(Capture(name, sensor, sensor.topic, m, image))
             if m is not None:
-                self._emit_data(sensor.topic, m, t_ns)
                 heapq.heappush(self._pending, (k + latency, self._seq, sensor.topic, m))
                 self._seq += 1
         delivered, pending = [], self._pending
@@ -263,20 +272,21 @@ class Runner:
         the plant steps, and its events are logged at the step's end (a collision with the
         controller's intent)."""
         k, plant = self.k, self.plant
-        t, t_ns = k / self.rate, self.t_ns(k)
+        t = k / self.rate
         if self._sensed[0] != k:
             self.sense()
         _, scene, delivered = self._sensed
+        rec = self._record
         if k % self.ctrl_div == 0:
-            self._control(t, t_ns, delivered, command)
+            self._control(t, delivered, command)
         if k % self.log_div == 0:
-            self._emit_all_data(plant.truth(t), t_ns)
-        if self.frame_div and k % self.frame_div == 0:  # the 3-D topics (replay/foxglove)
-            self.viz.frame(scene if scene is not None else plant.scene(), t_ns)
+            rec.state = plant.truth(t)
+        if self._frames and self.frame_div and k % self.frame_div == 0:  # the 3-D topics
+            rec.scene = scene if scene is not None else plant.scene()
+        self._hand()  # the step's record, once
         plant.step()
         self.k = k = k + 1
-        t1, t1_ns = k / self.rate, self.t_ns(k)
-        for occ in plant.pop_events():
+        for occ in plant.pop_events():  # the next record's first messages, at the step's end
             if occ.kind == "collision":
                 self._collisions += 1
                 occ.data = {
@@ -284,9 +294,10 @@ class Runner:
                     **occ.data,
                     "planned": self.controller.intent(),
                 }
-            self._event(occ, t1, t1_ns)
+            self._event(occ, self._record.events)
+        self._check_nan()
 
-    def _control(self, t: float, t_ns: int, delivered: list, command: Any = None) -> None:
+    def _control(self, t: float, delivered: list, command: Any = None) -> None:
         """The controller's turn: what the sensors delivered by now in, the command out (or
         the ``command`` given from outside)."""
         if command is None:
@@ -299,18 +310,20 @@ class Runner:
         occurrences = self.controller.pop_events()
         telemetry = self.controller.telemetry(t)
         for occ in occurrences:
-            self._event(occ, t, t_ns)
+            self._event(occ, self._record.control)
+        self._check_nan()
         if telemetry:
-            self._emit_all_data(telemetry, t_ns)
+            self._record.telemetry = telemetry
 
     def finish(self) -> RunResult:
         """The final state (so the log ends where the run ended), the ``outcome`` event, the
         log closed; the run's result."""
-        k, t_ns = self.k, self.t_ns(self.k)
-        self._emit_all_data(self.plant.truth(k / self.rate), t_ns)
-        if self.frame_div:
-            self.viz.frame(self.plant.scene(), t_ns)
-        self._outcome(self._verdict(k / self.rate))
+        rec, t = self._record, self.k / self.rate
+        rec.state = self.plant.truth(t)
+        if self._frames and self.frame_div:
+            rec.scene = self.plant.scene()
+        self._hand()
+        self._outcome(self._verdict(t))
         return self._finish()
 
     def fail(self, exc: NonFiniteValueError) -> RunResult:
@@ -319,7 +332,7 @@ class Runner:
         self.result.stopped_by = "error"
         self.result.error = str(exc)
         data = {"reason": "non-finite value", "topic": exc.topic, "fields": exc.fields}
-        self._write(TOPIC_EVENTS, Event(self.k / self.rate, "error", data), self.t_ns(self.k))
+        self._hand([Event(self.k / self.rate, "error", data)])
         reason = f"error: non-finite value on {exc.topic}"
         self._outcome({"success": False, "reason": reason})
         return self._finish()
@@ -328,7 +341,7 @@ class Runner:
         """End the run here as interrupted (Ctrl-C, or an environment's episode left before its
         end): an ``interrupted`` event, a failed outcome, the log kept as interrupted."""
         self.result.stopped_by = "interrupted"
-        self._write(TOPIC_EVENTS, Event(self.k / self.rate, "interrupted", {}), self.t_ns(self.k))
+        self._hand([Event(self.k / self.rate, "interrupted", {})])  # after what the step made
         self._outcome({"success": False, "reason": "interrupted"})
         return self._finish()
 
@@ -348,7 +361,7 @@ class Runner:
     def _outcome(self, verdict: dict) -> None:
         """Every run ends with one ``outcome`` event: the one place a user or a sweep reads it."""
         self.result.outcome = verdict
-        self._write(TOPIC_EVENTS, Event(self.k / self.rate, "outcome", verdict), self.t_ns(self.k))
+        self._hand([Event(self.k / self.rate, "outcome", verdict)])
 
     def _finish(self) -> RunResult:
         result, k = self.result, self.k
@@ -363,48 +376,36 @@ class Runner:
         result.wall_time = time.perf_counter() - self._wall0
         return result
 
-    def _emitter(self, log: LogWriter | UnwrittenLog) -> Callable[[str, object, int], None]:
-        """``write(topic, payload, t_ns)``: the log's own write, and the observers' after it."""
-        if not self.observers:
-            return log.write
-        observers = self.observers
+    def _hand(self, events: list[Event] | None = None) -> None:
+        """The record of step k now to every watcher, once; the next one begun. ``events``: the
+        record under way, then one of only these events."""
+        if events is not None:
+            self._hand()
+            self._record.events = events
+        rec, self._record = self._record, StepRecord(0, 0)
+        rec.k = k = self.k
+        rec.t_ns = k * 1_000_000_000 // self.rate  # (self.t_ns(k))
+        for watcher in self.watchers:
+            watcher.record(rec)
 
-        def write(topic: str, payload, t_ns: int) -> None:
-            log.write(topic, payload, t_ns)
-            for observe in observers:
-                observe(topic, payload, t_ns)
-
-        return write
-
-    def _emitter_all(self, log: LogWriter | UnwrittenLog) -> Callable[[dict, int], None]:
-        """``write_all(messages, t_ns)``: each (topic, payload) of a dict written, a list payload
-        as its items' messages; the log's own compiled write_all without observers."""
-        if not self.observers:
-            return log.write_all
-        write = self._emitter(log)
-
-        def write_all(messages: dict, t_ns: int) -> None:
-            for topic, payload in messages.items():
-                for item in payload if isinstance(payload, list) else (payload,):
-                    write(topic, item, t_ns)
-
-        return write_all
-
-    def _write(self, topic: str, payload, t_ns: int) -> None:
-        """A message outside the step's sensor, control and state topics (scenario, events,
-        outcome); an event is also a ``/log`` line of the Foxglove topics."""
-        self._emit(topic, payload, t_ns)
-        if topic == TOPIC_EVENTS:
-            self.viz.event(payload, t_ns)  # its /log line
-
-    def _event(self, occ, t: float, t_ns: int) -> None:
-        """An occurrence of the plant or the method, logged as an event; a stopping one sets
-        the run to end ``stop.after`` seconds later."""
-        self._write(TOPIC_EVENTS, Event(t, occ.kind, occ.data), t_ns)
+    def _event(self, occ, into: list[Event]) -> None:
+        """An occurrence of the plant or the method, an event of the record under way (``into``
+        its list); a stopping one sets the run to end ``stop.after`` seconds later."""
+        if self._nan is not None:
+            return  # (the run ends at the first non-finite value)
+        into.append(Event(self.k / self.rate, occ.kind, occ.data))
         events = self.result.events
         events[occ.kind] = events.get(occ.kind, 0) + 1
         if occ.kind == "nan":
-            raise NonFiniteValueError(TOPIC_EVENTS, occ.data)
+            self._nan = occ.data
         if self._stop_at is None and occ.kind in self.sc.stop.on_events:
             self.result.stopped_by = occ.kind
             self._stop_at = self.k + int(round(self.sc.stop.after * self.rate))
+
+    def _check_nan(self) -> None:
+        """A ``nan`` event (the plant's or the method's) ends the run now: its record handed
+        (what the step made until then), a :class:`NonFiniteValueError` raised."""
+        if self._nan is not None:
+            data, self._nan = self._nan, None
+            self._hand()
+            raise NonFiniteValueError(TOPIC_EVENTS, data)

@@ -1,4 +1,5 @@
-"""What a run writes for Foxglove and Rerun (replay/foxglove/topics.py), fed by the runner:
+"""What a run writes for Foxglove and Rerun (replay/foxglove/topics.py), fed by the log's
+observer of the runner's step records (:class:`replay.observers.LogObserver`):
 the URDF at the start, ``/tf`` + ``/scene`` + ``/joint_states`` at ``timing.frame_rate``, each
 camera frame of a sensor with ``log_images``, each event as a ``/log`` line."""
 

@@ -34,19 +34,3 @@ class UnwrittenLog:
 
     def close(self, status: str = "") -> Path:
         return Path(os.devnull)
-
-
-class NoTopics:
-    """The Foxglove topics of a run without a log: nothing to draw them for."""
-
-    def start(self, t_ns: int) -> None:
-        pass
-
-    def frame(self, scene, t_ns: int) -> None:
-        pass
-
-    def sensor(self, name: str, sensor, t_ns: int) -> None:
-        pass
-
-    def event(self, event, t_ns: int) -> None:
-        pass

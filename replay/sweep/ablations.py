@@ -13,7 +13,7 @@ from pathlib import Path
 
 from replay.resources import data_path, sweep_dir
 from replay.sweep.spec import SweepFile, SweepSpecError, load_sweep_file
-from replay.sweep.table import read_table
+from replay.sweep.table import column_name, read_table
 from replay.sweep.worker import load_function
 
 SWEEP_DIR = sweep_dir()
@@ -51,10 +51,10 @@ def store(name: str, table: Path) -> Path:
     dest = STORED_DIR / f"{name}.csv"
     dest.parent.mkdir(parents=True, exist_ok=True)
     with table.open(newline="", encoding="utf-8") as f:
-        columns = next(csv.reader(f))
+        head = next(csv.reader(f))  # (as written: with its units)
     with dest.open("w", newline="", encoding="utf-8") as f:
-        w = csv.DictWriter(f, fieldnames=columns)
-        w.writeheader()
+        csv.writer(f).writerow(head)
+        w = csv.DictWriter(f, fieldnames=[column_name(h) for h in head])
         for r in rows:
             w.writerow({**r, "log": ""})
     return dest

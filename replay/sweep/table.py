@@ -3,7 +3,10 @@
 Columns: ``index``, ``key``, the varied parameters, ``seed``, ``success``, ``reason``, the
 ``outcome`` event's metrics (``m.NAME``), the sweep's own metrics read from each log
 (``x.NAME``), the count of each event kind (``e.KIND``), ``stopped_by``, ``t_end``,
-``wall_time``, ``cpu_time``, ``log`` and ``version`` (the code version that ran it). The file is
+``wall_time``, ``cpu_time``, ``log`` and ``version`` (the code version that ran it). A column
+with a known unit says it in its header (``t_end [s]``, ``e.catch [1]``, ``m.contact_speed [m/s]``:
+:data:`UNITS`); :func:`read_table` reads a header with or without units alike. Measured numbers
+(metrics, ``t_end``) are written to 6 significant digits, varied parameters as given. The file is
 the sweep's memory: rows whose key is still a variant of the sweep are done; a killed sweep loses
 at most the variants that were running and those finished since the table was last written
 (``engine.SAVE_SHARE``); rows of other sweeps into the same folder stay.
@@ -24,13 +27,50 @@ FIRST = ["index", "key"]
 LAST = ["seed", "success", "reason"]
 TAIL = ["stopped_by", "t_end", "wall_time", "cpu_time", "log", "version"]
 
+# the unit of a column (an outcome metric ``m.NAME`` or a log metric ``x.NAME`` by NAME, as its
+# writer documents it: plants/arm_rig/outcome.py, plants/airtable's outcome in docs/DESIGN.md);
+# an event count ``e.KIND`` is a number [1]; other columns have none or a unit not known here
+UNITS = {
+    "t_end": "s",
+    "wall_time": "s",
+    "cpu_time": "s",
+    "catch_time": "s",
+    "first_contact_time": "s",
+    "closest_time": "s",
+    "contact_speed": "m/s",
+    "contact_offset": "m",
+    "closest_distance": "m",
+    "approach_angle": "deg",
+    "t_capture": "s",
+    "t_capture_method": "s",
+}
+_UNIT = re.compile(r" \[[^\]]*\]$")  # a header's " [unit]"
+
+
+def header(column: str) -> str:
+    """A column's header: its name, and its unit in brackets when known."""
+    if column.startswith("e."):
+        return f"{column} [1]"
+    unit = UNITS.get(column[2:] if column[:2] in ("m.", "x.") else column)
+    return f"{column} [{unit}]" if unit else column
+
+
+def column_name(head: str) -> str:
+    """A header's column name (its unit left out): ``t_end [s]`` -> ``t_end``."""
+    return _UNIT.sub("", head)
+
 
 def read_table(path: str | Path) -> list[dict[str, str]]:
+    """The rows of a table, keyed by column name, whether its header has units or not (tables
+    written before units, e.g. data/ablations/, load as they are)."""
     path = Path(path)
     if not path.is_file():
         return []
     with path.open(newline="", encoding="utf-8") as f:
-        return list(csv.DictReader(f))
+        head = next(csv.reader(f), None)
+        if head is None:
+            return []
+        return list(csv.DictReader(f, fieldnames=[column_name(h) for h in head]))
 
 
 class TableError(Exception):
@@ -97,10 +137,10 @@ def write_table(path: str | Path, rows: Iterable[dict[str, Any]], params: list[s
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
         with os.fdopen(fd, "w", newline="", encoding="utf-8") as f:
+            csv.writer(f).writerow([header(c) for c in columns + extra])
             w = csv.DictWriter(f, fieldnames=columns + extra, extrasaction="ignore")
-            w.writeheader()
             for r in rows:
-                w.writerow({k: _text(v) for k, v in r.items()})
+                w.writerow({k: _cell(k, v) for k, v in r.items()})
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except OSError as exc:
@@ -112,8 +152,14 @@ def write_table(path: str | Path, rows: Iterable[dict[str, Any]], params: list[s
         ) from None
 
 
-def _text(v: Any) -> Any:
-    return "" if v is None else v
+def _cell(column: str, v: Any) -> Any:
+    """A value as written: a measured number (a metric, ``t_end``) to 6 significant digits,
+    a varied parameter as given, None as empty."""
+    if v is None:
+        return ""
+    if type(v) is float and (column[:2] in ("m.", "x.") or column == "t_end"):
+        return float(f"{v:.6g}")
+    return v
 
 
 def as_bool(cell: Any) -> bool:

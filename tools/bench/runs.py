@@ -30,6 +30,7 @@ from pathlib import Path
 from replay.foxglove.run import RunTopics
 from replay.foxglove.topics import FoxgloveTopics
 from replay.log import LogWriter
+from replay.observers import LogObserver
 from replay.resources import scenario_dir
 from replay.runner import RunResult, Runner
 from replay.scenario import ScenarioError, load_scenario
@@ -47,8 +48,9 @@ DEFAULT = [
 
 
 # The parts of a run :func:`timed_run` times: sensors (measure); controller (update, pop_events,
-# telemetry, intent); plant (scene, apply, truth, step, pop_events); logging (the log's writes,
-# observers and the Foxglove topics); runner (the rest: the loop itself, delivery, set-up, closing).
+# telemetry, intent); plant (scene, apply, truth, step, pop_events); logging (the log's observer
+# of the step records: its writes and the Foxglove topics); runner (the rest: the loop itself,
+# delivery, set-up, closing).
 COMPONENTS = ("sensors", "controller", "plant", "logging", "runner")
 
 
@@ -79,7 +81,7 @@ def timed_run(runner: Runner, out: Path) -> tuple[RunResult, dict[str, float]]:
         sensor.measure = timed("sensors", sensor.measure)
     for attr in ("update", "pop_events", "telemetry", "intent"):
         setattr(runner.controller, attr, timed("controller", getattr(runner.controller, attr)))
-    logged = [(LogWriter, "write"), (LogWriter, "write_all")]
+    logged = [(LogWriter, "write"), (LogWriter, "write_all"), (LogObserver, "record")]
     logged += [(RunTopics, a) for a in ("start", "frame", "sensor", "event")]
     original = {(cls, attr): getattr(cls, attr) for cls, attr in logged}
     for (cls, attr), fn in original.items():
