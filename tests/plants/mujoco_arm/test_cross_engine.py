@@ -58,7 +58,7 @@ def test_mujoco_inverse_dynamics_and_mass_matrix_equal_rnea():
     rest at their posture), are the nominal model's RNEA and M with the hand as a payload."""
     plant = make("mujoco", **CATCHING)
     spec = plant.spec()
-    m, d, W = plant.mj, plant.md, plant.world
+    m, d, W = plant.engine.mj, plant.engine.md, plant.engine.world
     a = list(spec.active)
     rng = np.random.default_rng(3)
     lo, hi = wam_joint_limits(4)
@@ -306,7 +306,7 @@ def test_miss_event_when_ball_falls_past(engine):
 def test_nan_event_on_non_finite_state(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # MuJoCo writes its warning to ./MUJOCO_LOG.TXT
     plant = make("mujoco", **CATCHING)
-    plant.md.qvel[plant.world.object_dof] = float("nan")
+    plant.engine.md.qvel[plant.engine.world.object_dof] = float("nan")
     plant.invalidate_state()
     plant.apply(ArmCommand([0.0] * 4))
     plant.step()
