@@ -168,7 +168,8 @@ def test_every_grasp_row_shows_both_engines(tmp_path):
             for n in (name, name + "_mujoco"):
                 Runner(load_scenario(ROOT / "scenarios" / f"{n}.yaml")).run(tmp_path / f"{n}.mcap")
                 logs[n] = LogReader(str(tmp_path / f"{n}.mcap"))
-    pb, mj = split_logs(logs)
+    groups = split_logs(logs)
+    pb, mj = groups["PyBullet"], groups["MuJoCo"]
     assert set(pb) == set(mj) == {"grasp_hexahedron", "grasp_sphere"}
     rows = engine_rows(evaluate, logs)
     assert {r.quantity for r in rows} == {r.quantity for r in evaluate(pb)}
