@@ -3,17 +3,67 @@
 The rig owns one adapter (``ArmRig.engine``), built from the rig's public attributes (params,
 settings, model, urdf_path, dt, joint_names, active, locked, hand_names) after the rig has
 written its URDF; the adapter holds only engine calls and engine settings and reads none of the
-rig's private state. An engine is added by one adapter class (``plants.bullet_arm.plant``'s
-``PybulletEngine``, ``plants.mujoco_arm.plant``'s ``MujocoEngine``) and a plant registered with
-it. States are plain floats (lists or tuples), read once after each step and shared, never
-mutated.
+rig's private state. States are plain floats (lists or tuples), read once after each step and
+shared, never mutated.
+
+The engine is a field of the scenario, ``plant.params.engine: {type: NAME, ...its settings}``
+(empty: the plant type's own engine, PyBullet for ``bullet_arm``/``bullet_grasp``). An engine
+is registered by one entry point in the group ``paper_replay.engines``: NAME -> its settings
+dataclass (imports no engine), whose ``type`` field is NAME, whose fields are the engine's
+settings (checked as any params are) and whose class attributes ``arm`` and ``grasp`` name its
+adapters (``module:Class``) for the arm rig and the grasping rig.
 """
 
 from __future__ import annotations
 
-from typing import Protocol
+import importlib
+from functools import cache
+from importlib.metadata import entry_points
+from typing import Any, Protocol
 
+from replay.params import ParamError
 from replay.scene import Frame
+
+ENGINE_GROUP = "paper_replay.engines"
+
+
+@cache
+def engines() -> dict[str, Any]:
+    """The registered engines: name -> its entry point (loaded when first asked for)."""
+    return {e.name: e for e in entry_points(group=ENGINE_GROUP)}
+
+
+def engine_settings(value: Any) -> Any | None:
+    """``plant.params.engine`` (a mapping: a scenario's YAML node, a dict from Python or a log)
+    as its engine's typed settings; None where empty (the plant type's own engine)."""
+    import yaml
+
+    from replay.scenario.loader import build_dataclass, params_from_data
+
+    if isinstance(value, yaml.MappingNode):
+        if not value.value:
+            return None
+        kind = next((v.value for k, v in value.value if k.value == "type"), None)
+    elif isinstance(value, dict):
+        if not value:
+            return None
+        kind = value.get("type")
+    else:
+        raise ParamError("engine", "expected a mapping {type: ENGINE, ...its settings}")
+    known = engines()
+    if kind not in known:
+        names = ", ".join(sorted(known))
+        raise ParamError("engine", f"unknown engine type {kind!r} (known: {names})")
+    cls = known[kind].load()
+    if isinstance(value, yaml.MappingNode):
+        return build_dataclass(value, cls, "engine")
+    return params_from_data(cls, value, "engine")
+
+
+def adapter_class(settings: Any, rig: str) -> type:
+    """The adapter class of an engine's ``settings`` for ``rig`` ("arm" or "grasp")."""
+    module, name = getattr(settings, rig).split(":")
+    return getattr(importlib.import_module(module), name)
 
 
 class EngineAdapter(Protocol):

@@ -59,6 +59,7 @@ class GraspRig(ArmRig):
     spec_type = GraspSpec
     command_types = (ServoCommand,)  # type: ignore[assignment]
     hold_event = "grasp"
+    engine_role = "grasp"
 
     engine: GraspEngine
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import numpy as np
 
-from plants.arm_rig.engine import EngineAdapter
+from plants.arm_rig.engine import EngineAdapter, adapter_class
 from plants.arm_rig.arm_state import limit_flags, limit_torque, torque_limit_events
 from plants.arm_rig.impulse import ImpulseSchedule
 from plants.arm_rig.outcome import CatchWatch
@@ -115,7 +115,10 @@ class ArmRig(Plant):
         self._obj_albedo = float(P.object_albedo)
         self._obj_size = _vec3(P.object_size)
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
-        self.engine: EngineAdapter = self.Engine(self)  # the world, from the public state above
+        # the world, from the public state above: the engine field's adapter, else the type's
+        E = P.engine_settings
+        Engine = self.Engine if E is None else adapter_class(E, self.engine_role)
+        self.engine: EngineAdapter = Engine(self)
         self._spec = self._make_spec(S.initial_q.copy())
         self._watch = (  # the catch verdict (outcome.py): a free object and a hand
             CatchWatch(
@@ -131,6 +134,7 @@ class ArmRig(Plant):
 
     # ------------------------------------------------------------------ the engine
     Engine: type  # the engine adapter's class (engine.py ``EngineAdapter``), built from the rig
+    engine_role = "arm"  # which of an engine's adapters the rig takes (engine.py)
 
     def _state(self) -> tuple:
         """The engine's state (engine.py ``EngineAdapter.state``): the one read the grasping rig

@@ -45,7 +45,9 @@ class MujocoEngine:
         self.dof, self.active, self.hand_names = rig.dof, rig.active, rig.hand_names
         self._cache: tuple | None = None  # the state read this step (state)
         self.contacts: list = []  # the step's rows (body, position, normal, force): _read_contacts
-        W = self.world = build_world(P, S, rig.model, dt)
+        # MuJoCo's settings: the engine field's, else the mujoco_arm params' own (flat)
+        E = P.engine_settings if P.engine_settings is not None else P
+        W = self.world = build_world(P, S, rig.model, dt, E)
         m, d = self.mj, self.md = W.model, W.data
         self._arm_qpos, self._arm_dof = list(W.arm_qpos), list(W.arm_dof)
         self._hand_qpos, self._hand_dof = list(W.hand_qpos), list(W.hand_dof)
@@ -110,7 +112,7 @@ class MujocoEngine:
             )
             reach = ext + float(m.geom_rbound[self._obj_geom]) + NEAR
             self._hand_reach2 = reach * reach
-        self._hand_kv = float(P.hand_servo_gain)
+        self._hand_kv = float(E.hand_servo_gain)
         # MuJoCo resets the state where it diverges (a warning count): those are the "nan"
         self._bad = [
             int(w)

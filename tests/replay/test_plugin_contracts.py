@@ -49,8 +49,17 @@ def _short_run(scenario: str):
     return replay.run(scenario, set={"timing.duration": DURATION})
 
 
+# plant types kept for the logs made before the engine field (plant.params.engine): no shipped
+# scenario names them; tests/plants/mujoco_arm builds and runs them directly
+FOR_OLD_LOGS = {("plant", "mujoco_arm"), ("plant", "mujoco_grasp")}
+
+
 def _plugins(kind: str) -> list[str]:
-    return sorted(n for n in registry.names(kind) if not registry.is_import_path(n))
+    return sorted(
+        n
+        for n in registry.names(kind)
+        if not registry.is_import_path(n) and (kind, n) not in FOR_OLD_LOGS
+    )
 
 
 @pytest.mark.parametrize("name", _plugins("plant"))

@@ -385,17 +385,19 @@ def test_deterministic():
 # ---------------------------------------------------------------- the scenarios
 @pytest.mark.parametrize("name", ["catch_optimised", "catch_initial"])
 def test_mujoco_scenario_differs_only_in_the_plant(name):
-    """The resolved scenario of NAME_mujoco is NAME's with plant.type mujoco_arm and MuJoCo's
-    own settings added: every other field (plant params included) equal."""
+    """The resolved scenario of NAME_mujoco is NAME's with the engine field MuJoCo (its own
+    settings in it): every other field (plant type and params included) equal."""
     from replay.scenario import load_scenario
     from replay.scenario.loader import to_plain
 
     a = to_plain(load_scenario(ROOT / "scenarios" / f"{name}.yaml"))
     b = to_plain(load_scenario(ROOT / "scenarios" / f"{name}_mujoco.yaml"))
-    assert b["plant"]["type"] == "mujoco_arm" and a["plant"]["type"] == "bullet_arm"
-    pa, pb = a["plant"]["params"], b["plant"]["params"]
-    assert {k: pb[k] for k in pa} == pa
-    assert set(pb) - set(pa) == {
+    assert a["plant"]["type"] == b["plant"]["type"] == "bullet_arm"
+    pa, pb = a["plant"]["params"], dict(b["plant"]["params"])
+    engine = pb.pop("engine")
+    assert pb == pa and "engine" not in pa  # PyBullet: the field left out (empty)
+    assert engine["type"] == "mujoco" and set(engine) == {
+        "type",
         "mj_solref",
         "mj_limit_solref",
         "mj_solimp",
