@@ -14,10 +14,9 @@ import numpy as np
 import pytest
 import yaml
 
+from plants.arm_rig.engine import engines
 from plants.bullet_arm import BulletArmPlant
-from plants.bullet_arm import Params as BulletParams
-from plants.mujoco_arm import Params as MujocoParams
-from plants.mujoco_arm.plant import MujocoArmPlant
+from plants.bullet_arm import Params as ArmParams
 from replay.messages import JointState, ObjectState, to_dict
 from replay.robot.arm_types import ArmCommand, ArmSpec
 from replay.robot.hand import CATCH3
@@ -30,13 +29,16 @@ ROOT = Path(__file__).resolve().parents[3]
 DT = 1e-3
 START = [0.0, math.pi / 4, 0.0, 0.0]  # Namiki & Ishikawa IV-A
 CATCHING = dict(initial_q=START, locked_joints=["J3"])
-ENGINES = ("bullet", "mujoco")
+# every registered engine (plants/arm_rig/engine.py), each with its default settings: an engine
+# added by its adapter and entry point runs these tests
+ENGINES = sorted(engines())
+REFERENCE = "pybullet"
 
 
 def make(engine: str, **kw):
-    if engine == "bullet":
-        return BulletArmPlant(BulletParams(**kw), dt=DT, rng=np.random.default_rng(0))
-    return MujocoArmPlant(MujocoParams(**kw), dt=DT, rng=np.random.default_rng(0))
+    """The arm rig in ``engine`` (plant.params.engine's type)."""
+    params = ArmParams(**kw, engine={"type": engine})
+    return BulletArmPlant(params, dt=DT, rng=np.random.default_rng(0))
 
 
 def hold_torque(plant, q_ref, omega=30.0):
@@ -107,8 +109,8 @@ def test_one_step_of_free_motion_follows_the_model(engine):
 
 # ---------------------------------------------------------------- ballistic ball
 def test_ballistic_ball_agrees_between_engines():
-    """A thrown ball that touches nothing: both engines' paths agree within 1e-6 m (both
-    integrate by semi-implicit Euler) and are the parabola within g dt t / 2 (+ rounding)."""
+    """A thrown ball that touches nothing: every engine's path agrees with the reference's
+    within 1e-6 m (semi-implicit Euler) and is the parabola within g dt t / 2 (+ rounding)."""
     r0, v0 = np.array([2.6, 0.1, 1.0]), np.array([-8.0, 0.5, 1.0])
     kw = dict(object_position=r0.tolist(), object_velocity=v0.tolist(), **CATCHING)
     paths = {}
@@ -124,8 +126,8 @@ def test_ballistic_ball_agrees_between_engines():
     t = DT * np.arange(1, 151)[:, None]
     g = np.array([0.0, 0.0, -9.81])
     exact = r0 + v0 * t + 0.5 * g * t * t
-    np.testing.assert_allclose(paths["mujoco"], paths["bullet"], atol=1e-6)
-    for p in paths.values():
+    for engine, p in paths.items():
+        np.testing.assert_allclose(p, paths[REFERENCE], atol=1e-6, err_msg=engine)
         assert np.abs(p[:, :3] - exact).max() <= 9.81 * DT * t[-1, 0] / 2 + 1e-6
         np.testing.assert_allclose(p[:, 3:], v0 + g * t, atol=1e-9)
 
@@ -288,7 +290,7 @@ def test_fast_ball_is_stopped_by_the_palm(engine, speed):
     assert contacts[0].data["normal_speed"] == pytest.approx(speed, rel=0.02)
     assert penetration < 0.01
     vx = plant.object_state()[2][0]
-    assert vx > 0.0 if engine == "bullet" else vx > -0.05
+    assert vx > 0.0 if engine == REFERENCE else vx > -0.05
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -328,7 +330,7 @@ def test_object_impulse_changes_the_velocity(engine):
 # ---------------------------------------------------------------- log, frames, determinism
 def test_truth_payloads_and_frames_match_the_pybullet_plant():
     """The same topics with the same fields; the /tf chain of links ends at the tool frame."""
-    b, m = make("bullet", **CATCHING), make("mujoco", **CATCHING)
+    b, m = make(REFERENCE, **CATCHING), make("mujoco", **CATCHING)
     for plant in (b, m):
         plant.apply(ArmCommand([0.0] * 4))
         plant.step()
