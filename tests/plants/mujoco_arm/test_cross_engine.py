@@ -5,6 +5,7 @@ PyBullet twins only in the plant."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -17,6 +18,7 @@ import yaml
 from plants.arm_rig.engine import engines
 from plants.bullet_arm import BulletArmPlant
 from plants.bullet_arm import Params as ArmParams
+from plants.mujoco_arm.params import MujocoSettings
 from replay.messages import JointState, ObjectState, to_dict
 from replay.robot.arm_types import ArmCommand, ArmSpec
 from replay.robot.hand import CATCH3
@@ -398,18 +400,8 @@ def test_mujoco_scenario_differs_only_in_the_plant(name):
     pa, pb = a["plant"]["params"], dict(b["plant"]["params"])
     engine = pb.pop("engine")
     assert pb == pa and "engine" not in pa  # PyBullet: the field left out (empty)
-    assert engine["type"] == "mujoco" and set(engine) == {
-        "type",
-        "mj_solref",
-        "mj_limit_solref",
-        "mj_solimp",
-        "mj_cone",
-        "mj_condim",
-        "mj_iterations",
-        "mj_noslip_iterations",
-        "mj_integrator",
-        "hand_servo_gain",
-    }
+    fields = {f.name for f in dataclasses.fields(MujocoSettings)}  # the engine's settings
+    assert engine["type"] == "mujoco" and set(engine) == fields
     for key in set(a) - {"name", "description", "plant", "source"}:
         assert a[key] == b[key], key
     raw = yaml.safe_load((ROOT / "scenarios" / f"{name}_mujoco.yaml").read_text())
