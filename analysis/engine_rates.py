@@ -49,7 +49,10 @@ GRASP_PATHS = tuple((s, v) for s in range(101, 106) for v in (0.05, 0.15, 0.3)) 
 # strings on the same throws (catch_initial: MuJoCo's bounce, solref's damping ratio 1.0 against
 # PyBullet's restitution 0.18, decides the initial mapping's off-axis strike on finger f3)
 PROBES = {
-    "catch_initial": ("MuJoCo, mj_solref [0.002, 1.5]", ("plant.params.mj_solref=[0.002, 1.5]",)),
+    "catch_initial": (
+        "MuJoCo, mj_solref [0.002, 1.5]",
+        ("plant.params.engine.mj_solref=[0.002, 1.5]",),
+    ),
 }
 FIELDS = ("paper", "set", "scenario", "engine", "case", "success", "reason", "flag")
 

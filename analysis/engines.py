@@ -1,17 +1,20 @@
-"""Claims per physics engine: each arm claim's row with the PyBullet and the MuJoCo value side by
-side (docs/mujoco.md), the catch (or grasp) rates of both engines on the same throws (or human
-paths), and the closing note (which claims hold in both engines, which in one).
+"""Claims per physics engine: each arm claim's row with every engine's value side by side
+(docs/mujoco.md), the catch (or grasp) rates of the engines on the same throws (or human paths),
+and the closing note (which claims hold in every engine, which in some).
 
-A MuJoCo run is the scenario of the same name with ``_mujoco`` appended
-(``catch_optimised_mujoco`` is ``catch_optimised`` with ``plant.type: mujoco_arm``,
-``grasp_hexahedron_mujoco`` is ``grasp_hexahedron`` with ``mujoco_grasp``). The paper's own
-``evaluate`` (``analysis.catching.claims.evaluate``, ``analysis.grasping.claims.evaluate``: a MuJoCo
-log's typed params are the MuJoCo rig's, analysis/grasping/run.py) is run once on each engine's
-logs, named without the suffix, so both give the same rows; the rows are then joined by quantity.
-Every verdict stays the paper module's, from each engine's truth topics.
+A log's engine is its resolved scenario's (``engine_of``): ``plant.params.engine.type`` where the
+plant names one, else its plant type (``mujoco_arm``, ``mujoco_grasp``: MuJoCo; any other arm
+plant: PyBullet). A run in another engine than PyBullet is matched to its PyBullet twin by the
+scenario's name, less a ``_<engine>`` suffix (``catch_optimised_mujoco`` is ``catch_optimised``
+in MuJoCo). The paper's own ``evaluate`` (``analysis.catching.claims.evaluate``,
+``analysis.grasping.claims.evaluate``: a log's typed params are its plant's, analysis/grasping/run.py)
+is run once on each engine's logs, named without the suffix, so all give the same rows; the rows
+are then joined by quantity. Every verdict stays the paper module's, from each engine's truth
+topics.
 
 Wiring (for the claims table and the report): ``engine_rows(evaluate, logs)`` in place of
-``evaluate(logs)`` when ``logs`` holds ``*_mujoco`` runs; ``closing_note(rows)`` below the table.
+``evaluate(logs)`` when ``logs`` holds runs of another engine; ``closing_note(rows)`` below the
+table.
 """
 
 from __future__ import annotations
@@ -23,87 +26,97 @@ from typing import Any
 
 from analysis.claims import ASSESSED, Claim
 
-SUFFIX = "_mujoco"
-ENGINES = ("PyBullet", "MuJoCo")
+# each engine's name in a scenario (plant.params.engine.type) and its label in the tables, the
+# first the reference every other engine's runs are matched to; an engine not listed is shown
+# by its name
+LABELS = {"pybullet": "PyBullet", "mujoco": "MuJoCo"}
+ENGINES = tuple(LABELS.values())
+SUFFIX = "_mujoco"  # the MuJoCo twins' scenario names (analysis/engine_rates.py)
+_PLANT_ENGINES = {"mujoco_arm": "mujoco", "mujoco_grasp": "mujoco"}  # before the engine field
 
 
-def split_logs(logs: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(PyBullet logs, MuJoCo logs), the MuJoCo ones named as their PyBullet twins (by the
-    scenario's name: a key may carry a label after it, analysis/runs.py)."""
-    pb, mj = {}, {}
+def engine_of(config: Mapping[str, Any], name: str = "") -> str:
+    """The engine (its name, ``LABELS``' key) of a resolved scenario (``config``, a log's
+    ``scenario_config()``); where it has no plant (an unreadable one) the engine its ``name``
+    ends with (``_mujoco``), else the reference."""
+    plant = config.get("plant")
+    if isinstance(plant, Mapping):
+        params = plant.get("params")
+        engine = params.get("engine") if isinstance(params, Mapping) else None
+        if isinstance(engine, Mapping) and isinstance(engine.get("type"), str):
+            return engine["type"]
+        return _PLANT_ENGINES.get(str(plant.get("type")), "pybullet")
+    return next((e for e in LABELS if name.endswith(f"_{e}")), "pybullet")
+
+
+def split_logs(logs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """The logs per engine label (the reference engine first, then the others in ``LABELS``'
+    order), each named as its reference twin (by the scenario's name less ``_<engine>``: a key
+    may carry a label after it, analysis/runs.py)."""
+    out: dict[str, dict[str, Any]] = {ENGINES[0]: {}}
     for key, log in logs.items():
-        name = _name(key, log)
-        if name.endswith(SUFFIX) and key.startswith(name):
-            mj[name[: -len(SUFFIX)] + key[len(name) :]] = log
-        else:
-            pb[key] = log
-    return pb, mj
+        name = _read(log, "scenario").get("name")
+        name = name if isinstance(name, str) and name else key
+        engine = engine_of(_read(log, "scenario_config"), name)
+        label = LABELS.get(engine, engine)
+        suffix = f"_{engine}"
+        if label != ENGINES[0] and name.endswith(suffix) and key.startswith(name):
+            key = name[: -len(suffix)] + key[len(name) :]
+        out.setdefault(label, {})[key] = log
+    order = list(ENGINES) + sorted(set(out) - set(ENGINES))
+    return {e: out[e] for e in order if e in out}
 
 
-def _name(key: str, log: Any) -> str:
+def _read(log: Any, what: str) -> Mapping[str, Any]:
+    """``log.scenario()`` or ``log.scenario_config()``; {} where unreadable."""
     try:
-        name = log.scenario().get("name")
+        got = getattr(log, what)()
     except Exception:  # noqa: BLE001 - no readable scenario: the key is the name
-        name = None
-    return name if isinstance(name, str) and name else key
+        return {}
+    return got if isinstance(got, Mapping) else {}
 
 
-def join(pybullet: Sequence[Claim], mujoco: Sequence[Claim]) -> list[Claim]:
-    """One row per quantity: both engines' measurements; the status both share, else
-    ``differs`` (the claim does not hold in both engines) with each engine's status."""
-    by_q = {r.quantity: r for r in mujoco}
-    out = []
-    seen = set()
-    for a in pybullet:
-        b = by_q.get(a.quantity)
-        seen.add(a.quantity)
-        out.append(_pair(a, b))
-    for b in mujoco:
-        if b.quantity not in seen:
-            out.append(_pair(None, b))
-    return out
+def join(groups: Mapping[str, Sequence[Claim]]) -> list[Claim]:
+    """One row per quantity: every engine's measurement (``groups``: engine label -> its rows);
+    the status all share, else ``differs`` (the claim does not hold in every engine) with each
+    engine's status."""
+    by_q = {e: {r.quantity: r for r in rows} for e, rows in groups.items()}
+    quantities = dict.fromkeys(r.quantity for rows in groups.values() for r in rows)
+    return [_row({e: by_q[e].get(q) for e in groups}) for q in quantities]
 
 
-def _pair(a: Claim | None, b: Claim | None) -> Claim:
-    ref = a or b
-    assert ref is not None
-    ma = a.measured if a else "not run"
-    mb = b.measured if b else "not run"
-    sa = a.status if a else "not run"
-    sb = b.status if b else "not run"
-    if sa == sb:
-        status, parted = sa, ""
-    elif "not run" in (sa, sb):  # one engine has no run for it: the other's verdict stands
-        status, parted = (sb if sa == "not run" else sa), ""
+def _row(claims: Mapping[str, Claim | None]) -> Claim:
+    ref = next(c for c in claims.values() if c is not None)
+    status = {e: c.status if c else "not run" for e, c in claims.items()}
+    ran = [s for s in status.values() if s != "not run"]
+    parted = ""
+    if len(set(status.values())) == 1:
+        final = ran[0] if ran else "not run"
+    elif len(set(ran)) == 1:  # an engine without a run: the others' verdict stands
+        final = ran[0]
     else:
-        status = "differs" if "reproduced" in (sa, sb) else sb
-        parted = f"engines part: PyBullet {sa}, MuJoCo {sb}"
+        final = "differs" if "reproduced" in ran else ran[-1]
+        parted = "engines part: " + ", ".join(f"{e} {s}" for e, s in status.items())
     note = "; ".join(x for x in (parted, ref.note) if x)
+    measured = " ‖ ".join(f"{e}: {c.measured if c else 'not run'}" for e, c in claims.items())
     return Claim(
-        ref.quantity,
-        ref.stated,
-        f"PyBullet: {ma} ‖ MuJoCo: {mb}",
-        status,
-        note,
-        kind=ref.kind,
-        measures=ref.measures,
+        ref.quantity, ref.stated, measured, final, note, kind=ref.kind, measures=ref.measures
     )
 
 
 def engine_rows(evaluate: Callable[[dict], list[Claim]], logs: Mapping[str, Any]) -> list[Claim]:
     """The paper's rows per engine, joined (``join``)."""
-    pb, mj = split_logs(logs)
-    return join(evaluate(pb) if pb else [], evaluate(mj) if mj else [])
+    return join({e: evaluate(g) if g else [] for e, g in split_logs(logs).items()})
 
 
 def evaluate_runs(
     evaluate: Callable[[dict], list[Claim]], logs: Mapping[str, Any]
 ) -> tuple[list[Claim], str]:
-    """(rows, note) as the claims table and the report show them: with MuJoCo runs among
-    ``logs`` both engines side by side, then the stored robustness rates of both on the same
-    inputs (``stored_rate_rows``), and the closing note over both; else the paper's rows
-    alone."""
-    if not split_logs(logs)[1]:
+    """(rows, note) as the claims table and the report show them: with runs of another engine
+    than the reference among ``logs`` every engine side by side, then the stored robustness
+    rates of each on the same inputs (``stored_rate_rows``), and the closing note over them;
+    else the paper's rows alone."""
+    if len(split_logs(logs)) == 1:
         return evaluate(dict(logs)), ""
     papers = {log.scenario()["paper"] for log in logs.values() if hasattr(log, "scenario")}
     rows = engine_rows(evaluate, logs) + [r for p in sorted(papers) for r in stored_rate_rows(p)]
@@ -171,7 +184,10 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
     source = f"stored runs: data/ablations/{path.name} ({COMMAND})"
     out = []
     for s in dict.fromkeys(r["set"] for r in rows):
-        by_engine = {e: [r for r in rows if r["set"] == s and r["engine"] == e] for e in ENGINES}
+        # the engines of the set (the reference always: "not run" without rows), the rest probes
+        labels = {r["engine"] for r in rows if r["set"] == s}
+        engines = [e for e in ENGINES if e == ENGINES[0] or e in labels]
+        by_engine = {e: [r for r in rows if r["set"] == s and r["engine"] == e] for e in engines}
         row = rate_row(s, RATE_STATED.get(paper, "no rate stated"), by_engine)
         probes: dict[str, list[dict]] = {
             r["engine"]: [] for r in rows if r["set"] == s and r["engine"] not in ENGINES
@@ -189,23 +205,28 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
 
 def closing_note(rows: Sequence[Claim]) -> str:
     """Which assessed rows (measured, other regime, extension: those with a verdict) hold in
-    both engines, which in one (and why: the row's note)."""
-    both, one, neither, single = [], [], [], 0
+    every engine, which in some (and why: the row's note)."""
+    every, some, neither, single, n = [], [], [], 0, 2
     for r in rows:
         if r.kind not in ASSESSED:
             continue
-        if r.measured.startswith("PyBullet: not run") or r.measured.endswith("MuJoCo: not run"):
-            single += 1  # run in one engine only: no cross-engine verdict
+        parts = r.measured.split(" ‖ ")
+        n = max(n, len(parts))
+        if any(p.endswith(": not run") for p in parts):
+            single += 1  # not run in every engine: no cross-engine verdict
             continue
         if r.status == "reproduced":
-            both.append(r.quantity)
+            every.append(r.quantity)
         elif "engines part" in r.note:
-            one.append(f"{r.quantity} ({r.note.split(';')[0].removeprefix('engines part: ')})")
+            some.append(f"{r.quantity} ({r.note.split(';')[0].removeprefix('engines part: ')})")
         elif r.status == "differs":  # (ties, notes and rows not run in either: no verdict)
             neither.append(r.quantity)
-    lines = [f"Hold in both engines ({len(both)}): {', '.join(both) or 'none'}."]
-    lines.append(f"Hold in one engine only ({len(one)}): {', '.join(one) or 'none'}.")
-    lines.append(f"Hold in neither ({len(neither)}): {', '.join(neither) or 'none'}.")
+    all_n, part = ("both", "one engine only") if n == 2 else (f"all {n}", "some engines only")
+    lines = [f"Hold in {all_n} engines ({len(every)}): {', '.join(every) or 'none'}."]
+    lines.append(f"Hold in {part} ({len(some)}): {', '.join(some) or 'none'}.")
+    lines.append(f"Hold in {'neither' if n == 2 else 'none'} ({len(neither)}): ")
+    lines[-1] += f"{', '.join(neither) or 'none'}."
     if single:
-        lines.append(f"Run in one engine only, not compared: {single} rows.")
+        lines.append(f"Run in {'one engine only' if n == 2 else 'some engines only'}, ")
+        lines[-1] += f"not compared: {single} rows."
     return "\n".join(lines)

@@ -115,6 +115,8 @@ def _item(path: str, value: Any) -> str:
     parts = [p for p in path.split(".") if p != "params"]
     if parts[0] == "sensors" and len(parts) > 2:
         what = " ".join(parts[1:])
+    elif parts[-2:] == ["engine", "type"]:  # plant.params.engine.type
+        what = "engine"
     else:
         what = parts[-1].replace("_", " ")
     if parts[-1] in _SECONDS and isinstance(value, (int, float)) and 0 < value < 1:

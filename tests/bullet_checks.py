@@ -9,9 +9,9 @@ import numpy as np
 def _full_dofs(plant, q_arm, qd_arm=None, qdd_arm=None):
     hq, _, _ = plant.hand_state()
     pos, vel, acc = [], [], []
-    arm_of = {plant._jidx[plant.joint_names[i]]: i for i in plant.active}
-    hand_of = {j: k for k, j in enumerate(plant._hand_j)}
-    for j in plant._dofs:
+    arm_of = {plant.engine.jidx[plant.joint_names[i]]: i for i in plant.active}
+    hand_of = {j: k for k, j in enumerate(plant.engine.hand_j)}
+    for j in plant.engine.dofs:
         if j in arm_of:
             i = arm_of[j]
             pos.append(float(q_arm[i]))
@@ -25,7 +25,7 @@ def _full_dofs(plant, q_arm, qd_arm=None, qdd_arm=None):
         pos,
         vel,
         acc,
-        [plant._dofs.index(plant._jidx[plant.joint_names[i]]) for i in plant.active],
+        [plant.engine.dofs.index(plant.engine.jidx[plant.joint_names[i]]) for i in plant.active],
     )
 
 
@@ -33,7 +33,7 @@ def inverse_dynamics(plant, q, qd, qdd) -> np.ndarray:
     """PyBullet's inverse dynamics for the arm (hand joints frozen at their current angles);
     locked joints' entries are NaN."""
     pos, vel, acc, cols = _full_dofs(plant, q, qd, qdd)
-    tau = np.array(plant.bc.calculateInverseDynamics(plant.robot, pos, vel, acc))
+    tau = np.array(plant.engine.bc.calculateInverseDynamics(plant.engine.robot, pos, vel, acc))
     out = np.full(plant.dof, np.nan)
     out[list(plant.active)] = tau[cols]
     return out
@@ -42,5 +42,5 @@ def inverse_dynamics(plant, q, qd, qdd) -> np.ndarray:
 def mass_matrix(plant, q) -> np.ndarray:
     """PyBullet's mass matrix of the active arm joints (hand frozen), len(active) square."""
     pos, _, _, cols = _full_dofs(plant, q)
-    M = np.array(plant.bc.calculateMassMatrix(plant.robot, pos))
+    M = np.array(plant.engine.bc.calculateMassMatrix(plant.engine.robot, pos))
     return M[np.ix_(cols, cols)]

@@ -72,7 +72,7 @@ def main(path: str, reps: int = 5) -> None:
     commands: dict[int, list] = {}
     run_us: list[float] = []
     touch = [None]
-    set_motors, apply, step = plant._set_motors, plant.apply, plant.bc.stepSimulation
+    set_motors, apply, step = plant.engine.set_motors, plant.apply, plant.engine.bc.stepSimulation
 
     def record_motors(*a, **kw):
         pending.append((a, kw))
@@ -88,11 +88,11 @@ def main(path: str, reps: int = 5) -> None:
         c0 = clock()
         step()
         run_us.append(1e6 * (clock() - c0))
-        if touch[0] is None and plant.obj is not None:
-            if plant.bc.getContactPoints(bodyA=plant.obj, bodyB=plant.robot):
+        if touch[0] is None and plant.engine.obj is not None:
+            if plant.engine.bc.getContactPoints(bodyA=plant.engine.obj, bodyB=plant.engine.robot):
                 touch[0] = len(run_us)
 
-    plant._set_motors, plant.apply, plant.bc.stepSimulation = (
+    plant.engine.set_motors, plant.apply, plant.engine.bc.stepSimulation = (
         record_motors,
         record_apply,
         timed_step,
@@ -108,7 +108,7 @@ def main(path: str, reps: int = 5) -> None:
         rows = []
         for _ in range(reps):
             fresh = type(plant)(sc.plant.params, dt=runner.dt, rng=np.random.default_rng(0))
-            st, sm, us = fresh.bc.stepSimulation, fresh._set_motors, []
+            st, sm, us = fresh.engine.bc.stepSimulation, fresh.engine.set_motors, []
             if plant_too:  # the plant's own per-step work around the engine's step
 
                 def timed(st=st, us=us):
@@ -116,7 +116,7 @@ def main(path: str, reps: int = 5) -> None:
                     st()
                     us.append(1e6 * (clock() - c0))
 
-                fresh.bc.stepSimulation = timed
+                fresh.engine.bc.stepSimulation = timed
                 for i in range(n):
                     for c in commands.get(i, ()):
                         fresh.apply(c)

@@ -56,7 +56,7 @@ def main(path: str) -> None:
     sc = load_scenario(path)
     clock = time.process_time
     runner = Runner(sc)
-    bc, calls, times = runner.plant.bc, [], []
+    bc, calls, times = runner.plant.engine.bc, [], []
     for name in RECORDED:
         call = getattr(bc, name)
 
@@ -65,7 +65,9 @@ def main(path: str) -> None:
             return _call(*a, **k)
 
         setattr(bc, name, record)
-    runner.plant._set_motors = bc.setJointMotorControlArray  # the plant's bound one: recorded too
+    runner.plant.engine.set_motors = (
+        bc.setJointMotorControlArray
+    )  # the plant's bound one: recorded too
     step = bc.stepSimulation
 
     def timed() -> None:
@@ -84,7 +86,7 @@ def main(path: str) -> None:
     def replay(label, setup=lambda plant: None, skip=(), keep=lambda name, a: True) -> None:
         plant = cls(sc.plant.params, dt=1.0 / sc.timing.physics_rate, rng=np.random.default_rng(0))
         setup(plant)
-        cid, us = plant.bc._client, []
+        cid, us = plant.engine.bc._client, []
         for item in calls:
             if item is None:
                 c0 = clock()
@@ -95,7 +97,7 @@ def main(path: str) -> None:
         plant.close()
         _row(label, np.array(us) * 1e6)
 
-    arm = tuple(runner.plant._arm_j)
+    arm = tuple(runner.plant.engine.arm_j)
 
     def is_arm(name, a):
         return name != "setJointMotorControlArray" or tuple(a[1]) == arm
@@ -103,12 +105,12 @@ def main(path: str) -> None:
     replay("replayed back to back")
     replay(
         "replayed, human constraint removed",
-        lambda plant: plant.bc.removeConstraint(plant.human.cid),
+        lambda plant: plant.engine.bc.removeConstraint(plant.human.cid),
         skip=("changeConstraint",),
     )
     replay(
         "replayed, object removed",
-        lambda plant: plant.bc.removeBody(plant.obj),
+        lambda plant: plant.engine.bc.removeBody(plant.engine.obj),
         skip=("changeConstraint", "resetBaseVelocity"),
     )
     replay("replayed, no motor calls", skip=("setJointMotorControlArray",))
@@ -120,7 +122,7 @@ def main(path: str) -> None:
     for it in (1, 10, 25):
         replay(
             f"replayed, numSolverIterations={it} (not landed)",
-            lambda plant, it=it: plant.bc.setPhysicsEngineParameter(numSolverIterations=it),
+            lambda plant, it=it: plant.engine.bc.setPhysicsEngineParameter(numSolverIterations=it),
         )
 
 

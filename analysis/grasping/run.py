@@ -104,14 +104,16 @@ class GraspRun:
     @cached_property
     def params(self):
         """The rig's typed ``GraspParams``, rebuilt from the log's resolved scenario (every
-        default the plant's own): the PyBullet rig's, or the MuJoCo rig's (its contact settings
-        added) for a ``mujoco_grasp`` run."""
+        default the plant's own): its plant type's ``Params`` (an engine's settings included),
+        the engine-free rig's where the type is not installed."""
         from plants.arm_rig.params import GraspParams
-        from plants.mujoco_arm.params import GraspParams as MujocoGraspParams
+        from replay import registry
         from replay.scenario import params_from_data
 
-        mujoco = (self.scenario.get("plant") or {}).get("type") == "mujoco_grasp"
-        cls = MujocoGraspParams if mujoco else GraspParams
+        plant_type = str((self.scenario.get("plant") or {}).get("type"))
+        cls = GraspParams
+        if registry.known("plant", plant_type):
+            cls = getattr(registry.load("plant", plant_type), "Params", GraspParams)
         return params_from_data(cls, self.plant_params, "plant.params")
 
     @property

@@ -4,21 +4,23 @@ arm's 7 AC servos on velocity commands (``ServoCommand``; ``servo.VelocityServos
 F/T sensor and a human hand moving the object on its constraint plane.
 
 ``GraspRig`` owns, once for every engine: the head, the plane, the arm servos and their torques,
-``torque_limit`` events and the command; its logged topics are ``grasp_topics.GraspRigTopics``'s
-and its verdict ``grasp_verdict.GraspVerdict``'s (both subclasses). An engine's grasp plant
-answers the questions below (``_grasp_engine_setup``, ``_make_human``, ``arm_mass_matrix``,
-``_hand_velocity``) and sets ``_wrench`` (the wrist's true wrench, [F, M]) each step.
+``torque_limit`` events, the command and the step; its logged topics are
+``grasp_topics.GraspRigTopics``'s and its verdict ``grasp_verdict.GraspVerdict``'s (both
+subclasses). Its engine adapter (``engine``) is the arm rig's widened by the grasp's engine
+questions (``GraspEngine`` below).
 """
 
 from __future__ import annotations
 
 from abc import abstractmethod
-from typing import Any
+from typing import Protocol
 
 import numpy as np
 
+from plants.arm_rig.engine import EngineAdapter
 from plants.arm_rig.grasp_setup import head_setup, human_args, plane_setup
 from plants.arm_rig.head import HeadServo
+from plants.arm_rig.human_path import HumanPath
 from plants.arm_rig.params import GraspParams
 from plants.arm_rig.rig import ArmRig
 from plants.arm_rig.servo import VelocityServos
@@ -28,12 +30,38 @@ from replay.robot.head import camera_pose
 from replay.spatial import matrix_to_quaternion
 
 
+class GraspEngine(EngineAdapter, Protocol):
+    """The grasping rig's engine questions, on top of the arm rig's."""
+
+    wrench: list  # the wrist's true wrench [Fx, Fy, Fz, Mx, My, Mz] of the last step
+
+    def grasp_setup(self) -> tuple[list, np.ndarray]:
+        """The engine's hand drives and wrist sensor; (the arm joints' static torques at the
+        initial posture, the arm's mass matrix there): the servos' preload."""
+
+    def make_human(self, rng: np.random.Generator, args: dict) -> HumanPath:
+        """The human hand (a ``human_path.HumanPath`` the engine applies) from ``args``."""
+
+    def drive_human(self, human: HumanPath, t: float, obj: tuple) -> None:
+        """Apply the human's coupling at ``t`` (the object's state ``obj``) over the next step."""
+
+    def arm_mass_matrix(self) -> np.ndarray:
+        """The arm joints' block of the joint-space mass matrix now (kg m^2)."""
+
+    def hand_velocity(self, hand) -> None:
+        """Set the hand servos' velocity command (rad/s per hand joint)."""
+
+    def drive_hand_servos(self, qd: list) -> None:
+        """Drive the hand servos at their command over the coming step (``qd``: their speeds)."""
+
+
 class GraspRig(ArmRig):
     spec_type = GraspSpec
     command_types = (ServoCommand,)  # type: ignore[assignment]
     hold_event = "grasp"
+    engine_role = "grasp"
 
-    _wrench: list  # the wrist's true wrench [Fx, Fy, Fz, Mx, My, Mz]: the engine's plant's
+    engine: GraspEngine
 
     def __init__(self, params: GraspParams, *, dt: float, rng: np.random.Generator) -> None:
         if params.object == "none" or params.hand == "none":
@@ -44,33 +72,16 @@ class GraspRig(ArmRig):
         self.arm_servos = VelocityServos(
             self.torque_limits[list(self.active)], P.arm_servo_bandwidth, dt
         )
-        self._grasp_engine_setup()
+        self.arm_servos.preload(*self.engine.grasp_setup())  # held still before t = 0
+        self._read_servos()
         # the head, the constraint plane and the human (grasp_setup)
         self.head, h0 = head_setup(P)
         self.head_servo = HeadServo(self.head, P.head_servo_bandwidth, dt, h0)
         self.plane, u, v, n = plane_setup(P)
         self._u_l, self._v_l, self._n_l = u.tolist(), v.tolist(), [float(x) for x in n]
-        self.human = self._make_human(rng, human_args(P, u, v, n))
+        self.human = self.engine.make_human(rng, human_args(P, u, v, n))
         self._head_pose: tuple | None = None
         self._spec = self._grasp_spec(self._spec)
-
-    # ------------------------------------------------------------------ the engine's answers
-    @abstractmethod
-    def _grasp_engine_setup(self) -> None:
-        """The engine's drives, wrist sensor (``_wrench``), the servos' preload (``arm_servos``
-        made) and the state read."""
-
-    @abstractmethod
-    def _make_human(self, rng: np.random.Generator, args: dict) -> Any:
-        """The human hand (a ``human_path.HumanPath`` the engine applies) from ``args``."""
-
-    @abstractmethod
-    def arm_mass_matrix(self) -> np.ndarray:
-        """The arm joints' block of the joint-space mass matrix now (kg m^2)."""
-
-    @abstractmethod
-    def _hand_velocity(self, hand) -> None:
-        """The hand servos' velocity command (rad/s per hand joint)."""
 
     # ------------------------------------------------------------------ spec
     def _grasp_spec(self, base) -> GraspSpec:
@@ -91,14 +102,14 @@ class GraspRig(ArmRig):
                 raise ValueError(f"ServoCommand.arm needs {self.dof} values, got {qd.shape[0]}")
             self.arm_servos.set_command(qd if self._all_active else qd[list(self.active)])
         if command.hand is not None:
-            self._hand_velocity(command.hand)
+            self.engine.hand_velocity(command.hand)
         if command.head is not None:
             self.head_servo.set_command(command.head)
 
     def _servo_torques(self, qd: list) -> list:
         """The arm servos' torques for the coming step (active joints), at joint speeds ``qd``."""
         return self.arm_servos.torques(
-            qd if self._all_active else [qd[i] for i in self.active], self.arm_mass_matrix()
+            qd if self._all_active else [qd[i] for i in self.active], self.engine.arm_mass_matrix()
         )
 
     def _read_servos(self) -> None:
@@ -131,6 +142,29 @@ class GraspRig(ArmRig):
                     )
             self.clamp_count += sum(clamped)
         self._torque_episode = clamped
+
+    @abstractmethod
+    def _judge_step(self) -> None:
+        """The step's events and verdict (grasp_verdict.GraspVerdict)."""
+
+    def step(self) -> None:
+        E = self.engine
+        (_, qd), hand, obj = self._state()
+        E.drive_human(self.human, self._t, obj)
+        E.apply_torques(self._servo_torques(qd))
+        E.drive_hand_servos(hand[1])
+        self.head_servo.step()
+        self._obj_vel_before = obj[2]
+        diverged = E.advance()
+        self._steps += 1
+        self._t = self._steps * self.dt
+        self._head_pose = None
+        if diverged:
+            self._diverge()
+        if self.diverged:
+            return
+        self._read_servos()
+        self._judge_step()
 
     # ------------------------------------------------------------------ log and scene
     def _head_reading(self):

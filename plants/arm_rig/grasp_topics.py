@@ -52,7 +52,7 @@ class GraspRigTopics(GraspRig):
             [a - b for a, b in zip(pos, human.target_l)],
             human.limited,
         )
-        w = self._wrench
+        w = self.engine.wrench
         out["/wrist/wrench_truth"] = Wrench(t, w[:3], w[3:])
         return out
 
@@ -99,5 +99,5 @@ class GraspRigTopics(GraspRig):
             "camera_rotation": R,
             "camera_position": c,
         }
-        sc.readings["wrist"] = {"wrench": self._wrench}
+        sc.readings["wrist"] = {"wrench": self.engine.wrench}
         return sc

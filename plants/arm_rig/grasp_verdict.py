@@ -5,7 +5,7 @@ PyBullet rig (``grasp_plant.BulletGraspPlant``) and the MuJoCo one, so both engi
 by the same criterion.
 
 Its state is the rig's (``grasp_rig.GraspRig``, its base): the plane, the human, the object's
-state, the tool frame (``_effector_now``) and the contacts (``_contact_summary_now``).
+state, the tool frame (``engine.effector_now``) and the contacts (``engine.contact_summary``).
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ class GraspVerdict(GraspRig):
 
     def _in_hand_position(self, pos) -> list[float]:
         """The object's centre in the tool (= hand) frame (m): R^T (x - p)."""
-        (px, py, pz), (qx, qy, qz, qw), _, _ = self._effector_now()
+        (px, py, pz), (qx, qy, qz, qw), _, _ = self.engine.effector_now()
         dx, dy, dz = pos[0] - px, pos[1] - py, pos[2] - pz
         # the columns of R(q) dotted with d
         return [
@@ -72,7 +72,7 @@ class GraspVerdict(GraspRig):
         for ev in self._events[n_before:]:
             if ev.kind == "grasp":
                 self._grasp_start = self._t - ev.data.get("hold_time", 0.0)
-                ev.data["normal_force"] = float(self._contact_summary_now()[2])
+                ev.data["normal_force"] = float(self.engine.contact_summary()[2])
                 self._grasps.append(
                     {
                         "t": self._grasp_start,
@@ -90,7 +90,7 @@ class GraspVerdict(GraspRig):
                 held = self._t - self._grasp_start
                 self._grasps[-1]["held_for"] = held
                 ev.data["held_for"] = held
-        parts = self._contact_summary_now()[0]  # sorted, "arm" among them if it touches
+        parts = self.engine.contact_summary()[0]  # sorted, "arm" among them if it touches
         n_hand = len(parts) - ("arm" in parts)
         if n_hand:
             self._touched.update(x for x in parts if x != "arm")
@@ -131,7 +131,7 @@ class GraspVerdict(GraspRig):
         else:
             self._slipping = False
             self._in_hand.clear()
-            ex, ey, ez = self._effector_now()[0]
+            ex, ey, ez = self.engine.effector_now()[0]
             dx, dy, dz = ox - ex, oy - ey, oz - ez
             (ux, uy, uz), (vx, vy, vz) = self._u_l, self._v_l
             du = dx * ux + dy * uy + dz * uz

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from replay.params import ParamError, param
 from replay.robot.hand import CATCH_CLOSING_SPEED  # Namiki & Ishikawa IV-A: 90 deg in 20 ms
@@ -217,8 +218,26 @@ class Params:
         doc="object centre below this world z: drop (after a catch) or miss",
     )
 
+    engine: dict[str, Any] = param(
+        {},
+        omit_empty=True,
+        doc="the physics engine and its settings, {type: ENGINE, ...}: type pybullet (no "
+        "settings here: its contact fields are the ones above) or mujoco (mj_solref, "
+        "mj_limit_solref, mj_solimp, mj_cone, mj_condim, mj_iterations, mj_noslip_iterations, "
+        "mj_integrator, hand_servo_gain: docs/mujoco.md); empty: the plant type's own engine "
+        "(PyBullet for bullet_arm and bullet_grasp). Engines are registered in the entry point "
+        "group paper_replay.engines (plants/arm_rig/engine.py)",
+    )
+
     def __post_init__(self) -> None:
-        """Lists sized for the arm and hand chosen (the plant needs one value per joint)."""
+        """Lists sized for the arm and hand chosen (the plant needs one value per joint); the
+        engine's settings typed (``engine_settings``, not a field: ``engine`` keeps them as
+        plain data, every default filled in)."""
+        from plants.arm_rig.engine import engine_settings
+        from replay.scenario.loader import to_plain
+
+        self.engine_settings = engine_settings(self.engine)
+        self.engine = {} if self.engine_settings is None else to_plain(self.engine_settings)
         dof = _DOF[self.arm]
         for name in ("initial_q", "initial_qd", "torque_limits", "velocity_limits"):
             n = len(getattr(self, name))

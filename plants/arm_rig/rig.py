@@ -4,21 +4,18 @@ object, as every physics engine's plant shares it.
 ``ArmRig`` owns what does not depend on the engine, once: the resolved settings, the nominal
 spec, the torque limiting, the command, the truth topics, the events (``contact``, ``catch``,
 ``release``, ``drop``, ``miss``, ``torque_limit``, ``velocity_limit``, ``joint_limit``, ``nan``,
-``impulse``), the catch verdict (``outcome``) and the camera scene. An engine's plant
-(``plants.bullet_arm``, ``plants.mujoco_arm``) subclasses it, builds its world after
-``ArmRig.__init__`` and answers the engine questions below (``_state``, ``_effector_now``,
-``_point_velocity``, ``_object_contacts``, ``_touch``, ``_contact_summary_now``,
-``_set_object_velocity``, ``_engine_notes``, ``_apply_torques``, ``_drive_hand``,
-``_hold_object``, ``_advance``, ``frames``).
+``impulse``), the catch verdict (``outcome``) and the camera scene. It owns one engine adapter
+(``engine``, engine.py ``EngineAdapter``: the world, built from the rig's public attributes,
+answering the engine questions); an engine's plant (``plants.bullet_arm``, ``plants.mujoco_arm``)
+names its adapter class (``Engine``).
 """
 
 from __future__ import annotations
 
 import math
-from abc import abstractmethod
-
 import numpy as np
 
+from plants.arm_rig.engine import EngineAdapter, adapter_class
 from plants.arm_rig.arm_state import limit_flags, limit_torque, torque_limit_events
 from plants.arm_rig.impulse import ImpulseSchedule
 from plants.arm_rig.outcome import CatchWatch
@@ -39,7 +36,7 @@ from replay.messages import (
 from replay.robot.arm_types import ArmCommand, ArmSpec, HandSpec, ObjectSpec
 from replay.robot.hand import hand_mass
 from replay.robot.wam import DEFAULT_VELOCITY_LIMIT
-from replay.scene import Box, Primitive, Scene, Sphere
+from replay.scene import Box, Frame, Primitive, Scene, Sphere
 
 
 def floats(values, n: int, what: str) -> list[float]:
@@ -110,8 +107,6 @@ class ArmRig(Plant):
         self._hold = self._unhold = 0.0
         self.caught = self._ever_caught = self._fallen = self.diverged = False
         self._has_object = P.object != "none"
-        self._contacts: list = []  # the engine's contact rows of the step (_object_contacts)
-        self._palm_id: int | None = None  # the engine's id of the palm (None: no palm)
         self._obj_vel_before = (
             tuple(float(x) for x in P.object_velocity) if self._has_object else (0.0,) * 3
         )
@@ -120,7 +115,10 @@ class ArmRig(Plant):
         self._obj_albedo = float(P.object_albedo)
         self._obj_size = _vec3(P.object_size)
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
-        self._cache: tuple | None = None  # the engine's state read this step (_state)
+        # the world, from the public state above: the engine field's adapter, else the type's
+        E = P.engine_settings
+        Engine = self.Engine if E is None else adapter_class(E, self.engine_role)
+        self.engine: EngineAdapter = Engine(self)
         self._spec = self._make_spec(S.initial_q.copy())
         self._watch = (  # the catch verdict (outcome.py): a free object and a hand
             CatchWatch(
@@ -134,61 +132,25 @@ class ArmRig(Plant):
             else None
         )
 
-    # ------------------------------------------------------------------ the engine's answers
-    @abstractmethod
-    def _state(self) -> tuple:
-        """((q, qd), hand (q, qd, effort), object (pos, orn xyzw, v, w) or None) as plain
-        floats, read once after each step; shared, never mutated."""
+    # ------------------------------------------------------------------ the engine
+    Engine: type  # the engine adapter's class (engine.py ``EngineAdapter``), built from the rig
+    engine_role = "arm"  # which of an engine's adapters the rig takes (engine.py)
 
-    @abstractmethod
+    def _state(self) -> tuple:
+        """The engine's state (engine.py ``EngineAdapter.state``): the one read the grasping rig
+        widens with its servos' torques."""
+        return self.engine.state()
+
     def invalidate_state(self) -> None:
         """Forget the state read (after setting the simulation other than by stepping it)."""
+        self.engine.invalidate_state()
 
-    @abstractmethod
-    def _effector_now(self) -> tuple:
-        """The tool frame's (pos, orn xyzw, v, w) now, read once a step."""
+    def frames(self) -> list[Frame]:
+        return self.engine.frames()
 
-    @abstractmethod
-    def _point_velocity(self, link: int, point) -> tuple[float, float, float]:
-        """v + w x r of the point ``point`` moving with the robot link ``link`` (world)."""
-
-    @abstractmethod
-    def _object_contacts(self, pos, v) -> list:
-        """The step's object-robot contact rows (the object at ``pos`` moving at ``v``)."""
-
-    @abstractmethod
-    def _touch(self, contacts: list) -> tuple:
-        """(link, point, normal from the robot towards the object) of the strongest contact."""
-
-    @abstractmethod
-    def _contact_summary_now(self) -> tuple:
-        """(parts, links, total normal force in N) of the step's contacts, sorted."""
-
-    @abstractmethod
-    def _set_object_velocity(self, v: list, w) -> None:
-        """Set the object's velocity (a scenario's kick)."""
-
-    @abstractmethod
-    def _engine_notes(self) -> dict:
-        """The spec's notes on the engine."""
-
-    @abstractmethod
-    def _apply_torques(self, tau: list) -> None:
-        """Apply the arm's torques (N*m, one per active joint) over the coming step."""
-
-    @abstractmethod
-    def _drive_hand(self, v: list, qd: list) -> None:
-        """Drive the hand's servos at the speeds ``v`` (rad/s) over the coming step; ``qd``:
-        the hand joints' speeds now."""
-
-    @abstractmethod
-    def _hold_object(self, obj: tuple) -> None:
-        """Before the step: the forces the engine applies to the object itself (none, or
-        gravity's cancelled where ``object_gravity`` is off and the engine needs a force)."""
-
-    @abstractmethod
-    def _advance(self) -> bool:
-        """Step the engine by ``dt``; True when the run has diverged (the engine says so)."""
+    def close(self) -> None:
+        if getattr(self, "engine", None) is not None:  # None: the rig's __init__ failed first
+            self.engine.close()
 
     # ------------------------------------------------------------------ spec
     def _make_spec(self, q0: np.ndarray) -> ArmSpec:
@@ -239,7 +201,7 @@ class ArmRig(Plant):
                 else f"assumed {DEFAULT_VELOCITY_LIMIT} rad/s (no table source)",
                 "hand": ht.note if ht else "",
                 "urdf": str(self.urdf_path),
-                **self._engine_notes(),
+                **self.engine.notes(),
             },
         )
 
@@ -262,7 +224,7 @@ class ArmRig(Plant):
     def effector_state(self):
         """Tool frame: position, orientation [qx,qy,qz,qw], linear and angular velocity (read
         once a step, like the joint state)."""
-        return tuple(np.array(x) for x in self._effector_now())
+        return tuple(np.array(x) for x in self.engine.effector_now())
 
     # ------------------------------------------------------------------ command
     def apply(self, command: ArmCommand) -> None:
@@ -296,7 +258,7 @@ class ArmRig(Plant):
         J = self._impulses.pop(self._steps) if self._impulses.due else None
         if J is not None:
             v = (np.asarray(v) + J / self.params.object_mass).tolist()
-            self._set_object_velocity(v, obj[3])
+            self.engine.set_object_velocity(v, obj[3])
             self.invalidate_state()
             self._events.append(Occurrence("impulse", {"impulse": J.tolist(), "velocity_after": v}))
         self._obj_vel_before = tuple(v)
@@ -305,18 +267,19 @@ class ArmRig(Plant):
         (_, qd), hand, obj = self._state()
         self._limit_torque(qd)
         applied = self._tau_applied
-        self._apply_torques(applied if self._all_active else [applied[i] for i in self.active])
+        self.engine.apply_torques(
+            applied if self._all_active else [applied[i] for i in self.active]
+        )
         if self.hand_names:
             speed, dt = self._hand_speed, self.dt
             # rate-limited position servo: reach the target at most at the closing speed, the
             # last step landing on it
             v = [min(max((x - y) / dt, -speed), speed) for x, y in zip(self._hand_target, hand[0])]
-            self._drive_hand(v, hand[1])
+            self.engine.drive_hand(v, hand[1])
         if obj is not None:
             self._kick(obj)
-            self._hold_object(obj)
-        diverged = self._advance()
-        self._cache = None
+            self.engine.hold_object(obj)
+        diverged = self.engine.advance()
         self._steps += 1
         self._t = self._steps * self.dt
         if diverged:
@@ -387,13 +350,13 @@ class ArmRig(Plant):
             self._limit_events(ql, qdl, over, at)
         if pos is None or v is None:  # no object
             return
-        contacts = self._contacts = self._object_contacts(pos, v)
-        parts, links, _ = self._contact_summary_now()
+        contacts = self.engine.object_contacts(pos, v)
+        parts, links, _ = self.engine.contact_summary()
         if contacts and not self._in_contact:
-            link, point, normal = self._touch(contacts)
+            link, point, normal = self.engine.touch(contacts)
             point = np.array(point)
             n = np.array(normal)  # from the robot towards the object
-            v_rel = np.subtract(self._obj_vel_before, self._point_velocity(link, point))
+            v_rel = np.subtract(self._obj_vel_before, self.engine.point_velocity(link, point))
             self._events.append(
                 Occurrence(
                     "contact",
@@ -412,8 +375,8 @@ class ArmRig(Plant):
         # caught: touching enough hand parts and moving with the palm
         hand_parts = [x for x in parts if x != "arm"]
         held = False
-        if self._palm_id is not None and len(hand_parts) >= P.catch_min_parts:
-            px, py, pz = self._point_velocity(self._palm_id, pos)
+        if self.engine.palm_id is not None and len(hand_parts) >= P.catch_min_parts:
+            px, py, pz = self.engine.point_velocity(self.engine.palm_id, pos)
             dx, dy, dz = v[0] - px, v[1] - py, v[2] - pz
             held = math.sqrt(dx * dx + dy * dy + dz * dz) < P.catch_relative_speed
         if held:
@@ -444,7 +407,7 @@ class ArmRig(Plant):
             kind = "drop" if self._ever_caught else "miss"
             self._events.append(Occurrence(kind, {"position": list(pos), "velocity": list(v)}))
         if self._watch is not None:
-            pe, oe, ve, we = self._effector_now()  # floats: faster than arrays here
+            pe, oe, ve, we = self.engine.effector_now()  # floats: faster than arrays here
             self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
 
     def pop_events(self) -> list[Occurrence]:
@@ -477,7 +440,7 @@ class ArmRig(Plant):
                 t, list(self.hand_names), hq[:], hqd[:], heff[:]
             )
         # the tool frame's motion; /effector/state (actual and desired point) is the controller's
-        pe, oe, ve, we = self._effector_now()
+        pe, oe, ve, we = self.engine.effector_now()
         vx, vy, vz = ve
         out[TOPIC_EFFECTOR_MOTION] = EffectorMotion(
             t, list(pe), list(oe), list(ve), list(we), math.sqrt(vx * vx + vy * vy + vz * vz)
@@ -485,7 +448,7 @@ class ArmRig(Plant):
         if obj is not None:
             pos, orn, v, w = obj
             out[TOPIC_OBJECT_STATE] = ObjectState(t, list(pos), list(orn), list(v), list(w))
-            parts, links, force = self._contact_summary_now()
+            parts, links, force = self.engine.contact_summary()
             out[TOPIC_OBJECT_CONTACTS] = ObjectContacts(t, list(parts), list(links), force)
         return out
 

@@ -1,10 +1,10 @@
 """A torque-controlled arm with a position-controlled hand and one free object, in PyBullet.
 
 The engine-free arm rig (plants/arm_rig/rig.py ``ArmRig``: spec, torque limits, truth topics,
-events, outcome, scene) in PyBullet: this plant builds the world, steps PyBullet by a fixed
-``dt`` in DIRECT mode and answers the rig's engine questions (state, tool frame, point
-velocities, contacts, the object's velocity, link frames). It knows nothing of any paper's
-method.
+events, outcome, scene) owning a ``PybulletEngine`` (the adapter of plants/arm_rig/engine.py):
+the adapter builds the world, steps PyBullet by a fixed ``dt`` in DIRECT mode and answers the
+rig's engine questions (state, tool frame, point velocities, contacts, the object's velocity,
+link frames). It knows nothing of any paper's method.
 
 PyBullet facts used (shared/robots/README.md, measured on this machine):
 - URDFs are loaded with ``URDF_USE_INERTIA_FROM_FILE`` (else inertia comes from collision shapes);
@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 
 from plants.arm_rig.arm_state import joint_state
 from plants.arm_rig.params import Params as ArmParams
@@ -43,15 +42,19 @@ PER_STEP_CALLS = (
 )
 
 
-class BulletArmPlant(ArmRig):
-    Params = ArmParams
-    description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"
+class PybulletEngine:
+    """The rig's engine in PyBullet (plants/arm_rig/engine.py ``EngineAdapter``), built from the
+    rig's public attributes (``rig``: its params, settings, model, URDF, dt and joints)."""
 
-    def __init__(self, params: ArmParams, *, dt: float, rng: np.random.Generator) -> None:
-        super().__init__(params, dt=dt, rng=rng)  # the engine-free rig
-        P, S = params, self.settings
-        dof, names = self.dof, self.joint_names
+    def __init__(self, rig: ArmRig) -> None:
+        P, S, dt = rig.params, rig.settings, rig.dt
+        self.params, self.dt, self.model = P, dt, rig.model
+        dof, names, self.active = rig.dof, rig.joint_names, rig.active
+        self.hand_names, self.hand_table = rig.hand_names, rig.hand_table
         q0, qd0 = S.initial_q, S.initial_qd
+        self._steps = 0  # steps advanced (the tool frame's read: once a step)
+        self._cache: tuple | None = None  # the state read this step (state)
+        self.contacts: list = []  # the object-robot contact rows of the step (object_contacts)
 
         # ---- the world
         with quiet_c_output():  # connect prints "argv[0]="
@@ -64,17 +67,17 @@ class BulletArmPlant(ArmRig):
         )
         orn = matrix_to_quaternion(rpy_to_matrix(P.base_rpy))
         self.robot = bc.loadURDF(
-            str(self.urdf_path),
+            str(rig.urdf_path),
             basePosition=list(P.base_position),
             baseOrientation=list(orn),
             useFixedBase=True,
             flags=p.URDF_USE_INERTIA_FROM_FILE,
         )
-        self._jidx = {}
+        self.jidx = {}
         self._link_name = {-1: "wam_base"}
         for j in range(bc.getNumJoints(self.robot)):
             info = bc.getJointInfo(self.robot, j)
-            self._jidx[info[1].decode()] = j
+            self.jidx[info[1].decode()] = j
             self._link_name[j] = info[12].decode()
         self._link_index = {v: k for k, v in self._link_name.items()}
         # each link's parent link (-1: the base), for the link frames of 3-D viewers (frames())
@@ -85,12 +88,12 @@ class BulletArmPlant(ArmRig):
         bx, by, bz = P.base_position
         self._base_pose = ((float(bx), float(by), float(bz)), (qx, qy, qz, qw))
         self._all_links = list(range(len(self._parent_link)))
-        self._arm_j = [self._jidx[names[i]] for i in self.active]
-        self._hand_j = [self._jidx[n] for n in self.hand_names]
-        self._tool_link = self._link_index["wam_tool"]
-        self._palm_link = self._palm_id = self._link_index.get("palm")
+        self.arm_j = [self.jidx[names[i]] for i in self.active]
+        self.hand_j = [self.jidx[n] for n in self.hand_names]
+        self.tool_link = self._link_index["wam_tool"]
+        self.palm_link = self.palm_id = self._link_index.get("palm")
         # pybullet dof order (movable joints in index order) -> for calculate* helpers
-        self._dofs = [
+        self.dofs = [
             j
             for j in range(bc.getNumJoints(self.robot))
             if bc.getJointInfo(self.robot, j)[2] == p.JOINT_REVOLUTE
@@ -104,37 +107,35 @@ class BulletArmPlant(ArmRig):
                 lateralFriction=P.hand_lateral_friction,
                 restitution=P.hand_restitution,
             )
-        for k, j in enumerate(self._arm_j):
+        for k, j in enumerate(self.arm_j):
             bc.resetJointState(self.robot, j, q0[self.active[k]], qd0[self.active[k]])
         bc.setJointMotorControlArray(
-            self.robot, self._arm_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self._arm_j)
+            self.robot, self.arm_j, p.VELOCITY_CONTROL, forces=[0.0] * len(self.arm_j)
         )
-        for j, v in zip(self._hand_j, S.hand_initial):
+        for j, v in zip(self.hand_j, S.hand_initial):
             bc.resetJointState(self.robot, j, float(v), 0.0)
         # one getJointStates a step for the arm and the hand; q of the locked joints preset
-        self._read_j = self._arm_j + self._hand_j
-        self._na = len(self._arm_j)
-        self._q_locked_l = [float(self.locked.get(n, 0.0)) for n in names]
+        self._read_j = self.arm_j + self.hand_j
+        self.na = len(self.arm_j)
+        self.q_locked_l = [float(rig.locked.get(n, 0.0)) for n in names]
         # per arm joint its read joint's index, -1 for a locked one (arm_state.joint_state)
         slot = {i: k for k, i in enumerate(self.active)}
-        self._pick = tuple(slot.get(i, -1) for i in range(dof))
-        # the tool frame and the palm: one getLinkStates a step (_frames_now)
-        self._frame_links = [self._tool_link] + (
-            [] if self._palm_link is None else [self._palm_link]
-        )
+        self.pick = tuple(slot.get(i, -1) for i in range(dof))
+        # the tool frame and the palm: one getLinkStates a step (frames_now)
+        self._frame_links = [self.tool_link] + ([] if self.palm_link is None else [self.palm_link])
         # BulletClient makes a new functools.partial on every attribute access: bind the calls
         # made every step once; those called through the client (stepSimulation: the bench
         # times it there) are kept on it as attributes
         for name in PER_STEP_CALLS:
             setattr(bc, name, getattr(bc, name))
-        self._get_joint_states = bc.getJointStates
-        self._get_base_pose = bc.getBasePositionAndOrientation
-        self._get_base_velocity = bc.getBaseVelocity
+        self.get_joint_states = bc.getJointStates
+        self.get_base_pose = bc.getBasePositionAndOrientation
+        self.get_base_velocity = bc.getBaseVelocity
         self._get_link_state = bc.getLinkState
         self._get_link_states = bc.getLinkStates
         self._get_contact_points = bc.getContactPoints
-        self._set_motors = bc.setJointMotorControlArray
-        self._hand_forces = [float(P.hand_max_torque)] * len(self._hand_j)
+        self.set_motors = bc.setJointMotorControlArray
+        self._hand_forces = [float(P.hand_max_torque)] * len(self.hand_j)
         self._hand_v: list | None = None  # the hand motors' last targets (None: none set yet)
 
         # ---- the free object
@@ -174,14 +175,14 @@ class BulletArmPlant(ArmRig):
         # beyond this distance from the base the object touches nothing of the robot (m)
         self._contact_radius = (
             robot_reach(bc, self.robot, self._base_pose[0], self._parent_link)
-            + (self._obj_radius if P.object == "ball" else 0.5 * math.hypot(*self._obj_size))
+            + (P.object_radius if P.object == "ball" else 0.5 * math.hypot(*P.object_size))
             + 0.05
         )
         # (step, the tool link's state): read at most once a step
         self._effector: tuple[int, tuple] | None = None
 
     # ------------------------------------------------------------------ state
-    def _state(self) -> tuple:
+    def state(self) -> tuple:
         """((q, qd), hand (q, qd, effort), object (pos, orn, v, w) or None) as plain floats
         (lists; the object's PyBullet tuples), read from PyBullet once after each step (one
         getJointStates for arm and hand) and kept until the next one (``invalidate_state``
@@ -189,15 +190,15 @@ class BulletArmPlant(ArmRig):
         accessors below give copies."""
         if self._cache is None:
             arm, hand = joint_state(
-                self._get_joint_states(self.robot, self._read_j),
-                self._na,
-                self._pick,
-                self._q_locked_l,
+                self.get_joint_states(self.robot, self._read_j),
+                self.na,
+                self.pick,
+                self.q_locked_l,
             )
             obj = None
             if self.obj is not None:
-                pos, orn = self._get_base_pose(self.obj)
-                v, w = self._get_base_velocity(self.obj)
+                pos, orn = self.get_base_pose(self.obj)
+                v, w = self.get_base_velocity(self.obj)
                 obj = (pos, orn, v, w)
             self._cache = (arm, hand, obj)
         return self._cache
@@ -207,11 +208,11 @@ class BulletArmPlant(ArmRig):
         self._cache = None
         self._effector = None
 
-    def _effector_now(self) -> tuple:
+    def effector_now(self) -> tuple:
         """effector_state as PyBullet's tuples, read once a step."""
-        return self._frames_now()[0]
+        return self.frames_now()[0]
 
-    def _frames_now(self) -> tuple:
+    def frames_now(self) -> tuple:
         """(tool (pos, orn, v, w), palm link state or None): one getLinkStates a step for the
         tool frame and the palm (the catch check's point velocity)."""
         if self._effector is None or self._effector[0] != self._steps:
@@ -225,43 +226,45 @@ class BulletArmPlant(ArmRig):
             )
         return self._effector[1]
 
-    def _set_object_velocity(self, v: list, w) -> None:
+    def set_object_velocity(self, v: list, w) -> None:
         self.bc.resetBaseVelocity(self.obj, v, list(w))
 
-    def _engine_notes(self) -> dict:
+    def notes(self) -> dict:
         return {}
 
     # ------------------------------------------------------------------ step
-    def _apply_torques(self, tau: list) -> None:
-        self._set_motors(self.robot, self._arm_j, p.TORQUE_CONTROL, forces=tau)
+    def apply_torques(self, tau: list) -> None:
+        self.set_motors(self.robot, self.arm_j, p.TORQUE_CONTROL, forces=tau)
 
-    def _drive_hand(self, v: list, qd: list) -> None:
+    def drive_hand(self, v: list, qd: list) -> None:
         # PyBullet's velocity motor is implicit (the rig's rate-limited servo is stable); it keeps
         # its target and force until set again: the same targets as last step (closing at full
         # speed, at rest) need no call
         if v != self._hand_v:
-            self._set_motors(
+            self.set_motors(
                 self.robot,
-                self._hand_j,
+                self.hand_j,
                 p.VELOCITY_CONTROL,
                 targetVelocities=v,
                 forces=self._hand_forces,
             )
             self._hand_v = v
 
-    def _hold_object(self, obj: tuple) -> None:
+    def hold_object(self, obj: tuple) -> None:
         if not self.params.object_gravity:
             P = self.params
             force = [0.0, 0.0, P.object_mass * P.gravity]
             self.bc.applyExternalForce(self.obj, -1, force, list(obj[0]), p.WORLD_FRAME)
 
-    def _advance(self) -> bool:
+    def advance(self) -> bool:
         self.bc.stepSimulation()
+        self._steps += 1
+        self._cache = None
         return False  # a non-finite state is the rig's check (limit_flags)
 
     # ------------------------------------------------------------------ events
-    def _object_contacts(self, pos, v) -> list:
-        """Contact points object-robot that touch (normal force > 0 or no gap); none while
+    def object_contacts(self, pos, v) -> list:
+        """The step's contact points object-robot that touch (normal force > 0 or no gap); none while
         the object at ``pos`` (moving at ``v``) is beyond the robot's reach (reach.py) by more
         than its bounding radius, its travel in two steps and 5 cm: no point can be there (the
         points of a step are found at its start, nearer than Bullet's contact threshold)."""
@@ -271,19 +274,21 @@ class BulletArmPlant(ArmRig):
         far = self._contact_radius + 2.0 * self.dt * math.sqrt(vx * vx + vy * vy + vz * vz)
         dx, dy, dz = x - bx, y - by, z - bz
         if dx * dx + dy * dy + dz * dz > far * far:
-            return []
-        pts = self._get_contact_points(bodyA=self.obj, bodyB=self.robot)
-        return [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
+            self.contacts = []
+        else:
+            pts = self._get_contact_points(bodyA=self.obj, bodyB=self.robot)
+            self.contacts = [c for c in pts if c[9] > 0.0 or c[8] <= 1e-4]
+        return self.contacts
 
-    def _touch(self, contacts: list) -> tuple:
+    def touch(self, contacts: list) -> tuple:
         c = max(contacts, key=lambda c: c[9])
         return c[4], c[6], c[7]
 
-    def _point_velocity(self, link: int, point) -> tuple[float, float, float]:
+    def point_velocity(self, link: int, point) -> tuple[float, float, float]:
         """v + w x (point - link COM) of a robot link now (world), as floats."""
         if link < 0:
             return (0.0, 0.0, 0.0)
-        ls = self._frames_now()[1] if link == self._palm_link else None
+        ls = self.frames_now()[1] if link == self.palm_link else None
         if ls is None:
             ls = self._get_link_state(
                 self.robot, link, computeLinkVelocity=1, computeForwardKinematics=1
@@ -311,10 +316,10 @@ class BulletArmPlant(ArmRig):
             out.append(Frame(names[parent], names[j], rp, ro))
         return out
 
-    def _contact_summary_now(self) -> tuple[tuple, tuple, float]:
-        """(parts, links, total normal force) of ``_contacts`` (tuples, shared: copy them into
+    def contact_summary(self) -> tuple[tuple, tuple, float]:
+        """(parts, links, total normal force) of ``contacts`` (tuples, shared: copy them into
         a payload), summed once per list."""
-        contacts = self._contacts
+        contacts = self.contacts
         if self._contact_summary[0] is not contacts:
             if contacts:
                 key = tuple(c[4] for c in contacts)  # the touching links: names once per set
@@ -336,3 +341,9 @@ class BulletArmPlant(ArmRig):
             except Exception:
                 pass
             self.bc = None
+
+
+class BulletArmPlant(ArmRig):
+    Params = ArmParams
+    Engine = PybulletEngine
+    description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"

@@ -1,5 +1,6 @@
 """The grasping rig (Namiki, Nakabo, Ishii & Ishikawa 1999) in MuJoCo: physics only, the PyBullet
-rig's contract (plants/bullet_arm/grasp_plant.py ``BulletGraspPlant``) on ``MujocoArmPlant``:
+rig's contract (plants/bullet_arm/grasp_plant.py ``BulletGraspPlant``) on the MuJoCo adapter
+(``MujocoGraspEngine``, widening ``MujocoEngine``):
 
 - the arm's 7 AC servos take velocity commands (``ServoCommand.arm``): the engine-free
   inertia-decoupled ``servo.VelocityServos`` on MuJoCo's arm mass matrix (``mj_fullM``), their
@@ -24,18 +25,16 @@ from plants.arm_rig.grasp_verdict import GraspVerdict
 from plants.arm_rig.human_path import HumanPath
 from plants.mujoco_arm.human import drive_human
 from plants.mujoco_arm.params import GraspParams
-from plants.mujoco_arm.plant import MujocoArmPlant
+from plants.mujoco_arm.plant import MujocoEngine
 from plants.mujoco_arm.world import wrist_wrench
 
 
-class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
-    Params = GraspParams
-    description = (
-        "MuJoCo WAM-7 + 14-joint hand on velocity servos, pan/tilt head, wrist F/T, "
-        "an object moved by a human hand on a constraint plane"
-    )
+class MujocoGraspEngine(MujocoEngine):
+    """The MuJoCo adapter widened by the grasping rig's engine questions
+    (grasp_rig.py ``GraspEngine``): the hand servos' command band, the wrist's F/T sensor,
+    the arm's mass matrix and the human's forces."""
 
-    def _grasp_engine_setup(self) -> None:
+    def grasp_setup(self) -> tuple[list, np.ndarray]:
         m, d, W = self.mj, self.md, self.world
         # the hand servos: never clipped by MuJoCo (_hand_caps clips their command)
         m.actuator_forcerange[self._hand_act] = [(-1e6 * self._hand_cap, 1e6 * self._hand_cap)]
@@ -45,19 +44,26 @@ class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
         # MuJoCo's mass matrix (hand joints held by their servos), as the PyBullet rig's
         self._M = np.zeros((m.nv, m.nv))
         self._arm_block = np.ix_(W.arm_dof, W.arm_dof)
+        self.wrench = wrist_wrench(W, d)
         # held still before t = 0: the integrals carry the static (gravity) torques at the
         # initial posture (qfrc_bias at zero velocity)
-        self.arm_servos.preload(d.qfrc_bias[list(W.arm_dof)].tolist(), self.arm_mass_matrix())
-        self._read_servos()
-        self._wrench = wrist_wrench(W, d)
+        return d.qfrc_bias[list(W.arm_dof)].tolist(), self.arm_mass_matrix()
 
-    def _make_human(self, rng: np.random.Generator, args: dict) -> HumanPath:
+    def make_human(self, rng: np.random.Generator, args: dict) -> HumanPath:
         return HumanPath(rng, **args)
+
+    def drive_human(self, human: HumanPath, t: float, obj: tuple) -> None:
+        W = self.world
+        drive_human(human, self.md, t, W.object_qpos, W.object_dof, self._ob)
 
     # ------------------------------------------------------------------ state
     def arm_mass_matrix(self) -> np.ndarray:
         mujoco.mj_fullM(self.mj, self.md, self._M)
         return self._M[self._arm_block]
+
+    def _read_contacts(self) -> None:
+        super()._read_contacts()
+        self.wrench = wrist_wrench(self.world, self.md)  # the step's (acceleration-stage sensors)
 
     # ------------------------------------------------------------------ hand servos
     def _hand_caps(self, v_cmd: list, v: list) -> None:
@@ -80,7 +86,7 @@ class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
         return [kv * (x - y) for x, y in zip(self.md.ctrl[self._hand_act].tolist(), v)]
 
     # ------------------------------------------------------------------ command
-    def _hand_velocity(self, hand) -> None:
+    def hand_velocity(self, hand) -> None:
         h = np.asarray(hand, float).reshape(-1)
         if h.shape != (len(self._hand_act),):
             raise ValueError(
@@ -88,25 +94,14 @@ class MujocoGraspPlant(GraspVerdict, GraspRigTopics, MujocoArmPlant):
             )
         self._hand_v_cmd = [x if np.isfinite(x) else 0.0 for x in h.tolist()]
 
-    def step(self) -> None:
-        m, d, W = self.mj, self.md, self.world
-        (_, qd), hand, obj = self._state()
-        drive_human(self.human, d, self._t, W.object_qpos, W.object_dof, self._ob)
-        d.qfrc_applied[self._arm_dof] = self._servo_torques(qd)
-        self._hand_caps(self._hand_v_cmd, hand[1])
-        self.head_servo.step()
-        self._obj_vel_before = obj[2]
-        mujoco.mj_step2(m, d)
-        self._read_contacts()
-        self._wrench = wrist_wrench(W, d)  # the step's reaction (acceleration-stage sensors)
-        mujoco.mj_step1(m, d)
-        self._cache = None
-        self._steps += 1
-        self._t = self._steps * self.dt
-        self._head_pose = None
-        if not self.diverged and self._warned():
-            self._diverge()
-        if self.diverged:
-            return
-        self._read_servos()
-        self._judge_step()
+    def drive_hand_servos(self, qd: list) -> None:
+        self._hand_caps(self._hand_v_cmd, qd)
+
+
+class MujocoGraspPlant(GraspVerdict, GraspRigTopics):
+    Params = GraspParams
+    Engine = MujocoGraspEngine
+    description = (
+        "MuJoCo WAM-7 + 14-joint hand on velocity servos, pan/tilt head, wrist F/T, "
+        "an object moved by a human hand on a constraint plane"
+    )

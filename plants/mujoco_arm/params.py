@@ -1,12 +1,15 @@
-"""The mujoco_arm plant's scenario parameters: the bullet_arm plant's (the same robot, hand,
-object, limits and catch criterion, so a scenario changes only ``plant.type``) and MuJoCo's
-contact and solver settings. The PyBullet-only fields (``solver_iterations``, ``*_restitution``,
-``contact_stiffness``/``contact_damping``, rolling/spinning friction) are accepted and not used:
-MuJoCo has no restitution coefficient; the bounce is set by ``mj_solref``'s damping ratio."""
+"""MuJoCo's contact and solver settings: ``MujocoSettings``, the engine field's
+(``plant.params.engine: {type: mujoco, ...}``, plants/arm_rig/engine.py), and the same fields
+flat in the params of the plant types ``mujoco_arm``/``mujoco_grasp`` (``Params``,
+``GraspParams``: the scenarios and logs made before the engine field). The PyBullet-only fields
+(``solver_iterations``, ``*_restitution``, ``contact_stiffness``/``contact_damping``,
+rolling/spinning friction) are accepted and not used: MuJoCo has no restitution coefficient;
+the bounce is set by ``mj_solref``'s damping ratio."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 from plants.arm_rig.params import GraspParams as BulletGraspParams
 from plants.arm_rig.params import Params as ArmParams
@@ -14,7 +17,12 @@ from replay.params import ParamError, param
 
 
 @dataclass
-class Params(ArmParams):
+class _EngineType:
+    type: str = param("mujoco", choices=("mujoco",), doc="the engine: MuJoCo")
+
+
+@dataclass
+class _MujocoFields:
     mj_solref: list[float] = param(
         [0.002, 1.0],
         unit="s, 1",
@@ -85,12 +93,28 @@ class Params(ArmParams):
     )
 
     def __post_init__(self) -> None:
-        super().__post_init__()
         for name in ("mj_solref", "mj_limit_solref"):
             if getattr(self, name)[0] < 0.002 * 0.999:
                 # MuJoCo advises >= 2 steps; the plant runs at 1 ms (a finer step allows less,
                 # but no scenario uses one)
                 raise ParamError(name, "the time constant must be >= 0.002 s (2 physics steps)")
+
+
+@dataclass
+class MujocoSettings(_MujocoFields, _EngineType):
+    """``plant.params.engine`` of type mujoco: its settings and adapters."""
+
+    arm: ClassVar[str] = "plants.mujoco_arm.plant:MujocoEngine"
+    grasp: ClassVar[str] = "plants.mujoco_arm.grasp_plant:MujocoGraspEngine"
+
+
+@dataclass
+class Params(_MujocoFields, ArmParams):
+    """The mujoco_arm plant type's params: the rig's with MuJoCo's settings flat."""
+
+    def __post_init__(self) -> None:
+        ArmParams.__post_init__(self)
+        _MujocoFields.__post_init__(self)
 
 
 @dataclass

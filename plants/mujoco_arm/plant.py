@@ -36,14 +36,18 @@ def _index(ix: list) -> slice | list:
     return ix
 
 
-class MujocoArmPlant(ArmRig):
-    Params = MujocoParams
-    description = "MuJoCo WAM arm (torque control) + hand (velocity servos) + a free object"
+class MujocoEngine:
+    """The rig's engine in MuJoCo (plants/arm_rig/engine.py ``EngineAdapter``), built from the
+    rig's public attributes (``rig``: its params, settings, model, dt and joints)."""
 
-    def __init__(self, params: MujocoParams, *, dt: float, rng: np.random.Generator) -> None:
-        super().__init__(params, dt=dt, rng=rng)  # the engine-free rig
-        P, S = params, self.settings
-        W = self.world = build_world(P, S, self.model, dt)
+    def __init__(self, rig: ArmRig) -> None:
+        P, S, dt = rig.params, rig.settings, rig.dt
+        self.dof, self.active, self.hand_names = rig.dof, rig.active, rig.hand_names
+        self._cache: tuple | None = None  # the state read this step (state)
+        self.contacts: list = []  # the step's rows (body, position, normal, force): _read_contacts
+        # MuJoCo's settings: the engine field's, else the mujoco_arm params' own (flat)
+        E = P.engine_settings if P.engine_settings is not None else P
+        W = self.world = build_world(P, S, rig.model, dt, E)
         m, d = self.mj, self.md = W.model, W.data
         self._arm_qpos, self._arm_dof = list(W.arm_qpos), list(W.arm_dof)
         self._hand_qpos, self._hand_dof = list(W.hand_qpos), list(W.hand_dof)
@@ -51,7 +55,7 @@ class MujocoArmPlant(ArmRig):
         self._arm_dof_ix, self._hand_act_ix = _index(self._arm_dof), _index(self._hand_act)
         self._tool = W.body_names.index("wam_tool")
         self._palm = W.body_names.index("palm") if "palm" in W.body_names else -1
-        self._palm_id = self._palm if self._palm >= 0 else None
+        self.palm_id = self._palm if self._palm >= 0 else None
         self._ob = W.object_body
         # ---- the initial state
         q0, qd0 = S.initial_q, S.initial_qd
@@ -66,12 +70,12 @@ class MujocoArmPlant(ArmRig):
             R = d.xmat[self._ob].reshape(3, 3)
             d.qvel[b : b + 6] = free_velocity(R, P.object_velocity, P.object_angular_velocity)
         mujoco.mj_forward(m, d)
-        self._q_locked = [float(self.locked.get(n, 0.0)) for n in self.joint_names]
+        self._q_locked = [float(rig.locked.get(n, 0.0)) for n in rig.joint_names]
         # (arm joint index, qpos address, dof address) of each active joint
         self._arm_slots = [(i, W.arm_qpos[k], W.arm_dof[k]) for k, i in enumerate(self.active)]
         self._root = m.body_rootid.tolist()
         self._geom_body = m.geom_bodyid.tolist()
-        self._motions: dict = {}  # (step, body) -> _body_motion
+        self._motions: dict = {}  # body -> _body_motion, this step's
         # frames(): per robot body (body, parent, parent's name, its name)
         self._frame_rows = [
             (i, int(m.body_parentid[i]), W.body_names[int(m.body_parentid[i])], W.body_names[i])
@@ -108,7 +112,7 @@ class MujocoArmPlant(ArmRig):
             )
             reach = ext + float(m.geom_rbound[self._obj_geom]) + NEAR
             self._hand_reach2 = reach * reach
-        self._hand_kv = float(P.hand_servo_gain)
+        self._hand_kv = float(E.hand_servo_gain)
         # MuJoCo resets the state where it diverges (a warning count): those are the "nan"
         self._bad = [
             int(w)
@@ -118,10 +122,9 @@ class MujocoArmPlant(ArmRig):
                 mujoco.mjtWarning.mjWARN_BADQPOS,
             )
         ]
-        # _contacts: the step's rows (body, position, normal robot->object, normal force)
 
     # ------------------------------------------------------------------ state
-    def _state(self) -> tuple:
+    def state(self) -> tuple:
         """((q, qd), hand (q, qd, effort), object (pos, orn xyzw, v, w world) or None) as
         plain floats, read once after each step; shared, never mutated."""
         if self._cache is None:
@@ -158,12 +161,9 @@ class MujocoArmPlant(ArmRig):
         """(position, orientation xyzw, v, w) of a body's frame (world), from MuJoCo's cvel
         (rotation; translation of the point at the subtree centre of mass of the body's root,
         moving with the body), read once a step per body."""
-        key = (self._steps, body)
-        got = self._motions.get(key)
+        got = self._motions.get(body)
         if got is not None:
             return got
-        if len(self._motions) > 8:
-            self._motions.clear()
         d = self.md
         wx, wy, wz, ux, uy, uz = d.cvel[body].tolist()
         px, py, pz = d.xpos[body].tolist()
@@ -171,20 +171,20 @@ class MujocoArmPlant(ArmRig):
         rx, ry, rz = px - cx, py - cy, pz - cz
         v = (ux + wy * rz - wz * ry, uy + wz * rx - wx * rz, uz + wx * ry - wy * rx)
         got = ((px, py, pz), _xyzw(d.xquat[body].tolist()), v, (wx, wy, wz))
-        self._motions[key] = got
+        self._motions[body] = got
         return got
 
-    def _effector_now(self) -> tuple:
+    def effector_now(self) -> tuple:
         return self._body_motion(self._tool)
 
-    def _set_object_velocity(self, v: list, w) -> None:
+    def set_object_velocity(self, v: list, w) -> None:
         b = self.world.object_dof
         self.md.qvel[b : b + 3] = v
 
-    def _engine_notes(self) -> dict:
+    def notes(self) -> dict:
         return {"engine": f"mujoco {mujoco.__version__}"}
 
-    def _point_velocity(self, body: int, point) -> tuple[float, float, float]:
+    def point_velocity(self, body: int, point) -> tuple[float, float, float]:
         """v + w x (point - body origin) of a robot body now (world)."""
         if self.world.part_of_body[body] is None:
             return (0.0, 0.0, 0.0)
@@ -244,23 +244,25 @@ class MujocoArmPlant(ArmRig):
             ]
             self._hand_capped = capped
 
-    def _apply_torques(self, tau: list) -> None:
+    def apply_torques(self, tau: list) -> None:
         self.md.qfrc_applied[self._arm_dof_ix] = tau
 
-    def _drive_hand(self, v: list, qd: list) -> None:
+    def drive_hand(self, v: list, qd: list) -> None:
         self.md.ctrl[self._hand_act_ix] = v
         self._hand_caps(v, qd)
 
-    def _hold_object(self, obj: tuple) -> None:
+    def hold_object(self, obj: tuple) -> None:
         pass  # object_gravity off: the world's gravity compensation (world.py)
 
-    def _advance(self) -> bool:
+    def advance(self) -> bool:
         m, d = self.mj, self.md
         mujoco.mj_step2(m, d)
         self._read_contacts()
         mujoco.mj_step1(m, d)
+        self._cache = None
+        self._motions.clear()
         # MuJoCo found a non-finite or huge state and reset it: the run has diverged
-        return self.diverged or self._warned()
+        return self._warned()
 
     # ------------------------------------------------------------------ events
     def _warned(self) -> bool:
@@ -293,24 +295,24 @@ class MujocoArmPlant(ArmRig):
                     out.append((b1, pos[i], [nx, ny, nz], float(f6[0])))
                 else:
                     out.append((b2, pos[i], [-nx, -ny, -nz], float(f6[0])))
-        self._contacts = out
+        self.contacts = out
 
-    def _object_contacts(self, pos, v) -> list:
-        return self._contacts  # read within the step (_read_contacts)
+    def object_contacts(self, pos, v) -> list:
+        return self.contacts  # read within the step (_read_contacts)
 
-    def _touch(self, contacts: list) -> tuple:
+    def touch(self, contacts: list) -> tuple:
         c = max(contacts, key=lambda c: c[3])
         return c[0], c[1], c[2]
 
-    def _contact_summary_now(self) -> tuple[list, list, float]:
+    def contact_summary(self) -> tuple[list, list, float]:
         """(parts, links, total normal force) of the step's contacts."""
-        if not self._contacts:
+        if not self.contacts:
             return [], [], 0.0
         W = self.world
-        bodies = {c[0] for c in self._contacts}
+        bodies = {c[0] for c in self.contacts}
         links = sorted(W.body_names[b] for b in bodies)
         parts = sorted({W.part_of_body[b] or "arm" for b in bodies})
-        return parts, links, float(sum(c[3] for c in self._contacts))
+        return parts, links, float(sum(c[3] for c in self.contacts))
 
     # ------------------------------------------------------------------ log and scene
     def frames(self) -> list[Frame]:
@@ -343,3 +345,12 @@ class MujocoArmPlant(ArmRig):
                 )
             )
         return out
+
+    def close(self) -> None:
+        """Nothing to free: MuJoCo's model and data go with the adapter."""
+
+
+class MujocoArmPlant(ArmRig):
+    Params = MujocoParams
+    Engine = MujocoEngine
+    description = "MuJoCo WAM arm (torque control) + hand (velocity servos) + a free object"

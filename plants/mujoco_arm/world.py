@@ -28,9 +28,11 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from plants.arm_rig.params import Params as ArmParams
 from plants.arm_rig.settings import ArmSettings
 from plants.models.arm import ArmModel
-from plants.mujoco_arm.params import Params
+from plants.mujoco_arm.params import MujocoSettings
+from plants.mujoco_arm.params import Params as MujocoParams
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 
 ROBOT_BITS, OBJECT_BITS = 2, 1  # contype of each; conaffinity the other's: robot-robot never
@@ -69,34 +71,38 @@ class World:
     wrist_adr: int = -1  # sensordata address of the wrist's force (3) then torque (3); -1: none
 
 
-def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
+def build_world(
+    P: ArmParams, S: ArmSettings, arm: ArmModel, dt: float, E: MujocoSettings | MujocoParams
+) -> World:
+    """The MuJoCo world of the rig's params ``P`` (settings ``S``, robot ``arm``) at steps of
+    ``dt``, MuJoCo's settings from ``E`` (the engine field's, or the mujoco_arm params')."""
     spec = mujoco.MjSpec.from_string(arm.urdf)
     spec.compiler.fusestatic = False
     opt = spec.option
     opt.timestep = dt
     opt.gravity = [0.0, 0.0, -float(P.gravity)]
-    opt.integrator = INTEGRATORS[P.mj_integrator]
-    opt.cone = CONES[P.mj_cone]
-    opt.iterations = int(P.mj_iterations)
-    opt.noslip_iterations = int(P.mj_noslip_iterations)
+    opt.integrator = INTEGRATORS[E.mj_integrator]
+    opt.cone = CONES[E.mj_cone]
+    opt.iterations = int(E.mj_iterations)
+    opt.noslip_iterations = int(E.mj_noslip_iterations)
     base = spec.body("wam_base")
     base.pos = [float(x) for x in P.base_position]
     base.quat = wxyz(matrix_to_quaternion(rpy_to_matrix(P.base_rpy)))
     mu = float(P.hand_lateral_friction) * float(P.object_lateral_friction)  # PyBullet's product
-    solref, solimp = [float(x) for x in P.mj_solref], [float(x) for x in P.mj_solimp]
+    solref, solimp = [float(x) for x in E.mj_solref], [float(x) for x in E.mj_solimp]
     for g in spec.geoms:
         g.contype, g.conaffinity = ROBOT_BITS, OBJECT_BITS
         g.friction = [mu, 0.0, 0.0]
-        g.condim, g.solref, g.solimp = int(P.mj_condim), solref, solimp
+        g.condim, g.solref, g.solimp = int(E.mj_condim), solref, solimp
     for j in spec.joints:
-        j.solref_limit = [float(x) for x in P.mj_limit_solref]  # MuJoCo's default: 0.02 s
+        j.solref_limit = [float(x) for x in E.mj_limit_solref]  # MuJoCo's default: 0.02 s
         # the URDF's effort limit becomes a joint-level clip of actuator force, applied outside
         # the implicit step: the plant clips the arm's torques and the hand servos' itself
         j.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
     for name in arm.hand_joints:
         a = spec.add_actuator(name=f"{name}_servo", target=name)
         a.trntype = mujoco.mjtTrn.mjTRN_JOINT
-        a.set_to_velocity(kv=float(P.hand_servo_gain))
+        a.set_to_velocity(kv=float(E.hand_servo_gain))
         a.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
         a.forcerange = [-float(P.hand_max_torque), float(P.hand_max_torque)]
     if arm.palm_link is not None:
@@ -131,7 +137,7 @@ def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
             friction=[mu, 0.0, 0.0],
             contype=OBJECT_BITS,
             conaffinity=ROBOT_BITS,
-            condim=int(P.mj_condim),
+            condim=int(E.mj_condim),
             solref=solref,
             solimp=solimp,
         )

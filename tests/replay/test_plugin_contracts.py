@@ -56,6 +56,11 @@ def _short_run(scenario: str):
     return replay.run(scenario, set={"timing.duration": DURATION})
 
 
+# plant types kept for the logs made before the engine field (plant.params.engine): no shipped
+# scenario names them; tests/plants/mujoco_arm builds and runs them directly
+FOR_OLD_LOGS = {("plant", "mujoco_arm"), ("plant", "mujoco_grasp")}
+
+
 def _group(kind: str) -> list[str]:
     """Every installed entry point of ``kind``'s group."""
     return sorted(ep.name for ep in entry_points(group=registry.GROUPS[kind]))
@@ -63,8 +68,13 @@ def _group(kind: str) -> list[str]:
 
 def _plugins(kind: str) -> list[str]:
     """Every installed plug-in of ``kind``: its group's entry points and those the installed
-    papers name (replay/papers.py), not one a test registers in this process."""
-    return sorted(n for n in registry.names(kind) if n not in registry._registered[kind])
+    papers name (replay/papers.py), not one a test registers in this process, nor a plant type
+    kept only for old logs."""
+    return sorted(
+        n
+        for n in registry.names(kind)
+        if n not in registry._registered[kind] and (kind, n) not in FOR_OLD_LOGS
+    )
 
 
 @pytest.mark.parametrize("kind", ["paper", "plant", "sensor", "controller"])
@@ -73,7 +83,7 @@ def test_the_contracts_cover_every_entry_point_pyproject_declares(kind):
     with open(ROOT / "pyproject.toml", "rb") as f:
         declared = tomllib.load(f)["project"]["entry-points"].get(group, {})
     assert _group(kind) == sorted(declared), f"reinstall: {group} differs from pyproject.toml"
-    assert set(_group(kind)) <= set(_plugins(kind))
+    assert set(_group(kind)) <= set(registry.names(kind))
     assert kind == "paper" or len(_plugins(kind)) >= 3, _plugins(kind)  # the papers' own
 
 

@@ -103,13 +103,14 @@ def bare_stepper(runner: Runner):
     if space is not None and hasattr(space, "step"):  # Pymunk
         dt = plant.dt
         return "pymunk space.step", plant, lambda: space.step(dt)
-    bc = getattr(plant, "bc", None)
+    engine = getattr(plant, "engine", plant)  # the arm rig's engine adapter
+    bc = getattr(engine, "bc", None)
     if bc is not None:  # PyBullet (a BulletClient)
         import pybullet as p
 
         client = bc._client
         return "pybullet stepSimulation", plant, lambda: p.stepSimulation(physicsClientId=client)
-    mj, md = getattr(plant, "mj", None), getattr(plant, "md", None)
+    mj, md = getattr(engine, "mj", None), getattr(engine, "md", None)
     if mj is not None and md is not None:  # MuJoCo (an MjModel and its MjData)
         import mujoco
 
@@ -139,7 +140,8 @@ def engine_in_run(sc, out: Path) -> tuple[float, float, int]:
 
         return wrapper
 
-    space, bc = getattr(plant, "space", None), getattr(plant, "bc", None)
+    engine = getattr(plant, "engine", plant)  # the arm rig's engine adapter
+    space, bc = getattr(plant, "space", None), getattr(engine, "bc", None)
     restore = None
     if space is not None and hasattr(space, "step"):
         space.step = timed(space.step)
@@ -153,7 +155,7 @@ def engine_in_run(sc, out: Path) -> tuple[float, float, int]:
         def restore():
             pybullet.stepSimulation = original
 
-    elif getattr(plant, "md", None) is not None:
+    elif getattr(engine, "md", None) is not None:
         import mujoco
 
         originals = (mujoco.mj_step1, mujoco.mj_step2)

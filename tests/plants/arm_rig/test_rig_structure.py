@@ -43,7 +43,30 @@ def test_every_engine_plant_runs_the_rigs_own_methods():
             assert getattr(cls, name) is getattr(ArmRig, name), (cls.__name__, name)
         # the grasp rig's own truth, scene, command, verdict: one of each for both engines
         assert cls.truth.__module__ == cls.scene.__module__ == "plants.arm_rig.grasp_topics"
-        assert cls.apply is GraspRig.apply
+        assert cls.apply is GraspRig.apply and cls.step is GraspRig.step
         assert (
             cls.outcome.__module__ == cls._judge_step.__module__ == "plants.arm_rig.grasp_verdict"
         )
+
+
+def test_engine_plants_only_name_their_adapter():
+    """An engine's plant is the rig plus its adapter class (plants/arm_rig/engine.py): it defines
+    no method of its own, and its adapter defines every method of the adapter protocol."""
+    from plants.arm_rig.engine import EngineAdapter
+    from plants.arm_rig.grasp_rig import GraspEngine
+    from plants.bullet_arm.grasp_plant import BulletGraspPlant
+    from plants.bullet_arm.plant import BulletArmPlant
+    from plants.mujoco_arm.grasp_plant import MujocoGraspPlant
+    from plants.mujoco_arm.plant import MujocoArmPlant
+
+    def methods(protocol) -> set[str]:
+        return {n for n, v in vars(protocol).items() if callable(v) and not n.startswith("_")}
+
+    arm, grasp = methods(EngineAdapter), methods(GraspEngine)
+    assert {"state", "advance", "object_contacts", "frames"} <= arm
+    for cls in (BulletArmPlant, MujocoArmPlant, BulletGraspPlant, MujocoGraspPlant):
+        own = {n for n in vars(cls) if not n.startswith("_")}
+        assert own == {"Params", "Engine", "description"}, (cls.__name__, own)
+        want = arm | (grasp if cls in (BulletGraspPlant, MujocoGraspPlant) else set())
+        missing = [n for n in want if not callable(getattr(cls.Engine, n, None))]
+        assert not missing, (cls.Engine.__name__, missing)

@@ -388,7 +388,7 @@ def test_miss_event_when_ball_falls_past():
 
 def test_nan_event_on_non_finite_state():
     plant = make(**CATCHING)
-    plant.bc.resetBaseVelocity(plant.obj, [float("nan"), 0.0, 0.0], [0.0, 0.0, 0.0])
+    plant.engine.bc.resetBaseVelocity(plant.engine.obj, [float("nan"), 0.0, 0.0], [0.0, 0.0, 0.0])
     plant.apply(ArmCommand([0.0] * 4))
     plant.step()
     assert [e.kind for e in plant.pop_events()] == ["nan"]
@@ -528,7 +528,7 @@ def test_base_pose_and_nonzero_lock_match_the_model():
     pos, orn, _, _ = plant.effector_state()
     T = spec.model.fk(q)
     np.testing.assert_allclose(pos, T[:3, 3], atol=1e-6)
-    R = np.array(plant.bc.getMatrixFromQuaternion(orn.tolist())).reshape(3, 3)
+    R = np.array(plant.engine.bc.getMatrixFromQuaternion(orn.tolist())).reshape(3, 3)
     np.testing.assert_allclose(R, T[:3, :3], atol=1e-6)
     Mn = active_block(spec.model.mass_matrix(q), spec.active)
     np.testing.assert_allclose(

@@ -28,7 +28,7 @@ def settle(plant, n=300):
 
 
 def palm_rotation(plant) -> np.ndarray:
-    orn = plant.bc.getLinkState(plant.robot, plant._tool_link)[5]
+    orn = plant.engine.bc.getLinkState(plant.engine.robot, plant.engine.tool_link)[5]
     return np.array(p.getMatrixFromQuaternion(orn)).reshape(3, 3)
 
 
@@ -39,7 +39,7 @@ def test_wrist_sensor_reads_the_hands_weight_when_still():
     plant = rig()
     try:
         settle(plant)
-        w = np.array(plant._wrench)
+        w = np.array(plant.engine.wrench)
         R = palm_rotation(plant)
         m = hand_mass(GRASP4)
         g = np.array([0.0, 0.0, -9.81])
@@ -59,17 +59,19 @@ def test_wrist_sensor_reads_an_added_static_force():
     plant = rig()
     try:
         settle(plant)
-        base = np.array(plant._wrench)
+        base = np.array(plant.engine.wrench)
         F = np.array([0.0, 5.0, 0.0])
         for _ in range(400):
-            pos = plant.bc.getLinkState(plant.robot, plant._palm_link)[0]  # the palm's CoM
-            plant.bc.applyExternalForce(
-                plant.robot, plant._palm_link, F.tolist(), pos, p.WORLD_FRAME
+            pos = plant.engine.bc.getLinkState(plant.engine.robot, plant.engine.palm_link)[
+                0
+            ]  # the palm's CoM
+            plant.engine.bc.applyExternalForce(
+                plant.engine.robot, plant.engine.palm_link, F.tolist(), pos, p.WORLD_FRAME
             )
             plant.apply(ServoCommand(arm=[0.0] * 7, hand=[0.0] * 14))
             plant.step()
         R = palm_rotation(plant)
-        extra = np.array(plant._wrench) - base
+        extra = np.array(plant.engine.wrench) - base
         # the hand pushed +y; it loads the flange with the same force (palm frame)
         np.testing.assert_allclose(R @ extra[:3], F, atol=0.05)
         r = R @ np.array([0.0, 0.0, GRASP4.palm_size[2] / 2.0])
@@ -224,7 +226,9 @@ def test_strain_gauges_read_the_servo_torque_and_the_scene_has_the_readings():
         settle(plant, 50)
         sc = plant.scene()
         assert set(sc.readings) >= {"arm", "hand", "hand_torque", "head", "wrist"}
-        np.testing.assert_allclose(sc.readings["hand_torque"]["torque"], plant.hand_servos.torque)
+        np.testing.assert_allclose(
+            sc.readings["hand_torque"]["torque"], plant.engine.hand_servos.torque
+        )
         assert len(sc.readings["hand"]["position"]) == 14
         truth = plant.truth(0.05)
         assert {
@@ -256,7 +260,7 @@ def test_frames_read_once_a_step_equal_pybullets_own_reads_while_moving():
     plant = rig(human_speed=0.1)
     rng = np.random.default_rng(3)
     try:
-        bc = plant.bc
+        bc = plant.engine.bc
         for k in range(60):
             plant.apply(
                 ServoCommand(
@@ -269,20 +273,28 @@ def test_frames_read_once_a_step_equal_pybullets_own_reads_while_moving():
             if k % 10:
                 continue
             tool = bc.getLinkState(
-                plant.robot, plant._tool_link, computeLinkVelocity=1, computeForwardKinematics=1
+                plant.engine.robot,
+                plant.engine.tool_link,
+                computeLinkVelocity=1,
+                computeForwardKinematics=1,
             )
             pe, oe, ve, we = plant.effector_state()
             for got, want in zip((pe, oe, ve, we), (tool[4], tool[5], tool[6], tool[7])):
                 np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
             assert np.linalg.norm(ve) > 1e-3  # it moves: a stale cache would differ
             palm = bc.getLinkState(
-                plant.robot, plant._palm_link, computeLinkVelocity=1, computeForwardKinematics=1
+                plant.engine.robot,
+                plant.engine.palm_link,
+                computeLinkVelocity=1,
+                computeForwardKinematics=1,
             )
             point = plant.object_state()[0]
             want = np.array(palm[6]) + np.cross(np.array(palm[7]), point - np.array(palm[0]))
-            got = plant._point_velocity(plant._palm_link, point)
+            got = plant.engine.point_velocity(plant.engine.palm_link, point)
             np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
-            np.testing.assert_allclose(plant._frames_now()[0][0], tool[4], rtol=0.0, atol=1e-12)
+            np.testing.assert_allclose(
+                plant.engine.frames_now()[0][0], tool[4], rtol=0.0, atol=1e-12
+            )
     finally:
         plant.close()
 
@@ -300,7 +312,10 @@ def test_the_robot_never_collides_with_itself():
                 ServoCommand(arm=[0.0, 0.5, 0.0, 0.5, 0.0, 0.5, 0.0], hand=(closed - hq) * 20)
             )
             plant.step()
-            assert plant.bc.getContactPoints(bodyA=plant.robot, bodyB=plant.robot) == ()
+            assert (
+                plant.engine.bc.getContactPoints(bodyA=plant.engine.robot, bodyB=plant.engine.robot)
+                == ()
+            )
         # the fingers did close onto each other's space: the hand moved towards its grip
         assert (
             np.abs(plant.hand_state()[0] - closed).max()
@@ -317,15 +332,18 @@ def test_kept_pybullet_calls_stay_bound_to_each_rigs_own_client():
 
     a, b = rig(human_speed=0.1), rig(human_speed=0.1)
     try:
-        assert a.bc._client != b.bc._client
+        assert a.engine.bc._client != b.engine.bc._client
         for plant in (a, b):
             for name in PER_STEP_CALLS:
-                assert getattr(plant.bc, name).keywords["physicsClientId"] == plant.bc._client
+                assert (
+                    getattr(plant.engine.bc, name).keywords["physicsClientId"]
+                    == plant.engine.bc._client
+                )
         before = b.object_state()[0].copy()
         for _ in range(200):
             a.step()
         assert np.linalg.norm(a.object_state()[0] - before) > 1e-3  # a's human moved its box
-        b._read()
+        b.invalidate_state()
         np.testing.assert_array_equal(b.object_state()[0], before)
     finally:
         a.close()

@@ -111,13 +111,13 @@ def test_hand_motors_set_only_on_new_targets_move_the_hand_the_same():
     lazy, eager = make(**CATCHING, object="none"), make(**CATCHING, object="none")
     table = lazy.hand_table
     calls = []
-    set_motors = lazy._set_motors
-    lazy._set_motors = lambda *a, **kw: (calls.append(a[2]), set_motors(*a, **kw))[1]
+    set_motors = lazy.engine.set_motors
+    lazy.engine.set_motors = lambda *a, **kw: (calls.append(a[2]), set_motors(*a, **kw))[1]
     for k in range(120):
         hand = table.closed_posture if 20 <= k < 80 else table.open_posture
         for plant in (lazy, eager):
             plant.apply(ArmCommand([0.0] * 4, hand))
-        eager._hand_v = None  # forget the last targets: the call every step
+        eager.engine._hand_v = None  # forget the last targets: the call every step
         lazy.step()
         eager.step()
         assert lazy._state()[1] == eager._state()[1]
@@ -134,21 +134,28 @@ def test_nothing_of_the_robot_is_near_a_ball_beyond_its_reach():
     from the base is farther than 4 cm from every link (PyBullet's closest points), while a
     ball at the tool frame does touch (the check can fail)."""
     plant = make(**CATCHING)
-    bc, rng = plant.bc, np.random.default_rng(8)
-    base = np.asarray(plant._base_pose[0])
+    bc, rng = plant.engine.bc, np.random.default_rng(8)
+    base = np.asarray(plant.engine._base_pose[0])
     lo, hi = np.asarray(plant.lower), np.asarray(plant.upper)
     near = 0
     for _ in range(60):
         q = rng.uniform(lo, hi)
-        for j, i in zip(plant._arm_j, plant.active):
-            bc.resetJointState(plant.robot, j, q[i])
+        for j, i in zip(plant.engine.arm_j, plant.active):
+            bc.resetJointState(plant.engine.robot, j, q[i])
         d = rng.normal(size=3)
-        pos = base + plant._contact_radius * d / np.linalg.norm(d)
-        bc.resetBasePositionAndOrientation(plant.obj, pos.tolist(), [0, 0, 0, 1])
-        assert bc.getClosestPoints(bodyA=plant.obj, bodyB=plant.robot, distance=0.04) == ()
-        tool = bc.getLinkState(plant.robot, plant._tool_link, computeForwardKinematics=1)[4]
-        bc.resetBasePositionAndOrientation(plant.obj, list(tool), [0, 0, 0, 1])
-        near += bool(bc.getClosestPoints(bodyA=plant.obj, bodyB=plant.robot, distance=0.04))
+        pos = base + plant.engine._contact_radius * d / np.linalg.norm(d)
+        bc.resetBasePositionAndOrientation(plant.engine.obj, pos.tolist(), [0, 0, 0, 1])
+        assert (
+            bc.getClosestPoints(bodyA=plant.engine.obj, bodyB=plant.engine.robot, distance=0.04)
+            == ()
+        )
+        tool = bc.getLinkState(
+            plant.engine.robot, plant.engine.tool_link, computeForwardKinematics=1
+        )[4]
+        bc.resetBasePositionAndOrientation(plant.engine.obj, list(tool), [0, 0, 0, 1])
+        near += bool(
+            bc.getClosestPoints(bodyA=plant.engine.obj, bodyB=plant.engine.robot, distance=0.04)
+        )
     assert near == 60
     plant.close()
 
@@ -159,25 +166,29 @@ def test_contacts_skipped_only_where_pybullet_has_none(project_root, name, tmp_p
     none; the skip happens (most of the flight) and the ball is caught."""
     runner = Runner(load_scenario(project_root / "scenarios" / f"{name}.yaml"))
     plant = runner.plant
-    ask = plant._get_contact_points
+    ask = plant.engine._get_contact_points
     asked = [0]
 
     def counted(**kw):
         asked[0] += 1
         return ask(**kw)
 
-    plant._get_contact_points = counted
-    check = plant._object_contacts
+    plant.engine._get_contact_points = counted
+    check = plant.engine.object_contacts
     steps = [0]
 
     def both(pos, v):
         got = check(pos, v)
-        want = [c for c in ask(bodyA=plant.obj, bodyB=plant.robot) if c[9] > 0.0 or c[8] <= 1e-4]
+        want = [
+            c
+            for c in ask(bodyA=plant.engine.obj, bodyB=plant.engine.robot)
+            if c[9] > 0.0 or c[8] <= 1e-4
+        ]
         assert got == want
         steps[0] += 1
         return got
 
-    plant._object_contacts = both
+    plant.engine.object_contacts = both
     result = runner.run(tmp_path / "run.mcap")
     print(f"{name}: contacts asked for at {asked[0]} of {steps[0]} steps")
     assert result.outcome["success"]

@@ -26,20 +26,20 @@ ENGINES = {"PyBullet": "catch_optimised", "MuJoCo": "catch_optimised_mujoco"}
 # each neighbour of the scenario's contact settings: --set paths (plant.params.*)
 NEIGHBOURS = {
     "chosen": {},
-    "solref 3 ms": {"mj_solref": "[0.003, 1.0]"},
-    "solref 4 ms": {"mj_solref": "[0.004, 1.0]"},
-    "damping ratio 0.7": {"mj_solref": "[0.002, 0.7]"},
-    "damping ratio 1.5": {"mj_solref": "[0.002, 1.5]"},
-    "solimp d0 0.8": {"mj_solimp": "[0.8, 0.95, 0.001, 0.5, 2.0]"},
-    "solimp d 0.95-0.99": {"mj_solimp": "[0.95, 0.99, 0.001, 0.5, 2.0]"},
-    "elliptic cone": {"mj_cone": "elliptic"},
-    "condim 4": {"mj_condim": "4"},
-    "iterations 20": {"mj_iterations": "20"},
-    "iterations 100": {"mj_iterations": "100"},
+    "solref 3 ms": {"engine.mj_solref": "[0.003, 1.0]"},
+    "solref 4 ms": {"engine.mj_solref": "[0.004, 1.0]"},
+    "damping ratio 0.7": {"engine.mj_solref": "[0.002, 0.7]"},
+    "damping ratio 1.5": {"engine.mj_solref": "[0.002, 1.5]"},
+    "solimp d0 0.8": {"engine.mj_solimp": "[0.8, 0.95, 0.001, 0.5, 2.0]"},
+    "solimp d 0.95-0.99": {"engine.mj_solimp": "[0.95, 0.99, 0.001, 0.5, 2.0]"},
+    "elliptic cone": {"engine.mj_cone": "elliptic"},
+    "condim 4": {"engine.mj_condim": "4"},
+    "iterations 20": {"engine.mj_iterations": "20"},
+    "iterations 100": {"engine.mj_iterations": "100"},
     "friction mu 0.6": {"object_lateral_friction": "0.6"},
     "friction mu 1.0": {"object_lateral_friction": "1.0"},
-    "servo gain 30": {"hand_servo_gain": "30.0"},
-    "servo gain 1000": {"hand_servo_gain": "1000.0"},
+    "servo gain 30": {"engine.hand_servo_gain": "30.0"},
+    "servo gain 1000": {"engine.hand_servo_gain": "1000.0"},
 }
 
 

@@ -5,6 +5,7 @@ PyBullet twins only in the plant."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -14,10 +15,10 @@ import numpy as np
 import pytest
 import yaml
 
+from plants.arm_rig.engine import engines
 from plants.bullet_arm import BulletArmPlant
-from plants.bullet_arm import Params as BulletParams
-from plants.mujoco_arm import Params as MujocoParams
-from plants.mujoco_arm.plant import MujocoArmPlant
+from plants.bullet_arm import Params as ArmParams
+from plants.mujoco_arm.params import MujocoSettings
 from replay.messages import JointState, ObjectState, to_dict
 from replay.robot.arm_types import ArmCommand, ArmSpec
 from replay.robot.hand import CATCH3
@@ -30,13 +31,16 @@ ROOT = Path(__file__).resolve().parents[3]
 DT = 1e-3
 START = [0.0, math.pi / 4, 0.0, 0.0]  # Namiki & Ishikawa IV-A
 CATCHING = dict(initial_q=START, locked_joints=["J3"])
-ENGINES = ("bullet", "mujoco")
+# every registered engine (plants/arm_rig/engine.py), each with its default settings: an engine
+# added by its adapter and entry point runs these tests
+ENGINES = sorted(engines())
+REFERENCE = "pybullet"
 
 
 def make(engine: str, **kw):
-    if engine == "bullet":
-        return BulletArmPlant(BulletParams(**kw), dt=DT, rng=np.random.default_rng(0))
-    return MujocoArmPlant(MujocoParams(**kw), dt=DT, rng=np.random.default_rng(0))
+    """The arm rig in ``engine`` (plant.params.engine's type)."""
+    params = ArmParams(**kw, engine={"type": engine})
+    return BulletArmPlant(params, dt=DT, rng=np.random.default_rng(0))
 
 
 def hold_torque(plant, q_ref, omega=30.0):
@@ -58,7 +62,7 @@ def test_mujoco_inverse_dynamics_and_mass_matrix_equal_rnea():
     rest at their posture), are the nominal model's RNEA and M with the hand as a payload."""
     plant = make("mujoco", **CATCHING)
     spec = plant.spec()
-    m, d, W = plant.mj, plant.md, plant.world
+    m, d, W = plant.engine.mj, plant.engine.md, plant.engine.world
     a = list(spec.active)
     rng = np.random.default_rng(3)
     lo, hi = wam_joint_limits(4)
@@ -107,8 +111,8 @@ def test_one_step_of_free_motion_follows_the_model(engine):
 
 # ---------------------------------------------------------------- ballistic ball
 def test_ballistic_ball_agrees_between_engines():
-    """A thrown ball that touches nothing: both engines' paths agree within 1e-6 m (both
-    integrate by semi-implicit Euler) and are the parabola within g dt t / 2 (+ rounding)."""
+    """A thrown ball that touches nothing: every engine's path agrees with the reference's
+    within 1e-6 m (semi-implicit Euler) and is the parabola within g dt t / 2 (+ rounding)."""
     r0, v0 = np.array([2.6, 0.1, 1.0]), np.array([-8.0, 0.5, 1.0])
     kw = dict(object_position=r0.tolist(), object_velocity=v0.tolist(), **CATCHING)
     paths = {}
@@ -124,8 +128,8 @@ def test_ballistic_ball_agrees_between_engines():
     t = DT * np.arange(1, 151)[:, None]
     g = np.array([0.0, 0.0, -9.81])
     exact = r0 + v0 * t + 0.5 * g * t * t
-    np.testing.assert_allclose(paths["mujoco"], paths["bullet"], atol=1e-6)
-    for p in paths.values():
+    for engine, p in paths.items():
+        np.testing.assert_allclose(p, paths[REFERENCE], atol=1e-6, err_msg=engine)
         assert np.abs(p[:, :3] - exact).max() <= 9.81 * DT * t[-1, 0] / 2 + 1e-6
         np.testing.assert_allclose(p[:, 3:], v0 + g * t, atol=1e-9)
 
@@ -288,7 +292,7 @@ def test_fast_ball_is_stopped_by_the_palm(engine, speed):
     assert contacts[0].data["normal_speed"] == pytest.approx(speed, rel=0.02)
     assert penetration < 0.01
     vx = plant.object_state()[2][0]
-    assert vx > 0.0 if engine == "bullet" else vx > -0.05
+    assert vx > 0.0 if engine == REFERENCE else vx > -0.05
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -306,7 +310,7 @@ def test_miss_event_when_ball_falls_past(engine):
 def test_nan_event_on_non_finite_state(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # MuJoCo writes its warning to ./MUJOCO_LOG.TXT
     plant = make("mujoco", **CATCHING)
-    plant.md.qvel[plant.world.object_dof] = float("nan")
+    plant.engine.md.qvel[plant.engine.world.object_dof] = float("nan")
     plant.invalidate_state()
     plant.apply(ArmCommand([0.0] * 4))
     plant.step()
@@ -328,7 +332,7 @@ def test_object_impulse_changes_the_velocity(engine):
 # ---------------------------------------------------------------- log, frames, determinism
 def test_truth_payloads_and_frames_match_the_pybullet_plant():
     """The same topics with the same fields; the /tf chain of links ends at the tool frame."""
-    b, m = make("bullet", **CATCHING), make("mujoco", **CATCHING)
+    b, m = make(REFERENCE, **CATCHING), make("mujoco", **CATCHING)
     for plant in (b, m):
         plant.apply(ArmCommand([0.0] * 4))
         plant.step()
@@ -385,27 +389,19 @@ def test_deterministic():
 # ---------------------------------------------------------------- the scenarios
 @pytest.mark.parametrize("name", ["catch_optimised", "catch_initial"])
 def test_mujoco_scenario_differs_only_in_the_plant(name):
-    """The resolved scenario of NAME_mujoco is NAME's with plant.type mujoco_arm and MuJoCo's
-    own settings added: every other field (plant params included) equal."""
+    """The resolved scenario of NAME_mujoco is NAME's with the engine field MuJoCo (its own
+    settings in it): every other field (plant type and params included) equal."""
     from replay.scenario import load_scenario
     from replay.scenario.loader import to_plain
 
     a = to_plain(load_scenario(ROOT / "scenarios" / f"{name}.yaml"))
     b = to_plain(load_scenario(ROOT / "scenarios" / f"{name}_mujoco.yaml"))
-    assert b["plant"]["type"] == "mujoco_arm" and a["plant"]["type"] == "bullet_arm"
-    pa, pb = a["plant"]["params"], b["plant"]["params"]
-    assert {k: pb[k] for k in pa} == pa
-    assert set(pb) - set(pa) == {
-        "mj_solref",
-        "mj_limit_solref",
-        "mj_solimp",
-        "mj_cone",
-        "mj_condim",
-        "mj_iterations",
-        "mj_noslip_iterations",
-        "mj_integrator",
-        "hand_servo_gain",
-    }
+    assert a["plant"]["type"] == b["plant"]["type"] == "bullet_arm"
+    pa, pb = a["plant"]["params"], dict(b["plant"]["params"])
+    engine = pb.pop("engine")
+    assert pb == pa and "engine" not in pa  # PyBullet: the field left out (empty)
+    fields = {f.name for f in dataclasses.fields(MujocoSettings)}  # the engine's settings
+    assert engine["type"] == "mujoco" and set(engine) == fields
     for key in set(a) - {"name", "description", "plant", "source"}:
         assert a[key] == b[key], key
     raw = yaml.safe_load((ROOT / "scenarios" / f"{name}_mujoco.yaml").read_text())

@@ -32,7 +32,9 @@ def logs(tmp_path_factory):
 def test_every_catch_row_shows_both_engines(logs):
     from analysis.catching.claims import evaluate
 
-    pb, mj = split_logs(logs)
+    groups = split_logs(logs)
+    assert list(groups) == ["PyBullet", "MuJoCo"]
+    pb, mj = groups["PyBullet"], groups["MuJoCo"]
     assert set(pb) == set(mj) == set(NAMES)
     rows = engine_rows(evaluate, logs)
     assert {r.quantity for r in rows} == {r.quantity for r in evaluate(pb)}
@@ -52,7 +54,7 @@ def test_every_catch_row_shows_both_engines(logs):
 def test_rows_that_part_say_so():
     a = [Claim("q", "1", "1.0", "reproduced", "n"), Claim("only", "x", "y", "note")]
     b = [Claim("q", "1", "2.0", "differs", "n")]
-    rows = join(a, b)
+    rows = join({"PyBullet": a, "MuJoCo": b})
     assert rows[0].status == "differs" and rows[0].note.startswith(
         "engines part: PyBullet reproduced, MuJoCo differs"
     )
@@ -60,6 +62,61 @@ def test_rows_that_part_say_so():
     assert rows[1].measured.endswith("MuJoCo: not run")
     assert rows[1].status == "note"  # run in one engine only: that engine's verdict stands
     assert "q (PyBullet reproduced, MuJoCo differs)" in closing_note(rows)
+
+
+def test_any_number_of_engines_join_and_the_note_says_all():
+    a = [Claim("q", "1", "1.0", "reproduced", ""), Claim("r", "1", "1", "reproduced", "")]
+    b = [Claim("q", "1", "2.0", "reproduced", ""), Claim("r", "1", "1", "reproduced", "")]
+    c = [Claim("q", "1", "3.0", "differs", ""), Claim("r", "1", "1", "reproduced", "")]
+    rows = join({"PyBullet": a, "MuJoCo": b, "Drake": c})
+    assert rows[0].measured == "PyBullet: 1.0 ‖ MuJoCo: 2.0 ‖ Drake: 3.0"
+    assert rows[0].status == "differs"
+    assert rows[0].note == "engines part: PyBullet reproduced, MuJoCo reproduced, Drake differs"
+    assert rows[1].status == "reproduced"
+    note = closing_note(rows).splitlines()
+    assert note[0] == "Hold in all 3 engines (1): r."
+    assert note[1].startswith("Hold in some engines only (1): q (PyBullet reproduced")
+
+
+def test_the_engine_is_the_resolved_scenarios():
+    """A log's engine: plant.params.engine.type, else its plant type (logs before the field);
+    a twin named with ``_<engine>`` joins its reference run's name."""
+
+    class Log:
+        def __init__(self, scenario: dict) -> None:
+            self._scenario = scenario
+
+        def scenario(self) -> dict:
+            return {"name": self._scenario["name"]}
+
+        def scenario_config(self) -> dict:
+            return self._scenario
+
+    arm = {"type": "bullet_arm", "params": {}}
+    logs = {
+        "catch_optimised": Log({"name": "catch_optimised", "plant": arm}),
+        "catch_optimised_mujoco": Log(
+            {"name": "catch_optimised_mujoco", "plant": {"type": "mujoco_arm", "params": {}}}
+        ),
+        "catch_initial_drake": Log(
+            {
+                "name": "catch_initial_drake",
+                "plant": {"type": "bullet_arm", "params": {"engine": {"type": "drake"}}},
+            }
+        ),
+        "catch_initial_mujoco": Log(
+            {
+                "name": "catch_initial_mujoco",
+                "plant": {"type": "bullet_arm", "params": {"engine": {"type": "mujoco"}}},
+            }
+        ),
+    }
+    groups = split_logs(logs)
+    assert {e: sorted(g) for e, g in groups.items()} == {
+        "PyBullet": ["catch_optimised"],
+        "MuJoCo": ["catch_initial", "catch_optimised"],
+        "drake": ["catch_initial"],
+    }
 
 
 def test_rate_row():

@@ -71,10 +71,11 @@ def test_mujoco_grasp_scenario_differs_only_in_the_plant(name):
 
     a = to_plain(load_scenario(ROOT / "scenarios" / f"{name}.yaml"))
     b = to_plain(load_scenario(ROOT / "scenarios" / f"{name}_mujoco.yaml"))
-    assert b["plant"]["type"] == "mujoco_grasp" and a["plant"]["type"] == "bullet_grasp"
-    pa, pb = a["plant"]["params"], b["plant"]["params"]
-    assert {k: pb[k] for k in pa} == pa
-    assert set(pb) - set(pa) == MJ_FIELDS
+    assert a["plant"]["type"] == b["plant"]["type"] == "bullet_grasp"
+    pa, pb = a["plant"]["params"], dict(b["plant"]["params"])
+    engine = pb.pop("engine")
+    assert pb == pa and "engine" not in pa  # PyBullet: the field left out (empty)
+    assert engine["type"] == "mujoco" and set(engine) == MJ_FIELDS | {"type"}
     for key in set(a) - {"name", "description", "plant", "source"}:
         assert a[key] == b[key], key
     raw = yaml.safe_load((ROOT / "scenarios" / f"{name}_mujoco.yaml").read_text())
@@ -141,12 +142,12 @@ def test_contact_stiffness_neighbours_still_grasp(tmp_path, stiffness):
     kept): tc x sqrt(2), x 1 / sqrt(2)."""
     tc, z = yaml.safe_load((ROOT / "scenarios" / "grasp_hexahedron_mujoco.yaml").read_text())[
         "plant"
-    ]["params"]["mj_solref"]
+    ]["params"]["engine"]["mj_solref"]
     tc = max(tc / math.sqrt(stiffness), 0.002)
     (ok, why), flag = run(
         "grasp_hexahedron_mujoco",
         tmp_path / "n.mcap",
-        [f"plant.params.mj_solref=[{tc:.6f}, {z}]", "seed=226"],
+        [f"plant.params.engine.mj_solref=[{tc:.6f}, {z}]", "seed=226"],
     )
     print(stiffness, tc, ok, why)
     assert ok and flag["success"], (why, flag["reason"])
@@ -168,7 +169,8 @@ def test_every_grasp_row_shows_both_engines(tmp_path):
             for n in (name, name + "_mujoco"):
                 Runner(load_scenario(ROOT / "scenarios" / f"{n}.yaml")).run(tmp_path / f"{n}.mcap")
                 logs[n] = LogReader(str(tmp_path / f"{n}.mcap"))
-    pb, mj = split_logs(logs)
+    groups = split_logs(logs)
+    pb, mj = groups["PyBullet"], groups["MuJoCo"]
     assert set(pb) == set(mj) == {"grasp_hexahedron", "grasp_sphere"}
     rows = engine_rows(evaluate, logs)
     assert {r.quantity for r in rows} == {r.quantity for r in evaluate(pb)}

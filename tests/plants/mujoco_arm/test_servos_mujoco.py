@@ -23,9 +23,9 @@ BANDWIDTH = 500.0  # rad/s: scenarios/grasp_hexahedron.yaml's arm_servo_bandwidt
 def arm_mass_matrix(plant: MujocoArmPlant) -> np.ndarray:
     """The arm joints' block of MuJoCo's joint-space mass matrix now (hand joints held by their
     servos, as the PyBullet rig's)."""
-    M = np.zeros((plant.mj.nv, plant.mj.nv))
-    mujoco.mj_fullM(plant.mj, plant.md, M)  # MuJoCo 4: (model, data, out)
-    dofs = plant.world.arm_dof
+    M = np.zeros((plant.engine.mj.nv, plant.engine.mj.nv))
+    mujoco.mj_fullM(plant.engine.mj, plant.engine.md, M)  # MuJoCo 4: (model, data, out)
+    dofs = plant.engine.world.arm_dof
     return M[np.ix_(dofs, dofs)]
 
 
@@ -39,7 +39,9 @@ def step_response(j: int, steps: int = 100) -> np.ndarray:
     )  # fmt: skip
     servos = VelocityServos(plant.torque_limits, BANDWIDTH, DT)
     # held still before t = 0: the integrals carry the static (gravity) torques
-    servos.preload(plant.md.qfrc_bias[list(plant.world.arm_dof)].tolist(), arm_mass_matrix(plant))
+    servos.preload(
+        plant.engine.md.qfrc_bias[list(plant.engine.world.arm_dof)].tolist(), arm_mass_matrix(plant)
+    )
 
     def run(cmd) -> None:
         servos.set_command(cmd)

@@ -27,9 +27,9 @@ def bullet_still():
             plant.apply(ServoCommand(arm=[0.0] * 7, hand=[0.0] * 14, head=[0.0, 0.0]))
             plant.step()
         q, hq = plant.arm_state()[0], plant.hand_state()[0]
-        orn = plant.bc.getLinkState(plant.robot, plant._tool_link)[5]
+        orn = plant.engine.bc.getLinkState(plant.engine.robot, plant.engine.tool_link)[5]
         R = np.array(p.getMatrixFromQuaternion(orn)).reshape(3, 3)
-        return q, hq, R, np.array(plant._wrench)
+        return q, hq, R, np.array(plant.engine.wrench)
     finally:
         plant.close()
 
@@ -41,7 +41,7 @@ def mujoco_static(q, hq, push=None):
         Params(arm="wam7", hand="grasp4", object="none", initial_q=Q0), dt=DT,
         rng=np.random.default_rng(0),
     )  # fmt: skip
-    m, d, W = plant.mj, plant.md, plant.world
+    m, d, W = plant.engine.mj, plant.engine.md, plant.engine.world
     d.qpos[list(W.arm_qpos)] = q
     d.qpos[list(W.hand_qpos)] = hq
     d.qvel[:] = 0.0

@@ -1,0 +1,119 @@
+"""The engine adapter: what the arm rig (rig.py ``ArmRig``) asks of a physics engine.
+
+The rig owns one adapter (``ArmRig.engine``), built from the rig's public attributes (params,
+settings, model, urdf_path, dt, joint_names, active, locked, hand_names) after the rig has
+written its URDF; the adapter holds only engine calls and engine settings and reads none of the
+rig's private state. States are plain floats (lists or tuples), read once after each step and
+shared, never mutated.
+
+The engine is a field of the scenario, ``plant.params.engine: {type: NAME, ...its settings}``
+(empty: the plant type's own engine, PyBullet for ``bullet_arm``/``bullet_grasp``). An engine
+is registered by one entry point in the group ``paper_replay.engines``: NAME -> its settings
+dataclass (imports no engine), whose ``type`` field is NAME, whose fields are the engine's
+settings (checked as any params are) and whose class attributes ``arm`` and ``grasp`` name its
+adapters (``module:Class``) for the arm rig and the grasping rig.
+"""
+
+from __future__ import annotations
+
+import importlib
+from functools import cache
+from importlib.metadata import entry_points
+from typing import Any, Protocol
+
+from replay.params import ParamError
+from replay.scene import Frame
+
+ENGINE_GROUP = "paper_replay.engines"
+
+
+@cache
+def engines() -> dict[str, Any]:
+    """The registered engines: name -> its entry point (loaded when first asked for)."""
+    return {e.name: e for e in entry_points(group=ENGINE_GROUP)}
+
+
+def engine_settings(value: Any) -> Any | None:
+    """``plant.params.engine`` (a mapping: a scenario's YAML node, a dict from Python or a log)
+    as its engine's typed settings; None where empty (the plant type's own engine)."""
+    import yaml
+
+    from replay.scenario.loader import build_dataclass, params_from_data
+
+    if isinstance(value, yaml.MappingNode):
+        if not value.value:
+            return None
+        kind = next((v.value for k, v in value.value if k.value == "type"), None)
+    elif isinstance(value, dict):
+        if not value:
+            return None
+        kind = value.get("type")
+    else:
+        raise ParamError("engine", "expected a mapping {type: ENGINE, ...its settings}")
+    known = engines()
+    if kind not in known:
+        names = ", ".join(sorted(known))
+        raise ParamError("engine", f"unknown engine type {kind!r} (known: {names})")
+    cls = known[kind].load()
+    if isinstance(value, yaml.MappingNode):
+        return build_dataclass(value, cls, "engine")
+    return params_from_data(cls, value, "engine")
+
+
+def adapter_class(settings: Any, rig: str) -> type:
+    """The adapter class of an engine's ``settings`` for ``rig`` ("arm" or "grasp")."""
+    module, name = getattr(settings, rig).split(":")
+    return getattr(importlib.import_module(module), name)
+
+
+class EngineAdapter(Protocol):
+    palm_id: int | None  # the engine's id of the palm link (None: no palm)
+
+    def state(self) -> tuple:
+        """((q, qd), hand (q, qd, effort), object (pos, orn xyzw, v, w) or None), read once
+        after each step."""
+
+    def invalidate_state(self) -> None:
+        """Forget the state read (after setting the simulation other than by stepping it)."""
+
+    def effector_now(self) -> tuple:
+        """The tool frame's (pos, orn xyzw, v, w) now, read once a step."""
+
+    def point_velocity(self, link: int, point) -> tuple[float, float, float]:
+        """v + w x r of the point ``point`` moving with the robot link ``link`` (world)."""
+
+    def object_contacts(self, pos, v) -> list:
+        """The step's object-robot contact rows (the object at ``pos`` moving at ``v``)."""
+
+    def touch(self, contacts: list) -> tuple:
+        """(link, point, normal from the robot towards the object) of the strongest contact."""
+
+    def contact_summary(self) -> tuple:
+        """(parts, links, total normal force in N) of the step's contacts, sorted."""
+
+    def set_object_velocity(self, v: list, w) -> None:
+        """Set the object's velocity (a scenario's kick)."""
+
+    def notes(self) -> dict:
+        """The spec's notes on the engine."""
+
+    def apply_torques(self, tau: list) -> None:
+        """Apply the arm's torques (N*m, one per active joint) over the coming step."""
+
+    def drive_hand(self, v: list, qd: list) -> None:
+        """Drive the hand's servos at the speeds ``v`` (rad/s) over the coming step; ``qd``:
+        the hand joints' speeds now."""
+
+    def hold_object(self, obj: tuple) -> None:
+        """Before the step: the forces the engine applies to the object itself (none, or
+        gravity's cancelled where ``object_gravity`` is off and the engine needs a force)."""
+
+    def advance(self) -> bool:
+        """Step the engine by ``dt`` and forget the state read; True when the run has diverged
+        (the engine says so)."""
+
+    def frames(self) -> list[Frame]:
+        """Every URDF link in its parent link, the base in ``world``."""
+
+    def close(self) -> None:
+        """Free the engine's resources."""
