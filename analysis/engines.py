@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
+from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +32,28 @@ from analysis.claims import ASSESSED, Claim
 # by its name
 LABELS = {"pybullet": "PyBullet", "mujoco": "MuJoCo"}
 ENGINES = tuple(LABELS.values())
-SUFFIX = "_mujoco"  # the MuJoCo twins' scenario names (analysis/engine_rates.py)
+REFERENCE = next(iter(LABELS))
 _PLANT_ENGINES = {"mujoco_arm": "mujoco", "mujoco_grasp": "mujoco"}  # before the engine field
+GROUP = "paper_replay.engines"  # the engines' entry points (plants/arm_rig/engine.py)
+
+
+def label(engine: str) -> str:
+    """An engine's label in the tables (``LABELS``; else its name)."""
+    return LABELS.get(engine, engine)
+
+
+def registered() -> tuple[str, ...]:
+    """Every registered engine's name (entry points ``GROUP``: read, never imported, so the
+    analysis imports no plant), the reference first, then ``LABELS``' order, then by name."""
+    names = {e.name for e in entry_points(group=GROUP)} | {REFERENCE}
+    known = list(LABELS)
+    return tuple(sorted(names, key=lambda e: (known.index(e) if e in known else len(known), e)))
+
+
+def rank(engine_label: str) -> int:
+    """Where an engine's label goes in a row: the registered engines' order, any other last."""
+    order = [label(e) for e in registered()]
+    return order.index(engine_label) if engine_label in order else len(order)
 
 
 def engine_of(config: Mapping[str, Any], name: str = "") -> str:
@@ -45,26 +66,25 @@ def engine_of(config: Mapping[str, Any], name: str = "") -> str:
         engine = params.get("engine") if isinstance(params, Mapping) else None
         if isinstance(engine, Mapping) and isinstance(engine.get("type"), str):
             return engine["type"]
-        return _PLANT_ENGINES.get(str(plant.get("type")), "pybullet")
-    return next((e for e in LABELS if name.endswith(f"_{e}")), "pybullet")
+        return _PLANT_ENGINES.get(str(plant.get("type")), REFERENCE)
+    return next((e for e in (*LABELS, *registered()) if name.endswith(f"_{e}")), REFERENCE)
 
 
 def split_logs(logs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    """The logs per engine label (the reference engine first, then the others in ``LABELS``'
-    order), each named as its reference twin (by the scenario's name less ``_<engine>``: a key
+    """The logs per engine label (the registered engines' order, ``registered``, then any
+    other), each named as its reference twin (by the scenario's name less ``_<engine>``: a key
     may carry a label after it, analysis/runs.py)."""
-    out: dict[str, dict[str, Any]] = {ENGINES[0]: {}}
+    out: dict[str, dict[str, Any]] = {label(REFERENCE): {}}
     for key, log in logs.items():
         name = _read(log, "scenario").get("name")
         name = name if isinstance(name, str) and name else key
         engine = engine_of(_read(log, "scenario_config"), name)
-        label = LABELS.get(engine, engine)
         suffix = f"_{engine}"
-        if label != ENGINES[0] and name.endswith(suffix) and key.startswith(name):
+        if engine != REFERENCE and name.endswith(suffix) and key.startswith(name):
             key = name[: -len(suffix)] + key[len(name) :]
-        out.setdefault(label, {})[key] = log
-    order = list(ENGINES) + sorted(set(out) - set(ENGINES))
-    return {e: out[e] for e in order if e in out}
+        out.setdefault(label(engine), {})[key] = log
+    order = [label(e) for e in registered()]
+    return {e: out[e] for e in order + sorted(set(out) - set(order)) if e in out}
 
 
 def _read(log: Any, what: str) -> Mapping[str, Any]:
@@ -173,10 +193,11 @@ def rate_row(
 
 
 def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
-    """``paper``'s robustness rate rows from the stored runs of both engines on the same inputs
+    """``paper``'s robustness rate rows from the stored runs of every engine on the same inputs
     (data/ablations/engine_rates.csv, made by ``python -m analysis.engine_rates``): one per
-    set; none when the table has no runs of the paper."""
-    from analysis.engine_rates import COMMAND, TABLE, read
+    set, each engine the table holds side by side (the reference always: "not run" without
+    rows), then each probe's rate in the note; none when the table has no runs of the paper."""
+    from analysis.engine_rates import COMMAND, TABLE, is_probe, read
     from replay.resources import data_path
 
     path = path or data_path("ablations", f"{TABLE}.csv")
@@ -184,20 +205,18 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
     source = f"stored runs: data/ablations/{path.name} ({COMMAND})"
     out = []
     for s in dict.fromkeys(r["set"] for r in rows):
-        # the engines of the set (the reference always: "not run" without rows), the rest probes
-        labels = {r["engine"] for r in rows if r["set"] == s}
-        engines = [e for e in ENGINES if e == ENGINES[0] or e in labels]
-        by_engine = {e: [r for r in rows if r["set"] == s and r["engine"] == e] for e in engines}
-        row = rate_row(s, RATE_STATED.get(paper, "no rate stated"), by_engine)
-        probes: dict[str, list[dict]] = {
-            r["engine"]: [] for r in rows if r["set"] == s and r["engine"] not in ENGINES
-        }
+        by_label: dict[str, list[dict]] = {label(REFERENCE): []}
         for r in rows:
-            if r["engine"] in probes and r["set"] == s:
-                probes[r["engine"]].append(r)
-        why = [
-            "probe " + rate_row(s, "", {label: res}).measured for label, res in probes.items()
-        ]  # the twin with one setting changed, on the same inputs (analysis/engine_rates.py)
+            if r["set"] == s:
+                by_label.setdefault(r["engine"], []).append(r)
+        engines = {e: v for e, v in by_label.items() if not is_probe(e)}
+        ranked = {e: engines[e] for e in sorted(engines, key=rank)}
+        row = rate_row(s, RATE_STATED.get(paper, "no rate stated"), ranked)
+        why = [  # an engine's scenario with one setting changed, on the same inputs
+            "probe " + rate_row(s, "", {p: res}).measured
+            for p, res in by_label.items()
+            if is_probe(p)
+        ]
         row.note = "; ".join(x for x in (row.note, *why, TARGET_NOTE, source) if x)
         out.append(row)
     return out
