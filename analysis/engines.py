@@ -73,7 +73,8 @@ def engine_of(config: Mapping[str, Any], name: str = "") -> str:
 def split_logs(logs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
     """The logs per engine label (the registered engines' order, ``registered``, then any
     other), each named as its reference twin (by the scenario's name less ``_<engine>``: a key
-    may carry a label after it, analysis/runs.py)."""
+    may carry a label after it, analysis/runs.py; a run that differs from its scenario by the
+    engine alone, ``--set plant.params.engine.type=…``, by the scenario's name)."""
     out: dict[str, dict[str, Any]] = {label(REFERENCE): {}}
     for key, log in logs.items():
         name = _read(log, "scenario").get("name")
@@ -82,6 +83,8 @@ def split_logs(logs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
         suffix = f"_{engine}"
         if engine != REFERENCE and name.endswith(suffix) and key.startswith(name):
             key = name[: -len(suffix)] + key[len(name) :]
+        elif engine != REFERENCE and key == f"{name} (engine {engine})":  # --set its engine
+            key = name
         out.setdefault(label(engine), {})[key] = log
     order = [label(e) for e in registered()]
     return {e: out[e] for e in order + sorted(set(out) - set(order)) if e in out}
@@ -224,7 +227,7 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
 
 def closing_note(rows: Sequence[Claim]) -> str:
     """Which assessed rows (measured, other regime, extension: those with a verdict) hold in
-    every engine, which in some (and why: the row's note)."""
+    every engine, which in some (and why: the row's note, ``_why``), which in none."""
     every, some, neither, single, n = [], [], [], 0, 2
     for r in rows:
         if r.kind not in ASSESSED:
@@ -237,7 +240,7 @@ def closing_note(rows: Sequence[Claim]) -> str:
         if r.status == "reproduced":
             every.append(r.quantity)
         elif "engines part" in r.note:
-            some.append(f"{r.quantity} ({r.note.split(';')[0].removeprefix('engines part: ')})")
+            some.append(f"{r.quantity} ({_why(r.note)})")
         elif r.status == "differs":  # (ties, notes and rows not run in either: no verdict)
             neither.append(r.quantity)
     all_n, part = ("both", "one engine only") if n == 2 else (f"all {n}", "some engines only")
@@ -249,3 +252,11 @@ def closing_note(rows: Sequence[Claim]) -> str:
         lines.append(f"Run in {'one engine only' if n == 2 else 'some engines only'}, ")
         lines[-1] += f"not compared: {single} rows."
     return "\n".join(lines)
+
+
+def _why(note: str) -> str:
+    """Why a row holds in some engines only, from its note: each engine's verdict and, where a
+    probe ran (a rate row), each probe's rate: what decides the difference, measured."""
+    parts = note.split("; ")
+    probes = [p for p in parts if p.startswith("probe ")]
+    return "; ".join([parts[0].removeprefix("engines part: "), *probes])

@@ -137,7 +137,8 @@ def differences(stored: Mapping[str, Any], ref: Mapping[str, Any]) -> list[str]:
     phrases: a changed plug-in type names the new type (its params are then not listed)."""
     items, replaced = [], []
     sensors = sorted({p.split(".")[1] for p in stored if p.startswith("sensors.")})
-    for path in ("plant.type", "controller.type", *(f"sensors.{s}.type" for s in sensors)):
+    types = ("plant.type", "plant.params.engine.type", "controller.type")  # (an engine: its own
+    for path in (*types, *(f"sensors.{s}.type" for s in sensors)):  # settings, not listed)
         new = stored.get(path)
         if new is not None and new != ref.get(path):
             if path == "plant.type" and _engine(str(new)):

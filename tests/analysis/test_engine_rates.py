@@ -255,3 +255,101 @@ def test_the_reports_engine_note_keeps_its_lines():
     md = _markdown([sec], {}, [])
     assert "> Hold in both: a\n>\n> Hold in one: b\n>\n> neither: c" in md
     assert "Hold in both: a<br>Hold in one: b<br>neither: c</p>" in _html([sec], {}, [])
+
+
+def test_three_engines_side_by_side_and_the_note_says_why(tmp_path):
+    """A set where one of three engines misses the target: every engine's rate in the row, and
+    the closing note lists it under "some engines" with its probe's rate (the measured why)."""
+    from analysis.engines import closing_note
+
+    rows = []
+    for i in range(10):
+        for engine, ok in (("PyBullet", True), ("MuJoCo", True), ("Drake", i < 7)):
+            rows.append(
+                {
+                    "paper": "namiki1999",
+                    "set": "s",
+                    "scenario": "grasp_hexahedron",
+                    "engine": engine,
+                    "case": f"path {i}",
+                    "success": ok,
+                    "reason": "held" if ok else "box slid 12 mm",
+                    "flag": ok,
+                }
+            )
+    probe = "Drake, hydroelastic contact"
+    rows += [dict(r, engine=probe, success=True) for r in rows if r["engine"] == "Drake"]
+    write(rows, tmp_path / "t.csv")
+    (r,) = stored_rate_rows("namiki1999", tmp_path / "t.csv")
+    assert r.measured.startswith("PyBullet: 10/10 = 100 %") and r.status == "differs"
+    assert " ‖ MuJoCo: 10/10 = 100 %" in r.measured and " ‖ Drake: 7/10 = 70 %" in r.measured
+    assert probe not in r.measured and f"probe {probe}: 10/10 = 100 %" in r.note
+    note = closing_note([r]).splitlines()
+    assert note[0] == "Hold in all 3 engines (0): none."
+    assert note[1] == (
+        "Hold in some engines only (1): s (PyBullet reproduced, MuJoCo reproduced, Drake "
+        "differs (their intervals overlap: within the sampling error); "
+        f"probe {probe}: 10/10 = 100 % [72–100 %])."
+    )
+    assert note[2] == "Hold in none (0): none."
+
+
+def test_the_claims_join_the_runs_of_every_engine_present():
+    """Logs of three engines (the engine from each resolved scenario): one column each."""
+    from analysis.claims import Claim
+
+    class Log:
+        def __init__(self, name, engine):
+            self.name, self.engine = name, engine
+
+        def scenario(self):
+            return {"paper": "namiki1999", "name": self.name}
+
+        def scenario_config(self):
+            return {"plant": {"type": "bullet_grasp", "params": {"engine": {"type": self.engine}}}}
+
+    def evaluate(logs):
+        return [Claim(f"{n}: q", "1", str(len(n)), "reproduced") for n in logs]
+
+    logs = {
+        f"grasp_sphere{s}": Log(f"grasp_sphere{s}", e)
+        for s, e in (("", "pybullet"), ("_mujoco", "mujoco"), ("_drake", "drake"))
+    }
+    rows, note = evaluate_runs(evaluate, logs)
+    q = next(r for r in rows if r.quantity == "grasp_sphere: q")
+    assert q.measured == f"PyBullet: 12 ‖ MuJoCo: 12 ‖ {label('drake')}: 12"
+    assert note.startswith("Hold in all 3 engines") and "grasp_sphere: q" in note.splitlines()[0]
+
+
+def test_a_run_with_its_engine_set_joins_its_scenarios_row():
+    """``--set plant.params.engine.type=mujoco``: the run's label is the engine alone (its
+    settings are the engine's), and the claims join it with the scenario's reference run."""
+    from analysis.engines import split_logs
+    from analysis.runs import differences
+
+    ref = {"plant.type": "bullet_arm", "plant.params.hand_max_torque": 1.0}
+    stored = dict(ref, **{"plant.params.engine.type": "mujoco", "plant.params.engine.x": 1})
+    assert differences(stored, ref) == ["engine mujoco"]
+    assert differences(dict(stored, **{"plant.params.hand_max_torque": 2.0}), ref) == [
+        "engine mujoco",
+        "hand max torque 2",
+    ]
+
+    class Log:
+        def __init__(self, engine):
+            self.engine = engine
+
+        def scenario(self):
+            return {"name": "catch_initial"}
+
+        def scenario_config(self):
+            return {"plant": {"type": "bullet_arm", "params": {"engine": {"type": self.engine}}}}
+
+    logs = {
+        "catch_initial": Log("pybullet"),
+        "catch_initial (engine mujoco)": Log("mujoco"),
+        "catch_initial (engine mujoco, seed 3)": Log("mujoco"),
+    }
+    groups = split_logs(logs)
+    assert list(groups["MuJoCo"]) == ["catch_initial", "catch_initial (engine mujoco, seed 3)"]
+    assert list(groups["PyBullet"]) == ["catch_initial"]
