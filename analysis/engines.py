@@ -142,7 +142,9 @@ def evaluate_runs(
     if len(split_logs(logs)) == 1:
         return evaluate(dict(logs)), ""
     papers = {log.scenario()["paper"] for log in logs.values() if hasattr(log, "scenario")}
-    rows = engine_rows(evaluate, logs) + [r for p in sorted(papers) for r in stored_rate_rows(p)]
+    ran = list(split_logs(logs))
+    rows = engine_rows(evaluate, logs)
+    rows += [r for p in sorted(papers) for r in stored_rate_rows(p, engines=ran)]
     return rows, closing_note(rows)
 
 
@@ -161,8 +163,8 @@ def rate_row(
 ) -> Claim:
     """A catch (or grasp) rate per engine on the same perturbed set: ``outcomes`` maps an
     engine to its runs' verdicts (``success``, ``reason``), each rate with its Wilson 95 %
-    interval. "reproduced" (the target met) when every engine reaches :data:`TARGET`; where the
-    engines part the note says so (and whether their intervals overlap), then each engine's
+    interval. "reproduced" (the target met) when every engine run reaches :data:`TARGET`; where
+    the engines part the note says so (and whether their intervals overlap), then each engine's
     failures with their reasons."""
     from analysis.catching.ablations import wilson
 
@@ -176,9 +178,9 @@ def rate_row(
             parts.append(
                 f"{engine}: {k}/{n} = {100 * k / n:.0f} % [{100 * lo:.0f}–{100 * hi:.0f} %]"
             )
-        else:
+            passed[engine] = k >= TARGET * n
+        else:  # (no verdict: the closing note does not compare the row)
             parts.append(f"{engine}: not run")
-        passed[engine] = n > 0 and k >= TARGET * n
         why = Counter(str(o["reason"]) for o in res if not o["success"])
         if why:
             fails = "; ".join(f"{v}× {x}" for x, v in why.most_common())
@@ -191,15 +193,18 @@ def rate_row(
             f"engines part: {verdicts}"
             + (" (their intervals overlap: within the sampling error)" if overlap else ""),
         )
-    status = "reproduced" if all(passed.values()) else "differs"
+    status = "reproduced" if passed and all(passed.values()) else "differs"
     return Claim(label, stated, " ‖ ".join(parts), status, "; ".join(notes), kind=kind)
 
 
-def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
+def stored_rate_rows(
+    paper: str, path: Path | None = None, engines: Sequence[str] = ()
+) -> list[Claim]:
     """``paper``'s robustness rate rows from the stored runs of every engine on the same inputs
     (data/ablations/engine_rates.csv, made by ``python -m analysis.engine_rates``): one per
-    set, each engine the table holds side by side (the reference always: "not run" without
-    rows), then each probe's rate in the note; none when the table has no runs of the paper."""
+    set, each engine the table holds side by side (the reference and ``engines``, labels of the
+    engines whose logs are analysed, always: "not run" without rows), then each probe's rate in
+    the note; none when the table has no runs of the paper."""
     from analysis.engine_rates import COMMAND, TABLE, is_probe, read
     from replay.resources import data_path
 
@@ -208,12 +213,12 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
     source = f"stored runs: data/ablations/{path.name} ({COMMAND})"
     out = []
     for s in dict.fromkeys(r["set"] for r in rows):
-        by_label: dict[str, list[dict]] = {label(REFERENCE): []}
+        by_label: dict[str, list[dict]] = {e: [] for e in (label(REFERENCE), *engines)}
         for r in rows:
             if r["set"] == s:
                 by_label.setdefault(r["engine"], []).append(r)
-        engines = {e: v for e, v in by_label.items() if not is_probe(e)}
-        ranked = {e: engines[e] for e in sorted(engines, key=rank)}
+        shown = {e: v for e, v in by_label.items() if not is_probe(e)}
+        ranked = {e: shown[e] for e in sorted(shown, key=rank)}
         row = rate_row(s, RATE_STATED.get(paper, "no rate stated"), ranked)
         why = [  # an engine's scenario with one setting changed, on the same inputs
             "probe " + rate_row(s, "", {p: res}).measured

@@ -353,3 +353,35 @@ def test_a_run_with_its_engine_set_joins_its_scenarios_row():
     groups = split_logs(logs)
     assert list(groups["MuJoCo"]) == ["catch_initial", "catch_initial (engine mujoco, seed 3)"]
     assert list(groups["PyBullet"]) == ["catch_initial"]
+
+
+def test_an_engine_whose_rates_are_not_stored_is_said_not_run(tmp_path):
+    """Logs of an engine the stored table lacks: its rate "not run", the row not compared (it
+    does not "hold in all 3" on two engines' rates)."""
+    from analysis.engines import closing_note
+
+    rows = [
+        {
+            "paper": "namiki2003",
+            "set": "s",
+            "scenario": "catch_optimised",
+            "engine": engine,
+            "case": f"throw {i}",
+            "success": True,
+            "reason": "caught",
+            "flag": True,
+        }
+        for i in range(10)
+        for engine in ("PyBullet", "MuJoCo")
+    ]
+    write(rows, tmp_path / "t.csv")
+    (r,) = stored_rate_rows("namiki2003", tmp_path / "t.csv", ["PyBullet", "MuJoCo", "Drake"])
+    assert r.measured.endswith(" ‖ Drake: not run") and r.status == "reproduced", r
+    assert "engines part" not in r.note, r
+    note = closing_note([r]).splitlines()
+    assert note[0] == "Hold in all 3 engines (0): none."
+    assert note[-1] == "Run in some engines only, not compared: 1 rows."
+    (two,) = stored_rate_rows("namiki2003", tmp_path / "t.csv")
+    assert "not run" not in two.measured and closing_note([two]).startswith(
+        "Hold in both engines (1): s."
+    )
