@@ -173,22 +173,30 @@ def test_the_command_refuses_an_unknown_engine(capsys):
     assert exc.value.code != 0 and "invalid choice: 'nosuch'" in capsys.readouterr().err
 
 
+def _table(paper: str, oks: dict[str, list[bool]], why: str) -> list[dict]:
+    """A stored table's rows of one set: ``oks`` maps an engine's label to each case's success
+    (the same cases for all), a failure's reason ``why``."""
+    good = "caught" if paper == "namiki2003" else "held"
+    n = len(next(iter(oks.values())))
+    return [
+        {
+            "paper": paper,
+            "set": "s",
+            "scenario": "catch_optimised" if paper == "namiki2003" else "grasp_hexahedron",
+            "engine": engine,
+            "case": f"case {i}",
+            "success": ok[i],
+            "reason": good if ok[i] else why,
+            "flag": ok[i],
+        }
+        for i in range(n)
+        for engine, ok in oks.items()
+    ]
+
+
 def test_rows_where_the_engines_part_say_why(tmp_path):
-    rows = []
-    for i in range(10):
-        for engine, ok in (("PyBullet", True), ("MuJoCo", i < 6)):
-            rows.append(
-                {
-                    "paper": "namiki2003",
-                    "set": "s",
-                    "scenario": "catch_optimised",
-                    "engine": engine,
-                    "case": f"throw {i}",
-                    "success": ok,
-                    "reason": "caught" if ok else "ball bounced off finger f1",
-                    "flag": ok,
-                }
-            )
+    oks = {"PyBullet": [True] * 10, "MuJoCo": [i < 6 for i in range(10)]}
+    rows = _table("namiki2003", oks, "ball bounced off finger f1")
     probe = "MuJoCo, mj_solref [0.002, 1.5]"
     rows += [dict(r, engine=probe, success=True, reason="caught") for r in rows[1::2]]
     write(rows, tmp_path / "t.csv")
@@ -262,21 +270,8 @@ def test_three_engines_side_by_side_and_the_note_says_why(tmp_path):
     the closing note lists it under "some engines" with its probe's rate (the measured why)."""
     from analysis.engines import closing_note
 
-    rows = []
-    for i in range(10):
-        for engine, ok in (("PyBullet", True), ("MuJoCo", True), ("Drake", i < 7)):
-            rows.append(
-                {
-                    "paper": "namiki1999",
-                    "set": "s",
-                    "scenario": "grasp_hexahedron",
-                    "engine": engine,
-                    "case": f"path {i}",
-                    "success": ok,
-                    "reason": "held" if ok else "box slid 12 mm",
-                    "flag": ok,
-                }
-            )
+    oks = {"PyBullet": [True] * 10, "MuJoCo": [True] * 10, "Drake": [i < 7 for i in range(10)]}
+    rows = _table("namiki1999", oks, "box slid 12 mm")
     probe = "Drake, hydroelastic contact"
     rows += [dict(r, engine=probe, success=True) for r in rows if r["engine"] == "Drake"]
     write(rows, tmp_path / "t.csv")
@@ -360,20 +355,7 @@ def test_an_engine_whose_rates_are_not_stored_is_said_not_run(tmp_path):
     does not "hold in all 3" on two engines' rates)."""
     from analysis.engines import closing_note
 
-    rows = [
-        {
-            "paper": "namiki2003",
-            "set": "s",
-            "scenario": "catch_optimised",
-            "engine": engine,
-            "case": f"throw {i}",
-            "success": True,
-            "reason": "caught",
-            "flag": True,
-        }
-        for i in range(10)
-        for engine in ("PyBullet", "MuJoCo")
-    ]
+    rows = _table("namiki2003", {"PyBullet": [True] * 10, "MuJoCo": [True] * 10}, "")
     write(rows, tmp_path / "t.csv")
     (r,) = stored_rate_rows("namiki2003", tmp_path / "t.csv", ["PyBullet", "MuJoCo", "Drake"])
     assert r.measured.endswith(" ‖ Drake: not run") and r.status == "reproduced", r
