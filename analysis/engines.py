@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
+from functools import cache
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,7 @@ def label(engine: str) -> str:
     return LABELS.get(engine, engine)
 
 
+@cache  # (the installed entry points: 1.7 ms a read)
 def registered() -> tuple[str, ...]:
     """Every registered engine's name (entry points ``GROUP``: read, never imported, so the
     analysis imports no plant), the reference first, then ``LABELS``' order, then by name."""
