@@ -17,7 +17,9 @@ REPLAY := $(VENV)/bin/replay
 STAMP  := $(VENV)/.installed
 OUT    ?= out
 
-# the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md
+# the default scenarios `make run` runs, writing out/logs, out/figures and out/claims.md; every
+# engine's twins (`*_mujoco.yaml`, `*_drake.yaml`: any `<scenario>_<engine>`) are among them, and
+# the claims and the report join each with its PyBullet run (analysis/engines.py)
 SCENARIOS ?= $(wildcard scenarios/stick_*.yaml scenarios/catch_*.yaml scenarios/grasp_*.yaml)
 
 .PHONY: install run lint test test-pure bench ablations golden-check clean

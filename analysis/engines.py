@@ -21,6 +21,8 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
+from functools import cache
+from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +33,29 @@ from analysis.claims import ASSESSED, Claim
 # by its name
 LABELS = {"pybullet": "PyBullet", "mujoco": "MuJoCo"}
 ENGINES = tuple(LABELS.values())
-SUFFIX = "_mujoco"  # the MuJoCo twins' scenario names (analysis/engine_rates.py)
+REFERENCE = next(iter(LABELS))
 _PLANT_ENGINES = {"mujoco_arm": "mujoco", "mujoco_grasp": "mujoco"}  # before the engine field
+GROUP = "paper_replay.engines"  # the engines' entry points (plants/arm_rig/engine.py)
+
+
+def label(engine: str) -> str:
+    """An engine's label in the tables (``LABELS``; else its name)."""
+    return LABELS.get(engine, engine)
+
+
+@cache  # (the installed entry points: 1.7 ms a read)
+def registered() -> tuple[str, ...]:
+    """Every registered engine's name (entry points ``GROUP``: read, never imported, so the
+    analysis imports no plant), the reference first, then ``LABELS``' order, then by name."""
+    names = {e.name for e in entry_points(group=GROUP)} | {REFERENCE}
+    known = list(LABELS)
+    return tuple(sorted(names, key=lambda e: (known.index(e) if e in known else len(known), e)))
+
+
+def rank(engine_label: str) -> int:
+    """Where an engine's label goes in a row: the registered engines' order, any other last."""
+    order = [label(e) for e in registered()]
+    return order.index(engine_label) if engine_label in order else len(order)
 
 
 def engine_of(config: Mapping[str, Any], name: str = "") -> str:
@@ -45,26 +68,28 @@ def engine_of(config: Mapping[str, Any], name: str = "") -> str:
         engine = params.get("engine") if isinstance(params, Mapping) else None
         if isinstance(engine, Mapping) and isinstance(engine.get("type"), str):
             return engine["type"]
-        return _PLANT_ENGINES.get(str(plant.get("type")), "pybullet")
-    return next((e for e in LABELS if name.endswith(f"_{e}")), "pybullet")
+        return _PLANT_ENGINES.get(str(plant.get("type")), REFERENCE)
+    return next((e for e in (*LABELS, *registered()) if name.endswith(f"_{e}")), REFERENCE)
 
 
 def split_logs(logs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    """The logs per engine label (the reference engine first, then the others in ``LABELS``'
-    order), each named as its reference twin (by the scenario's name less ``_<engine>``: a key
-    may carry a label after it, analysis/runs.py)."""
-    out: dict[str, dict[str, Any]] = {ENGINES[0]: {}}
+    """The logs per engine label (the registered engines' order, ``registered``, then any
+    other), each named as its reference twin (by the scenario's name less ``_<engine>``: a key
+    may carry a label after it, analysis/runs.py; a run that differs from its scenario by the
+    engine alone, ``--set plant.params.engine.type=…``, by the scenario's name)."""
+    out: dict[str, dict[str, Any]] = {label(REFERENCE): {}}
     for key, log in logs.items():
         name = _read(log, "scenario").get("name")
         name = name if isinstance(name, str) and name else key
         engine = engine_of(_read(log, "scenario_config"), name)
-        label = LABELS.get(engine, engine)
         suffix = f"_{engine}"
-        if label != ENGINES[0] and name.endswith(suffix) and key.startswith(name):
+        if engine != REFERENCE and name.endswith(suffix) and key.startswith(name):
             key = name[: -len(suffix)] + key[len(name) :]
-        out.setdefault(label, {})[key] = log
-    order = list(ENGINES) + sorted(set(out) - set(ENGINES))
-    return {e: out[e] for e in order if e in out}
+        elif engine != REFERENCE and key == f"{name} (engine {engine})":  # --set its engine
+            key = name
+        out.setdefault(label(engine), {})[key] = log
+    order = [label(e) for e in registered()]
+    return {e: out[e] for e in order + sorted(set(out) - set(order)) if e in out}
 
 
 def _read(log: Any, what: str) -> Mapping[str, Any]:
@@ -119,7 +144,9 @@ def evaluate_runs(
     if len(split_logs(logs)) == 1:
         return evaluate(dict(logs)), ""
     papers = {log.scenario()["paper"] for log in logs.values() if hasattr(log, "scenario")}
-    rows = engine_rows(evaluate, logs) + [r for p in sorted(papers) for r in stored_rate_rows(p)]
+    ran = list(split_logs(logs))
+    rows = engine_rows(evaluate, logs)
+    rows += [r for p in sorted(papers) for r in stored_rate_rows(p, engines=ran)]
     return rows, closing_note(rows)
 
 
@@ -138,8 +165,8 @@ def rate_row(
 ) -> Claim:
     """A catch (or grasp) rate per engine on the same perturbed set: ``outcomes`` maps an
     engine to its runs' verdicts (``success``, ``reason``), each rate with its Wilson 95 %
-    interval. "reproduced" (the target met) when every engine reaches :data:`TARGET`; where the
-    engines part the note says so (and whether their intervals overlap), then each engine's
+    interval. "reproduced" (the target met) when every engine run reaches :data:`TARGET`; where
+    the engines part the note says so (and whether their intervals overlap), then each engine's
     failures with their reasons."""
     from analysis.catching.ablations import wilson
 
@@ -153,9 +180,9 @@ def rate_row(
             parts.append(
                 f"{engine}: {k}/{n} = {100 * k / n:.0f} % [{100 * lo:.0f}–{100 * hi:.0f} %]"
             )
-        else:
+            passed[engine] = k >= TARGET * n
+        else:  # (no verdict: the closing note does not compare the row)
             parts.append(f"{engine}: not run")
-        passed[engine] = n > 0 and k >= TARGET * n
         why = Counter(str(o["reason"]) for o in res if not o["success"])
         if why:
             fails = "; ".join(f"{v}× {x}" for x, v in why.most_common())
@@ -168,15 +195,19 @@ def rate_row(
             f"engines part: {verdicts}"
             + (" (their intervals overlap: within the sampling error)" if overlap else ""),
         )
-    status = "reproduced" if all(passed.values()) else "differs"
+    status = "reproduced" if passed and all(passed.values()) else "differs"
     return Claim(label, stated, " ‖ ".join(parts), status, "; ".join(notes), kind=kind)
 
 
-def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
-    """``paper``'s robustness rate rows from the stored runs of both engines on the same inputs
+def stored_rate_rows(
+    paper: str, path: Path | None = None, engines: Sequence[str] = ()
+) -> list[Claim]:
+    """``paper``'s robustness rate rows from the stored runs of every engine on the same inputs
     (data/ablations/engine_rates.csv, made by ``python -m analysis.engine_rates``): one per
-    set; none when the table has no runs of the paper."""
-    from analysis.engine_rates import COMMAND, TABLE, read
+    set, each engine the table holds side by side (the reference and ``engines``, labels of the
+    engines whose logs are analysed, always: "not run" without rows), then each probe's rate in
+    the note; none when the table has no runs of the paper."""
+    from analysis.engine_rates import COMMAND, TABLE, is_probe, read
     from replay.resources import data_path
 
     path = path or data_path("ablations", f"{TABLE}.csv")
@@ -184,20 +215,18 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
     source = f"stored runs: data/ablations/{path.name} ({COMMAND})"
     out = []
     for s in dict.fromkeys(r["set"] for r in rows):
-        # the engines of the set (the reference always: "not run" without rows), the rest probes
-        labels = {r["engine"] for r in rows if r["set"] == s}
-        engines = [e for e in ENGINES if e == ENGINES[0] or e in labels]
-        by_engine = {e: [r for r in rows if r["set"] == s and r["engine"] == e] for e in engines}
-        row = rate_row(s, RATE_STATED.get(paper, "no rate stated"), by_engine)
-        probes: dict[str, list[dict]] = {
-            r["engine"]: [] for r in rows if r["set"] == s and r["engine"] not in ENGINES
-        }
+        by_label: dict[str, list[dict]] = {e: [] for e in (label(REFERENCE), *engines)}
         for r in rows:
-            if r["engine"] in probes and r["set"] == s:
-                probes[r["engine"]].append(r)
-        why = [
-            "probe " + rate_row(s, "", {label: res}).measured for label, res in probes.items()
-        ]  # the twin with one setting changed, on the same inputs (analysis/engine_rates.py)
+            if r["set"] == s:
+                by_label.setdefault(r["engine"], []).append(r)
+        shown = {e: v for e, v in by_label.items() if not is_probe(e)}
+        ranked = {e: shown[e] for e in sorted(shown, key=rank)}
+        row = rate_row(s, RATE_STATED.get(paper, "no rate stated"), ranked)
+        why = [  # an engine's scenario with one setting changed, on the same inputs
+            "probe " + rate_row(s, "", {p: res}).measured
+            for p, res in by_label.items()
+            if is_probe(p)
+        ]
         row.note = "; ".join(x for x in (row.note, *why, TARGET_NOTE, source) if x)
         out.append(row)
     return out
@@ -205,7 +234,7 @@ def stored_rate_rows(paper: str, path: Path | None = None) -> list[Claim]:
 
 def closing_note(rows: Sequence[Claim]) -> str:
     """Which assessed rows (measured, other regime, extension: those with a verdict) hold in
-    every engine, which in some (and why: the row's note)."""
+    every engine, which in some (and why: the row's note, ``_why``), which in none."""
     every, some, neither, single, n = [], [], [], 0, 2
     for r in rows:
         if r.kind not in ASSESSED:
@@ -218,7 +247,7 @@ def closing_note(rows: Sequence[Claim]) -> str:
         if r.status == "reproduced":
             every.append(r.quantity)
         elif "engines part" in r.note:
-            some.append(f"{r.quantity} ({r.note.split(';')[0].removeprefix('engines part: ')})")
+            some.append(f"{r.quantity} ({_why(r.note)})")
         elif r.status == "differs":  # (ties, notes and rows not run in either: no verdict)
             neither.append(r.quantity)
     all_n, part = ("both", "one engine only") if n == 2 else (f"all {n}", "some engines only")
@@ -230,3 +259,11 @@ def closing_note(rows: Sequence[Claim]) -> str:
         lines.append(f"Run in {'one engine only' if n == 2 else 'some engines only'}, ")
         lines[-1] += f"not compared: {single} rows."
     return "\n".join(lines)
+
+
+def _why(note: str) -> str:
+    """Why a row holds in some engines only, from its note: each engine's verdict and, where a
+    probe ran (a rate row), each probe's rate: what decides the difference, measured."""
+    parts = note.split("; ")
+    probes = [p for p in parts if p.startswith("probe ")]
+    return "; ".join([parts[0].removeprefix("engines part: "), *probes])

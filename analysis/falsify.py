@@ -63,20 +63,30 @@ class Verdict:
         return f"{mark}  {self.row} | {self.variant} (replaces {self.replaces}) | {got}"
 
 
-# a second engine's twin of a scenario (``catch_optimised_mujoco``): the claims table joins its
-# rows with the PyBullet run's by quantity (analysis.engines); the falsifiers are the PyBullet
-# table's, so the check runs on the PyBullet runs
-SECOND_ENGINE = "_mujoco"
+# the scenarios and logs of another engine than the reference (``catch_optimised_mujoco``, or
+# any run whose scenario sets ``plant.params.engine``: analysis.engines.engine_of): the claims
+# table joins their rows with the reference run's by quantity; the falsifiers are the reference
+# table's, so the check runs on the reference engine's runs
+
+
+def _reference_engine(config: dict, name: str) -> bool:
+    """A resolved scenario (``config``, named ``name``) runs in the reference engine."""
+    from analysis.engines import REFERENCE, engine_of
+
+    return engine_of(config, name) == REFERENCE
 
 
 def default_scenarios(paper: str) -> list[Path]:
-    """The paper's default scenarios, as ``make run`` runs them (the second engine's aside)."""
+    """The paper's default scenarios, as ``make run`` runs them (other engines' aside)."""
+    from replay.scenario import resolved_yaml
+
     out = []
     for pattern in DEFAULT_GLOBS:
         for path in sorted(scenario_dir().glob(pattern)):
-            if path.stem.endswith(SECOND_ENGINE):
-                continue
-            if load_scenario(path).paper == paper:
+            sc = load_scenario(path)
+            if sc.paper == paper and _reference_engine(
+                yaml.safe_load(resolved_yaml(sc)), path.stem
+            ):
                 out.append(path)
     return out
 
@@ -165,7 +175,7 @@ def falsify_paper(
         for p in sorted(Path(logs_dir).glob("*.mcap")):
             r = LogReader(p)
             sc = r.scenario()
-            if sc["name"].endswith(SECOND_ENGINE):
+            if not _reference_engine(r.scenario_config(), sc["name"]):
                 continue
             if yaml.safe_load(sc["yaml"]).get("paper") == paper:
                 baseline[sc["name"]] = r

@@ -30,7 +30,6 @@ MAX_ITEMS = 3  # differences named in a label ("+N more" after)
 LABEL_LENGTH = 80  # characters of a label
 _IGNORED = {"name", "description", "notes", "paper"}
 _SECONDS = {"latency", "duration", "after"}  # fields in s, written in ms below 1 s
-_ENGINES = {"mujoco_arm": "MuJoCo", "mujoco_grasp": "MuJoCo", "bullet_arm": "PyBullet"}
 
 
 @dataclass(frozen=True)
@@ -124,16 +123,26 @@ def _item(path: str, value: Any) -> str:
     return f"{what} {_short(value)}"
 
 
+def _engine(plant_type: str) -> str:
+    """The engine's label a plant type names (an arm plant made before the engine field, or the
+    engine-free rig: the reference engine), else ""."""
+    from analysis.engines import REFERENCE, engine_of, label
+
+    engine = engine_of({"plant": {"type": plant_type}})
+    return label(engine) if engine != REFERENCE or plant_type == "bullet_arm" else ""
+
+
 def differences(stored: Mapping[str, Any], ref: Mapping[str, Any]) -> list[str]:
     """What ``stored`` (a flattened resolved scenario) sets differently from ``ref``, as short
     phrases: a changed plug-in type names the new type (its params are then not listed)."""
     items, replaced = [], []
     sensors = sorted({p.split(".")[1] for p in stored if p.startswith("sensors.")})
-    for path in ("plant.type", "controller.type", *(f"sensors.{s}.type" for s in sensors)):
+    types = ("plant.type", "plant.params.engine.type", "controller.type")  # (an engine: its own
+    for path in (*types, *(f"sensors.{s}.type" for s in sensors)):  # settings, not listed)
         new = stored.get(path)
         if new is not None and new != ref.get(path):
-            if path == "plant.type" and str(new) in _ENGINES:
-                items.append(f"engine {_ENGINES[str(new)]}")
+            if path == "plant.type" and _engine(str(new)):
+                items.append(f"engine {_engine(str(new))}")
             else:
                 items.append(f"{path.split('.')[-2]} {_short(new)}")
             replaced.append(path[: -len("type")])

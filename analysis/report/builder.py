@@ -236,13 +236,14 @@ def _build(out: Path, logs_dir: Path) -> None:
                 evaluate = registry.load("claims", key)
                 from analysis.claims import falsifiers_of, format_table, summary
                 from analysis.claims import shown as falsified
-                from analysis.engines import evaluate_runs
+                from analysis.engines import evaluate_runs, split_logs
 
                 with skipped_notes() as skipped:
                     sec.claims, engines_note = evaluate_runs(evaluate, readers)
                 sec.notes += skipped
-                if engines_note:
-                    sec.notes.append("Both physics engines (docs/mujoco.md): " + engines_note)
+                if engines_note:  # the engines of the logs present
+                    names = ", ".join(split_logs(readers))
+                    sec.notes.append(f"Physics engines {names} (docs/mujoco.md): {engines_note}")
 
                 sec.falsifiers = falsifiers_of(evaluate)
                 sec.shown = falsified(key)  # (what `replay falsify --store` last showed)
@@ -341,7 +342,9 @@ def _provenance(version: str) -> dict[str, str]:
         "python": platform.python_version(),
         "platform": platform.platform(),
     }
-    for pkg in PACKAGES:
+    from analysis.engines import registered
+
+    for pkg in dict.fromkeys((*PACKAGES, *registered())):  # an engine's name is its package's
         try:
             info[pkg] = metadata.version(pkg)
         except metadata.PackageNotFoundError:

@@ -265,3 +265,17 @@ def test_claims_on_make_runs_logs_count_no_row_outside_the_paper_and_no_finding_
         assert rec.when in out.output
     # what is outside the paper is shown, as rows of its own kind
     assert {"other regime", "extension"} <= kinds_shown
+
+
+def test_the_falsifiers_run_on_the_reference_engines_scenarios_only():
+    """Another engine's twins (``<scenario>_<engine>``, the engine read from each resolved
+    scenario) are joined with the reference's rows by the claims table, never falsified."""
+    from analysis.engines import REFERENCE, registered
+    from analysis.falsify import default_scenarios
+    from replay.resources import scenario_dir
+
+    others = [e for e in registered() if e != REFERENCE]
+    twins = {p.stem for p in scenario_dir().glob("*.yaml") for e in others if p.stem.endswith(e)}
+    chosen = {p.stem for paper in ("namiki2003", "namiki1999") for p in default_scenarios(paper)}
+    assert twins and {"catch_optimised", "grasp_sphere"} <= chosen
+    assert not chosen & twins
