@@ -188,7 +188,6 @@ def _inside(path: Path, folder: Path) -> bool:
 
 
 def _build(out: Path, logs_dir: Path) -> None:
-    from analysis.runs import describe
     from replay.sweep import ablations
     from replay.sweep.variants import code_version
 
@@ -199,64 +198,10 @@ def _build(out: Path, logs_dir: Path) -> None:
     for key, paper in papers().items():
         sec = PaperSection(key, paper.title, paper.authors)
         readers = by_paper.get(key, {})
-        for name, r in sorted(readers.items()):
-            sc = r.scenario()
-            sec.runs.append((name, sc.get("seed", "?"), str(getattr(r, "path", name))))
-            run = describe(r, name)
-            sec.scenarios[name] = (run.name, run.label, run.experiment)
         if readers:
-            figure_skips: list[str] = []
-            try:
-                make = registry.load("figures", key)
-                with skipped_notes() as figure_skips:
-                    paths = make(readers, out / "figures")
-            except registry.UnknownPlugin:
-                paths = []
-            except OSError:
-                raise
-            except Exception as exc:  # noqa: BLE001 - a damaged or hostile log: said, not fatal
-                sec.notes.append(f"No figures: they could not be made from these logs: {exc!r}")
-                paths = []
-            paths = [p if isinstance(p, Path) else Path(p) for p in paths]
-            paths = [p for p in paths if _inside(p, out / "figures")]
-            shown: set[str] = set()
-            for png in (p for p in paths if p.suffix == ".png"):
-                svg = png.with_suffix(".svg")
-                runs = runs_of(png, readers)
-                shown.update(runs)
-                sec.figures.append(
-                    Figure(
-                        png.relative_to(out).as_posix(),
-                        svg.relative_to(out).as_posix() if svg.is_file() else "",
-                        _caption(key, png.stem, _shows(runs, readers), _controllers(runs, readers)),
-                    )
-                )
-            sec.notes += figure_notes(readers, shown, figure_skips)
-            try:
-                evaluate = registry.load("claims", key)
-                from analysis.claims import falsifiers_of, format_table, summary
-                from analysis.claims import shown as falsified
-                from analysis.engines import evaluate_runs, split_logs
-
-                with skipped_notes() as skipped:
-                    sec.claims, engines_note = evaluate_runs(evaluate, readers)
-                sec.notes += skipped
-                if engines_note:  # the engines of the logs present
-                    names = ", ".join(split_logs(readers))
-                    sec.notes.append(f"Physics engines {names} (docs/mujoco.md): {engines_note}")
-
-                sec.falsifiers = falsifiers_of(evaluate)
-                sec.shown = falsified(key)  # (what `replay falsify --store` last showed)
-                sec.claims_md = format_table(
-                    paper.title, sec.claims, falsifiers=sec.falsifiers, record=sec.shown
-                )
-                sec.claims_summary = summary(sec.claims, sec.shown)
-            except registry.UnknownPlugin:
-                sec.notes.append("No claims table defined yet.")
-            except OSError:
-                raise
-            except Exception as exc:  # noqa: BLE001 - a damaged or hostile log: said, not fatal
-                sec.notes.append(f"No claims: they could not be evaluated on these logs: {exc!r}")
+            _section_runs(sec, readers)
+            _section_figures(sec, key, readers, out)
+            _section_claims(sec, key, paper, readers)
         for name in ablations.names():
             sf = ablations.load(name)
             if sf.paper != key:
@@ -275,6 +220,79 @@ def _build(out: Path, logs_dir: Path) -> None:
     said = _theses(left)
     (out / "index.md").write_text(_markdown(sections, info, commands, left, said), encoding="utf-8")
     (out / "index.html").write_text(_html(sections, info, commands, left, said), encoding="utf-8")
+
+
+def _section_runs(sec: PaperSection, readers: dict) -> None:
+    """The section's runs (name, seed, log) and what each is (analysis/runs.py)."""
+    from analysis.runs import describe
+
+    for name, r in sorted(readers.items()):
+        sc = r.scenario()
+        sec.runs.append((name, sc.get("seed", "?"), str(getattr(r, "path", name))))
+        run = describe(r, name)
+        sec.scenarios[name] = (run.name, run.label, run.experiment)
+
+
+def _section_figures(sec: PaperSection, key: str, readers: dict, out: Path) -> None:
+    """The paper's figures of ``readers`` into ``out/figures``, captioned by the runs they show;
+    a figure that cannot be made is said in the section's notes, not fatal."""
+    figure_skips: list[str] = []
+    try:
+        make = registry.load("figures", key)
+        with skipped_notes() as figure_skips:
+            paths = make(readers, out / "figures")
+    except registry.UnknownPlugin:
+        paths = []
+    except OSError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a damaged or hostile log: said, not fatal
+        sec.notes.append(f"No figures: they could not be made from these logs: {exc!r}")
+        paths = []
+    paths = [p if isinstance(p, Path) else Path(p) for p in paths]
+    paths = [p for p in paths if _inside(p, out / "figures")]
+    shown: set[str] = set()
+    for png in (p for p in paths if p.suffix == ".png"):
+        svg = png.with_suffix(".svg")
+        runs = runs_of(png, readers)
+        shown.update(runs)
+        sec.figures.append(
+            Figure(
+                png.relative_to(out).as_posix(),
+                svg.relative_to(out).as_posix() if svg.is_file() else "",
+                _caption(key, png.stem, _shows(runs, readers), _controllers(runs, readers)),
+            )
+        )
+    sec.notes += figure_notes(readers, shown, figure_skips)
+
+
+def _section_claims(sec: PaperSection, key: str, paper, readers: dict) -> None:
+    """The paper's claims table over ``readers`` (every engine's side by side), its falsifiers
+    and what ``replay falsify --store`` last showed; a table that cannot be made is said."""
+    try:
+        evaluate = registry.load("claims", key)
+        from analysis.claims import falsifiers_of, format_table, summary
+        from analysis.claims import shown as falsified
+        from analysis.engines import evaluate_runs, split_logs
+
+        with skipped_notes() as skipped:
+            sec.claims, engines_note = evaluate_runs(evaluate, readers)
+        sec.notes += skipped
+        if engines_note:  # the engines of the logs present
+            names = ", ".join(split_logs(readers))
+            sec.notes.append(f"Physics engines {names} (docs/mujoco.md): {engines_note}")
+
+        sec.falsifiers = falsifiers_of(evaluate)
+        sec.shown = falsified(key)  # (what `replay falsify --store` last showed)
+        sec.claims_md = format_table(
+            paper.title, sec.claims, falsifiers=sec.falsifiers, record=sec.shown
+        )
+        sec.claims_summary = summary(sec.claims, sec.shown)
+    except registry.UnknownPlugin:
+        sec.notes.append("No claims table defined yet.")
+    except OSError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a damaged or hostile log: said, not fatal
+        sec.notes.append(f"No claims: they could not be evaluated on these logs: {exc!r}")
 
 
 def _theses(notes: list[str]) -> list:
