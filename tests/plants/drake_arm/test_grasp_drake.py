@@ -1,4 +1,4 @@
-"""The grasp in Drake (plants/drake_arm/grasp_plant.py) on seeds and human speeds the scenarios do
+"""The grasp in Drake (plants/drake_arm/grasp_plant.py's adapter) on seeds and human speeds the scenarios do
 not use (they use seed 0 at 0.10 m/s), judged from the truth topics by the PyBullet robustness
 test's own criterion (analysis/grasping/judge.py): the ball is held >= 90 %; the box is held at the
 slower human speeds, and where not (docs/drake.md: 20/23 on analysis/engine_rates.py's paths, all
@@ -13,14 +13,11 @@ import math
 import os
 from pathlib import Path
 
-import numpy as np
 import pytest
 import yaml
-from grasp_rig import DT, rig
+from grasp_rig import rig
 
 from analysis.grasping.judge import physical_verdict
-from plants.drake_arm.grasp_plant import DrakeGraspPlant
-from plants.drake_arm.params import GraspParams
 from replay.robot.arm_types import ServoCommand
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -46,9 +43,7 @@ def run(scenario: str, out: Path, sets: list[str]):
 
 
 def test_truth_topics_and_fields_match_the_pybullet_rig():
-    pb = rig()
-    fields = {f.name: getattr(pb.params, f.name) for f in dataclasses.fields(pb.params)}
-    dk = DrakeGraspPlant(GraspParams(**fields), dt=DT, rng=np.random.default_rng(0))
+    pb, dk = rig(), rig(engine={"type": "drake"})
     try:
         cmd = ServoCommand(arm=[0.01] * 7, hand=[0.1] * 14, head=[0.1, 0.0])
         for plant in (pb, dk):
@@ -109,11 +104,11 @@ def test_contact_stiffness_neighbours_still_grasp(tmp_path, stiffness):
     """The point contact stiffness at half and twice the scenario's, on an unseen seed."""
     k = yaml.safe_load((ROOT / "scenarios" / "grasp_hexahedron_drake.yaml").read_text())["plant"][
         "params"
-    ]["dk_point_stiffness"]
+    ]["engine"]["dk_point_stiffness"]
     (ok, why), flag = run(
         "grasp_hexahedron_drake",
         tmp_path / "n.mcap",
-        [f"plant.params.dk_point_stiffness={k * stiffness:.1f}", "seed=226"],
+        [f"plant.params.engine.dk_point_stiffness={k * stiffness:.1f}", "seed=226"],
     )
     print(stiffness, ok, why)
     assert ok and flag["success"], (why, flag["reason"])
