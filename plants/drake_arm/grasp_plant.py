@@ -18,6 +18,7 @@ import numpy as np
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce
 
+from plants.arm_rig.grasp_rig import hand_speeds
 from plants.arm_rig.human_path import HumanPath
 from plants.drake_arm.plant import DrakeEngine
 from plants.drake_arm.world import vec
@@ -75,12 +76,7 @@ class DrakeGraspEngine(DrakeEngine):
 
     # ------------------------------------------------------------------ command
     def hand_velocity(self, hand) -> None:
-        h = np.asarray(hand, float).reshape(-1)
-        if h.shape != (len(self._hand_v_cmd),):
-            raise ValueError(
-                f"velocity command needs {len(self._hand_v_cmd)} values, got {h.shape[0]}"
-            )
-        self._hand_v_cmd = [x if np.isfinite(x) else 0.0 for x in h.tolist()]
+        self._hand_v_cmd = hand_speeds(hand, len(self._hand_v_cmd))
 
     def drive_hand_servos(self, qd: list) -> None:
         self.drive_hand(self._hand_v_cmd, qd)

@@ -23,7 +23,9 @@ from typing import Any
 
 import numpy as np
 from pydrake.multibody.math import SpatialVelocity
+from pydrake.multibody.tree import MultibodyForces
 
+from plants.arm_rig.engine import ContactRows
 from plants.arm_rig.rig import ArmRig
 from plants.drake_arm.world import build_world, set_object, vec
 from replay.scene import Frame
@@ -38,7 +40,7 @@ def _pose(X) -> tuple:
     return (x, y, z), (float(q.x()), float(q.y()), float(q.z()), float(q.w()))
 
 
-class DrakeEngine:
+class DrakeEngine(ContactRows):
     """The rig's engine in Drake (plants/arm_rig/engine.py ``EngineAdapter``), built from the
     rig's public attributes (``rig``: its params, settings, model, dt and joints)."""
 
@@ -47,6 +49,7 @@ class DrakeEngine:
         self.dof, self.dt = rig.dof, dt
         self._cache: tuple | None = None  # the state read this step (state)
         W = self.world = build_world(P, S, rig.model, dt, P.engine_settings)
+        self.body_names, self.part_of_body = W.body_names, W.part_of_body  # ContactRows
         p, ctx = self.mbp, self.ctx = W.plant, W.context
         # ---- the initial state
         q = p.GetPositions(ctx)
@@ -221,22 +224,20 @@ class DrakeEngine:
             n = (f_obj / size).tolist() if size > 0.0 else [0.0, 0.0, 0.0]
             out.append((index[robot], s.centroid().tolist(), n, size))
 
-    def object_contacts(self, pos, v) -> list:
-        return self.contacts  # read within the step (_read_contacts)
-
-    def touch(self, contacts: list) -> tuple:
-        c = max(contacts, key=lambda c: c[3])
-        return c[0], c[1], c[2]
-
-    def contact_summary(self) -> tuple[list, list, float]:
-        """(parts, links, total normal force) of the step's contacts."""
-        if not self.contacts:
-            return [], [], 0.0
-        W = self.world
-        bodies = {c[0] for c in self.contacts}
-        links = sorted(W.body_names[b] for b in bodies)
-        parts = sorted({W.part_of_body[b] for b in bodies})
-        return parts, links, float(sum(c[3] for c in self.contacts))
+    def inverse_dynamics(self, q, qd, qdd) -> tuple:
+        p, W = self.mbp, self.world
+        ctx = p.CreateDefaultContext()  # a scratch context: the simulation's untouched
+        x = p.GetPositions(self.ctx)
+        v: Any = np.zeros(self._nv)
+        vdot: Any = np.zeros(self._nv)
+        x[list(W.arm_q)], v[list(W.arm_v)], vdot[list(W.arm_v)] = q, qd, qdd
+        p.SetPositions(ctx, x)
+        p.SetVelocities(ctx, v)
+        gravity = MultibodyForces(p)
+        p.CalcForceElementsContribution(ctx, gravity)  # Drake's gravity is a force element
+        tau: Any = p.CalcInverseDynamics(ctx, vdot, gravity)
+        M: Any = p.CalcMassMatrix(ctx)
+        return tau[list(W.arm_v)], M[np.ix_(W.arm_v, W.arm_v)]
 
     # ------------------------------------------------------------------ log and scene
     def frames(self) -> list[Frame]:
