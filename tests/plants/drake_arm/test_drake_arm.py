@@ -1,23 +1,20 @@
 """The Drake adapter (plants/drake_arm) on its own: a fast ball stopped by the palm with point and
-hydroelastic contact, its bounce off the palm the documented one, two runs bit-identical, and the
-Drake scenarios differ from their PyBullet twins only in the engine field. The checks every
-engine passes (inverse dynamics against our RNEA, the ballistic ball, the wrist's static loads,
-the servos' step test, a grasp held still) are tests/plants/mujoco_arm/test_cross_engine.py's."""
+hydroelastic contact, its bounce off the palm the documented one, two runs bit-identical. The
+checks every engine passes (inverse dynamics against our RNEA, the ballistic ball, the wrist's
+static loads, the servos' step test, a grasp held still, the scenarios differing from their
+PyBullet twins only in the engine field) are tests/plants/mujoco_arm/test_cross_engine.py's."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from grasp_rig import DT
 
 from plants.arm_rig.params import Params
 from plants.bullet_arm import BulletArmPlant
-from plants.drake_arm.params import DrakeSettings
 from replay.robot.arm_types import ArmCommand
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -67,30 +64,6 @@ def test_fast_ball_is_stopped_by_the_palm(model):
     assert contact["normal_speed"] > 5.0  # the normal points from the palm towards the ball
     assert float(v @ n) >= -0.5  # stopped or bounced back
     assert float((pos - face) @ n) > 0.0  # the ball's centre never passed the face
-
-
-# ---------------------------------------------------------------- the scenarios
-@pytest.mark.parametrize(
-    "name", ["catch_optimised", "catch_initial", "grasp_hexahedron", "grasp_sphere"]
-)
-def test_drake_scenario_differs_only_in_the_engine(name):
-    """The resolved scenario of NAME_drake is NAME's with the engine field Drake (all its
-    settings in it): every other field (plant type and params included) equal."""
-    from replay.scenario import load_scenario
-    from replay.scenario.loader import to_plain
-
-    a = to_plain(load_scenario(ROOT / "scenarios" / f"{name}.yaml"))
-    b = to_plain(load_scenario(ROOT / "scenarios" / f"{name}_drake.yaml"))
-    assert a["plant"]["type"] == b["plant"]["type"]
-    pa, pb = a["plant"]["params"], dict(b["plant"]["params"])
-    engine = pb.pop("engine")
-    assert pb == pa and "engine" not in pa  # PyBullet: the field left out (empty)
-    assert engine["type"] == "drake"
-    assert set(engine) == {f.name for f in dataclasses.fields(DrakeSettings)}
-    for key in set(a) - {"name", "description", "plant", "source"}:
-        assert a[key] == b[key], key
-    raw = yaml.safe_load((ROOT / "scenarios" / f"{name}_drake.yaml").read_text())
-    assert raw.get("controller", {}).get("type") is None  # the method is inherited
 
 
 def test_deterministic():

@@ -15,12 +15,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from grasp_rig import DT, rig, rise_bandwidth
+from grasp_rig import DT, nudged_truth, rig, rise_bandwidth
 
 from plants.arm_rig.engine import engines
 from plants.bullet_arm import BulletArmPlant
 from plants.bullet_arm import Params as ArmParams
-from plants.mujoco_arm.params import MujocoSettings
 from replay.messages import JointState, ObjectState, to_dict
 from replay.robot.arm_types import ArmCommand, ArmSpec, ServoCommand
 from replay.robot.hand import CATCH3, GRASP4, hand_body, hand_mass
@@ -385,25 +384,42 @@ def test_deterministic():
 
 
 # ---------------------------------------------------------------- the scenarios
-@pytest.mark.parametrize("name", ["catch_optimised", "catch_initial"])
-def test_mujoco_scenario_differs_only_in_the_plant(name):
-    """The resolved scenario of NAME_mujoco is NAME's with the engine field MuJoCo (its own
-    settings in it): every other field (plant type and params included) equal."""
+# every scenario NAME_<engine> of a registered engine, with its engine
+TWINS = sorted(
+    (p.stem, engine) for engine in ENGINES for p in (ROOT / "scenarios").glob(f"*_{engine}.yaml")
+)
+
+
+@pytest.mark.parametrize("name, engine", TWINS)
+def test_an_engine_scenario_differs_from_its_twin_only_in_the_engine(name, engine):
+    """The resolved scenario NAME_<engine> is NAME's with the engine field (every setting of
+    the engine's in it): every other field (plant type and params included) equal, the method
+    inherited, not restated."""
     from replay.scenario import load_scenario
     from replay.scenario.loader import to_plain
 
-    a = to_plain(load_scenario(ROOT / "scenarios" / f"{name}.yaml"))
-    b = to_plain(load_scenario(ROOT / "scenarios" / f"{name}_mujoco.yaml"))
-    assert a["plant"]["type"] == b["plant"]["type"] == "bullet_arm"
+    twin = name.removesuffix(f"_{engine}")
+    a = to_plain(load_scenario(ROOT / "scenarios" / f"{twin}.yaml"))
+    b = to_plain(load_scenario(ROOT / "scenarios" / f"{name}.yaml"))
+    assert a["plant"]["type"] == b["plant"]["type"]
     pa, pb = a["plant"]["params"], dict(b["plant"]["params"])
-    engine = pb.pop("engine")
+    block = pb.pop("engine")
     assert pb == pa and "engine" not in pa  # PyBullet: the field left out (empty)
-    fields = {f.name for f in dataclasses.fields(MujocoSettings)}  # the engine's settings
-    assert engine["type"] == "mujoco" and set(engine) == fields
+    fields = {f.name for f in dataclasses.fields(engines()[engine].load())}
+    assert block["type"] == engine and set(block) == fields
     for key in set(a) - {"name", "description", "plant", "source"}:
         assert a[key] == b[key], key
-    raw = yaml.safe_load((ROOT / "scenarios" / f"{name}_mujoco.yaml").read_text())
-    assert raw.get("controller", {}).get("type") is None  # the method is inherited, not restated
+    raw = yaml.safe_load((ROOT / "scenarios" / f"{name}.yaml").read_text())
+    assert set(raw) <= {"extends", "name", "description", "plant", "controller"}
+    assert raw.get("controller", {}).get("type") is None
+
+
+def test_every_engine_has_its_catch_and_grasp_scenarios():
+    """Each engine but the reference runs the paper's four arm scenarios (goldens, claims)."""
+    for engine in ENGINES:
+        if engine != REFERENCE:
+            got = sorted(n.removesuffix(f"_{engine}") for n, e in TWINS if e == engine)
+            assert got == ["catch_initial", "catch_optimised", "grasp_hexahedron", "grasp_sphere"]
 
 
 # ---------------------------------------------------------------- the grasping rig held still
@@ -495,3 +511,27 @@ def test_each_arm_servo_has_the_stated_bandwidth(engine, joint):
     assert got == pytest.approx(bandwidth, rel=0.2)
     assert w[-10:, joint] == pytest.approx(STEP, rel=0.02)
     assert np.abs(np.delete(w, joint, axis=1)).max() < 0.1 * STEP
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_grasp_truth_topics_and_fields_match_the_reference(engine):
+    """The grasping rig in each engine gives the reference's truth topics with the same fields,
+    readings, frames and spec; the engine-free parts agree (the head turned alike, the human's
+    path the same); the hand servos' torques stay within their cap."""
+    ref, other = rig(), rig(engine={"type": engine})
+    try:
+        ta, tb = nudged_truth(ref), nudged_truth(other)
+        assert set(ta) == set(tb)
+        for topic in ta:
+            assert [f.name for f in dataclasses.fields(ta[topic])] == [
+                f.name for f in dataclasses.fields(tb[topic])
+            ], topic
+        assert set(ref.scene().readings) == set(other.scene().readings)
+        assert {f.child for f in ref.frames()} == {f.child for f in other.frames()}
+        assert isinstance(other.spec(), type(ref.spec()))
+        assert other.head_servo.q_l == pytest.approx(ref.head_servo.q_l, abs=1e-12)
+        assert other.human.target_l == pytest.approx(ref.human.target_l, abs=1e-12)
+        assert max(abs(x) for x in other.hand_state()[2]) <= ref.params.hand_max_torque + 1e-6
+    finally:
+        ref.close()
+        other.close()
