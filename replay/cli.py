@@ -658,6 +658,10 @@ def golden_check(names, quiet):
             failed += 1
             click.echo(one_line(f"FAIL {g.name}: {exc}"))
             continue
+        except Exception as exc:  # noqa: BLE001 - a run that crashes fails its golden only
+            failed += 1
+            click.echo(one_line(f"FAIL {g.name}: the run failed: {type(exc).__name__}: {exc}"))
+            continue
         finally:
             progress.done()
         if diffs:

@@ -54,6 +54,8 @@ def engine_settings(value: Any) -> Any | None:
     known = engines()
     if kind not in known:
         names = ", ".join(sorted(known))
+        if kind is None:  # (settings set on a scenario that names no engine)
+            raise ParamError("engine", f"settings without a type: add type: ENGINE ({names})")
         raise ParamError("engine", f"unknown engine type {kind!r} (known: {names})")
     cls = known[kind].load()
     if isinstance(value, yaml.MappingNode):

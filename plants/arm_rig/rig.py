@@ -353,26 +353,42 @@ class ArmRig(Plant):
         contacts = self.engine.object_contacts(pos, v)
         parts, links, _ = self.engine.contact_summary()
         if contacts and not self._in_contact:
-            link, point, normal = self.engine.touch(contacts)
-            point = np.array(point)
-            n = np.array(normal)  # from the robot towards the object
-            v_rel = np.subtract(self._obj_vel_before, self.engine.point_velocity(link, point))
-            self._events.append(
-                Occurrence(
-                    "contact",
-                    {
-                        "links": list(links),
-                        "parts": list(parts),
-                        "position": point.tolist(),
-                        "speed": float(np.linalg.norm(v_rel)),
-                        "normal_speed": float(-v_rel @ n),
-                        "object_velocity_before": list(self._obj_vel_before),
-                        "object_velocity_after": list(v),
-                    },
-                )
-            )
+            self._contact_event(contacts, parts, links, v)
         self._in_contact = bool(contacts)
-        # caught: touching enough hand parts and moving with the palm
+        self._hold_events(parts, links, pos, v)
+        if not self._fallen and pos[2] < P.miss_height:
+            self._fallen = True
+            kind = "drop" if self._ever_caught else "miss"
+            self._events.append(Occurrence(kind, {"position": list(pos), "velocity": list(v)}))
+        if self._watch is not None:
+            pe, oe, ve, we = self.engine.effector_now()  # floats: faster than arrays here
+            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
+
+    def _contact_event(self, contacts: list, parts, links, v) -> None:
+        """The ``contact`` event of the first touch: where, and how fast relative to the robot."""
+        link, point, normal = self.engine.touch(contacts)
+        point = np.array(point)
+        n = np.array(normal)  # from the robot towards the object
+        v_rel = np.subtract(self._obj_vel_before, self.engine.point_velocity(link, point))
+        self._events.append(
+            Occurrence(
+                "contact",
+                {
+                    "links": list(links),
+                    "parts": list(parts),
+                    "position": point.tolist(),
+                    "speed": float(np.linalg.norm(v_rel)),
+                    "normal_speed": float(-v_rel @ n),
+                    "object_velocity_before": list(self._obj_vel_before),
+                    "object_velocity_after": list(v),
+                },
+            )
+        )
+
+    def _hold_events(self, parts, links, pos, v) -> None:
+        """``catch`` (the rig's hold event) and ``release``: held while touching enough hand
+        parts and moving with the palm for ``catch_hold_time``."""
+        P = self.params
         hand_parts = [x for x in parts if x != "arm"]
         held = False
         if self.engine.palm_id is not None and len(hand_parts) >= P.catch_min_parts:
@@ -402,13 +418,6 @@ class ArmRig(Plant):
         if self.caught and not held and self._unhold >= P.catch_hold_time - eps:
             self.caught = False
             self._events.append(Occurrence("release", {"position": list(pos)}))
-        if not self._fallen and pos[2] < P.miss_height:
-            self._fallen = True
-            kind = "drop" if self._ever_caught else "miss"
-            self._events.append(Occurrence(kind, {"position": list(pos), "velocity": list(v)}))
-        if self._watch is not None:
-            pe, oe, ve, we = self.engine.effector_now()  # floats: faster than arrays here
-            self._watch.observe(self._t, pos, v, pe, oe, ve, we, parts, self.caught)
 
     def pop_events(self) -> list[Occurrence]:
         ev, self._events = self._events, []

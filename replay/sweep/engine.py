@@ -198,23 +198,78 @@ def _run_locked(
     retry_failed,
 ) -> SweepSummary:
     table = out_dir / TABLE
+    _refuse_outputs(out_dir, keep_logs)
+    params = list(dict.fromkeys(k for v in variants for k in v.params))
+    by_key = {v.key: v for v in variants}
+    old = read_table(table)
+    rows, others, stale = _sort_old_rows(old, by_key, len(variants), retry_failed)
+    columns = list(dict.fromkeys(params + [c for r in others for c in param_columns(r)]))
+    if stale:
+        _set_aside(out_dir / STALE, stale)
+    todo = [v for v in variants if v.key not in rows]
+    tasks = _tasks(todo, out_dir, keep_logs, metrics)
+
+    last = [0.0, 0.0]  # when the table was last written, and how long that took
+
+    def save(now: bool = True) -> None:
+        """The table written; unless ``now``, only if the time since the last write is at least
+        that write's cost over SAVE_SHARE (a table of 10,000 rows takes ~60 ms to write: after
+        each variant, the sweep would be quadratic in its size)."""
+        t = time.perf_counter()
+        if not now and t - last[0] < last[1] / SAVE_SHARE:
+            return
+        write_table(table, [*_with_params(rows.values(), by_key), *others], columns)
+        last[:] = [time.perf_counter(), time.perf_counter() - t]
+
+    t0 = time.perf_counter()
+    if stale or old or todo:
+        save()
+    ran, interrupted = _stream(
+        tasks, rows, save, workers or default_workers(), executor, address, progress
+    )
+    done = sorted(_with_params(rows.values(), by_key), key=lambda r: int(r["index"]))
+    if done:
+        write_summary(out_dir / SUMMARY, done, params)  # (the rate of each cell)
+    ok = sum(as_bool(r.get("success")) for r in done)
+    return SweepSummary(
+        total=len(variants),
+        ran=ran,
+        skipped=len(variants) - len(todo),
+        ok=ok,
+        failed=len(done) - ok,
+        wall_time=time.perf_counter() - t0,
+        table=table,
+        rows=done,
+        interrupted=interrupted,
+        stale=len(stale),
+    )
+
+
+def _refuse_outputs(out_dir: Path, keep_logs: bool) -> None:
+    """Refuse links (before anything is read from them) and files not of a sweep (a table.csv
+    of the user's is not replaced)."""
+    table = out_dir / TABLE
     for path in (
         table,
         out_dir / STALE,
         out_dir / SUMMARY,
         *([out_dir / "logs"] if keep_logs else []),
     ):
-        refuse_link(path)  # (before anything is read from them)
+        refuse_link(path)
     for path in (table, out_dir / STALE):
-        refuse_foreign(path)  # (a table.csv of the user's is not replaced)
+        refuse_foreign(path)
     refuse_foreign_summary(out_dir / SUMMARY)
-    params = list(dict.fromkeys(k for v in variants for k in v.params))
-    by_key = {v.key: v for v in variants}
-    versions = {v.version for v in variants}
-    old = read_table(table)
+
+
+def _sort_old_rows(
+    old: list[dict[str, Any]], by_key: dict[str, Variant], n: int, retry_failed: bool
+) -> tuple[dict[str, dict[str, Any]], list[dict[str, Any]], list[dict[str, Any]]]:
+    """The rows of an earlier table: (this sweep's finished rows by key, rows of other sweeps of
+    this code into this folder: kept, rows of another code or scenario version: set aside)."""
+    versions = {v.version for v in by_key.values()}
     rows: dict[str, dict[str, Any]] = {}
-    others: list[dict[str, Any]] = []  # rows of other sweeps of this code into this folder: kept
-    stale: list[dict[str, Any]] = []  # rows of another code or scenario version: set aside
+    others: list[dict[str, Any]] = []
+    stale: list[dict[str, Any]] = []
     for r in old:
         key = r.get("key", "")
         if key in by_key:
@@ -227,14 +282,14 @@ def _run_locked(
     for key, row in rows.items():  # the index follows this sweep's order
         row["index"] = by_key[key].index
     for i, row in enumerate(others):  # the other sweeps' rows after this one's
-        row["index"] = len(variants) + i
-    columns = list(dict.fromkeys(params + [c for r in others for c in param_columns(r)]))
-    if stale:
-        _set_aside(out_dir / STALE, stale)
-    todo = [v for v in variants if v.key not in rows]
+        row["index"] = n + i
+    return rows, others, stale
+
+
+def _tasks(todo: list[Variant], out_dir: Path, keep_logs: bool, metrics) -> list[dict]:
+    """One task dict per variant to run (what a worker, local or Ray, is given)."""
     plugins = registry.imported_plugins()  # (the planning imported them)
-    workers = workers or default_workers()
-    tasks = [
+    return [
         {
             "key": v.key,
             "index": v.index,
@@ -251,24 +306,13 @@ def _run_locked(
         for v in todo
     ]
 
-    last = [0.0, 0.0]  # when the table was last written, and how long that took
 
-    def save(now: bool = True) -> None:
-        """The table written; unless ``now``, only if the time since the last write is at least
-        that write's cost over SAVE_SHARE (a table of 10,000 rows takes ~60 ms to write: after
-        each variant, the sweep would be quadratic in its size)."""
-        t = time.perf_counter()
-        if not now and t - last[0] < last[1] / SAVE_SHARE:
-            return
-        write_table(table, [*_with_params(rows.values(), by_key), *others], columns)
-        last[:] = [time.perf_counter(), time.perf_counter() - t]
-
-    t0 = time.perf_counter()
+def _stream(tasks, rows, save, workers, executor, address, progress) -> tuple[int, bool]:
+    """Run ``tasks``, each finished row into ``rows`` and the table saved as they come;
+    (how many ran, whether Ctrl-C stopped the sweep)."""
     ran = failed_now = 0
     interrupted = False
-    bar = _progress(len(todo), progress)
-    if stale or old or todo:
-        save()
+    bar = _progress(len(tasks), progress)
     stream: Any = None  # (a generator: closed below)
     try:
         stream = (
@@ -293,22 +337,7 @@ def _run_locked(
         bar.close()
         if ran:
             save()  # (every finished row, whatever the last writes left out)
-    done = sorted(_with_params(rows.values(), by_key), key=lambda r: int(r["index"]))
-    if done:
-        write_summary(out_dir / SUMMARY, done, params)  # (the rate of each cell)
-    ok = sum(as_bool(r.get("success")) for r in done)
-    return SweepSummary(
-        total=len(variants),
-        ran=ran,
-        skipped=len(variants) - len(todo),
-        ok=ok,
-        failed=len(done) - ok,
-        wall_time=time.perf_counter() - t0,
-        table=table,
-        rows=done,
-        interrupted=interrupted,
-        stale=len(stale),
-    )
+    return ran, interrupted
 
 
 def _set_aside(path: Path, stale: list[dict[str, Any]]) -> None:

@@ -31,3 +31,20 @@ def test_a_changed_run_names_its_first_difference(project_root, tmp_path):
 def test_unknown_golden_is_one_line(project_root):
     r = CliRunner().invoke(main, ["golden", "check", "nope"])
     assert r.exit_code == 2 and "unknown golden log 'nope'" in r.output
+
+
+def test_a_run_that_crashes_fails_its_golden_and_the_rest_are_checked(project_root, monkeypatch):
+    import replay.golden as golden
+
+    real = golden.run_golden
+
+    def crash_one(g, out, progress=None):
+        if g.name == "catch_optimised":
+            raise AttributeError("'Plant' object has no attribute 'Engine'")
+        return real(g, out, progress)
+
+    monkeypatch.setattr(golden, "run_golden", crash_one)
+    r = CliRunner().invoke(main, ["golden", "check", "-q", "catch_optimised", "stick_3step"])
+    assert r.exit_code == 1 and "Traceback" not in r.output, r.output
+    assert "FAIL catch_optimised: the run failed: AttributeError: 'Plant' object" in r.output
+    assert "ok   stick_3step" in r.output
