@@ -31,7 +31,7 @@ from analysis.claims import ASSESSED, Claim
 # each engine's name in a scenario (plant.params.engine.type) and its label in the tables, the
 # first the reference every other engine's runs are matched to; an engine not listed is shown
 # by its name
-LABELS = {"pybullet": "PyBullet", "mujoco": "MuJoCo"}
+LABELS = {"pybullet": "PyBullet", "mujoco": "MuJoCo", "drake": "Drake"}
 ENGINES = tuple(LABELS.values())
 REFERENCE = next(iter(LABELS))
 _PLANT_ENGINES = {"mujoco_arm": "mujoco", "mujoco_grasp": "mujoco"}  # before the engine field

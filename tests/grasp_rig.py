@@ -8,6 +8,7 @@ import numpy as np
 
 from plants.bullet_arm.grasp_plant import BulletGraspPlant
 from plants.arm_rig.params import GraspParams
+from replay.robot.arm_types import ServoCommand
 
 DT = 1e-3
 Q0 = [0.0, 0.533482, 0.0, 2.134676, 0.0, -1.0973, 0.0]  # scenarios/grasp_hexahedron.yaml
@@ -29,6 +30,15 @@ def rig(**kw) -> BulletGraspPlant:
     )
     base.update(kw)
     return BulletGraspPlant(GraspParams(**base), dt=DT, rng=np.random.default_rng(0))
+
+
+def nudged_truth(plant, steps: int = 5) -> dict:
+    """The rig's truth topics after ``steps`` steps of a small command to arm, hand and head."""
+    cmd = ServoCommand(arm=[0.01] * 7, hand=[0.1] * 14, head=[0.1, 0.0])
+    for _ in range(steps):
+        plant.apply(cmd)
+        plant.step()
+    return plant.truth(steps * DT)
 
 
 def rise_bandwidth(w: np.ndarray, target: float, dt: float) -> float:

@@ -20,13 +20,11 @@ PAPER = Paper(
     plants={
         "bullet_arm": "plants.bullet_arm:BulletArmPlant",
         "mujoco_arm": "plants.mujoco_arm.plant:MujocoArmPlant",
-        "drake_arm": "plants.drake_arm.plant:DrakeArmPlant",
     },
     sensors={"stereo_ball": "replay.sensors.stereo:StereoBallCamera"},
     viewer_scenes={
         "bullet_arm": "plants.arm_rig.viewer_scene:ArmScene",
         "mujoco_arm": "plants.mujoco_arm.viewer_scene:MujocoArmScene",
-        "drake_arm": "plants.drake_arm.viewer_scene:DrakeArmScene",
     },
     figures="analysis.catching.figures:make_figures",
     claims="analysis.catching.claims:evaluate",

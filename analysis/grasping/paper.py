@@ -22,7 +22,6 @@ PAPER = Paper(
     plants={
         "bullet_grasp": "plants.bullet_arm.grasp_plant:BulletGraspPlant",
         "mujoco_grasp": "plants.mujoco_arm.grasp_plant:MujocoGraspPlant",
-        "drake_grasp": "plants.drake_arm.grasp_plant:DrakeGraspPlant",
     },
     sensors={
         "vision_chip": "replay.sensors.vision_chip:VisionChipSensor",
@@ -32,7 +31,6 @@ PAPER = Paper(
     viewer_scenes={
         "bullet_grasp": "plants.arm_rig.grasp_viewer_scene:GraspScene",
         "mujoco_grasp": "plants.mujoco_arm.viewer_scene:MujocoGraspScene",
-        "drake_grasp": "plants.drake_arm.viewer_scene:DrakeGraspScene",
     },
     figures="analysis.grasping.figures:make_figures",
     claims="analysis.grasping.claims:evaluate",

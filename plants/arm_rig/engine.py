@@ -19,6 +19,7 @@ from __future__ import annotations
 import importlib
 from functools import cache
 from importlib.metadata import entry_points
+from collections.abc import Sequence
 from typing import Any, Protocol
 
 from replay.params import ParamError
@@ -68,6 +69,33 @@ def adapter_class(settings: Any, rig: str) -> type:
     return getattr(importlib.import_module(module), name)
 
 
+class ContactRows:
+    """The contact questions (``EngineAdapter.object_contacts``, ``touch``, ``contact_summary``)
+    of an adapter that reads the step's object-robot contacts within the step as rows (body,
+    point, normal from the robot towards the object, normal force) into its ``contacts``, its
+    bodies' names and parts ("arm" where None) in its ``body_names`` and ``part_of_body``."""
+
+    contacts: list
+    body_names: Sequence[str]
+    part_of_body: Sequence[str | None]
+
+    def object_contacts(self, pos, v) -> list:
+        return self.contacts
+
+    def touch(self, contacts: list) -> tuple:
+        c = max(contacts, key=lambda c: c[3])
+        return c[0], c[1], c[2]
+
+    def contact_summary(self) -> tuple[list, list, float]:
+        """(parts, links, total normal force) of the step's contacts, sorted."""
+        if not self.contacts:
+            return [], [], 0.0
+        bodies = {c[0] for c in self.contacts}
+        links = sorted(self.body_names[b] for b in bodies)
+        parts = sorted({self.part_of_body[b] or "arm" for b in bodies})
+        return parts, links, float(sum(c[3] for c in self.contacts))
+
+
 class EngineAdapter(Protocol):
     palm_id: int | None  # the engine's id of the palm link (None: no palm)
 
@@ -113,6 +141,11 @@ class EngineAdapter(Protocol):
     def advance(self) -> bool:
         """Step the engine by ``dt`` and forget the state read; True when the run has diverged
         (the engine says so)."""
+
+    def inverse_dynamics(self, q, qd, qdd) -> tuple:
+        """(tau, M): the engine's inverse dynamics and mass matrix of the active arm joints at
+        (q, qd, qdd), one value per active joint, the hand's joints at rest at their posture now;
+        the simulation's state unchanged (the cross-engine checks against our RNEA)."""
 
     def frames(self) -> list[Frame]:
         """Every URDF link in its parent link, the base in ``world``."""

@@ -30,6 +30,15 @@ from replay.robot.head import camera_pose
 from replay.spatial import matrix_to_quaternion
 
 
+def hand_speeds(hand, n: int) -> list[float]:
+    """A hand velocity command (``ServoCommand.hand``) as ``n`` floats, a non-finite one 0;
+    ValueError for another count."""
+    h = np.asarray(hand, float).reshape(-1)
+    if h.shape != (n,):
+        raise ValueError(f"velocity command needs {n} values, got {h.shape[0]}")
+    return [x if np.isfinite(x) else 0.0 for x in h.tolist()]
+
+
 class GraspEngine(EngineAdapter, Protocol):
     """The grasping rig's engine questions, on top of the arm rig's."""
 

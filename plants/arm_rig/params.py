@@ -224,7 +224,9 @@ class Params:
         doc="the physics engine and its settings, {type: ENGINE, ...}: type pybullet (no "
         "settings here: its contact fields are the ones above) or mujoco (mj_solref, "
         "mj_limit_solref, mj_solimp, mj_cone, mj_condim, mj_iterations, mj_noslip_iterations, "
-        "mj_integrator, hand_servo_gain: docs/mujoco.md); empty: the plant type's own engine "
+        "mj_integrator, hand_servo_gain: docs/mujoco.md) or drake (dk_contact_approximation, "
+        "dk_contact_model, dk_hydroelastic_modulus, dk_point_stiffness, dk_dissipation, "
+        "dk_hand_servo_gain: docs/drake.md); empty: the plant type's own engine "
         "(PyBullet for bullet_arm and bullet_grasp). Engines are registered in the entry point "
         "group paper_replay.engines (plants/arm_rig/engine.py)",
     )

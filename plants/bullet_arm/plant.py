@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 
 from plants.arm_rig.arm_state import joint_state
 from plants.arm_rig.params import Params as ArmParams
@@ -299,6 +300,17 @@ class PybulletEngine:
         return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx)
 
     # ------------------------------------------------------------------ log and scene
+    def inverse_dynamics(self, q, qd, qdd) -> tuple:
+        bc, dofs = self.bc, self.dofs
+        pos = [s[0] for s in bc.getJointStates(self.robot, dofs)]
+        vel, acc = [0.0] * len(dofs), [0.0] * len(dofs)
+        cols = [dofs.index(j) for j in self.arm_j]
+        for c, x, v, a in zip(cols, q, qd, qdd):
+            pos[c], vel[c], acc[c] = float(x), float(v), float(a)
+        tau = np.array(bc.calculateInverseDynamics(self.robot, pos, vel, acc))
+        M = np.array(bc.calculateMassMatrix(self.robot, pos))
+        return tau[cols], M[np.ix_(cols, cols)]
+
     def frames(self) -> list[Frame]:
         """Every URDF link in its parent link (the base in ``world``): PyBullet's link frames
         (not its centre-of-mass frames), made relative to the parent's. The transform helpers

@@ -1,21 +1,25 @@
-"""The drake_arm plant's scenario parameters: the arm rig's (the same robot, hand, object, limits
-and catch criterion, so a scenario changes only ``plant.type``) and Drake's contact and solver
-settings. The PyBullet-only fields (``solver_iterations``, ``*_restitution``,
-``contact_stiffness``/``contact_damping``, rolling/spinning friction) are accepted and not used:
-Drake's point contact has no restitution coefficient; the bounce is set by its Hunt-Crossley
-dissipation (docs/drake.md)."""
+"""Drake's contact and solver settings: ``DrakeSettings``, the engine field's
+(``plant.params.engine: {type: drake, ...}``, plants/arm_rig/engine.py). The rig's own params
+(robot, hand, object, limits, catch criterion, friction) are the arm rig's; PyBullet's contact
+fields among them (``solver_iterations``, ``*_restitution``, ``contact_stiffness``/
+``contact_damping``, rolling/spinning friction) are not used: Drake's point contact has no
+restitution coefficient; the bounce is set by its Hunt-Crossley dissipation (docs/drake.md)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
-from plants.arm_rig.params import GraspParams as RigGraspParams
-from plants.arm_rig.params import Params as ArmParams
 from replay.params import param
 
 
 @dataclass
-class Params(ArmParams):
+class DrakeSettings:
+    """``plant.params.engine`` of type drake: its settings and adapters."""
+
+    type: str = param(
+        "drake", choices=("drake",), doc="the engine: Drake (pydrake's MultibodyPlant)"
+    )
     dk_contact_approximation: str = param(
         "lagged",
         choices=("sap", "similar", "lagged"),
@@ -70,9 +74,5 @@ class Params(ArmParams):
         "(a capped constraint); the MuJoCo plant's gain",
     )
 
-
-@dataclass
-class GraspParams(RigGraspParams, Params):
-    """The grasping rig's parameters (plants/arm_rig/params.py ``GraspParams``: servos, head,
-    human, verdict) with Drake's contact settings (``Params`` above), so a grasp scenario changes
-    only ``plant.type``."""
+    arm: ClassVar[str] = "plants.drake_arm.plant:DrakeEngine"
+    grasp: ClassVar[str] = "plants.drake_arm.grasp_plant:DrakeGraspEngine"

@@ -1,20 +1,19 @@
-"""A torque-controlled arm with a position-controlled hand and one free object, in Drake.
+"""The arm rig's engine in Drake: pydrake's MultibodyPlant from the rig's URDF, 1 kHz steps.
 
-The engine-free arm rig (plants/arm_rig/rig.py ``ArmRig``) in pydrake's MultibodyPlant, as the
-PyBullet and MuJoCo plants are in theirs: the same ``Params`` (plus Drake's contact settings),
-commands, limits, truth topics, events and ``outcome`` are the rig's, so a scenario differs from
-its PyBullet twin only in ``plant.type``. This plant builds the world (world.py) and answers the
-rig's engine questions. Physics only: it knows nothing of any paper's method.
+``DrakeEngine`` is the engine-free arm rig's (plants/arm_rig/rig.py ``ArmRig``) adapter
+(plants/arm_rig/engine.py ``EngineAdapter``), as ``PybulletEngine`` and ``MujocoEngine`` are in
+theirs: the rig's commands, limits, truth topics, events and ``outcome`` are the rig's, so a
+scenario differs from its PyBullet twin only in ``plant.params.engine``. The adapter builds the
+world (world.py) and answers the rig's engine questions; it holds only Drake calls and Drake
+state. Physics only: it knows nothing of any paper's method.
 
 Stepping: the plant's context is advanced directly, one discrete update a step
 (``EvalUniquePeriodicDiscreteUpdate``, then the new state set), no Simulator: the contact
 results, the hand servos' torques and the joints' reaction forces read between the two are the
 step's own (computed once, with the update), the kinematics read after it the new state's.
 
-The rig's state this plant reads (for the lead's adapter conversion): ``settings``, ``model``,
-``dt``, ``dof``, ``active``, ``locked``, ``joint_names``, ``diverged``; it sets ``_cache`` (the
-rig's state cache, ``None`` after a step), ``_palm_id`` and ``_contacts`` (the step's contact
-rows, which it also returns from ``_object_contacts``).
+The rig's public attributes it reads: ``params`` (its ``engine_settings``: ``DrakeSettings``),
+``settings``, ``model``, ``dt``, ``dof``, ``active``, ``locked``, ``joint_names``.
 """
 
 from __future__ import annotations
@@ -22,12 +21,12 @@ from __future__ import annotations
 import importlib.metadata
 from typing import Any
 
-
 import numpy as np
 from pydrake.multibody.math import SpatialVelocity
+from pydrake.multibody.tree import MultibodyForces
 
+from plants.arm_rig.engine import ContactRows
 from plants.arm_rig.rig import ArmRig
-from plants.drake_arm.params import Params as DrakeParams
 from plants.drake_arm.world import build_world, set_object, vec
 from replay.scene import Frame
 
@@ -41,19 +40,21 @@ def _pose(X) -> tuple:
     return (x, y, z), (float(q.x()), float(q.y()), float(q.z()), float(q.w()))
 
 
-class DrakeArmPlant(ArmRig):
-    Params = DrakeParams
-    description = "Drake WAM arm (torque control) + hand (velocity servos) + a free object"
+class DrakeEngine(ContactRows):
+    """The rig's engine in Drake (plants/arm_rig/engine.py ``EngineAdapter``), built from the
+    rig's public attributes (``rig``: its params, settings, model, dt and joints)."""
 
-    def __init__(self, params: DrakeParams, *, dt: float, rng: np.random.Generator) -> None:
-        super().__init__(params, dt=dt, rng=rng)  # the engine-free rig
-        P, S = params, self.settings
-        W = self.world = build_world(P, S, self.model, dt)
+    def __init__(self, rig: ArmRig) -> None:
+        P, S, dt = rig.params, rig.settings, rig.dt
+        self.dof, self.dt = rig.dof, dt
+        self._cache: tuple | None = None  # the state read this step (state)
+        W = self.world = build_world(P, S, rig.model, dt, P.engine_settings)
+        self.body_names, self.part_of_body = W.body_names, W.part_of_body  # ContactRows
         p, ctx = self.mbp, self.ctx = W.plant, W.context
         # ---- the initial state
         q = p.GetPositions(ctx)
         v = p.GetVelocities(ctx)
-        for k, i in enumerate(self.active):
+        for k, i in enumerate(rig.active):
             q[W.arm_q[k]], v[W.arm_v[k]] = S.initial_q[i], S.initial_qd[i]
         for a, x in zip(W.hand_q, S.hand_initial):
             q[a] = x
@@ -62,11 +63,11 @@ class DrakeArmPlant(ArmRig):
         if W.object_body is not None:
             set_object(W, P.object_position, P.object_rpy, P.object_velocity,
                        P.object_angular_velocity)  # fmt: skip
-        self._q_locked = [float(self.locked.get(n, 0.0)) for n in self.joint_names]
-        self._arm_slots = [(i, W.arm_q[k], W.arm_v[k]) for k, i in enumerate(self.active)]
+        self._q_locked = [float(rig.locked.get(n, 0.0)) for n in rig.joint_names]
+        self._arm_slots = [(i, W.arm_q[k], W.arm_v[k]) for k, i in enumerate(rig.active)]
         names = W.body_names
         self._tool = W.bodies[names.index("wam_tool")]
-        self._palm_id = names.index("palm") if "palm" in names else None
+        self.palm_id = names.index("palm") if "palm" in names else None
         self._nv = p.num_velocities()
         self._tau = [0.0] * self._nv  # the generalized forces of the coming step
         self._tau_port = p.get_applied_generalized_force_input_port()
@@ -85,10 +86,10 @@ class DrakeArmPlant(ArmRig):
                 (joint.parent_body(), joint.child_body(), joint.parent_body().name(),
                  joint.child_body().name())
             )  # fmt: skip
-        self._contacts = []
+        self.contacts: list = []  # the step's rows (body, point, normal, force): _read_contacts
 
     # ------------------------------------------------------------------ state
-    def _state(self) -> tuple:
+    def state(self) -> tuple:
         """((q, qd), hand (q, qd, effort), object (pos, orn xyzw, v, w world) or None) as
         plain floats, read once after each step; shared, never mutated."""
         if self._cache is None:
@@ -124,35 +125,35 @@ class DrakeArmPlant(ArmRig):
             self._motions[k] = got
         return got
 
-    def _effector_now(self) -> tuple:
+    def effector_now(self) -> tuple:
         return self._body_motion(-1)
 
-    def _point_velocity(self, link: int, point) -> tuple[float, float, float]:
+    def point_velocity(self, link: int, point) -> tuple[float, float, float]:
         """v + w x (point - body origin) of a robot body now (world)."""
         (cx, cy, cz), _, (vx, vy, vz), (wx, wy, wz) = self._body_motion(link)
         rx, ry, rz = (float(point[0]) - cx, float(point[1]) - cy, float(point[2]) - cz)
         return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx)
 
-    def _set_object_velocity(self, v: list, w) -> None:
+    def set_object_velocity(self, v: list, w) -> None:
         V = SpatialVelocity(vec(w), vec(v))
         self.mbp.SetFreeBodySpatialVelocity(self.ctx, self.world.object_body, V)
 
-    def _engine_notes(self) -> dict:
+    def notes(self) -> dict:
         return {"engine": f"drake {VERSION}"}
 
     # ------------------------------------------------------------------ command
-    def _apply_torques(self, tau: list) -> None:
+    def apply_torques(self, tau: list) -> None:
         for (_, _, b), x in zip(self._arm_slots, tau):
             self._tau[b] = x
 
-    def _drive_hand(self, v: list, qd: list) -> None:
+    def drive_hand(self, v: list, qd: list) -> None:
         # desired positions: unused (Kp = 0); desired velocities: the servos' speeds
-        self._desired_port.FixValue(self.ctx, np.array(self._state()[1][0] + list(v)))
+        self._desired_port.FixValue(self.ctx, np.array(self.state()[1][0] + list(v)))
 
-    def _hold_object(self, obj: tuple) -> None:
+    def hold_object(self, obj: tuple) -> None:
         pass  # object_gravity off: the object's model instance has no gravity (world.py)
 
-    def _advance(self) -> bool:
+    def advance(self) -> bool:
         p, ctx = self.mbp, self.ctx
         self._tau_port.FixValue(ctx, np.array(self._tau))
         try:
@@ -161,10 +162,12 @@ class DrakeArmPlant(ArmRig):
             ctx.SetDiscreteState(x)
         except RuntimeError:  # SAP found no solution (a non-finite state): diverged
             return True
+        finally:
+            self._cache = None
+            self._motions.clear()
         root = self.world.root
         root.SetTime(root.get_time() + self.dt)
-        self._motions.clear()
-        return self.diverged
+        return False
 
     def _read_step(self) -> None:
         """The step's own contact rows and hand servo torques (before its state is set)."""
@@ -184,7 +187,7 @@ class DrakeArmPlant(ArmRig):
             self._point_rows(res, out)
             if res.num_hydroelastic_contacts():
                 self._patch_rows(res, out)
-        self._contacts = out
+        self.contacts = out
 
     def _point_rows(self, res: Any, out: list) -> None:
         """Point contacts: Drake's normal from B into A, its force on B."""
@@ -221,22 +224,20 @@ class DrakeArmPlant(ArmRig):
             n = (f_obj / size).tolist() if size > 0.0 else [0.0, 0.0, 0.0]
             out.append((index[robot], s.centroid().tolist(), n, size))
 
-    def _object_contacts(self, pos, v) -> list:
-        return self._contacts  # read within the step (_read_contacts)
-
-    def _touch(self, contacts: list) -> tuple:
-        c = max(contacts, key=lambda c: c[3])
-        return c[0], c[1], c[2]
-
-    def _contact_summary_now(self) -> tuple[list, list, float]:
-        """(parts, links, total normal force) of the step's contacts."""
-        if not self._contacts:
-            return [], [], 0.0
-        W = self.world
-        bodies = {c[0] for c in self._contacts}
-        links = sorted(W.body_names[b] for b in bodies)
-        parts = sorted({W.part_of_body[b] for b in bodies})
-        return parts, links, float(sum(c[3] for c in self._contacts))
+    def inverse_dynamics(self, q, qd, qdd) -> tuple:
+        p, W = self.mbp, self.world
+        ctx = p.CreateDefaultContext()  # a scratch context: the simulation's untouched
+        x = p.GetPositions(self.ctx)
+        v: Any = np.zeros(self._nv)
+        vdot: Any = np.zeros(self._nv)
+        x[list(W.arm_q)], v[list(W.arm_v)], vdot[list(W.arm_v)] = q, qd, qdd
+        p.SetPositions(ctx, x)
+        p.SetVelocities(ctx, v)
+        gravity = MultibodyForces(p)
+        p.CalcForceElementsContribution(ctx, gravity)  # Drake's gravity is a force element
+        tau: Any = p.CalcInverseDynamics(ctx, vdot, gravity)
+        M: Any = p.CalcMassMatrix(ctx)
+        return tau[list(W.arm_v)], M[np.ix_(W.arm_v, W.arm_v)]
 
     # ------------------------------------------------------------------ log and scene
     def frames(self) -> list[Frame]:
@@ -249,3 +250,6 @@ class DrakeArmPlant(ArmRig):
             pos, orn = _pose(X)
             out.append(Frame(pn, cn, pos, orn))
         return out
+
+    def close(self) -> None:
+        """Nothing to free: Drake's diagram and context go with the adapter."""

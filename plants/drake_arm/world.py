@@ -1,5 +1,6 @@
-"""The Drake world of the arm plant, built from the generated URDF (``plants.models``: the one
-source of the robot) and the plant's ``Params``: no second robot description.
+"""The Drake world of the arm rig, built from the generated URDF (``plants.models``: the one
+source of the robot), the rig's ``Params`` and Drake's settings (``DrakeSettings``): no second
+robot description.
 
 Drake facts used (drake 1.51, checked by tests/plants/drake_arm):
 - the URDF is parsed as it is: every link a body of the same name (the massless ``wam_base`` and
@@ -51,7 +52,8 @@ from pydrake.multibody.tree import PdControllerGains, SpatialInertia
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from plants.arm_rig.settings import ArmSettings
-from plants.drake_arm.params import Params
+from plants.arm_rig.params import Params
+from plants.drake_arm.params import DrakeSettings
 from plants.models.arm import ArmModel
 
 OBJECT = "object"
@@ -86,24 +88,24 @@ def vec(values) -> Any:
     return np.asarray(values, dtype=float)
 
 
-def _material(P: Params) -> ProximityProperties:
+def _material(P: Params, E: DrakeSettings) -> ProximityProperties:
     """Proximity properties whose pair with another of the same gives (k, d, mu): Drake
     combines stiffness in series, so each geometry gets 2 k; with hydroelastic contact each is
     also compliant (modulus E, tessellated to 1 cm)."""
-    k, d = float(P.dk_point_stiffness), float(P.dk_dissipation)
+    k, d = float(E.dk_point_stiffness), float(E.dk_dissipation)
     mu = float(P.hand_lateral_friction) * float(P.object_lateral_friction)  # PyBullet's product
     props = ProximityProperties()
     AddContactMaterial(d, 2.0 * k, CoulombFriction(mu, mu), props)
-    if P.dk_contact_model == "hydroelastic":
-        AddCompliantHydroelasticProperties(0.01, float(P.dk_hydroelastic_modulus), props)
+    if E.dk_contact_model == "hydroelastic":
+        AddCompliantHydroelasticProperties(0.01, float(E.dk_hydroelastic_modulus), props)
     return props
 
 
-def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
+def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float, E: DrakeSettings) -> World:
     config = MultibodyPlantConfig(
         time_step=dt,
-        contact_model="point" if P.dk_contact_model == "point" else "hydroelastic_with_fallback",
-        discrete_contact_approximation=P.dk_contact_approximation,
+        contact_model="point" if E.dk_contact_model == "point" else "hydroelastic_with_fallback",
+        discrete_contact_approximation=E.dk_contact_approximation,
         use_sampled_output_ports=False,
     )
     builder = DiagramBuilder()
@@ -117,8 +119,8 @@ def build_world(P: Params, S: ArmSettings, arm: ArmModel, dt: float) -> World:
         a = plant.AddJointActuator(
             f"{name}_servo", plant.GetJointByName(name, robot), float(P.hand_max_torque)
         )
-        a.set_controller_gains(PdControllerGains(p=0.0, d=float(P.dk_hand_servo_gain)))
-    props = _material(P)
+        a.set_controller_gains(PdControllerGains(p=0.0, d=float(E.dk_hand_servo_gain)))
+    props = _material(P, E)
     body_ids = plant.GetBodyIndices(robot)
     robot_geoms = [
         g for b in body_ids for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))

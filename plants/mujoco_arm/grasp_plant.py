@@ -21,6 +21,7 @@ import mujoco
 import numpy as np
 
 from plants.arm_rig.grasp_topics import GraspRigTopics
+from plants.arm_rig.grasp_rig import hand_speeds
 from plants.arm_rig.grasp_verdict import GraspVerdict
 from plants.arm_rig.human_path import HumanPath
 from plants.mujoco_arm.human import drive_human
@@ -87,12 +88,7 @@ class MujocoGraspEngine(MujocoEngine):
 
     # ------------------------------------------------------------------ command
     def hand_velocity(self, hand) -> None:
-        h = np.asarray(hand, float).reshape(-1)
-        if h.shape != (len(self._hand_act),):
-            raise ValueError(
-                f"velocity command needs {len(self._hand_act)} values, got {h.shape[0]}"
-            )
-        self._hand_v_cmd = [x if np.isfinite(x) else 0.0 for x in h.tolist()]
+        self._hand_v_cmd = hand_speeds(hand, len(self._hand_act))
 
     def drive_hand_servos(self, qd: list) -> None:
         self._hand_caps(self._hand_v_cmd, qd)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from plants.arm_rig.engine import ContactRows
 from plants.arm_rig.rig import ArmRig
 from plants.mujoco_arm.params import Params as MujocoParams
 from plants.mujoco_arm.world import NEAR, build_world, free_velocity
@@ -36,7 +37,7 @@ def _index(ix: list) -> slice | list:
     return ix
 
 
-class MujocoEngine:
+class MujocoEngine(ContactRows):
     """The rig's engine in MuJoCo (plants/arm_rig/engine.py ``EngineAdapter``), built from the
     rig's public attributes (``rig``: its params, settings, model, dt and joints)."""
 
@@ -48,6 +49,7 @@ class MujocoEngine:
         # MuJoCo's settings: the engine field's, else the mujoco_arm params' own (flat)
         E = P.engine_settings if P.engine_settings is not None else P
         W = self.world = build_world(P, S, rig.model, dt, E)
+        self.body_names, self.part_of_body = W.body_names, W.part_of_body  # ContactRows
         m, d = self.mj, self.md = W.model, W.data
         self._arm_qpos, self._arm_dof = list(W.arm_qpos), list(W.arm_dof)
         self._hand_qpos, self._hand_dof = list(W.hand_qpos), list(W.hand_dof)
@@ -297,22 +299,17 @@ class MujocoEngine:
                     out.append((b2, pos[i], [-nx, -ny, -nz], float(f6[0])))
         self.contacts = out
 
-    def object_contacts(self, pos, v) -> list:
-        return self.contacts  # read within the step (_read_contacts)
-
-    def touch(self, contacts: list) -> tuple:
-        c = max(contacts, key=lambda c: c[3])
-        return c[0], c[1], c[2]
-
-    def contact_summary(self) -> tuple[list, list, float]:
-        """(parts, links, total normal force) of the step's contacts."""
-        if not self.contacts:
-            return [], [], 0.0
-        W = self.world
-        bodies = {c[0] for c in self.contacts}
-        links = sorted(W.body_names[b] for b in bodies)
-        parts = sorted({W.part_of_body[b] or "arm" for b in bodies})
-        return parts, links, float(sum(c[3] for c in self.contacts))
+    def inverse_dynamics(self, q, qd, qdd) -> tuple:
+        m, W = self.mj, self.world
+        d = mujoco.MjData(m)  # a scratch copy: the simulation's data untouched
+        d.qpos[:] = self.md.qpos
+        d.qpos[list(W.arm_qpos)] = q
+        d.qvel[list(W.arm_dof)] = qd
+        d.qacc[list(W.arm_dof)] = qdd
+        mujoco.mj_inverse(m, d)
+        M = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, M)
+        return d.qfrc_inverse[list(W.arm_dof)].copy(), M[np.ix_(W.arm_dof, W.arm_dof)]
 
     # ------------------------------------------------------------------ log and scene
     def frames(self) -> list[Frame]:

@@ -17,8 +17,8 @@ MuJoCo facts used (MuJoCo 4.0, checked by tests/plants/mujoco_arm):
   object's: the object may touch it within the step;
 - the wrist F/T sensor: MuJoCo's ``force``/``torque`` sensors on a site at the palm's origin give
   the flange's wrench on the palm about that point in the palm frame (``wrist_wrench`` negates it
-  to the PyBullet rig's convention; tests/plants/mujoco_arm/test_wrist_mujoco.py: the same static
-  loads as PyBullet's).
+  to the PyBullet rig's convention; tests/plants/mujoco_arm/test_wrist_mujoco.py and
+  test_cross_engine.py: the same static loads as PyBullet's).
 """
 
 from __future__ import annotations

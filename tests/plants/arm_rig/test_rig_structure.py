@@ -70,3 +70,10 @@ def test_engine_plants_only_name_their_adapter():
         want = arm | (grasp if cls in (BulletGraspPlant, MujocoGraspPlant) else set())
         missing = [n for n in want if not callable(getattr(cls.Engine, n, None))]
         assert not missing, (cls.Engine.__name__, missing)
+    from plants.arm_rig.engine import adapter_class, engines
+
+    for name, entry in engines().items():  # every registered engine's adapters
+        for role, want in (("arm", arm), ("grasp", arm | grasp)):
+            adapter = adapter_class(entry.load(), role)
+            missing = [n for n in want if not callable(getattr(adapter, n, None))]
+            assert not missing, (name, role, missing)

@@ -72,7 +72,7 @@ def run_throws(name: str, throws: list, out: Path, sets: dict | None = None) -> 
             f"plant.params.object_velocity={fmt(th['velocity'])}",
             "timing.duration=0.45",
             "stop.after=0.0",
-        ] + [f"plant.params.{k}={v}" for k, v in (sets or {}).items()]
+        ] + [f"plant.params.engine.{k}={v}" for k, v in (sets or {}).items()]
         r = Runner(load_scenario(ROOT / "scenarios" / f"{name}.yaml", args)).run(out / f"{i}.mcap")
         assert "warning" not in r.events, "stale alpha file"
         res.append((r.outcome, held_in_hand(LogReader(r.path))))

@@ -104,6 +104,12 @@ def test_the_engine_is_the_resolved_scenarios():
                 "plant": {"type": "bullet_arm", "params": {"engine": {"type": "drake"}}},
             }
         ),
+        "catch_optimised_newton": Log(
+            {
+                "name": "catch_optimised_newton",
+                "plant": {"type": "bullet_arm", "params": {"engine": {"type": "newton"}}},
+            }
+        ),
         "catch_initial_mujoco": Log(
             {
                 "name": "catch_initial_mujoco",
@@ -115,7 +121,8 @@ def test_the_engine_is_the_resolved_scenarios():
     assert {e: sorted(g) for e, g in groups.items()} == {
         "PyBullet": ["catch_optimised"],
         "MuJoCo": ["catch_initial", "catch_optimised"],
-        "drake": ["catch_initial"],
+        "Drake": ["catch_initial"],
+        "newton": ["catch_optimised"],  # an engine LABELS does not list: its name
     }
 
 
