@@ -74,31 +74,7 @@ class PybulletEngine:
             useFixedBase=True,
             flags=p.URDF_USE_INERTIA_FROM_FILE,
         )
-        self.jidx = {}
-        self._link_name = {-1: "wam_base"}
-        for j in range(bc.getNumJoints(self.robot)):
-            info = bc.getJointInfo(self.robot, j)
-            self.jidx[info[1].decode()] = j
-            self._link_name[j] = info[12].decode()
-        self._link_index = {v: k for k, v in self._link_name.items()}
-        # each link's parent link (-1: the base), for the link frames of 3-D viewers (frames())
-        self._parent_link = [
-            int(bc.getJointInfo(self.robot, j)[16]) for j in range(bc.getNumJoints(self.robot))
-        ]
-        qx, qy, qz, qw = orn
-        bx, by, bz = P.base_position
-        self._base_pose = ((float(bx), float(by), float(bz)), (qx, qy, qz, qw))
-        self._all_links = list(range(len(self._parent_link)))
-        self.arm_j = [self.jidx[names[i]] for i in self.active]
-        self.hand_j = [self.jidx[n] for n in self.hand_names]
-        self.tool_link = self._link_index["wam_tool"]
-        self.palm_link = self.palm_id = self._link_index.get("palm")
-        # pybullet dof order (movable joints in index order) -> for calculate* helpers
-        self.dofs = [
-            j
-            for j in range(bc.getNumJoints(self.robot))
-            if bc.getJointInfo(self.robot, j)[2] == p.JOINT_REVOLUTE
-        ]
+        self._index_links(bc, P, names)
         for j in range(-1, bc.getNumJoints(self.robot)):
             bc.changeDynamics(
                 self.robot,
@@ -124,49 +100,12 @@ class PybulletEngine:
         self.pick = tuple(slot.get(i, -1) for i in range(dof))
         # the tool frame and the palm: one getLinkStates a step (frames_now)
         self._frame_links = [self.tool_link] + ([] if self.palm_link is None else [self.palm_link])
-        # BulletClient makes a new functools.partial on every attribute access: bind the calls
-        # made every step once; those called through the client (stepSimulation: the bench
-        # times it there) are kept on it as attributes
-        for name in PER_STEP_CALLS:
-            setattr(bc, name, getattr(bc, name))
-        self.get_joint_states = bc.getJointStates
-        self.get_base_pose = bc.getBasePositionAndOrientation
-        self.get_base_velocity = bc.getBaseVelocity
-        self._get_link_state = bc.getLinkState
-        self._get_link_states = bc.getLinkStates
-        self._get_contact_points = bc.getContactPoints
-        self.set_motors = bc.setJointMotorControlArray
+        self._bind_calls(bc)
         self._hand_forces = [float(P.hand_max_torque)] * len(self.hand_j)
         self._hand_v: list | None = None  # the hand motors' last targets (None: none set yet)
 
         # ---- the free object
-        self.obj = None
-        if P.object != "none":
-            if P.object == "ball":
-                shape = bc.createCollisionShape(p.GEOM_SPHERE, radius=P.object_radius)
-            else:
-                shape = bc.createCollisionShape(
-                    p.GEOM_BOX, halfExtents=[s / 2 for s in P.object_size]
-                )
-            oorn = matrix_to_quaternion(rpy_to_matrix(P.object_rpy))
-            self.obj = bc.createMultiBody(
-                baseMass=P.object_mass,
-                baseCollisionShapeIndex=shape,
-                basePosition=list(P.object_position),
-                baseOrientation=list(oorn),
-            )
-            kw = dict(
-                linearDamping=0.0,
-                angularDamping=0.0,
-                lateralFriction=P.object_lateral_friction,
-                rollingFriction=P.object_rolling_friction,
-                spinningFriction=P.object_spinning_friction,
-                restitution=P.object_restitution,
-            )
-            if P.contact_stiffness > 0.0:
-                kw.update(contactStiffness=P.contact_stiffness, contactDamping=P.contact_damping)
-            bc.changeDynamics(self.obj, -1, **kw)
-            bc.resetBaseVelocity(self.obj, list(P.object_velocity), list(P.object_angular_velocity))
+        self.obj = self._make_object(bc, P)
 
         # ---- bookkeeping
         # (the contacts list it is of, parts, links, N)
@@ -181,6 +120,80 @@ class PybulletEngine:
         )
         # (step, the tool link's state): read at most once a step
         self._effector: tuple[int, tuple] | None = None
+
+    def _index_links(self, bc, P, names) -> None:
+        """The robot's joints and links by name and index, its base pose, the arm's and the
+        hand's joints, the tool and palm links and PyBullet's dof order."""
+        orn = matrix_to_quaternion(rpy_to_matrix(P.base_rpy))
+        self.jidx = {}
+        self._link_name = {-1: "wam_base"}
+        for j in range(bc.getNumJoints(self.robot)):
+            info = bc.getJointInfo(self.robot, j)
+            self.jidx[info[1].decode()] = j
+            self._link_name[j] = info[12].decode()
+        self._link_index = {v: k for k, v in self._link_name.items()}
+        # each link's parent link (-1: the base), for the link frames of 3-D viewers (frames())
+        self._parent_link = [
+            int(bc.getJointInfo(self.robot, j)[16]) for j in range(bc.getNumJoints(self.robot))
+        ]
+        qx, qy, qz, qw = orn
+        bx, by, bz = P.base_position
+        self._base_pose = ((float(bx), float(by), float(bz)), (qx, qy, qz, qw))
+        self._all_links = list(range(len(self._parent_link)))
+        self.arm_j = [self.jidx[names[i]] for i in self.active]
+        self.hand_j = [self.jidx[n] for n in self.hand_names]
+        self.tool_link = self._link_index["wam_tool"]
+        self.palm_link = self.palm_id = self._link_index.get("palm")
+        # pybullet dof order (movable joints in index order) -> for calculate* helpers
+        self.dofs = [
+            j
+            for j in range(bc.getNumJoints(self.robot))
+            if bc.getJointInfo(self.robot, j)[2] == p.JOINT_REVOLUTE
+        ]
+
+    def _bind_calls(self, bc) -> None:
+        """BulletClient makes a new functools.partial on every attribute access: the calls made
+        every step bound once; those called through the client (stepSimulation: the bench
+        times it there) are kept on it as attributes."""
+        for name in PER_STEP_CALLS:
+            setattr(bc, name, getattr(bc, name))
+        self.get_joint_states = bc.getJointStates
+        self.get_base_pose = bc.getBasePositionAndOrientation
+        self.get_base_velocity = bc.getBaseVelocity
+        self._get_link_state = bc.getLinkState
+        self._get_link_states = bc.getLinkStates
+        self._get_contact_points = bc.getContactPoints
+        self.set_motors = bc.setJointMotorControlArray
+
+    def _make_object(self, bc, P):
+        """The free object (a ball or a box) with its contact settings and initial velocity;
+        None when the scenario has none."""
+        if P.object == "none":
+            return None
+        if P.object == "ball":
+            shape = bc.createCollisionShape(p.GEOM_SPHERE, radius=P.object_radius)
+        else:
+            shape = bc.createCollisionShape(p.GEOM_BOX, halfExtents=[s / 2 for s in P.object_size])
+        oorn = matrix_to_quaternion(rpy_to_matrix(P.object_rpy))
+        obj = bc.createMultiBody(
+            baseMass=P.object_mass,
+            baseCollisionShapeIndex=shape,
+            basePosition=list(P.object_position),
+            baseOrientation=list(oorn),
+        )
+        kw = dict(
+            linearDamping=0.0,
+            angularDamping=0.0,
+            lateralFriction=P.object_lateral_friction,
+            rollingFriction=P.object_rolling_friction,
+            spinningFriction=P.object_spinning_friction,
+            restitution=P.object_restitution,
+        )
+        if P.contact_stiffness > 0.0:
+            kw.update(contactStiffness=P.contact_stiffness, contactDamping=P.contact_damping)
+        bc.changeDynamics(obj, -1, **kw)
+        bc.resetBaseVelocity(obj, list(P.object_velocity), list(P.object_angular_velocity))
+        return obj
 
     # ------------------------------------------------------------------ state
     def state(self) -> tuple:
