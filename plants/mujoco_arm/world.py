@@ -106,45 +106,60 @@ def build_world(
         a.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
         a.forcerange = [-float(P.hand_max_torque), float(P.hand_max_torque)]
     if arm.palm_link is not None:
-        # the wrist's 6-axis F/T sensor on the flange-palm joint (fixed, identity: the palm
-        # frame is the tool frame): a site at the palm body's origin, MuJoCo's force and torque
-        # sensors there (the palm's interaction with its parent, wam_tool; wrist_wrench)
-        site = spec.body(arm.palm_link).add_site(name=WRIST_SITE)
-        spec.add_sensor(
-            name="wrist_force", type=mujoco.mjtSensor.mjSENS_FORCE,
-            objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name,
-        )  # fmt: skip
-        spec.add_sensor(
-            name="wrist_torque", type=mujoco.mjtSensor.mjSENS_TORQUE,
-            objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name,
-        )  # fmt: skip
+        _add_wrist_sensor(spec, arm.palm_link)
     if P.object != "none":
-        body = spec.worldbody.add_body(
-            name=OBJECT_BODY,
-            pos=[float(x) for x in P.object_position],
-            quat=wxyz(matrix_to_quaternion(rpy_to_matrix(P.object_rpy))),
-        )
-        body.add_freejoint(name="object_free")
-        if P.object == "ball":
-            kind, size = mujoco.mjtGeom.mjGEOM_SPHERE, [float(P.object_radius), 0.0, 0.0]
-        else:
-            kind, size = mujoco.mjtGeom.mjGEOM_BOX, [float(s) / 2 for s in P.object_size]
-        body.add_geom(
-            name="object",
-            type=kind,
-            size=size,
-            mass=float(P.object_mass),
-            friction=[mu, 0.0, 0.0],
-            contype=OBJECT_BITS,
-            conaffinity=ROBOT_BITS,
-            condim=int(E.mj_condim),
-            solref=solref,
-            solimp=solimp,
-        )
-        if not P.object_gravity:
-            body.gravcomp = 1.0
+        _add_object(spec, P, E, mu, solref, solimp)
     model = spec.compile()
-    data = mujoco.MjData(model)
+    return _index(model, mujoco.MjData(model), S, arm)
+
+
+def _add_wrist_sensor(spec, palm_link: str) -> None:
+    """The wrist's 6-axis F/T sensor on the flange-palm joint (fixed, identity: the palm frame is
+    the tool frame): a site at the palm body's origin, MuJoCo's force and torque sensors there
+    (the palm's interaction with its parent, wam_tool; wrist_wrench)."""
+    site = spec.body(palm_link).add_site(name=WRIST_SITE)
+    spec.add_sensor(
+        name="wrist_force", type=mujoco.mjtSensor.mjSENS_FORCE,
+        objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name,
+    )  # fmt: skip
+    spec.add_sensor(
+        name="wrist_torque", type=mujoco.mjtSensor.mjSENS_TORQUE,
+        objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name,
+    )  # fmt: skip
+
+
+def _add_object(
+    spec, P: ArmParams, E: MujocoSettings | MujocoParams, mu: float, solref: list, solimp: list
+) -> None:
+    """The free object (ball or box) on a free joint, with the robot's contact settings."""
+    body = spec.worldbody.add_body(
+        name=OBJECT_BODY,
+        pos=[float(x) for x in P.object_position],
+        quat=wxyz(matrix_to_quaternion(rpy_to_matrix(P.object_rpy))),
+    )
+    body.add_freejoint(name="object_free")
+    if P.object == "ball":
+        kind, size = mujoco.mjtGeom.mjGEOM_SPHERE, [float(P.object_radius), 0.0, 0.0]
+    else:
+        kind, size = mujoco.mjtGeom.mjGEOM_BOX, [float(s) / 2 for s in P.object_size]
+    body.add_geom(
+        name="object",
+        type=kind,
+        size=size,
+        mass=float(P.object_mass),
+        friction=[mu, 0.0, 0.0],
+        contype=OBJECT_BITS,
+        conaffinity=ROBOT_BITS,
+        condim=int(E.mj_condim),
+        solref=solref,
+        solimp=solimp,
+    )
+    if not P.object_gravity:
+        body.gravcomp = 1.0
+
+
+def _index(model, data, S: ArmSettings, arm: ArmModel) -> World:
+    """The compiled world with the addresses the plant reads every step."""
     jid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)  # noqa: E731
     active = [S.joint_names[i] for i in S.active]
     arm_j = [jid(n) for n in active]
