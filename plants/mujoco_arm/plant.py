@@ -59,18 +59,7 @@ class MujocoEngine(ContactRows):
         self._palm = W.body_names.index("palm") if "palm" in W.body_names else -1
         self.palm_id = self._palm if self._palm >= 0 else None
         self._ob = W.object_body
-        # ---- the initial state
-        q0, qd0 = S.initial_q, S.initial_qd
-        for k, i in enumerate(self.active):
-            d.qpos[W.arm_qpos[k]] = q0[i]
-            d.qvel[W.arm_dof[k]] = qd0[i]
-        for a, v in zip(W.hand_qpos, S.hand_initial):
-            d.qpos[a] = v
-        if self._ob >= 0:
-            a, b = W.object_qpos, W.object_dof
-            mujoco.mj_forward(m, d)  # the object's rotation, for its body-frame spin
-            R = d.xmat[self._ob].reshape(3, 3)
-            d.qvel[b : b + 6] = free_velocity(R, P.object_velocity, P.object_angular_velocity)
+        self._set_initial_state(W, S, P)
         mujoco.mj_forward(m, d)
         self._q_locked = [float(rig.locked.get(n, 0.0)) for n in rig.joint_names]
         # (arm joint index, qpos address, dof address) of each active joint
@@ -85,6 +74,38 @@ class MujocoEngine(ContactRows):
             if W.part_of_body[i] is not None
         ]
         self._f6 = np.zeros(6)
+        self._index_hand(W, P, dt)
+        self._hand_kv = float(E.hand_servo_gain)
+        # MuJoCo resets the state where it diverges (a warning count): those are the "nan"
+        self._bad = [
+            int(w)
+            for w in (
+                mujoco.mjtWarning.mjWARN_BADQACC,
+                mujoco.mjtWarning.mjWARN_BADQVEL,
+                mujoco.mjtWarning.mjWARN_BADQPOS,
+            )
+        ]
+
+    def _set_initial_state(self, W, S, P) -> None:
+        """The arm, the hand and the object at the scenario's initial state (before the
+        final mj_forward)."""
+        m, d = W.model, W.data
+        q0, qd0 = S.initial_q, S.initial_qd
+        for k, i in enumerate(self.active):
+            d.qpos[W.arm_qpos[k]] = q0[i]
+            d.qvel[W.arm_dof[k]] = qd0[i]
+        for a, v in zip(W.hand_qpos, S.hand_initial):
+            d.qpos[a] = v
+        if self._ob >= 0:
+            a, b = W.object_qpos, W.object_dof
+            mujoco.mj_forward(m, d)  # the object's rotation, for its body-frame spin
+            R = d.xmat[self._ob].reshape(3, 3)
+            d.qvel[b : b + 6] = free_velocity(R, P.object_velocity, P.object_angular_velocity)
+
+    def _index_hand(self, W, P, dt: float) -> None:
+        """The hand servos' torque cap and inertia per step, each hand link's body and geoms,
+        and how near the object must be before a hand link can touch it."""
+        m, d = W.model, W.data
         # the hand servos' torque cap (N*m) and, per joint, the torque per rad/s of speed change
         # in one step, I / dt (I: its inertia about its axis; a finger joint's link is a leaf:
         # M_ii is constant), its link's body (contacts)
@@ -114,16 +135,6 @@ class MujocoEngine(ContactRows):
             )
             reach = ext + float(m.geom_rbound[self._obj_geom]) + NEAR
             self._hand_reach2 = reach * reach
-        self._hand_kv = float(E.hand_servo_gain)
-        # MuJoCo resets the state where it diverges (a warning count): those are the "nan"
-        self._bad = [
-            int(w)
-            for w in (
-                mujoco.mjtWarning.mjWARN_BADQACC,
-                mujoco.mjtWarning.mjWARN_BADQVEL,
-                mujoco.mjtWarning.mjWARN_BADQPOS,
-            )
-        ]
 
     # ------------------------------------------------------------------ state
     def state(self) -> tuple:
