@@ -32,7 +32,6 @@ from analysis.claims import ASSESSED, Claim
 # first the reference every other engine's runs are matched to; an engine not listed is shown
 # by its name
 LABELS = {"pybullet": "PyBullet", "mujoco": "MuJoCo", "drake": "Drake"}
-ENGINES = tuple(LABELS.values())
 REFERENCE = next(iter(LABELS))
 _PLANT_ENGINES = {"mujoco_arm": "mujoco", "mujoco_grasp": "mujoco"}  # before the engine field
 GROUP = "paper_replay.engines"  # the engines' entry points (plants/arm_rig/engine.py)
