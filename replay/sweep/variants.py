@@ -111,18 +111,33 @@ def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] | tuple = 
     ]
     for where, value in seeds:  # (a seed axis: each value a scenario's seed)
         check_seed(value, where)
-    keys = [a.name for a in spec.random]
+    keys = {r.name: r.lo for r in spec.random}  # key -> a value it takes (the first)
     for a in spec.grid:
         if a.name in (SCENARIO_AXIS, SEED_AXIS):
             continue
-        keys += list(a.values[0]) if isinstance(a.values[0], dict) else [a.name]
-    for key in keys:
+        first = a.values[0]
+        keys.update(first if isinstance(first, dict) else {a.name: first})
+    for key, value in keys.items():
         node: Any = base
         for depth, part in enumerate(key.split(".")):
             if not isinstance(node, dict) or part not in node:
+                if _settable(scenario, [*sets], key, value):
+                    break  # a field left out while empty (plant.params.engine: {}), set here
                 where = ".".join(key.split(".")[:depth]) or "(top level)"
                 choices = ", ".join(node) if isinstance(node, dict) else "(not a mapping)"
                 raise SweepSpecError(
                     f"{key}: no field {part!r} in {where} of {scenario} (fields: {choices})"
                 )
             node = node[part]
+
+
+def _settable(scenario: str | Path, sets: list[str], key: str, value: Any) -> bool:
+    """Whether the scenario loads with ``key`` set to ``value`` (as the variant will set it)."""
+    import yaml
+
+    text = yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("...").strip()
+    try:
+        load_scenario(scenario, sets=[*sets, f"{key}={text}"])
+    except ScenarioError:
+        return False
+    return True

@@ -262,3 +262,30 @@ def test_rows_of_another_code_version_are_set_aside(toy_yaml, tmp_path):
     assert (s.ran, s.stale) == (2, 2)
     assert {r["key"] for r in read_table(tmp_path / "table.stale.csv")} == keys_v1
     assert not keys_v1 & {r["key"] for r in read_table(tmp_path / "table.csv")}
+
+
+def test_the_physics_engine_is_an_axis_like_any_field(project_root, tmp_path):
+    """plant.params.engine is left out of a resolved scenario while empty (PyBullet's): a grid
+    over its type still plans, and each variant runs in its engine."""
+    engines = "pybullet,mujoco,drake"
+    r = CliRunner().invoke(
+        main,
+        ["sweep", "catch_optimised", "--grid", f"plant.params.engine.type={engines}"]
+        + ["--set", "timing.duration=0.45", "--no-logs", "-q", "-o", str(tmp_path)],
+    )
+    assert r.exit_code == 0, r.output
+    rows = read_table(tmp_path / "table.csv")
+    assert [row["plant.params.engine.type"] for row in rows] == engines.split(",")
+    assert all(row["reason"] == "caught" for row in rows), rows  # (each engine catches)
+    r = CliRunner().invoke(
+        main,
+        [
+            "sweep",
+            "catch_optimised",
+            "--grid",
+            "plant.params.engine.typo=1",
+            "-o",
+            str(tmp_path / "x"),
+        ],
+    )
+    assert r.exit_code == 2 and "no field" in r.output
