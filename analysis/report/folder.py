@@ -23,8 +23,21 @@ class ReportFolderError(ValueError):
     """The folder given to ``replay report -o`` is not one it may replace (one line)."""
 
 
+def _marked(folder: Path) -> bool:
+    """The report's marker in ``folder``: a regular file (not a link to one) of its text."""
+    marker = folder / MARKER
+    try:
+        return (
+            not marker.is_symlink()
+            and marker.is_file()
+            and marker.read_text(encoding="utf-8", errors="replace")[:200] == MARKER_TEXT
+        )
+    except OSError:
+        return False
+
+
 def _ours(folder: Path) -> bool:
-    if (folder / MARKER).is_file():
+    if _marked(folder):
         return True
     try:
         names = {p.name for p in folder.iterdir()}
@@ -98,5 +111,5 @@ def discard(work: Path) -> None:
     """Remove a staging folder of :func:`staging` (its marker inside) after a failed build;
     anything else at that path is left alone."""
     made = work.name.startswith(".") and work.name.endswith(".part")  # (staging's mkdtemp name)
-    if made and not work.is_symlink() and (work / MARKER).is_file():
+    if made and not work.is_symlink() and _marked(work):
         shutil.rmtree(work, ignore_errors=True)

@@ -407,6 +407,22 @@ def test_the_report_removes_only_what_it_made(tmp_path):
     (foreign / "data.csv").write_text("1")
     discard(foreign)  # no marker: left alone
     assert (foreign / "data.csv").is_file() and not (foreign / MARKER).exists()
+    # a marker that is a link to a file, or a file of other text, makes no folder a report
+    elsewhere = tmp_path / "note.txt"
+    elsewhere.write_text("made by `replay report`, which replaces this folder whole\n")
+    for name, make in (
+        (".linked.part", lambda m: m.symlink_to(elsewhere)),
+        (".forged.part", lambda m: m.write_text("anything")),
+    ):
+        fake = tmp_path / name
+        fake.mkdir()
+        (fake / "thesis.tex").write_text("mine")
+        make(fake / MARKER)
+        discard(fake)
+        assert (fake / "thesis.tex").read_text() == "mine"
+        with pytest.raises(ReportFolderError, match="changed during the build"):
+            swap_in(staging(fake), fake)
+        assert (fake / "thesis.tex").read_text() == "mine"
 
 
 def test_a_stored_name_no_scenario_may_have_does_not_sink_the_paper(stick_3step_log, tmp_path):
