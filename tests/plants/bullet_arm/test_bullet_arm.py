@@ -12,6 +12,7 @@ import pybullet as p
 import pytest
 from pybullet_utils import bullet_client
 
+from arm_checks import hold_torque
 from plants.bullet_arm import BulletArmPlant, Params
 from plants.models import build_arm
 from replay.interfaces import Plant
@@ -33,15 +34,6 @@ CATCHING = dict(initial_q=START, locked_joints=["J3"])
 
 def make(**kw) -> BulletArmPlant:
     return BulletArmPlant(Params(**kw), dt=DT, rng=np.random.default_rng(0))
-
-
-def hold_torque(plant, q_ref, omega=30.0):
-    """A test-side joint PD + gravity compensation from the nominal model (not the plant's);
-    gains from M's diagonal, so that each joint is a ~critically damped omega rad/s loop."""
-    q, qd = plant.arm_state()
-    model = plant.spec().model
-    m = np.diag(model.mass_matrix(q))
-    return model.gravity_torque(q) + m * omega**2 * (np.asarray(q_ref) - q) - 2.0 * m * omega * qd
 
 
 def palm_face(spec: ArmSpec, q) -> tuple[np.ndarray, np.ndarray]:

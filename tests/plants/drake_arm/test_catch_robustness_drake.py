@@ -8,20 +8,12 @@ must not decide the catch by themselves. Run with ``-s`` to see the rates."""
 
 from __future__ import annotations
 
-import importlib.util
 import os
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-ROOT = Path(__file__).resolve().parents[3]
-_spec = importlib.util.spec_from_file_location(
-    "catch_robustness", ROOT / "tests" / "analysis" / "test_catch_robustness.py"
-)
-assert _spec is not None and _spec.loader is not None
-robust = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(robust)
+from arm_checks import robust
+from arm_checks import run_throws as _run_throws
 
 N_NEIGHBOUR_THROWS = int(os.environ.get("DRAKE_NEIGHBOUR_THROWS", "4"))
 NEIGHBOURS = {
@@ -58,25 +50,13 @@ def held_in_hand(log, hold: float = 0.05) -> bool:
     return bool(drift < 0.005 and np.linalg.norm(a, axis=1).max() < 0.1 and t_end < 0.449)
 
 
-def run_throws(name: str, throws: list, out: Path, sets: dict | None = None) -> list[tuple]:
-    """(the plant's outcome, the truth's verdict) of scenario ``name`` on each throw."""
+def run_throws(name: str, throws: list, out, sets: dict | None = None) -> list[tuple]:
+    """(the plant's outcome, the truth's verdict) of scenario ``name`` on each throw, ``sets``
+    Drake's settings (plant.params.engine.*)."""
     from replay.log import LogReader
-    from replay.runner import Runner
-    from replay.scenario import load_scenario
 
-    fmt = lambda v: "[" + ", ".join(f"{x:.6f}" for x in v) + "]"  # noqa: E731
-    res = []
-    for i, th in enumerate(throws):
-        args = [
-            f"plant.params.object_position={fmt(th['position'])}",
-            f"plant.params.object_velocity={fmt(th['velocity'])}",
-            "timing.duration=0.45",
-            "stop.after=0.0",
-        ] + [f"plant.params.engine.{k}={v}" for k, v in (sets or {}).items()]
-        r = Runner(load_scenario(ROOT / "scenarios" / f"{name}.yaml", args)).run(out / f"{i}.mcap")
-        assert "warning" not in r.events, "stale alpha file"
-        res.append((r.outcome, held_in_hand(LogReader(r.path))))
-    return res
+    engine = {f"engine.{k}": v for k, v in (sets or {}).items()}
+    return [(o, held_in_hand(LogReader(p))) for o, p in _run_throws(name, throws, out, engine)]
 
 
 def rate(res: list[tuple]) -> float:

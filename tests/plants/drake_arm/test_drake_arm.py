@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from grasp_rig import DT
 
+from arm_checks import hold_torque
 from plants.arm_rig.params import Params
 from plants.bullet_arm import BulletArmPlant
 from replay.robot.arm_types import ArmCommand
@@ -27,14 +28,6 @@ def make(**kw) -> BulletArmPlant:
     engine = {k: kw.pop(k) for k in list(kw) if k.startswith("dk_")}
     params = Params(**kw, engine={"type": "drake", **engine})
     return BulletArmPlant(params, dt=DT, rng=np.random.default_rng(0))
-
-
-def hold_torque(plant, q_ref, omega=30.0):
-    """A test-side joint PD + gravity compensation from the nominal model (not the plant's)."""
-    q, qd = plant.arm_state()
-    model = plant.spec().model
-    m = np.diag(model.mass_matrix(q))
-    return model.gravity_torque(q) + m * omega**2 * (np.asarray(q_ref) - q) - 2.0 * m * omega * qd
 
 
 @pytest.mark.parametrize("model", ["point", "hydroelastic"])

@@ -7,19 +7,11 @@ values must not decide the catch by themselves. Run with ``-s`` to see the table
 
 from __future__ import annotations
 
-import importlib.util
 import os
-from pathlib import Path
 
 import pytest
-
-ROOT = Path(__file__).resolve().parents[3]
-_spec = importlib.util.spec_from_file_location(
-    "catch_robustness", ROOT / "tests" / "analysis" / "test_catch_robustness.py"
-)
-assert _spec is not None and _spec.loader is not None
-robust = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(robust)
+from arm_checks import robust
+from arm_checks import run_throws as _run_throws
 
 N_NEIGHBOUR_THROWS = int(os.environ.get("MUJOCO_NEIGHBOUR_THROWS", "4"))
 ENGINES = {"PyBullet": "catch_optimised", "MuJoCo": "catch_optimised_mujoco"}
@@ -43,25 +35,9 @@ NEIGHBOURS = {
 }
 
 
-def run_throws(name: str, throws: list, out: Path, sets: dict | None = None) -> list[dict]:
-    """The outcome of scenario ``name`` on each throw, ``sets`` (plant.params field -> YAML)
-    applied on top of the throw's."""
-    from replay.runner import Runner
-    from replay.scenario import load_scenario
-
-    fmt = lambda v: "[" + ", ".join(f"{x:.6f}" for x in v) + "]"  # noqa: E731
-    res = []
-    for i, th in enumerate(throws):
-        args = [
-            f"plant.params.object_position={fmt(th['position'])}",
-            f"plant.params.object_velocity={fmt(th['velocity'])}",
-            "timing.duration=0.45",
-            "stop.after=0.0",
-        ] + [f"plant.params.{k}={v}" for k, v in (sets or {}).items()]
-        r = Runner(load_scenario(ROOT / "scenarios" / f"{name}.yaml", args)).run(out / f"{i}.mcap")
-        assert "warning" not in r.events, "stale alpha file"
-        res.append(r.outcome)
-    return res
+def run_throws(name: str, throws: list, out, sets: dict | None = None) -> list[dict]:
+    """The outcome of scenario ``name`` on each throw (arm_checks.run_throws)."""
+    return [o for o, _ in _run_throws(name, throws, out, sets)]
 
 
 def rate(outcomes: list[dict]) -> float:

@@ -17,6 +17,7 @@ import pytest
 import yaml
 from grasp_rig import DT, nudged_truth, rig, rise_bandwidth
 
+from arm_checks import hold_torque
 from plants.arm_rig.engine import engines
 from plants.bullet_arm import BulletArmPlant
 from plants.bullet_arm import Params as ArmParams
@@ -41,14 +42,6 @@ def make(engine: str, **kw):
     """The arm rig in ``engine`` (plant.params.engine's type)."""
     params = ArmParams(**kw, engine={"type": engine})
     return BulletArmPlant(params, dt=DT, rng=np.random.default_rng(0))
-
-
-def hold_torque(plant, q_ref, omega=30.0):
-    """A test-side joint PD + gravity compensation from the nominal model (not the plant's)."""
-    q, qd = plant.arm_state()
-    model = plant.spec().model
-    m = np.diag(model.mass_matrix(q))
-    return model.gravity_torque(q) + m * omega**2 * (np.asarray(q_ref) - q) - 2.0 * m * omega * qd
 
 
 def palm_face(spec: ArmSpec, q) -> tuple[np.ndarray, np.ndarray]:
