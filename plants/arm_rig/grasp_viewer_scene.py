@@ -99,12 +99,7 @@ class GraspScene(ArmScene):
         p = self.params
         self.seen.visible = False  # ArmScene's /vision/object marker: not used here
         if p.object_position:  # the constraint plane through it
-            n = np.asarray(p.plane_normal, float)
-            n /= np.linalg.norm(n) or 1.0
-            axis = np.cross([1.0, 0.0, 0.0], n)
-            angle = math.atan2(np.linalg.norm(axis), n[0])
-            axis = axis / (np.linalg.norm(axis) or 1.0)
-            wxyz = (math.cos(angle / 2), *(math.sin(angle / 2) * axis))
+            _, wxyz = _x_to(p.plane_normal)
             self._add(
                 sc.add_box(
                     f"{r}/plane",
@@ -162,12 +157,7 @@ class GraspScene(ArmScene):
         """The human hand that moves the object: a palm on the far side of the object from the
         robot, at the hand's logged target (``/human/state``), facing along the plane normal."""
         p = self.params
-        n = np.asarray(p.plane_normal, float)
-        n /= np.linalg.norm(n) or 1.0
-        axis = np.cross([1.0, 0.0, 0.0], n)
-        angle = math.atan2(np.linalg.norm(axis), n[0])
-        axis = axis / (np.linalg.norm(axis) or 1.0)
-        wxyz = (math.cos(angle / 2), *(math.sin(angle / 2) * axis))
+        n, wxyz = _x_to(p.plane_normal)
         depth = max(p.object_size) if p.object_size else 2.0 * p.object_radius
         behind = 0.5 * float(depth) + 0.5 * HUMAN_HAND[0] + 0.01
 
@@ -238,3 +228,13 @@ class GraspScene(ArmScene):
             ),
             *super().plots(),
         ]
+
+
+def _x_to(normal) -> tuple[np.ndarray, tuple]:
+    """(the unit ``normal``, the rotation (w, x, y, z) turning the x axis onto it)."""
+    n = np.asarray(normal, float)
+    n /= np.linalg.norm(n) or 1.0
+    axis = np.cross([1.0, 0.0, 0.0], n)
+    angle = math.atan2(np.linalg.norm(axis), n[0])
+    axis = axis / (np.linalg.norm(axis) or 1.0)
+    return n, (math.cos(angle / 2), *(math.sin(angle / 2) * axis))
