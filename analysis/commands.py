@@ -102,20 +102,21 @@ def _paper_figures(paper: str, readers: dict[str, LogReader], out: Path) -> list
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+    done = False
     try:
         with quoted_warnings(), skipped_notes() as skipped:
             paths = make(readers, out)
-    except BaseException as exc:
-        for d in made:  # made for these figures, none made: not left behind empty
+        done = True
+    except OSError as exc:
+        fail(f"cannot write figures to {out}: {exc.strerror or exc}")
+    except LogError as exc:  # (a file there that is not an earlier figure)
+        fail(str(exc))
+    except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
+        _analysis_failed("figures", paper, readers, exc)
+    finally:
+        for d in made if not done else ():  # made for these figures, none made: not kept
             if d.is_dir() and not any(d.iterdir()):
                 d.rmdir()
-        if isinstance(exc, OSError):
-            fail(f"cannot write figures to {out}: {exc.strerror or exc}")
-        if isinstance(exc, LogError):  # (a file there that is not an earlier figure)
-            fail(str(exc))
-        if isinstance(exc, Exception):  # analysis of a damaged log: one line
-            _analysis_failed("figures", paper, readers, exc)
-        raise
     paths = [p if isinstance(p, Path) else Path(p) for p in paths]
     shown = {k for p in paths for k in runs_of(p, readers)}
     for text in figure_notes(readers, shown, skipped):
