@@ -22,7 +22,6 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
 from functools import cache
-from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +33,6 @@ from analysis.claims import ASSESSED, Claim
 LABELS = {"pybullet": "PyBullet", "mujoco": "MuJoCo", "drake": "Drake"}
 REFERENCE = next(iter(LABELS))
 _PLANT_ENGINES = {"mujoco_arm": "mujoco", "mujoco_grasp": "mujoco"}  # before the engine field
-GROUP = "paper_replay.engines"  # the engines' entry points (plants/arm_rig/engine.py)
 
 
 def label(engine: str) -> str:
@@ -42,11 +40,14 @@ def label(engine: str) -> str:
     return LABELS.get(engine, engine)
 
 
-@cache  # (the installed entry points: 1.7 ms a read)
+@cache
 def registered() -> tuple[str, ...]:
-    """Every registered engine's name (entry points ``GROUP``: read, never imported, so the
-    analysis imports no plant), the reference first, then ``LABELS``' order, then by name."""
-    names = {e.name for e in entry_points(group=GROUP)} | {REFERENCE}
+    """Every registered engine's name (plants/arm_rig/engine.py ``engines``: entry points read,
+    never loaded, so the analysis imports no simulator), the reference first, then ``LABELS``'
+    order, then by name."""
+    from plants.arm_rig.engine import engines
+
+    names = set(engines()) | {REFERENCE}
     known = list(LABELS)
     return tuple(sorted(names, key=lambda e: (known.index(e) if e in known else len(known), e)))
 
