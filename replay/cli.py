@@ -402,8 +402,10 @@ def list_(plugins):
 
 
 def params_markdown() -> str:
-    """Every scenario field and every plug-in's params, with units and ranges (docs/scenarios.md)."""
+    """Every scenario field and every plug-in's params, with units and ranges (docs/scenarios.md),
+    and the settings of each physics engine of the arm rig (entry points paper_replay.engines)."""
     import dataclasses
+    from importlib.metadata import entry_points
 
     from replay.params import describe
     from replay.scenario.schema import (
@@ -463,6 +465,10 @@ def params_markdown() -> str:
             doc = (cls.__doc__ or "").strip().splitlines()
             lines += ["", f"## {kind} `{name}`", "", doc[0] if doc else "", ""]
             lines += table(cls.Params, f"{where}.params.")
+    for engine in sorted(entry_points(group="paper_replay.engines"), key=lambda e: e.name):
+        cls = engine.load()  # (an arm rig's plant.params.engine: its settings, no simulator)
+        lines += ["", f"## engine `{engine.name}` (`plant.params.engine`)", ""]
+        lines += table(cls, "plant.params.engine.")
     return "\n".join(lines) + "\n"
 
 

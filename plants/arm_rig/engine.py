@@ -63,6 +63,62 @@ def engine_settings(value: Any) -> Any | None:
     return params_from_data(cls, value, "engine")
 
 
+# PyBullet's settings as the rig's params held them, flat, before the engine field did (scenarios
+# and logs made then): ``migrate_flat_settings`` moves them in
+FLAT_PYBULLET = (
+    "object_rolling_friction",
+    "object_spinning_friction",
+    "object_restitution",
+    "hand_restitution",
+    "contact_stiffness",
+    "contact_damping",
+    "solver_iterations",
+)
+
+
+def migrate_flat_settings(node: Any, own: str, *, log: bool) -> None:
+    """An older ``plant.params`` (a YAML mapping node: a scenario's, or a log's) with PyBullet's
+    settings flat in it (``FLAT_PYBULLET``) rewritten in place. Under PyBullet (the engine field's
+    type, else the plant type's own engine ``own``) they move into ``engine`` (one given flat
+    replaces the engine's own); another engine never used them: a log's are dropped, a
+    scenario's are an error naming the first (ParamError)."""
+    import yaml
+
+    flat = [(k, v) for k, v in node.value if k.value in FLAT_PYBULLET]
+    if not flat:
+        return
+    rest = [(k, v) for k, v in node.value if k.value not in FLAT_PYBULLET]
+    at = next((i for i, (k, _) in enumerate(rest) if k.value == "engine"), None)
+    given = rest[at][1] if at is not None else None
+    if not (isinstance(given, yaml.MappingNode) and given.value):
+        given = None
+    types = [] if given is None else [v.value for k, v in given.value if k.value == "type"]
+    kind = own if given is None else (types or [""])[0]
+    if kind != "pybullet" and not log:
+        raise ParamError(
+            flat[0][0].value,
+            f"a PyBullet setting, not used by engine {kind or '(no type)'}: remove it, or give "
+            "it in plant.params.engine with type: pybullet",
+        )
+    node.value = rest
+    if kind != "pybullet":
+        return
+    if given is None:  # (no engine named: the plant type's own, PyBullet, named now)
+        mark, tag = flat[0][0].start_mark, "tag:yaml.org,2002:str"
+        name = (yaml.ScalarNode(tag, "type", mark, mark), yaml.ScalarNode(tag, kind, mark, mark))
+        given = yaml.MappingNode("tag:yaml.org,2002:map", [name], mark, mark)
+        if at is None:
+            rest.append((yaml.ScalarNode(tag, "engine", mark, mark), given))
+        else:
+            rest[at] = (rest[at][0], given)
+    own_keys = [k.value for k, _ in given.value]
+    for k, v in flat:
+        if k.value in own_keys:
+            given.value[own_keys.index(k.value)] = (k, v)
+        else:
+            given.value.append((k, v))
+
+
 def adapter_class(settings: Any, rig: str) -> type:
     """The adapter class of an engine's ``settings`` for ``rig`` ("arm" or "grasp")."""
     module, name = getattr(settings, rig).split(":")

@@ -1,9 +1,10 @@
-"""The bullet_arm plant's scenario parameters (checked by the loader before a run starts)."""
+"""The arm rig's scenario parameters (checked by the loader before a run starts): what every
+engine reads; each engine's own settings are in ``engine`` (plants/arm_rig/engine.py)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 from replay.params import ParamError, param
 from replay.robot.hand import CATCH_CLOSING_SPEED  # Namiki & Ishikawa IV-A: 90 deg in 20 ms
@@ -167,36 +168,9 @@ class Params:
     object_lateral_friction: float = param(
         0.8, unit="1", ge=0.0, le=10, doc="Coulomb coefficient (rubber, assumed)"
     )
-    object_rolling_friction: float = param(
-        0.0, unit="m", ge=0.0, le=10, doc="PyBullet rolling friction"
-    )
-    object_spinning_friction: float = param(
-        0.0, unit="m", ge=0.0, le=10, doc="PyBullet spinning friction"
-    )
-    object_restitution: float = param(
-        0.6, unit="1", ge=0.0, le=1.0, doc="PyBullet restitution (multiplied with the robot's)"
-    )
     hand_lateral_friction: float = param(
         1.0, unit="1", ge=0.0, le=10, doc="Coulomb coefficient of palm/fingers (rubber pads)"
     )
-    hand_restitution: float = param(
-        0.3, unit="1", ge=0.0, le=1.0, doc="PyBullet restitution of the robot's links"
-    )
-    contact_stiffness: float = param(
-        0.0,
-        unit="N/m",
-        ge=0.0,
-        le=1e12,
-        doc="object contact stiffness; 0 = PyBullet's rigid contact",
-    )
-    contact_damping: float = param(
-        0.0,
-        unit="N*s/m",
-        ge=0.0,
-        le=1e9,
-        doc="object contact damping (used with contact_stiffness)",
-    )
-    solver_iterations: int = param(50, ge=1, le=1000, doc="PyBullet constraint solver iterations")
     gravity: float = param(9.81, unit="m/s^2", ge=0.0, le=100, doc="|g| along world -z")
     catch_hold_time: float = param(
         0.05,
@@ -221,15 +195,28 @@ class Params:
     engine: dict[str, Any] = param(
         {},
         omit_empty=True,
-        doc="the physics engine and its settings, {type: ENGINE, ...}: type pybullet (no "
-        "settings here: its contact fields are the ones above) or mujoco (mj_solref, "
+        doc="the physics engine and its settings, {type: ENGINE, ...}: type pybullet "
+        "(object_rolling_friction, object_spinning_friction, object_restitution, "
+        "hand_restitution, contact_stiffness, contact_damping, solver_iterations: flat here "
+        "in older scenarios and logs, moved in on load) or mujoco (mj_solref, "
         "mj_limit_solref, mj_solimp, mj_cone, mj_condim, mj_iterations, mj_noslip_iterations, "
         "mj_integrator, hand_servo_gain: docs/mujoco.md) or drake (dk_contact_approximation, "
         "dk_contact_model, dk_hydroelastic_modulus, dk_point_stiffness, dk_dissipation, "
-        "dk_hand_servo_gain: docs/drake.md); empty: the plant type's own engine "
-        "(PyBullet for bullet_arm and bullet_grasp). Engines are registered in the entry point "
-        "group paper_replay.engines (plants/arm_rig/engine.py)",
+        "dk_hand_servo_gain: docs/drake.md), each engine's as `replay describe` gives them; "
+        "empty: the plant type's own engine (PyBullet). Engines are registered in the entry "
+        "point group paper_replay.engines (plants/arm_rig/engine.py)",
     )
+
+    own_engine: ClassVar[str] = "pybullet"  # the engine where ``engine`` is empty
+
+    @classmethod
+    def migrate(cls, node: Any, *, log: bool) -> None:
+        """An older form of these params (a YAML mapping: a scenario's, ``log``: a log's) made
+        current in place before it is checked (replay/scenario/loader.py): PyBullet's settings
+        given flat moved into ``engine`` (engine.py ``migrate_flat_settings``)."""
+        from plants.arm_rig.engine import migrate_flat_settings
+
+        migrate_flat_settings(node, cls.own_engine, log=log)
 
     def __post_init__(self) -> None:
         """Lists sized for the arm and hand chosen (the plant needs one value per joint); the

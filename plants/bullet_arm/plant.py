@@ -25,6 +25,7 @@ from plants.arm_rig.params import Params as ArmParams
 from plants.arm_rig.rig import ArmRig
 from plants.bullet_arm.quiet import quiet_c_output
 from plants.bullet_arm.reach import robot_reach
+from plants.bullet_arm.settings import PybulletSettings
 from replay.scene import Frame
 from replay.spatial import matrix_to_quaternion, rpy_to_matrix
 
@@ -45,10 +46,13 @@ PER_STEP_CALLS = (
 
 class PybulletEngine:
     """The rig's engine in PyBullet (plants/arm_rig/engine.py ``EngineAdapter``), built from the
-    rig's public attributes (``rig``: its params, settings, model, URDF, dt and joints)."""
+    rig's public attributes (``rig``: its params, settings, model, URDF, dt and joints) and its
+    engine settings (``params.engine_settings``: ``PybulletSettings``, their defaults where the
+    scenario names no engine)."""
 
     def __init__(self, rig: ArmRig) -> None:
         P, S, dt = rig.params, rig.settings, rig.dt
+        E = P.engine_settings or PybulletSettings()
         self.params, self.dt, self.model = P, dt, rig.model
         dof, names, self.active = rig.dof, rig.joint_names, rig.active
         self.hand_names, self.hand_table = rig.hand_names, rig.hand_table
@@ -64,7 +68,7 @@ class PybulletEngine:
         bc.setTimeStep(dt)
         bc.setGravity(0.0, 0.0, -P.gravity)
         bc.setPhysicsEngineParameter(
-            numSolverIterations=int(P.solver_iterations), deterministicOverlappingPairs=1
+            numSolverIterations=int(E.solver_iterations), deterministicOverlappingPairs=1
         )
         orn = matrix_to_quaternion(rpy_to_matrix(P.base_rpy))
         self.robot = bc.loadURDF(
@@ -82,7 +86,7 @@ class PybulletEngine:
                 linearDamping=0.0,
                 angularDamping=0.0,
                 lateralFriction=P.hand_lateral_friction,
-                restitution=P.hand_restitution,
+                restitution=E.hand_restitution,
             )
         for k, j in enumerate(self.arm_j):
             bc.resetJointState(self.robot, j, q0[self.active[k]], qd0[self.active[k]])
@@ -105,7 +109,7 @@ class PybulletEngine:
         self._hand_v: list | None = None  # the hand motors' last targets (None: none set yet)
 
         # ---- the free object
-        self.obj = self._make_object(bc, P)
+        self.obj = self._make_object(bc, P, E)
 
         # ---- bookkeeping
         # (the contacts list it is of, parts, links, N)
@@ -165,7 +169,7 @@ class PybulletEngine:
         self._get_contact_points = bc.getContactPoints
         self.set_motors = bc.setJointMotorControlArray
 
-    def _make_object(self, bc, P):
+    def _make_object(self, bc, P, E: PybulletSettings):
         """The free object (a ball or a box) with its contact settings and initial velocity;
         None when the scenario has none."""
         if P.object == "none":
@@ -185,12 +189,12 @@ class PybulletEngine:
             linearDamping=0.0,
             angularDamping=0.0,
             lateralFriction=P.object_lateral_friction,
-            rollingFriction=P.object_rolling_friction,
-            spinningFriction=P.object_spinning_friction,
-            restitution=P.object_restitution,
+            rollingFriction=E.object_rolling_friction,
+            spinningFriction=E.object_spinning_friction,
+            restitution=E.object_restitution,
         )
-        if P.contact_stiffness > 0.0:
-            kw.update(contactStiffness=P.contact_stiffness, contactDamping=P.contact_damping)
+        if E.contact_stiffness > 0.0:
+            kw.update(contactStiffness=E.contact_stiffness, contactDamping=E.contact_damping)
         bc.changeDynamics(obj, -1, **kw)
         bc.resetBaseVelocity(obj, list(P.object_velocity), list(P.object_angular_velocity))
         return obj

@@ -1,9 +1,8 @@
 """Drake's contact and solver settings: ``DrakeSettings``, the engine field's
 (``plant.params.engine: {type: drake, ...}``, plants/arm_rig/engine.py). The rig's own params
 (robot, hand, object, limits, catch criterion, friction) are the arm rig's; PyBullet's contact
-fields among them (``solver_iterations``, ``*_restitution``, ``contact_stiffness``/
-``contact_damping``, rolling/spinning friction) are not used: Drake's point contact has no
-restitution coefficient; the bounce is set by its Hunt-Crossley dissipation (docs/drake.md)."""
+settings (``PybulletSettings``) are not Drake's: Drake's point contact has no restitution
+coefficient; the bounce is set by its Hunt-Crossley dissipation (docs/drake.md)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,11 @@
 """MuJoCo's contact and solver settings: ``MujocoSettings``, the engine field's
 (``plant.params.engine: {type: mujoco, ...}``, plants/arm_rig/engine.py), and the same fields
 flat in the params of the plant types ``mujoco_arm``/``mujoco_grasp`` (``Params``,
-``GraspParams``: the scenarios and logs made before the engine field). The PyBullet-only fields
+``GraspParams``: the scenarios and logs made before the engine field). PyBullet's settings
 (``solver_iterations``, ``*_restitution``, ``contact_stiffness``/``contact_damping``,
-rolling/spinning friction) are accepted and not used: MuJoCo has no restitution coefficient;
-the bounce is set by ``mj_solref``'s damping ratio."""
+rolling/spinning friction, flat in the logs of then) are dropped from a log and refused in a
+scenario (plants/arm_rig/engine.py ``migrate_flat_settings``): MuJoCo has no restitution
+coefficient; the bounce is set by ``mj_solref``'s damping ratio."""
 
 from __future__ import annotations
 
@@ -111,6 +112,8 @@ class MujocoSettings(_MujocoFields, _EngineType):
 @dataclass
 class Params(_MujocoFields, ArmParams):
     """The mujoco_arm plant type's params: the rig's with MuJoCo's settings flat."""
+
+    own_engine: ClassVar[str] = "mujoco"
 
     def __post_init__(self) -> None:
         ArmParams.__post_init__(self)

@@ -4,7 +4,9 @@
   key, anything else is replaced, and a plug-in section whose ``type:`` changes is replaced
   whole.
 - ``--set key.path=value`` overrides one field (the value is read as YAML); one that changes a
-  plug-in's ``type`` drops that section's ``params`` (they belong to the other plug-in).
+  plug-in's ``type`` drops that section's ``params`` (they belong to the other plug-in), and one
+  that changes the ``type`` of a mapping inside a plug-in's params (the arm rig's
+  ``plant.params.engine``) drops that mapping's other keys (the old type's settings).
 - A plug-in ``type`` is an installed plug-in's name or an import path ``module:Class``, imported
   from the folder of the file that wrote it (the cwd for ``--set``) when a scenario is loaded
   to run, never when a log's stored scenario is read (``plugins="known-only"``).
@@ -223,6 +225,8 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
         if last:
             if found and key == "type" and not _same_scalar(found[1], value):
                 _pop(node, "params")  # another plug-in: the old one's params do not apply
+                if "params" in keys[:-1]:  # a typed mapping in params: its keys are the type's
+                    node.value = [kv for kv in node.value if kv[0].value == "type"]
                 found = _get(node, key)
             if found:
                 node.value[node.value.index(found)] = (found[0], value)
@@ -648,6 +652,7 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode, plugins: str = "impor
         raw = spec.params
         if not isinstance(raw, yaml.Node):  # no params given: all defaults
             raw = yaml.MappingNode(_MAP, [], _nearest(root, path).start_mark, None)
+        _migrate(raw, cls.Params, f"{path}.params", log=plugins == "known-only")
         spec.params = build_dataclass(raw, cls.Params, f"{path}.params")
     # a plug-in whose Params declare an internal ``scenario_dir`` field gets the directory of the
     # file that wrote its file parameters (fields named ``*_file``), so that they resolve relative
@@ -809,7 +814,23 @@ def params_from_data(cls: type, data: dict | None, path: str, source: str = "<lo
     """A plug-in's typed ``Params`` (``cls``) from plain data, e.g. ``plant.params`` of a log's
     resolved scenario, checked field by field as a scenario file is. Raises ScenarioError."""
     node = _compose_root(yaml.safe_dump(data or {}), source)
+    _migrate(node, cls, path, log=True)
     return build_dataclass(node, cls, path)
+
+
+def _migrate(node: yaml.Node, cls: type, path: str, *, log: bool) -> None:
+    """A plug-in's ``params`` (``node``) in an older form made ``cls``'s current one in place,
+    where ``cls`` defines ``migrate(node, log=...)`` (e.g. fields since moved; ``log``: a log's
+    stored params, else a scenario's). Its ParamError names the field: one line."""
+    migrate = getattr(cls, "migrate", None)
+    if migrate is None or not isinstance(node, yaml.MappingNode):
+        return
+    try:
+        migrate(node, log=log)
+    except ParamError as exc:
+        raise ScenarioError(
+            exc.message, node=node_at(node, exc.field) or node, path=f"{path}.{exc.field}"
+        ) from None
 
 
 def to_plain(value: Any) -> Any:

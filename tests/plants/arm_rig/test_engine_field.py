@@ -1,11 +1,15 @@
 """``plant.params.engine``: a scenario's physics engine and its settings, refused in one line
-when the type is missing or unknown, or a setting is not the engine's."""
+when the type is missing or unknown, or a setting is not the engine's; PyBullet's settings given
+flat, as older scenarios and logs hold them, moved in (or refused beside another engine)."""
 
 from __future__ import annotations
 
 import pytest
+import yaml
 
 from replay.api import run
+from replay.scenario import load_scenario, scenario_from_text
+from replay.scenario.loader import to_plain
 from replay.scenario.yamlio import ScenarioError
 
 
@@ -28,3 +32,54 @@ def test_the_field_chooses_the_engine_of_the_same_scenario():
     r = run("catch_optimised", set=["plant.params.engine.type=mujoco", "timing.duration=0.05"])
     assert r.scenario["plant"]["params"]["engine"]["type"] == "mujoco"
     assert r.table("/object/state")["t"].size > 0
+
+
+# ---------------------------------------------------------------- PyBullet's settings, once flat
+FLAT = {"object_restitution": 0.25, "contact_stiffness": 2000.0, "solver_iterations": 30}
+
+
+def _old_form(name: str) -> str:
+    """The resolved text of shipped scenario ``name`` with PyBullet's settings ``FLAT`` flat in
+    ``plant.params``, as the scenarios and logs made before the engine field held them."""
+    data = to_plain(load_scenario(name))
+    params = data["plant"]["params"]
+    if params["engine"]["type"] == "pybullet":
+        params.update({k: v for k, v in params.pop("engine").items() if k != "type"})
+    params.update(FLAT)
+    return yaml.safe_dump(data, sort_keys=False)
+
+
+def test_an_old_scenario_with_pybullet_settings_flat_loads_them_into_the_engine(tmp_path):
+    old = tmp_path / "old.yaml"
+    old.write_text(_old_form("grasp_hexahedron"))
+    engine = load_scenario(old).plant.params.engine
+    assert engine == {**load_scenario("grasp_hexahedron").plant.params.engine, **FLAT}
+    logged = scenario_from_text(old.read_text(), plugins="known-only").plant.params.engine
+    assert logged == engine
+
+
+def test_pybullet_settings_flat_beside_another_engine(tmp_path):
+    """A log made then (every default written, PyBullet's flat ones unused) loads without them;
+    a scenario file giving one with engine mujoco is refused, naming it."""
+    text = _old_form("grasp_hexahedron_mujoco")
+    logged = scenario_from_text(text, plugins="known-only").plant.params
+    assert logged.engine == load_scenario("grasp_hexahedron_mujoco").plant.params.engine
+    old = tmp_path / "old_mujoco.yaml"
+    old.write_text(text)
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(old)
+    message = str(info.value)
+    assert "\n" not in message and "old_mujoco.yaml:" in message
+    assert "plant.params.object_restitution: a PyBullet setting, not used by engine mujoco" in (
+        message
+    )
+
+
+def test_a_set_that_changes_the_engine_drops_the_old_engines_settings():
+    own = load_scenario("grasp_hexahedron").plant.params.engine
+    assert own["contact_stiffness"] == 3000.0  # (the shipped soft pads)
+    drake = load_scenario("grasp_hexahedron", ["plant.params.engine.type=drake"])
+    engine = drake.plant.params.engine
+    assert engine["type"] == "drake" and not set(FLAT) & set(engine)
+    same = load_scenario("grasp_hexahedron", ["plant.params.engine.type=pybullet"])
+    assert same.plant.params.engine == own

@@ -367,6 +367,43 @@ def test_box_object_and_floating_object():
     plant.close()
 
 
+@pytest.mark.parametrize(
+    "engine",
+    [
+        {},  # no engine named: PyBullet's defaults
+        {
+            "type": "pybullet",
+            "object_rolling_friction": 0.01,
+            "object_spinning_friction": 0.02,
+            "object_restitution": 0.1,
+            "hand_restitution": 0.2,
+            "contact_stiffness": 2000.0,
+            "contact_damping": 30.0,
+            "solver_iterations": 7,
+        },
+    ],
+)
+def test_pybullets_settings_reach_pybullet(engine):
+    """The engine field's PyBullet settings (plants/bullet_arm/settings.py) as PyBullet holds
+    them: the object's and the links' dynamics, the solver's iterations."""
+    from plants.bullet_arm.settings import PybulletSettings
+
+    want = PybulletSettings(**engine)
+    plant = make(engine=engine)
+    e = plant.engine
+    # (mass, friction, inertia, its frame's position and orientation, restitution, rolling,
+    # spinning, damping, stiffness, ...)
+    info = e.bc.getDynamicsInfo(e.obj, -1)
+    assert info[5:8] == pytest.approx(
+        [want.object_restitution, want.object_rolling_friction, want.object_spinning_friction]
+    )
+    if want.contact_stiffness > 0:
+        assert info[8:10] == pytest.approx([want.contact_damping, want.contact_stiffness])
+    assert e.bc.getDynamicsInfo(e.robot, e.palm_link)[5] == pytest.approx(want.hand_restitution)
+    assert e.bc.getPhysicsEngineParameters()["numSolverIterations"] == want.solver_iterations
+    plant.close()
+
+
 def test_miss_event_when_ball_falls_past():
     plant = make(object_position=[1.5, 0.0, 0.3], miss_height=0.1, **CATCHING)
     kinds = []
