@@ -23,6 +23,7 @@ from typing import Any
 
 import yaml
 
+from replay import registry
 from replay.log import LogError, LogReader
 from replay.scenario.yamlio import one_line
 
@@ -129,7 +130,7 @@ def _engine(plant_type: str) -> str:
     from analysis.engines import REFERENCE, engine_of, label
 
     engine = engine_of({"plant": {"type": plant_type}})
-    return label(engine) if engine != REFERENCE or plant_type == "bullet_arm" else ""
+    return label(engine) if engine != REFERENCE or plant_type == "arm_rig" else ""
 
 
 def differences(stored: Mapping[str, Any], ref: Mapping[str, Any]) -> list[str]:
@@ -188,6 +189,8 @@ def describe(reader: LogReader, key: str | None = None) -> Run:
         stored = _flat(reader.scenario_config())
     except (LogError, AttributeError):
         sc, stored = {}, {}
+    if "plant.type" in stored:  # (an old log's renamed plant type: its name now)
+        stored["plant.type"] = registry.current_name("plant", str(stored["plant.type"]))
     name, paper = str(sc.get("name", key or "?")), str(sc.get("paper", ""))
     experiment, items = _compare(stored, name, paper) if stored else ("", [])
     run = Run(key or name, name, paper, _label(items), experiment, reader)

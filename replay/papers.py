@@ -24,6 +24,9 @@ class Paper:
     # and .viewer_scenes would hold them
     controllers: dict[str, str] = field(default_factory=dict)
     plants: dict[str, str] = field(default_factory=dict)
+    # a plant type's old name -> its name now: old scenarios and logs name it, the scenario
+    # loader reads it as the new one (replay.registry.current_name)
+    renamed_plants: dict[str, str] = field(default_factory=dict)
     sensors: dict[str, str] = field(default_factory=dict)
     viewer_scenes: dict[str, str] = field(default_factory=dict)
     figures: str = ""  # "module:function": make(logs_by_name, outdir) -> paths

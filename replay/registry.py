@@ -106,9 +106,25 @@ def is_import_path(name: str) -> bool:
     return ":" in name
 
 
+def current_name(kind: str, name: str) -> str:
+    """``name`` as the plug-in is called now: a plant type a registered paper renamed (its
+    ``renamed_plants``, kept for old scenarios and logs) -> its new name, for a plant or the
+    viewer scene registered under its type; any other unchanged."""
+    if kind not in ("plant", "viewer_scene") or is_import_path(name) or name in _entries(kind):
+        return name
+    for entry in _entries("paper").values():
+        new = entry.load().renamed_plants.get(name)
+        if new:
+            return new
+    return name
+
+
 def known(kind: str, name: str) -> bool:
-    """Whether :func:`load` finds ``name`` without importing anything new."""
-    return name in _imported[kind] if is_import_path(name) else name in _entries(kind)
+    """Whether :func:`load` finds ``name`` (or the name it was renamed to) without importing
+    anything new."""
+    if is_import_path(name):
+        return name in _imported[kind]
+    return current_name(kind, name) in _entries(kind)
 
 
 def _interface(kind: str) -> type | None:
@@ -193,6 +209,7 @@ def load(kind: str, name: str) -> Any:
             "loading a scenario to run, never from a log)"
         )
     entries = _entries(kind)
+    name = current_name(kind, name)
     if name not in entries:
         known = ", ".join(sorted(entries)) or "none installed"
         raise UnknownPlugin(f"unknown {kind} {name!r} (known: {known})")

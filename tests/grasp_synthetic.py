@@ -130,7 +130,7 @@ def write_grasp_log(
         "description": "synthetic grasping log",
         "seed": 0,
         "timing": {"physics_rate": rate, "duration": duration},
-        "plant": {"type": "bullet_grasp", "params": params},
+        "plant": {"type": "grasp_rig", "params": params},
         "sensors": {
             "chip": {
                 "type": "vision_chip",

@@ -251,7 +251,7 @@ def write_arm_log(
         }
     }
     paper = "namiki2003" if obj == "ball" else "namiki1999"
-    text = _scenario(name, paper, duration, rate, {"type": "bullet_arm", "params": params}, sensors)
+    text = _scenario(name, paper, duration, rate, {"type": "arm_rig", "params": params}, sensors)
     chain = wam_chain(dof)
     names = list(wam_joint_names(dof))
     n = int(round(duration * rate))

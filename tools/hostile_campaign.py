@@ -288,7 +288,7 @@ def shape_cases() -> list[Case]:
 
 
 def mismatch_cases() -> list[Case]:
-    child = f"extends: {HERE / STICK}\nplant: {{type: bullet_arm, params: {{}}}}\n"
+    child = f"extends: {HERE / STICK}\nplant: {{type: arm_rig, params: {{}}}}\n"
     return [
         Case(
             "mismatch",

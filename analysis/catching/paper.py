@@ -18,12 +18,14 @@ PAPER = Paper(
         "feedback": "replay.control.feedback:FeedbackController",
     },
     plants={
-        "bullet_arm": "plants.bullet_arm:BulletArmPlant",
-        "mujoco_arm": "plants.mujoco_arm.plant:MujocoArmPlant",
+        # the arm rig, its engine plant.params.engine (PyBullet where empty)
+        "arm_rig": "plants.bullet_arm:BulletArmPlant",
+        "mujoco_arm": "plants.mujoco_arm.plant:MujocoArmPlant",  # (MuJoCo's flat: old logs)
     },
+    renamed_plants={"bullet_arm": "arm_rig"},
     sensors={"stereo_ball": "replay.sensors.stereo:StereoBallCamera"},
     viewer_scenes={
-        "bullet_arm": "plants.arm_rig.viewer_scene:ArmScene",
+        "arm_rig": "plants.arm_rig.viewer_scene:ArmScene",
         "mujoco_arm": "plants.mujoco_arm.viewer_scene:MujocoArmScene",
     },
     figures="analysis.catching.figures:make_figures",

@@ -20,16 +20,18 @@ PAPER = Paper(
         "grasp_schedule": "replay.control.grasping:ScheduleTask",
     },
     plants={
-        "bullet_grasp": "plants.bullet_arm.grasp_plant:BulletGraspPlant",
-        "mujoco_grasp": "plants.mujoco_arm.grasp_plant:MujocoGraspPlant",
+        # the grasping rig, its engine plant.params.engine (PyBullet where empty)
+        "grasp_rig": "plants.bullet_arm.grasp_plant:BulletGraspPlant",
+        "mujoco_grasp": "plants.mujoco_arm.grasp_plant:MujocoGraspPlant",  # (MuJoCo's flat: old logs)
     },
+    renamed_plants={"bullet_grasp": "grasp_rig"},
     sensors={
         "vision_chip": "replay.sensors.vision_chip:VisionChipSensor",
         "wrist_ft": "replay.sensors.force:WristFTSensor",
         "hand_torque": "replay.sensors.force:HandTorqueSensor",
     },
     viewer_scenes={
-        "bullet_grasp": "plants.arm_rig.grasp_viewer_scene:GraspScene",
+        "grasp_rig": "plants.arm_rig.grasp_viewer_scene:GraspScene",
         "mujoco_grasp": "plants.mujoco_arm.viewer_scene:MujocoGraspScene",
     },
     figures="analysis.grasping.figures:make_figures",

@@ -7,7 +7,7 @@ rig's private state. States are plain floats (lists or tuples), read once after 
 shared, never mutated.
 
 The engine is a field of the scenario, ``plant.params.engine: {type: NAME, ...its settings}``
-(empty: the plant type's own engine, PyBullet for ``bullet_arm``/``bullet_grasp``). An engine
+(empty: the plant type's own engine, PyBullet for ``arm_rig``/``grasp_rig``). An engine
 is registered by one entry point in the group ``paper_replay.engines``: NAME -> its settings
 dataclass (imports no engine), whose ``type`` field is NAME, whose fields are the engine's
 settings (checked as any params are) and whose class attributes ``arm`` and ``grasp`` name its

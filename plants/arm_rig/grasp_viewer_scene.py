@@ -1,4 +1,4 @@
-"""The grasping rig (``bullet_grasp``) in the browser viewer (Namiki, Nakabo, Ishii & Ishikawa 1999):
+"""The grasping rig (``grasp_rig``) in the browser viewer (Namiki, Nakabo, Ishii & Ishikawa 1999):
 what ``ArmScene`` draws (the WAM-7 and the 14-joint hand from the plant's URDF at the logged joint
 angles, the object at its pose, its path) plus the pan/tilt head with the vision chip's camera frustum, showing the chip's
 16 x 16 binary image, at the logged camera pose (``/head/state``), the constraint plane, the
@@ -6,8 +6,8 @@ object as recognised (``/grasping/object``), the reaching target x_d^a (``/grasp
 schedule's phase (``phase`` events). Plots: the hand and the object along Y, the hand and the
 reaching target along X (Fig. 9).
 
-Registered under the plant's type in ``pyproject.toml`` (``paper_replay.viewer_scenes``,
-``bullet_grasp``). The URDF is the plant's own: ``ArmScene`` builds it from the rig's typed
+Registered under the plant's type in its paper's registration (analysis/grasping/paper.py,
+``grasp_rig``). The URDF is the plant's own: ``ArmScene`` builds it from the rig's typed
 ``GraspParams`` through the plant's resolver. No simulator is imported.
 """
 

@@ -1,4 +1,4 @@
-"""The bullet_arm plant's physical verdict on a free object and the hand: caught or not, and why.
+"""The arm rig's physical verdict on a free object and the hand: caught or not, and why.
 
 Physics only (no method): :class:`CatchWatch` follows the object and the palm frame (the arm's tool
 frame: z is the palm normal, the contact face at z = palm_thickness, see replay/robot/hand.py)

@@ -1,7 +1,7 @@
 """The arm plant in the browser viewer: arm and hand from the plant's own URDF, the free object.
 
-Registered under the plant's type in ``pyproject.toml``
-(``[project.entry-points."paper_replay.viewer_scenes"] bullet_arm = ...``). Sizes and the URDF
+Registered under the plant's type in its paper's registration (analysis/catching/paper.py,
+``viewer_scenes``: ``arm_rig``). Sizes and the URDF
 come from the plant's typed ``Params``, rebuilt from the run's resolved scenario, through the
 plant's resolver (``plants.arm_rig.settings``): no default is retyped here. No simulator is
 imported (the URDF is built by ``plants.models``, pure NumPy).

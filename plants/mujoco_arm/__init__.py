@@ -1,4 +1,4 @@
-"""MuJoCo arm plant: the bullet_arm plant's catching rig (WAM, hand, a free object) in a second
+"""MuJoCo arm plant: the arm rig's catching rig (WAM, hand, a free object) in a second
 physics engine, from the same robot tables and URDF generator (``plants.models``).
 
 ``params``, ``settings`` and ``viewer_scene`` import no simulator; ``MujocoArmPlant`` (MuJoCo) is

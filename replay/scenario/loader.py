@@ -644,6 +644,7 @@ def _resolve_plugins(sc: Scenario, root: yaml.MappingNode, plugins: str = "impor
             path="controller",
         )
     for kind, spec, path in plugin_sections(sc):
+        spec.type = registry.current_name(kind, spec.type)  # (a renamed plant: its name now)
         cls = _plugin_class(kind, spec, path, root, plugins)
         if cls is None:  # kept as the log stored it
             raw = spec.params

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from replay import registry
 from replay.limits import LimitError, check, limit
 from replay.log import LogError, LogReader
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, to_dict
@@ -223,7 +224,10 @@ class RunData:
 
     @property
     def plant_type(self) -> str:
-        return str(_mapping(self.config.get("plant")).get("type", ""))
+        """The plant's type as it is called now (a renamed one's old name mapped)."""
+        return registry.current_name(
+            "plant", str(_mapping(self.config.get("plant")).get("type", ""))
+        )
 
     @property
     def plant_params(self) -> dict:

@@ -131,7 +131,7 @@ class RunScene:
 
     @classmethod
     def suits(cls, run: RunData) -> bool:
-        """For a variant (registered as ``PLANT.VARIANT``, e.g. ``bullet_arm.grasp``): whether it
+        """For a variant (registered as ``PLANT.VARIANT``, e.g. ``arm_rig.grasp``): whether it
         should draw this run of plant type PLANT instead of that plant's own scene (e.g. by
         ``run.scenario["paper"]`` or ``run.plant_params``)."""
         return True

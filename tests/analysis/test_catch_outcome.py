@@ -1,4 +1,4 @@
-"""The bullet_arm plant's catch verdict (plants/arm_rig/outcome.py): every outcome says why."""
+"""The arm rig's catch verdict (plants/arm_rig/outcome.py): every outcome says why."""
 
 from __future__ import annotations
 

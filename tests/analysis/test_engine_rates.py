@@ -308,7 +308,7 @@ def test_the_claims_join_the_runs_of_every_engine_present():
             return {"paper": "namiki1999", "name": self.name}
 
         def scenario_config(self):
-            return {"plant": {"type": "bullet_grasp", "params": {"engine": {"type": self.engine}}}}
+            return {"plant": {"type": "grasp_rig", "params": {"engine": {"type": self.engine}}}}
 
     def evaluate(logs):
         return [Claim(f"{n}: q", "1", str(len(n)), "reproduced") for n in logs]
@@ -329,7 +329,7 @@ def test_a_run_with_its_engine_set_joins_its_scenarios_row():
     from analysis.engines import split_logs
     from analysis.runs import differences
 
-    ref = {"plant.type": "bullet_arm", "plant.params.hand_max_torque": 1.0}
+    ref = {"plant.type": "arm_rig", "plant.params.hand_max_torque": 1.0}
     stored = dict(ref, **{"plant.params.engine.type": "mujoco", "plant.params.engine.x": 1})
     assert differences(stored, ref) == ["engine mujoco"]
     assert differences(dict(stored, **{"plant.params.hand_max_torque": 2.0}), ref) == [
@@ -345,7 +345,7 @@ def test_a_run_with_its_engine_set_joins_its_scenarios_row():
             return {"name": "catch_initial"}
 
         def scenario_config(self):
-            return {"plant": {"type": "bullet_arm", "params": {"engine": {"type": self.engine}}}}
+            return {"plant": {"type": "arm_rig", "params": {"engine": {"type": self.engine}}}}
 
     logs = {
         "catch_initial": Log("pybullet"),

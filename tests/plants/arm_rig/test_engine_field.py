@@ -7,9 +7,10 @@ from __future__ import annotations
 import pytest
 import yaml
 
+from replay import registry
 from replay.api import run
 from replay.scenario import load_scenario, scenario_from_text
-from replay.scenario.loader import to_plain
+from replay.scenario.loader import resolved_yaml, to_plain
 from replay.scenario.yamlio import ScenarioError
 
 
@@ -38,10 +39,15 @@ def test_the_field_chooses_the_engine_of_the_same_scenario():
 FLAT = {"object_restitution": 0.25, "contact_stiffness": 2000.0, "solver_iterations": 30}
 
 
+OLD_NAMES = {"arm_rig": "bullet_arm", "grasp_rig": "bullet_grasp"}
+
+
 def _old_form(name: str) -> str:
     """The resolved text of shipped scenario ``name`` with PyBullet's settings ``FLAT`` flat in
-    ``plant.params``, as the scenarios and logs made before the engine field held them."""
+    ``plant.params`` and the rig's plant type by its old name, as the scenarios and logs made
+    before the engine field held them."""
     data = to_plain(load_scenario(name))
+    data["plant"]["type"] = OLD_NAMES[data["plant"]["type"]]
     params = data["plant"]["params"]
     if params["engine"]["type"] == "pybullet":
         params.update({k: v for k, v in params.pop("engine").items() if k != "type"})
@@ -52,10 +58,22 @@ def _old_form(name: str) -> str:
 def test_an_old_scenario_with_pybullet_settings_flat_loads_them_into_the_engine(tmp_path):
     old = tmp_path / "old.yaml"
     old.write_text(_old_form("grasp_hexahedron"))
-    engine = load_scenario(old).plant.params.engine
-    assert engine == {**load_scenario("grasp_hexahedron").plant.params.engine, **FLAT}
-    logged = scenario_from_text(old.read_text(), plugins="known-only").plant.params.engine
-    assert logged == engine
+    plant = load_scenario(old).plant
+    assert plant.type == "grasp_rig"
+    assert plant.params.engine == {**load_scenario("grasp_hexahedron").plant.params.engine, **FLAT}
+    logged = scenario_from_text(old.read_text(), plugins="known-only").plant
+    assert (logged.type, logged.params.engine) == ("grasp_rig", plant.params.engine)
+    assert "type: grasp_rig" in resolved_yaml(load_scenario(old))  # (a run's log: the new name)
+
+
+def test_the_rigs_old_plant_types_are_read_as_their_names_now():
+    for new, old in OLD_NAMES.items():
+        assert registry.current_name("plant", old) == new and registry.known("plant", old)
+        assert registry.load("plant", old) is registry.load("plant", new)
+        assert registry.load("viewer_scene", old) is registry.load("viewer_scene", new)
+        assert old not in registry.names("plant")  # (not listed, nor described)
+    assert registry.current_name("plant", "mujoco_arm") == "mujoco_arm"  # (its own, for old logs)
+    assert registry.current_name("sensor", "bullet_arm") == "bullet_arm"
 
 
 def test_pybullet_settings_flat_beside_another_engine(tmp_path):

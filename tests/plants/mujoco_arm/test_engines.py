@@ -92,7 +92,7 @@ def test_the_engine_is_the_resolved_scenarios():
         def scenario_config(self) -> dict:
             return self._scenario
 
-    arm = {"type": "bullet_arm", "params": {}}
+    arm = {"type": "arm_rig", "params": {}}
     logs = {
         "catch_optimised": Log({"name": "catch_optimised", "plant": arm}),
         "catch_optimised_mujoco": Log(
@@ -101,19 +101,19 @@ def test_the_engine_is_the_resolved_scenarios():
         "catch_initial_drake": Log(
             {
                 "name": "catch_initial_drake",
-                "plant": {"type": "bullet_arm", "params": {"engine": {"type": "drake"}}},
+                "plant": {"type": "arm_rig", "params": {"engine": {"type": "drake"}}},
             }
         ),
         "catch_optimised_newton": Log(
             {
                 "name": "catch_optimised_newton",
-                "plant": {"type": "bullet_arm", "params": {"engine": {"type": "newton"}}},
+                "plant": {"type": "arm_rig", "params": {"engine": {"type": "newton"}}},
             }
         ),
         "catch_initial_mujoco": Log(
             {
                 "name": "catch_initial_mujoco",
-                "plant": {"type": "bullet_arm", "params": {"engine": {"type": "mujoco"}}},
+                "plant": {"type": "arm_rig", "params": {"engine": {"type": "mujoco"}}},
             }
         ),
     }

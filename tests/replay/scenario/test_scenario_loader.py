@@ -255,7 +255,7 @@ def test_plugin_mismatch_is_one_line_at_controller_type(project_root, tmp_path):
     child = tmp_path / "child.yaml"
     child.write_text(
         f"extends: {project_root / 'scenarios/stick_3step.yaml'}\n"
-        "plant: {type: bullet_arm, params: {}}\n"
+        "plant: {type: arm_rig, params: {}}\n"
     )
     with pytest.raises(ScenarioError) as info:
         load_scenario(child)

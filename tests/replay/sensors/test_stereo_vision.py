@@ -27,7 +27,7 @@ from replay.sensors.stereo import StereoBallCamera, StereoBallCameraParams
 
 from pixel_checks import in_image
 
-R_BALL = 0.0175  # the bullet_arm plant's ball (35 mm, assumed)
+R_BALL = 0.0175  # the arm rig's ball (35 mm, assumed)
 START = np.array([3.2, 0.0, 1.0])  # release point of the catching problem's throw set
 G = np.array([0.0, 0.0, -9.81])
 

@@ -227,7 +227,7 @@ def test_the_viewer_engine_imports_no_plugin_and_no_simulator():
         "import sys; import replay.viewer.app; "
         "assert not [m for m in sys.modules if m.startswith('plants')], 'a plug-in'; "
         "from replay.viewer.scenes import scene_classes; s = scene_classes(); "
-        "assert {'airtable', 'bullet_arm'} <= set(s), s; "
+        "assert {'airtable', 'arm_rig'} <= set(s), s; "
         "assert 'pybullet' not in sys.modules and 'pymunk' not in sys.modules, 'simulator'"
     )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)

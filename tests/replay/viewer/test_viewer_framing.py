@@ -199,7 +199,7 @@ def test_extra_bodies_of_a_scene_are_drawn_moved_and_framed(viewer_factory, tmp_
 
             return [Body("human_hand", "box", (0.08, 0.1, 0.03), pose, label="human hand")]
 
-    monkeypatch.setitem(registry._registered["viewer_scene"], "bullet_arm", WithHuman)
+    monkeypatch.setitem(registry._registered["viewer_scene"], "arm_rig", WithHuman)
     v = viewer_factory([write_arm_log(tmp_path / "c.mcap")])
     scene = v.scenes[0]
     assert isinstance(scene, WithHuman)
