@@ -63,7 +63,7 @@ def _rows(
 
 def _scenario(reader: LogReader) -> dict[str, Any]:
     try:
-        flat = runs._flat(reader.scenario_config())
+        flat = runs._flat(runs.current_config(reader))
     except (LogError, AttributeError):
         return {}
     return {k: v for k, v in flat.items() if k.split(".")[0] not in _TEXT_FIELDS}

@@ -55,6 +55,26 @@ def _flat(data: Any, prefix: str = "") -> dict[str, Any]:
     return {prefix.rstrip("."): data}
 
 
+def current_config(reader: LogReader) -> dict[str, Any]:
+    """The log's resolved scenario; an old one's (its plant type since renamed) as the loader
+    reads it now: the type's name now, fields since moved in their places (a ``Params``'
+    ``migrate``), all else as stored, or as stored where it does not load here. (Loading costs
+    the plant's imports, ~0.1 s: a log of today's names is as stored.) Raises LogError as
+    ``scenario_config`` does."""
+    from replay.scenario import ScenarioError, resolved_yaml, scenario_from_text
+
+    config = reader.scenario_config()
+    plant = config.get("plant")
+    kind = str(plant.get("type")) if isinstance(plant, dict) else ""
+    if registry.current_name("plant", kind) == kind:
+        return config
+    try:
+        sc = scenario_from_text(reader.scenario()["yaml"], plugins="known-only")
+        return yaml.safe_load(resolved_yaml(sc))
+    except (ScenarioError, KeyError, TypeError, ValueError, yaml.YAMLError):
+        return config
+
+
 @lru_cache(maxsize=1)
 def _shipped_names() -> frozenset[str]:
     from replay.resources import scenario_dir
@@ -186,11 +206,9 @@ def describe(reader: LogReader, key: str | None = None) -> Run:
         return known
     try:
         sc = reader.scenario()
-        stored = _flat(reader.scenario_config())
+        stored = _flat(current_config(reader))
     except (LogError, AttributeError):
         sc, stored = {}, {}
-    if "plant.type" in stored:  # (an old log's renamed plant type: its name now)
-        stored["plant.type"] = registry.current_name("plant", str(stored["plant.type"]))
     name, paper = str(sc.get("name", key or "?")), str(sc.get("paper", ""))
     experiment, items = _compare(stored, name, paper) if stored else ("", [])
     run = Run(key or name, name, paper, _label(items), experiment, reader)

@@ -101,3 +101,26 @@ def test_a_set_that_changes_the_engine_drops_the_old_engines_settings():
     assert engine["type"] == "drake" and not set(FLAT) & set(engine)
     same = load_scenario("grasp_hexahedron", ["plant.params.engine.type=pybullet"])
     assert same.plant.params.engine == own
+
+
+def test_an_old_log_reads_as_its_scenario_now_in_the_analysis(tmp_path):
+    """The runs' labels and `replay compare` read an old log's scenario as the loader does now
+    (analysis/runs.py ``current_config``): no difference from the same run logged today."""
+    from analysis import runs
+    from replay.log import LogReader, LogWriter
+    from replay.messages import TOPIC_SCENARIO, ScenarioInfo
+
+    def log(name: str, text: str) -> LogReader:
+        path = tmp_path / f"{name}.mcap"
+        with LogWriter(path) as w:
+            w.write(
+                TOPIC_SCENARIO, ScenarioInfo(0.0, "grasp_hexahedron", "namiki1999", text, 0, ""), 0
+            )
+        return LogReader(path)
+
+    old = log("old", _old_form("grasp_hexahedron"))
+    sets = [f"plant.params.engine.{k}={v}" for k, v in FLAT.items()]
+    new = log("new", resolved_yaml(load_scenario("grasp_hexahedron", sets)))
+    assert old.scenario_config()["plant"]["type"] == "bullet_grasp"  # (as stored)
+    assert runs.current_config(old) == runs.current_config(new)
+    assert runs.current_config(old)["plant"]["type"] == "grasp_rig"
