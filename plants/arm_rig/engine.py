@@ -59,8 +59,8 @@ def engine_settings(value: Any) -> Any | None:
         raise ParamError("engine", f"unknown engine type {kind!r} (known: {names})")
     cls = known[kind].load()
     if isinstance(value, yaml.MappingNode):
-        return build_dataclass(value, cls, "engine")
-    return params_from_data(cls, value, "engine")
+        return build_dataclass(value, cls, "plant.params.engine")
+    return params_from_data(cls, value, "plant.params.engine")
 
 
 # PyBullet's settings as the rig's params held them, flat, before the engine field did (scenarios

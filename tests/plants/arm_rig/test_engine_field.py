@@ -21,6 +21,10 @@ from replay.scenario.yamlio import ScenarioError
         ("plant.params.engine.type=bogus", "unknown engine type 'bogus' (known: "),
         ("plant.params.engine={type: mujoco, dk_nope: 1}", "dk_nope"),
         ("plant.params.engine=3", "expected a mapping, got '3'"),
+        (
+            "plant.params.engine={type: pybullet, solver_iterations: 0}",
+            "plant.params.engine.solver_iterations: expected a whole number >= 1",
+        ),
     ],
 )
 def test_a_bad_engine_field_is_one_line(setting, words):
