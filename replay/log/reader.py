@@ -60,6 +60,9 @@ _CHUNK_OPCODE, _LENGTH_PENDING = 0x06, (1 << 64) - 1
 _SCHEMA_OPCODE, _CHANNEL_OPCODE, _MESSAGE_OPCODE = 0x03, 0x04, 0x05
 _MESSAGE = struct.Struct("<HIQQ")  # a message's channel id, sequence, log and publish times
 _RECORD_HEAD = 1024  # bytes of a record besides its payload (a message's or chunk's header)
+# bytes of chunks (uncompressed) a reader keeps parsed, so that reading topic after topic
+# decompresses each chunk once: a grasp run's log is ~21 MB, make run's longest ~47 MB
+CACHED_CHUNK_BYTES = 128 * 1024 * 1024
 
 
 def content_end(f, size: int) -> tuple[int, bool]:
@@ -429,6 +432,11 @@ class LogReader(LogMessages):
             raise NotALogError(f"{self.path}: not an MCAP log (bad magic bytes)")
         self._start_reading()
         self._bad_chunks: dict[int, str] = {}  # chunk offset -> why it does not read
+        # chunk offset -> channel id -> [(place in the chunk, message)]: each chunk read once
+        # (a grasp log is ~30 topics in 80 chunks, its analysis reads each topic), up to
+        # CACHED_CHUNK_BYTES of them uncompressed; past that a chunk is read again when asked
+        self._chunk_messages: dict[int, dict[int, list[tuple[int, Message]]]] = {}
+        self._cached_bytes = 0
         self._checked = False
         self._end = self.size  # where the records end (before zeros or garbage)
         self._summary = self._read_summary() if tail == MAGIC else None
@@ -607,6 +615,23 @@ class LogReader(LogMessages):
             f"read ({type(exc).__name__}): its messages are missing, the other chunks are read"
         )
 
+    def _messages_of(self, f, index) -> dict[int, list[tuple[int, Message]]]:
+        """The messages of the chunk an index entry points at, by channel (those the summary
+        names), each with its place in the chunk: read once and kept while the kept chunks
+        stay under CACHED_CHUNK_BYTES uncompressed."""
+        kept = self._chunk_messages.get(index.chunk_start_offset)
+        if kept is not None:
+            return kept
+        channels = self._summary.channels if self._summary is not None else {}
+        by_channel: dict[int, list[tuple[int, Message]]] = {}
+        for i, record in enumerate(self._read_chunk(f, index)):
+            if isinstance(record, Message) and record.channel_id in channels:
+                by_channel.setdefault(record.channel_id, []).append((i, record))
+        if self._cached_bytes + index.uncompressed_size <= CACHED_CHUNK_BYTES:
+            self._cached_bytes += index.uncompressed_size
+            self._chunk_messages[index.chunk_start_offset] = by_channel
+        return by_channel
+
     def _indexed(self, wanted) -> Iterator[tuple[Any, Channel, Message]]:
         """(schema, channel, message) through the index, in log-time order (ties in file
         order), chunk by chunk: a message is handed on once no chunk still to be read can
@@ -635,16 +660,16 @@ class LogReader(LogMessages):
                     _, _, _, channel, msg = heapq.heappop(heap)
                     yield schemas.get(channel.schema_id), channel, msg
                 try:
-                    records = self._read_chunk(f, c)
+                    by_channel = self._messages_of(f, c)
                 except LogLimitError:
                     raise
                 except Exception as exc:  # noqa: BLE001 - any damage of its bytes
                     self._bad_chunk(number[c.chunk_start_offset], len(indexes), c, exc)
                     continue
-                for i, record in enumerate(records):
-                    if isinstance(record, Message) and record.channel_id in channels:
-                        channel = channels[record.channel_id]
-                        if wanted is None or channel.topic in wanted:
+                for channel_id, messages in by_channel.items():
+                    channel = channels[channel_id]
+                    if wanted is None or channel.topic in wanted:
+                        for i, record in messages:
                             item = (record.log_time, c.chunk_start_offset, i, channel, record)
                             heapq.heappush(heap, item)
         while heap:
