@@ -55,6 +55,23 @@ def _flat(data: Any, prefix: str = "") -> dict[str, Any]:
     return {prefix.rstrip("."): data}
 
 
+_TYPED: weakref.WeakKeyDictionary[LogReader, Any] = weakref.WeakKeyDictionary()
+
+
+def typed_scenario(reader: LogReader):
+    """The log's stored scenario loaded as the loader types it (known plug-ins only), once per
+    reader: the claims and figures ask it of one log many times (~20 ms of YAML each). The
+    caller reads it, never changes it. Raises what ``scenario_from_text`` raises."""
+    from replay.scenario import scenario_from_text
+
+    typed = _TYPED.get(reader)
+    if typed is None:
+        name = f"{reader.path.name}:/scenario"
+        typed = scenario_from_text(reader.scenario()["yaml"], name=name, plugins="known-only")
+        _TYPED[reader] = typed
+    return typed
+
+
 def current_config(reader: LogReader) -> dict[str, Any]:
     """The log's resolved scenario; an old one's (its plant type since renamed) as the loader
     reads it now: the type's name now, fields since moved in their places (a ``Params``'

@@ -3,10 +3,11 @@ and which runs are the paper's own experiment: what the claims table and the fig
 
 from __future__ import annotations
 
+import copy
+
 from dataclasses import dataclass, field
 
 import numpy as np
-import yaml
 
 from analysis.series import events
 from plants.arm_rig.settings import ArmSettings, resolve
@@ -22,7 +23,7 @@ from replay.messages import (
     TOPIC_OPTIMIZATION_COST,
     TOPIC_VISION_OBJECT,
 )
-from replay.scenario import scenario_from_text
+from analysis.runs import typed_scenario
 
 ACTIVE = (0, 1, 3)  # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
 
@@ -53,7 +54,7 @@ def scope(name: str) -> str:
 
 
 def _scenario(log: LogReader) -> dict:
-    return yaml.safe_load(log.scenario()["yaml"])
+    return copy.deepcopy(log.scenario_config())
 
 
 def _vec(rows: list[dict], key: str) -> np.ndarray:
@@ -124,9 +125,7 @@ class CatchRun:
 
 def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     sc = _scenario(log)
-    typed = scenario_from_text(
-        log.scenario()["yaml"], name=f"{log.path.name}:/scenario", plugins="known-only"
-    )
+    typed = typed_scenario(log)
     eff = [m for m in log.series(TOPIC_EFFECTOR_STATE) if m["desired_position"] and m["position"]]
     cmd = log.series(TOPIC_ARM_JOINT_COMMAND)
     cmd_t = {round(m["t"], 9): m for m in cmd}

@@ -11,11 +11,12 @@ plant's grasp/release events.
 
 from __future__ import annotations
 
+import copy
+
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-import yaml
 
 from analysis.series import events
 from replay.log import LogReader
@@ -218,7 +219,7 @@ def _first3(rows: list[dict], key: str) -> np.ndarray:
 
 
 def load_run(log: LogReader, name: str | None = None) -> GraspRun:
-    sc = yaml.safe_load(log.scenario()["yaml"])
+    sc = copy.deepcopy(log.scenario_config())
     eff = [m for m in log.series(T_ARM_TASK) if m.get("x_a") and m.get("x_d") and m.get("x_o")]
     ob = log.series(T_OBJECT)
     arm = log.series(T_ARM)

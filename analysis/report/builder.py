@@ -15,6 +15,8 @@ both pages (``markup``), and the report links only files inside its own folder (
 
 from __future__ import annotations
 
+import copy
+
 import platform
 import re
 import shlex
@@ -155,7 +157,7 @@ def _controllers(runs, readers) -> set[str]:
         if r is None:
             continue
         try:
-            kind = yaml.safe_load(r.scenario()["yaml"])["controller"]["type"]
+            kind = copy.deepcopy(r.scenario_config())["controller"]["type"]
         except (LogError, yaml.YAMLError, KeyError, TypeError):
             continue
         if isinstance(kind, str):

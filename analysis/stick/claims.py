@@ -47,7 +47,7 @@ from analysis.stick.run import (
 )
 from replay.messages import TOPIC_STICK_STATE
 from replay.resources import data_path
-from replay.scenario import scenario_from_text
+from analysis.runs import typed_scenario
 from replay.robot.stick_impact import (
     pure_rotation_min_spin,
     quadratic_roots,
@@ -264,7 +264,7 @@ def _capture_decided(name: str, logs: dict[str, LogReader]) -> bool:
 
 def _captured_row(log: LogReader, name: str, st: dict) -> Claim:
     o = outcome(log)
-    dur = scenario_from_text(log.scenario()["yaml"], plugins="known-only").timing.duration
+    dur = typed_scenario(log).timing.duration
     t_stated = st["results"]["t_stopped"]["value"]
     if o.get("captured"):
         t = o["t_capture"]

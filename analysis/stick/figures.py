@@ -3,6 +3,8 @@ during the capture, collision instants marked — drawn from a run's log."""
 
 from __future__ import annotations
 
+import copy
+
 from pathlib import Path
 
 import matplotlib
@@ -10,7 +12,6 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-import yaml  # noqa: E402
 
 from analysis.figure_files import save  # noqa: E402
 from analysis import line_labels  # noqa: E402
@@ -90,7 +91,7 @@ def friction_overlay(logs: dict[str, LogReader], labels: dict[str, str] | None =
 
 def _params(log: LogReader) -> Params:
     """The air table's typed params, rebuilt from the log's resolved scenario by the loader."""
-    sc = yaml.safe_load(log.scenario()["yaml"])
+    sc = copy.deepcopy(log.scenario_config())
     return params_from_data(Params, sc["plant"].get("params"), "plant.params")
 
 
@@ -114,7 +115,7 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
         )
     by_strategy: dict[str, dict[str, LogReader]] = {}
     for name, log in logs.items():
-        sc = yaml.safe_load(log.scenario()["yaml"])
+        sc = copy.deepcopy(log.scenario_config())
         if _params(log).stick.collision_width == 0.0:
             by_strategy.setdefault(sc["controller"]["type"], {})[name] = log
     for strategy, group in sorted(by_strategy.items()):

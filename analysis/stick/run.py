@@ -3,14 +3,15 @@ outcome, when the stick stopped, and the plant's and controller's parameters it 
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
-import yaml
 
 from analysis.series import arrays, events
 from plants.airtable.params import Params as AirTableParams
 from replay.log import LogReader
 from replay.messages import TOPIC_STICK_STATE
-from replay.scenario import scenario_from_text
+from analysis.runs import typed_scenario
 
 
 def collision(log: LogReader, index: int) -> dict | None:
@@ -35,8 +36,7 @@ def time_stopped(log: LogReader, speed: float = 0.02) -> float | None:
 
 
 def plant_params(log: LogReader) -> AirTableParams:
-    text = log.scenario()["yaml"]
-    plant = scenario_from_text(text, plugins="known-only").plant.params  # typed by the loader
+    plant = typed_scenario(log).plant.params  # typed by the loader
     assert isinstance(plant, AirTableParams)
     return plant
 
@@ -47,4 +47,4 @@ def outcome(log: LogReader) -> dict:
 
 
 def controller_params(log: LogReader) -> dict:
-    return yaml.safe_load(log.scenario()["yaml"])["controller"].get("params", {}) or {}
+    return copy.deepcopy(log.scenario_config())["controller"].get("params", {}) or {}
