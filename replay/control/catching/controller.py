@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from replay.control.catching.base import CatchArmController
+from replay.control.catching.payloads import CatchingState
 from replay.control.catching.estimator import BallisticEstimator, LastFrameEstimator
 from replay.control.catching.optimise import (
     CostRecord,
@@ -47,7 +48,7 @@ from replay.control.catching.optimise import (
 from replay.control.catching.model import ARM_JOINTS
 from replay.control.catching.problem import ProblemConfig, build_problem
 from replay.interfaces import Occurrence
-from replay.messages import TOPIC_CATCHING_STATE, TOPIC_OPTIMIZATION_COST, OptimizationCost, Vec3
+from replay.messages import TOPIC_CATCHING_STATE, TOPIC_OPTIMIZATION_COST, OptimizationCost
 from replay.params import ParamError, param
 from replay.robot.arm_types import ArmCommand, ArmSpec
 
@@ -275,21 +276,6 @@ def problem_config(
         torque_cost=P.torque_cost,
         excess_weight=P.excess_weight,
     )
-
-
-@dataclass
-class CatchingState:
-    """``/catching/state``: the mapping's inner quantities at a control step."""
-
-    t: float
-    r_o: Vec3  # used object position (m)
-    r_o_velocity: Vec3  # estimated (m/s)
-    q_o: list[float]  # l_c^-1(r_o), active joints (rad)
-    velocity_desired: list[float]  # qd_d (rad/s), all arm joints
-    in_domain: bool
-    predicted_catch_time: float  # s, -1 if unknown
-    hand_closing: bool
-    holding: bool
 
 
 # the annotations' name for Params (inside the controller, ``Params`` is its class attribute)
