@@ -64,6 +64,19 @@ def test_rows_that_part_say_so():
     assert "q (PyBullet reproduced, MuJoCo differs)" in closing_note(rows)
 
 
+def test_a_row_an_engine_did_not_run_is_not_compared():
+    # MuJoCo's logs lack the row's runs (its evaluate says "not run", with why): no engine
+    # comparison, so the closing note does not say it holds in both
+    a = [Claim("q", "1", "caught", "reproduced", "")]
+    b = [Claim("q", "1", "(no catch_optimised log)", "not run", "")]
+    rows = join({"PyBullet": a, "MuJoCo": b})
+    assert rows[0].measured == "PyBullet: caught ‖ MuJoCo: not run (no catch_optimised log)"
+    assert rows[0].status == "reproduced"  # the engine that ran decides the row
+    note = closing_note(rows).splitlines()
+    assert note[0] == "Hold in both engines (0): none."
+    assert note[-1] == "Run in one engine only, not compared: 1 rows."
+
+
 def test_any_number_of_engines_join_and_the_note_says_all():
     a = [Claim("q", "1", "1.0", "reproduced", ""), Claim("r", "1", "1", "reproduced", "")]
     b = [Claim("q", "1", "2.0", "reproduced", ""), Claim("r", "1", "1", "reproduced", "")]
