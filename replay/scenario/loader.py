@@ -4,7 +4,9 @@
   key, anything else is replaced, and a plug-in section whose ``type:`` changes is replaced
   whole.
 - ``--set key.path=value`` overrides one field (the value is read as YAML); one that changes a
-  plug-in's ``type`` drops that section's ``params`` (they belong to the other plug-in).
+  plug-in's ``type`` drops that section's ``params`` (they belong to the other plug-in), one
+  that changes a ``type`` inside params (``plant.params.engine.type``) drops the settings
+  beside it.
 - A plug-in ``type`` is an installed plug-in's name or an import path ``module:Class``, imported
   from the folder of the file that wrote it (the cwd for ``--set``) when a scenario is loaded
   to run, never when a log's stored scenario is read (``plugins="known-only"``).
@@ -222,7 +224,7 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
         found = _get(node, key)
         if last:
             if found and key == "type" and not _same_scalar(found[1], value):
-                _pop(node, "params")  # another plug-in: the old one's params do not apply
+                _drop_settings(node, inside_params="params" in keys[:-1])
                 found = _get(node, key)
             if found:
                 node.value[node.value.index(found)] = (found[0], value)
@@ -246,6 +248,16 @@ def _apply_set(root: yaml.MappingNode, assignment: str) -> None:
                 f"--set {key_path}: {'.'.join(keys[: depth + 1])} is not a mapping",
                 file=_SET_SOURCE,
             )
+
+
+def _drop_settings(node: yaml.MappingNode, inside_params: bool) -> None:
+    """What belonged to the ``type`` a ``--set`` replaces: a plug-in section's ``params`` (its
+    rate and wiring stay the runner's), or, for a typed mapping inside params (the engine's
+    ``{type: drake, dk_...}``), every setting beside the type, as ``extends:`` replaces it."""
+    if not inside_params:
+        _pop(node, "params")
+        return
+    node.value[:] = [(k, v) for k, v in node.value if k.value == "type"]
 
 
 def _same_scalar(a: yaml.Node, b: yaml.Node) -> bool:
