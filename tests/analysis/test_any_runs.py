@@ -101,6 +101,25 @@ def test_catch_variants_are_overlaid_on_the_pair_and_labelled(catch, tmp_path):
     assert "stereo latency 10 ms" in svg  # the legend says what differs
 
 
+def test_a_lone_variant_is_named_by_what_it_changes(catch, tmp_path):
+    """Without the shipped run among the logs a variant keeps the plain key (the paper's rows
+    find it), but its figures say what it changes: titles and legends, catch and grasp."""
+    from analysis.catching.figures import make_figures
+
+    paths = make_figures(runs.keyed([LogReader(catch["lat"])]), tmp_path)
+    assert {p.name for p in paths} >= {f"catch_fig{k}.svg" for k in (6, 7, 8, 9)}
+    for k in (6, 7, 8, 9):
+        svg = (tmp_path / f"catch_fig{k}.svg").read_text()
+        assert "catch_optimised (stereo latency 10 ms)" in svg, k
+    g = run(
+        tmp_path / "g.mcap", "grasp_sphere", "timing.duration=0.1", "plant.params.human_speed=0.3"
+    )
+    r = invoke("figures", g, "-o", tmp_path / "g")
+    assert r.exit_code == 0, r.output
+    for svg in (tmp_path / "g").glob("*.svg"):
+        assert "grasp_sphere (human speed 0.3, duration 100 ms)" in svg.read_text(), svg.name
+
+
 def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     """A controller that publishes no /effector/state: Figs. 7-9 and the claims rows that read
     it are left out for that run with a note naming the topic; the rest is made."""
