@@ -120,6 +120,21 @@ def test_a_lone_variant_is_named_by_what_it_changes(catch, tmp_path):
         assert "grasp_sphere (human speed 0.3, duration 100 ms)" in svg.read_text(), svg.name
 
 
+def test_the_claims_say_when_the_papers_run_is_a_variant(catch, tmp_path):
+    """A variant alone takes its scenario's plain name, so the paper's rows read it as the
+    paper's run: the claims say so (stderr and the Markdown table); beside the shipped run
+    the variant has a key of its own and nothing is said."""
+    md = tmp_path / "claims.md"
+    r = invoke("claims", catch["lat"], "--markdown", md)
+    assert r.exit_code == 0, r.output
+    said = [line for line in r.stderr.splitlines() if "stereo latency 10 ms" in line]
+    assert len(said) == 1 and said[0].startswith("warning: catch_optimised"), r.stderr
+    assert "not the shipped scenario" in said[0]
+    assert "not the shipped scenario" in md.read_text()
+    both = invoke("claims", catch["opt"], catch["lat"], catch["renamed"])  # catch_lat10: named
+    assert both.exit_code == 0 and "not the shipped scenario" not in both.stderr, both.stderr
+
+
 def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     """A controller that publishes no /effector/state: Figs. 7-9 and the claims rows that read
     it are left out for that run with a note naming the topic; the rest is made."""
