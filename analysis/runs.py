@@ -250,7 +250,9 @@ def name_of(reader: LogReader) -> str:
 
 def unreadable(reader: LogReader) -> str:
     """Why ``reader``'s log is no run the analysis can read, "" when it is one: its /scenario
-    message can be read and names a paper and a scenario."""
+    message can be read, names a paper and a scenario, and its plant's params type here as the
+    analysis types them (a value of the wrong type, an engine not registered here do not; a
+    plant not installed here keeps them as data)."""
     try:
         sc = reader.scenario()
     except LogError as exc:
@@ -258,4 +260,22 @@ def unreadable(reader: LogReader) -> str:
     paper, name = sc.get("paper"), sc.get("name")
     if not (isinstance(paper, str) and paper and isinstance(name, str) and name):
         return "its /scenario message names no paper or scenario (not a run log?)"
+    return _untyped_plant(reader)
+
+
+def _untyped_plant(reader: LogReader) -> str:
+    """Why the stored plant's params do not type with its installed plant's ``Params``."""
+    from replay import registry
+    from replay.scenario import ScenarioError, params_from_data
+
+    plant = reader.scenario_config().get("plant") or {}
+    kind = plant.get("type")
+    if not (isinstance(kind, str) and registry.known("plant", kind)):
+        return ""
+    cls = getattr(registry.load("plant", kind), "Params", None)
+    try:
+        if cls is not None:
+            params_from_data(cls, plant.get("params"), "plant.params", "<stored plant.params>")
+    except ScenarioError as exc:
+        return f"its stored plant does not load here: {exc}"
     return ""
