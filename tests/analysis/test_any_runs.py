@@ -135,6 +135,21 @@ def test_the_claims_say_when_the_papers_run_is_a_variant(catch, tmp_path):
     assert both.exit_code == 0 and "not the shipped scenario" not in both.stderr, both.stderr
 
 
+def test_a_catch_cut_before_the_ball_arrives_decides_no_arrival_row(tmp_path):
+    """A run that ends before the ball reaches the hand (a short duration, a truncated log, a
+    throw that misses) has no arrival speed: the rows that compare the paper's numbers with it
+    say so, and the acceleration row is no verdict ("consistent" read a NaN before)."""
+    from analysis.catching.claims import evaluate
+
+    log = run(tmp_path / "short.mcap", "catch_optimised", "timing.duration=0.15")
+    rows = {r.quantity: r for r in evaluate({"catch_optimised": LogReader(log)})}
+    acc = rows["end-effector maximum acceleration"]
+    assert acc.status == "not run" and "nan" not in acc.measured, acc
+    assert "did not reach the hand" in acc.measured
+    speed = rows["hand speed eq. 4 demands at t_c vs the arm's 5 m/s"]
+    assert "nan" not in speed.measured and "did not reach the hand" in speed.measured, speed
+
+
 def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     """A controller that publishes no /effector/state: Figs. 7-9 and the claims rows that read
     it are left out for that run with a note naming the topic; the rest is made."""
