@@ -29,7 +29,7 @@ from replay.scenario.yamlio import one_line
 MAX_ITEMS = 3  # differences named in a label ("+N more" after)
 LABEL_LENGTH = 80  # characters of a label
 _IGNORED = {"name", "description", "notes", "paper"}
-_SECONDS = {"latency", "duration", "after"}  # fields in s, written in ms below 1 s
+_SECONDS = {"latency", "duration", "after"}  # fields in s, written in ms below 1 s, else in s
 
 
 @dataclass(frozen=True)
@@ -118,8 +118,8 @@ def _item(path: str, value: Any) -> str:
         what = "engine"
     else:
         what = parts[-1].replace("_", " ")
-    if parts[-1] in _SECONDS and isinstance(value, (int, float)) and 0 < value < 1:
-        return f"{what} {1000 * value:g} ms"
+    if parts[-1] in _SECONDS and type(value) in (int, float) and value > 0:
+        return f"{what} {1000 * value:g} ms" if value < 1 else f"{what} {value:g} s"
     return f"{what} {_short(value)}"
 
 

@@ -281,6 +281,14 @@ def test_each_log_gets_its_key_and_label(stick, catch):
     assert runs.titled("catch_lat10", logs[2]) == "catch_lat10 (stereo latency 10 ms)"
 
 
+def test_a_label_gives_seconds_their_unit():
+    """A time in s is written in ms below 1 s and in s from 1 s ("duration 1" said no unit)."""
+    ref = {"timing.duration": 2.0, "sensors.chip.latency": 0.001, "stop.after": 0.1}
+    assert runs.differences(
+        {"timing.duration": 1.0, "sensors.chip.latency": 0.0025, "stop.after": 12}, ref
+    ) == ["chip latency 2.5 ms", "after 12 s", "duration 1 s"]
+
+
 def test_a_renamed_run_with_another_controller_is_a_variant_of_the_papers_own():
     """A user's scenario ``extends: catch_optimised`` with its own controller is as far from
     every catch scenario that differs only in controller params: it is compared with the
