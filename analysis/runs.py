@@ -202,7 +202,8 @@ def label(reader: LogReader) -> str:
 def keyed(readers: Iterable[LogReader]) -> dict[str, LogReader]:
     """A unique key per log (in the order given): the scenario name; a second log of that name
     gets the name and its label (``name (label)``), or ``name #2``; the log matching the shipped
-    scenario keeps the plain name."""
+    scenario keeps the plain name. No key is another run's title (:func:`titled`: a plain key
+    with its label): a second log of the plain key's variant is ``name (label) #2``."""
     runs = [describe(r) for r in readers]
     taken: dict[str, int] = {}
     for r in runs:
@@ -214,13 +215,14 @@ def keyed(readers: Iterable[LogReader]) -> dict[str, LogReader]:
         if r.name not in first or (not r.label and first[r.name].label):
             first[r.name] = r
     out: dict[str, LogReader] = {}
+    titles = {f"{f.name} ({f.label})" for f in first.values() if f.label}  # the plain keys' titles
     for r in runs:
         key = r.name
         if first[r.name] is not r:
             key = f"{r.name} ({r.label})" if r.label else r.name
         n = 2
         base = key
-        while key in out:
+        while key in out or (key != r.name and key in titles):
             key, n = f"{base} #{n}", n + 1
         _RUNS[r.reader] = Run(key, r.name, r.paper, r.label, r.experiment, r.reader)
         out[key] = r.reader

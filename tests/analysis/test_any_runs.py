@@ -281,6 +281,21 @@ def test_each_log_gets_its_key_and_label(stick, catch):
     assert runs.titled("catch_lat10", logs[2]) == "catch_lat10 (stereo latency 10 ms)"
 
 
+def test_two_logs_of_one_variant_are_named_apart(stick, tmp_path):
+    """Two logs of the same variant (a copy, a truncated one) without the shipped run: the
+    first keeps the plain key and is titled with its label, so the second's key must differ
+    from that title (compare's warnings name the second by its key)."""
+    import shutil
+
+    copy = tmp_path / "copy.mcap"
+    shutil.copy(stick["mu1"], copy)
+    keyed = runs.keyed([LogReader(stick["mu1"]), LogReader(copy)])
+    titles = [runs.titled(k, r) for k, r in keyed.items()]
+    assert len(set(titles)) == 2, titles
+    assert titles[0] == "stick_3step (friction 1, duration 300 ms)"
+    assert titles[1] == "stick_3step (friction 1, duration 300 ms) #2"
+
+
 def test_a_label_gives_seconds_their_unit():
     """A time in s is written in ms below 1 s and in s from 1 s ("duration 1" said no unit)."""
     ref = {"timing.duration": 2.0, "sensors.chip.latency": 0.001, "stop.after": 0.1}
