@@ -150,6 +150,17 @@ def test_a_catch_cut_before_the_ball_arrives_decides_no_arrival_row(tmp_path):
     assert "nan" not in speed.measured and "did not reach the hand" in speed.measured, speed
 
 
+def test_a_stick_throw_the_plan_never_reached_names_no_nan(tmp_path):
+    """With no spin (ω_0 = 0) the 3-step finds no reachable contact, its collisions come by
+    chance and no plan of the second is logged: the r_x,2 row says so (it read "nan mm")."""
+    from analysis.stick.claims import evaluate
+
+    log = run(tmp_path / "w0.mcap", "stick_3step", "plant.params.initial.omega=0")
+    rows = {r.quantity: r for r in evaluate({"stick_3step": LogReader(log)})}
+    row = rows["fingertip position r_x,2"]
+    assert "nan" not in row.note and "no plan of collision 2" in row.note, row
+
+
 def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     """A controller that publishes no /effector/state: Figs. 7-9 and the claims rows that read
     it are left out for that run with a note naming the topic; the rest is made."""
