@@ -298,7 +298,7 @@ def compare(logs, out, no_figures, markdown) -> None:
     "--logs",
     "logs_dir",
     type=click.Path(file_okay=False, exists=True),
-    help="baseline logs from this folder (e.g. out/logs) instead of fresh runs (a variant: left out)",
+    help="baseline logs from this folder (e.g. out/logs), not fresh runs (a variant: left out)",
 )
 @click.option(
     "--keep",

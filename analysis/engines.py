@@ -132,12 +132,12 @@ def _row(claims: Mapping[str, Claim | None]) -> Claim:
 def _measured(claim: Claim | None) -> str:
     """An engine's part of a joined row: its measurement, or "not run" first (and why, where
     its rows say), which ``closing_note`` reads as no verdict of that engine."""
-    if claim is None:
+    if claim is None or (claim.status == "not run" and not claim.measured):
         return "not run"
     if claim.status != "not run":
         return claim.measured
     why = claim.measured if claim.measured.startswith("(") else f"({claim.measured})"
-    return f"not run {why}" if claim.measured else "not run"
+    return f"not run {why}"
 
 
 def engine_rows(evaluate: Callable[[dict], list[Claim]], logs: Mapping[str, Any]) -> list[Claim]:

@@ -3,9 +3,10 @@
 For a paper, the baseline logs are its default scenarios (those ``make run`` runs:
 ``scenarios/{stick,catch,grasp}_*.yaml`` whose ``paper`` is it) run into a folder, or the logs
 already in ``--logs DIR`` that are runs of a scenario as shipped (a variant, one with a
-``--set``, is left out with a note: the falsifiers run the shipped scenario). Each :class:`~analysis.claims.Falsifier` the paper's claims module
-declares is then run (its scenario with its overrides) and stands in for the log it
-``replaces``; the paper's rows are evaluated again and the falsifier's row must read "differs".
+``--set``, is left out with a note: the falsifiers run the shipped scenario). Each
+:class:`~analysis.claims.Falsifier` the paper's claims module declares is then run (its scenario
+with its overrides) and stands in for the log it ``replaces``; the paper's rows are evaluated
+again and the falsifier's row must read "differs".
 
 A measured row that is "reproduced" at baseline and has no falsifier, or whose falsifier leaves
 it anything but "differs", fails the check. Rows of other kinds (``other regime``,
