@@ -385,7 +385,7 @@ def _range_row(runs: dict[str, CatchRun]) -> list[Claim]:
         ok = ok and caught
         touch = _touch(o)
         parts.append(
-            f"{sp[0] if sp else float('nan'):.2f} m/s: "
+            (f"{sp[0]:.2f} m/s: " if sp else "the ball never seen: ")
             + (
                 f"caught at t = {catch['t']:.3f} s"
                 if caught and catch is not None

@@ -148,6 +148,10 @@ def test_a_catch_cut_before_the_ball_arrives_decides_no_arrival_row(tmp_path):
     assert "did not reach the hand" in acc.measured
     speed = rows["hand speed eq. 4 demands at t_c vs the arm's 5 m/s"]
     assert "nan" not in speed.measured and "did not reach the hand" in speed.measured, speed
+    early = run(tmp_path / "early.mcap", "catch_optimised", "timing.duration=0.05")
+    rows = {r.quantity: r for r in evaluate({"catch_optimised": LogReader(early)})}
+    throws = rows["catch over the stated throws, 8 ~ 10 m/s"]  # (ended before t0: never seen)
+    assert "nan" not in throws.measured and "never seen" in throws.measured, throws
 
 
 def test_a_stick_throw_the_plan_never_reached_names_no_nan(tmp_path):
