@@ -40,7 +40,8 @@ def test_every_catch_row_shows_both_engines(logs):
     assert {r.quantity for r in rows} == {r.quantity for r in evaluate(pb)}
     for r in rows:
         assert r.measured.startswith("PyBullet: ") and " ‖ MuJoCo: " in r.measured, r.quantity
-        assert "not run" not in r.measured, r.quantity
+        if r.status != "not run":  # (a row neither engine's logs decide says "not run" in both)
+            assert "not run" not in r.measured, r.quantity
     # the optimised catch is the paper's throws' row, the unoptimised one a note of its own
     caught = {r.quantity: r for r in rows if "caught" in r.quantity or "throws, 8" in r.quantity}
     assert set(caught) == {"catch over the stated throws, 8 ~ 10 m/s", "catch_initial: ball caught"}
