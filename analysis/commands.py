@@ -163,6 +163,7 @@ def claims(logs, markdown):
             fail(str(exc))
         except Exception as exc:  # noqa: BLE001 - analysis of a damaged log: one line
             _analysis_failed("claims", paper, readers, exc)
+        skipped = [*_variants_read_as_shipped(readers), *skipped]
         for text in skipped:
             warn(text)
         title = registered()[paper].title if paper in registered() else paper
@@ -178,6 +179,22 @@ def claims(logs, markdown):
     if markdown:  # (the log's names escaped: no raw HTML where the Markdown is rendered)
         text = "\n\n".join([CLAIMS_HEADER, *md_sections]) + "\n"
         write_text(Path(markdown), text, kind="claims table", magic=CLAIMS_HEADER.encode())
+
+
+def _variants_read_as_shipped(readers: dict[str, LogReader]) -> list[str]:
+    """A note per log that changes its scenario yet holds its plain name (no run of the
+    scenario as shipped among the logs): the paper's rows read it as the paper's run."""
+    from analysis.runs import describe
+
+    out = []
+    for key, r in readers.items():
+        run = describe(r, key)
+        if run.label and key == run.name == run.experiment:  # (a shipped name, kept plain)
+            out.append(
+                f"{key}: this log is a variant ({run.label}), not the shipped scenario: the rows "
+                f"that read {key} describe the variant"
+            )
+    return out
 
 
 @click.command()
@@ -281,7 +298,7 @@ def compare(logs, out, no_figures, markdown) -> None:
     "--logs",
     "logs_dir",
     type=click.Path(file_okay=False, exists=True),
-    help="baseline logs from this folder (e.g. out/logs) instead of fresh runs",
+    help="baseline logs from this folder (e.g. out/logs), not fresh runs (a variant: left out)",
 )
 @click.option(
     "--keep",

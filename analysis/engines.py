@@ -123,10 +123,21 @@ def _row(claims: Mapping[str, Claim | None]) -> Claim:
         final = "differs" if "reproduced" in ran else ran[-1]
         parted = "engines part: " + ", ".join(f"{e} {s}" for e, s in status.items())
     note = "; ".join(x for x in (parted, ref.note) if x)
-    measured = " ‖ ".join(f"{e}: {c.measured if c else 'not run'}" for e, c in claims.items())
+    measured = " ‖ ".join(f"{e}: {_measured(c)}" for e, c in claims.items())
     return Claim(
         ref.quantity, ref.stated, measured, final, note, kind=ref.kind, measures=ref.measures
     )
+
+
+def _measured(claim: Claim | None) -> str:
+    """An engine's part of a joined row: its measurement, or "not run" first (and why, where
+    its rows say), which ``closing_note`` reads as no verdict of that engine."""
+    if claim is None or (claim.status == "not run" and not claim.measured):
+        return "not run"
+    if claim.status != "not run":
+        return claim.measured
+    why = claim.measured if claim.measured.startswith("(") else f"({claim.measured})"
+    return f"not run {why}"
 
 
 def engine_rows(evaluate: Callable[[dict], list[Claim]], logs: Mapping[str, Any]) -> list[Claim]:
@@ -241,7 +252,7 @@ def closing_note(rows: Sequence[Claim]) -> str:
             continue
         parts = r.measured.split(" ‖ ")
         n = max(n, len(parts))
-        if any(p.endswith(": not run") for p in parts):
+        if any(p.partition(": ")[2].startswith("not run") for p in parts):
             single += 1  # not run in every engine: no cross-engine verdict
             continue
         if r.status == "reproduced":

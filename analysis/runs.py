@@ -30,7 +30,7 @@ from replay.scenario.yamlio import one_line
 MAX_ITEMS = 3  # differences named in a label ("+N more" after)
 LABEL_LENGTH = 80  # characters of a label
 _IGNORED = {"name", "description", "notes", "paper"}
-_SECONDS = {"latency", "duration", "after"}  # fields in s, written in ms below 1 s
+_SECONDS = {"latency", "duration", "after"}  # fields in s, written in ms below 1 s, else in s
 
 
 @dataclass(frozen=True)
@@ -156,8 +156,8 @@ def _item(path: str, value: Any) -> str:
         what = "engine"
     else:
         what = parts[-1].replace("_", " ")
-    if parts[-1] in _SECONDS and isinstance(value, (int, float)) and 0 < value < 1:
-        return f"{what} {1000 * value:g} ms"
+    if parts[-1] in _SECONDS and type(value) in (int, float) and value > 0:
+        return f"{what} {1000 * value:g} ms" if value < 1 else f"{what} {value:g} s"
     return f"{what} {_short(value)}"
 
 
@@ -240,7 +240,8 @@ def label(reader: LogReader) -> str:
 def keyed(readers: Iterable[LogReader]) -> dict[str, LogReader]:
     """A unique key per log (in the order given): the scenario name; a second log of that name
     gets the name and its label (``name (label)``), or ``name #2``; the log matching the shipped
-    scenario keeps the plain name."""
+    scenario keeps the plain name. No key is another run's title (:func:`titled`: a plain key
+    with its label): a second log of the plain key's variant is ``name (label) #2``."""
     runs = [describe(r) for r in readers]
     taken: dict[str, int] = {}
     for r in runs:
@@ -252,13 +253,14 @@ def keyed(readers: Iterable[LogReader]) -> dict[str, LogReader]:
         if r.name not in first or (not r.label and first[r.name].label):
             first[r.name] = r
     out: dict[str, LogReader] = {}
+    titles = {f"{f.name} ({f.label})" for f in first.values() if f.label}  # the plain keys' titles
     for r in runs:
         key = r.name
         if first[r.name] is not r:
             key = f"{r.name} ({r.label})" if r.label else r.name
         n = 2
         base = key
-        while key in out:
+        while key in out or (key != r.name and key in titles):
             key, n = f"{base} #{n}", n + 1
         _RUNS[r.reader] = Run(key, r.name, r.paper, r.label, r.experiment, r.reader)
         out[key] = r.reader
@@ -288,7 +290,9 @@ def name_of(reader: LogReader) -> str:
 
 def unreadable(reader: LogReader) -> str:
     """Why ``reader``'s log is no run the analysis can read, "" when it is one: its /scenario
-    message can be read and names a paper and a scenario."""
+    message can be read, names a paper and a scenario, and its plant's params type here as the
+    analysis types them (a value of the wrong type, an engine not registered here do not; a
+    plant not installed here keeps them as data)."""
     try:
         sc = reader.scenario()
     except LogError as exc:
@@ -296,4 +300,22 @@ def unreadable(reader: LogReader) -> str:
     paper, name = sc.get("paper"), sc.get("name")
     if not (isinstance(paper, str) and paper and isinstance(name, str) and name):
         return "its /scenario message names no paper or scenario (not a run log?)"
+    return _untyped_plant(reader)
+
+
+def _untyped_plant(reader: LogReader) -> str:
+    """Why the stored plant's params do not type with its installed plant's ``Params``."""
+    from replay import registry
+    from replay.scenario import ScenarioError, params_from_data
+
+    plant = reader.scenario_config().get("plant") or {}
+    kind = plant.get("type")
+    if not (isinstance(kind, str) and registry.known("plant", kind)):
+        return ""
+    cls = getattr(registry.load("plant", kind), "Params", None)
+    try:
+        if cls is not None:
+            params_from_data(cls, plant.get("params"), "plant.params", "<stored plant.params>")
+    except ScenarioError as exc:
+        return f"its stored plant does not load here: {exc}"
     return ""

@@ -299,6 +299,11 @@ def optimise(scenario, out, quiet):
         fail("the scenario sets no controller.params.alpha_file: give -o FILE")
     base = getattr(sc.controller.params, "scenario_dir", "")  # files resolve from the scenario
     path = Path(out) if out else Path(base, stored).resolve() if base else Path(stored)
+    if not out and base and sc.inputs and Path(base).resolve() != sc.inputs[0].parent.resolve():
+        fail(  # (an extended scenario's file, e.g. the shipped mapping: never replaced so)
+            f"the alpha_file {path} is named by a scenario {scenario} extends: give -o FILE.json "
+            "(and controller.params.alpha_file: FILE.json) for one of its own"
+        )
     if path.resolve() in set(sc.inputs) or path.suffix in (".yaml", ".yml", ".mcap"):
         fail(
             f"will not write the optimisation over {path} (a scenario or a log): give -o FILE.json"

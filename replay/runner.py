@@ -408,4 +408,9 @@ class Runner:
         if self._nan is not None:
             data, self._nan = self._nan, None
             self._hand()
-            raise NonFiniteValueError(TOPIC_EVENTS, data)
+            said = data.get("fields")  # (the air table's names them; the arm rig's the step)
+            named = [str(f) for f in said] if isinstance(said, list) and said else []
+            step = data.get("step", "?")
+            raise NonFiniteValueError(
+                TOPIC_EVENTS, data, named or [f"the simulation diverged at step {step}"]
+            )

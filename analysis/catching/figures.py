@@ -65,26 +65,33 @@ TOPICS = {
     ),
     "Fig. 9": (TOPIC_EFFECTOR_STATE, TOPIC_ARM_JOINT_COMMAND, TOPIC_OBJECT_STATE),
 }
-_VARIANT: dict[str, tuple[int, str]] = {}  # run key -> (its variant index, its label)
+_VARIANT: dict[str, int] = {}  # run key -> its variant index (-1: a run drawn alone)
+_LABEL: dict[str, str] = {}  # run key -> what its scenario changes (analysis/runs.py)
+
+
+def _titled(run: CatchRun) -> str:
+    """The run's key with what it changes, where the key does not say it already."""
+    label = _LABEL.get(run.name, "")
+    return f"{run.name} ({label})" if label and label not in run.name else run.name
 
 
 def _label(run: CatchRun) -> str:
     what = "optimised" if run.mapping == "optimised" else "initial parameters"
     if run.mapping not in ("optimised", "initial"):
         what = f"controller {run.mapping}"
-    label = _VARIANT.get(run.name, (0, ""))[1]
+    label = _LABEL.get(run.name, "")
     return f"{run.name} ({what}{'; ' + label if label and label not in run.name else ''})"
 
 
 def _style(run: CatchRun) -> dict:
-    if run.name in _VARIANT and _VARIANT[run.name][0] >= 0:
-        return VARIANT_STYLES[_VARIANT[run.name][0] % len(VARIANT_STYLES)]
+    if _VARIANT.get(run.name, -1) >= 0:
+        return VARIANT_STYLES[_VARIANT[run.name] % len(VARIANT_STYLES)]
     return STYLE["optimised" if run.mapping == "optimised" else "initial"]
 
 
 def _color(run: CatchRun) -> str:
-    if run.name in _VARIANT and _VARIANT[run.name][0] >= 0:
-        return VARIANT_COLORS[_VARIANT[run.name][0] % len(VARIANT_COLORS)]
+    if _VARIANT.get(run.name, -1) >= 0:
+        return VARIANT_COLORS[_VARIANT[run.name] % len(VARIANT_COLORS)]
     return "tab:blue" if run.mapping == "optimised" else "tab:red"
 
 
@@ -146,7 +153,7 @@ def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, .
     fig, (ax_t, ax_w) = plt.subplots(2, 1, sharex=True, figsize=(6.0, 5.0))
     pair = ((opt, "tab:blue", "optimisation (eq. 25)"), (ini, "tab:red", "initial parameters"))
     for run, color, label in (
-        *((r, c, f"{r.name}: {what}") for r, c, what in pair if r is not None),
+        *((r, c, f"{_titled(r)}: {what}") for r, c, what in pair if r is not None),
         *((r, _color(r), _label(r)) for r in variants),
     ):
         if not run.costs:
@@ -379,7 +386,7 @@ def _pair_figures(
     whose logs hold what it reads (the others named in a note)."""
     opt = next((r for r in pair if r.mapping == "optimised" and r.name not in _VARIANT), None)
     ini = next((r for r in pair if r is not opt and r.name not in _VARIANT), None)
-    what = " vs ".join(r.name for r in pair if r.name not in _VARIANT) + note
+    what = " vs ".join(_titled(r) for r in pair if r.name not in _VARIANT) + note
     if any(r.name in _VARIANT for r in pair):
         what += f" and {sum(r.name in _VARIANT for r in pair)} variant(s)"
 
@@ -434,6 +441,8 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     if not runs:
         return []
     _VARIANT.clear()
+    _LABEL.clear()
+    _LABEL.update({n: run_labels.describe(log, n).label for n, log in logs.items()})
     slow = [runs[n] for n in SLOW_PAIR if n in runs]
     rest = {n: r for n, r in runs.items() if n not in SLOW_PAIR}
     opt, ini = optimised_and_initial(rest) if rest else (None, None)
@@ -449,7 +458,7 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
         more = _variants(group, alone, logs)
         for k, r in enumerate(more):
             if k < MAX_VARIANTS:
-                _VARIANT[r.name] = (k, run_labels.describe(logs[r.name], r.name).label)
+                _VARIANT[r.name] = k
                 alone.pop(r.name)
             else:
                 skip(
@@ -458,7 +467,7 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
                 )
         paths += _pair_figures(group + more[:MAX_VARIANTS], logs, out, prefix, note)
     for name, run in alone.items():
-        _VARIANT[name] = (-1, run_labels.describe(logs[name], name).label)
+        _VARIANT[name] = -1
         if has({name: logs[name]}, TOPICS["Fig. 7"], "catch Fig. 7"):
             paths += save(
                 fig7([run], f"Catching trajectory: {_label(run)} (cf. Fig. 7)"),

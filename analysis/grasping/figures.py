@@ -22,6 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from analysis import runs as run_labels  # noqa: E402
 from analysis.figure_files import save  # noqa: E402
 from analysis.line_labels import MORE, first  # noqa: E402
 from analysis.needs import has  # noqa: E402
@@ -115,7 +116,7 @@ def _footer(drawn: set[str]) -> str:
     )
 
 
-def fig9(run: GraspRun):
+def fig9(run: GraspRun, key: str = ""):
     fig, (ax_y, ax_x, ax_f) = plt.subplots(
         3, 1, sharex=True, figsize=(7.0, 6.8), gridspec_kw={"height_ratios": [3, 3, 2]}
     )
@@ -153,7 +154,7 @@ def fig9(run: GraspRun):
         ax.set_xlim(0.0, run.t_end)
         drawn |= _shade(ax, run, labels=ax is ax_y)
     ax_f.set_xlabel("time [s]")
-    ax_y.set_title(f"Feedback response: {one_line(run.name)} (cf. Fig. 9)", fontsize=10)
+    ax_y.set_title(f"Feedback response: {one_line(key or run.name)} (cf. Fig. 9)", fontsize=10)
     fig.text(
         0.01,
         0.005,
@@ -327,7 +328,8 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
         if not has({name: log}, TOPICS["Fig. 9"], "grasp Fig. 9"):
             continue
         run = load_run(log, name)
-        paths += save(fig9(run), out, f"{name}_fig9", [name])
+        titled = run_labels.titled(name, log)  # (a variant: what it changes)
+        paths += save(fig9(run, titled), out, f"{name}_fig9", [name])
         if has({name: log}, TOPICS["filmstrip"], "grasp filmstrip (Figs. 6-8)"):
             what = (
                 "a sphere (cf. Fig. 8)"
@@ -335,6 +337,6 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
                 else "a hexahedron (cf. Figs. 6, 7)"
             )
             paths += save(
-                filmstrip(run, f"Grasping of {what}: {name}"), out, f"{name}_filmstrip", [name]
+                filmstrip(run, f"Grasping of {what}: {titled}"), out, f"{name}_filmstrip", [name]
             )
     return paths

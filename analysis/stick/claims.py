@@ -341,7 +341,13 @@ def _collision_2_rows(log: LogReader, c2: dict | None, r: dict) -> list[Claim]:
     planned: dict = next(
         (e["data"] for e in events(log, "plan") if e["data"].get("index") == 2), {}
     )
-    solved = abs(planned.get("r_x_solved", float("nan")))
+    said = planned.get("r_x_solved")  # (none: collisions by chance, no plan of the second)
+    solved = abs(said) if isinstance(said, (int, float)) else None
+    plan = (
+        f"the plan solved F_ω,2(0) = {solved * 1e3:.1f} mm"
+        if solved is not None
+        else "no plan of collision 2 was logged"
+    )
     return [
         Claim(
             "time of collision 2",
@@ -355,11 +361,11 @@ def _collision_2_rows(log: LogReader, c2: dict | None, r: dict) -> list[Claim]:
             f"{r['r_x_2']['value'] * 1e3:.1f} mm",
             f"hit at {abs(d['r_x']) * 1e3:.1f} mm",
             within(abs(d["r_x"]), r["r_x_2"]["value"], abs_=0.002),
-            f"tolerance 2 mm (1 px); the plan solved F_ω,2(0) = {solved * 1e3:.1f} mm"
+            f"tolerance 2 mm (1 px); {plan}"
             + (
                 f", beyond L/2 = {half * 1e3:.0f} mm: it falls back to "
                 f"{abs(planned.get('r_x', float('nan'))) * 1e3:.1f} mm"
-                if solved > half
+                if solved is not None and solved > half
                 else ""
             ),
         ),

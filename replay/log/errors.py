@@ -19,10 +19,10 @@ class NotALogError(LogError):
 class NonFiniteValueError(LogError):
     """A payload held NaN or infinity (NaN is not JSON): a physics error, not a message."""
 
-    def __init__(self, topic: str, payload: dict):
+    def __init__(self, topic: str, payload: dict, fields: list[str] | None = None):
         self.topic = topic
         self.payload = payload
-        bad = sorted(_non_finite_paths(payload))
+        bad = sorted(_non_finite_paths(payload)) if fields is None else fields
         self.fields = bad
         super().__init__(f"non-finite value on {topic}: {', '.join(bad) or '?'}")
 

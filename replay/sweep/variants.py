@@ -119,9 +119,10 @@ def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] | tuple = 
         keys.update(first if isinstance(first, dict) else {a.name: first})
     for key, value in keys.items():
         node: Any = base
+        others = [_assignment(k, v) for k, v in keys.items() if k != key]  # (as variants run)
         for depth, part in enumerate(key.split(".")):
             if not isinstance(node, dict) or part not in node:
-                if _settable(scenario, [*sets], key, value):
+                if _settable(scenario, [*sets, *others], key, value):
                     break  # a field left out while empty (plant.params.engine: {}), set here
                 where = ".".join(key.split(".")[:depth]) or "(top level)"
                 choices = ", ".join(node) if isinstance(node, dict) else "(not a mapping)"
@@ -131,13 +132,19 @@ def check_keys(scenario: str | Path, spec: SweepSpec, sets: list[str] | tuple = 
             node = node[part]
 
 
-def _settable(scenario: str | Path, sets: list[str], key: str, value: Any) -> bool:
-    """Whether the scenario loads with ``key`` set to ``value`` (as the variant will set it)."""
+def _assignment(key: str, value: Any) -> str:
+    """``key=value`` as a ``--set`` assignment."""
     import yaml
 
     text = yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("...").strip()
+    return f"{key}={text}"
+
+
+def _settable(scenario: str | Path, sets: list[str], key: str, value: Any) -> bool:
+    """Whether the scenario loads with ``key`` set to ``value`` (as the variant will set it,
+    with ``sets``: the command's and the other axes' first values)."""
     try:
-        load_scenario(scenario, sets=[*sets, f"{key}={text}"])
+        load_scenario(scenario, sets=[*sets, _assignment(key, value)])
     except ScenarioError:
         return False
     return True

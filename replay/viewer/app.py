@@ -18,7 +18,7 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from replay.viewer.data import RunAccumulator, RunData, load_run
+from replay.viewer.data import RunAccumulator, RunData, distinct_labels, load_run
 from replay.viewer import guard
 from replay.viewer.errors import ViewerError
 from replay.viewer.images import ImagePanel, load_image_tracks
@@ -144,7 +144,7 @@ class Viewer:
     @classmethod
     def open(cls, paths: Iterable[str | Path], **kw) -> "Viewer":
         """Load the logs (one-line :class:`ViewerError` if one cannot be shown), then serve."""
-        runs = [load_run(p) for p in paths]
+        runs = distinct_labels([load_run(p) for p in paths])
         for run in runs:
             scene_class(run)  # fail before starting a server
         viewer = cls(**kw)

@@ -27,7 +27,7 @@ from replay.limits import LimitError, check, limit
 from replay.log import LogError, LogReader
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO, to_dict
 from replay.viewer.errors import ViewerError
-from replay.viewer.markup import clean
+from replay.viewer.markup import LABEL_CHARS, clean
 
 # topics kept as Python objects rather than columns (few messages, free-form data)
 OBJECT_TOPICS = (TOPIC_SCENARIO, TOPIC_EVENTS)
@@ -385,6 +385,16 @@ class RunAccumulator:
             truncated=truncated,
             notes=notes,
         )
+
+
+def distinct_labels(runs: list[RunData]) -> list[RunData]:
+    """``runs`` with a label several share (one scenario name: the default and a variant)
+    followed by each one's file name, so the overlay's title, legend and notes tell them apart."""
+    shared = [r.label for r in runs]
+    for run in runs:
+        if shared.count(run.label) > 1 and run.path is not None:
+            run.label = clean(f"{clean(run.label, LABEL_CHARS // 2)} ({Path(run.path).name})")
+    return runs
 
 
 def load_run(path: str | Path) -> RunData:

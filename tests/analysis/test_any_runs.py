@@ -101,6 +101,70 @@ def test_catch_variants_are_overlaid_on_the_pair_and_labelled(catch, tmp_path):
     assert "stereo latency 10 ms" in svg  # the legend says what differs
 
 
+def test_a_lone_variant_is_named_by_what_it_changes(catch, tmp_path):
+    """Without the shipped run among the logs a variant keeps the plain key (the paper's rows
+    find it), but its figures say what it changes: titles and legends, catch and grasp."""
+    from analysis.catching.figures import make_figures
+
+    paths = make_figures(runs.keyed([LogReader(catch["lat"])]), tmp_path)
+    assert {p.name for p in paths} >= {f"catch_fig{k}.svg" for k in (6, 7, 8, 9)}
+    for k in (6, 7, 8, 9):
+        svg = (tmp_path / f"catch_fig{k}.svg").read_text()
+        assert "catch_optimised (stereo latency 10 ms)" in svg, k
+    g = run(
+        tmp_path / "g.mcap", "grasp_sphere", "timing.duration=0.1", "plant.params.human_speed=0.3"
+    )
+    r = invoke("figures", g, "-o", tmp_path / "g")
+    assert r.exit_code == 0, r.output
+    for svg in (tmp_path / "g").glob("*.svg"):
+        assert "grasp_sphere (human speed 0.3, duration 100 ms)" in svg.read_text(), svg.name
+
+
+def test_the_claims_say_when_the_papers_run_is_a_variant(catch, tmp_path):
+    """A variant alone takes its scenario's plain name, so the paper's rows read it as the
+    paper's run: the claims say so (stderr and the Markdown table); beside the shipped run
+    the variant has a key of its own and nothing is said."""
+    md = tmp_path / "claims.md"
+    r = invoke("claims", catch["lat"], "--markdown", md)
+    assert r.exit_code == 0, r.output
+    said = [line for line in r.stderr.splitlines() if "stereo latency 10 ms" in line]
+    assert len(said) == 1 and said[0].startswith("warning: catch_optimised"), r.stderr
+    assert "not the shipped scenario" in said[0]
+    assert "not the shipped scenario" in md.read_text()
+    both = invoke("claims", catch["opt"], catch["lat"], catch["renamed"])  # catch_lat10: named
+    assert both.exit_code == 0 and "not the shipped scenario" not in both.stderr, both.stderr
+
+
+def test_a_catch_cut_before_the_ball_arrives_decides_no_arrival_row(tmp_path):
+    """A run that ends before the ball reaches the hand (a short duration, a truncated log, a
+    throw that misses) has no arrival speed: the rows that compare the paper's numbers with it
+    say so, and the acceleration row is no verdict ("consistent" read a NaN before)."""
+    from analysis.catching.claims import evaluate
+
+    log = run(tmp_path / "short.mcap", "catch_optimised", "timing.duration=0.15")
+    rows = {r.quantity: r for r in evaluate({"catch_optimised": LogReader(log)})}
+    acc = rows["end-effector maximum acceleration"]
+    assert acc.status == "not run" and "nan" not in acc.measured, acc
+    assert "did not reach the hand" in acc.measured
+    speed = rows["hand speed eq. 4 demands at t_c vs the arm's 5 m/s"]
+    assert "nan" not in speed.measured and "did not reach the hand" in speed.measured, speed
+    early = run(tmp_path / "early.mcap", "catch_optimised", "timing.duration=0.05")
+    rows = {r.quantity: r for r in evaluate({"catch_optimised": LogReader(early)})}
+    throws = rows["catch over the stated throws, 8 ~ 10 m/s"]  # (ended before t0: never seen)
+    assert "nan" not in throws.measured and "never seen" in throws.measured, throws
+
+
+def test_a_stick_throw_the_plan_never_reached_names_no_nan(tmp_path):
+    """With no spin (ω_0 = 0) the 3-step finds no reachable contact, its collisions come by
+    chance and no plan of the second is logged: the r_x,2 row says so (it read "nan mm")."""
+    from analysis.stick.claims import evaluate
+
+    log = run(tmp_path / "w0.mcap", "stick_3step", "plant.params.initial.omega=0")
+    rows = {r.quantity: r for r in evaluate({"stick_3step": LogReader(log)})}
+    row = rows["fingertip position r_x,2"]
+    assert "nan" not in row.note and "no plan of collision 2" in row.note, row
+
+
 def test_a_log_lacking_a_topic_skips_what_reads_it(catch, stick, tmp_path):
     """A controller that publishes no /effector/state: Figs. 7-9 and the claims rows that read
     it are left out for that run with a note naming the topic; the rest is made."""
@@ -230,6 +294,29 @@ def test_each_log_gets_its_key_and_label(stick, catch):
     ]
     assert labels["catch_lat10"] == "stereo latency 10 ms"
     assert runs.titled("catch_lat10", logs[2]) == "catch_lat10 (stereo latency 10 ms)"
+
+
+def test_two_logs_of_one_variant_are_named_apart(stick, tmp_path):
+    """Two logs of the same variant (a copy, a truncated one) without the shipped run: the
+    first keeps the plain key and is titled with its label, so the second's key must differ
+    from that title (compare's warnings name the second by its key)."""
+    import shutil
+
+    copy = tmp_path / "copy.mcap"
+    shutil.copy(stick["mu1"], copy)
+    keyed = runs.keyed([LogReader(stick["mu1"]), LogReader(copy)])
+    titles = [runs.titled(k, r) for k, r in keyed.items()]
+    assert len(set(titles)) == 2, titles
+    assert titles[0] == "stick_3step (friction 1, duration 300 ms)"
+    assert titles[1] == "stick_3step (friction 1, duration 300 ms) #2"
+
+
+def test_a_label_gives_seconds_their_unit():
+    """A time in s is written in ms below 1 s and in s from 1 s ("duration 1" said no unit)."""
+    ref = {"timing.duration": 2.0, "sensors.chip.latency": 0.001, "stop.after": 0.1}
+    assert runs.differences(
+        {"timing.duration": 1.0, "sensors.chip.latency": 0.0025, "stop.after": 12}, ref
+    ) == ["chip latency 2.5 ms", "after 12 s", "duration 1 s"]
 
 
 def test_a_renamed_run_with_another_controller_is_a_variant_of_the_papers_own():

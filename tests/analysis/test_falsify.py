@@ -279,3 +279,20 @@ def test_the_falsifiers_run_on_the_reference_engines_scenarios_only():
     chosen = {p.stem for paper in ("namiki2003", "namiki1999") for p in default_scenarios(paper)}
     assert twins and {"catch_optimised", "grasp_sphere"} <= chosen
     assert not chosen & twins
+
+
+def test_a_variant_in_the_logs_folder_is_no_baseline(tmp_path):
+    """``replay falsify --logs DIR``: a log there that changes its scenario (here stick_3step
+    cut to 0.3 s) would be judged against falsifiers run from the shipped scenario: it is left
+    out, with a note saying what it changes, and nothing is falsified against it."""
+    from analysis.falsify import falsify_paper, run_scenario
+
+    (tmp_path / "logs").mkdir()
+    run_scenario("stick_3step", tmp_path / "logs" / "stick_3step.mcap", ["timing.duration=0.3"])
+    said: list[str] = []
+    verdicts = falsify_paper(
+        "higashimori2007", tmp_path / "work", tmp_path / "logs", progress=said.append
+    )
+    assert any("left out" in s and "(duration 300 ms)" in s for s in said), said
+    assert not any(v.status for v in verdicts)  # no variant run: no baseline to replace
+    assert not list((tmp_path / "work" / "variants").glob("*.mcap"))

@@ -190,6 +190,23 @@ def test_optimise_without_a_file_is_one_line(project_root):
     assert r.exit_code == 2 and "will not write" in _one_error_line(r)
 
 
+def test_optimise_never_writes_the_alpha_file_of_an_extended_scenario(project_root, tmp_path):
+    """A variant of mine (``extends: catch_optimised``, other throw speeds) inherits the shipped
+    alpha_file: writing its optimisation there would replace the shipped mapping (inside the
+    installed package after pip install). Refused in one line, before any work, unless -o."""
+    shipped = project_root / "data/catching/alpha_optimised.json"
+    before = shipped.read_bytes()
+    mine = tmp_path / "my_fast.yaml"
+    mine.write_text(
+        "extends: catch_optimised\nname: my_fast\n"
+        "controller:\n  params:\n    throw_speeds: [10.0, 11.0, 12.0]\n"
+    )
+    r = invoke("optimise", mine)
+    line = _one_error_line(r)
+    assert r.exit_code == 2 and "-o" in line and "alpha_optimised.json" in line, line
+    assert shipped.read_bytes() == before
+
+
 def test_ctrl_c_while_starting_exits_130(tmp_path):
     import signal
     import subprocess

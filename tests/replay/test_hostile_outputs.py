@@ -448,6 +448,37 @@ def test_a_stored_name_no_scenario_may_have_does_not_sink_the_paper(stick_3step_
     assert "<img src=x" not in html and "Log left out" not in html
 
 
+@pytest.mark.parametrize("what", ["a value of the wrong type", "another machine's engine"])
+def test_a_stored_scenario_that_does_not_load_here_is_left_out_alone(
+    stick_3step_log, tmp_path, what
+):
+    """One log whose stored scenario does not type here (tampered, or run with an engine
+    plug-in this machine lacks) is left out with one line naming why; the paper's other logs
+    are still analysed (before, the paper's figures and claims failed whole, exit 1)."""
+    import yaml
+
+    from replay.api import run
+
+    if what == "a value of the wrong type":
+        base = stick_3step_log
+        stored = yaml.safe_load(LogReader(base).scenario()["yaml"])
+        stored["plant"]["params"]["initial"]["vy"] = "fast"
+    else:
+        base = tmp_path / "catch.mcap"
+        run("catch_optimised", set={"timing.duration": 0.02}, log=base)
+        stored = yaml.safe_load(LogReader(base).scenario()["yaml"])
+        stored["plant"]["params"]["engine"] = {"type": "their_engine", "their_setting": 1}
+    bad = forge(base, tmp_path / "logs" / "bad.mcap", yaml=yaml.safe_dump(stored))
+    good = forge(base, tmp_path / "logs" / "good.mcap")
+    for command in (["claims"], ["figures", "-o", tmp_path / "figs"]):
+        r = invoke(*command, bad, good)
+        assert r.exit_code == 0 and "Traceback" not in r.output, r.output
+        left = [line for line in r.stderr.splitlines() if "bad.mcap" in line]
+        assert len(left) == 1 and left[0].startswith("warning: left out: "), r.stderr
+        assert ("fast" if what.startswith("a value") else "their_engine") in left[0]
+    assert list((tmp_path / "figs").glob("*.png")), "the good log's figures"
+
+
 # -- a log's event count does not set a figure's cost ----------------------------------------
 
 

@@ -62,6 +62,28 @@ def test_every_run_ends_with_an_outcome(toy_yaml, tmp_path):
     assert "non-finite" in last["data"]["reason"]
 
 
+def test_a_diverged_run_says_what_diverged(toy_yaml, tmp_path, monkeypatch):
+    """A plant reports its divergence as a ``nan`` event (the arm rig's holds the step, the air
+    table's also the fields): the run's error says so, not "non-finite value on /events: ?"."""
+    from replay.interfaces import Occurrence
+
+    for said, expected in (
+        ({"step": 50}, ["the simulation diverged at step 50"]),
+        ({"fields": ["omega", "x"], "step": 50}, ["omega", "x"]),
+    ):
+        runner = Runner(load_scenario(toy_yaml))
+        pop = runner.plant.pop_events
+        monkeypatch.setattr(
+            runner.plant,
+            "pop_events",
+            lambda pop=pop, said=said, r=runner: pop() + [Occurrence("nan", said)] * (r.k == 50),
+        )
+        result = runner.run(tmp_path / "nan.mcap")
+        assert result.stopped_by == "error" and "?" not in result.error, result.error
+        error = next(e for e in LogReader(result.path).events() if e["kind"] == "error")
+        assert error["data"]["fields"] == expected, error
+
+
 def test_controller_drives_plant(toy_yaml, tmp_path):
     _, _, log = _run(toy_yaml, tmp_path, sets=["timing.duration=3.0"])
     last = log.series("/toy/state")[-1]

@@ -289,3 +289,18 @@ def test_the_physics_engine_is_an_axis_like_any_field(project_root, tmp_path):
         ],
     )
     assert r.exit_code == 2 and "no field" in r.output
+
+
+def test_an_engine_setting_is_an_axis_beside_the_engine_axis(project_root, tmp_path):
+    """A setting of an engine the grid itself chooses (the shipped scenario's engine is empty):
+    checked with the other axes' first values set, as its variants will run, not alone ("no
+    field 'engine' in plant.params")."""
+    r = CliRunner().invoke(
+        main,
+        ["sweep", "catch_optimised", "--grid", "plant.params.engine.mj_iterations=10,50"]
+        + ["--grid", "plant.params.engine.type=mujoco", "--set", "timing.duration=0.02"]
+        + ["--no-logs", "-q", "-o", str(tmp_path)],
+    )
+    assert r.exit_code == 0, r.output
+    rows = read_table(tmp_path / "table.csv")
+    assert [row["plant.params.engine.mj_iterations"] for row in rows] == ["10", "50"]

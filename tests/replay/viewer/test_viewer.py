@@ -107,6 +107,24 @@ def test_log_loads_into_arrays_found_by_time(stick_log):
     assert run.notes == []
 
 
+def test_overlaid_logs_of_one_scenario_name_are_told_apart(stick_log, tmp_path, monkeypatch):
+    """`replay view a.mcap b.mcap` of one scenario (the default and a --set variant): each run's
+    label, its title, legend and warnings' prefix, says its file where the name is shared."""
+    import shutil
+
+    other = tmp_path / "variant.mcap"
+    shutil.copy(stick_log, other)
+    monkeypatch.setattr(Viewer, "load", lambda self, runs: setattr(self, "runs", runs))
+    monkeypatch.setattr(Viewer, "__init__", lambda self, **kw: None)
+    v = Viewer.open([stick_log, other])
+    assert [r.label for r in v.runs] == [
+        "synthetic_stick (stick.mcap)",
+        "synthetic_stick (variant.mcap)",
+    ]
+    alone = Viewer.open([stick_log])
+    assert [r.label for r in alone.runs] == ["synthetic_stick"]
+
+
 def test_names_are_kept_once_and_ragged_fields_noted(tmp_path):
     path = tmp_path / "r.mcap"
     with LogWriter(path) as log:
@@ -289,7 +307,7 @@ def test_cli_view_serves_on_localhost_then_stops(stick_log, tmp_path):
     )
     assert r.exit_code == 0, r.output
     assert "viewer: http://127.0.0.1:" in r.output
-    assert "warning: synthetic_stick: truncated log" in r.output
+    assert "warning: synthetic_stick (cut.mcap): truncated log" in r.output  # (which of the two)
 
 
 # ----------------------------------------------------------------------------- ports
