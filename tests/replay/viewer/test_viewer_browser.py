@@ -178,9 +178,9 @@ def test_viewer_draws_and_moves_in_a_browser(browser, name, make, tmp_path):
         first = _poll(page, lambda img: _colours(img) > 60, deadline, "the scene to be drawn")
         _close_toasts(page)
         # the view is fitted to the moving parts (the hand, the object near it): in a catch log
-        # the arm waits still until the ball is seen (0.1 s of 0.3), so where nothing in view
-        # moves yet, the next time is tried
-        a = _moved_to(page, viewer, first, (0.15, 0.5, 0.75), 0.0005, deadline)
+        # the arm waits still until the ball is seen (0.1 s of 0.3), so mid-run comes first
+        # (0.15 there waited out its 8 s), and where nothing in view moves, the next is tried
+        a = _moved_to(page, viewer, first, (0.5, 0.15, 0.75), 0.0005, deadline)
         time.sleep(1.0)  # let the frame settle, then take it
         a = _image(page.screenshot(path=str(tmp_path / f"{name}_a.png"), timeout=SHOT_TIMEOUT))
         b = _moved_to(page, viewer, a, (0.85, 0.95, 0.3), 0.001, deadline)
