@@ -73,17 +73,14 @@ def limit_torque_loop(cmd: list, tlim: list, locked: list, enforce: bool, vlim: 
 
 
 def torque_limit_events(clamped, episode, cmd, applied, names, tlim) -> list[Occurrence]:
-    """A ``torque_limit`` event per joint clamped now and not in the step before (``episode``)."""
-    return [
-        Occurrence(
-            "torque_limit",
-            {
-                "joint": names[i],
-                "commanded": cmd[i] if math.isfinite(cmd[i]) else None,
-                "applied": applied[i],
-                "limit": tlim[i],
-            },
-        )
-        for i, c in enumerate(clamped)
-        if c and not episode[i]
-    ]
+    """A ``torque_limit`` event per joint clamped now and not in the step before (``episode``);
+    ``cmd`` None: torques no command gave (velocity servos' own), no ``commanded`` field."""
+    events = []
+    for i, c in enumerate(clamped):
+        if c and not episode[i]:
+            data: dict = {"joint": names[i]}
+            if cmd is not None:
+                data["commanded"] = cmd[i] if math.isfinite(cmd[i]) else None
+            data["applied"], data["limit"] = applied[i], tlim[i]
+            events.append(Occurrence("torque_limit", data))
+    return events

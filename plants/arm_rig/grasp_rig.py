@@ -4,29 +4,39 @@ arm's 7 AC servos on velocity commands (``ServoCommand``; ``servo.VelocityServos
 F/T sensor and a human hand moving the object on its constraint plane.
 
 ``GraspRig`` owns, once for every engine: the head, the plane, the arm servos and their torques,
-``torque_limit`` events, the command and the step; its logged topics are
-``grasp_topics.GraspRigTopics``'s and its verdict ``grasp_verdict.GraspVerdict``'s (both
-subclasses). Its engine adapter (``engine``) is the arm rig's widened by the grasp's engine
-questions (``GraspEngine`` below).
+the command, the step, its logged topics (the functions of ``grasp_topics``, fed the servos',
+head's, human's and engine's readings) and its verdict (``verdict``, a
+``grasp_verdict.GraspVerdict`` fed each step's readings). Its engine adapter (``engine``) is the
+arm rig's widened by the grasp's engine questions (``GraspEngine`` below); an engine's grasp plant
+is this class with its ``Params``, ``Engine`` and ``description``.
 """
 
 from __future__ import annotations
 
-from abc import abstractmethod
 from typing import Protocol
 
 import numpy as np
 
 from plants.arm_rig.engine import EngineAdapter
 from plants.arm_rig.grasp_setup import head_setup, human_args, plane_setup
+from plants.arm_rig.grasp_topics import (
+    HEAD_JOINTS,
+    grasp_readings,
+    head_frame,
+    head_topics,
+    human_topics,
+    servo_topic,
+    wrist_topic,
+)
+from plants.arm_rig.grasp_verdict import GraspReading, GraspVerdict
 from plants.arm_rig.head import HeadServo
 from plants.arm_rig.human_path import HumanPath
 from plants.arm_rig.params import GraspParams
 from plants.arm_rig.rig import ArmRig
 from plants.arm_rig.servo import VelocityServos
-from replay.interfaces import Occurrence
 from replay.robot.arm_types import GraspSpec, ServoCommand
 from replay.robot.head import camera_pose
+from replay.scene import Frame, Scene
 from replay.spatial import matrix_to_quaternion
 
 
@@ -87,8 +97,8 @@ class GraspRig(ArmRig):
         self.head, h0 = head_setup(P)
         self.head_servo = HeadServo(self.head, P.head_servo_bandwidth, dt, h0)
         self.plane, u, v, n = plane_setup(P)
-        self._u_l, self._v_l, self._n_l = u.tolist(), v.tolist(), [float(x) for x in n]
         self.human = self.engine.make_human(rng, human_args(P, u, v, n))
+        self.verdict = GraspVerdict(P, self.plane, u, v, dt)
         self._head_pose: tuple | None = None
         self._spec = self._grasp_spec(self._spec)
 
@@ -133,29 +143,6 @@ class GraspRig(ArmRig):
         self._tau_applied = self._tau_cmd = tau
         self._clamped = clamped
 
-    def _servo_limit_events(self) -> None:
-        """A ``torque_limit`` event per servo saturated anew this step."""
-        clamped, episode = self._clamped, self._torque_episode
-        if True in clamped:
-            for i, c in enumerate(clamped):
-                if c and not episode[i]:
-                    self._events.append(
-                        Occurrence(
-                            "torque_limit",
-                            {
-                                "joint": self.joint_names[i],
-                                "applied": self._tau_applied[i],
-                                "limit": self._tlim_l[i],
-                            },
-                        )
-                    )
-            self.clamp_count += sum(clamped)
-        self._torque_episode = clamped
-
-    @abstractmethod
-    def _judge_step(self) -> None:
-        """The step's events and verdict (grasp_verdict.GraspVerdict)."""
-
     def step(self) -> None:
         E = self.engine
         (_, qd), hand, obj = self._state()
@@ -173,7 +160,23 @@ class GraspRig(ArmRig):
         if self.diverged:
             return
         self._read_servos()
-        self._judge_step()
+        self._torque_events(None, self._tau_applied, self._clamped)
+        n_before = len(self._events)
+        self._check_events()
+        self._events += self.verdict.observe(self._reading(), self._events[n_before:])
+
+    def _reading(self) -> GraspReading:
+        """This step's truth for the verdict."""
+        E, human = self.engine, self.human
+        parts, _, force = E.contact_summary()
+        pos = self._state()[2][0]
+        return GraspReading(
+            self._t, pos, E.effector_now(), parts, force, self.caught, human.target_l, human.force_l
+        )
+
+    def outcome(self, t: float) -> dict:
+        """The physical verdict (grasp_verdict.py ``GraspVerdict.outcome``)."""
+        return self.verdict.outcome(t)
 
     # ------------------------------------------------------------------ log and scene
     def _head_reading(self):
@@ -183,3 +186,32 @@ class GraspRig(ArmRig):
             R, c = camera_pose(self.head, *self.head_servo.q_l)
             self._head_pose = (R, c, [float(x) for x in matrix_to_quaternion(R)])
         return self._head_pose
+
+    def truth(self, t: float) -> dict:
+        out = super().truth(t)
+        del out["/arm/applied_torque"]
+        out["/arm/servo"] = servo_topic(
+            t, self.joint_names, self.active, self.arm_servos, self._tau_applied, self._clamped
+        )
+        out.update(head_topics(t, self.head_servo, self._head_reading()))
+        out.update(human_topics(t, self.human, self._state()[2][0]))
+        out["/wrist/wrench_truth"] = wrist_topic(t, self.engine.wrench)
+        return out
+
+    def joints(self) -> tuple[list, list, list, list]:
+        """The arm's and hand's joints, then the head's pan and tilt."""
+        names, q, qd, effort = super().joints()
+        hs = self.head_servo
+        return names + list(HEAD_JOINTS), q + hs.q_l, qd + hs.qd_l, effort + hs.torque_l
+
+    def frames(self) -> list[Frame]:
+        """The robot's links and the head's camera in ``world``."""
+        return super().frames() + [head_frame(self._head_reading())]
+
+    def scene(self) -> Scene:
+        sc = super().scene()
+        camera, wrench = self._head_reading(), self.engine.wrench
+        sc.readings.update(
+            grasp_readings(self.hand_names, self._state()[1], self.head_servo, camera, wrench)
+        )
+        return sc

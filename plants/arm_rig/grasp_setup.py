@@ -1,7 +1,7 @@
 """The grasping rig's engine-free set-up from its ``GraspParams``: the pan/tilt head's spec and
-initial angles, the constraint plane and its axes, the human hand's path arguments. Shared by
-the PyBullet rig (``grasp_plant.BulletGraspPlant``) and the MuJoCo one, so both build the same
-head, plane and human from a scenario."""
+initial angles, the constraint plane and its axes, the human hand's path arguments: the grasping
+rig (grasp_rig.py ``GraspRig``) builds the same head, plane and human from a scenario in every
+engine."""
 
 from __future__ import annotations
 

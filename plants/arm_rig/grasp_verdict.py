@@ -1,144 +1,176 @@
-"""The grasping rig's physical verdict, engine-free: the record kept each step from the truth
-(each grasp's drift in the hand, its distance to the human's path, the object's distance off its
-plane, slips, the tracking error before the grasp) and the run's ``outcome``. Shared by the
-PyBullet rig (``grasp_plant.BulletGraspPlant``) and the MuJoCo one, so both engines are judged
-by the same criterion.
+"""The grasping rig's physical verdict, engine-free: a component the rig owns
+(``GraspRig.verdict``), fed each step with that step's truth (``GraspReading``) and events, which
+keeps its own record (each grasp's drift in the hand, its distance to the human's path, the
+object's distance off its plane, slips, the tracking error before the grasp) and gives the run's
+``outcome``. Every engine's grasp rig is judged by this one criterion.
 
-Its state is the rig's (``grasp_rig.GraspRig``, its base): the plane, the human, the object's
-state, the tool frame (``engine.effector_now``) and the contacts (``engine.contact_summary``).
+It reads nothing of the rig: the plane, its in-plane axes and the criteria (``GraspParams``) are
+given once, the readings each step (``GraspVerdict.observe``).
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
-import numpy as np
+from typing import NamedTuple, Sequence
 
-from plants.arm_rig.grasp_rig import GraspRig
 from plants.arm_rig.params import GraspParams
 from replay.interfaces import Occurrence
+from replay.robot.arm_types import PlaneSpec
 
 
-class GraspVerdict(GraspRig):
-    def __init__(self, params: GraspParams, *, dt: float, rng: np.random.Generator) -> None:
-        super().__init__(params, dt=dt, rng=rng)
-        self._start_verdict(params.slip_time, dt)
+class GraspReading(NamedTuple):
+    """One step's truth for the verdict (world frame, plain floats)."""
 
-    def _start_verdict(self, slip_time: float, dt: float) -> None:
-        """The verdict's record, empty."""
+    t: float  # s
+    pos: Sequence[float]  # m: the object's centre
+    tool: tuple  # the tool (= hand) frame: (position m, orientation [qx, qy, qz, qw], ...)
+    parts: Sequence[str]  # the robot's parts touching the object, sorted ("arm" among them)
+    normal_force: float  # N: the contacts' total normal force
+    held: bool  # the rig holds the object (its hold event's state)
+    human_target: Sequence[float]  # m: the human's path point now
+    human_force: Sequence[float]  # N: the human's force on the object over the last step
+
+
+def in_hand_position(pos, tool: tuple) -> list[float]:
+    """The object's centre ``pos`` in the tool (= hand) frame ``tool`` (m): R^T (x - p)."""
+    (px, py, pz), (qx, qy, qz, qw) = tool[0], tool[1]
+    dx, dy, dz = pos[0] - px, pos[1] - py, pos[2] - pz
+    # the columns of R(q) dotted with d
+    return [
+        (1 - 2 * (qy * qy + qz * qz)) * dx
+        + 2 * (qx * qy + qz * qw) * dy
+        + 2 * (qx * qz - qy * qw) * dz,
+        2 * (qx * qy - qz * qw) * dx
+        + (1 - 2 * (qx * qx + qz * qz)) * dy
+        + 2 * (qy * qz + qx * qw) * dz,
+        2 * (qx * qz + qy * qw) * dx
+        + 2 * (qy * qz - qx * qw) * dy
+        + (1 - 2 * (qx * qx + qy * qy)) * dz,
+    ]
+
+
+class GraspVerdict:
+    """The physical verdict's record and outcome. ``plane``: the object's constraint plane;
+    ``u``, ``v``: its in-plane unit axes (the tracking error's components); ``P``: the
+    criteria; ``dt``: the step (s)."""
+
+    def __init__(self, P: GraspParams, plane: PlaneSpec, u, v, dt: float) -> None:
+        self.params = P
+        self._point = [float(x) for x in plane.point]
+        self._normal = [float(x) for x in plane.normal]
+        self._u, self._v = [float(x) for x in u], [float(x) for x in v]
         self._grasps: list[dict] = []
         self._grasp_start = 0.0
         self._slipping = False
         self._slips = 0
         self._held_path = 0.0
-        self._in_hand: deque = deque(maxlen=max(1, round(slip_time / dt)) + 1)
+        self._window = max(1, round(P.slip_time / dt)) + 1  # steps: slip_time and its start
+        self._in_hand: deque = deque(maxlen=self._window)
         self._off_plane = 0.0  # m, the largest |(x - plane point) . n| of the run
         self._off_plane_t = 0.0
         self._max_parts = 0
         self._touched: set = set()
         self._track_sq = 0.0
         self._track_n = 0
-        self._last_pos: tuple | None = None
+        self._last_pos: Sequence[float] | None = None
 
-    def _in_hand_position(self, pos) -> list[float]:
-        """The object's centre in the tool (= hand) frame (m): R^T (x - p)."""
-        (px, py, pz), (qx, qy, qz, qw), _, _ = self.engine.effector_now()
-        dx, dy, dz = pos[0] - px, pos[1] - py, pos[2] - pz
-        # the columns of R(q) dotted with d
-        return [
-            (1 - 2 * (qy * qy + qz * qz)) * dx
-            + 2 * (qx * qy + qz * qw) * dy
-            + 2 * (qx * qz - qy * qw) * dz,
-            2 * (qx * qy - qz * qw) * dx
-            + (1 - 2 * (qx * qx + qz * qz)) * dy
-            + 2 * (qy * qz + qx * qw) * dz,
-            2 * (qx * qz + qy * qw) * dx
-            + 2 * (qy * qz - qx * qw) * dy
-            + (1 - 2 * (qx * qx + qy * qy)) * dz,
-        ]
-
-    def _judge_step(self) -> None:
-        """After a step: the servos' torque_limit events, the arm rig's events and the
-        verdict's record."""
-        self._servo_limit_events()
-        n_before = len(self._events)
-        self._check_events()
-        self._grasp_bookkeeping(n_before)
-
-    def _grasp_bookkeeping(self, n_before: int) -> None:
-        """The physical verdict's record, from the truth of this step: each grasp's drift in
-        the hand, its distance to the human's path, the run's distance off the plane, slips."""
-        pos, _, v, _ = self._state()[2]
-        for ev in self._events[n_before:]:
+    def observe(self, r: GraspReading, events: Sequence[Occurrence]) -> list[Occurrence]:
+        """Record the step ``r`` after the rig's events of this step (``events``: a ``grasp``
+        starts a grasp's record and gets its ``normal_force``, a ``release`` ends it and gets
+        its ``held_for``); the step's ``slip`` events."""
+        for ev in events:
             if ev.kind == "grasp":
-                self._grasp_start = self._t - ev.data.get("hold_time", 0.0)
-                ev.data["normal_force"] = float(self.engine.contact_summary()[2])
-                self._grasps.append(
-                    {
-                        "t": self._grasp_start,
-                        "held_for": None,
-                        "in_hand": self._in_hand_position(pos),
-                        "drift": 0.0,
-                        "human": 0.0,
-                        "force_sq": 0.0,
-                        "force_max": 0.0,
-                        "n": 0,
-                    }
-                )
-                self._in_hand.clear()
+                self._start_grasp(r, ev)
             elif ev.kind == "release" and self._grasps:
-                held = self._t - self._grasp_start
+                held = r.t - self._grasp_start
                 self._grasps[-1]["held_for"] = held
                 ev.data["held_for"] = held
-        parts = self.engine.contact_summary()[0]  # sorted, "arm" among them if it touches
+        self._contacts_and_plane(r)
+        slips: list[Occurrence] = []
+        if r.held and self._grasps:
+            slips = self._holding(r)
+        else:
+            self._slipping = False
+            self._in_hand.clear()
+            self._tracking(r)
+        self._last_pos = r.pos
+        return slips
+
+    def _start_grasp(self, r: GraspReading, ev: Occurrence) -> None:
+        """A grasp's record, from its event (which began ``hold_time`` before it)."""
+        self._grasp_start = r.t - ev.data.get("hold_time", 0.0)
+        ev.data["normal_force"] = float(r.normal_force)
+        self._grasps.append(
+            {
+                "t": self._grasp_start,
+                "held_for": None,
+                "in_hand": in_hand_position(r.pos, r.tool),
+                "drift": 0.0,
+                "human": 0.0,
+                "force_sq": 0.0,
+                "force_max": 0.0,
+                "n": 0,
+            }
+        )
+        self._in_hand.clear()
+
+    def _contacts_and_plane(self, r: GraspReading) -> None:
+        """The hand parts touched and the run's distance off the plane."""
+        parts = r.parts
         n_hand = len(parts) - ("arm" in parts)
         if n_hand:
             self._touched.update(x for x in parts if x != "arm")
         self._max_parts = max(self._max_parts, n_hand)
-        # 3-vectors in floats
-        ox, oy, oz = pos
-        (cx, cy, cz), (nx, ny, nz) = self.plane.point, self._n_l
+        ox, oy, oz = r.pos
+        (cx, cy, cz), (nx, ny, nz) = self._point, self._normal
         off = abs((ox - cx) * nx + (oy - cy) * ny + (oz - cz) * nz)
         if off > self._off_plane:
-            self._off_plane, self._off_plane_t = off, self._t
-        if self.caught and self._grasps:
-            if self._last_pos is not None:
-                lx, ly, lz = ox - self._last_pos[0], oy - self._last_pos[1], oz - self._last_pos[2]
-                self._held_path += math.sqrt(lx * lx + ly * ly + lz * lz)
-            g = self._grasps[-1]
-            h = self._in_hand_position(pos)
-            r0 = g["in_hand"]
-            g["drift"] = max(g["drift"], math.dist(h, r0))
-            g["human"] = max(g["human"], math.dist(pos, self.human.target_l))
-            fx, fy, fz = self.human.force_l  # the human's force on the object (last step)
-            f2 = fx * fx + fy * fy + fz * fz
-            g["force_sq"] += f2
-            g["force_max"] = max(g["force_max"], math.sqrt(f2))
-            g["n"] += 1
-            # a slip: the object moved >= slip_distance in the hand within slip_time
-            # (sustained relative motion); over when it moves less than half of that
-            buf = self._in_hand
-            buf.append(h)
-            if len(buf) == buf.maxlen:
-                d = math.dist(h, buf[0])
-                P = self.params
-                if d >= P.slip_distance and not self._slipping:
-                    self._slips += 1
-                    self._slipping = True
-                    self._events.append(Occurrence("slip", {"distance": d, "position": list(pos)}))
-                elif self._slipping and d < 0.5 * P.slip_distance:
-                    self._slipping = False
-        else:
+            self._off_plane, self._off_plane_t = off, r.t
+
+    def _holding(self, r: GraspReading) -> list[Occurrence]:
+        """While grasped: the path held, the grasp's drift in the hand, its distance to the
+        human's path and the human's force; a ``slip`` when the object moved >= slip_distance
+        in the hand within slip_time (sustained relative motion), over when it moves less
+        than half of that."""
+        pos = r.pos
+        ox, oy, oz = pos
+        if self._last_pos is not None:
+            lx, ly, lz = ox - self._last_pos[0], oy - self._last_pos[1], oz - self._last_pos[2]
+            self._held_path += math.sqrt(lx * lx + ly * ly + lz * lz)
+        g = self._grasps[-1]
+        h = in_hand_position(pos, r.tool)
+        g["drift"] = max(g["drift"], math.dist(h, g["in_hand"]))
+        g["human"] = max(g["human"], math.dist(pos, r.human_target))
+        fx, fy, fz = r.human_force
+        f2 = fx * fx + fy * fy + fz * fz
+        g["force_sq"] += f2
+        g["force_max"] = max(g["force_max"], math.sqrt(f2))
+        g["n"] += 1
+        buf = self._in_hand
+        buf.append(h)
+        if len(buf) < self._window:
+            return []
+        d = math.dist(h, buf[0])
+        P = self.params
+        if d >= P.slip_distance and not self._slipping:
+            self._slips += 1
+            self._slipping = True
+            return [Occurrence("slip", {"distance": d, "position": list(pos)})]
+        if self._slipping and d < 0.5 * P.slip_distance:
             self._slipping = False
-            self._in_hand.clear()
-            ex, ey, ez = self.engine.effector_now()[0]
-            dx, dy, dz = ox - ex, oy - ey, oz - ez
-            (ux, uy, uz), (vx, vy, vz) = self._u_l, self._v_l
-            du = dx * ux + dy * uy + dz * uz
-            dv = dx * vx + dy * vy + dz * vz
-            self._track_sq += du**2 + dv**2
-            self._track_n += 1
-        self._last_pos = pos
+        return []
+
+    def _tracking(self, r: GraspReading) -> None:
+        """Before a grasp: the hand's in-plane distance to the object (the tracking error)."""
+        ox, oy, oz = r.pos
+        ex, ey, ez = r.tool[0]
+        dx, dy, dz = ox - ex, oy - ey, oz - ez
+        (ux, uy, uz), (vx, vy, vz) = self._u, self._v
+        du = dx * ux + dy * uy + dz * uz
+        dv = dx * vx + dy * vy + dz * vz
+        self._track_sq += du**2 + dv**2
+        self._track_n += 1
 
     # ------------------------------------------------------------------ verdict
     def outcome(self, t: float) -> dict:
@@ -148,16 +180,16 @@ class GraspVerdict(GraspRig):
         grasp), **on its plane** (within ``grasp_max_off_plane`` all run), one grasp at least
         ``grasp_min_hold`` long and the object moved while held; a failure names every
         criterion it missed."""
-        P = self.params
-        holds = [(g["held_for"] if g["held_for"] is not None else t - g["t"]) for g in self._grasps]
-        drift = max((g["drift"] for g in self._grasps), default=0.0)
-        human = max((g["human"] for g in self._grasps), default=0.0)
-        n_held = sum(g["n"] for g in self._grasps)
+        grasps = self._grasps
+        holds = [(g["held_for"] if g["held_for"] is not None else t - g["t"]) for g in grasps]
+        drift = max((g["drift"] for g in grasps), default=0.0)
+        human = max((g["human"] for g in grasps), default=0.0)
+        n_held = sum(g["n"] for g in grasps)
         out = {
             "success": True,
             "reason": "grasped and held with the human",
-            "grasps": len(self._grasps),
-            "first_grasp_t": self._grasps[0]["t"] if self._grasps else None,
+            "grasps": len(grasps),
+            "first_grasp_t": grasps[0]["t"] if grasps else None,
             "hold_time": float(sum(holds)),
             "longest_hold": max(holds, default=0.0),
             "held_path": self._held_path,
@@ -166,14 +198,23 @@ class GraspVerdict(GraspRig):
             "hold_human_offset_max": human,
             "off_plane_max": self._off_plane,
             "hold_human_force_rms": (
-                math.sqrt(sum(g["force_sq"] for g in self._grasps) / n_held) if n_held else None
+                math.sqrt(sum(g["force_sq"] for g in grasps) / n_held) if n_held else None
             ),
-            "hold_human_force_max": max((g["force_max"] for g in self._grasps), default=None),
+            "hold_human_force_max": max((g["force_max"] for g in grasps), default=None),
             "tracking_error_rms": (
                 math.sqrt(self._track_sq / self._track_n) if self._track_n else None
             ),
             "hand_parts_touched": sorted(self._touched),
         }
+        why = self._misses(holds, drift, human)
+        if why:
+            out["success"] = False
+            out["reason"] = "; ".join(why)
+        return out
+
+    def _misses(self, holds: list, drift: float, human: float) -> list[str]:
+        """Every criterion the run missed, in words."""
+        P = self.params
         why: list[str] = []
         if not self._grasps:
             if not self._touched:
@@ -209,7 +250,4 @@ class GraspVerdict(GraspRig):
                 f"off its plane: {1e3 * self._off_plane:.1f} mm at {self._off_plane_t:.3f} s "
                 f"(> {1e3 * P.grasp_max_off_plane:g} mm)"
             )
-        if why:
-            out["success"] = False
-            out["reason"] = "; ".join(why)
-        return out
+        return why

@@ -244,6 +244,12 @@ class ArmRig(Plant):
             cmd, self._tlim_l, self._locked_l, self._enforce_vlim, self._vlim_l, qdl
         )
         self._tau_applied = applied
+        self._torque_events(cmd, applied, clamped)
+
+    def _torque_events(self, cmd: list | None, applied: list, clamped: list) -> None:
+        """The step's torques ``applied`` (``clamped`` per joint; ``cmd`` the commanded ones,
+        None where the servos' own): a ``torque_limit`` event per joint clamped anew (arm_state's
+        ``torque_limit_events``), counted."""
         if True in clamped:
             self._events += torque_limit_events(
                 clamped, self._torque_episode, cmd, applied, self.joint_names, self._tlim_l

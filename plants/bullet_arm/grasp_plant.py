@@ -1,6 +1,6 @@
 """The grasping rig (Namiki, Nakabo, Ishii & Ishikawa 1999) in PyBullet: physics only.
 
-The engine-free rig (plants/arm_rig/grasp_rig.py ``GraspRig``, its topics and verdict) on
+The engine-free rig (plants/arm_rig/grasp_rig.py ``GraspRig``, with its topics and verdict) on
 the PyBullet adapter (``PybulletGraspEngine``); this module holds its PyBullet drives, sensor
 and human. The rig:
 
@@ -26,8 +26,7 @@ import numpy as np
 from plants.bullet_arm.engine import pybullet as p
 
 from plants.arm_rig.arm_state import joint_state
-from plants.arm_rig.grasp_topics import GraspRigTopics
-from plants.arm_rig.grasp_verdict import GraspVerdict
+from plants.arm_rig.grasp_rig import GraspRig
 from plants.arm_rig.params import GraspParams
 from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.human_hand import HumanHand
@@ -113,7 +112,7 @@ class PybulletGraspEngine(PybulletEngine):
         self.hand_servos.actuate()
 
 
-class BulletGraspPlant(GraspVerdict, GraspRigTopics):
+class BulletGraspPlant(GraspRig):
     Params = GraspParams
     Engine = PybulletGraspEngine
     description = (

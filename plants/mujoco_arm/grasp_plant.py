@@ -20,9 +20,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from plants.arm_rig.grasp_topics import GraspRigTopics
-from plants.arm_rig.grasp_rig import hand_speeds
-from plants.arm_rig.grasp_verdict import GraspVerdict
+from plants.arm_rig.grasp_rig import GraspRig, hand_speeds
 from plants.arm_rig.human_path import HumanPath
 from plants.mujoco_arm.human import drive_human
 from plants.mujoco_arm.params import GraspParams
@@ -94,7 +92,7 @@ class MujocoGraspEngine(MujocoEngine):
         self._hand_caps(self._hand_v_cmd, qd)
 
 
-class MujocoGraspPlant(GraspVerdict, GraspRigTopics):
+class MujocoGraspPlant(GraspRig):
     Params = GraspParams
     Engine = MujocoGraspEngine
     description = (

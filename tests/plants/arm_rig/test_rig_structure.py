@@ -5,6 +5,7 @@ than a copy of its own."""
 from __future__ import annotations
 
 import pkgutil
+import re
 import subprocess
 import sys
 
@@ -38,15 +39,27 @@ def test_every_engine_plant_runs_the_rigs_own_methods():
         for name in RIG_METHODS + ("truth", "scene", "outcome", "step", "apply"):
             assert getattr(cls, name) is getattr(ArmRig, name), (cls.__name__, name)
     for cls in (BulletGraspPlant, MujocoGraspPlant):
-        assert issubclass(cls, GraspRig)
-        for name in RIG_METHODS:
+        assert cls.__bases__ == (GraspRig,), cls.__mro__  # the rig itself, no mixin
+        for name in RIG_METHODS + ("_torque_events",):
             assert getattr(cls, name) is getattr(ArmRig, name), (cls.__name__, name)
-        # the grasp rig's own truth, scene, command, verdict: one of each for both engines
-        assert cls.truth.__module__ == cls.scene.__module__ == "plants.arm_rig.grasp_topics"
-        assert cls.apply is GraspRig.apply and cls.step is GraspRig.step
-        assert (
-            cls.outcome.__module__ == cls._judge_step.__module__ == "plants.arm_rig.grasp_verdict"
-        )
+        # the grasp rig's own truth, scene, command, verdict: one of each for every engine
+        for name in ("truth", "scene", "joints", "frames", "apply", "step", "outcome"):
+            assert getattr(cls, name) is vars(GraspRig)[name], (cls.__name__, name)
+
+
+def test_no_arm_rig_class_reads_another_objects_private_state():
+    """The rig's parts (verdict, topics, servos, head, human, set-up) are fed readings or read
+    public attributes: no ``x._name`` in plants/arm_rig but on ``self``."""
+    from pathlib import Path
+
+    pattern = re.compile(r"\b(?!self\b)[A-Za-z_][A-Za-z0-9_]*\)?\._[a-z]")
+    found = [
+        f"{path.name}:{i}: {line.strip()}"
+        for path in sorted(Path(plants.arm_rig.__path__[0]).glob("*.py"))
+        for i, line in enumerate(path.read_text().splitlines(), 1)
+        if pattern.search(line)
+    ]
+    assert found == []
 
 
 def test_engine_plants_only_name_their_adapter():
