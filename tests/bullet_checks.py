@@ -1,4 +1,4 @@
-"""PyBullet's own dynamics of a BulletArmPlant's arm, to cross-check the NumPy model in tests
+"""PyBullet's own dynamics of the arm rig's arm (PyBullet engine), to cross-check the NumPy model in tests
 (moved out of the plant: only tests need it)."""
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from plants.bullet_arm.grasp_plant import BulletGraspPlant
+from plants.arm_rig.grasp_rig import GraspRig
 from plants.arm_rig.params import GraspParams
 from replay.robot.arm_types import ServoCommand
 
@@ -14,7 +14,7 @@ DT = 1e-3
 Q0 = [0.0, 0.533482, 0.0, 2.134676, 0.0, -1.0973, 0.0]  # scenarios/grasp_hexahedron.yaml
 
 
-def rig(**kw) -> BulletGraspPlant:
+def rig(**kw) -> GraspRig:
     base = dict(
         arm="wam7",
         hand="grasp4",
@@ -29,7 +29,7 @@ def rig(**kw) -> BulletGraspPlant:
         velocity_limits=[3.0] * 7,
     )
     base.update(kw)
-    return BulletGraspPlant(GraspParams(**base), dt=DT, rng=np.random.default_rng(0))
+    return GraspRig(GraspParams(**base), dt=DT, rng=np.random.default_rng(0))
 
 
 def nudged_truth(plant, steps: int = 5) -> dict:

@@ -19,7 +19,7 @@ PAPER = Paper(
     },
     plants={
         # the arm rig, its engine plant.params.engine (PyBullet where empty)
-        "arm_rig": "plants.bullet_arm:BulletArmPlant",
+        "arm_rig": "plants.arm_rig.rig:ArmRig",
         "mujoco_arm": "plants.mujoco_arm.plant:MujocoArmPlant",  # (MuJoCo's flat: old logs)
     },
     renamed_plants={"bullet_arm": "arm_rig"},

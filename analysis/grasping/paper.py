@@ -21,7 +21,7 @@ PAPER = Paper(
     },
     plants={
         # the grasping rig, its engine plant.params.engine (PyBullet where empty)
-        "grasp_rig": "plants.bullet_arm.grasp_plant:BulletGraspPlant",
+        "grasp_rig": "plants.arm_rig.grasp_rig:GraspRig",
         "mujoco_grasp": "plants.mujoco_arm.grasp_plant:MujocoGraspPlant",  # (MuJoCo's flat: old logs)
     },
     renamed_plants={"bullet_grasp": "grasp_rig"},

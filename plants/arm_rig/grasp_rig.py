@@ -13,7 +13,7 @@ is this class with its ``Params``, ``Engine`` and ``description``.
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import ClassVar, Protocol
 
 import numpy as np
 
@@ -75,6 +75,12 @@ class GraspEngine(EngineAdapter, Protocol):
 
 
 class GraspRig(ArmRig):
+    Params: ClassVar[type] = GraspParams
+    description = (
+        "the grasping rig: a WAM-7 and a 14-joint hand on velocity servos, a pan/tilt head, a "
+        "wrist F/T sensor and an object moved by a human hand on a constraint plane, on the "
+        "physics engine plant.params.engine names (PyBullet where it is empty)"
+    )
     spec_type = GraspSpec
     command_types = (ServoCommand,)  # type: ignore[assignment]
     hold_event = "grasp"

@@ -13,13 +13,14 @@ names its adapter class (``Engine``).
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 import numpy as np
 
-from plants.arm_rig.engine import EngineAdapter, adapter_class
+from plants.arm_rig.engine import EngineAdapter, adapter_class, engine_settings
 from plants.arm_rig.arm_state import limit_flags, limit_torque, torque_limit_events
 from plants.arm_rig.impulse import ImpulseSchedule
 from plants.arm_rig.outcome import CatchWatch
-from plants.arm_rig.params import Params
+from plants.arm_rig.params import Params as ArmParams
 from plants.arm_rig.payloads import AppliedTorque, EffectorMotion, ObjectContacts
 from plants.arm_rig.settings import resolve
 from replay.interfaces import Occurrence, Plant
@@ -59,11 +60,16 @@ def _vec3(values) -> tuple[float, float, float]:
 
 
 class ArmRig(Plant):
+    Params: ClassVar[type] = ArmParams
+    description = (
+        "the arm rig: a WAM arm (torque control), a hand and a free object, on the physics "
+        "engine plant.params.engine names (PyBullet where it is empty)"
+    )
     spec_type = ArmSpec
     command_types = (ArmCommand,)
     hold_event = "catch"  # the event kind of "held by the hand" (the grasping rig: "grasp")
 
-    def __init__(self, params: Params, *, dt: float, rng: np.random.Generator) -> None:
+    def __init__(self, params: ArmParams, *, dt: float, rng: np.random.Generator) -> None:
         super().__init__(params, dt=dt, rng=rng)
         P = params
         S = self.settings = resolve(P)  # every default worked out (also for the viewer)
@@ -115,9 +121,13 @@ class ArmRig(Plant):
         self._obj_albedo = float(P.object_albedo)
         self._obj_size = _vec3(P.object_size)
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
-        # the world, from the public state above: the engine field's adapter, else the type's
+        # the world, from the public state above: the engine field's adapter, else the one an
+        # old log's plant type names (``Engine``), else the params' own engine's
         E = P.engine_settings
-        Engine = self.Engine if E is None else adapter_class(E, self.engine_role)
+        if E is None and self.Engine is None:
+            E = engine_settings({"type": P.own_engine})
+        Engine = adapter_class(E, self.engine_role) if E is not None else self.Engine
+        assert Engine is not None
         self.engine: EngineAdapter = Engine(self)
         self._spec = self._make_spec(S.initial_q.copy())
         self._watch = (  # the catch verdict (outcome.py): a free object and a hand
@@ -133,7 +143,9 @@ class ArmRig(Plant):
         )
 
     # ------------------------------------------------------------------ the engine
-    Engine: type  # the engine adapter's class (engine.py ``EngineAdapter``), built from the rig
+    # an old plant type's fixed adapter class (engine.py ``EngineAdapter``; mujoco_arm's), else
+    # None: the engine the params name
+    Engine: type | None = None
     engine_role = "arm"  # which of an engine's adapters the rig takes (engine.py)
 
     def _state(self) -> tuple:

@@ -26,8 +26,6 @@ import numpy as np
 from plants.bullet_arm.engine import pybullet as p
 
 from plants.arm_rig.arm_state import joint_state
-from plants.arm_rig.grasp_rig import GraspRig
-from plants.arm_rig.params import GraspParams
 from plants.bullet_arm.ft_sensor import WristFT
 from plants.bullet_arm.human_hand import HumanHand
 from plants.bullet_arm.motors import VelocityMotors
@@ -110,12 +108,3 @@ class PybulletGraspEngine(PybulletEngine):
 
     def drive_hand_servos(self, qd: list) -> None:
         self.hand_servos.actuate()
-
-
-class BulletGraspPlant(GraspRig):
-    Params = GraspParams
-    Engine = PybulletGraspEngine
-    description = (
-        "PyBullet WAM-7 + 14-joint hand on velocity servos, pan/tilt head, wrist F/T, "
-        "an object moved by a human hand on a constraint plane"
-    )

@@ -21,7 +21,6 @@ import math
 import numpy as np
 
 from plants.arm_rig.arm_state import joint_state
-from plants.arm_rig.params import Params as ArmParams
 from plants.arm_rig.rig import ArmRig
 from plants.bullet_arm.quiet import quiet_c_output
 from plants.bullet_arm.reach import robot_reach
@@ -370,9 +369,3 @@ class PybulletEngine:
             except Exception:
                 pass
             self.bc = None
-
-
-class BulletArmPlant(ArmRig):
-    Params = ArmParams
-    Engine = PybulletEngine
-    description = "PyBullet WAM arm (torque control) + hand (position control) + a free object"

@@ -1,5 +1,5 @@
 """The grasping rig (Namiki, Nakabo, Ishii & Ishikawa 1999) in MuJoCo: physics only, the PyBullet
-rig's contract (plants/bullet_arm/grasp_plant.py ``BulletGraspPlant``) on the MuJoCo adapter
+rig's contract (plants/arm_rig/grasp_rig.py ``GraspRig``) on the MuJoCo adapter
 (``MujocoGraspEngine``, widening ``MujocoEngine``):
 
 - the arm's 7 AC servos take velocity commands (``ServoCommand.arm``): the engine-free

@@ -26,20 +26,23 @@ def test_no_arm_rig_module_imports_an_engine():
     assert out.stdout.strip() == "[]"
 
 
-def test_every_engine_plant_runs_the_rigs_own_methods():
+def test_the_plant_types_are_the_rigs_and_old_types_run_the_rigs_own_methods():
+    """``arm_rig`` and ``grasp_rig`` are the engine-free rigs themselves (the engine from the
+    field); an old log's ``mujoco_arm``/``mujoco_grasp`` is the rig with a fixed adapter."""
     from plants.arm_rig.grasp_rig import GraspRig
     from plants.arm_rig.rig import ArmRig
-    from plants.bullet_arm.grasp_plant import BulletGraspPlant
-    from plants.bullet_arm.plant import BulletArmPlant
     from plants.mujoco_arm.grasp_plant import MujocoGraspPlant
     from plants.mujoco_arm.plant import MujocoArmPlant
+    from replay import registry
 
-    for cls in (BulletArmPlant, MujocoArmPlant):
-        assert issubclass(cls, ArmRig)
-        for name in RIG_METHODS + ("truth", "scene", "outcome", "step", "apply"):
-            assert getattr(cls, name) is getattr(ArmRig, name), (cls.__name__, name)
-    for cls in (BulletGraspPlant, MujocoGraspPlant):
-        assert cls.__bases__ == (GraspRig,), cls.__mro__  # the rig itself, no mixin
+    assert registry.load("plant", "arm_rig") is ArmRig and ArmRig.Engine is None
+    assert registry.load("plant", "grasp_rig") is GraspRig and GraspRig.Engine is None
+    assert registry.load("plant", "bullet_arm") is ArmRig  # (an old log's name, renamed)
+    assert MujocoArmPlant.__bases__ == (ArmRig,) and GraspRig.__bases__ == (ArmRig,)
+    for name in RIG_METHODS + ("truth", "scene", "outcome", "step", "apply"):
+        assert getattr(MujocoArmPlant, name) is getattr(ArmRig, name), name
+    assert MujocoGraspPlant.__bases__ == (GraspRig,), MujocoGraspPlant.__mro__  # no mixin
+    for cls in (GraspRig, MujocoGraspPlant):
         for name in RIG_METHODS + ("_torque_events",):
             assert getattr(cls, name) is getattr(ArmRig, name), (cls.__name__, name)
         # the grasp rig's own truth, scene, command, verdict: one of each for every engine
@@ -67,8 +70,6 @@ def test_engine_plants_only_name_their_adapter():
     no method of its own, and its adapter defines every method of the adapter protocol."""
     from plants.arm_rig.engine import EngineAdapter
     from plants.arm_rig.grasp_rig import GraspEngine
-    from plants.bullet_arm.grasp_plant import BulletGraspPlant
-    from plants.bullet_arm.plant import BulletArmPlant
     from plants.mujoco_arm.grasp_plant import MujocoGraspPlant
     from plants.mujoco_arm.plant import MujocoArmPlant
 
@@ -77,10 +78,10 @@ def test_engine_plants_only_name_their_adapter():
 
     arm, grasp = methods(EngineAdapter), methods(GraspEngine)
     assert {"state", "advance", "object_contacts", "frames"} <= arm
-    for cls in (BulletArmPlant, MujocoArmPlant, BulletGraspPlant, MujocoGraspPlant):
+    for cls in (MujocoArmPlant, MujocoGraspPlant):  # (old logs' types)
         own = {n for n in vars(cls) if not n.startswith("_")}
         assert own == {"Params", "Engine", "description"}, (cls.__name__, own)
-        want = arm | (grasp if cls in (BulletGraspPlant, MujocoGraspPlant) else set())
+        want = arm | (grasp if cls is MujocoGraspPlant else set())
         missing = [n for n in want if not callable(getattr(cls.Engine, n, None))]
         assert not missing, (cls.Engine.__name__, missing)
     from plants.arm_rig.engine import adapter_class, engines

@@ -13,7 +13,8 @@ import pytest
 from pybullet_utils import bullet_client
 
 from arm_checks import hold_torque
-from plants.bullet_arm import BulletArmPlant, Params
+from plants.arm_rig.params import Params
+from plants.arm_rig.rig import ArmRig
 from plants.models import build_arm
 from replay.interfaces import Plant
 from replay.messages import JointState, ObjectState, json_schema, to_dict
@@ -32,8 +33,8 @@ START = [0.0, math.pi / 4, 0.0, 0.0]  # Namiki & Ishikawa IV-A
 CATCHING = dict(initial_q=START, locked_joints=["J3"])
 
 
-def make(**kw) -> BulletArmPlant:
-    return BulletArmPlant(Params(**kw), dt=DT, rng=np.random.default_rng(0))
+def make(**kw) -> ArmRig:
+    return ArmRig(Params(**kw), dt=DT, rng=np.random.default_rng(0))
 
 
 def palm_face(spec: ArmSpec, q) -> tuple[np.ndarray, np.ndarray]:

@@ -10,7 +10,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
-from plants.bullet_arm.grasp_plant import BulletGraspPlant
+from plants.arm_rig.grasp_rig import GraspRig
 from plants.arm_rig.head import HeadServo
 from plants.bullet_arm.human_hand import band_limited_path
 from plants.arm_rig.params import GraspParams
@@ -191,7 +191,7 @@ def test_human_path_has_the_scenarios_rms_speed():
 def test_human_moves_the_object_and_seeds_give_other_paths():
     paths = []
     for seed in (0, 1):
-        plant = BulletGraspPlant(
+        plant = GraspRig(
             GraspParams(
                 arm="wam7",
                 hand="grasp4",

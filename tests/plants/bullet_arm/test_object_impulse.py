@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plants.bullet_arm import BulletArmPlant, Params
+from plants.arm_rig.params import Params
+from plants.arm_rig.rig import ArmRig
 from plants.arm_rig.impulse import ImpulseSchedule
 
 DT = 1e-3
@@ -21,7 +22,7 @@ def _plant(**kw):
         object_velocity=[-2.0, 0.0, 0.0],
     )
     base.update(kw)
-    return BulletArmPlant(Params(**base), dt=DT, rng=np.random.default_rng(0))
+    return ArmRig(Params(**base), dt=DT, rng=np.random.default_rng(0))
 
 
 def test_a_kick_changes_the_velocity_by_j_over_m_once_at_its_time():

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from plants.bullet_arm import BulletArmPlant, Params
+from plants.arm_rig.params import Params
+from plants.arm_rig.rig import ArmRig
 from plants.arm_rig.arm_state import limit_torque, limit_torque_loop
 from plants.arm_rig.rig import floats
 from replay.robot.arm_types import ArmCommand
@@ -22,8 +23,8 @@ DT = 1e-3
 CATCHING = dict(initial_q=[0.0, math.pi / 4, 0.0, 0.0], locked_joints=["J3"])
 
 
-def make(**kw) -> BulletArmPlant:
-    return BulletArmPlant(Params(**kw), dt=DT, rng=np.random.default_rng(0))
+def make(**kw) -> ArmRig:
+    return ArmRig(Params(**kw), dt=DT, rng=np.random.default_rng(0))
 
 
 def test_commands_read_as_numpy_reads_them():

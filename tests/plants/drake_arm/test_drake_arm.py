@@ -15,7 +15,7 @@ from grasp_rig import DT
 
 from arm_checks import hold_torque
 from plants.arm_rig.params import Params
-from plants.bullet_arm import BulletArmPlant
+from plants.arm_rig.rig import ArmRig
 from replay.robot.arm_types import ArmCommand
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -23,11 +23,11 @@ START = [0.0, math.pi / 4, 0.0, 0.0]  # Namiki & Ishikawa IV-A
 CATCHING = dict(initial_q=START, locked_joints=["J3"])
 
 
-def make(**kw) -> BulletArmPlant:
+def make(**kw) -> ArmRig:
     """The arm rig in Drake; ``dk_*`` keywords are Drake's settings, the rest the rig's."""
     engine = {k: kw.pop(k) for k in list(kw) if k.startswith("dk_")}
     params = Params(**kw, engine={"type": "drake", **engine})
-    return BulletArmPlant(params, dt=DT, rng=np.random.default_rng(0))
+    return ArmRig(params, dt=DT, rng=np.random.default_rng(0))
 
 
 @pytest.mark.parametrize("model", ["point", "hydroelastic"])

@@ -19,8 +19,8 @@ from grasp_rig import DT, nudged_truth, rig, rise_bandwidth
 
 from arm_checks import hold_torque
 from plants.arm_rig.engine import engines
-from plants.bullet_arm import BulletArmPlant
-from plants.bullet_arm import Params as ArmParams
+from plants.arm_rig.rig import ArmRig
+from plants.arm_rig.params import Params as ArmParams
 from replay.messages import JointState, ObjectState, to_dict
 from replay.robot.arm_types import ArmCommand, ArmSpec, ServoCommand
 from replay.robot.hand import CATCH3, GRASP4, hand_body, hand_mass
@@ -41,7 +41,7 @@ REFERENCE = "pybullet"
 def make(engine: str, **kw):
     """The arm rig in ``engine`` (plant.params.engine's type)."""
     params = ArmParams(**kw, engine={"type": engine})
-    return BulletArmPlant(params, dt=DT, rng=np.random.default_rng(0))
+    return ArmRig(params, dt=DT, rng=np.random.default_rng(0))
 
 
 def palm_face(spec: ArmSpec, q) -> tuple[np.ndarray, np.ndarray]:
