@@ -31,7 +31,7 @@ from __future__ import annotations
 import inspect
 import json
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -172,6 +172,22 @@ def shown(paper: str, path: Path | None = None) -> Shown | None:
 
 def _flipped(record: Shown | None) -> frozenset[str]:
     return record.flipped if record is not None else frozenset()
+
+
+def variants_apart(rows: Iterable[Claim], variants: Mapping[str, str]) -> list[Claim]:
+    """The rows with every measured one that a variant decides (``variants``: run key ->
+    what it changes; ``analysis.runs.variants_as_shipped``) shown as "other regime": a run
+    that changes the paper's conditions is not the paper's experiment, so its rows keep their
+    verdict and are never counted."""
+    out = []
+    for r in rows:
+        runs = {run for m in r.measures for run in m.split(":", 1)[0].split("/")}
+        hit = sorted(runs & set(variants))
+        if r.kind == "measured" and hit:
+            why = "; ".join(f"{k} is a variant ({variants[k]}), not the paper's run" for k in hit)
+            r = replace(r, kind="other regime", note=f"{r.note}; {why}" if r.note else why)
+        out.append(r)
+    return out
 
 
 def counted(rows: Iterable[Claim], record: Shown | None = None) -> tuple[int, int]:

@@ -152,11 +152,15 @@ def evaluate_runs(
     than the reference among ``logs`` every engine side by side, then the stored robustness
     rates of each on the same inputs (``stored_rate_rows``), and the closing note over them;
     else the paper's rows alone."""
+    from analysis.claims import variants_apart
+    from analysis.runs import variants_as_shipped
+
+    variants = variants_as_shipped(logs)  # (their rows: not the paper's experiment)
     if len(split_logs(logs)) == 1:
-        return evaluate(dict(logs)), ""
+        return variants_apart(evaluate(dict(logs)), variants), ""
     papers = {log.scenario()["paper"] for log in logs.values() if hasattr(log, "scenario")}
     ran = list(split_logs(logs))
-    rows = engine_rows(evaluate, logs)
+    rows = variants_apart(engine_rows(evaluate, logs), variants)
     rows += [r for p in sorted(papers) for r in stored_rate_rows(p, engines=ran)]
     return rows, closing_note(rows)
 

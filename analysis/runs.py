@@ -233,6 +233,22 @@ def describe(reader: LogReader, key: str | None = None) -> Run:
     return run
 
 
+def variants_as_shipped(readers: Mapping[str, LogReader]) -> dict[str, str]:
+    """key -> label of each log that changes its shipped scenario yet holds its plain name (no
+    run of the scenario as shipped among the logs): the paper's rows would read it as the
+    paper's run. A run that differs by its engine alone (``engine …``) is the experiment in
+    another simulator, not a variant of it."""
+    out = {}
+    for key, r in readers.items():
+        if not isinstance(r, LogReader):
+            continue
+        run = describe(r, key)
+        if run.label and key == run.name == run.experiment:
+            if not (run.label.startswith("engine ") and "," not in run.label):
+                out[key] = run.label
+    return out
+
+
 def label(reader: LogReader) -> str:
     return describe(reader).label
 
