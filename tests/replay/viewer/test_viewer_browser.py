@@ -183,7 +183,7 @@ def test_viewer_draws_and_moves_in_a_browser(browser, name, make, tmp_path):
         a = _moved_to(page, viewer, first, (0.5, 0.15, 0.75), 0.0005, deadline)
         time.sleep(1.0)  # let the frame settle, then take it
         a = _image(page.screenshot(path=str(tmp_path / f"{name}_a.png"), timeout=SHOT_TIMEOUT))
-        b = _moved_to(page, viewer, a, (0.85, 0.95, 0.3), 0.001, deadline)
+        b = _moved_to(page, viewer, a, (0.3, 0.85, 0.95), 0.001, deadline)
         time.sleep(1.0)
         b = _image(page.screenshot(path=str(tmp_path / f"{name}_b.png"), timeout=SHOT_TIMEOUT))
         assert _colours(a) > 60 and _colours(b) > 60, "the canvas is not drawn"
