@@ -8,21 +8,22 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
-# The files that take the most CPU, longest first (those with a figure measured alone on this
-# project's 2-core machine, user+sys with the browser's and subprocesses' CPU, 2026-12-05; the
-# others ranked by the suite's --durations): they run before every other file, so that with
-# `make test`'s --dist loadfile --no-loadscope-reorder the two workers start on the two longest
-# and the short files fill the end, instead of a long one starting last (xdist's own order is by
-# test count).
+# The files that take longest, longest first (their time in `make test` on 2 quiet workers,
+# 2026-12-05, `--durations=0` summed per file): they run before every other file, so that with
+# `make test`'s --dist loadfile --no-loadscope-reorder the two workers start on the longest and
+# the short files fill the end, instead of a long one starting last (xdist's own order is by
+# test count). The browser pages and the wheel's `replay` subprocesses are mostly waiting.
 LONGEST_FIRST = (
-    "tests/replay/viewer/test_viewer_browser.py",  # ~150 s, most of it Chromium's software WebGL
-    "tests/analysis/test_falsify.py",  # ~100 s: `replay falsify` of the three papers
-    "tests/replay/test_wheel_install.py",  # ~87 s: two wheels built, runs from each
-    "tests/analysis/test_grasp_figures_claims.py",  # ~48 s
-    "tests/replay/viewer/test_viewer_browser_framing.py",
-    "tests/plants/mujoco_arm/test_grasp_mujoco.py",
-    "tests/replay/control/predictive/test_predictive.py",
-    "tests/replay/sweep/test_sweep_files.py",  # ~35 s
+    "tests/replay/viewer/test_viewer_browser.py",  # ~80 s: 8 pages in Chromium's software WebGL
+    "tests/replay/test_wheel_install.py",  # ~78 s: two wheels built, runs and analysis from each
+    "tests/analysis/test_falsify.py",  # ~60 s: `replay falsify` of the three papers
+    "tests/replay/viewer/test_viewer_browser_framing.py",  # ~43 s
+    "tests/replay/control/predictive/test_predictive.py",  # ~31 s
+    "tests/analysis/test_any_runs.py",  # ~27 s
+    "tests/plants/mujoco_arm/test_grasp_mujoco.py",  # ~26 s
+    "tests/plants/drake_arm/test_grasp_drake.py",  # ~24 s
+    "tests/replay/test_hostile_outputs.py",  # ~21 s
+    "tests/analysis/test_grasp_figures_claims.py",  # ~19 s
 )
 
 
