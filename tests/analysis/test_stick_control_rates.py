@@ -55,8 +55,9 @@ def test_capture_rate_over_controller_rates(by_rate):
 
 def test_frames_read_on_time_plan_alike(by_rate):
     """300 and 3000 Hz read every frame at the same instant, so a method that follows time
-    makes the same plans and meets the stick at the same times (a per-call increment or a
-    span counted in ticks would differ by the factor of 10)."""
+    makes the same plans and meets the stick at the same times on the shipped throw (a
+    per-call increment or a span counted in ticks would differ by the factor of 10). Not so on
+    every throw: a waypoint due between ticks is commanded at the next one (docs/stick.md)."""
     _, runs = by_rate
 
     def contacts(run) -> list:
