@@ -32,8 +32,9 @@ Cycle of one planned collision i:
    ``keep_in_reach`` later (else among all), is the plan; it is refined with new estimates
    until ``freeze`` before the contact (staged routes too: a plan made from the few samples just
    after a collision extrapolates a noisy velocity), re-planned only when an estimate moves the
-   contact beyond ``replan_tol`` / ``replan_theta`` / ``replan_dt`` (the 1 kHz ticks between
-   300 Hz frames and the frames that change nothing cost no planning).
+   contact beyond ``replan_tol`` / ``replan_theta`` / ``replan_dt`` (a control tick without a new
+   frame plans nothing, at any controller rate, nor does a frame that changes nothing; every
+   span here is in seconds of the frames' and ticks' own times, none counted in calls).
 4. A model break of the estimator within ``detect_window`` of the planned time, or whose unseen
    gap (last fitted sample .. first deviating one, e.g. the stick out of the camera's view)
    contains it, is the planned collision; the plan for the next step is then made from fresh
@@ -45,7 +46,8 @@ behind it; the other waits on the line through the centre of mass along v, ahead
 the point the stick reaches first that the hand can get to in time (going around an end of the
 stick when it starts behind it); the rear fingertip waits behind the stick while the slider
 moves (finger joints cannot hold a tip still against a moving slider), then follows the stick
-along that line (``follow_gap`` behind) to the final gap W + 2 tip_radius + grip_clearance.
+along that line (``follow_gap`` behind) to the final gap W + 2 tip_radius + grip_clearance; the
+front tip's route keeps a full tip radius clear of the predicted stick before the meeting.
 Whatever spin is left is ignored by the closing plan (the fingers then squeeze a turning stick:
 not friction independent); but a closing to be (re)planned on a stick spinning faster than
 ``respin`` first gets a spin-stop collision (eq. 30), up to ``max_extra`` in all.

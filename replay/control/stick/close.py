@@ -11,9 +11,11 @@ ahead of the stick, at the point the stick reaches first that the hand can get t
 (going around an end of the stick when it starts behind it, :meth:`ClosePlanner.around`). The
 rear fingertip waits behind the stick while the slider moves (finger joints cannot hold a tip
 still against a moving slider), then follows the stick along the line (``follow_gap`` behind)
-to the final gap W + 2 tip_radius + grip_clearance (:meth:`ClosePlanner.command`). Whatever spin
-is left is ignored by the closing plan (the fingers then squeeze a turning stick: not friction
-independent). The waiting front tip is moved onto the refined line of motion while the stick
+to the final gap W + 2 tip_radius + grip_clearance (:meth:`ClosePlanner.command`). The front
+tip's route keeps a full tip radius clear of the predicted stick until just before the meeting
+(a collision's route may graze it by 0.5 mm: its tip ends at a contact; a front tip touching the
+stick early pushes it into the rear tip). Whatever spin is left is ignored by the closing plan
+(the fingers then squeeze a turning stick: not friction independent). The waiting front tip is moved onto the refined line of motion while the stick
 has touched nothing (:meth:`ClosePlanner.refine`).
 
 The result is a :class:`ClosePlan` (the closing phase's plan; its ``intent`` is the ``plan``
@@ -190,7 +192,11 @@ class ClosePlanner:
                 continue
             cfg = cfg.with_finger(rear, qp)
             for route in [[(t, cfg)]] + self.around(t, now, cfg, front, F, pre):
-                arrival = self.planner.route_clear(t, now, route, front, pre, t_m)
+                # the front tip waits ahead of the stick: a touch before the meeting pushes
+                # the stick into the rear tip, so its route keeps a full tip radius clear
+                arrival = self.planner.route_clear(
+                    t, now, route, front, pre, t_m, tip_clear=hand.tip_radius
+                )
                 if arrival is not None:
                     return (arrival, cfg, route)
         return None

@@ -363,11 +363,14 @@ class ContactPlanner:
         motion: Motion,
         t_c: float,
         check_idle: bool = True,
+        tip_clear: float | None = None,
     ) -> float | None:
         """The arrival time of ``route`` if every segment finishes before the next starts, the
         last before t_c - arrive_margin, and no fingertip is hit by the predicted sweep: on the
         way (both tips) and, once arrived, finger k's tip until just before t_c and the idle
-        tip (``sweep_margin`` clear) until t_c + post_horizon. Else None. The answer of the
+        tip (``sweep_margin`` clear) until t_c + post_horizon. Else None. Finger k's tip counts
+        as hit within ``tip_clear`` of the stick (default tip_radius - 0.5 mm: a tip whose
+        route ends at a contact may graze the stick just before it). The answer of the
         array oracle (tests/replay/control/stick/oracles.py): the samples while the hand moves
         in whole arrays, those after it stands still (on its last waypoint) as fixed points
         (``coverage.covered_fixed``: only the samples near the stick made)."""
@@ -391,7 +394,7 @@ class ContactPlanner:
             q = route_axes(hand, starts, frm, to, times)
         x, y, th = motion.poses_before_switch(times)
         half_l, half_w = 0.5 * st.length, 0.5 * st.width
-        tip_r = hand.tip_radius - 5e-4
+        tip_r = hand.tip_radius - 5e-4 if tip_clear is None else tip_clear
         j = 1 - k
         ak = min(a, m2)
         tx, ty = finger_tips(hand, q[:ak], k)
