@@ -220,6 +220,13 @@ main()
 """
 
 
+def _sigint_as_from_a_shell() -> None:
+    """The child starts with SIGINT's default action, as a shell's foreground command does
+    (not whatever the test worker holds: it inherits an ignored one, and some earlier test's
+    library in the same xdist worker has been seen to leave it ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
     """The interrupted run is closed properly under its own name; an old log at -o stays."""
     out = tmp_path / "run.mcap"
@@ -228,7 +235,11 @@ def test_ctrl_c_keeps_a_closed_log_and_exits_130(toy_yaml, tmp_path):
         tests=str(Path(__file__).resolve().parents[1]), yaml=str(toy_yaml), out=str(out)
     )
     proc = subprocess.Popen(
-        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_sigint_as_from_a_shell,
     )
     try:
         assert proc.stdout.readline().strip() == "ready"
@@ -252,6 +263,14 @@ def test_sigint_mid_record_is_held_until_the_record_is_whole(tmp_path):
     """Ctrl-C while a record is written is raised only once the write is done, so the log never
     holds a torn record; after close the default handler is back. (The signal arrives while the
     mcap writer writes the chunk the message filled to the file.)"""
+    found = signal.signal(signal.SIGINT, signal.default_int_handler)  # (what a CLI starts with)
+    try:
+        _held_until_whole(tmp_path)
+    finally:
+        signal.signal(signal.SIGINT, found)
+
+
+def _held_until_whole(tmp_path) -> None:
     w = LogWriter(tmp_path / "x.mcap", chunk_size=100)
     add, reached = w._file.write, []
 
