@@ -14,9 +14,6 @@ from pathlib import Path
 
 MARKER = ".paper-replay-report"
 MARKER_TEXT = "made by `replay report`, which replaces this folder whole on its next run\n"
-# a report written before the marker existed: these entries only, and its index.html's title
-_OLD_ENTRIES = {"index.html", "index.md", "figures", "ablations", "tables", "sweeps"}
-_OLD_TITLE = "<title>paper-replay: reproduction report</title>"
 
 
 class ReportFolderError(ValueError):
@@ -37,14 +34,9 @@ def _marked(folder: Path) -> bool:
 
 
 def _ours(folder: Path) -> bool:
-    if _marked(folder):
-        return True
-    try:
-        names = {p.name for p in folder.iterdir()}
-        head = (folder / "index.html").read_text(encoding="utf-8", errors="replace")[:300]
-    except OSError:
-        return False
-    return names <= _OLD_ENTRIES and _OLD_TITLE in head
+    """A report's folder: its marker only (a folder that merely looks like a report, e.g. a
+    copy of one's pages or one written before the marker existed, is not replaced)."""
+    return _marked(folder)
 
 
 def check_folder(out: Path, logs: Path) -> None:

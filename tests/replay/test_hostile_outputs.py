@@ -226,24 +226,24 @@ def test_report_replaces_its_own_folder_and_keeps_it_when_a_build_fails(site, mo
     assert sorted(p.name for p in site.iterdir()) == ["logs", "main.py", "notes", "rep"]
 
 
-def test_report_takes_an_empty_folder_a_new_one_and_a_report_without_marker(site):
+def test_report_takes_an_empty_folder_a_new_one_and_never_one_without_its_marker(site):
     (site / "empty").mkdir()
     for out in ("empty", "new/deeper", "logs/report"):  # (a folder inside --logs is no harm)
         r = invoke("report", "-o", out, "--logs", "logs")
         assert r.exit_code == 0, r.output
         assert (site / out / MARKER).is_file() and (site / out / "index.html").is_file()
-    old = site / "old"  # a report written before the marker existed
+    old = site / "old"  # looks like a report (a copy of its pages, or one from before the marker)
     old.mkdir()
     (old / "figures").mkdir()
     (old / "index.html").write_text(
         "<!doctype html>\n<html lang='en'><head><meta charset='utf-8'>\n"
         "<title>paper-replay: reproduction report</title>\n"
     )
-    assert invoke("report", "-o", "old", "--logs", "logs").exit_code == 0
-    assert (old / MARKER).is_file()
+    assert "not empty" in one_error(invoke("report", "-o", "old", "--logs", "logs"))
+    assert (old / "index.html").is_file() and not (old / MARKER).exists()
     (site / "notes" / "index.html").write_text(
         "<title>paper-replay: reproduction report</title>"
-    )  # ... but not with a file of the user's beside it
+    )  # ... nor with a file of the user's beside it
     assert "not empty" in one_error(invoke("report", "-o", "notes", "--logs", "logs"))
     assert (site / "notes" / "a.txt").read_text() == "mine\n"
 
@@ -407,6 +407,13 @@ def test_the_report_removes_only_what_it_made(tmp_path):
     (foreign / "data.csv").write_text("1")
     discard(foreign)  # no marker: left alone
     assert (foreign / "data.csv").is_file() and not (foreign / MARKER).exists()
+    # a folder that only looks like a report (its pages copied, no marker) is not replaced
+    copy = tmp_path / "pages"
+    copy.mkdir()
+    (copy / "index.html").write_text("<title>paper-replay: reproduction report</title>")
+    with pytest.raises(ReportFolderError, match="changed during the build"):
+        swap_in(staging(copy), copy)
+    assert (copy / "index.html").is_file()
     # a marker that is a link to a file, or a file of other text, makes no folder a report
     elsewhere = tmp_path / "note.txt"
     elsewhere.write_text("made by `replay report`, which replaces this folder whole\n")
