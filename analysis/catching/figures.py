@@ -159,25 +159,17 @@ def fig6(opt: CatchRun | None, ini: CatchRun | None, variants: tuple[CatchRun, .
         if not run.costs:
             continue
         it = [c["iteration"] for c in run.costs]
-        marker = "o" if len(it) > 1 else "s"
-        ax_t.plot(
-            it,
-            [c["torque_cost"] for c in run.costs],
-            marker=marker,
-            color=color,
-            label=label,
-            ms=5 if len(it) > 1 else 8,
-            fillstyle="none" if len(it) == 1 else "full",
-        )
-        ax_w.plot(
-            it,
-            [c["velocity_cost"] for c in run.costs],
-            marker=marker,
-            color=color,
-            label=label,
-            ms=5 if len(it) > 1 else 8,
-            fillstyle="none" if len(it) == 1 else "full",
-        )
+        one = len(it) == 1  # (a single iterate: an open square)
+        style = dict(marker="s" if one else "o", ms=8 if one else 5)
+        for ax, cost in ((ax_t, "torque_cost"), (ax_w, "velocity_cost")):
+            ax.plot(
+                it,
+                [c[cost] for c in run.costs],
+                color=color,
+                label=label,
+                fillstyle="none" if one else "full",
+                **style,
+            )
     ax_t.set_ylabel("Σ τᵀ K_τ τ (dynamics)")
     ax_w.set_ylabel("Σ ωᵀ K_ω ω (kinematics)")
     ax_w.set_xlabel("optimisation iteration")
