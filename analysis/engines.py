@@ -25,7 +25,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from analysis.claims import ASSESSED, Claim
+from analysis.claims import ASSESSED, Claim, variants_apart
+from analysis.runs import variants_as_shipped
 
 # each engine's name in a scenario (plant.params.engine.type) and its label in the tables, the
 # first the reference every other engine's runs are matched to; an engine not listed is shown
@@ -152,9 +153,6 @@ def evaluate_runs(
     than the reference among ``logs`` every engine side by side, then the stored robustness
     rates of each on the same inputs (``stored_rate_rows``), and the closing note over them;
     else the paper's rows alone."""
-    from analysis.claims import variants_apart
-    from analysis.runs import variants_as_shipped
-
     variants = variants_as_shipped(logs)  # (their rows: not the paper's experiment)
     if len(split_logs(logs)) == 1:
         return variants_apart(evaluate(dict(logs)), variants), ""
