@@ -141,6 +141,18 @@ def _set_time(page, viewer: Viewer, t: float, deadline: float) -> None:
     _wait_for(lambda: abs(viewer.time - t) < 1e-3, deadline, f"the server to show t = {t}")
 
 
+def _settled(page, path: Path, deadline: float) -> np.ndarray:
+    """The screenshot (kept at ``path``) once two in a row are the same: the moved scene has been
+    drawn whole (or the deadline, 3 s at most, has passed)."""
+    deadline = min(deadline, time.monotonic() + 3.0)
+    last = _image(page.screenshot(timeout=SHOT_TIMEOUT))
+    while True:
+        img = _image(page.screenshot(path=str(path), timeout=SHOT_TIMEOUT))
+        if _changed(img, last) == 0.0 or time.monotonic() > deadline:
+            return img
+        last = img
+
+
 def _moved_to(page, viewer: Viewer, ref: np.ndarray, fractions, least: float, deadline: float):
     """Move the slider to the first of ``fractions`` of the run at which the scene differs from
     ``ref`` (more than ``least`` of its pixels); the screenshot there."""
@@ -180,12 +192,10 @@ def test_viewer_draws_and_moves_in_a_browser(browser, name, make, tmp_path):
         # the view is fitted to the moving parts (the hand, the object near it): in a catch log
         # the arm waits still until the ball is seen (0.1 s of 0.3), so mid-run comes first
         # (0.15 there waited out its 8 s), and where nothing in view moves, the next is tried
-        a = _moved_to(page, viewer, first, (0.5, 0.15, 0.75), 0.0005, deadline)
-        time.sleep(1.0)  # let the frame settle, then take it
-        a = _image(page.screenshot(path=str(tmp_path / f"{name}_a.png"), timeout=SHOT_TIMEOUT))
-        b = _moved_to(page, viewer, a, (0.3, 0.85, 0.95), 0.001, deadline)
-        time.sleep(1.0)
-        b = _image(page.screenshot(path=str(tmp_path / f"{name}_b.png"), timeout=SHOT_TIMEOUT))
+        _moved_to(page, viewer, first, (0.5, 0.15, 0.75), 0.0005, deadline)
+        a = _settled(page, tmp_path / f"{name}_a.png", deadline)
+        _moved_to(page, viewer, a, (0.3, 0.85, 0.95), 0.001, deadline)
+        b = _settled(page, tmp_path / f"{name}_b.png", deadline)
         assert _colours(a) > 60 and _colours(b) > 60, "the canvas is not drawn"
         assert _changed(a, b) > 0.001, "the scene did not change between the slider positions"
         keep = os.environ.get("PAPER_REPLAY_SCREENSHOTS")
