@@ -100,8 +100,13 @@ def _as_interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
 
-def _serve(conn, parent: int) -> None:
-    """A worker: variants in, rows out, until the pipe closes."""
+def _serve(conn, parent: int, not_ours: list) -> None:
+    """A worker: variants in, rows out, until the pipe closes. ``not_ours``: the sweep's ends of
+    the pipes, this worker's and those of the workers forked before it, which a fork copies:
+    closed here, so that the sweep closing its end is an end of input (``EOFError``) for this
+    worker, instead of a wait for the kill after ``STOP_GRACE``."""
+    for end in not_ours:
+        end.close()
     _die_with(parent)
     try:
         while True:
@@ -131,7 +136,7 @@ def run_local(tasks: list[dict], workers: int) -> Iterator[dict]:
 
     def start() -> None:
         ours, theirs = ctx.Pipe()
-        proc = ctx.Process(target=_serve, args=(theirs, os.getpid()), daemon=True)
+        proc = ctx.Process(target=_serve, args=(theirs, os.getpid(), [ours, *procs]), daemon=True)
         proc.start()
         theirs.close()
         procs[ours] = proc

@@ -207,6 +207,8 @@ def slow(self):
     time.sleep(0.001)
     step(self)
 toy_plugins.ToyPlant.step = slow
+import replay.sweep.executors
+replay.sweep.executors.STOP_GRACE = 60.0  # a worker that does not end by itself: the wait fails
 from replay.cli import main
 sys.argv = ["replay", "sweep", {yaml!r}, "--grid", "plant.params.mass=1,2,3,4,5,6",
             "-o", {out!r}, "--workers", "2", "-q", "--set", "timing.duration=60"]
