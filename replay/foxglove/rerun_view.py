@@ -197,8 +197,11 @@ def stop_group(proc: subprocess.Popen, grace: float = STOP_GRACE) -> None:
 
 
 @contextlib.contextmanager
-def running(cmd: list[str], quiet: bool = True) -> Iterator[subprocess.Popen]:
-    """``cmd`` in a process group of its own, stopped with all it started on leaving."""
+def running(
+    cmd: list[str], quiet: bool = True, grace: float = STOP_GRACE
+) -> Iterator[subprocess.Popen]:
+    """``cmd`` in a process group of its own, stopped with all it started on leaving (what
+    ignores SIGTERM killed after ``grace`` seconds)."""
     out = subprocess.DEVNULL if quiet else None
     proc = subprocess.Popen(
         cmd, stdout=out, stderr=out, start_new_session=True, preexec_fn=_die_with_parent()
@@ -209,7 +212,7 @@ def running(cmd: list[str], quiet: bool = True) -> Iterator[subprocess.Popen]:
         held = {signal.SIGINT, *STOP_SIGNALS}
         old = signal.pthread_sigmask(signal.SIG_BLOCK, held)  # (none interrupts the stop)
         try:
-            stop_group(proc)
+            stop_group(proc, grace)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
 

@@ -75,7 +75,7 @@ def test_the_timeline_is_in_simulated_seconds(tmp_path):
 def test_every_process_of_the_group_is_stopped(tmp_path):
     # a child that starts its own children, and one that ignores SIGTERM
     script = "trap '' TERM; sleep 60 & sleep 60 & wait"
-    with running(["sh", "-c", script]) as proc:
+    with running(["sh", "-c", script], grace=0.5) as proc:
         pgid = proc.pid
         deadline = time.monotonic() + 20
         while len(_group_alive(pgid)) < 3 and time.monotonic() < deadline:
