@@ -428,12 +428,17 @@ def make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     overlaid (a variant: the same scenario with a setting changed, up to MAX_VARIANTS), again
     for the 4.5 m/s pair (``catch_5ms_fig*``, outside the paper's 8-10 m/s), and Fig. 7 for
     every other run."""
-    out = Path(out)
+    try:
+        return _make_figures(logs, Path(out))
+    finally:  # (fig6 ... fig9 called alone afterwards draw their runs plainly)
+        _VARIANT.clear()
+        _LABEL.clear()
+
+
+def _make_figures(logs: dict[str, LogReader], out: Path) -> list[Path]:
     runs = {name: load_run(log, name) for name, log in sorted(logs.items())}
     if not runs:
         return []
-    _VARIANT.clear()
-    _LABEL.clear()
     _LABEL.update({n: run_labels.describe(log, n).label for n, log in logs.items()})
     slow = [runs[n] for n in SLOW_PAIR if n in runs]
     rest = {n: r for n, r in runs.items() if n not in SLOW_PAIR}

@@ -89,7 +89,6 @@ def assert_readable(fig) -> list[Annotation]:
 
 @pytest.fixture
 def pair(logs):
-    catch_figures._VARIANT.clear()
     return [load_run(logs[n], n) for n in ("catch_optimised", "catch_initial")]
 
 
