@@ -23,7 +23,7 @@ from replay.messages import (
     TOPIC_OPTIMIZATION_COST,
     TOPIC_VISION_OBJECT,
 )
-from analysis.runs import typed_scenario
+from analysis.runs import once_per_reader, typed_scenario
 
 ACTIVE = (0, 1, 3)  # axes 1, 2, 4 (axis 3 locked, Sec. IV-A)
 
@@ -123,6 +123,7 @@ class CatchRun:
         return self.scenario["controller"]["params"]
 
 
+@once_per_reader
 def load_run(log: LogReader, name: str | None = None) -> CatchRun:
     sc = _scenario(log)
     typed = typed_scenario(log)

@@ -18,6 +18,7 @@ from functools import cached_property
 
 import numpy as np
 
+from analysis.runs import once_per_reader
 from analysis.series import events
 from replay.log import LogReader
 
@@ -218,6 +219,7 @@ def _first3(rows: list[dict], key: str) -> np.ndarray:
     return np.array([r[key][:3] for r in rows], dtype=float).reshape(len(rows), 3)
 
 
+@once_per_reader
 def load_run(log: LogReader, name: str | None = None) -> GraspRun:
     sc = copy.deepcopy(log.scenario_config())
     eff = [m for m in log.series(T_ARM_TASK) if m.get("x_a") and m.get("x_d") and m.get("x_o")]

@@ -337,3 +337,36 @@ def test_a_renamed_run_with_another_controller_is_a_variant_of_the_papers_own():
     assert runs._compare(stick, "stick_mine", "higashimori2007") == ("stick_3step", [])
     assert runs._depth("catch_optimised") == 0 and runs._depth("catch_initial") == 1
     assert runs._depth("stick_3step_width10_long") == 2 and runs._depth("no_such") == 0
+
+
+def test_a_log_is_read_into_a_run_once_per_reader_and_its_arrays_are_read_only(catch):
+    from analysis.catching.run import load_run
+
+    reader = LogReader(catch["opt"])
+    a = load_run(reader, "catch_optimised")
+    assert load_run(reader, "catch_optimised") is a  # (the claims, figures, falsifiers: once)
+    assert load_run(reader, "other").name == "other"  # a run per name asked
+    fresh = load_run(LogReader(catch["opt"]), "catch_optimised")
+    assert fresh is not a and (fresh.q_desired == a.q_desired).all()  # another reader: read again
+    with pytest.raises(ValueError, match="read-only"):
+        a.q_desired[0, 0] = 1.0  # what is shared is not changed by one of its readers
+
+
+def test_figures_drawn_alone_after_make_figures_show_no_label_of_those_runs(catch, tmp_path):
+    from analysis.catching import figures
+    from analysis.catching.run import load_run
+
+    logs = runs.keyed(LogReader(catch[k]) for k in ("lat", "ini"))
+    figures.make_figures(logs, tmp_path)  # catch_optimised here is the 10 ms latency variant
+    pair = [
+        load_run(LogReader(catch[k]), n)
+        for k, n in (("opt", "catch_optimised"), ("ini", "catch_initial"))
+    ]
+    fig = figures.fig6(*pair)
+    try:
+        said = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        assert said[0] == "catch_optimised: optimisation (eq. 25)", said
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
