@@ -47,9 +47,11 @@ from replay.log.errors import LogError, LogLimitError, NotALogError
 from replay.messages import TOPIC_EVENTS, TOPIC_SCENARIO
 
 _loads = orjson.loads
-# every digit as "0", every other byte as " ": a run of 20 digits is then a plain substring
-_DIGITS_ONLY = bytes(0x30 if 0x30 <= i <= 0x39 else 0x20 for i in range(256))
-_TWENTY_DIGITS = b"0" * 20
+# every digit as "0", "." as itself, every other byte as " ": a whole number of 20 digits is
+# then a plain substring, " " and 20 "0"s (a fraction's digits follow a ".": orjson reads those
+# as the standard decoder does, and small floats are written with many of them)
+_DIGITS_ONLY = bytes(0x30 if 0x30 <= i <= 0x39 else i if i == 0x2E else 0x20 for i in range(256))
+_TWENTY_DIGITS = b" " + b"0" * 20
 _RECORD_LIMIT = 1 << 30  # no record of ours is near 1 GiB: a bigger length is damage
 _OPCODES = range(0x01, 0x10)  # MCAP's record opcodes (0x00 is none: zeros are not records)
 _HEAD = struct.Struct("<BQ")  # a record's opcode and length
