@@ -14,16 +14,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 # the short files fill the end, instead of a long one starting last (xdist's own order is by
 # test count). The browser pages and the wheel's `replay` subprocesses are mostly waiting.
 LONGEST_FIRST = (
-    "tests/replay/viewer/test_viewer_browser.py",  # ~80 s: 8 pages in Chromium's software WebGL
-    "tests/replay/test_wheel_install.py",  # ~78 s: two wheels built, runs and analysis from each
-    "tests/analysis/test_falsify.py",  # ~60 s: `replay falsify` of the three papers
-    "tests/replay/viewer/test_viewer_browser_framing.py",  # ~43 s
+    "tests/replay/test_wheel_install.py",  # ~89 s: two wheels built, runs and analysis from each
+    "tests/replay/viewer/test_viewer_browser.py",  # ~56 s: 8 pages in Chromium's software WebGL
+    "tests/analysis/test_falsify.py",  # ~48 s: `replay falsify` of the three papers
     "tests/replay/control/predictive/test_predictive.py",  # ~31 s
     "tests/analysis/test_any_runs.py",  # ~27 s
-    "tests/plants/mujoco_arm/test_grasp_mujoco.py",  # ~26 s
-    "tests/plants/drake_arm/test_grasp_drake.py",  # ~24 s
+    "tests/plants/drake_arm/test_grasp_drake.py",  # ~23 s
+    "tests/replay/viewer/test_viewer_browser_framing.py",  # ~21 s
     "tests/replay/test_hostile_outputs.py",  # ~21 s
-    "tests/analysis/test_grasp_figures_claims.py",  # ~19 s
+    "tests/plants/mujoco_arm/test_grasp_mujoco.py",  # ~20 s
+    "tests/replay/sweep/test_ray_cluster.py",  # ~15 s
 )
 
 
