@@ -7,7 +7,9 @@ the name and its label, ``catch_optimised (stereo latency 10 ms)``) and a label:
 of its stored, resolved scenario against the shipped scenario of the same name, or for a name
 that is not shipped against the nearest shipped scenario of its paper (its experiment: a renamed
 variant ``catch_lat10`` is a variant of ``catch_optimised``; of equally near ones the fewest
-``extends:`` steps from the paper's own).
+``extends:`` steps from the paper's own). A setting stated at the value the other side leaves to
+its default is no difference: an engine named with its defaults (``--set
+plant.params.engine.type=pybullet``) where the shipped scenario names none (its plant's own).
 
 The paper's own rows look their runs up by scenario name: the log that matches the shipped
 scenario keeps the plain name.
@@ -194,9 +196,45 @@ def _engine(plant_type: str) -> str:
     return label(engine) if engine != REFERENCE or plant_type == "arm_rig" else ""
 
 
+_ENGINE = "plant.params.engine."
+
+
+@lru_cache(maxsize=None)
+def _own_engine(plant_type: str) -> tuple[tuple[str, Any], ...]:
+    """The engine a plant of ``plant_type`` runs where its ``plant.params.engine`` is empty, as
+    a resolved scenario would state it, flattened: its params' own engine (``own_engine``) with
+    the engine's defaults (plants/arm_rig/rig.py); () for a plant without one (no engine field,
+    an old plant type that brings its own, one not installed here). Loads the plant, as typing
+    the shipped scenario (``_shipped``) already has."""
+    from replay.scenario.loader import to_plain
+
+    if not registry.known("plant", plant_type):
+        return ()
+    plant = registry.load("plant", plant_type)
+    own = getattr(getattr(plant, "Params", None), "own_engine", None)
+    if not isinstance(own, str) or getattr(plant, "Engine", None) is not None:
+        return ()
+    from plants.arm_rig.engine import engine_settings
+
+    return tuple(_flat(to_plain(engine_settings({"type": own})), _ENGINE).items())
+
+
+def _engine_stated(flat: Mapping[str, Any], other: Mapping[str, Any]) -> Mapping[str, Any]:
+    """``flat`` (a flattened resolved scenario) with its plant's own engine stated, defaults
+    filled, where it names no engine and ``other`` does: an empty engine field is that engine,
+    so a run stating it (``--set plant.params.engine.type=pybullet``) changes nothing."""
+    if f"{_ENGINE}type" in flat or f"{_ENGINE}type" not in other:
+        return flat
+    own = _own_engine(str(flat.get("plant.type")))
+    return {**flat, **dict(own)} if own else flat
+
+
 def differences(stored: Mapping[str, Any], ref: Mapping[str, Any]) -> list[str]:
     """What ``stored`` (a flattened resolved scenario) sets differently from ``ref``, as short
-    phrases: a changed plug-in type names the new type (its params are then not listed)."""
+    phrases: a changed plug-in type names the new type (its params are then not listed). A
+    setting stated at the value its side leaves to the default (an engine named with its
+    defaults where the other names none: :func:`_engine_stated`) is no difference."""
+    stored, ref = _engine_stated(stored, ref), _engine_stated(ref, stored)
     items, replaced = [], []
     sensors = sorted({p.split(".")[1] for p in stored if p.startswith("sensors.")})
     types = ("plant.type", "plant.params.engine.type", "controller.type")  # (an engine: its own
