@@ -95,3 +95,26 @@ def test_each_run_joins_its_engines_column(logs):
     assert list(split) == ["PyBullet", "MuJoCo"]
     assert split["PyBullet"] == {"catch_optimised": logs["pybullet"]}
     assert split["MuJoCo"] == {"catch_optimised": logs["mujoco"]}
+
+
+def test_an_old_log_of_the_shipped_scenario_is_no_variant(tmp_path):
+    """A log made before the engine field (plant ``bullet_arm``, PyBullet's settings flat at
+    their defaults) reads as the engine named (``current_config``), yet is the shipped run."""
+    import yaml
+
+    from plants.bullet_arm.settings import PybulletSettings
+    from replay.log import LogWriter
+    from replay.messages import TOPIC_SCENARIO, ScenarioInfo
+    from replay.scenario import load_scenario
+    from replay.scenario.loader import to_plain
+
+    data = to_plain(load_scenario("catch_optimised"))
+    data["plant"]["type"] = "bullet_arm"
+    flat = {k: v for k, v in to_plain(PybulletSettings()).items() if k != "type"}
+    data["plant"]["params"].update(flat)
+    with LogWriter(tmp_path / "old.mcap") as w:
+        text = yaml.safe_dump(data, sort_keys=False)
+        w.write(TOPIC_SCENARIO, ScenarioInfo(0.0, "catch_optimised", "namiki2003", text, 0, ""), 0)
+    old = LogReader(tmp_path / "old.mcap")
+    assert runs.current_config(old)["plant"]["params"]["engine"]["type"] == "pybullet"
+    assert runs.describe(old).label == ""
