@@ -221,9 +221,12 @@ def _own_engine(plant_type: str) -> tuple[tuple[str, Any], ...]:
 
 def _engine_stated(flat: Mapping[str, Any], other: Mapping[str, Any]) -> Mapping[str, Any]:
     """``flat`` (a flattened resolved scenario) with its plant's own engine stated, defaults
-    filled, where it names no engine and ``other`` does: an empty engine field is that engine,
-    so a run stating it (``--set plant.params.engine.type=pybullet``) changes nothing."""
+    filled, where it names no engine and ``other``, of the same plant type (the shipped one,
+    whose plant is loaded), does: an empty engine field is that engine, so a run stating it
+    (``--set plant.params.engine.type=pybullet``) changes nothing."""
     if f"{_ENGINE}type" in flat or f"{_ENGINE}type" not in other:
+        return flat
+    if flat.get("plant.type") != other.get("plant.type"):  # (its params: not compared)
         return flat
     own = _own_engine(str(flat.get("plant.type")))
     return {**flat, **dict(own)} if own else flat
