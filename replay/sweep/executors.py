@@ -101,10 +101,11 @@ def _as_interrupt(signum, frame) -> None:
 
 
 def _serve(conn, parent: int, not_ours: list) -> None:
-    """A worker: variants in, rows out, until the pipe closes. ``not_ours``: the sweep's ends of
-    the pipes, this worker's and those of the workers forked before it, which a fork copies:
-    closed here, so that the sweep closing its end is an end of input (``EOFError``) for this
-    worker, instead of a wait for the kill after ``STOP_GRACE``."""
+    """A worker: variants in, rows out, until the pipe closes, or is reset (the sweep stopped
+    with a row of this worker's unread). ``not_ours``: the sweep's ends of the pipes, this
+    worker's and those of the workers forked before it, which a fork copies: closed here, so
+    that the sweep closing its end is an end of input (``EOFError``) for this worker, instead
+    of a wait for the kill after ``STOP_GRACE``."""
     for end in not_ours:
         end.close()
     _die_with(parent)
@@ -115,7 +116,7 @@ def _serve(conn, parent: int, not_ours: list) -> None:
             except EOFError:
                 return
             conn.send(run_variant(task))
-    except (KeyboardInterrupt, BrokenPipeError, EOFError):
+    except (KeyboardInterrupt, ConnectionError, EOFError):
         return
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)  # (a late stop ends it quietly)

@@ -338,3 +338,29 @@ def test_a_sweep_started_with_sigint_ignored_still_stops_on_sigint(toy_yaml, tmp
             os.killpg(proc.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="AF_UNIX reset on close")
+def test_a_worker_whose_row_is_left_unread_at_the_stop_ends_without_a_traceback(
+    toy_yaml, tmp_path, capfd
+):
+    """Stopped while a worker's finished row waits unread in its pipe (Ctrl-C between two
+    rows): the sweep closing its end resets the pipe, and the worker's next read is a
+    ConnectionResetError, which must end it quietly as an end of input does."""
+    from replay.sweep.engine import _tasks
+    from replay.sweep.executors import run_local
+
+    spec = from_options(["plant.params.mass=1,2,3"], [], None)
+    tasks = _tasks(expand(toy_yaml, spec, 0, version="test"), tmp_path / "D", False, "")
+    stream = run_local(tasks, 2)
+    first = next(stream)  # (held at the yield: the other worker's row comes and stays unread)
+    running = stream.gi_frame.f_locals["running"]  # conn -> task of the worker still busy
+    workers = list(stream.gi_frame.f_locals["procs"].values())
+    deadline = time.monotonic() + 30
+    while not any(conn.poll() for conn in running) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert any(conn.poll() for conn in running), "the other worker sent no row"
+    stream.close()
+    err = capfd.readouterr().err
+    assert first["key"] and [p.exitcode for p in workers] == [0, 0]  # (an exception: 1)
+    assert "Traceback" not in err and "ConnectionResetError" not in err, err
