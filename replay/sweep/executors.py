@@ -97,7 +97,15 @@ def _die_with(parent: int) -> None:
 
 
 def _as_interrupt(signum, frame) -> None:
-    raise KeyboardInterrupt
+    """SIGTERM in a worker: what Ctrl-C does there (its handler holds it while a log record or
+    the log's close is written, then raises KeyboardInterrupt), once a variant: a second one
+    (the watchdog's after the kernel's, the sweep's after a group's) would break the log's
+    close and leave its ``.part``; a worker that does not end is killed after ``STOP_GRACE``."""
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    handler = signal.getsignal(signal.SIGINT)
+    if not callable(handler):
+        raise KeyboardInterrupt
+    handler(signal.SIGINT, frame)
 
 
 _STOPS = {signal.SIGINT, signal.SIGTERM}
@@ -130,6 +138,7 @@ def _serve(conn, parent: int, not_ours: list) -> None:
         if _MASKS:  # (held by the fork: a stop that came meanwhile is raised here)
             signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
         while True:
+            signal.signal(signal.SIGTERM, _as_interrupt)  # (again: one a variant, see there)
             try:
                 task = conn.recv()
             except EOFError:

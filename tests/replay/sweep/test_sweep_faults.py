@@ -405,3 +405,32 @@ def test_a_sigterm_while_a_worker_is_forked_stops_the_sweep(toy_yaml, tmp_path):
     finally:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX signals")
+def test_a_worker_takes_sigterm_as_a_held_ctrl_c_once_a_variant():
+    """A worker's SIGTERM is its Ctrl-C: held while a log record (or the log's close) is
+    written, raised after it; a second one (the watchdog's after the kernel's PDEATHSIG, 0-0.5 s
+    apart) is ignored instead of breaking the close, which left the log as a ``.part`` (6 in
+    10 sweeps whose parent was SIGKILLed)."""
+    from replay.log.output import HeldSigint
+    from replay.sweep.executors import _as_interrupt
+
+    before = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    held = HeldSigint()
+    try:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, _as_interrupt)
+        held.install()
+        with pytest.raises(KeyboardInterrupt):
+            with held:  # (a record being written)
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.01)  # (the handler runs: held, not raised)
+                assert held.pending
+                os.kill(os.getpid(), signal.SIGTERM)  # the second: ignored
+                time.sleep(0.01)
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+    finally:
+        held.uninstall()
+        signal.signal(signal.SIGTERM, before[0])
+        signal.signal(signal.SIGINT, before[1])
