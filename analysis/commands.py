@@ -294,7 +294,8 @@ def compare(logs, out, no_figures, markdown) -> None:
     "--logs",
     "logs_dir",
     type=click.Path(file_okay=False, exists=True),
-    help="baseline logs from this folder (e.g. out/logs), not fresh runs (a variant: left out)",
+    help="baseline logs from this folder (e.g. out/logs), not fresh runs (left out: a variant, a "
+    "log not whole, a second log of one name)",
 )
 @click.option(
     "--keep",

@@ -164,6 +164,38 @@ def check(
     return out
 
 
+def _baseline_logs(paper: str, logs_dir: Path, say: Callable[[str], None]) -> dict[str, LogReader]:
+    """``paper``'s runs as shipped in ``logs_dir`` by scenario name (``--logs``). Left out with
+    a note: a variant, a log that is not whole (truncated, damaged: the falsifiers' runs are),
+    and a second log of one name (the first by file name is the baseline)."""
+    baseline: dict[str, LogReader] = {}
+    for p in sorted(logs_dir.glob("*.mcap")):
+        r = LogReader(p)
+        sc = r.scenario()
+        if not _reference_engine(r.scenario_config(), sc["name"]):
+            continue
+        if yaml.safe_load(sc["yaml"]).get("paper") != paper:
+            continue
+        why = _no_baseline(r, baseline.get(sc["name"]))
+        if why:
+            say(f"{paper}: left out {p}: {sc['name']} {why}")
+            continue
+        baseline[sc["name"]] = r
+    return baseline
+
+
+def _no_baseline(log: LogReader, first: LogReader | None) -> str:
+    """Why ``log`` is no baseline ("" if it is one); ``first``: the baseline of its name."""
+    changed = describe(log).label  # (the falsifiers run the scenario as shipped)
+    if changed:
+        return f"({changed}) is no baseline"
+    if log.check().status != "complete":
+        return f"is {log.status}: no baseline"
+    if first is not None:
+        return f"has another log, {first.path}: the baseline"
+    return ""
+
+
 def falsify_paper(
     paper: str,
     work: Path,
@@ -175,18 +207,7 @@ def falsify_paper(
     evaluate = registry.load("claims", paper)
     baseline: dict[str, LogReader] = {}
     if logs_dir is not None:
-        for p in sorted(Path(logs_dir).glob("*.mcap")):
-            r = LogReader(p)
-            sc = r.scenario()
-            if not _reference_engine(r.scenario_config(), sc["name"]):
-                continue
-            if yaml.safe_load(sc["yaml"]).get("paper") != paper:
-                continue
-            changed = describe(r).label  # (the falsifiers run the scenario as shipped)
-            if changed:
-                say(f"{paper}: left out {p}: {sc['name']} ({changed}) is no baseline")
-                continue
-            baseline[sc["name"]] = r
+        baseline = _baseline_logs(paper, Path(logs_dir), say)
     else:
         (work / "baseline").mkdir(parents=True, exist_ok=True)
         for path in default_scenarios(paper):

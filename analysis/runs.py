@@ -71,10 +71,10 @@ def once_per_reader(load: Callable[[LogReader, str | None], T]) -> Callable[...,
     made: weakref.WeakKeyDictionary[LogReader, dict[str | None, T]] = weakref.WeakKeyDictionary()
 
     @functools.wraps(load)
-    def cached(reader: LogReader, name: str | None = None) -> T:
-        of_reader = made.setdefault(reader, {})
+    def cached(log: LogReader, name: str | None = None) -> T:  # (the loaders' own names)
+        of_reader = made.setdefault(log, {})
         if name not in of_reader:
-            run = load(reader, name)
+            run = load(log, name)
             for value in vars(run).values():
                 if isinstance(value, np.ndarray):
                     value.flags.writeable = False

@@ -15,6 +15,7 @@ half the run's own time: stick_3step 0.18 -> 0.26 s, catch_optimised 0.29 -> 0.3
 
 from __future__ import annotations
 
+import copy
 import numbers
 import os
 import tempfile
@@ -111,10 +112,11 @@ class Run:
 
     @property
     def events(self) -> list[dict]:
-        """The ``/events`` payloads (``t``, ``kind``, ``data``) in order."""
+        """The ``/events`` payloads (``t``, ``kind``, ``data``) in order: a copy (what the
+        caller changes in it is not seen by a later ``events``, ``outcome`` or ``table``)."""
         if self._events is None:
             self._events = self._read_events()
-        return list(self._events)
+        return copy.deepcopy(self._events)
 
     @property
     def outcome(self) -> dict | None:

@@ -97,25 +97,54 @@ def _die_with(parent: int) -> None:
 
 
 def _as_interrupt(signum, frame) -> None:
-    raise KeyboardInterrupt
+    """SIGTERM in a worker: what Ctrl-C does there (its handler holds it while a log record or
+    the log's close is written, then raises KeyboardInterrupt), once a variant: a second one
+    (the watchdog's after the kernel's, the sweep's after a group's) would break the log's
+    close and leave its ``.part``; a worker that does not end is killed after ``STOP_GRACE``."""
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    handler = signal.getsignal(signal.SIGINT)
+    if not callable(handler):
+        raise KeyboardInterrupt
+    handler(signal.SIGINT, frame)
+
+
+_STOPS = {signal.SIGINT, signal.SIGTERM}
+_MASKS = hasattr(signal, "pthread_sigmask")  # (POSIX)
+
+
+@contextlib.contextmanager
+def _stops_held() -> Iterator[None]:
+    """Ctrl-C and SIGTERM held while a worker is forked, raised after. Else one arriving in
+    between is raised in the fork's own handlers, where Python drops it (the sweep does not
+    stop), or in the worker before its handlers are set (a traceback, exit code 1)."""
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS) if _MASKS else None
+    try:
+        yield
+    finally:
+        if before is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def _serve(conn, parent: int, not_ours: list) -> None:
-    """A worker: variants in, rows out, until the pipe closes. ``not_ours``: the sweep's ends of
-    the pipes, this worker's and those of the workers forked before it, which a fork copies:
-    closed here, so that the sweep closing its end is an end of input (``EOFError``) for this
-    worker, instead of a wait for the kill after ``STOP_GRACE``."""
+    """A worker: variants in, rows out, until the pipe closes, or is reset (the sweep stopped
+    with a row of this worker's unread). ``not_ours``: the sweep's ends of the pipes, this
+    worker's and those of the workers forked before it, which a fork copies: closed here, so
+    that the sweep closing its end is an end of input (``EOFError``) for this worker, instead
+    of a wait for the kill after ``STOP_GRACE``."""
     for end in not_ours:
         end.close()
     _die_with(parent)
     try:
+        if _MASKS:  # (held by the fork: a stop that came meanwhile is raised here)
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
         while True:
+            signal.signal(signal.SIGTERM, _as_interrupt)  # (again: one a variant, see there)
             try:
                 task = conn.recv()
             except EOFError:
                 return
             conn.send(run_variant(task))
-    except (KeyboardInterrupt, BrokenPipeError, EOFError):
+    except (KeyboardInterrupt, ConnectionError, EOFError):
         return
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)  # (a late stop ends it quietly)
@@ -137,9 +166,10 @@ def run_local(tasks: list[dict], workers: int) -> Iterator[dict]:
     def start() -> None:
         ours, theirs = ctx.Pipe()
         proc = ctx.Process(target=_serve, args=(theirs, os.getpid(), [ours, *procs]), daemon=True)
-        proc.start()
-        theirs.close()
-        procs[ours] = proc
+        with _stops_held():  # (a stop while forking: raised once the worker is known)
+            proc.start()
+            procs[ours] = proc
+            theirs.close()
 
     def give(conn) -> None:
         if queue:

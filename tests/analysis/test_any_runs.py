@@ -346,6 +346,7 @@ def test_a_log_is_read_into_a_run_once_per_reader_and_its_arrays_are_read_only(c
     a = load_run(reader, "catch_optimised")
     assert load_run(reader, "catch_optimised") is a  # (the claims, figures, falsifiers: once)
     assert load_run(reader, "other").name == "other"  # a run per name asked
+    assert load_run(log=reader, name="catch_optimised") is a  # (as its signature says)
     fresh = load_run(LogReader(catch["opt"]), "catch_optimised")
     assert fresh is not a and (fresh.q_desired == a.q_desired).all()  # another reader: read again
     with pytest.raises(ValueError, match="read-only"):

@@ -296,3 +296,28 @@ def test_a_variant_in_the_logs_folder_is_no_baseline(tmp_path):
     assert any("left out" in s and "(duration 300 ms)" in s for s in said), said
     assert not any(v.status for v in verdicts)  # no variant run: no baseline to replace
     assert not list((tmp_path / "work" / "variants").glob("*.mcap"))
+
+
+def test_a_cut_log_or_a_second_log_of_one_name_in_the_logs_folder_is_no_baseline(
+    tmp_path, monkeypatch
+):
+    """``--logs DIR`` holding a run as shipped, a copy of it under another file name and a
+    truncated one (a sweep or a run killed mid-way): the first is the baseline, the others are
+    left out with a note saying why, instead of the last by file name silently replacing it."""
+    from analysis import falsify
+
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    whole = logs / "stick_3step.mcap"
+    falsify.run_scenario("stick_3step", whole)
+    (logs / "stick_3step_copy.mcap").write_bytes(whole.read_bytes())
+    (logs / "stick_3step_cut.mcap").write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])
+    used: dict = {}
+    monkeypatch.setattr(falsify, "check", lambda evaluate, baseline, *a, **k: used.update(baseline))
+    said: list[str] = []
+    falsify.falsify_paper("higashimori2007", tmp_path / "work", logs, progress=said.append)
+    assert {n: r.path.name for n, r in used.items()} == {"stick_3step": "stick_3step.mcap"}
+    notes = [s for s in said if "left out" in s]
+    assert len(notes) == 2, said
+    assert "stick_3step_copy.mcap: stick_3step has another log" in notes[0], notes
+    assert "stick_3step_cut.mcap: stick_3step is truncated: no baseline" in notes[1], notes

@@ -63,6 +63,15 @@ def test_a_kept_run_gives_exactly_what_its_log_holds(tmp_path):
     assert f"outcome: {verdict}: {run.outcome['reason']}" in info.stdout, info.stderr
 
 
+def test_what_a_caller_changes_in_events_or_outcome_is_not_seen_later():
+    run = replay.run("stick_3step", set=SHORT)
+    reason, first = run.outcome["reason"], run.events[0]["kind"]
+    run.outcome["reason"] = "changed"  # (a notebook annotating its results)
+    run.events[0]["kind"] = "changed"
+    assert run.outcome["reason"] == reason and run.events[0]["kind"] == first
+    assert run.table("/events")["kind"][0] == first
+
+
 def test_a_run_in_memory_writes_no_file_and_equals_its_logged_twin(tmp_path, monkeypatch):
     cwd, tmp = tmp_path / "cwd", tmp_path / "tmp"
     cwd.mkdir()

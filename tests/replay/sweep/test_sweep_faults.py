@@ -4,6 +4,7 @@ at a time, tables of different grids merge, workers die with their parent."""
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import signal
@@ -338,3 +339,98 @@ def test_a_sweep_started_with_sigint_ignored_still_stops_on_sigint(toy_yaml, tmp
             os.killpg(proc.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="AF_UNIX reset on close")
+def test_a_worker_whose_row_is_left_unread_at_the_stop_ends_without_a_traceback(
+    toy_yaml, tmp_path, capfd
+):
+    """Stopped while a worker's finished row waits unread in its pipe (Ctrl-C between two
+    rows): the sweep closing its end resets the pipe, and the worker's next read is a
+    ConnectionResetError, which must end it quietly as an end of input does."""
+    from replay.sweep.engine import _tasks
+    from replay.sweep.executors import run_local
+
+    spec = from_options(["plant.params.mass=1,2,3"], [], None)
+    tasks = _tasks(expand(toy_yaml, spec, 0, version="test"), tmp_path / "D", False, "")
+    stream = run_local(tasks, 2)
+    first = next(stream)  # (held at the yield: the other worker's row comes and stays unread)
+    running = stream.gi_frame.f_locals["running"]  # conn -> task of the worker still busy
+    workers = list(stream.gi_frame.f_locals["procs"].values())
+    deadline = time.monotonic() + 30
+    while not any(conn.poll() for conn in running) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert any(conn.poll() for conn in running), "the other worker sent no row"
+    stream.close()
+    err = capfd.readouterr().err
+    assert first["key"] and [p.exitcode for p in workers] == [0, 0]  # (an exception: 1)
+    assert "Traceback" not in err and "ConnectionResetError" not in err, err
+
+
+FORKED_UNDER_SIGTERM = r"""
+import os, signal, sys
+sys.path.insert(0, {tests!r})
+import toy_plugins; toy_plugins.install()
+def stop():
+    os.kill(os.getpid(), signal.SIGTERM)
+os.register_at_fork(after_in_parent=stop, after_in_child=stop)  # a group's SIGTERM mid-fork
+from replay.cli import main
+sys.argv = ["replay", "sweep", {yaml!r}, "--grid", "plant.params.mass=1,2,3,4",
+            "-o", {out!r}, "--workers", "2", "-q"]
+main()
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="pthread_sigmask, fork")
+def test_a_sigterm_while_a_worker_is_forked_stops_the_sweep(toy_yaml, tmp_path):
+    """SIGTERM to the sweep's whole group (``kill -TERM -PGID``, a scheduler) as a worker is
+    forked: raised in the fork's own handlers, Python dropped it (the sweep ran on to its end,
+    exit 0); held over the fork, it stops the sweep (exit 143) and the worker, quietly."""
+    out = tmp_path / "D"
+    code = FORKED_UNDER_SIGTERM.format(tests=str(TESTS), yaml=str(toy_yaml), out=str(out))
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        start_new_session=True,  # (its own session: its survivors found below)
+    )
+    try:
+        stdout, stderr = proc.communicate(timeout=120)
+        assert proc.returncode == 143, (proc.returncode, stdout, stderr[-2000:])
+        assert "Traceback" not in stderr and "Exception ignored" not in stderr, stderr
+        assert stdout.startswith("interrupted: sweep: 4 variants: 0 ran"), stdout
+        assert _gone_within(_session(proc.pid), 15), "a worker outlived the sweep"
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX signals")
+def test_a_worker_takes_sigterm_as_a_held_ctrl_c_once_a_variant():
+    """A worker's SIGTERM is its Ctrl-C: held while a log record (or the log's close) is
+    written, raised after it; a second one (the watchdog's after the kernel's PDEATHSIG, 0-0.5 s
+    apart) is ignored instead of breaking the close, which left the log as a ``.part`` (6 in
+    10 sweeps whose parent was SIGKILLed)."""
+    from replay.log.output import HeldSigint
+    from replay.sweep.executors import _as_interrupt
+
+    before = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    held = HeldSigint()
+    try:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, _as_interrupt)
+        held.install()
+        with pytest.raises(KeyboardInterrupt):
+            with held:  # (a record being written)
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.01)  # (the handler runs: held, not raised)
+                assert held.pending
+                os.kill(os.getpid(), signal.SIGTERM)  # the second: ignored
+                time.sleep(0.01)
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+    finally:
+        held.uninstall()
+        signal.signal(signal.SIGTERM, before[0])
+        signal.signal(signal.SIGINT, before[1])
