@@ -67,7 +67,9 @@ def once_per_reader(load: Callable[[LogReader, str | None], T]) -> Callable[...,
     """``load(reader, name)`` made once per reader and name, as long as the reader lives: a
     run's claims, figures and falsifiers read the same log into the same arrays again (the
     grasp falsifiers evaluated the whole table seven times, ~0.85 s of JSON a log each time).
-    The caller reads what it is given, never changes it: its arrays are made read-only."""
+    The caller reads what it is given, never changes it: the run's own arrays are made
+    read-only (a slip raises); its dicts and lists (the scenario, the events) are shared as
+    they are, for reading (a copy to change: ``copy.deepcopy``)."""
     made: weakref.WeakKeyDictionary[LogReader, dict[str | None, T]] = weakref.WeakKeyDictionary()
 
     @functools.wraps(load)
