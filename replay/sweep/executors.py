@@ -108,23 +108,6 @@ def _as_interrupt(signum, frame) -> None:
     handler(signal.SIGINT, frame)
 
 
-_STOPS = {signal.SIGINT, signal.SIGTERM}
-_MASKS = hasattr(signal, "pthread_sigmask")  # (POSIX)
-
-
-@contextlib.contextmanager
-def _stops_held() -> Iterator[None]:
-    """Ctrl-C and SIGTERM held while a worker is forked, raised after. Else one arriving in
-    between is raised in the fork's own handlers, where Python drops it (the sweep does not
-    stop), or in the worker before its handlers are set (a traceback, exit code 1)."""
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS) if _MASKS else None
-    try:
-        yield
-    finally:
-        if before is not None:
-            signal.pthread_sigmask(signal.SIG_SETMASK, before)
-
-
 def _serve(conn, parent: int, not_ours: list) -> None:
     """A worker: variants in, rows out, until the pipe closes, or is reset (the sweep stopped
     with a row of this worker's unread). ``not_ours``: the sweep's ends of the pipes, this
@@ -135,8 +118,6 @@ def _serve(conn, parent: int, not_ours: list) -> None:
         end.close()
     _die_with(parent)
     try:
-        if _MASKS:  # (held by the fork: a stop that came meanwhile is raised here)
-            signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
         while True:
             signal.signal(signal.SIGTERM, _as_interrupt)  # (again: one a variant, see there)
             try:
@@ -166,10 +147,9 @@ def run_local(tasks: list[dict], workers: int) -> Iterator[dict]:
     def start() -> None:
         ours, theirs = ctx.Pipe()
         proc = ctx.Process(target=_serve, args=(theirs, os.getpid(), [ours, *procs]), daemon=True)
-        with _stops_held():  # (a stop while forking: raised once the worker is known)
-            proc.start()
-            procs[ours] = proc
-            theirs.close()
+        proc.start()
+        theirs.close()
+        procs[ours] = proc
 
     def give(conn) -> None:
         if queue:

@@ -4,7 +4,6 @@ at a time, tables of different grids merge, workers die with their parent."""
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import os
 import signal
@@ -365,46 +364,6 @@ def test_a_worker_whose_row_is_left_unread_at_the_stop_ends_without_a_traceback(
     err = capfd.readouterr().err
     assert first["key"] and [p.exitcode for p in workers] == [0, 0]  # (an exception: 1)
     assert "Traceback" not in err and "ConnectionResetError" not in err, err
-
-
-FORKED_UNDER_SIGTERM = r"""
-import os, signal, sys
-sys.path.insert(0, {tests!r})
-import toy_plugins; toy_plugins.install()
-def stop():
-    os.kill(os.getpid(), signal.SIGTERM)
-os.register_at_fork(after_in_parent=stop, after_in_child=stop)  # a group's SIGTERM mid-fork
-from replay.cli import main
-sys.argv = ["replay", "sweep", {yaml!r}, "--grid", "plant.params.mass=1,2,3,4",
-            "-o", {out!r}, "--workers", "2", "-q"]
-main()
-"""
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="pthread_sigmask, fork")
-def test_a_sigterm_while_a_worker_is_forked_stops_the_sweep(toy_yaml, tmp_path):
-    """SIGTERM to the sweep's whole group (``kill -TERM -PGID``, a scheduler) as a worker is
-    forked: raised in the fork's own handlers, Python dropped it (the sweep ran on to its end,
-    exit 0); held over the fork, it stops the sweep (exit 143) and the worker, quietly."""
-    out = tmp_path / "D"
-    code = FORKED_UNDER_SIGTERM.format(tests=str(TESTS), yaml=str(toy_yaml), out=str(out))
-    proc = subprocess.Popen(
-        [sys.executable, "-c", code],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-        start_new_session=True,  # (its own session: its survivors found below)
-    )
-    try:
-        stdout, stderr = proc.communicate(timeout=120)
-        assert proc.returncode == 143, (proc.returncode, stdout, stderr[-2000:])
-        assert "Traceback" not in stderr and "Exception ignored" not in stderr, stderr
-        assert stdout.startswith("interrupted: sweep: 4 variants: 0 ran"), stdout
-        assert _gone_within(_session(proc.pid), 15), "a worker outlived the sweep"
-    finally:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(proc.pid, signal.SIGKILL)
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX signals")
