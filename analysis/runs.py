@@ -203,22 +203,17 @@ _ENGINE = "plant.params.engine."
 
 @lru_cache(maxsize=None)
 def _own_engine(plant_type: str) -> tuple[tuple[str, Any], ...]:
-    """The engine a plant of ``plant_type`` runs where its ``plant.params.engine`` is empty, as
-    a resolved scenario would state it, flattened: its params' own engine (``own_engine``) with
-    the engine's defaults (plants/arm_rig/rig.py); () for a plant without one (no engine field,
-    an old plant type that brings its own, one not installed here). Loads the plant, as typing
-    the shipped scenario (``_shipped``) already has."""
+    """The engine a plant of ``plant_type`` runs where its ``plant.params.engine`` is empty
+    (plants/arm_rig/engine.py ``own_engine_settings``), as a resolved scenario would state it,
+    flattened; () for a plant without one or not installed here. Loads the plant, as typing the
+    shipped scenario (``_shipped``) already has."""
+    from plants.arm_rig.engine import own_engine_settings
     from replay.scenario.loader import to_plain
 
     if not registry.known("plant", plant_type):
         return ()
-    plant = registry.load("plant", plant_type)
-    own = getattr(getattr(plant, "Params", None), "own_engine", None)
-    if not isinstance(own, str) or getattr(plant, "Engine", None) is not None:
-        return ()
-    from plants.arm_rig.engine import engine_settings
-
-    return tuple(_flat(to_plain(engine_settings({"type": own})), _ENGINE).items())
+    settings = own_engine_settings(registry.load("plant", plant_type))
+    return () if settings is None else tuple(_flat(to_plain(settings), _ENGINE).items())
 
 
 def _engine_stated(flat: Mapping[str, Any], other: Mapping[str, Any]) -> Mapping[str, Any]:

@@ -63,6 +63,16 @@ def engine_settings(value: Any) -> Any | None:
     return params_from_data(cls, value, "plant.params.engine")
 
 
+def own_engine_settings(plant: type) -> Any | None:
+    """The engine a rig of class ``plant`` runs where ``plant.params.engine`` is empty: its
+    params' own engine (``own_engine``) with that engine's defaults; None for an old plant type
+    that brings its own adapter (``Engine``) or a plant with no own engine."""
+    own = getattr(getattr(plant, "Params", None), "own_engine", None)
+    if not isinstance(own, str) or getattr(plant, "Engine", None) is not None:
+        return None
+    return engine_settings({"type": own})
+
+
 # PyBullet's settings as the rig's params held them, flat, before the engine field did (scenarios
 # and logs made then): ``migrate_flat_settings`` moves them in
 FLAT_PYBULLET = (

@@ -16,7 +16,7 @@ import math
 from typing import ClassVar
 import numpy as np
 
-from plants.arm_rig.engine import EngineAdapter, adapter_class, engine_settings
+from plants.arm_rig.engine import EngineAdapter, adapter_class, own_engine_settings
 from plants.arm_rig.arm_state import limit_flags, limit_torque, torque_limit_events
 from plants.arm_rig.impulse import ImpulseSchedule
 from plants.arm_rig.outcome import CatchWatch
@@ -123,9 +123,7 @@ class ArmRig(Plant):
         self._impulses = ImpulseSchedule(P.object_impulses, dt)
         # the world, from the public state above: the engine field's adapter, else the one an
         # old log's plant type names (``Engine``), else the params' own engine's
-        E = P.engine_settings
-        if E is None and self.Engine is None:
-            E = engine_settings({"type": P.own_engine})
+        E = P.engine_settings if P.engine_settings is not None else own_engine_settings(type(self))
         Engine = adapter_class(E, self.engine_role) if E is not None else self.Engine
         assert Engine is not None
         self.engine: EngineAdapter = Engine(self)
